@@ -1,0 +1,1 @@
+"""Config front end: lexer, parsers, checker and the typed model."""

@@ -1,0 +1,652 @@
+"""The checker: syntax tree to typed model, with every rule of the spec
+(§3, §4, §5) and located errors; warnings for what is legal but almost
+certainly a mistake (`fsw check`)."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from . import model as M
+from . import syntax as S
+from .diagnostics import SM, SS, SV, Diagnostics, Source
+from .evaluate import NotConstant, evaluate, local_values
+from .numeric import F64MODE, exact_literal, truthy
+from .types import TYPES, U32, U64
+
+MAX_WINDOW = 100000
+ROLL = {"roll_avg": "avg", "roll_median": "median", "roll_min": "min",
+        "roll_max": "max", "roll_range": "range"}
+DEFAULT_MAX_STEPS = 1000000
+
+
+# ---- state vector -----------------------------------------------------------
+
+def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
+    lang = SV
+    lock = False
+    for o in f.options:
+        if o.name == "lock" and not o.args:
+            lock = True
+        elif o.name == "lock":
+            a = o.args[0]
+            diags.error(src, lang, a.line, a.col, f"unexpected `{a.text}` after option `lock`")
+        else:
+            diags.error(src, lang, o.line, o.col, f"unknown option `{o.name}`")
+    regions: list[M.Region] = []
+    elements: list[M.Element] = []
+    region_lines: dict[str, int] = {}
+    elem_lines: dict[str, int] = {}
+    offset = 0
+    for r in f.regions:
+        h = r.header
+        if h.name in region_lines:
+            diags.error(src, lang, h.line, h.col + 1,
+                        f"reuse of region name `{h.name}` (previously used on line {region_lines[h.name]})")
+        else:
+            region_lines[h.name] = h.line
+        if not r.elements:
+            diags.error(src, lang, h.line, h.col + 1, f"empty region `{h.name}`")
+        start = offset
+        mine = []
+        for d in r.elements:
+            t = TYPES.get(d.type)
+            if t is None:
+                diags.error(src, lang, d.line, d.type_col, f"unknown type `{d.type}`")
+                continue
+            if d.name in elem_lines:
+                diags.error(src, lang, d.line, d.name_col,
+                            f"reuse of element name `{d.name}` (previously used on line {elem_lines[d.name]})")
+                continue
+            elem_lines[d.name] = d.line
+            e = M.Element(d.name, t, h.name, offset, d.line)
+            offset += t.size
+            mine.append(e)
+        elements.extend(mine)
+        regions.append(M.Region(h.name, start, offset - start, tuple(mine), h.line))
+    return M.StateVector(src.path, lock, tuple(regions), tuple(elements), offset)
+
+
+# ---- expressions ------------------------------------------------------------
+
+class Resolver:
+    """Resolves names of a syntax expression to model variables."""
+
+    def __init__(self, src: Source, diags: Diagnostics, lang: str, names: dict[str, int],
+                 vars_: list[M.Var], windows: list[M.Window], size_value):
+        self.src, self.diags, self.lang = src, diags, lang
+        self.names = names
+        self.vars = vars_
+        self.windows = windows
+        self.size_value = size_value  # resolves a window size expression to a value
+        self.used: set[int] = set()
+        self.unknown = "unknown element `{}`"
+
+    def error(self, line: int, col: int, msg: str) -> None:
+        self.diags.error(self.src, self.lang, line, col, msg)
+
+    def expr(self, e: S.Expr) -> M.Expr:
+        t = type(e)
+        if t is S.Num:
+            return M.Const(e.text, e.line, e.col)
+        if t is S.Bool:
+            return M.Const("1" if e.value else "0", e.line, e.col)
+        if t is S.Name:
+            i = self.names.get(e.name)
+            if i is None:
+                self.error(e.line, e.col, self.unknown.format(e.name))
+                return M.Const("0", e.line, e.col)
+            self.used.add(i)
+            return M.Ref(i, e.line, e.col)
+        if t is S.Unary:
+            inner = self.expr(e.operand)
+            if e.op == "-":
+                return M.Neg(inner, e.line, e.col)
+            return M.Not(inner, e.line, e.col)
+        if t is S.Binary:
+            left, right = self.expr(e.left), self.expr(e.right)
+            if e.op in ("+", "-", "*", "/"):
+                return M.Arith(e.op, left, right, e.line, e.col)
+            if e.op in ("and", "or"):
+                return M.Logic(e.op, left, right, e.line, e.col)
+            return M.Cmp(e.op, left, right, e.line, e.col)
+        if t is S.Chain:
+            return M.ChainCmp(tuple(self.expr(o) for o in e.operands), e.ops, e.line, e.col)
+        if t is S.Call:
+            return self.call(e)
+        raise TypeError(t)
+
+    def call(self, e: S.Call) -> M.Expr:
+        func = ROLL.get(e.func)
+        if func is None:
+            self.error(e.line, e.col, f"unknown function `{e.func}`")
+            for a in e.args:
+                self.expr(a)
+            return M.Const("0", e.line, e.col)
+        if len(e.args) != 2:
+            self.error(e.line, e.col, f"`{e.func}` takes 2 arguments (a value and a window size), "
+                                      f"found {len(e.args)}")
+            for a in e.args:
+                self.expr(a)
+            return M.Const("0", e.line, e.col)
+        arg = self.expr(e.args[0])  # inner calls get their windows first
+        size = self.window_size(e.args[1])
+        if size is None:
+            return M.Const("0", e.line, e.col)
+        w = M.Window(len(self.windows), func, size, arg, e.line, e.col)
+        self.windows.append(w)
+        return M.Roll(func, arg, size, w.index, e.line, e.col)
+
+    def window_size(self, e: S.Expr) -> int | None:
+        n = e
+        value = self.size_value(self, n)
+        if value is None:
+            return None
+        if value != value or value in (float("inf"), float("-inf")) or value != int(value):
+            self.error(n.line, n.col, f"window size must be an integer from 1 to {MAX_WINDOW}, "
+                                      f"found {format_number(value)}")
+            return None
+        if not 1 <= value <= MAX_WINDOW:
+            self.error(n.line, n.col, f"window size must be an integer from 1 to {MAX_WINDOW}, "
+                                      f"found {format_number(value)}")
+            return None
+        return int(value)
+
+
+def format_number(v) -> str:
+    if isinstance(v, Fraction):
+        return str(v.numerator) if v.denominator == 1 else f"{float(v):g}"
+    if v == int(v) if v == v and abs(v) != float("inf") else False:
+        return str(int(v))
+    return repr(v)
+
+
+def constant_size(res: Resolver, n: S.Expr, vars_, consts):
+    """The value of a window size expression: literals and locals' initial
+    values only (spec §4.4); None after reporting why not."""
+    errors = len(res.diags.errors)
+    sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None)
+    me = sub.expr(n)
+    res.used |= sub.used
+    if len(res.diags.errors) != errors:
+        return None
+    if _has(me, (M.Roll,)) or any(vars_[i].kind != M.LOCAL for i in _refs(me)):
+        res.error(n.line, n.col, "window size must be a constant: literals and locals' initial values")
+        return None
+    try:
+        return evaluate(me, F64MODE, lambda i: F64MODE.read(vars_[i].type, consts[i]))
+    except (NotConstant, KeyError):
+        return None
+
+
+# ---- state machine ----------------------------------------------------------
+
+def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
+             warnings: bool = False) -> M.Machine | None:
+    """The typed machine, or None when it has errors (all reported)."""
+    lang = SM
+    before = len(diags.errors)
+    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+    vars_: list[M.Var] = []
+    names: dict[str, int] = {}
+    name_lines: dict[str, int] = {}
+    listed: dict[str, int] = {}
+    g = s = None
+    for d in f.elements:
+        t = TYPES.get(d.type)
+        if t is None:
+            err(d.line, d.type_col, f"unknown type `{d.type}`")
+            continue
+        if d.name in listed:
+            err(d.line, d.name_col, f"reuse of element name `{d.name}` (previously used on line {listed[d.name]})")
+            continue
+        listed[d.name] = d.line
+        e = sv.find(d.name)
+        if e is None:
+            err(d.line, d.name_col, f"element `{d.name}` is not in the state vector config ({sv.path})")
+        elif e.type is not t:
+            err(d.line, d.type_col, f"type mismatch: `{d.name}` is {e.type} in the state vector config, not {t}")
+        for n, col in ((d.name, d.name_col), (d.alias, d.alias_col)):
+            if n is None:
+                continue
+            if n in names:
+                err(d.line, col, f"reuse of name `{n}` (previously used on line {name_lines[n]})")
+            elif n == "T":
+                err(d.line, col, "`T` is the built-in time in state and cannot name an element")
+        idx = len(vars_)
+        role = "G" if "G" in (d.name, d.alias) else "S" if "S" in (d.name, d.alias) else None
+        if role == "G":
+            if g is not None:
+                err(d.line, d.alias_col if d.alias == "G" else d.name_col,
+                    f"`G` is already defined on line {vars_[g].line}")
+            elif t is not U64:
+                err(d.line, d.type_col, f"`G` (global time) must be U64, not {t}")
+            else:
+                g = idx
+        elif role == "S":
+            if s is not None:
+                err(d.line, d.alias_col if d.alias == "S" else d.name_col,
+                    f"`S` is already defined on line {vars_[s].line}")
+            elif t is not U32:
+                err(d.line, d.type_col, f"`S` (current state) must be U32, not {t}")
+            else:
+                s = idx
+        vars_.append(M.Var(idx, M.ELEMENT, d.name, d.alias, t, d.read_only or role is not None, d.line))
+        for n in (d.name, d.alias):
+            if n is not None and n not in names and n != "T":
+                names[n] = idx
+                name_lines[n] = d.line
+    where = f.sv_header or S.Header(1, 0, "")
+    if g is None:
+        err(where.line, where.col + 1, "missing `G`: one U64 element must be named or aliased `G` (global time)")
+    if s is None:
+        err(where.line, where.col + 1, "missing `S`: one U32 element must be named or aliased `S` (current state)")
+
+    # locals
+    windows: list[M.Window] = []
+    local_decls: dict[str, S.LocalDecl] = {d.name: d for d in reversed(f.locals)}
+    init_used: set[int] = set()
+    for d in f.locals:
+        t = TYPES.get(d.type)
+        if t is None:
+            err(d.line, d.type_col, f"unknown type `{d.type}`")
+            continue
+        if d.name == "T":
+            err(d.line, d.name_col, "`T` is the built-in time in state and cannot name a local")
+            continue
+        if d.name in names:
+            err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
+            continue
+        init_resolver = Resolver(src, diags, lang, dict(names), vars_, [], None)
+        init = _resolve_init(init_resolver, d, local_decls, vars_)
+        init_used |= init_resolver.used
+        idx = len(vars_)
+        vars_.append(M.Var(idx, M.LOCAL, d.name, None, t, d.read_only, d.line, init))
+        names[d.name] = idx
+        name_lines[d.name] = d.line
+    t_idx = len(vars_)
+    vars_.append(M.Var(t_idx, M.TIME_IN_STATE, "T", None, U64, True, 0))
+    names["T"] = t_idx
+
+    # local values, for window sizes and constant folding
+    consts: dict[int, object] = {}
+    if len(diags.errors) == before:
+        probe = M.Machine(src.path, "", sv, tuple(vars_), (), (), 0, 0, t_idx)
+        try:
+            consts = local_values(probe, F64MODE)
+        except NotConstant:
+            consts = {}
+
+    def size_value(res: Resolver, n: S.Expr):
+        return constant_size(res, n, vars_, consts)
+
+    res = Resolver(src, diags, lang, names, vars_, windows, size_value)
+    res.used |= init_used
+
+    # states
+    state_lines: dict[str, int] = {}
+    state_index: dict[str, int] = {}
+    for st in f.states:
+        h = st.header
+        if h.name in state_lines:
+            err(h.line, h.col + 1, f"reuse of state name `{h.name}` (previously used on line {state_lines[h.name]})")
+        else:
+            state_lines[h.name] = h.line
+            state_index[h.name] = len(state_index)
+    if not f.states:
+        n = len(src.lines)
+        last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
+        err(last, 1, "a state machine needs at least one state")
+
+    states: list[M.State] = []
+    seen_states: set[str] = set()
+    for st in f.states:
+        blocks = {"entry": (), "step": (), "exit": ()}
+        for b in st.blocks:
+            blocks[b.label] = _stmts(b.stmts, res, state_index, b.label == "exit", err)
+        if st.header.name in seen_states:
+            continue
+        seen_states.add(st.header.name)
+        idx = len(states)
+        states.append(M.State(idx, idx + 1, st.header.name, st.header.line,
+                              blocks["entry"], blocks["step"], blocks["exit"]))
+
+    if len(diags.errors) != before or g is None or s is None:
+        return None
+    name = src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
+    m = M.Machine(src.path, name, sv, tuple(vars_), tuple(states), tuple(windows), g, s, t_idx)
+    if warnings:
+        machine_warnings(m, f, src, diags, consts, res.used)
+    return m
+
+
+def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_) -> M.Expr:
+    """A local's initial value: literals and earlier locals only."""
+    ok = True
+
+    def visit(e):
+        nonlocal ok
+        if isinstance(e, S.Name):
+            if e.name == d.name:
+                res.error(e.line, e.col, f"local `{d.name}` cannot be used in its own initial value")
+                ok = False
+            elif e.name in res.names and vars_[res.names[e.name]].kind != M.LOCAL:
+                res.error(e.line, e.col, f"initial value of `{d.name}` uses element `{e.name}`: "
+                                         "only literals and earlier locals are allowed")
+                ok = False
+            elif e.name == "T":
+                res.error(e.line, e.col, f"initial value of `{d.name}` uses `T`: "
+                                         "only literals and earlier locals are allowed")
+                ok = False
+            elif e.name not in res.names and e.name in local_decls:
+                res.error(e.line, e.col, f"initial value of `{d.name}` uses `{e.name}`, declared later "
+                                         f"(line {local_decls[e.name].line}): only earlier locals are allowed")
+                ok = False
+        elif isinstance(e, S.Call):
+            res.error(e.line, e.col, f"`{e.func}` cannot be used in an initial value")
+            ok = False
+            return
+        for c in _children(e):
+            visit(c)
+
+    visit(d.expr)
+    if not ok:
+        return M.Const("0", d.line, d.name_col)
+    return res.expr(d.expr)
+
+
+def _children(e):
+    if isinstance(e, S.Binary):
+        return (e.left, e.right)
+    if isinstance(e, S.Unary):
+        return (e.operand,)
+    if isinstance(e, S.Chain):
+        return e.operands
+    if isinstance(e, S.Call):
+        return e.args
+    return ()
+
+
+def _stmts(stmts, res: Resolver, state_index, in_exit: bool, err) -> tuple[M.Stmt, ...]:
+    out = []
+    for st in stmts:
+        t = type(st)
+        if t is S.Assign:
+            i = res.names.get(st.target)
+            expr = res.expr(st.expr)
+            if i is None:
+                err(st.line, st.col, f"unknown element `{st.target}`")
+                continue
+            v = res.vars[i]
+            res.used.add(i)
+            if v.kind == M.TIME_IN_STATE:
+                err(st.line, st.col, "`T` is read-only: it is the time spent in the current state")
+                continue
+            if v.read_only:
+                kind = "local" if v.kind == M.LOCAL else "element"
+                err(st.line, st.col, f"{kind} `{st.target}` is read-only")
+                continue
+            out.append(M.Assign(i, expr, st.line, st.col))
+        elif t is S.Transition:
+            if in_exit:
+                err(st.line, st.col, "illegal transition in exit label")
+                continue
+            target = state_index.get(st.target)
+            if target is None:
+                err(st.line, st.target_col, f"unknown state `{st.target}`")
+                continue
+            out.append(M.Goto(target, st.line, st.col))
+        else:
+            cond = res.expr(st.cond)
+            then = _stmts(st.body, res, state_index, in_exit, err)
+            orelse = _stmts(st.orelse, res, state_index, in_exit, err) if st.orelse is not None else ()
+            out.append(M.If(cond, then, orelse, st.line, st.col))
+    return tuple(out)
+
+
+def _refs(e: M.Expr):
+    """Variable indices an expression reads."""
+    todo = [e]
+    while todo:
+        n = todo.pop()
+        if isinstance(n, M.Ref):
+            yield n.var
+        else:
+            todo.extend(model_children(n))
+
+
+def _has(e: M.Expr, kinds) -> bool:
+    todo = [e]
+    while todo:
+        n = todo.pop()
+        if isinstance(n, kinds):
+            return True
+        todo.extend(model_children(n))
+    return False
+
+
+def model_children(n: M.Expr):
+    if isinstance(n, (M.Arith, M.Cmp, M.Logic)):
+        return (n.left, n.right)
+    if isinstance(n, (M.Neg, M.Not)):
+        return (n.operand,)
+    if isinstance(n, M.ChainCmp):
+        return n.operands
+    if isinstance(n, M.Roll):
+        return (n.arg,)
+    return ()
+
+
+# ---- warnings -----------------------------------------------------------------
+
+def fold(e: M.Expr, m: M.Machine, consts) -> float | None:
+    """The value of a guard when it is a compile-time constant (literals and
+    read-only locals), else None."""
+    def read(i):
+        v = m.vars[i]
+        if v.kind == M.LOCAL and v.read_only and i in consts:
+            return F64MODE.read(v.type, consts[i])
+        raise NotConstant(None)
+    try:
+        return evaluate(e, F64MODE, read)
+    except NotConstant:
+        return None
+
+
+def machine_warnings(m: M.Machine, f: S.SmFile, src: Source, diags: Diagnostics, consts, used) -> None:
+    warn = lambda line, col, msg: diags.warning(src, SM, line, col, msg)  # noqa: E731
+
+    def walk(stmts) -> bool:
+        """Warns about dead statements and constant guards; True when the
+        list always ends in a transition."""
+        ends = False
+        for st in stmts:
+            if ends:
+                warn(st.line, st.col, "statement can never run: it follows a transition")
+                return True
+            if isinstance(st, M.Goto):
+                ends = True
+            elif isinstance(st, M.If):
+                c = fold(st.cond, m, consts)
+                if c is None:
+                    a, b = walk(st.then), walk(st.orelse)
+                    ends = a and b
+                elif truthy(c):
+                    warn(st.cond.line, st.cond.col, "guard is always true")
+                    if st.orelse:
+                        s0 = st.orelse[0]
+                        warn(s0.line, s0.col, "statement can never run: the guard before `else` is always true")
+                    ends = walk(st.then)
+                else:
+                    warn(st.cond.line, st.cond.col, "guard is always false")
+                    if st.then:
+                        s0 = st.then[0]
+                        warn(s0.line, s0.col, "statement can never run: its guard is always false")
+                    ends = walk(st.orelse)
+        return ends
+
+    for st in m.states:
+        for block in (st.entry, st.step, st.exit):
+            walk(block)
+
+    # states no transition reaches from the initial state
+    edges = {st.index: set() for st in m.states}
+    for st in m.states:
+        for block in (st.entry, st.step):
+            for g in gotos(block):
+                edges[st.index].add(g.state)
+    seen = {0}
+    todo = [0]
+    while todo:
+        for nxt in edges[todo.pop()]:
+            if nxt not in seen:
+                seen.add(nxt)
+                todo.append(nxt)
+    for st, decl in zip(m.states, f.states):
+        if st.index not in seen:
+            warn(decl.header.line, decl.header.col + 1,
+                 f"state `{st.name}` is never reached: no transition from the initial state leads to it")
+
+    for v in m.vars:
+        if v.index in used or v.index in (m.g, m.s) or v.kind == M.TIME_IN_STATE:
+            continue
+        if v.kind == M.LOCAL:
+            d = next(d for d in f.locals if d.name == v.name)
+            warn(d.line, d.name_col, f"local `{v.name}` is never used")
+        else:
+            d = next(d for d in f.elements if d.name == v.name)
+            warn(d.line, d.name_col, f"element `{v.name}` is listed but never used")
+
+
+def gotos(stmts):
+    """Every transition in a statement list, nested ones included."""
+    for st in stmts:
+        if isinstance(st, M.Goto):
+            yield st
+        elif isinstance(st, M.If):
+            yield from gotos(st.then)
+            yield from gotos(st.orelse)
+
+
+# ---- state script -----------------------------------------------------------------
+
+def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
+    lang = SS
+    before = len(diags.errors)
+    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+    delta_t = init_state = max_steps = None
+    seen: dict[str, int] = {}
+    for o in f.options:
+        if o.name in seen:
+            err(o.line, o.col, f"duplicate option `{o.name}` (previously on line {seen[o.name]})")
+            continue
+        seen[o.name] = o.line
+        if o.name in ("delta_t", "max_steps"):
+            v = _int_option(o, err)
+            if v is not None:
+                if o.name == "delta_t":
+                    delta_t = v
+                else:
+                    max_steps = v
+        elif o.name == "init_state":
+            if len(o.args) != 1 or o.args[0].kind != "id":
+                col = o.args[0].col if o.args else o.col + len(o.name)
+                err(o.line, col, "`init_state` takes one state name")
+                continue
+            st = m.state(o.args[0].text)
+            if st is None:
+                err(o.line, o.args[0].col, f"unknown state `{o.args[0].text}`")
+            else:
+                init_state = st.index
+        else:
+            err(o.line, o.col, f"unknown option `{o.name}`: expected `delta_t`, `init_state` or `max_steps`")
+    if delta_t is None and "delta_t" not in seen:
+        line, col = _options_pos(f)
+        err(line, col, "missing option `delta_t` (how much `G` grows per step)")
+
+    names: dict[str, int] = {}
+    for v in m.vars:
+        names.setdefault(v.name, v.index)
+        if v.alias is not None:
+            names.setdefault(v.alias, v.index)
+    windows: list[M.Window] = []
+    consts: dict[int, object] = {}
+    try:
+        consts = local_values(m, F64MODE)
+    except NotConstant:
+        pass
+
+    def size_value(res, n):
+        return constant_size(res, n, m.vars, consts)
+
+    res = Resolver(src, diags, lang, names, list(m.vars), windows, size_value)
+    owned = {m.g: "G", m.s: "S", m.t: "T"}
+    sections = []
+    state_sections: dict[int, int] = {}
+    has_stop = False
+    for sec in f.sections:
+        h = sec.header
+        if h.name == "all_states":
+            state = None
+        else:
+            st = m.state(h.name)
+            if st is None:
+                err(h.line, h.col + 1, f"unknown state `{h.name}`")
+                state = -1
+            elif st.index in state_sections:
+                err(h.line, h.col + 1,
+                    f"duplicate section for state `{h.name}` (previously on line {state_sections[st.index]})")
+                state = -1
+            else:
+                state = st.index
+                state_sections[st.index] = h.line
+        inputs, checks = [], []
+        for g in sec.stmts:
+            guard = res.expr(g.cond)
+            ins, chk = [], []
+            for st in g.body:
+                if isinstance(st, S.Assign):
+                    i = names.get(st.target)
+                    expr = res.expr(st.expr)
+                    if i is None:
+                        err(st.line, st.col, f"unknown element `{st.target}`")
+                    elif i in owned:
+                        err(st.line, st.col, f"`{st.target}` cannot be written by a state script: "
+                                             f"`{owned[i]}` is owned by the script runner and the machine")
+                    else:
+                        ins.append(M.Assign(i, expr, st.line, st.col))
+                elif isinstance(st, S.Assert):
+                    chk.append(M.Assert(res.expr(st.expr), st.line, st.col))
+                else:
+                    has_stop = True
+                    chk.append(M.Stop(st.line, st.col))
+            if ins:
+                inputs.append(M.InputGroup(guard, tuple(ins)))
+            if chk:
+                checks.append(M.CheckGroup(guard, tuple(chk)))
+        if state != -1:
+            sections.append(M.ScriptSection(state, tuple(inputs), tuple(checks), h.line))
+    if not has_stop:
+        n = len(src.lines)
+        last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
+        err(last, 1, "the state script has no `@stop`: it would never end")
+    if len(diags.errors) != before:
+        return None
+    return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
+                    max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
+                    tuple(sections), tuple(windows))
+
+
+def _int_option(o: S.Option, err) -> int | None:
+    if len(o.args) != 1 or o.args[0].kind != "num":
+        col = o.args[0].col if o.args else o.col + len(o.name)
+        err(o.line, col, f"`{o.name}` takes one positive integer")
+        return None
+    q = exact_literal(o.args[0].text)
+    if q is None or q.denominator != 1 or q <= 0 or q >= 1 << 64:
+        err(o.line, o.args[0].col, f"`{o.name}` must be a positive integer, found `{o.args[0].text}`")
+        return None
+    return int(q)
+
+
+def _options_pos(f: S.SsFile):
+    return (1, 1)

@@ -1,0 +1,82 @@
+"""The lexer shared by every config language (spec §1): line oriented,
+`#` comments, whole-word keywords, numbers with optional fraction and
+exponent, `-` always an operator."""
+
+from __future__ import annotations
+
+import re
+from typing import NamedTuple
+
+from .diagnostics import Diagnostics, Source, visual_col
+
+KEYWORDS = frozenset({"if", "else", "and", "or", "not", "true", "false"})
+ANNOTATIONS = frozenset({"@read_only", "@alias", "@assert", "@stop"})
+
+# Token kinds.
+NUM, ID, KW, OP, ANNOT, LABEL, NL, EOF = "num", "id", "kw", "op", "annot", "label", "nl", "eof"
+
+
+class Tok(NamedTuple):
+    kind: str
+    text: str
+    line: int
+    col: int  # 1-based, tabs expanded
+
+
+_TOKEN = re.compile(r"""
+    (?P<ws>[ \t\f\v\r]+)
+  | (?P<comment>\#.*)
+  | (?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)
+  | (?P<id>[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<annot>@[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<label>\.[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<op>->|<=|>=|==|!=|[-+*/<>=!(){}:,\[\]])
+""", re.X)
+_NUMBER_TAIL = re.compile(r"[A-Za-z0-9_.]+")
+
+
+def describe(ch: str) -> str:
+    return f"`{ch}`" if ch.isprintable() else f"character U+{ord(ch):04X}"
+
+
+def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> list[Tok]:
+    """Tokens of line `n` (without its newline). Lexical errors are reported
+    and the offending characters skipped."""
+    toks: list[Tok] = []
+    pos, end = 0, len(text)
+    match = _TOKEN.match
+    tabs = "\t" in text
+    while pos < end:
+        m = match(text, pos)
+        if m is None:
+            col = visual_col(text, pos) if tabs else pos + 1
+            diags.error(src, lang, n, col, f"unexpected character {describe(text[pos])}")
+            pos += 1
+            continue
+        kind = m.lastgroup
+        s = m.group()
+        col = visual_col(text, pos) if tabs else pos + 1
+        pos = m.end()
+        if kind == "ws" or kind == "comment":
+            continue
+        if kind == "num":
+            tail = _NUMBER_TAIL.match(text, pos)
+            if tail:
+                diags.error(src, lang, n, col, f"malformed number `{s + tail.group()}`")
+                pos = tail.end()
+                continue
+        elif kind == "id":
+            if s in KEYWORDS:
+                kind = KW
+        elif kind == "annot":
+            if s not in ANNOTATIONS:
+                diags.error(src, lang, n, col, f"unknown annotation `{s}`")
+                continue
+        toks.append(Tok(kind, s, n, col))
+    return toks
+
+
+def lex(src: Source, diags: Diagnostics, lang: str) -> list[list[Tok]]:
+    """Tokens line by line; index 0 is line 1. Blank and comment-only lines
+    give empty lists."""
+    return [lex_line(src, i + 1, text, diags, lang) for i, text in enumerate(src.lines)]

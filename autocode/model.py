@@ -1,0 +1,272 @@
+"""The typed model: one frozen description of a state vector, a state
+machine or a state script, checked and resolved. The interpreter, the code
+generator and the telemetry schema read only this; nothing downstream
+re-parses text."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Union
+
+from .types import ElemType
+
+
+# ---- state vector (spec §3) --------------------------------------------------
+
+@dataclass(frozen=True)
+class Element:
+    name: str
+    type: ElemType
+    region: str
+    offset: int  # bytes from the start of the state vector
+    line: int
+
+
+@dataclass(frozen=True)
+class Region:
+    name: str
+    offset: int
+    size: int
+    elements: tuple[Element, ...]
+    line: int
+
+
+@dataclass(frozen=True)
+class StateVector:
+    path: str
+    lock: bool
+    regions: tuple[Region, ...]
+    elements: tuple[Element, ...]  # layout order
+    size: int
+
+    def find(self, name: str) -> Element | None:
+        for e in self.elements:
+            if e.name == name:
+                return e
+        return None
+
+
+# ---- variables a machine knows (spec §4.1, §4.2) -------------------------------
+
+ELEMENT, LOCAL, TIME_IN_STATE = "element", "local", "T"
+
+
+@dataclass(frozen=True)
+class Var:
+    index: int  # position in Machine.vars
+    kind: str  # ELEMENT, LOCAL or TIME_IN_STATE
+    name: str
+    alias: str | None
+    type: ElemType
+    read_only: bool  # for the machine; G, S and T always are
+    line: int
+    init: "Expr | None" = None  # locals: the initial value
+
+    @property
+    def display(self) -> str:
+        """The name the report prints: element name or alias, whichever
+        sorts first in byte order."""
+        if self.alias is not None and self.alias.encode() < self.name.encode():
+            return self.alias
+        return self.name
+
+
+# ---- expressions: every operand converted to R ---------------------------------
+
+@dataclass(frozen=True)
+class Const:
+    text: str  # the literal as written ("1"/"0" for true/false)
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Ref:
+    var: int
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Neg:
+    operand: "Expr"
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Not:
+    operand: "Expr"
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Arith:
+    op: str  # + - * /
+    left: "Expr"
+    right: "Expr"
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Cmp:
+    op: str  # < <= > >= == !=
+    left: "Expr"
+    right: "Expr"
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class ChainCmp:
+    """`a < b <= c`: each adjacent pair compared, middle operands once."""
+    operands: tuple["Expr", ...]
+    ops: tuple[str, ...]
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Logic:
+    op: str  # and, or
+    left: "Expr"
+    right: "Expr"
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Roll:
+    func: str  # avg, median, min, max, range
+    arg: "Expr"
+    size: int
+    window: int  # index into the owner's windows
+    line: int
+    col: int
+
+
+Expr = Union[Const, Ref, Neg, Not, Arith, Cmp, ChainCmp, Logic, Roll]
+
+
+# ---- statements ----------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Assign:
+    var: int
+    expr: Expr
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Goto:
+    state: int  # index into Machine.states
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class If:
+    cond: Expr
+    then: tuple["Stmt", ...]
+    orelse: tuple["Stmt", ...]
+    line: int
+    col: int
+
+
+Stmt = Union[Assign, Goto, If]
+
+
+@dataclass(frozen=True)
+class Window:
+    """One rolling window: one per `roll_*` call site."""
+    index: int
+    func: str
+    size: int
+    arg: Expr
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class State:
+    index: int
+    id: int  # 1, 2, 3, ... in file order
+    name: str
+    line: int
+    entry: tuple[Stmt, ...]
+    step: tuple[Stmt, ...]
+    exit: tuple[Stmt, ...]
+
+
+@dataclass(frozen=True)
+class Machine:
+    path: str
+    name: str
+    sv: StateVector
+    vars: tuple[Var, ...]  # listed elements, then locals, then T
+    states: tuple[State, ...]
+    windows: tuple[Window, ...]  # update order: inner calls before outer
+    g: int  # var index of G
+    s: int  # var index of S
+    t: int  # var index of T
+
+    def var(self, name: str) -> Var | None:
+        for v in self.vars:
+            if v.name == name or v.alias == name:
+                return v
+        return None
+
+    def state(self, name: str) -> State | None:
+        for st in self.states:
+            if st.name == name:
+                return st
+        return None
+
+
+# ---- state scripts (spec §5) -----------------------------------------------------
+
+@dataclass(frozen=True)
+class Assert:
+    expr: Expr
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class Stop:
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
+class InputGroup:
+    guard: Expr
+    inputs: tuple[Assign, ...]
+
+
+@dataclass(frozen=True)
+class CheckGroup:
+    guard: Expr
+    checks: tuple[Union[Assert, Stop], ...]
+
+
+@dataclass(frozen=True)
+class ScriptSection:
+    state: int | None  # None: [all_states]
+    inputs: tuple[InputGroup, ...]
+    checks: tuple[CheckGroup, ...]
+    line: int
+
+
+@dataclass(frozen=True)
+class Script:
+    path: str
+    machine: Machine
+    delta_t: int
+    init_state: int
+    max_steps: int
+    sections: tuple[ScriptSection, ...]
+    windows: tuple[Window, ...]  # the script's own roll_* windows

@@ -1,0 +1,87 @@
+"""Finding and loading a project's configs: the machine and state vector
+beside a state script, the state vector beside a machine."""
+
+from __future__ import annotations
+
+import os
+
+from . import model as M
+from .check import check_sm, check_ss, check_sv
+from .diagnostics import SM, SS, Diagnostics, Source, read_source
+from .parser import parse_sm, parse_ss, parse_sv
+
+
+def find_beside(path: str, ext: str) -> str | None:
+    """The `ext` file that belongs with `path`: same stem; else the one whose
+    stem is the longest prefix of this stem (`tank_770.ss` → `tank.sm`);
+    else the only one in the folder."""
+    folder = os.path.dirname(path)
+    stem = os.path.splitext(os.path.basename(path))[0]
+    try:
+        names = sorted(n for n in os.listdir(folder or ".") if n.endswith(ext))
+    except OSError:
+        return None
+    stems = [n[: -len(ext)] for n in names]
+    if stem in stems:
+        return os.path.join(folder, stem + ext)
+    prefixes = [s for s in stems if stem.startswith(s) and stem[len(s)] in "_-."]
+    if prefixes:
+        return os.path.join(folder, max(prefixes, key=len) + ext)
+    if len(names) == 1:
+        return os.path.join(folder, names[0])
+    return None
+
+
+def load_sv(path: str, diags: Diagnostics) -> M.StateVector | None:
+    from .diagnostics import SV
+
+    src = read_source(path, diags, SV)
+    if src is None:
+        return None
+    return check_sv(parse_sv(src, diags), src, diags)
+
+
+def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
+                 warnings: bool = False) -> M.Machine | None:
+    """The checked machine, or None with every error in `diags`."""
+    src = read_source(sm_path, diags, SM)
+    if src is None:
+        return None
+    if sv_path is None:
+        sv_path = find_beside(sm_path, ".sv")
+        if sv_path is None:
+            diags.error(src, SM, 1, 1, f"no state vector config (.sv) found beside {sm_path}: "
+                                       "name one with --sv")
+            return None
+    errors = len(diags.errors)
+    sv = load_sv(sv_path, diags)
+    if sv is None:
+        return None
+    sv_ok = len(diags.errors) == errors
+    f = parse_sm(src, diags)
+    m = check_sm(f, src, sv, diags, warnings=warnings)
+    return m if sv_ok else None
+
+
+def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
+                sv_path: str | None = None) -> M.Script | None:
+    src = read_source(ss_path, diags, SS)
+    if src is None:
+        return None
+    if sm_path is None:
+        sm_path = find_beside(ss_path, ".sm")
+        if sm_path is None:
+            diags.error(src, SS, 1, 1, f"no state machine config (.sm) found beside {ss_path}: "
+                                       "name one with --sm")
+            return None
+    m = load_machine(sm_path, diags, sv_path)
+    f = parse_ss(src, diags)
+    if m is None:
+        return None
+    return check_ss(f, src, m, diags)
+
+
+def source_of(path: str) -> Source:
+    """A file's text for rendering a diagnostic after the fact."""
+    with open(path, "rb") as fh:
+        return Source.from_text(path, fh.read().decode("utf-8", errors="replace"))

@@ -1,0 +1,200 @@
+"""The `fsw` command line."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from fswkit import __version__
+from fswkit.autocode.diagnostics import Diagnostics
+
+EXIT_OK, EXIT_FAIL, EXIT_CONFIG, EXIT_INTERNAL = 0, 1, 2, 3
+CONFIG_EXTS = (".sv", ".sm", ".ss")
+
+
+def _print_diags(diags: Diagnostics) -> None:
+    if diags.items:
+        sys.stderr.write(diags.render() + "\n")
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+# ---- fsw check ----------------------------------------------------------------
+
+def collect(paths: list[str], diags: Diagnostics) -> list[str] | None:
+    files: list[str] = []
+    for p in paths:
+        if os.path.isdir(p):
+            for root, dirs, names in os.walk(p):
+                dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+                files += [os.path.normpath(os.path.join(root, n))
+                          for n in sorted(names) if n.endswith(CONFIG_EXTS)]
+        elif p.endswith(CONFIG_EXTS) or not os.path.exists(p):
+            files.append(p)
+        else:
+            sys.stderr.write(f"fsw check: {p}: not a config file (expected {', '.join(CONFIG_EXTS)} or a folder)\n")
+            return None
+    return files
+
+
+def cmd_check(args) -> int:
+    from fswkit.autocode.project import load_machine, load_script, load_sv
+
+    diags = Diagnostics()
+    files = collect(args.paths, diags)
+    if files is None:
+        return EXIT_CONFIG
+    if not files:
+        sys.stderr.write("fsw check: no config files found\n")
+        return EXIT_FAIL
+    for f in files:
+        if f.endswith(".sv"):
+            load_sv(f, diags)
+        elif f.endswith(".sm"):
+            load_machine(f, diags, args.sv, warnings=True)
+        else:
+            load_script(f, diags, args.sm, args.sv)
+    _print_diags(diags)
+    errors, warnings = len(diags.errors), len(diags.warnings)
+    sys.stderr.write(f"fsw check: {_plural(len(files), 'file')}, {_plural(errors, 'error')}, "
+                     f"{_plural(warnings, 'warning')}\n")
+    if errors or (args.strict and warnings):
+        return EXIT_FAIL
+    return EXIT_OK
+
+
+# ---- fsw test -------------------------------------------------------------------
+
+def cmd_test(args) -> int:
+    from fswkit.autocode.numeric import MODES
+    from fswkit.autocode.project import load_script, source_of
+    from fswkit.script import run
+
+    diags = Diagnostics()
+    script = load_script(args.script, diags, args.sm, args.sv)
+    if script is None:
+        _print_diags(diags)
+        return EXIT_CONFIG
+    _print_diags(diags)  # warnings only
+    sources: dict[str, object] = {}
+
+    def line_of(path: str, n: int) -> str:
+        if path not in sources:
+            sources[path] = source_of(path)
+        return sources[path].line(n)
+
+    try:
+        result = run(script, MODES[args.real], trace_path=args.trace, source_line=line_of)
+    except OSError as e:
+        sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
+        return EXIT_FAIL
+    sys.stdout.write(result.report())
+    return EXIT_OK if result.passed else EXIT_FAIL
+
+
+# ---- fsw graph / fsw skeleton ---------------------------------------------------------
+
+def _machine_or_exit(args):
+    from fswkit.autocode.project import load_machine
+
+    diags = Diagnostics()
+    m = load_machine(args.machine, diags, args.sv)
+    _print_diags(diags)
+    return m
+
+
+def _write(text: str, out: str | None) -> int:
+    if out is None or out == "-":
+        sys.stdout.write(text)
+        return EXIT_OK
+    try:
+        with open(out, "w") as f:
+            f.write(text)
+    except OSError as e:
+        sys.stderr.write(f"fsw: cannot write {out}: {e.strerror or e}\n")
+        return EXIT_FAIL
+    return EXIT_OK
+
+
+def cmd_graph(args) -> int:
+    from fswkit.graph import to_dot, to_mermaid
+
+    m = _machine_or_exit(args)
+    if m is None:
+        return EXIT_CONFIG
+    return _write(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output)
+
+
+def cmd_skeleton(args) -> int:
+    from fswkit.skeleton import skeleton
+
+    m = _machine_or_exit(args)
+    if m is None:
+        return EXIT_CONFIG
+    return _write(skeleton(m, delta_t=args.delta_t), args.output)
+
+
+# ---- entry point -------------------------------------------------------------------
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="fsw", description="fswkit: flight software from configs.")
+    p.add_argument("--version", action="version", version=f"fsw {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    c = sub.add_parser("check", help="check configs (.sv .sm .ss) or folders of them")
+    c.add_argument("paths", nargs="+", metavar="PATH")
+    c.add_argument("--strict", action="store_true", help="warnings fail the check too")
+    c.add_argument("--sv", help="the state vector config to check machines against")
+    c.add_argument("--sm", help="the state machine config to check scripts against")
+    c.set_defaults(func=cmd_check)
+
+    t = sub.add_parser("test", help="run a state script against its machine")
+    t.add_argument("script", metavar="SCRIPT.ss")
+    t.add_argument("--sm", help="the machine (default: the .sm beside the script)")
+    t.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    t.add_argument("--real", choices=("f64", "f32"), default="f64",
+                   help="evaluation type R: binary64 (hosts, default) or binary32 (AVR boards)")
+    t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
+    t.set_defaults(func=cmd_test)
+
+    g = sub.add_parser("graph", help="a machine as Graphviz DOT or Mermaid")
+    g.add_argument("machine", metavar="MACHINE.sm")
+    g.add_argument("--format", choices=("dot", "mermaid"), default="dot")
+    g.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    g.add_argument("-o", "--output", help="write here instead of standard output")
+    g.set_defaults(func=cmd_graph)
+
+    s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
+    s.add_argument("machine", metavar="MACHINE.sm")
+    s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    s.add_argument("--delta-t", type=int, default=10, help="time step of the script (default 10)")
+    s.add_argument("-o", "--output", help="write here instead of standard output")
+    s.set_defaults(func=cmd_skeleton)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return EXIT_OK
+    except RecursionError:
+        sys.stderr.write("fsw: input nested too deeply to process\n")
+        return EXIT_INTERNAL
+    except Exception as e:  # a bug of the kit, never the user's input: no traceback
+        if os.environ.get("FSW_DEBUG"):
+            raise
+        sys.stderr.write(f"fsw: internal error: {type(e).__name__}: {e}\n"
+                         "  (this is a bug in fswkit; run with FSW_DEBUG=1 for details)\n")
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())

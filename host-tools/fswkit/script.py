@@ -1,0 +1,166 @@
+"""State scripts (spec §5): drive a machine step by step, apply inputs,
+check asserts, stop. The run loop and its report are the contract users
+know from the reference implementation."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+
+from fswkit.autocode import model as M
+from fswkit.autocode.diagnostics import Diagnostic, SS
+from fswkit.autocode.numeric import Real
+from fswkit.interp import ERR_TIME, MachineRun, _Emitter, build
+from fswkit.windows import make_window
+
+U64_MOD = 1 << 64
+
+
+@dataclass
+class Result:
+    passed: bool
+    steps: int
+    asserts: int
+    failure: Diagnostic | None
+    values: list[tuple[str, str]]
+
+    def report(self) -> str:
+        lines = [f"state script ran for {self.steps} step{'' if self.steps == 1 else 's'}",
+                 f"{self.asserts} assert{'' if self.asserts == 1 else 's'} passed"]
+        if self.failure is not None:
+            lines.append(self.failure.render())
+        lines.append("final state vector:")
+        lines += [f"  {name} = {value}" for name, value in self.values]
+        return "\n".join(lines) + "\n"
+
+
+def _compile(script: M.Script, real: Real):
+    """Python functions for the script: `pre(v, wv, sw, state)` applies the
+    inputs of the active sections and returns the checks whose guards held;
+    check `k` is evaluated after the step by `check_k(v, wv, sw)`."""
+    m = script.machine
+    em = _Emitter(m.vars, real)
+    src = ["def update(v, wv, sw, W):"]
+    sem = _Emitter(m.vars, real, wv="sw")
+    for w in script.windows:
+        src.append(f"    sw[{w.index}] = W[{w.index}]({sem.value(w.arg)})")
+    src.append("    pass")
+    src.append("def pre(v, wv, sw, state):")
+    src.append("    rem = []")
+    checks: list[M.Assert | M.Stop] = []
+    for sec in script.sections:
+        ind = "    "
+        if sec.state is not None:
+            src.append(f"    if state == {sec.state}:")
+            ind = "        "
+        body_start = len(src)
+        for g in sec.inputs:
+            src.append(f"{ind}if {sem.cond(g.guard)}:")
+            for a in g.inputs:
+                src.append(f"{ind}    {sem.assign(a.var, a.expr)}")
+        for g in sec.checks:
+            ids = []
+            for c in g.checks:
+                ids.append(len(checks))
+                checks.append(c)
+            src.append(f"{ind}if {sem.cond(g.guard)}:")
+            src.append(f"{ind}    rem.extend({tuple(ids)!r})")
+        if len(src) == body_start:
+            src.append(f"{ind}pass")
+    src.append("    return rem")
+    for k, c in enumerate(checks):
+        src.append(f"def check_{k}(v, wv, sw):")
+        if isinstance(c, M.Assert):
+            src.append(f"    return {sem.cond(c.expr)}")
+        else:
+            src.append("    return None")
+    ns = build("\n".join(src) + "\n", script.path)
+    del em
+    return ns, checks
+
+
+def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None) -> Result:
+    """Runs a checked script. `source_line(path, line)` gives the text of a
+    script line for the failure diagnostic."""
+    m = script.machine
+    run_ = MachineRun(m, real, script.init_state)
+    ns, checks = _compile(script, real)
+    pre, update = ns["pre"], ns["update"]
+    check = [ns[f"check_{k}"] for k in range(len(checks))]
+    windows = [make_window(w.func, w.size, real).push for w in script.windows]
+    sw = [0.0] * len(script.windows)
+    v, wv = run_.v, run_.wv
+    g_i = m.g
+    delta = script.delta_t
+    g = 0
+    steps = asserts = 0
+    failure = None
+    passed = False
+    tracer = _Tracer(trace_path, m) if trace_path else None
+
+    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
+        text = source_line(script.path, line) if source_line else ""
+        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
+
+    try:
+        while True:
+            if steps >= script.max_steps:
+                stop = next(c for c in checks if isinstance(c, M.Stop))
+                failure = located(stop.line, stop.col, None,
+                                  f"`@stop` not reached within {script.max_steps} steps "
+                                  "(raise `max_steps` in [options] if the script needs more)")
+                break
+            v[g_i] = g
+            run_.pre_step_view(g)
+            if windows:
+                update(v, wv, sw, windows)
+            rem = pre(v, wv, sw, run_.state)
+            if run_.step() == ERR_TIME:
+                steps += 1
+                failure = located(1, 1, None, "the machine refused the step: `G` did not increase "
+                                              "(it wrapped around at 2^64: lower `delta_t`)")
+                break
+            steps += 1
+            if tracer:
+                tracer.row(steps, v)
+            done = False
+            for k in rem:
+                c = checks[k]
+                if type(c) is M.Stop:
+                    passed = done = True
+                    break
+                if check[k](v, wv, sw):
+                    asserts += 1
+                else:
+                    failure = located(c.line, c.col, "assertion failure", "assertion failed")
+                    done = True
+                    break
+            if done:
+                break
+            g = (g + delta) % U64_MOD
+    finally:
+        if tracer:
+            tracer.close()
+    return Result(passed and failure is None, steps, asserts, failure, run_.values())
+
+
+class _Tracer:
+    """`--trace FILE.csv`: every variable after every step."""
+
+    def __init__(self, path: str, m: M.Machine):
+        self.f = open(path, "w", newline="")
+        self.w = csv.writer(self.f)
+        order = sorted(m.vars, key=lambda var: var.display.encode())
+        self.idx = [var.index for var in order]
+        self.kinds = [var.type.kind for var in order]
+        self.w.writerow(["step"] + [var.display for var in order])
+
+    def row(self, step: int, v) -> None:
+        out = [step]
+        for i, k in zip(self.idx, self.kinds):
+            x = v[i]
+            out.append(("true" if x else "false") if k == "bool" else repr(x) if k == "float" else x)
+        self.w.writerow(out)
+
+    def close(self) -> None:
+        self.f.close()

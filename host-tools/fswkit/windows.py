@@ -23,36 +23,37 @@ class Window:
 
 
 class AvgWindow(Window):
-    """Mean of the samples: a running sum in R (add the new sample, then
-    subtract the one that leaves), recomputed from the samples in order,
-    oldest first, every N updates so rounding error cannot accumulate."""
+    """Mean of the samples, exactly as the firmware computes it: the sum is
+    `base + fresh`; each new sample is added to `fresh` and the leaving one
+    subtracted from `base`; at the end of every full lap of the ring `fresh`
+    holds the in-order sum of exactly the window's samples and replaces
+    `base`, so rounding drift cannot accumulate."""
 
-    __slots__ = ("sum", "since")
+    __slots__ = ("ring", "base", "fresh", "count", "head")
 
     def __init__(self, n, real):
         super().__init__(n, real)
-        self.sum = 0.0
-        self.since = 0
+        self.ring = [0.0] * n
+        self.base = self.fresh = 0.0
+        self.count = self.head = 0
 
     def push(self, x: float) -> float:
         r = self.real.rnd
-        if x != x:
+        if x != x or x == 0:
             x = 0.0
-        buf = self.buf
-        buf.append(x)
-        if len(buf) > self.n:
-            old = buf.popleft()
-            self.sum = r(r(self.sum + x) - old)
+        n, head = self.n, self.head
+        if self.count == n:
+            self.base = r(self.base - self.ring[head])
         else:
-            self.sum = r(self.sum + x)
-        self.since += 1
-        if self.since >= self.n:
-            self.since = 0
-            s = 0.0
-            for y in buf:
-                s = r(s + y)
-            self.sum = s
-        return r(self.sum / len(buf))
+            self.count += 1
+        self.ring[head] = x
+        self.fresh = r(self.fresh + x)
+        head += 1
+        if head == n:
+            head = 0
+            self.base, self.fresh = self.fresh, 0.0
+        self.head = head
+        return r(r(self.base + self.fresh) / self.count)
 
 
 class _Extremum(Window):
@@ -66,7 +67,7 @@ class _Extremum(Window):
         self.count = 0
 
     def _push(self, x: float, keep_front_if) -> float:
-        if x != x:
+        if x != x or x == 0:
             x = 0.0
         mono = self.mono
         while mono and keep_front_if(mono[-1][1], x):
@@ -117,7 +118,7 @@ class MedianWindow(Window):
         self.sorted: list[float] = []
 
     def push(self, x: float) -> float:
-        if x != x:
+        if x != x or x == 0:
             x = 0.0
         buf, s = self.buf, self.sorted
         buf.append(x)

@@ -86,8 +86,34 @@ def cmd_test(args) -> int:
             sources[path] = source_of(path)
         return sources[path].line(n)
 
+    real_name = args.real
+    if args.board is not None:
+        from fswkit.autocode.board import BoardError, load_board
+        try:
+            board = load_board(args.board)
+        except BoardError as e:
+            sys.stderr.write(f"fsw test: {e}\n")
+            return EXIT_CONFIG
+        if real_name is not None and real_name != board.real:
+            sys.stderr.write(f"fsw test: --real {real_name} contradicts board `{board.name}`, "
+                             f"whose evaluation type is {board.real}\n")
+            return EXIT_CONFIG
+        real_name = board.real
+    real = MODES[real_name or "f64"]
+    if args.native:
+        from fswkit import native
+        try:
+            code, report = native.run(script, real, line_of, trace_path=args.trace)
+        except native.NativeError as e:
+            sys.stderr.write(f"fsw test: {e}\n")
+            return EXIT_INTERNAL
+        except OSError as e:
+            sys.stderr.write(f"fsw test: {e.filename or ''}: {e.strerror or e}\n")
+            return EXIT_FAIL
+        sys.stdout.write(report)
+        return EXIT_OK if code == 0 else EXIT_FAIL
     try:
-        result = run(script, MODES[args.real], trace_path=args.trace, source_line=line_of)
+        result = run(script, real, trace_path=args.trace, source_line=line_of)
     except OSError as e:
         sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
         return EXIT_FAIL
@@ -156,8 +182,11 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument("script", metavar="SCRIPT.ss")
     t.add_argument("--sm", help="the machine (default: the .sm beside the script)")
     t.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
-    t.add_argument("--real", choices=("f64", "f32"), default="f64",
+    t.add_argument("--real", choices=("f64", "f32"), default=None,
                    help="evaluation type R: binary64 (hosts, default) or binary32 (AVR boards)")
+    t.add_argument("--board", help="run with this board's evaluation type (e.g. uno: binary32)")
+    t.add_argument("--native", action="store_true",
+                   help="run the generated C++ compiled for this host instead of the interpreter")
     t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
     t.set_defaults(func=cmd_test)
 

@@ -74,9 +74,30 @@ def _compile(script: M.Script, real: Real):
             src.append(f"    return {sem.cond(c.expr)}")
         else:
             src.append("    return None")
-    ns = build("\n".join(src) + "\n", script.path)
+    ns = build("\n".join(src) + "\n", script.path, {"_deep": sem.deep})
     del em
     return ns, checks
+
+
+def failure_diagnostics(script: M.Script, source_line) -> dict:
+    """Every located failure a run of `script` can end with, rendered the
+    same by the interpreter and the native runner: `max_steps`,
+    `step_error`, and `asserts` (one per `@assert`, in section order)."""
+    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
+        text = source_line(script.path, line) if source_line else ""
+        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
+
+    stop = next(c for sec in script.sections for g in sec.checks for c in g.checks if isinstance(c, M.Stop))
+    return {
+        "max_steps": located(stop.line, stop.col, None,
+                             f"`@stop` not reached within {script.max_steps} steps "
+                             "(raise `max_steps` in [options] if the script needs more)"),
+        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
+                                          "(it wrapped around at 2^64: lower `delta_t`)"),
+        "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
+                    for sec in script.sections for g in sec.checks for c in g.checks
+                    if isinstance(c, M.Assert)],
+    }
 
 
 def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None) -> Result:
@@ -98,17 +119,14 @@ def run(script: M.Script, real: Real, trace_path: str | None = None, source_line
     passed = False
     tracer = _Tracer(trace_path, m) if trace_path else None
 
-    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
-        text = source_line(script.path, line) if source_line else ""
-        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
+    fails = failure_diagnostics(script, source_line)
+    assert_number = {id(c): k for k, c in enumerate(
+        c for sec in script.sections for g in sec.checks for c in g.checks if isinstance(c, M.Assert))}
 
     try:
         while True:
             if steps >= script.max_steps:
-                stop = next(c for c in checks if isinstance(c, M.Stop))
-                failure = located(stop.line, stop.col, None,
-                                  f"`@stop` not reached within {script.max_steps} steps "
-                                  "(raise `max_steps` in [options] if the script needs more)")
+                failure = fails["max_steps"]
                 break
             v[g_i] = g
             run_.pre_step_view(g)
@@ -117,8 +135,7 @@ def run(script: M.Script, real: Real, trace_path: str | None = None, source_line
             rem = pre(v, wv, sw, run_.state)
             if run_.step() == ERR_TIME:
                 steps += 1
-                failure = located(1, 1, None, "the machine refused the step: `G` did not increase "
-                                              "(it wrapped around at 2^64: lower `delta_t`)")
+                failure = fails["step_error"]
                 break
             steps += 1
             if tracer:
@@ -132,7 +149,7 @@ def run(script: M.Script, real: Real, trace_path: str | None = None, source_line
                 if check[k](v, wv, sw):
                     asserts += 1
                 else:
-                    failure = located(c.line, c.col, "assertion failure", "assertion failed")
+                    failure = fails["asserts"][assert_number[id(c)]]
                     done = True
                     break
             if done:

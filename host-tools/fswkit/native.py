@@ -1,0 +1,123 @@
+"""`fsw test --native`: the generated C++ of a machine and its state script,
+compiled with the host compiler against the runtime and run. Builds are
+cached by the hash of everything that goes into them."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import struct
+import subprocess
+import sys
+
+from fswkit.autocode import model as M
+from fswkit.autocode.emit_cpp import script_files
+from fswkit.autocode.numeric import Real
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+RUNTIME = os.path.join(ROOT, "firmware", "src")
+CXX = os.environ.get("CXX", "g++")
+# binary32 builds mirror an AVR: float R and software binary64 conversion.
+FLAGS = {32: ["-DFSW_REAL_IS_FLOAT=1", "-DFSW_F64_SOFT=1"], 64: ["-DFSW_REAL_IS_FLOAT=0", "-DFSW_F64_SOFT=0"]}
+CXXFLAGS = ["-std=gnu++11", "-O2", "-ffp-contract=off", "-fno-exceptions", "-fno-rtti",
+            "-Wall", "-Wextra", "-Werror", "-Wno-unused-function"]
+
+
+class NativeError(Exception):
+    """The host compiler is missing or failed."""
+
+
+def cache_dir() -> str:
+    base = os.environ.get("FSW_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "fswkit")
+    return os.path.join(base, "native")
+
+
+def runtime_sources() -> list[str]:
+    return sorted(os.path.join(RUNTIME, n) for n in os.listdir(RUNTIME)
+                  if n.endswith(".cpp") and n != "psl_arduino.cpp")
+
+
+def _key(files: dict[str, str], real: Real) -> str:
+    h = hashlib.sha256()
+    for path in runtime_sources() + sorted(os.path.join(RUNTIME, n) for n in os.listdir(RUNTIME) if n.endswith(".h")):
+        with open(path, "rb") as f:
+            h.update(path.encode() + b"\0" + f.read())
+    for name in sorted(files):
+        h.update(name.encode() + b"\0" + files[name].encode())
+    h.update(" ".join([CXX] + CXXFLAGS + FLAGS[real.bits]).encode())
+    return h.hexdigest()[:20]
+
+
+def build(script: M.Script, real: Real, source_line) -> str:
+    """Generates and compiles the runner; returns the executable's path."""
+    if shutil.which(CXX) is None:
+        raise NativeError(f"no host C++ compiler `{CXX}` (install g++, or set CXX)")
+    files = script_files(script, real, source_line)
+    key = _key(files, real)
+    out = os.path.join(cache_dir(), key)
+    exe = os.path.join(out, "runner")
+    if os.path.exists(exe):
+        return exe
+    tmp = out + f".tmp{os.getpid()}"
+    os.makedirs(tmp, exist_ok=True)
+    for name, text in files.items():
+        with open(os.path.join(tmp, name), "w") as f:
+            f.write(text)
+    cpp = [os.path.join(tmp, n) for n in sorted(files) if n.endswith(".cpp")]
+    cmd = [CXX] + CXXFLAGS + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp + runtime_sources() + \
+        ["-o", os.path.join(tmp, "runner")]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise NativeError("the generated code did not compile (a bug in fswkit):\n" + r.stderr[-4000:])
+    try:
+        os.replace(tmp, out)
+    except OSError:  # another process built the same runner first
+        shutil.rmtree(tmp, ignore_errors=True)
+    return exe
+
+
+def run(script: M.Script, real: Real, source_line, trace_path: str | None = None) -> tuple[int, str]:
+    """Runs the native runner: (exit status, report). With `trace_path`,
+    writes the same CSV trace as the interpreter."""
+    exe = build(script, real, source_line)
+    raw = None
+    args = [exe]
+    if trace_path:
+        raw = trace_path + ".raw"
+        args.append(raw)
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode not in (0, 1):
+        raise NativeError(f"the native runner failed (status {r.returncode}): {r.stderr.strip()}")
+    if raw:
+        try:
+            _raw_to_csv(script.machine, raw, trace_path)
+        finally:
+            if os.path.exists(raw):
+                os.remove(raw)
+    return r.returncode, r.stdout
+
+
+def _raw_to_csv(m: M.Machine, raw: str, path: str) -> None:
+    from fswkit.script import _Tracer
+
+    order = sorted(m.vars, key=lambda v: v.display.encode())
+    fmt = "<" + "".join("q" if (v.type.is_int and v.type.signed) else "d" if v.type.is_float else "Q"
+                        for v in order)
+    size = 8 * len(order)
+    tracer = _Tracer(path, m)
+    v = [0] * len(m.vars)
+    try:
+        with open(raw, "rb") as f:
+            step = 0
+            while True:
+                row = f.read(size)
+                if len(row) < size:
+                    break
+                step += 1
+                for var, x in zip(order, struct.unpack(fmt, row)):
+                    v[var.index] = x
+                tracer.row(step, v)
+    finally:
+        tracer.close()

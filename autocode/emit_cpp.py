@@ -58,6 +58,7 @@ def real_literal(x: float, real: Real) -> str:
         for digits in range(1, 10):
             s = "%.*g" % (digits, x)
             if f32(float(s)) == x:
+                s = repr(float(s))  # the same value, spelled as a plain decimal where short
                 break
     if "e" not in s and "." not in s and "inf" not in s:
         s += ".0"

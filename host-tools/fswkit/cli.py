@@ -10,7 +10,7 @@ from fswkit import __version__
 from fswkit.autocode.diagnostics import Diagnostics
 
 EXIT_OK, EXIT_FAIL, EXIT_CONFIG, EXIT_INTERNAL = 0, 1, 2, 3
-CONFIG_EXTS = (".sv", ".sm", ".ss")
+CONFIG_EXTS = (".sv", ".sm", ".ss", ".app")
 
 
 def _print_diags(diags: Diagnostics) -> None:
@@ -55,6 +55,9 @@ def cmd_check(args) -> int:
             load_sv(f, diags)
         elif f.endswith(".sm"):
             load_machine(f, diags, args.sv, warnings=True)
+        elif f.endswith(".app"):
+            from fswkit.autocode.app import load_app
+            load_app(f, diags)
         else:
             load_script(f, diags, args.sm, args.sv)
     _print_diags(diags)
@@ -163,6 +166,89 @@ def cmd_skeleton(args) -> int:
     return _write(skeleton(m, delta_t=args.delta_t), args.output)
 
 
+# ---- fsw gen / fsw build ---------------------------------------------------------------
+
+def _load_app(args, command: str):
+    from fswkit.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags, args.board)
+    except BuildError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    _print_diags(diags)
+    return app
+
+
+def _generate(app, out: str, command: str):
+    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.build import write_files
+
+    try:
+        files = emit_app(app)
+    except GenError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    try:
+        write_files(files, out)
+    except OSError as e:
+        sys.stderr.write(f"fsw {command}: cannot write {e.filename or out}: {e.strerror or e}\n")
+        return None
+    return files
+
+
+def cmd_gen(args) -> int:
+    from fswkit.build import default_out
+
+    app = _load_app(args, "gen")
+    if app is None:
+        return EXIT_CONFIG
+    out = args.out or os.path.join(default_out(app), "gen")
+    files = _generate(app, out, "gen")
+    if files is None:
+        return EXIT_FAIL
+    sys.stderr.write(f"fsw gen: {len(files)} files in {out}\n")
+    return EXIT_OK
+
+
+def cmd_build(args) -> int:
+    from fswkit.build import BuildError, Size, default_out, elf_size, make
+
+    app = _load_app(args, "build")
+    if app is None:
+        return EXIT_CONFIG
+    out = args.out or default_out(app)
+    if _generate(app, os.path.join(out, "gen"), "build") is None:
+        return EXIT_FAIL
+    try:
+        artifact, proc = make(app, out)
+    except BuildError as e:
+        sys.stderr.write(f"fsw build: {e}\n")
+        return EXIT_FAIL
+    if proc.returncode != 0:
+        sys.stderr.write(proc.stdout[-2000:] + proc.stderr[-6000:])
+        sys.stderr.write("fsw build: the build failed\n")
+        return EXIT_FAIL
+    b = app.board
+    print(f"fsw build: {os.path.basename(app.path)} for {b.name} ({b.mcu})")
+    if not b.is_avr:
+        print(f"  {artifact}")
+        return EXIT_OK
+    try:
+        flash, ram = elf_size(artifact)
+    except BuildError as e:
+        sys.stderr.write(f"fsw build: {e}\n")
+        return EXIT_FAIL
+    size = Size(flash, ram, b.flash, b.ram)
+    print(size.table())
+    print(f"  {artifact}\n  {artifact[:-4]}.hex")
+    if not size.fits:
+        sys.stderr.write(f"fsw build: the firmware does not fit the {b.name}\n")
+        return EXIT_FAIL
+    return EXIT_OK
+
+
 # ---- entry point -------------------------------------------------------------------
 
 def parser() -> argparse.ArgumentParser:
@@ -196,6 +282,18 @@ def parser() -> argparse.ArgumentParser:
     g.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     g.add_argument("-o", "--output", help="write here instead of standard output")
     g.set_defaults(func=cmd_graph)
+
+    gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
+    gn.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    gn.add_argument("--board", help="build for this board instead of the one the .app names")
+    gn.add_argument("--out", help="where to write (default PROJECT/build/BOARD/gen)")
+    gn.set_defaults(func=cmd_gen)
+
+    b = sub.add_parser("build", help="build an application's firmware (.elf/.hex, or a host executable)")
+    b.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    b.add_argument("--board", help="build for this board instead of the one the .app names")
+    b.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    b.set_defaults(func=cmd_build)
 
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
     s.add_argument("machine", metavar="MACHINE.sm")

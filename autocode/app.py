@@ -1,0 +1,406 @@
+"""The application config (spec §7): ties a state vector, machines and I/O
+tables to a board, orders the tasks of the executor, and names the
+telemetry streams and the elements the ground may write.
+
+    [application]
+    board uno
+    rate  100                 # executor cycles per second
+    [configs]
+    state_vector tank.sv
+    machine      tank.sm
+    io           tank.aio
+    [time]
+    source clock              # clock | cycle
+    unit   ms                 # ms | us
+    [tasks]
+    sense    inputs          rate=100
+    control  machine tank    rate=100  mode=controlMode
+    act      outputs         rate=100
+    [telemetry]
+    Sensors  rate=10
+    [uplink]
+    valveOpen
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from fractions import Fraction
+
+from . import model as M
+from .board import Board, BoardError, load_board
+from .check import check_sm, check_sv
+from .diagnostics import APP, Diagnostics, Source, read_source
+from .iotables import Channel, check_table
+from .lexer import ID, NUM, OP, lex
+from .numeric import exact_literal
+from .parser import parse_sm, parse_sv, show, split_sections
+from .types import U8
+
+TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink")
+MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
+
+
+@dataclass(frozen=True)
+class Task:
+    name: str
+    kind: str  # one of TASK_KINDS
+    machine: int | None  # index into Application.machines for kind "machine"
+    rate: Fraction  # Hz
+    divider: int  # runs every `divider` executor cycles
+    mode: M.Element | None  # U8: 0 disabled, 1 safed, 2 enabled
+    start: str  # the mode at boot
+    line: int
+
+
+@dataclass(frozen=True)
+class Stream:
+    region: M.Region
+    rate: Fraction
+    divider: int  # executor cycles between samples
+    line: int
+
+
+@dataclass(frozen=True)
+class Application:
+    path: str
+    name: str
+    board: Board
+    rate: int  # executor cycles per second
+    baud: int
+    sv: M.StateVector
+    machines: tuple[M.Machine, ...]
+    channels: tuple[Channel, ...]
+    tasks: tuple[Task, ...]
+    time_element: M.Element
+    time_source: str  # "clock" or "cycle"
+    time_unit: str  # "ms" or "us"
+    telemetry: tuple[Stream, ...]
+    writable: tuple[M.Element, ...]
+
+
+def _kv(toks, start, src, diags):
+    """`key=value` pairs from toks[start:]; returns {key: (tok, value tok)}."""
+    out = {}
+    i = start
+    while i < len(toks):
+        t = toks[i]
+        if (t.kind == ID and i + 2 < len(toks) and toks[i + 1].kind == OP and toks[i + 1].text == "="
+                and toks[i + 2].kind in (ID, NUM)):
+            if t.text in out:
+                diags.error(src, APP, t.line, t.col, f"`{t.text}=` given twice")
+            out[t.text] = (t, toks[i + 2])
+            i += 3
+        else:
+            diags.error(src, APP, t.line, t.col, f"unexpected {show(t)}: expected `key=value`")
+            return out
+    return out
+
+
+def _positive(tok, src, diags, what) -> Fraction | None:
+    q = exact_literal(tok.text) if tok.kind == NUM else None
+    if q is None or q <= 0 or q > 10**9:
+        diags.error(src, APP, tok.line, tok.col, f"{what} must be a positive number, found `{tok.text}`")
+        return None
+    return q
+
+
+def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -> Application | None:
+    """The checked application with its state vector, machines and tables;
+    None with every error in `diags`."""
+    src = read_source(path, diags, APP)
+    if src is None:
+        return None
+    before = len(diags.errors)
+    err = lambda t, msg: diags.error(src, APP, t.line, t.col, msg)  # noqa: E731
+    folder = os.path.dirname(path)
+    lines = lex(src, diags, APP)
+    pre, sections = split_sections(src, lines, diags, APP)
+    for toks in pre:
+        err(toks[0], f"unexpected {show(toks[0])} before the first section")
+    known = ("application", "configs", "time", "tasks", "telemetry", "uplink")
+    body: dict[str, list] = {}
+    for header, rows in sections:
+        if header.name == "<malformed>":
+            continue
+        if header.name not in known:
+            diags.error(src, APP, header.line, header.col + 1,
+                        f"unknown section `[{header.name}]`: expected one of "
+                        + ", ".join(f"[{k}]" for k in known))
+            continue
+        if header.name in body:
+            diags.error(src, APP, header.line, header.col + 1, f"duplicate section `[{header.name}]`")
+            continue
+        body[header.name] = rows
+
+    # [application]
+    settings: dict[str, object] = {}
+    for toks in body.get("application", []):
+        key = toks[0]
+        if key.text not in ("name", "board", "rate", "baud"):
+            err(key, f"unknown setting `{key.text}`: expected `name`, `board`, `rate` or `baud`")
+            continue
+        if len(toks) != 2:
+            err(toks[min(2, len(toks) - 1)] if len(toks) > 2 else key, f"`{key.text}` takes one value")
+            continue
+        settings[key.text] = toks[1]
+    name = settings["name"].text if "name" in settings else os.path.splitext(os.path.basename(path))[0]
+    board = None
+    board_tok = settings.get("board")
+    board_name = board_override or (board_tok.text if board_tok is not None else None)
+    if board_name is None:
+        diags.error(src, APP, 1, 1, "missing `board` in [application]")
+    else:
+        try:
+            board = load_board(board_name)
+        except BoardError as e:
+            if board_tok is not None and board_override is None:
+                err(board_tok, str(e))
+            else:
+                diags.error(src, APP, 1, 1, str(e))
+    rate = 100
+    if "rate" in settings:
+        q = _positive(settings["rate"], src, diags, "`rate`")
+        if q is not None:
+            if q.denominator != 1 or q > 100000 or 1000000 % q != 0:
+                err(settings["rate"], "`rate` must be a whole number of cycles per second that divides "
+                                      "1000000 (a whole number of microseconds per cycle)")
+            else:
+                rate = int(q)
+    baud = 115200
+    if "baud" in settings:
+        q = _positive(settings["baud"], src, diags, "`baud`")
+        if q is not None and q.denominator == 1:
+            baud = int(q)
+
+    # [configs]
+    sv_tok = None
+    machine_toks, io_toks = [], []
+    for toks in body.get("configs", []):
+        key = toks[0]
+        if key.text not in ("state_vector", "machine", "io"):
+            err(key, f"unknown config kind `{key.text}`: expected `state_vector`, `machine` or `io`")
+            continue
+        if len(toks) < 2:
+            err(key, f"`{key.text}` takes a file name")
+            continue
+        fname = src.line(key.line)[_col_index(src.line(key.line), toks[1].col):].split("#", 1)[0].strip()
+        entry = (key, toks[1], os.path.join(folder, fname))
+        if key.text == "state_vector":
+            if sv_tok is not None:
+                err(key, "only one `state_vector` per application")
+            sv_tok = entry
+        elif key.text == "machine":
+            machine_toks.append(entry)
+        else:
+            io_toks.append(entry)
+    if sv_tok is None:
+        diags.error(src, APP, 1, 1, "missing `state_vector` in [configs]")
+        return None
+    sv_src = read_source(sv_tok[2], diags, APP)
+    if sv_src is None:
+        return None
+    sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
+    machines: list[M.Machine] = []
+    machine_names: dict[str, int] = {}
+    for key, tok, mpath in machine_toks:
+        msrc = read_source(mpath, diags, APP)
+        if msrc is None:
+            continue
+        m = check_sm(parse_sm(msrc, diags), msrc, sv, diags)
+        if m is None:
+            continue
+        if m.name in machine_names:
+            err(tok, f"two machines are named `{m.name}`")
+            continue
+        machine_names[m.name] = len(machines)
+        machines.append(m)
+    channels: list[Channel] = []
+    if board is not None:
+        used_pins: dict = {}
+        used_inputs: dict = {}
+        for key, tok, ipath in io_toks:
+            if not ipath.endswith((".aio", ".dio")):
+                err(tok, "an I/O table is a `.aio` (analog) or `.dio` (digital) file")
+                continue
+            isrc = read_source(ipath, diags, APP)
+            if isrc is None:
+                continue
+            channels += check_table(isrc, ipath.endswith(".aio"), sv, board, diags, used_pins, used_inputs)
+
+    # [time]
+    time_source, time_unit = "clock", "ms"
+    for toks in body.get("time", []):
+        key = toks[0]
+        allowed = {"source": ("clock", "cycle"), "unit": ("ms", "us")}.get(key.text)
+        if allowed is None:
+            err(key, f"unknown setting `{key.text}`: expected `source` or `unit`")
+        elif len(toks) != 2 or toks[1].text not in allowed:
+            err(toks[1] if len(toks) > 1 else key, f"`{key.text}` is one of: {', '.join(allowed)}")
+        elif key.text == "source":
+            time_source = toks[1].text
+        else:
+            time_unit = toks[1].text
+    g_elems = {m.vars[m.g].name for m in machines}
+    time_element = None
+    if len(g_elems) > 1:
+        diags.error(src, APP, 1, 1, "the machines disagree on `G`: " + ", ".join(sorted(g_elems))
+                    + " (every machine's `G` must be the same element)")
+    elif g_elems:
+        time_element = sv.find(g_elems.pop())
+    if time_source == "cycle" and time_unit == "ms" and 1000 % rate != 0:
+        diags.error(src, APP, 1, 1, f"`source cycle` with `unit ms` needs a rate that divides 1000 "
+                                    f"(one cycle must be a whole number of ms); rate is {rate}")
+
+    # [tasks]
+    tasks: list[Task] = []
+    task_lines: dict[str, int] = {}
+    machine_tasks: dict[int, int] = {}
+    for toks in body.get("tasks", []):
+        tname = toks[0]
+        if tname.kind != ID:
+            err(tname, f"expected a task name, found {show(tname)}")
+            continue
+        if tname.text in task_lines:
+            err(tname, f"reuse of task name `{tname.text}` (previously used on line {task_lines[tname.text]})")
+            continue
+        if len(toks) < 2 or toks[1].text not in TASK_KINDS:
+            t = toks[1] if len(toks) > 1 else tname
+            err(t, f"expected what the task runs: one of {', '.join(TASK_KINDS)}")
+            continue
+        kind = toks[1].text
+        i = 2
+        midx = None
+        if kind == "machine":
+            if len(toks) < 3 or toks[2].kind != ID or (len(toks) > 3 and toks[3].text == "="):
+                err(toks[1], "`machine` takes the name of a machine from [configs]")
+                continue
+            mt = toks[2]
+            i = 3
+            if mt.text not in machine_names:
+                err(mt, f"unknown machine `{mt.text}`"
+                        + (f" (machines: {', '.join(machine_names)})" if machine_names else ""))
+                continue
+            midx = machine_names[mt.text]
+            if midx in machine_tasks:
+                err(mt, f"machine `{mt.text}` already runs in task on line {machine_tasks[midx]}")
+                continue
+            machine_tasks[midx] = tname.line
+        opts = _kv(toks, i, src, diags)
+        for k, (kt, _) in opts.items():
+            if k not in ("rate", "mode", "start"):
+                err(kt, f"unknown task setting `{k}`: expected `rate`, `mode` or `start`")
+        task_rate = Fraction(rate)
+        if "rate" in opts:
+            q = _positive(opts["rate"][1], src, diags, "`rate`")
+            if q is None:
+                continue
+            task_rate = q
+        divider = Fraction(rate) / task_rate
+        if divider.denominator != 1:
+            err(opts["rate"][1], f"task rate {opts['rate'][1].text} Hz must divide the executor rate {rate} Hz")
+            continue
+        mode_el = None
+        if "mode" in opts:
+            mt = opts["mode"][1]
+            mode_el = sv.find(mt.text)
+            if mode_el is None:
+                err(mt, f"unknown element `{mt.text}`")
+                continue
+            if mode_el.type is not U8:
+                err(mt, f"a task's mode element must be U8 (0 disabled, 1 safed, 2 enabled); "
+                        f"`{mt.text}` is {mode_el.type}")
+                continue
+        start = "enabled"
+        if "start" in opts:
+            st = opts["start"][1]
+            if st.text not in MODES:
+                err(st, "`start` is one of: enabled, safed, disabled")
+                continue
+            if mode_el is None:
+                err(st, "`start` needs a `mode` element to hold the task's mode")
+                continue
+            start = st.text
+        task_lines[tname.text] = tname.line
+        tasks.append(Task(tname.text, kind, midx, task_rate, int(divider), mode_el, start, tname.line))
+    for name_, idx in machine_names.items():
+        if idx not in machine_tasks:
+            tok = next(t for k, t, p in machine_toks if os.path.splitext(os.path.basename(p))[0] == name_)
+            err(tok, f"machine `{name_}` runs in no task: add `NAME machine {name_}` to [tasks]")
+    per_second = 1000 if time_unit == "ms" else 1000000
+    for t in tasks:
+        if t.kind == "machine" and t.rate > per_second:
+            diags.error(src, APP, t.line, 1, f"task `{t.name}` runs at {t.rate} Hz but `G` counts in {time_unit}: "
+                                             "`G` would not increase between its steps (use `unit us`)")
+    mode_owner: dict[str, int] = {}
+    for t in tasks:
+        if t.mode is not None:
+            if t.mode.name in mode_owner:
+                diags.error(src, APP, t.line, 1, f"mode element `{t.mode.name}` is already the mode of "
+                                                 f"the task on line {mode_owner[t.mode.name]}")
+            mode_owner[t.mode.name] = t.line
+
+    # [telemetry]
+    streams: list[Stream] = []
+    tele = next((t for t in tasks if t.kind == "telemetry"), None)
+    for toks in body.get("telemetry", []):
+        rt = toks[0]
+        region = next((r for r in sv.regions if r.name == rt.text), None)
+        if region is None:
+            err(rt, f"unknown region `{rt.text}`")
+            continue
+        opts = _kv(toks, 1, src, diags)
+        if "rate" not in opts:
+            err(rt, f"region `{rt.text}` needs `rate=HZ`")
+            continue
+        q = _positive(opts["rate"][1], src, diags, "`rate`")
+        if q is None:
+            continue
+        if tele is None:
+            err(rt, "telemetry streams need a `telemetry` task in [tasks]")
+            continue
+        div = tele.rate / q
+        if div.denominator != 1:
+            err(opts["rate"][1], f"stream rate {opts['rate'][1].text} Hz must divide the telemetry "
+                                 f"task's rate {tele.rate} Hz")
+            continue
+        streams.append(Stream(region, q, int(div) * tele.divider, rt.line))
+
+    # [uplink]
+    writable: list[M.Element] = []
+    owners = {m.vars[m.g].name: f"`G` of machine `{m.name}`" for m in machines}
+    owners.update({m.vars[m.s].name: f"`S` of machine `{m.name}`" for m in machines})
+    inputs = {c.element.name: f"input channel {c.path}:{c.line}" for c in channels if c.direction == "i"}
+    for toks in body.get("uplink", []):
+        et = toks[0]
+        e = sv.find(et.text)
+        if e is None:
+            err(et, f"unknown element `{et.text}`")
+        elif et.text in owners:
+            err(et, f"element `{et.text}` is {owners[et.text]}: it cannot be written over the uplink")
+        elif et.text in inputs:
+            err(et, f"element `{et.text}` is written by {inputs[et.text]}: an uplink write would be lost")
+        elif e in writable:
+            err(et, f"element `{et.text}` is listed twice")
+        else:
+            writable.append(e)
+            if len(toks) > 1:
+                err(toks[1], f"unexpected {show(toks[1])}: one element per line")
+
+    if len(diags.errors) != before or board is None or time_element is None:
+        if time_element is None and not machines and len(diags.errors) == before:
+            diags.error(src, APP, 1, 1, "an application needs at least one `machine` in [configs]")
+        return None
+    return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
+                       tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable))
+
+
+def _col_index(line: str, col: int) -> int:
+    """The index in `line` of visual column `col`."""
+    if "\t" not in line:
+        return col - 1
+    for i in range(len(line) + 1):
+        if len(line[:i].expandtabs(8)) + 1 >= col:
+            return i
+    return len(line)

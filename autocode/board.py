@@ -1,0 +1,89 @@
+"""Board definitions (`boards/<name>.toml`): what the checker, the code
+generator and the build need to know about a board."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from dataclasses import dataclass, field
+
+BOARDS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "boards")
+
+
+@dataclass(frozen=True)
+class Board:
+    name: str
+    mcu: str
+    f_cpu: int
+    flash: int
+    ram: int
+    eeprom: int
+    real: str  # evaluation type R: "f32" or "f64"
+    digital_pins: frozenset[int]
+    analog_pins: dict[str, int]  # "A0" -> pin number
+    pwm_pins: frozenset[int]
+    reserved: dict[int, str]  # pin -> why it is reserved
+    adc_bits: int
+    adc_vref: float
+    raw: dict = field(default_factory=dict, compare=False, repr=False)  # the whole definition
+
+    def pin(self, text: str) -> int | None:
+        """The pin number a table names (`A0`, `4`), or None."""
+        if text in self.analog_pins:
+            return self.analog_pins[text]
+        if text.isdigit():
+            n = int(text)
+            if n in self.digital_pins or n in self.reserved or n in self.analog_pins.values():
+                return n
+        return None
+
+    @property
+    def is_avr(self) -> bool:
+        return self.raw.get("board", {}).get("arch") == "avr"
+
+
+class BoardError(Exception):
+    pass
+
+
+def board_names() -> list[str]:
+    try:
+        return sorted(n[:-5] for n in os.listdir(BOARDS_DIR) if n.endswith(".toml"))
+    except OSError:
+        return []
+
+
+def load_board(name: str) -> Board:
+    """The named board; BoardError (with the known names) when there is none."""
+    path = os.path.join(BOARDS_DIR, name + ".toml")
+    if not name.replace("_", "").isalnum() or not os.path.isfile(path):
+        known = ", ".join(board_names()) or "none"
+        raise BoardError(f"unknown board `{name}` (known boards: {known})")
+    try:
+        with open(path, "rb") as f:
+            d = tomllib.load(f)
+        return board_from_dict(name, d)
+    except (OSError, tomllib.TOMLDecodeError, KeyError, TypeError, ValueError) as e:
+        raise BoardError(f"board definition {path} is unreadable: {e}") from e
+
+
+def board_from_dict(name: str, d: dict) -> Board:
+    """A Board from a parsed definition (fields: docs/boards.md)."""
+    pins = d["pins"]
+    b = d["board"]
+    return Board(
+        name=b.get("name", name),
+        mcu=b["mcu"],
+        f_cpu=int(b["f_cpu"]),
+        flash=int(d["memory"].get("flash_usable", d["memory"]["flash"])),
+        ram=int(d["memory"]["ram"]),
+        eeprom=int(d["memory"].get("eeprom", 0)),
+        real=d["eval"]["R"],
+        digital_pins=frozenset(int(p) for p in pins["digital"]),
+        analog_pins={k: int(v) for k, v in pins["analog"].items()},
+        pwm_pins=frozenset(int(p) for p in pins.get("pwm", [])),
+        reserved={int(r["pin"]): str(r["reason"]) for r in pins.get("reserved", [])},
+        adc_bits=int(d["adc"]["bits"]),
+        adc_vref=float(d["adc"]["vref"]),
+        raw=d,
+    )

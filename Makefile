@@ -10,6 +10,8 @@ BUILD   ?= build
 
 .PHONY: all setup test test-python fuzz bench clean
 
+include mk/firmware.mk
+
 all: test
 
 $(STAMP): pyproject.toml tools/bootstrap.sh
@@ -18,8 +20,9 @@ $(STAMP): pyproject.toml tools/bootstrap.sh
 
 setup: $(STAMP)
 
-## test: every test suite (pytest; later, the runtime's Unity suites)
-test: setup test-python
+## test: every test suite: pytest, then the runtime's Unity suites natively
+## (R = binary64 and binary32) and on a simulated ATmega328P
+test: setup test-python test-firmware
 
 test-python: setup
 	$(PY) -m pytest tests

@@ -8,9 +8,9 @@ VENV=${VENV:-.venv}
 PYTHON=${PYTHON:-python3}
 
 # Debian packages: the AVR toolchain and Arduino core, the simulated board,
-# avrdude for flashing and graphviz to render `fsw graph`.
+# avrdude for flashing, graphviz to render `fsw graph`, valgrind for `make bench`.
 APT_PACKAGES=(gcc-avr avr-libc binutils-avr avrdude arduino-core-avr simavr libsimavr-dev
-              g++ make graphviz)
+              g++ make graphviz valgrind)
 
 as_root() {
     if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi

@@ -1,0 +1,70 @@
+// The 64-bit integer conversions (out of line: on AVR they pull in large
+// library routines, which one shared copy keeps small).
+#include "fsw_convert.h"
+
+namespace fsw {
+
+static const int64_t kI64Max = 0x7FFFFFFFFFFFFFFFLL;
+static const int64_t kI64Min = -kI64Max - 1;
+static const uint64_t kU64Max = 0xFFFFFFFFFFFFFFFFULL;
+
+// Magnitude -> Real, correctly rounded (to nearest, ties to even).
+static Real real_from_magnitude(uint64_t m) {
+#if FSW_REAL_IS_FLOAT
+    // Done in 32-bit halves: no 64-bit shifts on 8-bit MCUs, and no reliance
+    // on a 64-bit conversion routine that might round twice. Shift the value
+    // right until it fits 32 bits, folding every dropped bit into bit 0
+    // (sticky): binary32 keeps 24 bits, so rounding that 32-bit value rounds
+    // the original exactly; then scale back by 2^s, which is exact (the
+    // result is at most 2^64: always finite).
+    const uint32_t hi = static_cast<uint32_t>(m >> 32);
+    const uint32_t lo = static_cast<uint32_t>(m);
+    if (hi == 0) return static_cast<Real>(lo);
+    uint8_t s = 0;
+    for (uint32_t h = hi; h != 0; h >>= 1) ++s;  // bits in hi: 1..32
+    uint32_t reduced;
+    uint32_t dropped;
+    if (s == 32) {
+        reduced = hi;
+        dropped = lo;
+    } else {
+        reduced = (lo >> s) | (hi << (32 - s));
+        dropped = lo & ((static_cast<uint32_t>(1) << s) - 1u);
+    }
+    if (dropped != 0) reduced |= 1u;
+    // reduced >= 2^31, so its binary32 value is normal: scaling by 2^s is
+    // adding s to the exponent field (no multiply routine pulled in).
+    const float f = static_cast<float>(reduced);
+    uint32_t bits;
+    memcpy(&bits, &f, sizeof bits);
+    bits += static_cast<uint32_t>(s) << 23;
+    Real r;
+    memcpy(&r, &bits, sizeof r);
+    return r;
+#else
+    return static_cast<Real>(m);  // hardware conversion rounds once, correctly
+#endif
+}
+
+Real real_from_U64(uint64_t v) { return real_from_magnitude(v); }
+
+Real real_from_I64(int64_t v) {
+    if (v >= 0) return real_from_magnitude(static_cast<uint64_t>(v));
+    // Negate in unsigned arithmetic: well defined for the most negative value.
+    return -real_from_magnitude(static_cast<uint64_t>(0) - static_cast<uint64_t>(v));
+}
+
+int64_t I64_from_real(Real r) {
+    if (r != r) return 0;
+    if (r >= Real(9223372036854775808.0)) return kI64Max;   // 2^63
+    if (r <= Real(-9223372036854775808.0)) return kI64Min;  // -2^63
+    return static_cast<int64_t>(r);
+}
+
+uint64_t U64_from_real(Real r) {
+    if (!(r > 0)) return 0;  // NaN, zero, negatives
+    if (r >= Real(18446744073709551616.0)) return kU64Max;  // 2^64
+    return static_cast<uint64_t>(r);
+}
+
+}  // namespace fsw

@@ -1,0 +1,41 @@
+// Run-time typed element access, for table-driven code (I/O channels,
+// ground writes); an unknown type reads as 0 and is never written.
+#include "fsw_element.h"
+
+namespace fsw {
+
+Real read_elem(const uint8_t* p, uint8_t type) {
+    switch (type) {
+        case kI8: return read_I8(p);
+        case kI16: return read_I16(p);
+        case kI32: return read_I32(p);
+        case kI64: return read_I64(p);
+        case kU8: return read_U8(p);
+        case kU16: return read_U16(p);
+        case kU32: return read_U32(p);
+        case kU64: return read_U64(p);
+        case kF32: return read_F32(p);
+        case kF64: return read_F64(p);
+        case kBool: return read_bool(p);
+        default: return 0;
+    }
+}
+
+void write_elem(uint8_t* p, uint8_t type, Real r) {
+    switch (type) {
+        case kI8: write_I8(p, r); break;
+        case kI16: write_I16(p, r); break;
+        case kI32: write_I32(p, r); break;
+        case kI64: write_I64(p, r); break;
+        case kU8: write_U8(p, r); break;
+        case kU16: write_U16(p, r); break;
+        case kU32: write_U32(p, r); break;
+        case kU64: write_U64(p, r); break;
+        case kF32: write_F32(p, r); break;
+        case kF64: write_F64(p, r); break;
+        case kBool: write_bool(p, r); break;
+        default: break;
+    }
+}
+
+}  // namespace fsw

@@ -1,0 +1,59 @@
+// Typed access to packed, little-endian element bytes (state vector or
+// locals) by pointer: raw load/store, and read_X/write_X through Real.
+#ifndef FSW_ELEMENT_H
+#define FSW_ELEMENT_H
+
+#include "fsw_convert.h"
+
+namespace fsw {
+
+// Raw access, safe at any alignment: memcpy into a local compiles to plain
+// loads and stores. T is an integer type, float, or (host) double.
+template <typename T>
+inline T load(const uint8_t* p) {
+    T v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+template <typename T>
+inline void store(uint8_t* p, T v) {
+    memcpy(p, &v, sizeof v);
+}
+// bool elements are one byte; any non-zero byte reads as true.
+inline bool load_bool(const uint8_t* p) { return *p != 0; }
+inline void store_bool(uint8_t* p, bool v) { *p = v ? 1 : 0; }
+
+// ---- element -> Real (reads, spec 4.5) -------------------------------------
+inline Real read_I8(const uint8_t* p) { return real_from_I8(load<int8_t>(p)); }
+inline Real read_I16(const uint8_t* p) { return real_from_I16(load<int16_t>(p)); }
+inline Real read_I32(const uint8_t* p) { return real_from_I32(load<int32_t>(p)); }
+inline Real read_I64(const uint8_t* p) { return real_from_I64(load<int64_t>(p)); }
+inline Real read_U8(const uint8_t* p) { return real_from_U8(*p); }
+inline Real read_U16(const uint8_t* p) { return real_from_U16(load<uint16_t>(p)); }
+inline Real read_U32(const uint8_t* p) { return real_from_U32(load<uint32_t>(p)); }
+inline Real read_U64(const uint8_t* p) { return real_from_U64(load<uint64_t>(p)); }
+inline Real read_F32(const uint8_t* p) { return real_from_F32(load<float>(p)); }
+inline Real read_F64(const uint8_t* p) { return real_from_F64_bits(load<uint64_t>(p)); }
+inline Real read_bool(const uint8_t* p) { return real_from_bool(load_bool(p)); }
+
+// ---- Real -> element (assignments, spec 4.5) -------------------------------
+inline void write_I8(uint8_t* p, Real r) { store<int8_t>(p, I8_from_real(r)); }
+inline void write_I16(uint8_t* p, Real r) { store<int16_t>(p, I16_from_real(r)); }
+inline void write_I32(uint8_t* p, Real r) { store<int32_t>(p, I32_from_real(r)); }
+inline void write_I64(uint8_t* p, Real r) { store<int64_t>(p, I64_from_real(r)); }
+inline void write_U8(uint8_t* p, Real r) { *p = U8_from_real(r); }
+inline void write_U16(uint8_t* p, Real r) { store<uint16_t>(p, U16_from_real(r)); }
+inline void write_U32(uint8_t* p, Real r) { store<uint32_t>(p, U32_from_real(r)); }
+inline void write_U64(uint8_t* p, Real r) { store<uint64_t>(p, U64_from_real(r)); }
+inline void write_F32(uint8_t* p, Real r) { store<float>(p, F32_from_real(r)); }
+inline void write_F64(uint8_t* p, Real r) { store<uint64_t>(p, F64_bits_from_real(r)); }
+inline void write_bool(uint8_t* p, Real r) { store_bool(p, bool_from_real(r)); }
+
+// Run-time dispatch on an ElemType (for tables: I/O channels, uplink).
+// Generated step code calls the typed functions above instead.
+Real read_elem(const uint8_t* p, uint8_t type);
+void write_elem(uint8_t* p, uint8_t type, Real r);
+
+}  // namespace fsw
+
+#endif  // FSW_ELEMENT_H

@@ -1,0 +1,81 @@
+// Tasks and the fixed-rate cooperative executor: tasks run in table order,
+// each every `divider` base cycles, in its mode (disabled / safed / enabled);
+// per-task overruns and worst step time; watchdog kick; reset cause.
+#ifndef FSW_EXECUTOR_H
+#define FSW_EXECUTOR_H
+
+#include "fsw_types.h"
+
+namespace fsw {
+
+// A task's step: kOk, or a fault code (the task is then safed).
+typedef Result (*TaskStepFn)(void* ctx);
+// What a safed task runs instead of its step.
+typedef void (*TaskSafeFn)(void* ctx);
+
+// Task modes, as stored in a task's U8 mode element. Any other value is
+// treated as safed (the conservative reading of a corrupted byte).
+enum TaskMode : uint8_t { kModeDisabled = 0, kModeSafed = 1, kModeEnabled = 2 };
+
+// One row of the task table: constant data (FSW_FLASH on AVR).
+struct Task {
+    TaskStepFn step;
+    TaskSafeFn safe;         // may be null: a safed task then does nothing
+    void* ctx;               // passed to step/safe
+    uint16_t divider;        // runs every `divider` base cycles, >= 1
+    uint16_t phase;          // first runs at cycle `phase`, < divider
+    ElemOff mode_off;        // U8 mode element, or kNoElement (mode kept in TaskStats)
+    ElemOff overruns_off;    // U16 element mirroring TaskStats::overruns, or kNoElement
+    ElemOff worst_us_off;    // U32 element mirroring TaskStats::worst_us, or kNoElement
+    uint8_t init_mode;       // mode set by executor_begin
+};
+
+// Per-task run-time record (RAM, zero-initialised).
+struct TaskStats {
+    uint32_t worst_us;       // longest step (or safe) call, microseconds
+    uint32_t runs;           // calls of step or safe
+    uint16_t overruns;       // calls longer than the task's period (saturates)
+    uint16_t faults;         // steps that returned a fault (saturates)
+    uint16_t countdown;      // base cycles until the next run
+    uint8_t mode;            // the mode, for a task without a mode element
+    uint8_t last_fault;      // the last fault code its step returned
+};
+
+// Executor configuration (copied into the Executor by executor_begin).
+struct ExecConfig {
+    const Task* tasks;       // FSW_FLASH table of n_tasks rows
+    TaskStats* stats;        // n_tasks records
+    uint8_t* sv;             // state vector bytes (mode and stat elements)
+    uint32_t period_us;      // base period: the fastest rate
+    ElemOff reset_cause_off; // U8 element receiving the reset cause, or kNoElement
+    uint8_t n_tasks;
+    bool sv_lock;            // state vector `lock` option
+};
+
+struct Executor {
+    ExecConfig cfg;
+    uint64_t next_due_us;    // start time of the next cycle
+    uint32_t cycles;         // cycles run
+    uint16_t late;           // cycles that started a full period or more late
+    uint8_t reset_cause;     // captured at executor_begin
+};
+
+// Validates the table (dividers, phases), sets every task's initial mode,
+// starts the platform, arms the watchdog, captures the reset cause. The
+// first cycle is due at once.
+FSW_MUST_CHECK Result executor_begin(Executor& ex, const ExecConfig& cfg);
+// Runs one cycle now: kicks the watchdog, then each due task in order.
+void executor_run_cycle(Executor& ex);
+// Runs a cycle if one is due (call from loop()); true when one ran. A cycle
+// that starts a full period late counts in `late`, and the schedule
+// restarts from now (missed cycles are skipped, not run in a burst).
+bool executor_poll(Executor& ex);
+
+// A task's current mode (from its element or its TaskStats).
+uint8_t executor_task_mode(const Executor& ex, uint8_t i);
+// Sets a task's mode (ground command, tests).
+void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode);
+
+}  // namespace fsw
+
+#endif  // FSW_EXECUTOR_H

@@ -1,0 +1,65 @@
+// State-machine bookkeeping (spec 4.6) for generated step() functions:
+// current state, first-step flag, entry time, T in exact U64 arithmetic,
+// and the "G must strictly increase" check.
+#ifndef FSW_MACHINE_H
+#define FSW_MACHINE_H
+
+#include "fsw_types.h"
+
+namespace fsw {
+
+// One per machine. Static, initialised with FSW_MACHINE_INIT(first state id)
+// or machine_reset().
+struct Machine {
+    uint64_t last_g;    // G at the previous accepted step
+    uint64_t entry_g;   // G at the first step of the current state
+    uint64_t t;         // T of the current step: G - entry_g
+    uint32_t state;     // current state id (1, 2, ...)
+    uint8_t pending;    // 1: the next step is the first in `state`
+    uint8_t entering;   // 1: the current step is the first in `state`
+    uint8_t started;    // 1: at least one step was accepted (last_g valid)
+};
+
+#define FSW_MACHINE_INIT(initial_state) {0, 0, 0, (initial_state), 1, 0, 0}
+
+// Puts the machine in `initial_state`, as before its first step.
+inline void machine_reset(Machine& m, uint32_t initial_state) {
+    m.last_g = 0;
+    m.entry_g = 0;
+    m.t = 0;
+    m.state = initial_state;
+    m.pending = 1;
+    m.entering = 0;
+    m.started = 0;
+}
+
+// Steps 1-2 of spec 4.6. kErrTime (and no change at all) when G is not
+// strictly greater than at the previous step. Otherwise, on the first step
+// in a state records the entry time and sets `entering` (the caller then
+// writes m.state to S and runs .entry); sets m.t = G - entry time.
+FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
+    if (m.started != 0 && g <= m.last_g) return kErrTime;
+    m.started = 1;
+    m.last_g = g;
+    m.entering = m.pending;
+    if (m.pending != 0) {
+        m.entry_g = g;
+        m.pending = 0;
+    }
+    m.t = g - m.entry_g;
+    return kOk;
+}
+
+// T, the time spent in the current state (valid after machine_begin_step).
+inline uint64_t machine_T(const Machine& m) { return m.t; }
+
+// `-> target`, called after the current state's .exit ran: the next step
+// is the target's first (a state may transition to itself).
+inline void machine_transition(Machine& m, uint32_t target) {
+    m.state = target;
+    m.pending = 1;
+}
+
+}  // namespace fsw
+
+#endif  // FSW_MACHINE_H

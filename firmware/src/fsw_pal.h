@@ -1,0 +1,92 @@
+// Platform abstraction layer: the free functions every PSL implements
+// (clock, analog/digital I/O, console, critical section, watchdog). One PSL
+// is compiled per build: psl_arduino.cpp or psl_native.cpp. No virtuals.
+#ifndef FSW_PAL_H
+#define FSW_PAL_H
+
+#include "fsw_types.h"
+
+#if defined(__AVR__)
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#endif
+
+namespace fsw {
+namespace pal {
+
+// ---- lifecycle --------------------------------------------------------------
+// Starts the platform (called once by executor_begin; idempotent).
+void begin();
+
+// ---- Clock ------------------------------------------------------------------
+// 32-bit microseconds / milliseconds since boot (wrap every 71.6 min / 49.7 d).
+uint32_t micros32();
+uint32_t millis32();
+// 64-bit monotonic time, extended from the 32-bit counters (fsw_clock.h).
+// Each must be called at least once per wrap period of its 32-bit source;
+// the executor calls both every cycle.
+uint64_t micros64();
+uint64_t millis64();
+
+// ---- AnalogIO ---------------------------------------------------------------
+// Raw ADC reading of an analog pin (board pin number, e.g. A0 = 14 on an Uno).
+uint16_t analog_read(uint8_t pin);
+// PWM output, duty 0..255.
+void analog_write(uint8_t pin, uint8_t duty);
+
+// ---- DigitalIO --------------------------------------------------------------
+enum PinMode : uint8_t { kInput = 0, kInputPullup = 1, kOutput = 2 };
+void pin_mode(uint8_t pin, uint8_t mode);
+bool digital_read(uint8_t pin);
+void digital_write(uint8_t pin, bool high);
+
+// ---- Console (the serial port) ----------------------------------------------
+void console_begin(uint32_t baud);
+void console_write(const uint8_t* data, uint16_t len);
+// Next received byte, or -1 when none is waiting.
+int16_t console_read();
+
+// ---- Critical section -------------------------------------------------------
+// Interrupts off on an MCU (nests: the previous state is restored); a
+// re-entrant process-wide lock on the host.
+typedef uint8_t IrqState;
+#if defined(__AVR__)
+// Inline on AVR: three instructions, cheap enough to wrap every element access.
+inline IrqState critical_enter() {
+    const IrqState s = SREG;
+    cli();  // also a compiler memory barrier
+    return s;
+}
+inline void critical_exit(IrqState saved) {
+    __asm__ __volatile__("" ::: "memory");
+    SREG = saved;
+}
+#else
+IrqState critical_enter();
+void critical_exit(IrqState saved);
+#endif
+
+// ---- Watchdog ---------------------------------------------------------------
+// Arms the watchdog (FSW_WATCHDOG_MS) when FSW_WATCHDOG is on.
+void watchdog_begin();
+void watchdog_kick();
+// Reset cause captured at boot (AVR: MCUSR bits; native: settable by tests).
+uint8_t reset_cause();
+
+}  // namespace pal
+
+// Scoped critical section.
+class CriticalSection {
+public:
+    CriticalSection() : saved_(pal::critical_enter()) {}
+    ~CriticalSection() { pal::critical_exit(saved_); }
+
+private:
+    CriticalSection(const CriticalSection&);
+    CriticalSection& operator=(const CriticalSection&);
+    pal::IrqState saved_;
+};
+
+}  // namespace fsw
+
+#endif  // FSW_PAL_H

@@ -1,0 +1,81 @@
+// Basic vocabulary of the runtime: the evaluation type Real, result codes,
+// element types, and flash-table helpers shared by every other file.
+#ifndef FSW_TYPES_H
+#define FSW_TYPES_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "fsw_config.h"
+
+#if FSW_USE_PROGMEM
+#include <avr/pgmspace.h>
+#endif
+
+// A function whose result code must not be dropped by its caller.
+#define FSW_MUST_CHECK __attribute__((warn_unused_result))
+
+// Marks a constant table that lives in flash on AVR (read with flash_read).
+#if FSW_USE_PROGMEM
+#define FSW_FLASH PROGMEM
+#else
+#define FSW_FLASH
+#endif
+
+namespace fsw {
+
+// The machine's evaluation type R (spec 4.5).
+#if FSW_REAL_IS_FLOAT
+typedef float Real;
+#else
+typedef double Real;
+#endif
+
+// Result codes. kOk is zero so `if (r != kOk)` reads naturally.
+enum Result : uint8_t {
+    kOk = 0,
+    kErrTime = 1,       // G did not strictly increase since the previous step
+    kErrFault = 2,      // a task's step reported a fault (generic code)
+    kErrConfig = 3,     // a table or argument is invalid (divider 0, bad type)
+    kErrRange = 4,      // an offset or length falls outside the state vector
+};
+
+// Element types of the languages (spec 2); values are stable (telemetry).
+enum ElemType : uint8_t {
+    kI8 = 0, kI16 = 1, kI32 = 2, kI64 = 3,
+    kU8 = 4, kU16 = 5, kU32 = 6, kU64 = 7,
+    kF32 = 8, kF64 = 9, kBool = 10,
+};
+
+// Size in bytes of an element type (0 for an unknown type).
+inline uint8_t elem_size(uint8_t t) {
+    return t == kI8 || t == kU8 || t == kBool ? 1
+         : t == kI16 || t == kU16             ? 2
+         : t == kI32 || t == kU32 || t == kF32 ? 4
+         : t == kI64 || t == kU64 || t == kF64 ? 8 : 0;
+}
+
+// Offsets into the state vector are 16 bits; this one means "no element".
+typedef uint16_t ElemOff;
+static const ElemOff kNoElement = 0xFFFFu;
+
+// Index type of rolling windows (see FSW_WINDOW_INDEX_BITS).
+#if FSW_WINDOW_INDEX_BITS == 16
+typedef uint16_t WinIdx;
+#else
+typedef uint32_t WinIdx;
+#endif
+
+// Copies a constant table entry (marked FSW_FLASH) into RAM.
+inline void flash_read(void* dst, const void* src, size_t n) {
+#if FSW_USE_PROGMEM
+    memcpy_P(dst, src, n);
+#else
+    memcpy(dst, src, n);
+#endif
+}
+
+}  // namespace fsw
+
+#endif  // FSW_TYPES_H

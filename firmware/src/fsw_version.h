@@ -1,0 +1,12 @@
+// Runtime version, for the `#error` handshake in generated code.
+// Must equal the Python package's version (host-tools/fswkit/version.py);
+// tests/firmware/check_version.sh checks it and firmware/library.properties.
+#ifndef FSW_VERSION_H
+#define FSW_VERSION_H
+
+#define FSW_RUNTIME_VERSION_MAJOR 0
+#define FSW_RUNTIME_VERSION_MINOR 1
+#define FSW_RUNTIME_VERSION_PATCH 0
+#define FSW_RUNTIME_VERSION_STRING "0.1.0"
+
+#endif

@@ -1,0 +1,186 @@
+// Native (host) PSL: simulated clock and pins for tests and host runs, the
+// console on stdout, and a re-entrant spin lock as the critical section.
+#include "fsw_config.h"
+
+#if FSW_PLATFORM_NATIVE
+
+#include <poll.h>
+#include <stdio.h>
+#include <unistd.h>
+#include <time.h>
+
+#include "fsw_clock.h"
+#include "fsw_pal.h"
+#include "psl_native.h"
+
+namespace fsw {
+
+namespace {
+
+uint64_t g_time_us;
+bool g_real_time;
+uint64_t g_real_origin_us;
+Clock64 g_micros_ext;
+Clock64 g_millis_ext;
+uint16_t g_analog[256];
+uint8_t g_pwm[256];
+uint8_t g_level[256];
+uint8_t g_mode[256];
+bool g_modes_cleared;
+uint8_t* g_cap_buf;
+uint16_t g_cap_cap;
+uint16_t* g_cap_len;
+uint8_t g_in[256];
+uint16_t g_in_head;
+uint16_t g_in_len;
+uint32_t g_kicks;
+bool g_wdt_armed;
+uint8_t g_reset_cause;
+bool g_use_stdin;
+
+// Re-entrant spin lock: the owner is the address of a thread-local byte.
+__thread char t_token;
+void* g_owner;
+uint32_t g_depth;
+
+uint64_t host_monotonic_us() {
+    timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1000000u + static_cast<uint64_t>(ts.tv_nsec) / 1000u;
+}
+
+uint64_t now_us() { return g_real_time ? host_monotonic_us() - g_real_origin_us : g_time_us; }
+
+void clear_modes() {
+    if (!g_modes_cleared) {
+        memset(g_mode, 0xFF, sizeof g_mode);
+        g_modes_cleared = true;
+    }
+}
+
+}  // namespace
+
+namespace native {
+
+void sim_set_time_us(uint64_t t) { g_time_us = t; }
+void sim_advance_us(uint64_t dt) { g_time_us += dt; }
+uint64_t sim_time_us() { return now_us(); }
+void use_real_time(bool on) {
+    g_real_time = on;
+    g_real_origin_us = host_monotonic_us() - g_time_us;
+}
+void sim_set_analog(uint8_t pin, uint16_t raw) { g_analog[pin] = raw; }
+uint8_t sim_pwm(uint8_t pin) { return g_pwm[pin]; }
+void sim_set_digital(uint8_t pin, bool high) { g_level[pin] = high ? 1 : 0; }
+bool sim_digital(uint8_t pin) { return g_level[pin] != 0; }
+uint8_t sim_pin_mode(uint8_t pin) {
+    clear_modes();
+    return g_mode[pin];
+}
+void console_capture(uint8_t* buf, uint16_t cap, uint16_t* len) {
+    g_cap_buf = buf;
+    g_cap_cap = cap;
+    g_cap_len = len;
+    if (len != 0) *len = 0;
+}
+void console_use_stdin(bool on) { g_use_stdin = on; }
+void console_feed(const uint8_t* data, uint16_t len) {
+    for (uint16_t i = 0; i < len && g_in_len < sizeof g_in; ++i) {
+        g_in[(g_in_head + g_in_len) % sizeof g_in] = data[i];
+        ++g_in_len;
+    }
+}
+uint32_t watchdog_kicks() { return g_kicks; }
+bool watchdog_armed() { return g_wdt_armed; }
+void sim_set_reset_cause(uint8_t cause) { g_reset_cause = cause; }
+
+void sim_reset() {
+    g_time_us = 0;
+    g_real_time = false;
+    memset(&g_micros_ext, 0, sizeof g_micros_ext);
+    memset(&g_millis_ext, 0, sizeof g_millis_ext);
+    memset(g_analog, 0, sizeof g_analog);
+    memset(g_pwm, 0, sizeof g_pwm);
+    memset(g_level, 0, sizeof g_level);
+    g_modes_cleared = false;
+    clear_modes();
+    g_cap_buf = 0;
+    g_cap_len = 0;
+    g_in_head = 0;
+    g_in_len = 0;
+    g_kicks = 0;
+    g_wdt_armed = false;
+    g_reset_cause = 0;
+}
+
+}  // namespace native
+
+namespace pal {
+
+void begin() { clear_modes(); }
+
+uint32_t micros32() { return static_cast<uint32_t>(now_us()); }
+uint32_t millis32() { return static_cast<uint32_t>(now_us() / 1000u); }
+uint64_t micros64() { return clock64_extend(g_micros_ext, micros32()); }
+uint64_t millis64() { return clock64_extend(g_millis_ext, millis32()); }
+
+uint16_t analog_read(uint8_t pin) { return g_analog[pin]; }
+void analog_write(uint8_t pin, uint8_t duty) { g_pwm[pin] = duty; }
+
+void pin_mode(uint8_t pin, uint8_t mode) {
+    clear_modes();
+    g_mode[pin] = mode;
+}
+bool digital_read(uint8_t pin) { return g_level[pin] != 0; }
+void digital_write(uint8_t pin, bool high) { g_level[pin] = high ? 1 : 0; }
+
+void console_begin(uint32_t baud) { (void)baud; }
+void console_write(const uint8_t* data, uint16_t len) {
+    if (g_cap_buf != 0) {
+        for (uint16_t i = 0; i < len && *g_cap_len < g_cap_cap; ++i) g_cap_buf[(*g_cap_len)++] = data[i];
+        return;
+    }
+    fwrite(data, 1, len, stdout);
+    fflush(stdout);
+}
+int16_t console_read() {
+    if (g_in_len == 0 && g_use_stdin) {
+        pollfd p = {0, POLLIN, 0};
+        uint8_t b;
+        if (poll(&p, 1, 0) == 1 && read(0, &b, 1) == 1) return b;
+    }
+    if (g_in_len == 0) return -1;
+    const uint8_t b = g_in[g_in_head];
+    g_in_head = static_cast<uint16_t>((g_in_head + 1u) % sizeof g_in);
+    --g_in_len;
+    return b;
+}
+
+IrqState critical_enter() {
+    void* const me = &t_token;
+    if (__atomic_load_n(&g_owner, __ATOMIC_ACQUIRE) == me) {
+        ++g_depth;
+        return 0;
+    }
+    void* expected = 0;
+    while (!__atomic_compare_exchange_n(&g_owner, &expected, me, true, __ATOMIC_ACQUIRE,
+                                        __ATOMIC_RELAXED)) {
+        expected = 0;
+    }
+    g_depth = 1;
+    return 0;
+}
+
+void critical_exit(IrqState saved) {
+    (void)saved;
+    if (--g_depth == 0) __atomic_store_n(&g_owner, static_cast<void*>(0), __ATOMIC_RELEASE);
+}
+
+void watchdog_begin() { g_wdt_armed = true; }  // simulated whatever FSW_WATCHDOG says
+void watchdog_kick() { ++g_kicks; }
+uint8_t reset_cause() { return g_reset_cause; }
+
+}  // namespace pal
+}  // namespace fsw
+
+#endif  // FSW_PLATFORM_NATIVE

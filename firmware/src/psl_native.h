@@ -1,0 +1,47 @@
+// Hooks into the native (host) PSL: a simulated clock tests advance by hand,
+// simulated pins tests set and read, console capture and input.
+#ifndef PSL_NATIVE_H
+#define PSL_NATIVE_H
+
+#include "fsw_types.h"
+
+#if FSW_PLATFORM_NATIVE
+
+namespace fsw {
+namespace native {
+
+// Simulated time in microseconds. micros32()/millis32() are its low 32 bits
+// (so they wrap exactly like a board's), micros64()/millis64() extend them.
+void sim_set_time_us(uint64_t t);
+void sim_advance_us(uint64_t dt);
+uint64_t sim_time_us();
+// Follow the host's monotonic clock instead of the simulated one.
+void use_real_time(bool on);
+
+// Pins 0..255: ADC values read by analog_read, PWM duty written by
+// analog_write, digital levels and modes.
+void sim_set_analog(uint8_t pin, uint16_t raw);
+uint8_t sim_pwm(uint8_t pin);
+void sim_set_digital(uint8_t pin, bool high);
+bool sim_digital(uint8_t pin);
+uint8_t sim_pin_mode(uint8_t pin);  // 0xFF: never set
+
+// Console: output goes to stdout unless a capture buffer is set; input
+// comes from bytes fed here, or from stdin (non-blocking) when enabled.
+void console_use_stdin(bool on);
+void console_capture(uint8_t* buf, uint16_t cap, uint16_t* len);
+void console_feed(const uint8_t* data, uint16_t len);
+
+// Watchdog and reset cause.
+uint32_t watchdog_kicks();
+bool watchdog_armed();
+void sim_set_reset_cause(uint8_t cause);
+
+// Back to power-on state: time 0, pins cleared, counters zero.
+void sim_reset();
+
+}  // namespace native
+}  // namespace fsw
+
+#endif  // FSW_PLATFORM_NATIVE
+#endif  // PSL_NATIVE_H

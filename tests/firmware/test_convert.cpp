@@ -1,0 +1,269 @@
+// Scenario: element <-> Real conversions (spec 4.5) at their boundaries:
+// saturation, truncation toward zero, NaN, +-inf, U64/I64 bounds, rounding.
+#include "test_support.h"
+
+using namespace fsw;
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static const Real kInf = static_cast<Real>(__builtin_inf());
+static Real nan_real() {
+    volatile Real z = 0;
+    return z / z;
+}
+
+static void test_reads_of_integers_are_exact_where_R_holds_them(void) {
+    ASSERT_REAL_SAME(Real(255), real_from_U8(255));
+    ASSERT_REAL_SAME(Real(-128), real_from_I8(-128));
+    ASSERT_REAL_SAME(Real(65535), real_from_U16(65535));
+    ASSERT_REAL_SAME(Real(-32768), real_from_I16(-32768));
+    ASSERT_REAL_SAME(Real(16777216), real_from_U32(16777216UL));
+    ASSERT_REAL_SAME(Real(-16777216), real_from_I32(-16777216L));
+    ASSERT_REAL_SAME(Real(1), real_from_bool(true));
+    ASSERT_REAL_SAME(Real(0), real_from_bool(false));
+}
+
+static void test_reads_of_64_bit_integers_round_once_to_nearest_even(void) {
+    // 2^64 - 1 and 2^63 - 1 round up to powers of two in either R.
+    ASSERT_REAL_SAME(Real(18446744073709551616.0), real_from_U64(0xFFFFFFFFFFFFFFFFULL));
+    ASSERT_REAL_SAME(Real(9223372036854775808.0), real_from_I64(0x7FFFFFFFFFFFFFFFLL));
+    ASSERT_REAL_SAME(Real(-9223372036854775808.0), real_from_I64(-0x7FFFFFFFFFFFFFFFLL - 1));
+    ASSERT_REAL_SAME(Real(0), real_from_U64(0));
+    ASSERT_REAL_SAME(Real(1000), real_from_U64(1000));
+    ASSERT_REAL_SAME(Real(-1000), real_from_I64(-1000));
+#if FSW_REAL_IS_FLOAT
+    // 2^24 + 1 is a tie: to even. 2^24 + 3: up.
+    ASSERT_REAL_SAME(16777216.0f, real_from_U64(16777217ULL));
+    ASSERT_REAL_SAME(16777220.0f, real_from_U64(16777219ULL));
+    ASSERT_REAL_SAME(16777216.0f, real_from_U32(16777217UL));
+    // 2^56 + 2^32 + 1: just above half an ulp (2^33), so up. Rounding
+    // through binary64 first would give a tie and round down to 2^56.
+    ASSERT_REAL_SAME(72057602627862528.0f, real_from_U64(0x0100000100000001ULL));
+    ASSERT_REAL_SAME(-72057602627862528.0f, real_from_I64(-0x0100000100000001LL));
+    // 2^56 + 2^32 exactly: a tie, to even (2^56).
+    ASSERT_REAL_SAME(72057594037927936.0f, real_from_U64(0x0100000100000000ULL));
+    // A value whose rounding carries into the next power of two.
+    ASSERT_REAL_SAME(4294967296.0f, real_from_U64(0xFFFFFFFFULL + 0ULL));
+    ASSERT_REAL_SAME(1099511627776.0f, real_from_U64(0xFFFFFF8000ULL));
+    ASSERT_REAL_SAME(1099511562240.0f, real_from_U64(0xFFFFFF7FFFULL));
+#else
+    // 2^53 + 1 is a tie: to even. 2^53 + 3: up.
+    ASSERT_REAL_SAME(9007199254740992.0, real_from_U64(9007199254740993ULL));
+    ASSERT_REAL_SAME(9007199254740996.0, real_from_U64(9007199254740995ULL));
+    ASSERT_REAL_SAME(-9007199254740996.0, real_from_I64(-9007199254740995LL));
+#endif
+}
+
+static void test_reads_of_floats_turn_nan_into_zero(void) {
+    ASSERT_REAL_SAME(Real(0), real_from_F32(static_cast<float>(nan_real())));
+    ASSERT_REAL_SAME(Real(1.5), real_from_F32(1.5f));
+    ASSERT_REAL_SAME(kInf, real_from_F32(static_cast<float>(kInf)));
+    ASSERT_REAL_SAME(-kInf, real_from_F32(static_cast<float>(-kInf)));
+    ASSERT_REAL_SAME(Real(0), real_from_F64_bits(0x7FF8000000000000ULL));
+    ASSERT_REAL_SAME(Real(0), real_from_F64_bits(0xFFF0000000000001ULL));
+    ASSERT_REAL_SAME(Real(-2.5), real_from_F64_bits(0xC004000000000000ULL));
+    ASSERT_REAL_SAME(kInf, real_from_F64_bits(0x7FF0000000000000ULL));
+#if FSW_REAL_IS_FLOAT
+    ASSERT_REAL_SAME(kInf, real_from_F64_bits(0x47F0000000000000ULL));  // 2^128
+    ASSERT_REAL_SAME(0.1f, real_from_F64_bits(0x3FB999999999999AULL));
+#else
+    ASSERT_REAL_SAME(0.1, real_from_F64_bits(0x3FB999999999999AULL));
+#endif
+}
+
+static void test_assign_u8_saturates_and_truncates(void) {
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(300));
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(256));
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(Real(255.99)));
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(255));
+    TEST_ASSERT_EQUAL_UINT8(254, U8_from_real(Real(254.7)));
+    TEST_ASSERT_EQUAL_UINT8(2, U8_from_real(Real(2.9)));
+    TEST_ASSERT_EQUAL_UINT8(0, U8_from_real(Real(-0.5)));
+    TEST_ASSERT_EQUAL_UINT8(0, U8_from_real(-1));
+    TEST_ASSERT_EQUAL_UINT8(0, U8_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(kInf));
+    TEST_ASSERT_EQUAL_UINT8(0, U8_from_real(-kInf));
+}
+
+static void test_assign_signed_small_types(void) {
+    TEST_ASSERT_EQUAL_INT8(-2, I8_from_real(Real(-2.9)));
+    TEST_ASSERT_EQUAL_INT8(2, I8_from_real(Real(2.9)));
+    TEST_ASSERT_EQUAL_INT8(127, I8_from_real(Real(127.5)));
+    TEST_ASSERT_EQUAL_INT8(127, I8_from_real(128));
+    TEST_ASSERT_EQUAL_INT8(-128, I8_from_real(Real(-128.9)));
+    TEST_ASSERT_EQUAL_INT8(-128, I8_from_real(-kInf));
+    TEST_ASSERT_EQUAL_INT8(0, I8_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_INT16(32767, I16_from_real(40000));
+    TEST_ASSERT_EQUAL_INT16(-32768, I16_from_real(-40000));
+    TEST_ASSERT_EQUAL_INT16(-32767, I16_from_real(Real(-32767.9)));
+    TEST_ASSERT_EQUAL_UINT16(65535, U16_from_real(65536));
+    TEST_ASSERT_EQUAL_UINT16(65535, U16_from_real(kInf));
+    TEST_ASSERT_EQUAL_UINT16(1, U16_from_real(Real(1.999)));
+}
+
+static void test_assign_32_bit_bounds(void) {
+    TEST_ASSERT_EQUAL_INT32(2147483647L, I32_from_real(Real(2147483648.0)));
+    TEST_ASSERT_EQUAL_INT32(-2147483647L - 1, I32_from_real(Real(-2147483648.0)));
+    TEST_ASSERT_EQUAL_INT32(-2147483647L - 1, I32_from_real(-kInf));
+    TEST_ASSERT_EQUAL_INT32(0, I32_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_UINT32(4294967295UL, U32_from_real(Real(4294967296.0)));
+    TEST_ASSERT_EQUAL_UINT32(4294967295UL, U32_from_real(kInf));
+    TEST_ASSERT_EQUAL_UINT32(0, U32_from_real(-kInf));
+#if FSW_REAL_IS_FLOAT
+    // Largest binary32 values below the bounds survive unchanged.
+    TEST_ASSERT_EQUAL_UINT32(4294967040UL, U32_from_real(4294967040.0f));
+    TEST_ASSERT_EQUAL_INT32(2147483520L, I32_from_real(2147483520.0f));
+    TEST_ASSERT_EQUAL_INT32(-2147483520L, I32_from_real(-2147483520.0f));
+#else
+    TEST_ASSERT_EQUAL_UINT32(4294967295UL, U32_from_real(4294967295.9));
+    TEST_ASSERT_EQUAL_INT32(2147483647L, I32_from_real(2147483647.5));
+    TEST_ASSERT_EQUAL_INT32(-2147483647L - 1, I32_from_real(-2147483648.9));
+#endif
+}
+
+static void test_assign_64_bit_bounds(void) {
+    const int64_t i64max = 0x7FFFFFFFFFFFFFFFLL;
+    const int64_t i64min = -i64max - 1;
+    const uint64_t u64max = 0xFFFFFFFFFFFFFFFFULL;
+    TEST_ASSERT_EQUAL_INT64(i64max, I64_from_real(Real(9223372036854775808.0)));
+    TEST_ASSERT_EQUAL_INT64(i64min, I64_from_real(Real(-9223372036854775808.0)));
+    TEST_ASSERT_EQUAL_INT64(i64max, I64_from_real(kInf));
+    TEST_ASSERT_EQUAL_INT64(i64min, I64_from_real(-kInf));
+    TEST_ASSERT_EQUAL_INT64(0, I64_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_INT64(-2, I64_from_real(Real(-2.9)));
+    TEST_ASSERT_EQUAL_UINT64(u64max, U64_from_real(Real(18446744073709551616.0)));
+    TEST_ASSERT_EQUAL_UINT64(u64max, U64_from_real(kInf));
+    TEST_ASSERT_EQUAL_UINT64(0, U64_from_real(-kInf));
+    TEST_ASSERT_EQUAL_UINT64(0, U64_from_real(Real(-1)));
+    TEST_ASSERT_EQUAL_UINT64(0, U64_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_UINT64(1000000ULL, U64_from_real(Real(1000000.75)));
+#if FSW_REAL_IS_FLOAT
+    // Largest binary32 values below 2^64 and 2^63.
+    TEST_ASSERT_EQUAL_UINT64(18446742974197923840ULL, U64_from_real(18446742974197923840.0f));
+    TEST_ASSERT_EQUAL_INT64(9223371487098961920LL, I64_from_real(9223371487098961920.0f));
+    TEST_ASSERT_EQUAL_INT64(-9223371487098961920LL, I64_from_real(-9223371487098961920.0f));
+#else
+    TEST_ASSERT_EQUAL_UINT64(18446744073709549568ULL, U64_from_real(18446744073709549568.0));
+    TEST_ASSERT_EQUAL_INT64(9223372036854774784LL, I64_from_real(9223372036854774784.0));
+    TEST_ASSERT_EQUAL_INT64(-9223372036854774784LL, I64_from_real(-9223372036854774784.0));
+#endif
+}
+
+static void test_assign_bool_and_truthiness(void) {
+    TEST_ASSERT_FALSE(bool_from_real(nan_real()));
+    TEST_ASSERT_FALSE(bool_from_real(0));
+    TEST_ASSERT_FALSE(bool_from_real(-Real(0)));
+    TEST_ASSERT_TRUE(bool_from_real(Real(1e-30)));
+    TEST_ASSERT_TRUE(bool_from_real(-kInf));
+    TEST_ASSERT_TRUE(bool_from_real(Real(-0.5)));
+    TEST_ASSERT_FALSE(truthy(nan_real()));
+    TEST_ASSERT_TRUE(truthy(Real(2)));
+    ASSERT_REAL_SAME(Real(1), real_from_truth(true));
+    ASSERT_REAL_SAME(Real(0), real_from_truth(false));
+}
+
+static void test_assign_floats_nan_to_zero_and_ieee_rounding(void) {
+    TEST_ASSERT_EQUAL_HEX32(0, bits_of(F32_from_real(nan_real())));
+    TEST_ASSERT_EQUAL_HEX32(0x7F800000UL, bits_of(F32_from_real(kInf)));
+    TEST_ASSERT_EQUAL_HEX32(0xFF800000UL, bits_of(F32_from_real(-kInf)));
+    TEST_ASSERT_EQUAL_HEX32(0x80000000UL, bits_of(F32_from_real(-Real(0))));
+    TEST_ASSERT_EQUAL_HEX64(0, F64_bits_from_real(nan_real()));
+    TEST_ASSERT_EQUAL_HEX64(0x7FF0000000000000ULL, F64_bits_from_real(kInf));
+    TEST_ASSERT_EQUAL_HEX64(0x3FF8000000000000ULL, F64_bits_from_real(Real(1.5)));
+#if FSW_REAL_IS_FLOAT
+    TEST_ASSERT_EQUAL_HEX64(0x3FB99999A0000000ULL, F64_bits_from_real(0.1f));  // exact widening
+#else
+    TEST_ASSERT_EQUAL_HEX32(0x7F800000UL, bits_of(F32_from_real(1e39)));   // overflow -> inf
+    TEST_ASSERT_EQUAL_HEX32(0xFF800000UL, bits_of(F32_from_real(-1e39)));
+    TEST_ASSERT_EQUAL_HEX32(0x7F7FFFFFUL, bits_of(F32_from_real(3.4028235e38)));
+    TEST_ASSERT_EQUAL_HEX32(0x3DCCCCCDUL, bits_of(F32_from_real(0.1)));   // round to nearest
+    TEST_ASSERT_EQUAL_HEX64(0x3FB999999999999AULL, F64_bits_from_real(0.1));
+#endif
+}
+
+static void test_division_by_zero_follows_ieee(void) {
+    volatile Real zero = 0;
+    volatile Real one = 1;
+    ASSERT_REAL_SAME(kInf, one / zero);
+    ASSERT_REAL_SAME(-kInf, -one / zero);
+    TEST_ASSERT_TRUE(zero / zero != zero / zero);
+    TEST_ASSERT_EQUAL_UINT8(255, U8_from_real(one / zero));
+}
+
+static void test_element_pointer_access_round_trips_every_type(void) {
+    uint8_t buf[9 + 8];
+    for (uint8_t t = kI8; t <= kBool; ++t) {
+        memset(buf, 0xAA, sizeof buf);
+        uint8_t* p = buf + 1;  // deliberately unaligned
+        write_elem(p, t, Real(300.7));
+        const Real back = read_elem(p, t);
+        Real expected;
+        switch (t) {
+            case kI8: expected = 127; break;
+            case kU8: expected = 255; break;
+            case kBool: expected = 1; break;
+            case kF32: expected = static_cast<Real>(300.7f); break;
+            case kF64: expected = Real(300.7); break;
+            default: expected = 300; break;
+        }
+        ASSERT_REAL_SAME(expected, back);
+        TEST_ASSERT_EQUAL_HEX8(0xAA, buf[0]);                    // no write before
+        TEST_ASSERT_EQUAL_HEX8(0xAA, buf[1 + elem_size(t)]);     // nor after
+    }
+    ASSERT_REAL_SAME(Real(0), read_elem(buf, 99));
+}
+
+static void test_typed_writes_saturate_through_pointers(void) {
+    uint8_t b[8];
+    write_U8(b, 256);
+    TEST_ASSERT_EQUAL_HEX8(0xFF, b[0]);
+    write_I16(b + 1, -40000);
+    TEST_ASSERT_EQUAL_HEX8(0x00, b[1]);
+    TEST_ASSERT_EQUAL_HEX8(0x80, b[2]);
+    write_bool(b, nan_real());
+    TEST_ASSERT_EQUAL_HEX8(0, b[0]);
+    b[0] = 7;  // any non-zero byte reads as true
+    ASSERT_REAL_SAME(Real(1), read_bool(b));
+}
+
+#if !defined(__AVR__)
+// Host only: random 64-bit integers against conversion through x87 long
+// double, which holds every 64-bit integer exactly (one rounding only).
+static void test_64_bit_reads_match_single_rounding_reference(void) {
+    uint64_t x = 0x9E3779B97F4A7C15ULL;
+    for (int i = 0; i < 200000; ++i) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        const uint64_t u = x >> (i % 60);
+        const int64_t s = static_cast<int64_t>(x);
+        if (!fsw_test_same(static_cast<Real>(static_cast<long double>(u)), real_from_U64(u)) ||
+            !fsw_test_same(static_cast<Real>(static_cast<long double>(s)), real_from_I64(s))) {
+            TEST_FAIL_MESSAGE("64-bit integer read rounded differently from the reference");
+        }
+    }
+}
+#endif
+
+static void run(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_reads_of_integers_are_exact_where_R_holds_them);
+    RUN_TEST(test_reads_of_64_bit_integers_round_once_to_nearest_even);
+    RUN_TEST(test_reads_of_floats_turn_nan_into_zero);
+    RUN_TEST(test_assign_u8_saturates_and_truncates);
+    RUN_TEST(test_assign_signed_small_types);
+    RUN_TEST(test_assign_32_bit_bounds);
+    RUN_TEST(test_assign_64_bit_bounds);
+    RUN_TEST(test_assign_bool_and_truthiness);
+    RUN_TEST(test_assign_floats_nan_to_zero_and_ieee_rounding);
+    RUN_TEST(test_division_by_zero_follows_ieee);
+    RUN_TEST(test_element_pointer_access_round_trips_every_type);
+    RUN_TEST(test_typed_writes_saturate_through_pointers);
+#if !defined(__AVR__)
+    RUN_TEST(test_64_bit_reads_match_single_rounding_reference);
+#endif
+    (void)UNITY_END();
+}
+
+FSW_TEST_MAIN(run)

@@ -1,0 +1,234 @@
+// Scenario: the cooperative executor: declared order, rate dividers and
+// phases, modes (disabled / safed / enabled), fault -> safed, overrun count
+// and worst step time (host: simulated clock; AVR: real time in simavr),
+// late cycles, watchdog kicks, reset cause, table validation.
+#include "test_support.h"
+
+#if FSW_PLATFORM_NATIVE
+#include "psl_native.h"
+#else
+#include <Arduino.h>
+#include <avr/wdt.h>
+#endif
+
+using namespace fsw;
+
+static char trace[64];
+static uint8_t trace_len;
+static uint8_t fail_on_call[4];   // step of task i faults on its n-th call (0: never)
+static uint8_t calls[4];
+static uint16_t busy_us[4];       // how long step i takes
+
+static void note(char c) {
+    if (trace_len + 1u < sizeof trace) trace[trace_len++] = c;
+    trace[trace_len] = 0;
+}
+
+static void spend(uint16_t us) {
+    if (us == 0) return;
+#if FSW_PLATFORM_NATIVE
+    native::sim_advance_us(us);
+#else
+    delayMicroseconds(us);
+#endif
+}
+
+static Result step_fn(void* ctx) {
+    const uint8_t i = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(ctx));
+    note(static_cast<char>('A' + i));
+    ++calls[i];
+    spend(busy_us[i]);
+    return fail_on_call[i] != 0 && calls[i] == fail_on_call[i] ? kErrFault : kOk;
+}
+
+static void safe_fn(void* ctx) {
+    const uint8_t i = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(ctx));
+    note(static_cast<char>('a' + i));
+}
+
+#define CTX(i) reinterpret_cast<void*>(static_cast<uintptr_t>(i))
+
+// sv layout: modes @0..2 (U8), overruns of task 0 @3 (U16), worst of task 0
+// @5 (U32), reset cause @9.
+static uint8_t sv[10];
+static TaskStats stats[3];
+static Executor ex;
+
+static const Task kTasks[3] FSW_FLASH = {
+    {step_fn, safe_fn, CTX(0), 1, 0, 0, 3, 5, kModeEnabled},
+    {step_fn, safe_fn, CTX(1), 2, 0, 1, kNoElement, kNoElement, kModeEnabled},
+    {step_fn, 0, CTX(2), 3, 1, 2, kNoElement, kNoElement, kModeEnabled},
+};
+
+static ExecConfig config(uint32_t period_us) {
+    ExecConfig c = {kTasks, stats, sv, period_us, 9, 3, false};
+    return c;
+}
+
+void setUp(void) {
+    trace_len = 0;
+    trace[0] = 0;
+    memset(fail_on_call, 0, sizeof fail_on_call);
+    memset(calls, 0, sizeof calls);
+    memset(busy_us, 0, sizeof busy_us);
+    memset(sv, 0, sizeof sv);
+#if FSW_PLATFORM_NATIVE
+    native::sim_reset();
+    native::sim_set_reset_cause(0x08);
+#endif
+}
+
+void tearDown(void) {
+#if !FSW_PLATFORM_NATIVE
+    wdt_disable();  // output after the test must not be cut by a reset
+#endif
+}
+
+static void test_tasks_run_in_order_at_their_dividers_and_phases(void) {
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    for (int c = 0; c < 6; ++c) {
+        executor_run_cycle(ex);
+        note('|');
+    }
+    // A every cycle; B every 2nd from 0; C every 3rd from cycle 1.
+    TEST_ASSERT_EQUAL_STRING("AB|AC|AB|A|ABC|A|", trace);
+    TEST_ASSERT_EQUAL_UINT32(6, ex.cycles);
+    TEST_ASSERT_EQUAL_UINT32(6, stats[0].runs);
+    TEST_ASSERT_EQUAL_UINT32(3, stats[1].runs);
+    TEST_ASSERT_EQUAL_UINT32(2, stats[2].runs);
+}
+
+static void test_begin_writes_initial_modes_into_mode_elements(void) {
+    sv[0] = sv[1] = sv[2] = 77;
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[0]);
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[1]);
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[2]);
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, executor_task_mode(ex, 1));
+}
+
+static void test_modes_disabled_safed_enabled(void) {
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    sv[0] = kModeDisabled;
+    sv[1] = kModeSafed;
+    executor_run_cycle(ex);  // cycle 0: A disabled, B safed -> b
+    TEST_ASSERT_EQUAL_STRING("b", trace);
+    sv[0] = 200;             // not a mode: treated as safed
+    executor_run_cycle(ex);  // cycle 1: A -> a, C enabled
+    TEST_ASSERT_EQUAL_STRING("baC", trace);
+    executor_set_task_mode(ex, 2, kModeSafed);  // C has no safe function
+    sv[0] = kModeEnabled;
+    executor_run_cycle(ex);
+    executor_run_cycle(ex);  // cycle 3: A only
+    executor_run_cycle(ex);  // cycle 4: A, B safed, C safed (nothing)
+    TEST_ASSERT_EQUAL_STRING("baCAbAAb", trace);
+    TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[2]);
+}
+
+static void test_a_faulting_step_safes_its_task(void) {
+    fail_on_call[0] = 2;
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    executor_run_cycle(ex);
+    executor_run_cycle(ex);  // A faults here
+    TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[0]);
+    TEST_ASSERT_EQUAL_UINT16(1, stats[0].faults);
+    TEST_ASSERT_EQUAL_UINT8(kErrFault, stats[0].last_fault);
+    trace_len = 0;
+    executor_run_cycle(ex);  // cycle 2: A safed -> a, B
+    TEST_ASSERT_EQUAL_STRING("aB", trace);
+    TEST_ASSERT_EQUAL_UINT8(2, calls[0]);
+}
+
+static void test_overrun_and_worst_step_time(void) {
+    busy_us[0] = 1500;  // longer than its 1000 us period
+    busy_us[1] = 1500;  // shorter than its 2000 us period
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    executor_run_cycle(ex);
+    executor_run_cycle(ex);
+    TEST_ASSERT_EQUAL_UINT16(2, stats[0].overruns);
+    TEST_ASSERT_EQUAL_UINT16(0, stats[1].overruns);
+    TEST_ASSERT_TRUE(stats[0].worst_us >= 1500);
+    TEST_ASSERT_TRUE(stats[0].worst_us < 1700);
+    TEST_ASSERT_TRUE(stats[1].worst_us >= 1500);
+    // Mirrored into the state vector for telemetry.
+    TEST_ASSERT_EQUAL_UINT16(2, load<uint16_t>(sv + 3));
+    TEST_ASSERT_EQUAL_UINT32(stats[0].worst_us, load<uint32_t>(sv + 5));
+}
+
+static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
+#if FSW_PLATFORM_NATIVE
+    native::sim_set_time_us(5000);
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_TRUE(executor_poll(ex));     // due at once (t=5000)
+    TEST_ASSERT_FALSE(executor_poll(ex));
+    native::sim_advance_us(999);
+    TEST_ASSERT_FALSE(executor_poll(ex));
+    native::sim_advance_us(1);
+    TEST_ASSERT_TRUE(executor_poll(ex));     // t=6000
+    native::sim_advance_us(1200);
+    TEST_ASSERT_TRUE(executor_poll(ex));     // t=7200, due 7000: late but < 1 period
+    TEST_ASSERT_EQUAL_UINT16(0, ex.late);
+    native::sim_advance_us(800);
+    TEST_ASSERT_TRUE(executor_poll(ex));     // t=8000: schedule kept, no drift
+    native::sim_advance_us(3500);
+    TEST_ASSERT_TRUE(executor_poll(ex));     // t=11500: a full period late
+    TEST_ASSERT_EQUAL_UINT16(1, ex.late);
+    TEST_ASSERT_FALSE(executor_poll(ex));    // missed cycles are not run in a burst
+    native::sim_advance_us(1000);
+    TEST_ASSERT_TRUE(executor_poll(ex));
+    TEST_ASSERT_EQUAL_UINT32(6, ex.cycles);
+    TEST_ASSERT_EQUAL_UINT32(6, native::watchdog_kicks());
+    TEST_ASSERT_TRUE(native::watchdog_armed());
+#else
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_TRUE((WDTCSR & _BV(WDE)) != 0);  // watchdog armed
+    const uint32_t start = micros();
+    uint16_t ran = 0;
+    while (micros() - start < 10500UL) {
+        if (executor_poll(ex)) ++ran;
+    }
+    TEST_ASSERT_TRUE(ran >= 10 && ran <= 12);
+    TEST_ASSERT_EQUAL_UINT16(0, ex.late);
+#endif
+}
+
+static void test_reset_cause_is_captured(void) {
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL_UINT8(pal::reset_cause(), ex.reset_cause);
+    TEST_ASSERT_EQUAL_UINT8(ex.reset_cause, sv[9]);
+#if FSW_PLATFORM_NATIVE
+    TEST_ASSERT_EQUAL_UINT8(0x08, sv[9]);
+#endif
+}
+
+static const Task kBadDivider[1] FSW_FLASH = {{step_fn, 0, CTX(0), 0, 0, kNoElement, kNoElement, kNoElement, 2}};
+static const Task kBadPhase[1] FSW_FLASH = {{step_fn, 0, CTX(0), 2, 2, kNoElement, kNoElement, kNoElement, 2}};
+static const Task kNoStep[1] FSW_FLASH = {{0, 0, CTX(0), 1, 0, kNoElement, kNoElement, kNoElement, 2}};
+
+static void test_begin_refuses_bad_tables(void) {
+    ExecConfig c = config(1000);
+    c.n_tasks = 1;
+    c.tasks = kBadDivider;
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
+    c.tasks = kBadPhase;
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
+    c.tasks = kNoStep;
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
+    c = config(0);
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
+}
+
+static void run(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_tasks_run_in_order_at_their_dividers_and_phases);
+    RUN_TEST(test_begin_writes_initial_modes_into_mode_elements);
+    RUN_TEST(test_modes_disabled_safed_enabled);
+    RUN_TEST(test_a_faulting_step_safes_its_task);
+    RUN_TEST(test_overrun_and_worst_step_time);
+    RUN_TEST(test_poll_keeps_the_rate_and_counts_late_cycles);
+    RUN_TEST(test_reset_cause_is_captured);
+    RUN_TEST(test_begin_refuses_bad_tables);
+    (void)UNITY_END();
+}
+
+FSW_TEST_MAIN(run)

@@ -1,0 +1,104 @@
+// Scenario: analog and digital I/O tables as executor task steps: ADC counts
+// to volts to engineering units, PWM duty from volts, digital mirrors, pin
+// modes, table validation. Pins are simulated on the host.
+#include "test_support.h"
+
+#if FSW_PLATFORM_NATIVE
+#include "psl_native.h"
+#endif
+
+using namespace fsw;
+
+void setUp(void) {
+#if FSW_PLATFORM_NATIVE
+    native::sim_reset();
+#endif
+}
+void tearDown(void) {}
+
+static void test_analog_conversion_formula(void) {
+    ASSERT_REAL_SAME(Real(5), analog_value_from_raw(1023, 5, 10, 1, 0));
+    ASSERT_REAL_SAME(Real(0), analog_value_from_raw(0, 5, 10, 1, 0));
+    ASSERT_REAL_SAME(Real(-3), analog_value_from_raw(0, 5, 10, 2, -3));
+    const Real volts = Real(512) * Real(5) / Real(1023);
+    ASSERT_REAL_SAME(volts * Real(250) + Real(-125), analog_value_from_raw(512, 5, 10, 250, -125));
+    ASSERT_REAL_SAME(Real(3.3), analog_value_from_raw(4095, Real(3.3), 12, 1, 0));
+}
+
+static void test_pwm_duty_from_volts(void) {
+    TEST_ASSERT_EQUAL_UINT8(0, pwm_duty_from_volts(0, 5));
+    TEST_ASSERT_EQUAL_UINT8(255, pwm_duty_from_volts(5, 5));
+    TEST_ASSERT_EQUAL_UINT8(128, pwm_duty_from_volts(Real(2.5), 5));  // 127.5 rounds up
+    TEST_ASSERT_EQUAL_UINT8(255, pwm_duty_from_volts(12, 5));
+    TEST_ASSERT_EQUAL_UINT8(0, pwm_duty_from_volts(-1, 5));
+    volatile Real z = 0;
+    TEST_ASSERT_EQUAL_UINT8(0, pwm_duty_from_volts(z / z, 5));
+}
+
+#if FSW_PLATFORM_NATIVE
+// sv: F32 pressure @0, F64 heater volts @4, bool limit @12, bool valve @13.
+static uint8_t sv[14];
+static const AnalogChannel kAnalog[2] FSW_FLASH = {
+    {Real(250), Real(-125), 0, 14, kIoIn, kF32},
+    {Real(1), Real(0), 4, 9, kIoOut, kF64},
+};
+static const AnalogTable kAnalogTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 10, false};
+static const DigitalChannel kDigital[2] FSW_FLASH = {{12, 2, kIoInPullup}, {13, 4, kIoOut}};
+static const DigitalTable kDigitalTable FSW_FLASH = {kDigital, sv, 2, true};
+
+static void test_analog_task_reads_and_writes(void) {
+    TEST_ASSERT_EQUAL(kOk, io_analog_begin(&kAnalogTable));
+    TEST_ASSERT_EQUAL_UINT8(pal::kOutput, native::sim_pin_mode(9));
+    TEST_ASSERT_EQUAL_UINT8(0xFF, native::sim_pin_mode(14));  // analog inputs untouched
+    native::sim_set_analog(14, 1023);
+    write_F64(sv + 4, Real(2.5));
+    TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogTable)));
+    ASSERT_REAL_SAME(Real(1125), read_F32(sv + 0));  // 5 V * 250 - 125
+    TEST_ASSERT_EQUAL_UINT8(128, native::sim_pwm(9));
+    native::sim_set_analog(14, 0);
+    TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogTable)));
+    ASSERT_REAL_SAME(Real(-125), read_F32(sv + 0));
+}
+
+static void test_digital_task_mirrors_pins(void) {
+    TEST_ASSERT_EQUAL(kOk, io_digital_begin(&kDigitalTable));
+    TEST_ASSERT_EQUAL_UINT8(pal::kInputPullup, native::sim_pin_mode(2));
+    TEST_ASSERT_EQUAL_UINT8(pal::kOutput, native::sim_pin_mode(4));
+    native::sim_set_digital(2, true);
+    sv[13] = 1;
+    TEST_ASSERT_EQUAL(kOk, io_digital_task(const_cast<DigitalTable*>(&kDigitalTable)));
+    TEST_ASSERT_EQUAL_UINT8(1, sv[12]);
+    TEST_ASSERT_TRUE(native::sim_digital(4));
+    native::sim_set_digital(2, false);
+    sv[13] = 0;
+    TEST_ASSERT_EQUAL(kOk, io_digital_task(const_cast<DigitalTable*>(&kDigitalTable)));
+    TEST_ASSERT_EQUAL_UINT8(0, sv[12]);
+    TEST_ASSERT_FALSE(native::sim_digital(4));
+}
+
+static const AnalogChannel kBadType[1] FSW_FLASH = {{1, 0, 0, 14, kIoIn, kU8}};
+static const AnalogTable kBadTypeTable FSW_FLASH = {kBadType, sv, Real(5), 1, 10, false};
+static const AnalogTable kBadBitsTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 0, false};
+static const DigitalChannel kBadDir[1] FSW_FLASH = {{12, 2, 9}};
+static const DigitalTable kBadDirTable FSW_FLASH = {kBadDir, sv, 1, false};
+
+static void test_begin_refuses_bad_tables(void) {
+    TEST_ASSERT_EQUAL(kErrConfig, io_analog_begin(&kBadTypeTable));
+    TEST_ASSERT_EQUAL(kErrConfig, io_analog_begin(&kBadBitsTable));
+    TEST_ASSERT_EQUAL(kErrConfig, io_digital_begin(&kBadDirTable));
+}
+#endif
+
+static void run(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_analog_conversion_formula);
+    RUN_TEST(test_pwm_duty_from_volts);
+#if FSW_PLATFORM_NATIVE
+    RUN_TEST(test_analog_task_reads_and_writes);
+    RUN_TEST(test_digital_task_mirrors_pins);
+    RUN_TEST(test_begin_refuses_bad_tables);
+#endif
+    (void)UNITY_END();
+}
+
+FSW_TEST_MAIN(run)

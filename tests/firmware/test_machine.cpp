@@ -1,0 +1,86 @@
+// Scenario: state-machine bookkeeping (spec 4.6): G must strictly increase,
+// first-step entry, T in exact U64 arithmetic, transitions and self-loops.
+#include "test_support.h"
+
+using namespace fsw;
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static void test_first_step_enters_the_initial_state_with_T_zero(void) {
+    Machine m = FSW_MACHINE_INIT(1);
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 0));
+    TEST_ASSERT_EQUAL_UINT8(1, m.entering);
+    TEST_ASSERT_EQUAL_UINT32(1, m.state);
+    TEST_ASSERT_EQUAL_UINT64(0, machine_T(m));
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 10));
+    TEST_ASSERT_EQUAL_UINT8(0, m.entering);
+    TEST_ASSERT_EQUAL_UINT64(10, machine_T(m));
+}
+
+static void test_G_must_strictly_increase_and_a_refused_step_changes_nothing(void) {
+    Machine m;
+    machine_reset(m, 2);
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 100));
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 110));
+    Machine before = m;
+    TEST_ASSERT_EQUAL(kErrTime, machine_begin_step(m, 110));  // equal
+    TEST_ASSERT_EQUAL(kErrTime, machine_begin_step(m, 50));   // backwards
+    TEST_ASSERT_EQUAL_UINT64(before.last_g, m.last_g);
+    TEST_ASSERT_EQUAL_UINT64(before.entry_g, m.entry_g);
+    TEST_ASSERT_EQUAL_UINT64(before.t, m.t);
+    TEST_ASSERT_EQUAL_UINT32(before.state, m.state);
+    TEST_ASSERT_EQUAL_UINT8(before.pending, m.pending);
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 111));
+    TEST_ASSERT_EQUAL_UINT64(11, machine_T(m));
+}
+
+static void test_transition_makes_the_next_step_the_targets_first(void) {
+    Machine m = FSW_MACHINE_INIT(1);
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 0));
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 5));
+    machine_transition(m, 3);
+    TEST_ASSERT_EQUAL_UINT32(3, m.state);
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 7));
+    TEST_ASSERT_EQUAL_UINT8(1, m.entering);
+    TEST_ASSERT_EQUAL_UINT64(0, machine_T(m));
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 20));
+    TEST_ASSERT_EQUAL_UINT8(0, m.entering);
+    TEST_ASSERT_EQUAL_UINT64(13, machine_T(m));
+    machine_transition(m, 3);  // to itself: restarts
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, 21));
+    TEST_ASSERT_EQUAL_UINT8(1, m.entering);
+    TEST_ASSERT_EQUAL_UINT64(0, machine_T(m));
+}
+
+static void test_T_is_exact_beyond_what_R_can_hold(void) {
+    Machine m = FSW_MACHINE_INIT(1);
+    const uint64_t entry = (1ULL << 60) + 1;
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, entry));
+    TEST_ASSERT_EQUAL(kOk, machine_begin_step(m, entry + (1ULL << 40) + 6));
+    TEST_ASSERT_EQUAL_UINT64((1ULL << 40) + 6, machine_T(m));
+    TEST_ASSERT_EQUAL(kErrTime, machine_begin_step(m, entry + 3));
+}
+
+static void test_init_macro_equals_reset(void) {
+    Machine a = FSW_MACHINE_INIT(4);
+    Machine b;
+    memset(&b, 0x5A, sizeof b);
+    machine_reset(b, 4);
+    TEST_ASSERT_EQUAL_UINT32(a.state, b.state);
+    TEST_ASSERT_EQUAL_UINT8(a.pending, b.pending);
+    TEST_ASSERT_EQUAL_UINT8(a.started, b.started);
+    TEST_ASSERT_EQUAL_UINT64(a.entry_g, b.entry_g);
+}
+
+static void run(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_first_step_enters_the_initial_state_with_T_zero);
+    RUN_TEST(test_G_must_strictly_increase_and_a_refused_step_changes_nothing);
+    RUN_TEST(test_transition_makes_the_next_step_the_targets_first);
+    RUN_TEST(test_T_is_exact_beyond_what_R_can_hold);
+    RUN_TEST(test_init_macro_equals_reset);
+    (void)UNITY_END();
+}
+
+FSW_TEST_MAIN(run)

@@ -12,12 +12,16 @@ import re
 
 from . import model as M
 from .diagnostics import Diagnostic, SS
-from .evaluate import local_values
+from .evaluate import NotConstant, compare, evaluate, local_values
 from .numeric import Real, f32, to_type
 from .schema import schema_hash
 from ..version import __version__
 
 RUNTIME_MAJOR, RUNTIME_MINOR = (int(x) for x in __version__.split(".")[:2])
+
+
+def _no_reads(i: int):
+    raise NotConstant(None)
 
 
 # ---- small pieces -------------------------------------------------------------
@@ -179,6 +183,9 @@ class ExprEmitter:
     def cond(self, e: M.Expr) -> str:
         t = type(e)
         if t is M.Cmp:
+            fast = self.int_compare(e.left, e.op, e.right)
+            if fast is not None:
+                return fast
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
         if t is M.ChainCmp:
             # Each middle operand is evaluated once: a lambda holds them.
@@ -192,6 +199,155 @@ class ExprEmitter:
         if t is M.Not:
             return f"(!{self.cond(e.operand)})"
         return f"fsw::truthy({self.value(e)})"
+
+    # -- integer fast paths, bit-identical to the R semantics ------------------
+    def assign(self, var: int, e: M.Expr) -> str:
+        """An assignment statement: `x = a + k` / `x = a - k` on integers take
+        an integer path when a range check proves R would be exact."""
+        const = self.constant_store(var, e)
+        if const is not None:
+            return const
+        fast = self.int_add(var, e)
+        return fast if fast is not None else self.write(var, self.value(e))
+
+    def constant_store(self, var: int, e: M.Expr):
+        """`x = <literals only>`: the converted value is known now; store it."""
+        if self.sv_lock and self.m.vars[var].kind == M.ELEMENT:
+            return None
+        try:
+            x = evaluate(e, self.real, _no_reads)
+        except NotConstant:
+            return None
+        t = self.m.vars[var].type
+        value = to_type(t, x)
+        ptr = self.ptr(self.m.vars[var])
+        if t.kind == "bool":
+            return f"fsw::store_bool({ptr}, {'true' if value else 'false'});"
+        if t.kind == "int":
+            ctype = ("int" if t.signed else "uint") + f"{t.size * 8}_t"
+            if t.signed and value == t.lo:
+                literal = f"({t.lo + 1}LL - 1)"  # the minimum has no literal of its own
+            else:
+                literal = f"{value}{'LL' if t.signed else 'ULL'}"
+            return f"fsw::store<{ctype}>({ptr}, static_cast<{ctype}>({literal}));"
+        import struct
+        bits = struct.unpack("<I", struct.pack("<f", value))[0] if t.size == 4 else \
+            struct.unpack("<Q", struct.pack("<d", value))[0]
+        ctype = "uint32_t" if t.size == 4 else "uint64_t"
+        return f"fsw::store<{ctype}>({ptr}, 0x{bits:0{t.size * 2}x}ULL);  // {value!r}"
+
+    def int_add(self, var: int, e: M.Expr):
+        target = self.m.vars[var]
+        if type(e) is not M.Arith or e.op not in ("+", "-") or target.type.kind != "int":
+            return None
+        if self.sv_lock and target.kind == M.ELEMENT:
+            return None
+        a, k = self.int_operand(e.left), self.exact_int_const(e.right)
+        if e.op == "+" and (a is None or k is None):
+            a, k = self.int_operand(e.right), self.exact_int_const(e.left)
+        if a is None or k is None or a[1].kind != "int":
+            return None
+        if e.op == "-":
+            k = -k
+        text, ta = a
+        limit = (1 << (24 if self.real.bits == 32 else 53)) - 1 - abs(k)
+        if limit < 0:
+            return None
+        # |a| <= limit: a, a + k and the result are all exact in R, so the
+        # assignment is the integer a + k clamped to the target's range.
+        tt = target.type
+        ctype = ("int" if tt.signed else "uint") + f"{tt.size * 8}_t"
+        guard = []
+        if ta.signed and -limit > ta.lo:
+            guard.append(f"a >= -{limit}LL")
+        if limit < ta.hi:
+            guard.append(f"a <= {limit}{'LL' if ta.signed else 'ULL'}")
+        r = f"static_cast<int64_t>(a) + ({k}LL)"
+        lo_r = max(ta.lo, -limit) + k
+        hi_r = min(ta.hi, limit) + k
+        if lo_r < tt.lo:
+            r = f"(r < {tt.lo}LL ? {tt.lo}LL : r)" if hi_r <= tt.hi else f"(r < {tt.lo}LL ? {tt.lo}LL : r > {tt.hi}LL ? {tt.hi}LL : r)"
+            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+        elif hi_r > tt.hi:
+            r = f"(r > {tt.hi}LL ? {tt.hi}LL : r)"
+            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+        else:
+            pre = ""
+        ptr = self.ptr(target)
+        fast = f"{pre}fsw::store<{ctype}>({ptr}, static_cast<{ctype}>({r}));"
+        if self.real.bits == 32 and not ta.signed and abs(k) < (1 << 23):
+            # Past the fast range binary32 still only rounds integers: round a
+            # to 24 bits, add k, round again, saturate - with no float code.
+            sat = "over" if tt.hi == (1 << 64) - 1 else f"(over || s > {tt.hi}ULL)"
+            step = f"s += {k}ULL; s = fsw::round_to_f32_precision(s, over);" if k >= 0 else \
+                f"s -= {-k}ULL; s = fsw::round_to_f32_precision(s, over);"
+            slow = (f"bool over = false; uint64_t s = fsw::round_to_f32_precision(a, over); "
+                    f"if (!over) {{ {step} }} "
+                    f"fsw::store<{ctype}>({ptr}, {sat} ? static_cast<{ctype}>({tt.hi}{'LL' if tt.signed else 'ULL'}) "
+                    f": static_cast<{ctype}>(s));")
+        else:
+            slow = self.write(var, f"({self.read_int(text, ta)} {'+' if k >= 0 else '-'} "
+                                   f"{real_literal(float(abs(k)), self.real)})")
+        if not guard:
+            return f"{{ const {self._ctype(ta)} a = {text}; {fast} }}"
+        return (f"{{ const {self._ctype(ta)} a = {text}; if ({' && '.join(guard)}) {{ {fast} }} "
+                f"else {{ {slow} }} }}")
+
+    @staticmethod
+    def _ctype(t) -> str:
+        return ("int" if t.signed else "uint") + f"{t.size * 8}_t"
+
+    def read_int(self, text: str, t) -> str:
+        """`a` (an integer local copy) as an R."""
+        return f"fsw::real_from_{t.name}(a)"
+
+    def int_operand(self, e: M.Expr):
+        """(C++ integer expression, type) when `e` reads an integer or bool
+        variable (or T) without conversion, else None."""
+        if type(e) is not M.Ref or (self.sv_lock and self.m.vars[e.var].kind == M.ELEMENT):
+            return None
+        v = self.m.vars[e.var]
+        if v.kind == M.TIME_IN_STATE:
+            return f"{self.prefix}machine.t", v.type
+        if e.var in self.consts or v.type.kind == "float":
+            return None
+        if v.type.kind == "bool":
+            return f"fsw::load_bool({self.ptr(v)})", v.type
+        ctype = ("int" if v.type.signed else "uint") + f"{v.type.size * 8}_t"
+        return f"fsw::load<{ctype}>({self.ptr(v)})", v.type
+
+    def exact_int_const(self, e: M.Expr):
+        """The value of a literal that is an integer of magnitude below
+        2^p (p = 24 or 53), so that every integer near it is exact in R."""
+        if type(e) is not M.Const:
+            return None
+        x = self.real.literal(e.text)
+        if x != x or x in (float("inf"), float("-inf")) or x != int(x):
+            return None
+        c = int(x)
+        return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
+
+    def int_compare(self, left: M.Expr, op: str, right: M.Expr):
+        """`x op c` on the integer itself. Converting an integer to R is
+        monotonic and exact near c, so `R(x) op c` equals `x op c`."""
+        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+        a, c = self.int_operand(left), self.exact_int_const(right)
+        if a is None or c is None:
+            a, c = self.int_operand(right), self.exact_int_const(left)
+            if a is None or c is None:
+                return None
+            op = flip[op]
+        text, t = a
+        lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
+        # Constant over the type's whole range (c outside it, or `x >= 0` on an
+        # unsigned type): fold it, as compilers would warn about the test.
+        points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
+        results = {compare(op, x, c) for x in points}
+        if len(results) == 1:
+            return "true" if results.pop() else "false"
+        if t.kind == "bool":
+            return f"(static_cast<int>({text}) {op} {c})"
+        return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"
 
 
 # ---- machines -------------------------------------------------------------------------
@@ -329,7 +485,7 @@ def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.M
     for st in stmts:
         t = type(st)
         if t is M.Assign:
-            out.append(f"{indent}{ex.write(st.var, ex.value(st.expr))}  // {src}:{st.line}")
+            out.append(f"{indent}{ex.assign(st.var, st.expr)}  // {src}:{st.line}")
         elif t is M.Goto:
             out.append(f"{indent}return S_{m.states[st.state].name};  // {src}:{st.line}")
             return
@@ -452,7 +608,7 @@ def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
         for grp in sec.inputs:
             c.append(f"{ind}if ({ex.cond(grp.guard)}) {{")
             for a in grp.inputs:
-                c.append(f"{ind}    {ex.write(a.var, ex.value(a.expr))}  // {basename(script.path)}:{a.line}")
+                c.append(f"{ind}    {ex.assign(a.var, a.expr)}  // {basename(script.path)}:{a.line}")
             c.append(f"{ind}}}")
         for grp in sec.checks:
             ids = []

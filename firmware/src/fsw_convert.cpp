@@ -67,4 +67,19 @@ uint64_t U64_from_real(Real r) {
     return static_cast<uint64_t>(r);
 }
 
+uint64_t round_to_f32_precision(uint64_t m, bool& over) {
+    if (m < (static_cast<uint64_t>(1) << 24)) return m;
+    uint8_t drop = 0;  // low bits that do not fit in 24 significant bits
+    for (uint64_t t = m >> 24; t != 0; t >>= 1) ++drop;
+    const uint64_t unit = static_cast<uint64_t>(1) << drop;
+    const uint64_t low = m & (unit - 1u);
+    const uint64_t half = unit >> 1;
+    m -= low;
+    if (low > half || (low == half && (m & unit) != 0)) {
+        m += unit;
+        if (m == 0) over = true;  // rounded up to 2^64
+    }
+    return m;
+}
+
 }  // namespace fsw

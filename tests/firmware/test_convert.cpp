@@ -246,6 +246,67 @@ static void test_64_bit_reads_match_single_rounding_reference(void) {
 }
 #endif
 
+// Integers rounded to binary32's 24 significant bits without floating point
+// (generated code's exact slow path of `a + k`). Expected values computed
+// independently, with exact rational arithmetic.
+static void test_round_to_f32_precision_matches_binary32(void) {
+    struct Case {
+        uint64_t in;
+        uint64_t out;
+        bool over;
+    };
+    static const Case cases[] = {
+        {0ULL, 0ULL, false},
+        {1ULL, 1ULL, false},
+        {16777215ULL, 16777215ULL, false},
+        {16777216ULL, 16777216ULL, false},
+        {16777217ULL, 16777216ULL, false},
+        {16777218ULL, 16777218ULL, false},
+        {16777219ULL, 16777220ULL, false},
+        {33554433ULL, 33554432ULL, false},
+        {33554434ULL, 33554432ULL, false},
+        {33554438ULL, 33554440ULL, false},
+        {4294967295ULL, 4294967296ULL, false},
+        {1099511693312ULL, 1099511627776ULL, false},
+        {1099511693313ULL, 1099511758848ULL, false},
+        {1099511824384ULL, 1099511889920ULL, false},
+        {9223372036854775808ULL, 9223372036854775808ULL, false},
+        {9223372586610589696ULL, 9223372036854775808ULL, false},
+        {9223372586610589697ULL, 9223373136366403584ULL, false},
+        {18446742974197923840ULL, 18446742974197923840ULL, false},
+        {18446743523953737727ULL, 18446742974197923840ULL, false},
+        {18446743523953737728ULL, 0ULL, true},
+        {18446744073709551615ULL, 0ULL, true},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        bool over = false;
+        const uint64_t r = round_to_f32_precision(cases[i].in, over);
+        TEST_ASSERT_TRUE(over == cases[i].over);
+        if (!over) TEST_ASSERT_TRUE(r == cases[i].out);
+    }
+}
+
+#if !defined(__AVR__)
+static void test_round_to_f32_precision_matches_the_host_conversion(void) {
+    uint64_t x = 0x9E3779B97F4A7C15ULL;
+    for (int i = 0; i < 20000; ++i) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        const uint64_t u = x >> (i % 64);
+        const float f = static_cast<float>(u);  // correctly rounded on the host
+        bool over = false;
+        const uint64_t r = round_to_f32_precision(u, over);
+        if (f >= 18446744073709551616.0f) {
+            TEST_ASSERT_TRUE(over);
+        } else {
+            TEST_ASSERT_FALSE(over);
+            TEST_ASSERT_TRUE(r == static_cast<uint64_t>(f));
+        }
+    }
+}
+#endif
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_reads_of_integers_are_exact_where_R_holds_them);
@@ -260,8 +321,10 @@ static void run(void) {
     RUN_TEST(test_division_by_zero_follows_ieee);
     RUN_TEST(test_element_pointer_access_round_trips_every_type);
     RUN_TEST(test_typed_writes_saturate_through_pointers);
+    RUN_TEST(test_round_to_f32_precision_matches_binary32);
 #if !defined(__AVR__)
     RUN_TEST(test_64_bit_reads_match_single_rounding_reference);
+    RUN_TEST(test_round_to_f32_precision_matches_the_host_conversion);
 #endif
     (void)UNITY_END();
 }

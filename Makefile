@@ -31,9 +31,11 @@ test-python: setup
 fuzz: setup
 	FSW_FUZZ_EXAMPLES=$${FSW_FUZZ_EXAMPLES:-1000000} $(PY) -m pytest -q -p no:cacheprovider tests/fuzz
 
-## bench: measured numbers against targets.md
+## bench: measured numbers against targets.md (deterministic counts)
 bench: setup
 	$(PY) tools/bench.py
+	$(PY) tools/bench_firmware.py
+	$(MAKE) --no-print-directory bench-firmware
 
 clean:
 	rm -rf $(BUILD) .pytest_cache .hypothesis

@@ -24,6 +24,24 @@ def _no_reads(i: int):
     raise NotConstant(None)
 
 
+def assigned_vars(m: M.Machine) -> set[int]:
+    """Every variable some statement of the machine assigns."""
+    out: set[int] = set()
+
+    def walk(stmts):
+        for st in stmts:
+            if isinstance(st, M.Assign):
+                out.add(st.var)
+            elif isinstance(st, M.If):
+                walk(st.then)
+                walk(st.orelse)
+
+    for st in m.states:
+        for block in (st.entry, st.step, st.exit):
+            walk(block)
+    return out
+
+
 # ---- small pieces -------------------------------------------------------------
 
 def c_ident(name: str) -> str:
@@ -138,8 +156,12 @@ class ExprEmitter:
         self.windows = windows
         self.consts: dict[int, float] = {}
         values = local_values(m, real)
+        # In firmware only the machine writes its locals: one it never
+        # assigns keeps its initial value, exactly like a @read_only one.
+        # (A state script may write any local, so scripts keep them all.)
+        written = assigned_vars(m)
         for v in m.vars:
-            if v.kind == M.LOCAL and v.read_only and not scriptable:
+            if v.kind == M.LOCAL and not scriptable and (v.read_only or v.index not in written):
                 self.consts[v.index] = real.read(v.type, values[v.index])
         self.sv_lock = m.sv.lock
 
@@ -184,10 +206,17 @@ class ExprEmitter:
         t = type(e)
         if t is M.Cmp:
             fast = self.int_compare(e.left, e.op, e.right)
+            if fast is None and self.real.bits == 32:
+                fast = self.float_threshold(e.left, e.op, e.right)
             if fast is not None:
                 return fast
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
         if t is M.ChainCmp:
+            if all(type(o) in (M.Const, M.Ref) for o in e.operands):
+                # Literals and variables read the same twice: test pair by pair.
+                pairs = [self.cond(M.Cmp(op, e.operands[k], e.operands[k + 1], e.line, e.col))
+                         for k, op in enumerate(e.ops)]
+                return "(" + " && ".join(pairs) + ")"
             # Each middle operand is evaluated once: a lambda holds them.
             names = [f"c{k}" for k in range(len(e.operands))]
             decl = " ".join(f"const fsw::Real {n} = {self.value(o)};" for n, o in zip(names, e.operands))
@@ -199,6 +228,42 @@ class ExprEmitter:
         if t is M.Not:
             return f"(!{self.cond(e.operand)})"
         return f"fsw::truthy({self.value(e)})"
+
+    def float_threshold(self, left: M.Expr, op: str, right: M.Expr):
+        """binary32 R: `R(x) op c` for a float variable x and a literal c as
+        integer threshold tests on x's stored bytes (autocode/thresholds.py)."""
+        from .thresholds import tests
+        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+        x, cv = left, self.known(right)
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            x, cv, op = right, self.known(left), flip[op]
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            return None
+        v = self.m.vars[x.var]
+        if v.kind == M.TIME_IN_STATE or v.type.kind != "float":
+            return None
+        if self.sv_lock and v.kind == M.ELEMENT:
+            return None
+        negate = op == "!="
+        terms = tests("==" if negate else op, cv, v.type.size)
+        if terms is None:
+            return None
+        nan_result = compare(op, 0.0, cv)  # a NaN element reads as 0
+        bits = 64 if v.type.size == 8 else 32
+        parts = []
+        for neg, t in terms:
+            if isinstance(t, bool):
+                test = "true" if t else "false"
+            else:
+                key, inclusive = t
+                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}ULL"
+            parts.append(f"!({test})" if neg else f"({test})")
+        body = " && ".join(parts)
+        if negate:
+            body = f"!({body})"
+        return (f"([&]() -> bool {{ const uint8_t* p = {self.ptr(v)}; "
+                f"if (fsw::f{bits}_is_nan(p)) return {'true' if nan_result else 'false'}; "
+                f"const uint{bits}_t k = fsw::f{bits}_key(p); return {body}; }}())")
 
     # -- integer fast paths, bit-identical to the R semantics ------------------
     def assign(self, var: int, e: M.Expr) -> str:
@@ -316,12 +381,20 @@ class ExprEmitter:
         ctype = ("int" if v.type.signed else "uint") + f"{v.type.size * 8}_t"
         return f"fsw::load<{ctype}>({self.ptr(v)})", v.type
 
+    def known(self, e: M.Expr):
+        """The R value of a literal or of a local folded to a constant."""
+        if type(e) is M.Const:
+            return self.real.literal(e.text)
+        if type(e) is M.Ref and e.var in self.consts:
+            return self.consts[e.var]
+        return None
+
     def exact_int_const(self, e: M.Expr):
-        """The value of a literal that is an integer of magnitude below
+        """The value of a known operand that is an integer of magnitude below
         2^p (p = 24 or 53), so that every integer near it is exact in R."""
-        if type(e) is not M.Const:
+        x = self.known(e)
+        if x is None:
             return None
-        x = self.real.literal(e.text)
         if x != x or x in (float("inf"), float("-inf")) or x != int(x):
             return None
         c = int(x)
@@ -359,8 +432,8 @@ def _window_type(w: M.Window) -> str:
 
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
-    keeps read-only locals in memory (a state script may write them) and
-    adds `reset()`."""
+    keeps every local in memory, for a state script that writes locals;
+    otherwise locals that never change are folded into the code."""
     name = c_ident(m.name)
     src = basename(m.path)
     ex = ExprEmitter(m, real, scriptable)
@@ -391,9 +464,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
     h.append("")
     h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
     h.append("FSW_MUST_CHECK fsw::Result step();")
-    if scriptable:
-        h.append("// Back to the state before the first step, starting in `initial`.")
-        h.append("void reset(uint32_t initial);")
+    h.append("// Back to the state before the first step, starting in `initial`.")
+    h.append("void reset(uint32_t initial);")
     h += ["", f"}}  // namespace {name}", "}  // namespace fsw_gen", "", f"#endif  // {guard}", ""]
 
     c = [banner([m.path, m.sv.path], m.sv), f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
@@ -407,7 +479,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
         c.append(f"{_window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
     if m.windows:
         c.append("")
-    if scriptable and stored:
+    if stored:
         c.append(f"const uint8_t kLocInit[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
         c.append("")
     for st in m.states:
@@ -460,15 +532,14 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
     c.append("    }")
     c.append("    return fsw::kOk;")
     c.append("}")
-    if scriptable:
-        c.append("")
-        c.append("void reset(uint32_t initial) {")
-        c.append("    fsw::machine_reset(machine, initial);")
-        if stored:
-            c.append("    memcpy(loc, kLocInit, sizeof loc);")
-        for w in m.windows:
-            c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
-        c.append("}")
+    c.append("")
+    c.append("void reset(uint32_t initial) {")
+    c.append("    fsw::machine_reset(machine, initial);")
+    if stored:
+        c.append("    memcpy(loc, kLocInit, sizeof loc);")
+    for w in m.windows:
+        c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
+    c.append("}")
     c += ["", f"}}  // namespace {name}", "}  // namespace fsw_gen", ""]
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}
 
@@ -500,6 +571,12 @@ def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.M
 
 # ---- state-script runner (host only) ----------------------------------------------------
 
+def script_writes_locals(script: M.Script) -> bool:
+    m = script.machine
+    return any(m.vars[a.var].kind == M.LOCAL
+               for sec in script.sections for g in sec.inputs for a in g.inputs)
+
+
 def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
     """`script_main.cpp`: runs the script against the generated machine and
     prints the report `fsw test` prints, byte for byte. With a file name as
@@ -510,8 +587,9 @@ def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
     m = script.machine
     name = c_ident(m.name)
     ns = f"fsw_gen::{name}::"
-    ex = ExprEmitter(m, real, True, prefix=ns, windows="sw")
+    ex = ExprEmitter(m, real, script_writes_locals(script), prefix=ns, windows="sw")
     order = sorted(m.vars, key=lambda v: v.display.encode())
+    folded = {i: _bytes(m.vars[i].type, to_type(m.vars[i].type, x)) for i, x in ex.consts.items()}
     checks: list = []
     c = [banner([script.path, m.path, m.sv.path], m.sv), "#include <inttypes.h>", "#include <stdio.h>", "",
          '#include "fswkit.h"', '#include "sv.gen.h"', f'#include "{name}.gen.h"', "",
@@ -551,6 +629,9 @@ def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
     for k, v in enumerate(order):
         if v.kind == M.TIME_IN_STATE:
             c.append(f"    case {k}: memcpy(out, &{ns}machine.t, 8); break;")
+        elif v.index in folded:  # a local folded into the code: its constant bytes
+            data = ", ".join(str(b) for b in folded[v.index])
+            c.append(f"    case {k}: {{ static const uint8_t b[] = {{{data}}}; memcpy(out, b, {v.type.size}); break; }}")
         else:
             c.append(f"    case {k}: memcpy(out, {ex.ptr(v)}, {v.type.size}); break;")
     c.append("    default: break;")
@@ -665,6 +746,6 @@ def script_files(script: M.Script, real: Real, source_line) -> dict[str, str]:
     runner."""
     files = {}
     files.update(emit_sv(script.machine.sv))
-    files.update(emit_machine(script.machine, real, scriptable=True))
+    files.update(emit_machine(script.machine, real, scriptable=script_writes_locals(script)))
     files.update(emit_script(script, real, source_line))
     return files

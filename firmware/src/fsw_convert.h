@@ -105,7 +105,7 @@ inline double F64_from_real(Real r) { return r == r ? static_cast<double>(r) : 0
 // holds for the integer m. Sets `over` when the result is 2^64, which a
 // uint64_t cannot hold. Generated code uses it to evaluate `a + k` on
 // unsigned integers exactly as binary32 arithmetic does, with no float code.
-uint64_t round_to_f32_precision(uint64_t m, bool& over);
+FSW_NOINLINE uint64_t round_to_f32_precision(uint64_t m, bool& over);
 
 }  // namespace fsw
 

@@ -33,7 +33,17 @@ inline Real read_U16(const uint8_t* p) { return real_from_U16(load<uint16_t>(p))
 inline Real read_U32(const uint8_t* p) { return real_from_U32(load<uint32_t>(p)); }
 inline Real read_U64(const uint8_t* p) { return real_from_U64(load<uint64_t>(p)); }
 inline Real read_F32(const uint8_t* p) { return real_from_F32(load<float>(p)); }
-inline Real read_F64(const uint8_t* p) { return real_from_F64_bits(load<uint64_t>(p)); }
+inline Real read_F64(const uint8_t* p) {
+#if FSW_F64_SOFT
+    // Straight from the bytes: no 64-bit value on an 8-bit MCU.
+    const uint32_t u = f32_bits_from_f64_bytes(p);
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f == f ? f : 0.0f;
+#else
+    return real_from_F64_bits(load<uint64_t>(p));
+#endif
+}
 inline Real read_bool(const uint8_t* p) { return real_from_bool(load_bool(p)); }
 
 // ---- Real -> element (assignments, spec 4.5) -------------------------------

@@ -18,7 +18,33 @@ uint64_t f64_bits_from_f32(float v);
 
 // Same two conversions on raw binary32 bit patterns.
 uint32_t f32_bits_from_f64_bits(uint64_t bits);
+// The same from the pattern's 8 little-endian bytes (an element in memory).
+uint32_t f32_bits_from_f64_bytes(const uint8_t* bytes);
 uint64_t f64_bits_from_f32_bits(uint32_t bits);
+
+// ---- order-preserving keys ---------------------------------------------------
+// For float patterns a and b that are not NaN, a < b as values iff key(a) <
+// key(b) (-0 sorts just below +0). Generated code compares an element with a
+// threshold it computed at build time this way, with no float arithmetic.
+inline uint64_t f64_key(const uint8_t* p) {
+    uint64_t bits;
+    memcpy(&bits, p, sizeof bits);
+    return (p[7] & 0x80u) != 0 ? ~bits : bits | 0x8000000000000000ULL;
+}
+inline uint32_t f32_key(const uint8_t* p) {
+    uint32_t bits;
+    memcpy(&bits, p, sizeof bits);
+    return (p[3] & 0x80u) != 0 ? ~bits : bits | 0x80000000UL;
+}
+// True when the pattern is a NaN (all-ones exponent, non-zero fraction).
+inline bool f64_is_nan(const uint8_t* p) {
+    if ((p[7] & 0x7Fu) != 0x7Fu || (p[6] & 0xF0u) != 0xF0u) return false;
+    return ((p[6] & 0x0Fu) | p[5] | p[4] | p[3] | p[2] | p[1] | p[0]) != 0;
+}
+inline bool f32_is_nan(const uint8_t* p) {
+    if ((p[3] & 0x7Fu) != 0x7Fu || (p[2] & 0x80u) == 0) return false;
+    return ((p[2] & 0x7Fu) | p[1] | p[0]) != 0;
+}
 
 }  // namespace fsw
 

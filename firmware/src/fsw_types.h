@@ -16,6 +16,10 @@
 // A function whose result code must not be dropped by its caller.
 #define FSW_MUST_CHECK __attribute__((warn_unused_result))
 
+// Keeps a rarely taken, sizeable routine out of line (LTO would copy it into
+// each caller: flash matters more than a call on the slow path).
+#define FSW_NOINLINE __attribute__((noinline))
+
 // Marks a constant table that lives in flash on AVR (read with flash_read).
 #if FSW_USE_PROGMEM
 #define FSW_FLASH PROGMEM

@@ -43,11 +43,13 @@ Result io_analog_task(void* ctx) {
             const Real v = analog_value_from_raw(pal::analog_read(c.pin), tab.vref, tab.adc_bits,
                                                  c.scale, c.offset);
             const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
-            write_elem(p, c.type, v);
+            // Analog elements are F32 or F64 (checked at begin): no general
+            // dispatch, which would link every type's conversions.
+            if (c.type == kF64) write_F64(p, v); else write_F32(p, v);
             if (tab.lock) pal::critical_exit(saved);
         } else {
             const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
-            const Real volts = read_elem(p, c.type);
+            const Real volts = c.type == kF64 ? read_F64(p) : read_F32(p);
             if (tab.lock) pal::critical_exit(saved);
             pal::analog_write(c.pin, pwm_duty_from_volts(volts, tab.vref));
         }

@@ -52,6 +52,8 @@ class Task:
     mode: M.Element | None  # U8: 0 disabled, 1 safed, 2 enabled
     start: str  # the mode at boot
     line: int
+    overruns: M.Element | None = None  # U16: steps longer than the task's period
+    worst_us: M.Element | None = None  # U32: the longest step, microseconds
 
 
 @dataclass(frozen=True)
@@ -78,6 +80,7 @@ class Application:
     time_unit: str  # "ms" or "us"
     telemetry: tuple[Stream, ...]
     writable: tuple[M.Element, ...]
+    reset_cause: M.Element | None = None  # U8: the MCU's reset cause at boot
 
 
 def _kv(toks, start, src, diags):
@@ -138,8 +141,9 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     settings: dict[str, object] = {}
     for toks in body.get("application", []):
         key = toks[0]
-        if key.text not in ("name", "board", "rate", "baud"):
-            err(key, f"unknown setting `{key.text}`: expected `name`, `board`, `rate` or `baud`")
+        if key.text not in ("name", "board", "rate", "baud", "reset_cause"):
+            err(key, f"unknown setting `{key.text}`: expected `name`, `board`, `rate`, `baud` "
+                     "or `reset_cause`")
             continue
         if len(toks) != 2:
             err(toks[min(2, len(toks) - 1)] if len(toks) > 2 else key, f"`{key.text}` takes one value")
@@ -289,8 +293,25 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             machine_tasks[midx] = tname.line
         opts = _kv(toks, i, src, diags)
         for k, (kt, _) in opts.items():
-            if k not in ("rate", "mode", "start"):
-                err(kt, f"unknown task setting `{k}`: expected `rate`, `mode` or `start`")
+            if k not in ("rate", "mode", "start", "overruns", "worst_us"):
+                err(kt, f"unknown task setting `{k}`: expected `rate`, `mode`, `start`, "
+                        "`overruns` or `worst_us`")
+        stat_elems = {}
+        bad_stat = False
+        for k, want in (("overruns", "U16"), ("worst_us", "U32")):
+            if k in opts:
+                et = opts[k][1]
+                el = sv.find(et.text)
+                if el is None:
+                    err(et, f"unknown element `{et.text}`")
+                    bad_stat = True
+                elif el.type.name != want:
+                    err(et, f"`{k}` needs a {want} element; `{et.text}` is {el.type}")
+                    bad_stat = True
+                else:
+                    stat_elems[k] = el
+        if bad_stat:
+            continue
         task_rate = Fraction(rate)
         if "rate" in opts:
             q = _positive(opts["rate"][1], src, diags, "`rate`")
@@ -323,7 +344,8 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
                 continue
             start = st.text
         task_lines[tname.text] = tname.line
-        tasks.append(Task(tname.text, kind, midx, task_rate, int(divider), mode_el, start, tname.line))
+        tasks.append(Task(tname.text, kind, midx, task_rate, int(divider), mode_el, start, tname.line,
+                          stat_elems.get("overruns"), stat_elems.get("worst_us")))
     for name_, idx in machine_names.items():
         if idx not in machine_tasks:
             tok = next(t for k, t, p in machine_toks if os.path.splitext(os.path.basename(p))[0] == name_)
@@ -388,12 +410,22 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             if len(toks) > 1:
                 err(toks[1], f"unexpected {show(toks[1])}: one element per line")
 
+    reset_cause = None
+    if "reset_cause" in settings:
+        rt = settings["reset_cause"]
+        reset_cause = sv.find(rt.text)
+        if reset_cause is None:
+            err(rt, f"unknown element `{rt.text}`")
+        elif reset_cause.type is not U8:
+            err(rt, f"`reset_cause` needs a U8 element; `{rt.text}` is {reset_cause.type}")
+
     if len(diags.errors) != before or board is None or time_element is None:
         if time_element is None and not machines and len(diags.errors) == before:
             diags.error(src, APP, 1, 1, "an application needs at least one `machine` in [configs]")
         return None
     return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
-                       tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable))
+                       tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable),
+                       reset_cause)
 
 
 def _col_index(line: str, col: int) -> int:

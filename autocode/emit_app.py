@@ -95,12 +95,15 @@ def _app_cpp(app: Application) -> str:
     c.append(f"const fsw::Task kTasks[{max(n, 1)}] FSW_FLASH = {{")
     for t in app.tasks:
         mode = f"E_{t.mode.name}" if t.mode is not None else "fsw::kNoElement"
-        c.append(f"    {{task_{t.name}, 0, 0, {t.divider}, 0, {mode}, fsw::kNoElement, fsw::kNoElement, "
+        over = f"E_{t.overruns.name}" if t.overruns is not None else "fsw::kNoElement"
+        worst = f"E_{t.worst_us.name}" if t.worst_us is not None else "fsw::kNoElement"
+        c.append(f"    {{task_{t.name}, 0, 0, {t.divider}, 0, {mode}, {over}, {worst}, "
                  f"{MODES[t.start]}}},  // {basename(app.path)}:{t.line} {t.name}")
     if not app.tasks:
         c.append("    {0, 0, 0, 1, 0, fsw::kNoElement, fsw::kNoElement, fsw::kNoElement, 0},")
     c.append("};")
-    c.append(f"const fsw::ExecConfig kConfig = {{kTasks, stats, sv, kPeriodUs, fsw::kNoElement, {n}, kSvLock}};")
+    cause = f"E_{app.reset_cause.name}" if app.reset_cause is not None else "fsw::kNoElement"
+    c.append(f"const fsw::ExecConfig kConfig = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock}};")
     c.append("")
     c.append("}  // namespace")
     c.append("")

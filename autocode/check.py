@@ -8,7 +8,7 @@ from fractions import Fraction
 
 from . import model as M
 from . import syntax as S
-from .diagnostics import SM, SS, SV, Diagnostics, Source
+from .diagnostics import SM, SS, SV, Diagnostics, Source, visual_col
 from .evaluate import NotConstant, evaluate, local_values
 from .numeric import F64MODE, exact_literal, truthy
 from .types import TYPES, U32, U64
@@ -21,6 +21,13 @@ DEFAULT_MAX_STEPS = 1000000
 
 # ---- state vector -----------------------------------------------------------
 
+def unknown_type(name: str) -> str:
+    near = [t for t in TYPES if t.lower() == name.lower()]
+    if near:
+        return f"unknown type `{name}` (did you mean `{near[0]}`?)"
+    return f"unknown type `{name}`: expected one of {' '.join(TYPES)}"
+
+
 def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     lang = SV
     lock = False
@@ -31,7 +38,7 @@ def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
             a = o.args[0]
             diags.error(src, lang, a.line, a.col, f"unexpected `{a.text}` after option `lock`")
         else:
-            diags.error(src, lang, o.line, o.col, f"unknown option `{o.name}`")
+            diags.error(src, lang, o.line, o.col, f"unknown option `{o.name}`: the only option is `lock`")
     regions: list[M.Region] = []
     elements: list[M.Element] = []
     region_lines: dict[str, int] = {}
@@ -39,19 +46,22 @@ def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     offset = 0
     for r in f.regions:
         h = r.header
-        if h.name in region_lines:
+        malformed = h.name == "<malformed>"  # already reported by the parser
+        if malformed:
+            pass
+        elif h.name in region_lines:
             diags.error(src, lang, h.line, h.col + 1,
                         f"reuse of region name `{h.name}` (previously used on line {region_lines[h.name]})")
         else:
             region_lines[h.name] = h.line
-        if not r.elements:
+        if not r.lines and not malformed:
             diags.error(src, lang, h.line, h.col + 1, f"empty region `{h.name}`")
         start = offset
         mine = []
         for d in r.elements:
             t = TYPES.get(d.type)
             if t is None:
-                diags.error(src, lang, d.line, d.type_col, f"unknown type `{d.type}`")
+                diags.error(src, lang, d.line, d.type_col, unknown_type(d.type))
                 continue
             if d.name in elem_lines:
                 diags.error(src, lang, d.line, d.name_col,
@@ -89,7 +99,7 @@ class Resolver:
         if t is S.Num:
             return M.Const(e.text, e.line, e.col)
         if t is S.Bool:
-            return M.Const("1" if e.value else "0", e.line, e.col)
+            return M.Const("true" if e.value else "false", e.line, e.col)
         if t is S.Name:
             i = self.names.get(e.name)
             if i is None:
@@ -194,8 +204,11 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
     for d in f.elements:
         t = TYPES.get(d.type)
         if t is None:
-            err(d.line, d.type_col, f"unknown type `{d.type}`")
-            continue
+            err(d.line, d.type_col, unknown_type(d.type))
+            # Carry on with the state vector's type, so that the element's
+            # uses are not reported again.
+            known = sv.find(d.name)
+            t = known.type if known is not None else TYPES["F64"]
         if d.name in listed:
             err(d.line, d.name_col, f"reuse of element name `{d.name}` (previously used on line {listed[d.name]})")
             continue
@@ -216,16 +229,14 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
         role = "G" if "G" in (d.name, d.alias) else "S" if "S" in (d.name, d.alias) else None
         if role == "G":
             if g is not None:
-                err(d.line, d.alias_col if d.alias == "G" else d.name_col,
-                    f"`G` is already defined on line {vars_[g].line}")
+                pass  # reported above as a reuse of the name `G`
             elif t is not U64:
                 err(d.line, d.type_col, f"`G` (global time) must be U64, not {t}")
             else:
                 g = idx
         elif role == "S":
             if s is not None:
-                err(d.line, d.alias_col if d.alias == "S" else d.name_col,
-                    f"`S` is already defined on line {vars_[s].line}")
+                pass  # reported above as a reuse of the name `S`
             elif t is not U32:
                 err(d.line, d.type_col, f"`S` (current state) must be U32, not {t}")
             else:
@@ -236,9 +247,11 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
                 names[n] = idx
                 name_lines[n] = d.line
     where = f.sv_header or S.Header(1, 0, "")
-    if g is None:
+    # A `G` or `S` that is declared but wrong was reported where it stands.
+    declared = {n for d in f.elements for n in (d.name, d.alias)}
+    if g is None and "G" not in declared:
         err(where.line, where.col + 1, "missing `G`: one U64 element must be named or aliased `G` (global time)")
-    if s is None:
+    if s is None and "S" not in declared:
         err(where.line, where.col + 1, "missing `S`: one U32 element must be named or aliased `S` (current state)")
 
     # locals
@@ -248,8 +261,8 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
     for d in f.locals:
         t = TYPES.get(d.type)
         if t is None:
-            err(d.line, d.type_col, f"unknown type `{d.type}`")
-            continue
+            err(d.line, d.type_col, unknown_type(d.type))
+            t = TYPES["F64"]  # carry on, so that its uses are not reported again
         if d.name == "T":
             err(d.line, d.name_col, "`T` is the built-in time in state and cannot name a local")
             continue
@@ -383,7 +396,12 @@ def _stmts(stmts, res: Resolver, state_index, in_exit: bool, err) -> tuple[M.Stm
                 continue
             if v.read_only:
                 kind = "local" if v.kind == M.LOCAL else "element"
-                err(st.line, st.col, f"{kind} `{st.target}` is read-only")
+                why = ""
+                for role, what in (("G", "the global time, written by the application"),
+                                   ("S", "the current state's ID, written by the machine itself")):
+                    if v.kind == M.ELEMENT and role in (v.name, v.alias):
+                        why = f": it is {what}" if st.target == role else f": it is `{role}`, {what}"
+                err(st.line, st.col, f"{kind} `{st.target}` is read-only{why}")
                 continue
             out.append(M.Assign(i, expr, st.line, st.col))
         elif t is S.Transition:
@@ -560,7 +578,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         else:
             err(o.line, o.col, f"unknown option `{o.name}`: expected `delta_t`, `init_state` or `max_steps`")
     if delta_t is None and "delta_t" not in seen:
-        line, col = _options_pos(f)
+        line, col = _options_pos(src)
         err(line, col, "missing option `delta_t` (how much `G` grows per step)")
 
     names: dict[str, int] = {}
@@ -579,7 +597,9 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         return constant_size(res, n, m.vars, consts)
 
     res = Resolver(src, diags, lang, names, list(m.vars), windows, size_value)
-    owned = {m.g: "G", m.s: "S", m.t: "T"}
+    owned = {m.g: ("G", "the global time, which the script runner advances by `delta_t` each step"),
+             m.s: ("S", "the current state's ID, written by the machine"),
+             m.t: ("T", "the time spent in the current state, kept by the machine")}
     sections = []
     state_sections: dict[int, int] = {}
     has_stop = False
@@ -610,8 +630,9 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
                     if i is None:
                         err(st.line, st.col, f"unknown element `{st.target}`")
                     elif i in owned:
-                        err(st.line, st.col, f"`{st.target}` cannot be written by a state script: "
-                                             f"`{owned[i]}` is owned by the script runner and the machine")
+                        role, what = owned[i]
+                        it = "it is" if st.target == role else f"it is `{role}`,"
+                        err(st.line, st.col, f"`{st.target}` cannot be written by a state script: {it} {what}")
                     else:
                         ins.append(M.Assign(i, expr, st.line, st.col))
                 elif isinstance(st, S.Assert):
@@ -625,7 +646,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
                 checks.append(M.CheckGroup(guard, tuple(chk)))
         if state != -1:
             sections.append(M.ScriptSection(state, tuple(inputs), tuple(checks), h.line))
-    if not has_stop:
+    if not has_stop and not before:  # after a syntax error, the `@stop` may be in the broken part
         n = len(src.lines)
         last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
         err(last, 1, "the state script has no `@stop`: it would never end")
@@ -648,5 +669,10 @@ def _int_option(o: S.Option, err) -> int | None:
     return int(q)
 
 
-def _options_pos(f: S.SsFile):
-    return (1, 1)
+def _options_pos(src: Source):
+    """Where a missing option belongs: the `[options]` header, else 1:1."""
+    for n, text in enumerate(src.lines, 1):
+        code = text.split("#", 1)[0]
+        if code.replace(" ", "").replace("\t", "") == "[options]":
+            return n, visual_col(text, code.index("options"))
+    return 1, 1

@@ -75,7 +75,7 @@ class Var:
 
 @dataclass(frozen=True)
 class Const:
-    text: str  # the literal as written ("1"/"0" for true/false)
+    text: str  # the literal as written, `true` and `false` included
     line: int
     col: int
 

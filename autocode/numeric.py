@@ -106,6 +106,9 @@ class Real:
         return self.name
 
 
+BOOL_LITERALS = {"true": 1.0, "false": 0.0}
+
+
 class _F64(Real):
     name, bits = "f64", 64
 
@@ -116,6 +119,8 @@ class _F64(Real):
         return float(i)
 
     def literal(self, text: str) -> float:
+        if text in BOOL_LITERALS:
+            return BOOL_LITERALS[text]
         return float(text)
 
 
@@ -129,6 +134,8 @@ class _F32(Real):
         return f32_from_int(i)
 
     def literal(self, text: str) -> float:
+        if text in BOOL_LITERALS:
+            return BOOL_LITERALS[text]
         d = float(text)
         if d == 0.0 or d == INF:
             return d  # underflows or overflows binary64: binary32 too

@@ -167,6 +167,8 @@ def to_syntax(e: M.Expr, m: M.Machine) -> S.Expr:
     (an alias where there is one)."""
     t = type(e)
     if t is M.Const:
+        if e.text in ("true", "false"):
+            return S.Bool(e.line, e.col, e.text == "true")
         return S.Num(e.line, e.col, e.text)
     if t is M.Ref:
         v = m.vars[e.var]

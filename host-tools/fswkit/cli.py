@@ -251,6 +251,16 @@ def cmd_build(args) -> int:
 
 # ---- entry point -------------------------------------------------------------------
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, found {text!r}")
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, found {value}")
+    return value
+
+
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="fsw", description="fswkit: flight software from configs.")
     p.add_argument("--version", action="version", version=f"fsw {__version__}")
@@ -298,7 +308,7 @@ def parser() -> argparse.ArgumentParser:
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
     s.add_argument("machine", metavar="MACHINE.sm")
     s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
-    s.add_argument("--delta-t", type=int, default=10, help="time step of the script (default 10)")
+    s.add_argument("--delta-t", type=_positive_int, default=10, help="time step of the script (default 10)")
     s.add_argument("-o", "--output", help="write here instead of standard output")
     s.set_defaults(func=cmd_skeleton)
     return p

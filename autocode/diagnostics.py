@@ -79,6 +79,8 @@ class Diagnostics:
 
     def add(self, src: Source, lang: str, line: int, col: int, message: str,
             severity: str = "error") -> None:
+        if (src.path, line) in self._lexical:
+            return  # the line's lexical error said it: what follows is its echo
         d = Diagnostic(lang, severity, src.path, line, col, message, src.line(line))
         if d not in self._seen:
             self._seen.add(d)
@@ -86,6 +88,16 @@ class Diagnostics:
 
     def __post_init__(self):
         self._seen: set[Diagnostic] = set()
+        self._lexical: set[tuple[str, int]] = set()
+
+    def lexical_error(self, src: Source, lang: str, line: int, col: int, message: str) -> None:
+        """A lexical error: reported, and no later diagnostic about the same
+        line is (the tokens it left are not what the user meant)."""
+        d = Diagnostic(lang, "error", src.path, line, col, message, src.line(line))
+        if d not in self._seen:
+            self._seen.add(d)
+            self.items.append(d)
+        self._lexical.add((src.path, line))
 
     def error(self, src: Source, lang: str, line: int, col: int, message: str) -> None:
         self.add(src, lang, line, col, message, "error")
@@ -107,8 +119,16 @@ class Diagnostics:
     def warnings(self) -> list[Diagnostic]:
         return [d for d in self.items if d.severity == "warning"]
 
+    def in_order(self) -> list[Diagnostic]:
+        """Files in the order they were first reported on; within a file, by
+        line and column (stable, so one spot's diagnostics keep their order)."""
+        first: dict[str, int] = {}
+        for d in self.items:
+            first.setdefault(d.path, len(first))
+        return sorted(self.items, key=lambda d: (first[d.path], d.line, d.col))
+
     def render(self) -> str:
-        return "\n".join(d.render() for d in self.items)
+        return "\n".join(d.render() for d in self.in_order())
 
 
 class ConfigError(Exception):
@@ -128,4 +148,11 @@ def read_source(path: str, diags: Diagnostics, lang: str) -> Source | None:
         src = Source.from_text(path, "")
         diags.error(src, lang, 1, 1, f"cannot read file: {e.strerror or e}")
         return None
-    return Source.from_text(path, data.decode("utf-8", errors="replace"))
+    return Source.from_text(path, decode(data))
+
+
+def decode(data: bytes) -> str:
+    """A config file's text: UTF-8, a leading byte order mark dropped. Bytes
+    that are not UTF-8 become U+DC80..U+DCFF, which the lexer reports by
+    value (and `display_line` shows as `?`)."""
+    return data.decode("utf-8-sig", errors="surrogateescape")

@@ -36,7 +36,9 @@ _NUMBER_TAIL = re.compile(r"[A-Za-z0-9_.]+")
 
 
 def describe(ch: str) -> str:
-    return f"`{ch}`" if ch.isprintable() else f"character U+{ord(ch):04X}"
+    if 0xDC80 <= ord(ch) <= 0xDCFF:  # a byte that is not UTF-8 (diagnostics.decode)
+        return f"byte 0x{ord(ch) - 0xDC00:02X} (the file is not valid UTF-8)"
+    return f"character `{ch}`" if ch.isprintable() else f"character U+{ord(ch):04X}"
 
 
 def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> list[Tok]:
@@ -46,12 +48,15 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
     pos, end = 0, len(text)
     match = _TOKEN.match
     tabs = "\t" in text
+    bad_end = -1  # a run of unexpected characters is reported once, at its start
     while pos < end:
         m = match(text, pos)
         if m is None:
-            col = visual_col(text, pos) if tabs else pos + 1
-            diags.error(src, lang, n, col, f"unexpected character {describe(text[pos])}")
+            if pos != bad_end:
+                col = visual_col(text, pos) if tabs else pos + 1
+                diags.lexical_error(src, lang, n, col, f"unexpected {describe(text[pos])}")
             pos += 1
+            bad_end = pos
             continue
         kind = m.lastgroup
         s = m.group()
@@ -62,7 +67,7 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
         if kind == "num":
             tail = _NUMBER_TAIL.match(text, pos)
             if tail:
-                diags.error(src, lang, n, col, f"malformed number `{s + tail.group()}`")
+                diags.lexical_error(src, lang, n, col, f"malformed number `{s + tail.group()}`")
                 pos = tail.end()
                 continue
         elif kind == "id":
@@ -70,7 +75,7 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
                 kind = KW
         elif kind == "annot":
             if s not in ANNOTATIONS:
-                diags.error(src, lang, n, col, f"unknown annotation `{s}`")
+                diags.lexical_error(src, lang, n, col, f"unknown annotation `{s}`")
                 continue
         toks.append(Tok(kind, s, n, col))
     return toks

@@ -121,7 +121,8 @@ class Parser:
     def enter(self, t: Tok) -> None:
         self.nesting += 1
         if self.nesting > MAX_NESTING:
-            raise ParseError(t, f"nested too deeply (more than {MAX_NESTING} levels)")
+            raise ParseError(t, f"nested too deeply (more than {MAX_NESTING} levels of guards, "
+                                "parentheses and unary operators)")
 
     def resync(self) -> None:
         """Skips the rest of a bad line, and the body of any `{` opened on it."""
@@ -130,6 +131,8 @@ class Parser:
             t = self.peek()
             if t.kind == EOF:
                 return
+            if t.kind == LABEL and self.lang == SM and self.toks[self.i - 1].kind == NL:
+                return  # a label opens the next block, even inside an unclosed `{`
             if t.kind == OP and t.text == "{":
                 depth += 1
             elif t.kind == OP and t.text == "}":
@@ -149,7 +152,7 @@ class Parser:
         e = self.or_expr()
         if tree_depth(e) > MAX_DEPTH:
             raise ParseError(Tok(OP, "", e.line, e.col),
-                             f"expression is nested too deeply (more than {MAX_DEPTH} levels)")
+                             f"expression is nested too deeply (more than {MAX_DEPTH} levels of operators)")
         return e
 
     def or_expr(self) -> S.Expr:
@@ -336,18 +339,15 @@ class Parser:
         return False
 
     def sm_braced(self) -> tuple[S.Stmt, ...]:
-        open_ = self.next()  # "{"
-        self.enter(open_)
+        open_ = self.next()  # "{"; its `if` already counts as a level of nesting
         out: list[S.Stmt] = []
         while True:
             self.skip_newlines()
             t = self.peek()
             if t.kind == OP and t.text == "}":
                 self.next()
-                self.nesting -= 1
                 return tuple(out)
             if t.kind in (EOF, LABEL):
-                self.nesting -= 1
                 raise ParseError(open_, "unclosed `{`")
             saved = self.nesting
             try:
@@ -369,6 +369,14 @@ class Parser:
         nxt = self.peek()
         if nxt.kind == OP and nxt.text == ":":
             self.next()
+            if self.at_end():
+                # `else:` then `if` on the next line chains like `else` then `if`.
+                j = self.i
+                while self.toks[j].kind == NL:
+                    j += 1
+                if self.toks[j].kind == KW and self.toks[j].text == "if":
+                    self.i = j
+                    return (self.sm_statement(),), False
             if self.at_end() or self.at_op("}"):
                 raise ParseError(t, "expected logic after else")
             return (self.sm_statement(),), False
@@ -535,7 +543,7 @@ def parse_sv(src: Source, diags: Diagnostics) -> S.SvFile:
             d = _elem_decl(toks, src, diags, lang)
             if d is not None:
                 elems.append(d)
-        regions.append(S.RegionDecl(header, tuple(elems)))
+        regions.append(S.RegionDecl(header, tuple(elems), len(body)))
     return S.SvFile(src.path, tuple(options), tuple(regions))
 
 
@@ -687,7 +695,10 @@ def _state_blocks(body: list[list[Tok]], src, diags, lang) -> tuple[S.Block, ...
                 diags.error(src, lang, t.line, t.col,
                             "text before the first label: expected `.entry`, `.step` or `.exit`")
                 reported_text = True
+            at = p.i
             p.resync()
+            if p.i == at:  # resync stops before a `}`: step over it
+                p.next()
             continue
         p.next()
         label = t.text[1:]

@@ -7,7 +7,7 @@ import os
 
 from . import model as M
 from .check import check_sm, check_ss, check_sv
-from .diagnostics import SM, SS, Diagnostics, Source, read_source
+from .diagnostics import SM, SS, Diagnostics, Source, decode, read_source
 from .parser import parse_sm, parse_ss, parse_sv
 
 
@@ -52,15 +52,19 @@ def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
         if sv_path is None:
             diags.error(src, SM, 1, 1, f"no state vector config (.sv) found beside {sm_path}: "
                                        "name one with --sv")
+            parse_sm(src, diags)  # its syntax errors still count
             return None
-    errors = len(diags.errors)
-    sv = load_sv(sv_path, diags)
-    if sv is None:
-        return None
-    sv_ok = len(diags.errors) == errors
-    f = parse_sm(src, diags)
-    m = check_sm(f, src, sv, diags, warnings=warnings)
-    return m if sv_ok else None
+    # Counted apart: errors already in `diags` (another file's, or this
+    # state vector's reported before) must not decide, and neither may
+    # this one's be missed because `diags` had seen them.
+    mine = Diagnostics()
+    m = None
+    sv = load_sv(sv_path, mine)
+    f = parse_sm(src, mine)
+    if sv is not None:
+        m = check_sm(f, src, sv, mine, warnings=warnings and not mine.errors)
+    diags.extend(mine)
+    return m if not mine.errors else None
 
 
 def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
@@ -73,15 +77,17 @@ def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
         if sm_path is None:
             diags.error(src, SS, 1, 1, f"no state machine config (.sm) found beside {ss_path}: "
                                        "name one with --sm")
+            parse_ss(src, diags)  # its syntax errors still count
             return None
     m = load_machine(sm_path, diags, sv_path)
-    f = parse_ss(src, diags)
-    if m is None:
-        return None
-    return check_ss(f, src, m, diags)
+    mine = Diagnostics()
+    f = parse_ss(src, mine)
+    script = check_ss(f, src, m, mine) if m is not None else None
+    diags.extend(mine)
+    return script if not mine.errors else None
 
 
 def source_of(path: str) -> Source:
     """A file's text for rendering a diagnostic after the fact."""
     with open(path, "rb") as fh:
-        return Source.from_text(path, fh.read().decode("utf-8", errors="replace"))
+        return Source.from_text(path, decode(fh.read()))

@@ -148,6 +148,7 @@ class ElemDecl:
 class RegionDecl:
     header: Header
     elements: tuple[ElemDecl, ...]
+    lines: int = 0  # non-blank lines in the section, well-formed or not
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,26 @@ from __future__ import annotations
 import math
 
 from fswkit.autocode import model as M
+from fswkit.autocode.evaluate import evaluate
 from fswkit.autocode.numeric import Real, div, f32, f32_from_int
 from fswkit.windows import make_window
 
 OK = 0
 ERR_TIME = 1  # G did not increase since the previous step
+
+# Expression nodes nested deeper than this are handed to the tree walker of
+# fswkit.autocode.evaluate (the same semantics), so the generated Python
+# stays far below its parser's limit of 200 nested parentheses (each level
+# here opens at most 2).
+DEEP = 40
+
+
+def _walker(e: M.Expr, vars_, real: Real):
+    types = [var.type for var in vars_]
+
+    def run(v, wv):
+        return evaluate(e, real, lambda i: real.read(types[i], v[i]), wv.__getitem__)
+    return run
 
 
 class _Emitter:
@@ -27,6 +42,12 @@ class _Emitter:
         self.wv = wv
         self.tmp = 0
         self.consts: dict[str, float] = {}
+        self.depth = 0
+        self.deep: list = []  # `_deep[k]` of the generated code: see DEEP
+
+    def walk(self, e: M.Expr) -> str:
+        self.deep.append(_walker(e, self.vars, self.real))
+        return f"_deep[{len(self.deep) - 1}](v, {self.wv})"
 
     def temp(self) -> str:
         self.tmp += 1
@@ -54,6 +75,15 @@ class _Emitter:
 
     def value(self, e: M.Expr) -> str:
         """An expression giving the R value."""
+        if self.depth >= DEEP:
+            return self.walk(e)
+        self.depth += 1
+        try:
+            return self._value(e)
+        finally:
+            self.depth -= 1
+
+    def _value(self, e: M.Expr) -> str:
         t = type(e)
         if t is M.Const:
             return self.const(self.real.literal(e.text))
@@ -72,6 +102,16 @@ class _Emitter:
 
     def cond(self, e: M.Expr) -> str:
         """An expression giving a Python bool: true when non-zero, not NaN."""
+        if self.depth >= DEEP:
+            x = self.temp()
+            return f"(({x} := {self.walk(e)}) != 0 and {x} == {x})"
+        self.depth += 1
+        try:
+            return self._cond(e)
+        finally:
+            self.depth -= 1
+
+    def _cond(self, e: M.Expr) -> str:
         t = type(e)
         if t is M.Cmp:
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
@@ -122,8 +162,9 @@ class _Emitter:
 GLOBALS = {"_f32": f32, "_fi": f32_from_int, "_div": div, "_NAN": math.nan, "_INF": math.inf}
 
 
-def build(source: str, name: str) -> dict:
+def build(source: str, name: str, extra: dict | None = None) -> dict:
     namespace = dict(GLOBALS)
+    namespace.update(extra or {})
     exec(compile(source, f"<fswkit:{name}>", "exec"), namespace)  # generated from the model only
     return namespace
 
@@ -157,7 +198,7 @@ class MachineRun:
                 src.append(f"def s{st.index}_{label}(v, wv):")
                 em.block(getattr(st, label), "    ", src)
                 src.append("    return -1")
-        ns = build("\n".join(src) + "\n", m.name)
+        ns = build("\n".join(src) + "\n", m.name, {"_deep": em.deep})
         self._update = ns["update"]
         self._push = [w.push for w in self.windows]
         self._entry = [ns[f"s{i}_entry"] for i in range(len(m.states))]
@@ -169,7 +210,9 @@ class MachineRun:
         step at time `g` (what a state script sees before the step)."""
         v, m = self.v, self.m
         v[m.s] = self.state + 1
-        v[m.t] = 0 if self.first else g - self.entry_time
+        # U64 arithmetic, as the machine keeps T: when `G` wrapped around
+        # (the step will be refused) the difference wraps too.
+        v[m.t] = 0 if self.first else (g - self.entry_time) % (1 << 64)
 
     def step(self) -> int:
         m, v = self.m, self.v

@@ -1,0 +1,5 @@
+[options]
+delta_t 10
+
+[all_states]
+G == 100: @stop

@@ -1,0 +1,8 @@
+[options]
+delta_t 10
+
+[all_states]
+G == 0 {
+	pressure =	600 $
+}
+G == 100: @stop

@@ -1,0 +1,8 @@
+[options]
+delta_t 10
+
+[all_states]
+G == 100: @stop
+
+[Idle]
+true: @assert valve

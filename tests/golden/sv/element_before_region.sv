@@ -1,0 +1,5 @@
+# a state vector config
+U8 count
+
+[Sensors]
+F64 pressure

@@ -1,0 +1,4 @@
+[Sensors]
+
+[Effectors]
+bool valve

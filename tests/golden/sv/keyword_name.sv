@@ -1,0 +1,3 @@
+[Sensors]
+F64 if
+bool true

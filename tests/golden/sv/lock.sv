@@ -1,0 +1,5 @@
+[options]
+lock
+
+[Sensors]
+F64 pressure

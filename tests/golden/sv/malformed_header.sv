@@ -1,0 +1,4 @@
+[Sensors
+F64 pressure
+[Effectors] valve
+[]

@@ -1,0 +1,3 @@
+[Sensors]
+F64
+U8 3count

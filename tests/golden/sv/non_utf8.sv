@@ -1,0 +1,3 @@
+[Sensors]
+F64 pressure # kPa, étalé
+U8 coÿunt

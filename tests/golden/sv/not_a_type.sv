@@ -1,0 +1,2 @@
+[Sensors]
+= pressure

@@ -1,0 +1,5 @@
+[options]
+lock all
+
+[Sensors]
+F64 pressure

@@ -1,0 +1,3 @@
+[Sensors]
+F64 pressure kPa
+U8 count = 3

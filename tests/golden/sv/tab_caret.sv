@@ -1,0 +1,3 @@
+[Sensors]
+	F64	pressure
+	U9	count

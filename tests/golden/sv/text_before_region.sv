@@ -1,0 +1,3 @@
+lock
+[Sensors]
+F64 pressure

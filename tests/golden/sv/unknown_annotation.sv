@@ -1,0 +1,2 @@
+[Sensors]
+F64 pressure @readonly

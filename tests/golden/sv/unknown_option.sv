@@ -1,0 +1,6 @@
+[options]
+lock
+atomic
+
+[Sensors]
+F64 pressure

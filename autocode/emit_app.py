@@ -7,8 +7,12 @@ from __future__ import annotations
 from .app import MODES, Application, Task
 from .emit_cpp import basename, banner, c_ident, emit_machine, emit_sv, real_check, real_literal, version_check
 from .numeric import MODES as REALS
+from .schema import app_schema_hash, link_plan
 
 TYPE_CODE = {"F32": "fsw::kF32", "F64": "fsw::kF64"}
+ELEM_CODE = {"I8": "fsw::kI8", "I16": "fsw::kI16", "I32": "fsw::kI32", "I64": "fsw::kI64",
+             "U8": "fsw::kU8", "U16": "fsw::kU16", "U32": "fsw::kU32", "U64": "fsw::kU64",
+             "F32": "fsw::kF32", "F64": "fsw::kF64", "bool": "fsw::kBool"}
 
 
 class GenError(Exception):
@@ -90,6 +94,9 @@ def _app_cpp(app: Application) -> str:
     c.append("fsw::Executor ex;")
     c.append(f"fsw::TaskStats stats[{max(n, 1)}];")
     c.append("")
+    has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
+    if has_link:
+        c += _link(app)
     for t in app.tasks:
         c += _task_fn(app, t, tables)
     c.append(f"const fsw::Task kTasks[{max(n, 1)}] FSW_FLASH = {{")
@@ -112,11 +119,25 @@ def _app_cpp(app: Application) -> str:
     c.append("    if (fsw::executor_begin(ex, kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
         c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
+    if has_link:
+        c.append("    if (fsw::link_begin(link, &kLinkConfig) != fsw::kOk) return false;")
     c.append("    return true;")
     c.append("}")
     c.append("")
-    c.append("// Runs a cycle when one is due.")
-    c.append("void poll() { (void)fsw::executor_poll(ex); }")
+    if has_link:
+        c.append("// Runs a cycle when one is due; between cycles, feeds the serial link.")
+        c.append("void poll() {")
+        c.append("    (void)fsw::executor_poll(ex);")
+        c.append("    fsw::link_poll(link);")
+        c.append("}")
+    else:
+        c.append("// Runs a cycle when one is due.")
+        c.append("void poll() { (void)fsw::executor_poll(ex); }")
+    c.append("// Microseconds until the next cycle is due (hosts: sleep between cycles).")
+    c.append("uint64_t idle_us() {")
+    c.append("    const uint64_t now = fsw::pal::micros64();")
+    c.append("    return ex.next_due_us > now ? ex.next_due_us - now : 0;")
+    c.append("}")
     c.append("// Runs one cycle now (hosts: simulations and tests).")
     c.append("void run_cycle() { fsw::executor_run_cycle(ex); }")
     c.append("")
@@ -131,26 +152,7 @@ def _app_cpp(app: Application) -> str:
     c.append("}")
     c.append("void loop() { fsw_gen::poll(); }")
     c.append("#elif !defined(FSW_NO_MAIN)")
-    c.append("#include <stdio.h>")
-    c.append("#include <stdlib.h>")
-    c.append('#include "psl_native.h"')
-    c.append("// Host build: `app CYCLES` runs that many cycles on the simulated clock, then")
-    c.append("// prints the state vector as hex; with no argument it follows the real clock.")
-    c.append("int main(int argc, char** argv) {")
-    c.append("    if (!fsw_gen::begin()) { fprintf(stderr, \"the runtime refused a table\\n\"); return 3; }")
-    c.append("    if (argc < 2) {")
-    c.append("        fsw::native::use_real_time(true);")
-    c.append("        for (;;) fsw_gen::poll();")
-    c.append("    }")
-    c.append("    const unsigned long cycles = strtoul(argv[1], 0, 10);")
-    c.append("    for (unsigned long i = 0; i < cycles; ++i) {")
-    c.append("        fsw_gen::run_cycle();")
-    c.append("        fsw::native::sim_advance_us(fsw_gen::kPeriodUs);")
-    c.append("    }")
-    c.append("    for (uint16_t i = 0; i < fsw_gen::kSvSize; ++i) printf(\"%02x\", fsw_gen::sv[i]);")
-    c.append("    printf(\"\\n\");")
-    c.append("    return 0;")
-    c.append("}")
+    c += _native_main(app)
     c.append("#endif")
     c.append("")
     return "\n".join(c)
@@ -179,9 +181,143 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
             else:
                 out.append(f"    const fsw::Result r{k} = {call};")
                 out.append(f"    if (r{k} != fsw::kOk) return r{k};")
+    elif t.kind == "telemetry":
+        out.append("    return fsw::link_telemetry_task(&link);")
+    elif t.kind == "uplink":
+        out.append("    return fsw::link_uplink_task(&link);")
     else:
-        raise GenError(f"{basename(app.path)}:{t.line}: task `{t.name}`: `{t.kind}` tasks cannot be "
-                       "generated yet: the telemetry link is not part of this version of the kit")
+        raise GenError(f"{basename(app.path)}:{t.line}: task `{t.name}`: unknown task kind `{t.kind}`")
     out.append("}")
     out.append("")
     return out
+
+
+def _link(app: Application) -> list[str]:
+    """The serial link's tables (docs/telemetry.md): streams, writable
+    elements, buffers and the configuration, all constant data."""
+    plan = link_plan(app)
+    name = basename(app.path)
+    c = ["// ---- the serial link (docs/telemetry.md) ----",
+         f"// Link schema: the layout, the tasks, {len(plan.streams)} stream(s) and "
+         f"{len(plan.writable)} writable element(s).",
+         f"const uint32_t kLinkSchema = 0x{app_schema_hash(app):08x}UL;",
+         f"const uint16_t kLinkTxSize = {plan.tx_cap};  // the longest encoded frame",
+         "uint8_t link_tx[kLinkTxSize];"]
+    load = 0.0
+    for s in plan.streams:
+        frame = s.batch * s.region.size + 8 + 2 + (s.batch * s.region.size + 8) // 254
+        load += float(s.rate) / s.batch * frame
+        if s.batch > 1:
+            c.append(f"uint8_t link_store_{s.index}[{(s.batch - 1) * s.region.size}];  "
+                     f"// the first {s.batch - 1} sample(s) of a {s.region.name} frame")
+    if plan.streams:
+        c.append(f"const fsw::LinkStream kLinkStreams[{len(plan.streams)}] FSW_FLASH = {{")
+        for s in plan.streams:
+            st = next(x for x in app.telemetry if x.region is s.region)
+            store = f"link_store_{s.index}" if s.batch > 1 else "0"
+            c.append(f"    {{R_{s.region.name}_off, R_{s.region.name}_size, {s.every}, {s.batch}, {store}}},  "
+                     f"// {name}:{st.line} {s.region.name} at {s.rate} Hz, {s.batch} per frame")
+        c.append("};")
+        c.append(f"fsw::LinkStreamState link_streams[{len(plan.streams)}];")
+    index = {e.name: i for i, e in enumerate(app.sv.elements)}
+    rows = sorted(plan.writable, key=lambda e: index[e.name])
+    if rows:
+        c.append(f"const fsw::LinkWritable kLinkWritable[{len(rows)}] FSW_FLASH = {{")
+        for e in rows:
+            c.append(f"    {{{index[e.name]}, E_{e.name}, {ELEM_CODE[e.type.name]}}},  // {e.name} ({e.type.name})")
+        c.append("};")
+    c.append(f"uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, {app.time_unit}")
+    hz = float(plan.health_every and app.tasks[plan.telemetry_task].rate / plan.health_every)
+    load += hz * encoded_health(plan) + hz / max(plan.hello_every, 1) * 27
+    capacity = app.baud / 10
+    c.append(f"// Link load: about {round(load)} B/s of {round(capacity)} B/s at {app.baud} baud "
+             f"({100 * load / capacity:.0f} %).")
+    if load > capacity:
+        raise GenError(f"{name}: the telemetry streams need about {round(load)} B/s but the link carries "
+                       f"{round(capacity)} B/s at {app.baud} baud: lower the stream rates or raise `baud`")
+    up = plan.uplink_task if plan.uplink_task is not None else 0xFF
+    c.append("const fsw::LinkConfig kLinkConfig FSW_FLASH = {")
+    c.append(f"    sv, {'kLinkStreams' if plan.streams else '0'}, {'link_streams' if plan.streams else '0'}, "
+             f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, {app.baud}UL, kSvSize,")
+    c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
+             f"{plan.hello_every}, {up}, kSvLock}};")
+    c.append("fsw::Link link;")
+    c.append("")
+    return c
+
+
+def encoded_health(plan) -> int:
+    return plan.health_payload + 8 + 2
+
+
+def _native_main(app: Application) -> list[str]:
+    has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
+    c = ['#include <stdio.h>',
+         '#include <stdlib.h>',
+         '#include <string.h>',
+         '#include <unistd.h>',
+         '#include "psl_native.h"',
+         '// Host build:',
+         '//   app [PINS]             follows the real clock; the serial link on stdin/stdout',
+         '//   app CYCLES [PINS]      runs CYCLES cycles on the simulated clock, then prints',
+         '//                          the state vector as hex (link output discarded)',
+         '//   app CYCLES --link [--uart BAUD] [PINS]',
+         "//                          the same, with the link's bytes on stdout instead of the",
+         "//                          hex; --uart models the UART's speed on the simulated clock",
+         '//   PINS: aPIN=RAW sets an ADC reading, dPIN=0|1 a digital input level.',
+         'int main(int argc, char** argv) {',
+         '    unsigned long cycles = 0, baud = 0;',
+         '    bool simulated = false, link_out = false;',
+         '    for (int i = 1; i < argc; ++i) {',
+         '        unsigned pin = 0, value = 0;',
+         '        char tail = 0;',
+         '        if (strcmp(argv[i], "--link") == 0) {',
+         '            link_out = true;',
+         '        } else if (strcmp(argv[i], "--uart") == 0 && i + 1 < argc) {',
+         '            baud = strtoul(argv[++i], 0, 10);',
+         '        } else if (sscanf(argv[i], "a%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 65536) {',
+         '            fsw::native::sim_set_analog(static_cast<uint8_t>(pin), static_cast<uint16_t>(value));',
+         '        } else if (sscanf(argv[i], "d%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 2) {',
+         '            fsw::native::sim_set_digital(static_cast<uint8_t>(pin), value != 0);',
+         "        } else if (argv[i][0] >= '0' && argv[i][0] <= '9') {",
+         '            cycles = strtoul(argv[i], 0, 10);',
+         '            simulated = true;',
+         '        } else {',
+         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [aPIN=RAW] [dPIN=0|1]\\n", argv[0]);',
+         '            return 2;',
+         '        }',
+         '    }',
+         '    static uint8_t discard[1];',
+         '    static uint16_t discarded;',
+         '    if (simulated && !link_out) fsw::native::console_capture(discard, 0, &discarded);',
+         '    if (baud != 0) fsw::native::console_model_uart(static_cast<uint32_t>(baud), 64);',
+         '    if (!fsw_gen::begin()) { fprintf(stderr, "the runtime refused a table\\n"); return 3; }',
+         '    if (!simulated) {',
+         '        fsw::native::console_use_stdin(true);',
+         '        fsw::native::use_real_time(true);',
+         '        for (;;) {',
+         '            fsw_gen::poll();',
+         '            const uint64_t idle = fsw_gen::idle_us();',
+         '            if (idle > 200) usleep(static_cast<useconds_t>(idle > 2000 ? 1000 : idle - 100));',
+         '        }',
+         '    }',
+         '    for (unsigned long i = 0; i < cycles; ++i) {',
+         '        fsw_gen::run_cycle();']
+    if has_link:
+        c += ['        for (uint32_t t = 0; t < fsw_gen::kPeriodUs; t += 50) {  // loop() between cycles',
+              '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs - t < 50 ? fsw_gen::kPeriodUs - t : 50);',
+              '            fsw::link_poll(fsw_gen::link);',
+              '        }']
+    else:
+        c += ['        fsw::native::sim_advance_us(fsw_gen::kPeriodUs);']
+    c += ['    }',
+          '    if (link_out) {']
+    if has_link:
+        c += ['        fprintf(stderr, "console overruns: %lu\\n", static_cast<unsigned long>(fsw::native::console_overruns()));']
+    c += ['        return 0;',
+          '    }',
+          '    for (uint16_t i = 0; i < fsw_gen::kSvSize; ++i) printf("%02x", fsw_gen::sv[i]);',
+          '    printf("\\n");',
+          '    return 0;',
+          '}']
+    return c

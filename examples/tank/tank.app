@@ -16,6 +16,16 @@ source clock
 unit   ms
 
 [tasks]
+uplink   uplink        rate=100
 sense    inputs        rate=100
 control  machine tank  rate=100
 act      outputs       rate=100
+downlink telemetry     rate=100
+
+[telemetry]            # regions streamed to the ground
+Sensors    rate=50
+Effectors  rate=10
+
+[uplink]               # elements the ground may write
+valveOpen
+

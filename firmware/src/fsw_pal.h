@@ -45,6 +45,9 @@ void console_begin(uint32_t baud);
 void console_write(const uint8_t* data, uint16_t len);
 // Next received byte, or -1 when none is waiting.
 int16_t console_read();
+// Bytes console_write can take now without waiting (the transmit buffer's
+// free space): telemetry writes no more than this, so it never blocks.
+uint16_t console_write_space();
 
 // ---- Critical section -------------------------------------------------------
 // Interrupts off on an MCU (nests: the previous state is restored); a

@@ -15,5 +15,6 @@
 #include "fsw_clock.h"
 #include "fsw_executor.h"
 #include "fsw_io.h"
+#include "fsw_link.h"
 
 #endif  // FSWKIT_H

@@ -14,6 +14,7 @@ namespace pal {
 void console_begin(uint32_t baud) { Serial.begin(baud); }
 void console_write(const uint8_t* data, uint16_t len) { Serial.write(data, len); }
 int16_t console_read() { return static_cast<int16_t>(Serial.read()); }
+uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableForWrite()); }
 
 }  // namespace pal
 }  // namespace fsw

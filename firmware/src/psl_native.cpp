@@ -37,6 +37,11 @@ uint32_t g_kicks;
 bool g_wdt_armed;
 uint8_t g_reset_cause;
 bool g_use_stdin;
+uint32_t g_uart_baud;
+uint16_t g_uart_buffer;
+uint64_t g_uart_busy_until_bits;  // simulated time (in bit times) the last queued byte ends
+uint32_t g_uart_overruns;
+uint32_t g_written;
 
 // Re-entrant spin lock: the owner is the address of a thread-local byte.
 __thread char t_token;
@@ -50,6 +55,13 @@ uint64_t host_monotonic_us() {
 }
 
 uint64_t now_us() { return g_real_time ? host_monotonic_us() - g_real_origin_us : g_time_us; }
+
+// The UART model: bytes still queued at time `now` (bit times: us * baud / 1e6).
+uint32_t uart_queued() {
+    const uint64_t now_bits = now_us() * g_uart_baud / 1000000u;
+    if (g_uart_busy_until_bits <= now_bits) return 0;
+    return static_cast<uint32_t>((g_uart_busy_until_bits - now_bits + 9u) / 10u);
+}
 
 void clear_modes() {
     if (!g_modes_cleared) {
@@ -84,6 +96,13 @@ void console_capture(uint8_t* buf, uint16_t cap, uint16_t* len) {
     if (len != 0) *len = 0;
 }
 void console_use_stdin(bool on) { g_use_stdin = on; }
+void console_model_uart(uint32_t baud, uint16_t buffer) {
+    g_uart_baud = baud;
+    g_uart_buffer = buffer;
+    g_uart_busy_until_bits = 0;
+}
+uint32_t console_overruns() { return g_uart_overruns; }
+uint32_t console_written() { return g_written; }
 void console_feed(const uint8_t* data, uint16_t len) {
     for (uint16_t i = 0; i < len && g_in_len < sizeof g_in; ++i) {
         g_in[(g_in_head + g_in_len) % sizeof g_in] = data[i];
@@ -111,6 +130,11 @@ void sim_reset() {
     g_kicks = 0;
     g_wdt_armed = false;
     g_reset_cause = 0;
+    g_uart_baud = 0;
+    g_uart_buffer = 0;
+    g_uart_busy_until_bits = 0;
+    g_uart_overruns = 0;
+    g_written = 0;
 }
 
 }  // namespace native
@@ -135,7 +159,19 @@ bool digital_read(uint8_t pin) { return g_level[pin] != 0; }
 void digital_write(uint8_t pin, bool high) { g_level[pin] = high ? 1 : 0; }
 
 void console_begin(uint32_t baud) { (void)baud; }
+uint16_t console_write_space() {
+    if (g_uart_baud == 0) return 0xFFFFu;
+    const uint32_t q = uart_queued();
+    return static_cast<uint16_t>(q >= g_uart_buffer ? 0u : g_uart_buffer - q);
+}
 void console_write(const uint8_t* data, uint16_t len) {
+    g_written += len;
+    if (g_uart_baud != 0) {
+        if (len > console_write_space()) ++g_uart_overruns;
+        const uint64_t now_bits = now_us() * g_uart_baud / 1000000u;
+        if (g_uart_busy_until_bits < now_bits) g_uart_busy_until_bits = now_bits;
+        g_uart_busy_until_bits += 10u * static_cast<uint64_t>(len);
+    }
     if (g_cap_buf != 0) {
         for (uint16_t i = 0; i < len && *g_cap_len < g_cap_cap; ++i) g_cap_buf[(*g_cap_len)++] = data[i];
         return;

@@ -31,6 +31,14 @@ uint8_t sim_pin_mode(uint8_t pin);  // 0xFF: never set
 void console_use_stdin(bool on);
 void console_capture(uint8_t* buf, uint16_t cap, uint16_t* len);
 void console_feed(const uint8_t* data, uint16_t len);
+// A UART model on the simulated clock: console_write_space() is `buffer`
+// minus the bytes not yet sent at `baud` (10 bits a byte). baud 0: no limit
+// (the default). Bytes written past the space count in console_overruns()
+// (a write that would have blocked on a board).
+void console_model_uart(uint32_t baud, uint16_t buffer);
+uint32_t console_overruns();
+// Bytes written to the console since sim_reset().
+uint32_t console_written();
 
 // Watchdog and reset cause.
 uint32_t watchdog_kicks();

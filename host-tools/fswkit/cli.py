@@ -249,6 +249,94 @@ def cmd_build(args) -> int:
     return EXIT_OK
 
 
+# ---- the serial link: fsw monitor / cmd / log2csv / replay / plot ----------------------
+
+def _link_layout(project: str, command: str):
+    """The link layout of a project's configs, or None after a message."""
+    from fswkit.build import BuildError, load
+    from fswkit.link.layout import from_app
+
+    diags = Diagnostics()
+    try:
+        app = load(project, diags)
+    except BuildError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    _print_diags(diags)
+    if app is None:
+        return None
+    return from_app(app)
+
+
+def _ground(command: str, fn, *a) -> int:
+    from fswkit.link.layout import LayoutError
+    from fswkit.link.log import LogError
+    from fswkit.link.port import PortError
+    from fswkit.monitor import GroundError
+
+    try:
+        return fn(*a)
+    except (GroundError, PortError, LogError, LayoutError) as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return EXIT_FAIL
+
+
+def cmd_monitor(args) -> int:
+    from fswkit.monitor import monitor
+
+    layout = _link_layout(args.project, "monitor")
+    if layout is None:
+        return EXIT_CONFIG
+    return _ground("monitor", monitor, layout, args.project, args.port, args.baud, args.log, args.headless,
+                   args.ignore_schema, args.duration, args.frames)
+
+
+def cmd_cmd(args) -> int:
+    from fswkit.monitor import command
+
+    layout = _link_layout(args.project, "cmd")
+    if layout is None:
+        return EXIT_CONFIG
+    return _ground("cmd", command, layout, args.project, args.port, args.baud, args.what, args.args,
+                   args.ignore_schema)
+
+
+def cmd_log2csv(args) -> int:
+    from fswkit.monitor import log2csv
+
+    if args.output in (None, "-"):
+        return _ground("log2csv", log2csv, args.log, sys.stdout, args.ignore_schema)
+    try:
+        f = open(args.output, "w", newline="")
+    except OSError as e:
+        sys.stderr.write(f"fsw log2csv: cannot write {args.output}: {e.strerror or e}\n")
+        return EXIT_FAIL
+    with f:
+        return _ground("log2csv", log2csv, args.log, f, args.ignore_schema)
+
+
+def cmd_replay(args) -> int:
+    from fswkit.monitor import replay
+
+    return _ground("replay", replay, args.log, args.headless, args.speed, args.ignore_schema)
+
+
+def cmd_plot(args) -> int:
+    from fswkit.monitor import plot
+
+    return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)
+
+
+def _nonneg_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, found {text}")
+    return value
+
+
 # ---- entry point -------------------------------------------------------------------
 
 def _positive_int(text: str) -> int:
@@ -311,6 +399,47 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--delta-t", type=_positive_int, default=10, help="time step of the script (default 10)")
     s.add_argument("-o", "--output", help="write here instead of standard output")
     s.set_defaults(func=cmd_skeleton)
+
+    m = sub.add_parser("monitor", help="decode a target's telemetry live (docs/telemetry.md)")
+    m.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (folder or .app)")
+    m.add_argument("--port", required=True, help="serial device (/dev/ttyACM0, a pty) or pyserial URL")
+    m.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
+    m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE")
+    m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")
+    m.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
+    m.add_argument("--duration", type=_nonneg_float, metavar="S", help="stop after S seconds")
+    m.add_argument("--frames", type=_positive_int, metavar="N", help="stop after N frames")
+    m.set_defaults(func=cmd_monitor)
+
+    cm = sub.add_parser("cmd", help="send a command over the uplink and wait for its acknowledgement")
+    cm.add_argument("what", choices=("set", "mode", "ping", "hello", "snapshot"), metavar="COMMAND",
+                    help="set ELEMENT VALUE | mode TASK disabled|safed|enabled | ping | hello | snapshot")
+    cm.add_argument("args", nargs="*", metavar="ARG")
+    cm.add_argument("--port", required=True, help="serial device or pyserial URL")
+    cm.add_argument("-p", "--project", default=".", help="the project the firmware was built from (default .)")
+    cm.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
+    cm.add_argument("--ignore-schema", action="store_true", help="send even when the schema hash differs")
+    cm.set_defaults(func=cmd_cmd)
+
+    lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")
+    lc.add_argument("log", metavar="LOG")
+    lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")
+    lc.add_argument("--ignore-schema", action="store_true")
+    lc.set_defaults(func=cmd_log2csv)
+
+    rp = sub.add_parser("replay", help="the monitor's view of a link log")
+    rp.add_argument("log", metavar="LOG")
+    rp.add_argument("--headless", action="store_true", help="print decoded frames as lines")
+    rp.add_argument("--speed", type=_nonneg_float, default=1.0, help="1 = as recorded, 0 = as fast as possible")
+    rp.add_argument("--ignore-schema", action="store_true")
+    rp.set_defaults(func=cmd_replay)
+
+    pl = sub.add_parser("plot", help="time series of elements from a link log, state transitions marked")
+    pl.add_argument("log", metavar="LOG")
+    pl.add_argument("-e", "--element", nargs="+", required=True, metavar="ELEMENT")
+    pl.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    pl.add_argument("--ignore-schema", action="store_true")
+    pl.set_defaults(func=cmd_plot)
     return p
 
 

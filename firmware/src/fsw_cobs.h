@@ -1,0 +1,40 @@
+// COBS framing of the telemetry link (docs/telemetry.md): an incremental
+// encoder that writes a frame body and its CRC-16 straight into a buffer,
+// ending with the 0x00 delimiter, and an in-place decoder.
+#ifndef FSW_COBS_H
+#define FSW_COBS_H
+
+#include "fsw_types.h"
+
+namespace fsw {
+
+// Encoded size bound of a frame of `n` bytes (body + CRC), delimiter included.
+inline uint16_t cobs_max_encoded(uint16_t n) { return static_cast<uint16_t>(n + n / 254u + 2u); }
+
+struct CobsEncoder {
+    uint8_t* out;      // the encoded frame so far
+    uint16_t len;      // bytes of `out` used
+    uint16_t code_at;  // where the open block's code byte goes
+    uint8_t code;      // the open block's code (1 + its data bytes)
+    uint16_t crc;      // CRC of the body so far
+};
+
+// Starts a frame in `out` (room for cobs_max_encoded(body + 2) bytes).
+void cobs_begin(CobsEncoder& e, uint8_t* out);
+// Appends body bytes (encoded, and folded into the CRC).
+void cobs_put(CobsEncoder& e, uint8_t b);
+void cobs_put_bytes(CobsEncoder& e, const uint8_t* p, uint16_t n);
+void cobs_put_u16(CobsEncoder& e, uint16_t v);  // little-endian
+void cobs_put_u32(CobsEncoder& e, uint32_t v);  // little-endian
+// Appends the CRC (high byte first), closes the last block and writes the
+// delimiter; returns the encoded length.
+uint16_t cobs_end(CobsEncoder& e);
+
+// Decodes one frame (the bytes between two delimiters, none of them 0x00)
+// in place; returns its length, or -1 when the bytes are not a valid COBS
+// encoding (a block that runs past the end, or a zero byte).
+int16_t cobs_decode(uint8_t* buf, uint16_t n);
+
+}  // namespace fsw
+
+#endif  // FSW_COBS_H

@@ -1,0 +1,149 @@
+// The serial link (docs/telemetry.md): the telemetry task streams regions,
+// health and hello frames without ever blocking; the uplink task parses,
+// verifies and applies ground commands between tasks. COBS frames with a
+// CRC-16; constant tables generated from the application config.
+#ifndef FSW_LINK_H
+#define FSW_LINK_H
+
+#include "fsw_executor.h"
+#include "fsw_types.h"
+
+namespace fsw {
+
+static const uint8_t kLinkProtocol = 1;
+
+// Downlink frame types (target -> ground). A sample frame's type is
+// kFrameSample | stream index (streams 0..127).
+enum LinkFrame : uint8_t {
+    kFrameHello = 0x01,
+    kFrameHealth = 0x02,
+    kFrameAck = 0x03,
+    kFrameSnapshot = 0x04,
+    kFrameSample = 0x80,
+};
+
+// Uplink opcodes (ground -> target).
+enum LinkOp : uint8_t {
+    kOpPing = 0x01,      // no arguments: acknowledged
+    kOpHello = 0x02,     // no arguments: a hello frame follows the ack
+    kOpSnapshot = 0x03,  // no arguments: the whole state vector follows
+    kOpSet = 0x04,       // element index (u16), value (the element's bytes)
+    kOpMode = 0x05,      // task index (u8), mode (u8: 0 disabled, 1 safed, 2 enabled)
+};
+
+// Acknowledgement status: 0 applied, anything else refused (a NACK).
+enum LinkStatus : uint8_t {
+    kAckOk = 0,
+    kAckReplay = 1,       // sequence number not newer than the last accepted one
+    kAckUnknownOp = 2,
+    kAckBadLength = 3,    // arguments of the wrong length for the opcode / element
+    kAckNotWritable = 4,  // the element is not in the application's [uplink] list
+    kAckBadTask = 5,      // no such task
+    kAckBadMode = 6,      // mode not 0, 1 or 2
+    kAckLocked = 7,       // the uplink task's own mode cannot be changed over the link
+};
+
+static const uint8_t kLinkHeader = 6;  // type, sequence number, time (low 32 bits)
+// Receive buffer: the longest uplink frame encoded (SET of an 8-byte
+// element: 13 bytes + CRC, one COBS code byte) with room to spare.
+#ifndef FSW_LINK_RX_CAP
+#define FSW_LINK_RX_CAP 24
+#endif
+// Uplink bytes read per run of the uplink task (bounds its step time).
+#ifndef FSW_LINK_RX_PER_RUN
+#define FSW_LINK_RX_PER_RUN 64
+#endif
+
+// One telemetry stream (FSW_FLASH table row).
+struct LinkStream {
+    uint16_t off;    // region offset in the state vector
+    uint16_t size;   // region size, bytes
+    uint16_t every;  // telemetry-task runs between two samples, >= 1
+    uint8_t batch;   // samples per frame, >= 1
+    uint8_t* store;  // RAM for the first batch - 1 samples (null when batch is 1)
+};
+
+// A stream's run-time record (RAM, zero-initialised).
+struct LinkStreamState {
+    uint32_t t0;         // time of the first sample of the open batch
+    uint16_t countdown;  // telemetry runs until the next sample
+    uint16_t late0;      // executor `late` count when the batch opened
+    uint8_t count;       // samples in the open batch
+};
+
+// An element the ground may write (FSW_FLASH table row, sorted by index).
+struct LinkWritable {
+    uint16_t index;  // the element's position in the state vector layout
+    uint16_t off;    // its offset
+    uint8_t type;    // ElemType
+};
+
+typedef uint64_t (*LinkClockFn)();
+
+// The link's configuration: constant data generated from the application
+// config (FSW_FLASH), pointing at the RAM it works in.
+struct LinkConfig {
+    uint8_t* sv;
+    const LinkStream* streams;        // n_streams rows
+    LinkStreamState* stream_state;    // n_streams records
+    const LinkWritable* writable;     // n_writable rows
+    Executor* ex;                     // task health and modes
+    LinkClockFn now;                  // the time `G` is written from
+    uint8_t* tx;                      // transmit buffer of tx_cap bytes
+    uint32_t schema;                  // schema hash of layout + link configuration
+    uint32_t baud;
+    uint16_t sv_size;
+    uint16_t tx_cap;                  // >= the longest encoded frame
+    uint16_t health_every;            // telemetry runs between health frames (0: none)
+    uint16_t snapshot_chunk;          // state vector bytes per snapshot frame
+    uint8_t n_streams;
+    uint8_t n_writable;
+    uint8_t hello_every;              // health frames between hellos (0: only on request)
+    uint8_t uplink_task;              // index of the uplink task (0xFF: none)
+    bool lock;                        // state vector `lock` option
+};
+
+// Counters reported in health frames (saturating where 16-bit).
+struct LinkCounters {
+    uint32_t frames;        // frames sent: the next frame's full sequence number
+    uint32_t dropped;       // frames not sent because the transmit buffer was busy
+    uint16_t rx_ok;         // commands applied
+    uint16_t rx_crc;        // uplink frames with a CRC mismatch
+    uint16_t rx_malformed;  // bad COBS, too short, unknown opcode, wrong argument length
+    uint16_t rx_oversized;  // longer than the receive buffer
+    uint16_t rx_replayed;   // sequence number not newer than the last accepted one
+    uint16_t rx_refused;    // well-formed but refused (not writable, bad task or mode, locked)
+    uint16_t last_seq;      // sequence number of the last accepted command
+};
+
+struct Link {
+    const LinkConfig* cfg;  // FSW_FLASH
+    uint8_t* tx;
+    uint16_t tx_len;        // bytes of the frame in tx (0: free)
+    uint16_t tx_pos;        // bytes of it handed to the console
+    LinkCounters n;
+    uint16_t health_countdown;
+    uint16_t snapshot_at;   // next snapshot offset (0xFFFF: no snapshot under way)
+    uint16_t ack_seq;
+    uint8_t ack_op;
+    uint8_t ack_status;
+    uint8_t pending;        // control frames waiting for the transmit buffer
+    uint8_t hello_countdown;
+    uint8_t rx_len;
+    bool rx_over;
+    uint8_t rx[FSW_LINK_RX_CAP];
+};
+
+// Validates the configuration, opens the console at cfg->baud and queues
+// the boot hello. `cfg` points at an FSW_FLASH object.
+FSW_MUST_CHECK Result link_begin(Link& link, const LinkConfig* cfg);
+// Executor task steps (ctx = the Link): never block, never fault.
+Result link_telemetry_task(void* link);
+Result link_uplink_task(void* link);
+// From loop(), between cycles: sends waiting control frames and feeds the
+// transmit buffer to the console as it drains.
+void link_poll(Link& link);
+
+}  // namespace fsw
+
+#endif  // FSW_LINK_H

@@ -1,0 +1,106 @@
+"""The ground end of a live link: reads the port into a Session (and a log),
+sends commands with fresh sequence numbers and waits for their
+acknowledgements."""
+
+from __future__ import annotations
+
+import time
+
+from . import wire
+from .log import RX, TX, LogWriter
+from .session import Event, Session
+
+
+class LinkTimeout(Exception):
+    pass
+
+
+class Ground:
+    def __init__(self, port, session: Session, log: LogWriter | None = None):
+        self.port = port
+        self.session = session
+        self.log = log
+        self.events: list[Event] = []  # decoded, not yet taken by the caller
+        self._next_seq: int | None = None
+
+    def read(self, wait: float = 0.05) -> list[Event]:
+        """Bytes waiting on the port (at most `wait` seconds for the first)."""
+        port = self.port
+        n = port.in_waiting
+        data = port.read(n if n else 1) if wait else port.read(n)
+        if n == 0 and data:
+            more = port.in_waiting
+            if more:
+                data += port.read(more)
+        if data:
+            now = time.time_ns()
+            if self.log is not None:
+                self.log.record(RX, now, data)
+            self.events += self.session.feed(data, now / 1e9)
+        out, self.events = self.events, []
+        return out
+
+    def send(self, data: bytes) -> None:
+        if self.log is not None:
+            self.log.record(TX, time.time_ns(), data)
+        self.port.write(data)
+        self.port.flush()
+
+    def _seq(self) -> int:
+        s = self.session
+        known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
+        if self._next_seq is None:
+            self._next_seq = (max(known) + 1) & 0xFFFF if known else 1
+        if self._next_seq == 0:
+            self._next_seq = 1
+        return self._next_seq
+
+    def command(self, op: int, args: bytes = b"", tries: int = 3, timeout: float = 1.0,
+                on_event=None) -> dict:
+        """Sends a command until it is acknowledged; returns the ack's fields
+        (status 0: applied). A REPLAY answer carries the target's last
+        accepted number: the command is sent again after it."""
+        replays = 0
+        attempt = 0
+        while attempt < tries:
+            seq = self._seq()
+            self._next_seq = (seq + 1) & 0xFFFF
+            self.send(wire.uplink(op, seq, args))
+            deadline = time.monotonic() + timeout
+            ack = None
+            while ack is None and time.monotonic() < deadline:
+                for ev in self.read():  # every event is passed on, the ack's too
+                    if on_event is not None:
+                        on_event(ev)
+                    else:
+                        self.events.append(ev)
+                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq and ack is None:
+                        ack = ev.info
+            if ack is not None:
+                if ack["status"] == 1 and replays < 2:  # REPLAY: resynchronise on its last number
+                    self._next_seq = (ack["last_seq"] + 1) & 0xFFFF
+                    replays += 1
+                    continue
+                return ack
+            attempt += 1
+        raise LinkTimeout(f"no acknowledgement of `{wire.OP_NAMES.get(op, op)}` after {tries} tries")
+
+    def handshake(self, timeout: float = 3.0, on_event=None) -> dict:
+        """Asks for a hello (when the application has an uplink) and waits for
+        one; returns its fields."""
+        if self.session.layout.has_uplink:
+            self.send(b"\0")  # ends whatever partial frame the target holds
+            try:
+                self.command(wire.OP_HELLO, tries=3, timeout=timeout / 3, on_event=on_event)
+            except LinkTimeout:
+                pass
+        deadline = time.monotonic() + timeout
+        while self.session.hello is None and time.monotonic() < deadline:
+            for ev in self.read():
+                if on_event is not None:
+                    on_event(ev)
+                else:
+                    self.events.append(ev)
+        if self.session.hello is None:
+            raise LinkTimeout("no hello from the target")
+        return self.session.hello

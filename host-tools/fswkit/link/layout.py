@@ -1,0 +1,209 @@
+"""What the ground needs to decode a target's frames: the state vector
+layout, the streams with their batching, tasks, writable elements, state
+names and analog calibrations. Built from the checked application by the
+one front end (autocode), and saved as JSON at the head of every log so a
+log decodes without the configs."""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from fractions import Fraction
+
+FORMATS = {"I8": "b", "I16": "h", "I32": "i", "I64": "q", "U8": "B", "U16": "H", "U32": "I", "U64": "Q",
+           "F32": "f", "F64": "d", "bool": "B"}
+SIZES = {"I8": 1, "I16": 2, "I32": 4, "I64": 8, "U8": 1, "U16": 2, "U32": 4, "U64": 8, "F32": 4, "F64": 8,
+         "bool": 1}
+INT_RANGE = {"I8": (-2**7, 2**7 - 1), "I16": (-2**15, 2**15 - 1), "I32": (-2**31, 2**31 - 1),
+             "I64": (-2**63, 2**63 - 1), "U8": (0, 2**8 - 1), "U16": (0, 2**16 - 1), "U32": (0, 2**32 - 1),
+             "U64": (0, 2**64 - 1)}
+
+
+class LayoutError(Exception):
+    pass
+
+
+@dataclass(frozen=True)
+class Element:
+    index: int
+    name: str
+    type: str
+    offset: int
+    region: str
+
+    @property
+    def size(self) -> int:
+        return SIZES[self.type]
+
+
+@dataclass(frozen=True)
+class Region:
+    name: str
+    offset: int
+    size: int
+    elements: tuple[Element, ...]
+    struct: struct.Struct  # the region's elements, packed little-endian
+    bools: tuple[int, ...]  # positions of bool elements (stored as bytes, any non-zero is true)
+    names: tuple[str, ...]
+
+    def decode(self, data: bytes, at: int = 0) -> tuple:
+        vals = self.struct.unpack_from(data, at)
+        if not self.bools:
+            return vals
+        return self._fix(vals)
+
+    def decode_all(self, data: bytes) -> list[tuple]:
+        """Every sample of a batch (len(data) a multiple of the size)."""
+        vals = list(self.struct.iter_unpack(data))
+        if self.bools:
+            vals = [self._fix(v) for v in vals]
+        return vals
+
+    def _fix(self, vals: tuple) -> tuple:
+        v = list(vals)
+        for i in self.bools:
+            v[i] = v[i] != 0
+        return tuple(v)
+
+
+@dataclass(frozen=True)
+class Stream:
+    index: int
+    region: Region
+    rate: float  # samples per second
+    batch: int
+    period: float  # time units between two samples
+
+
+@dataclass(frozen=True)
+class Layout:
+    schema: int
+    name: str
+    sv_size: int
+    time_unit: str  # ms | us
+    rate: int
+    elements: tuple[Element, ...]
+    regions: tuple[Region, ...]
+    streams: tuple[Stream, ...]
+    tasks: tuple[tuple[str, str], ...]  # (name, kind)
+    writable: tuple[str, ...]
+    states: dict  # S element name -> {state id: state name}
+    analog: dict  # element name -> {pin, scale, offset, vref, bits}
+    health_payload: int
+    raw: dict  # the JSON form
+
+    def element(self, name: str) -> Element | None:
+        return next((e for e in self.elements if e.name == name), None)
+
+    def task_index(self, name: str) -> int | None:
+        return next((i for i, (n, _) in enumerate(self.tasks) if n == name), None)
+
+    @property
+    def has_uplink(self) -> bool:
+        return any(k == "uplink" for _, k in self.tasks)
+
+    def show(self, name: str, value) -> str:
+        """A value as the monitor shows it: state names for S, units detail."""
+        if value is None:
+            return "—"
+        if name in self.states:
+            st = self.states[name].get(int(value))
+            return f"{value} ({st})" if st else str(value)
+        if isinstance(value, bool):
+            return "true" if value else "false"
+        if isinstance(value, float):
+            return f"{value:.6g}"
+        return str(value)
+
+
+def _region(name, offset, size, elems) -> Region:
+    fmt = "<" + "".join(FORMATS[e.type] for e in elems)
+    if struct.calcsize(fmt) != size:
+        raise LayoutError(f"region `{name}`: elements add up to {struct.calcsize(fmt)} bytes, not {size}")
+    return Region(name, offset, size, tuple(elems), struct.Struct(fmt),
+                  tuple(i for i, e in enumerate(elems) if e.type == "bool"), tuple(e.name for e in elems))
+
+
+def from_dict(d: dict) -> Layout:
+    """A layout from its JSON form (a log header)."""
+    try:
+        elements = tuple(Element(i, e["name"], e["type"], e["offset"], e["region"])
+                         for i, e in enumerate(d["elements"]))
+        regions = tuple(_region(r["name"], r["offset"], r["size"],
+                                [e for e in elements if e.region == r["name"]]) for r in d["regions"])
+        by_name = {r.name: r for r in regions}
+        streams = tuple(Stream(i, by_name[s["region"]], float(Fraction(s["rate"])), s["batch"],
+                               float(Fraction(s["period"]))) for i, s in enumerate(d["streams"]))
+        return Layout(int(d["schema"]), d["name"], d["sv_size"], d["time_unit"], d["rate"], elements, regions,
+                      streams, tuple((t["name"], t["kind"]) for t in d["tasks"]), tuple(d["writable"]),
+                      {k: {int(i): n for i, n in v.items()} for k, v in d["states"].items()},
+                      d["analog"], d["health_payload"], d)
+    except (KeyError, TypeError, ValueError, ZeroDivisionError) as e:
+        raise LayoutError(f"not a link layout: {type(e).__name__}: {e}") from None
+
+
+def from_app(app) -> Layout:
+    """The layout of a checked application (fswkit.autocode.app.Application)."""
+    from fswkit.autocode.schema import app_schema_hash, link_plan
+
+    plan = link_plan(app)
+    per_second = 1000 if app.time_unit == "ms" else 1000000
+    tele_div = app.tasks[plan.telemetry_task].divider if plan.telemetry_task is not None else 1
+    streams = []
+    for s in plan.streams:
+        period = Fraction(s.every * tele_div * per_second, app.rate)
+        streams.append({"region": s.region.name, "rate": str(s.rate), "batch": s.batch, "period": str(period)})
+    states = {}
+    for m in app.machines:
+        states[m.vars[m.s].name] = {str(st.id): st.name for st in m.states}
+    analog = {}
+    for c in app.channels:
+        if c.analog:
+            analog[c.element.name] = {"pin": c.pin, "dir": c.direction, "scale": c.scale, "offset": c.offset,
+                                      "vref": app.board.adc_vref, "bits": app.board.adc_bits}
+    d = {
+        "schema": app_schema_hash(app),
+        "name": app.name,
+        "sv_size": app.sv.size,
+        "time_unit": app.time_unit,
+        "rate": app.rate,
+        "elements": [{"name": e.name, "type": e.type.name, "offset": e.offset, "region": e.region}
+                     for e in app.sv.elements],
+        "regions": [{"name": r.name, "offset": r.offset, "size": r.size} for r in app.sv.regions],
+        "streams": streams,
+        "tasks": [{"name": t.name, "kind": t.kind} for t in app.tasks],
+        "writable": [e.name for e in plan.writable],
+        "states": states,
+        "analog": analog,
+        "health_payload": plan.health_payload,
+    }
+    return from_dict(d)
+
+
+def encode_value(el: Element, text: str) -> bytes:
+    """The element's bytes for a value typed by a user; LayoutError with a
+    clear reason when the text is not a value of the element's type."""
+    t = el.type
+    if t == "bool":
+        v = text.strip().lower()
+        if v in ("true", "1"):
+            return b"\x01"
+        if v in ("false", "0"):
+            return b"\x00"
+        raise LayoutError(f"`{el.name}` is bool: give true, false, 1 or 0, not `{text}`")
+    if t in ("F32", "F64"):
+        try:
+            x = float(text)
+        except ValueError:
+            raise LayoutError(f"`{el.name}` is {t}: `{text}` is not a number") from None
+        if t == "F32" and abs(x) != float("inf") and x == x and abs(x) > 3.4028234663852886e38:
+            raise LayoutError(f"`{el.name}` is F32: {text} is out of its range")
+        return struct.pack("<" + FORMATS[t], x)
+    try:
+        v = int(text, 0)
+    except ValueError:
+        raise LayoutError(f"`{el.name}` is {t}: `{text}` is not a whole number") from None
+    lo, hi = INT_RANGE[t]
+    if not lo <= v <= hi:
+        raise LayoutError(f"`{el.name}` is {t}: {v} is outside {lo}..{hi}")
+    return struct.pack("<" + FORMATS[t], v)

@@ -1,0 +1,97 @@
+"""Link logs: an append-only binary file of the raw bytes that crossed the
+link, with host timestamps, headed by the layout the recording decoded with.
+Every chunk is written (unbuffered) as soon as it is read, so a Ctrl-C or a
+yanked cable loses nothing already received; the file is fsync'ed on close.
+
+    magic     8 bytes  b"FSWLOG1\\n"
+    header    u32 length + that many bytes of JSON: {"format": 1, "layout": {...}, ...}
+    records   dir u8 (0 from the target, 1 to the target), host time u64 (ns since
+              the Unix epoch), length u32, the bytes
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+
+from .layout import Layout, LayoutError, from_dict
+
+MAGIC = b"FSWLOG1\n"
+_REC = struct.Struct("<BQI")
+RX, TX = 0, 1
+
+
+class LogError(Exception):
+    pass
+
+
+class LogWriter:
+    def __init__(self, path: str, layout: Layout, **meta):
+        try:
+            self._fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_APPEND, 0o644)
+        except OSError as e:
+            raise LogError(f"cannot write {path}: {e.strerror or e}") from None
+        self.path = path
+        head = json.dumps({"format": 1, "layout": layout.raw, **meta}, sort_keys=True).encode()
+        self._write(MAGIC + struct.pack("<I", len(head)) + head)
+
+    def _write(self, data: bytes) -> None:
+        view = memoryview(data)
+        while view:
+            n = os.write(self._fd, view)
+            view = view[n:]
+
+    def record(self, direction: int, host_time_ns: int, data: bytes) -> None:
+        if data and self._fd is not None:
+            self._write(_REC.pack(direction, host_time_ns, len(data)) + data)
+
+    def close(self) -> None:
+        if self._fd is not None:
+            try:
+                os.fsync(self._fd)
+            except OSError:
+                pass
+            os.close(self._fd)
+            self._fd = None
+
+
+class LogReader:
+    """A log's layout and records. A record cut short (the recorder died
+    mid-write) ends the log: `truncated` says so."""
+
+    def __init__(self, path: str):
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except OSError as e:
+            raise LogError(f"cannot read {path}: {e.strerror or e}") from None
+        if not data.startswith(MAGIC) or len(data) < len(MAGIC) + 4:
+            raise LogError(f"{path}: not an fswkit link log (no FSWLOG1 header)")
+        (n,) = struct.unpack_from("<I", data, len(MAGIC))
+        start = len(MAGIC) + 4
+        try:
+            self.header = json.loads(data[start:start + n].decode())
+            self.layout = from_dict(self.header["layout"])
+        except (ValueError, KeyError, TypeError, LayoutError) as e:
+            raise LogError(f"{path}: damaged log header ({e})") from None
+        self._data = data
+        self._at = start + n
+        self.path = path
+        self.truncated = False
+
+    def records(self):
+        """(direction, host time in seconds, bytes) in recording order."""
+        data, at = self._data, self._at
+        size = _REC.size
+        while at < len(data):
+            if at + size > len(data):
+                self.truncated = True
+                return
+            d, t, n = _REC.unpack_from(data, at)
+            at += size
+            if at + n > len(data) or d not in (RX, TX):
+                self.truncated = True
+                return
+            yield d, t / 1e9, data[at:at + n]
+            at += n

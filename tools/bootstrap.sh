@@ -8,9 +8,10 @@ VENV=${VENV:-.venv}
 PYTHON=${PYTHON:-python3}
 
 # Debian packages: the AVR toolchain and Arduino core, the simulated board,
-# avrdude for flashing, graphviz to render `fsw graph`, valgrind for `make bench`.
+# avrdude for flashing, graphviz to render `fsw graph`, valgrind for `make bench`,
+# clang and its runtime (libFuzzer, sanitizers) for the uplink fuzzer.
 APT_PACKAGES=(gcc-avr avr-libc binutils-avr avrdude arduino-core-avr simavr libsimavr-dev
-              g++ make graphviz valgrind)
+              g++ make graphviz valgrind clang libclang-rt-14-dev)
 
 as_root() {
     if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi

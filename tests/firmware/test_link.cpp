@@ -1,0 +1,371 @@
+// Scenario: the serial link on the native PSL: CRC-16 and COBS, telemetry
+// frames (samples with batching, hello, health), the transmit path never
+// blocking (a full UART drops frames and counts them), and the uplink:
+// writable elements only, modes, replays, CRC errors, malformed, truncated
+// and oversized frames refused and counted, never acted on.
+#include "test_support.h"
+
+#include "fsw_cobs.h"
+#include "fsw_crc.h"
+#include "psl_native.h"
+
+using namespace fsw;
+
+// sv: Sensors = U32 a @0, F32 b @4 (8 bytes); Cmd = U8 mode @8, bool flag @9,
+// I16 level @10, F64 gain @12 (12 bytes); 20 bytes.
+static uint8_t sv[20];
+static uint8_t store0[8];
+static LinkStreamState states[2];
+static uint8_t tx[96];
+static TaskStats stats[2];
+static Executor ex;
+static Link link;
+static uint64_t clock_ms;
+
+static uint64_t now_fn() { return clock_ms; }
+
+static const Task kTasks[2] FSW_FLASH = {
+    {link_uplink_task, 0, &link, 1, 0, kNoElement, kNoElement, kNoElement, kModeEnabled},
+    {link_telemetry_task, 0, &link, 1, 0, 8, kNoElement, kNoElement, kModeEnabled},
+};
+static const LinkStream kStreams[2] FSW_FLASH = {
+    {0, 8, 1, 2, store0},  // Sensors every run, 2 per frame
+    {8, 12, 4, 1, 0},      // Cmd every 4th run
+};
+// writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
+static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
+static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
+                                             115200UL, 20, 96, 10, 20, 2, 3, 3, 0, false};
+
+static uint8_t out[8192];
+static uint16_t out_len;
+
+void setUp(void) {
+    native::sim_reset();
+    memset(sv, 0, sizeof sv);
+    clock_ms = 1000;
+    native::console_capture(out, sizeof out, &out_len);
+    const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 2, false};
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, cfg));
+    TEST_ASSERT_EQUAL(kOk, link_begin(link, &kConfig));
+}
+void tearDown(void) {}
+
+// ---- a tiny ground: split the captured bytes into verified frames ------------
+struct Frame {
+    uint8_t body[128];
+    int16_t len;  // body length without CRC; -1 bad
+};
+static Frame frames[64];
+static uint8_t n_frames;
+
+static void collect() {
+    n_frames = 0;
+    uint16_t start = 0;
+    for (uint16_t i = 0; i < out_len && n_frames < 64; ++i) {
+        if (out[i] != 0) continue;
+        Frame& f = frames[n_frames++];
+        const uint16_t n = static_cast<uint16_t>(i - start);
+        memcpy(f.body, out + start, n);
+        int16_t d = cobs_decode(f.body, n);
+        f.len = (d >= 8 && crc16(f.body, static_cast<uint16_t>(d)) == 0) ? static_cast<int16_t>(d - 2) : -1;
+        start = static_cast<uint16_t>(i + 1);
+    }
+    out_len = 0;
+}
+
+static const Frame* find(uint8_t type, uint8_t nth = 0) {
+    for (uint8_t i = 0; i < n_frames; ++i) {
+        if (frames[i].len >= 0 && frames[i].body[0] == type && nth-- == 0) return &frames[i];
+    }
+    return 0;
+}
+
+static void run(uint16_t cycles) {
+    for (uint16_t i = 0; i < cycles; ++i) {
+        executor_run_cycle(ex);
+        clock_ms += 10;
+        link_poll(link);
+    }
+}
+
+static void send_cmd(uint8_t op, uint16_t seq, const uint8_t* args, uint8_t n) {
+    uint8_t raw[64];
+    CobsEncoder e;
+    cobs_begin(e, raw);
+    cobs_put(e, op);
+    cobs_put_u16(e, seq);
+    cobs_put_bytes(e, args, n);
+    const uint16_t len = cobs_end(e);
+    native::console_feed(raw, len);
+}
+
+// The status of the last ack for command `seq`, or -1.
+static int ack_status(uint16_t seq) {
+    collect();
+    int st = -1;
+    for (uint8_t i = 0; i < n_frames; ++i) {
+        const Frame& f = frames[i];
+        if (f.len == 12 && f.body[0] == kFrameAck && (f.body[6] | (f.body[7] << 8)) == seq) st = f.body[9];
+    }
+    return st;
+}
+
+// ---- CRC and COBS ------------------------------------------------------------
+
+static void test_crc_is_ccitt_false(void) {
+    const uint8_t check[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    TEST_ASSERT_EQUAL_HEX16(0x29B1, crc16(check, 9));  // binascii.crc_hqx(b"123456789", 0xFFFF)
+}
+
+static void test_cobs_roundtrip_and_limits(void) {
+    static uint8_t raw[600], enc[700];
+    uint32_t x = 12345;
+    for (uint16_t n = 0; n < 600; n = static_cast<uint16_t>(n + 7)) {
+        for (uint16_t i = 0; i < n; ++i) {
+            x = x * 1103515245u + 12345u;
+            raw[i] = (x >> 16) % 3 == 0 ? 0 : static_cast<uint8_t>(x >> 8);
+        }
+        CobsEncoder e;
+        cobs_begin(e, enc);
+        cobs_put_bytes(e, raw, n);
+        const uint16_t len = cobs_end(e);
+        TEST_ASSERT_TRUE(len <= cobs_max_encoded(static_cast<uint16_t>(n + 2)));
+        TEST_ASSERT_EQUAL_UINT8(0, enc[len - 1]);
+        for (uint16_t i = 0; i + 1 < len; ++i) TEST_ASSERT_NOT_EQUAL(0, enc[i]);
+        const int16_t d = cobs_decode(enc, static_cast<uint16_t>(len - 1));
+        TEST_ASSERT_EQUAL_INT16(n + 2, d);
+        if (n != 0) TEST_ASSERT_EQUAL_MEMORY(raw, enc, n);
+        TEST_ASSERT_EQUAL_UINT16(0, crc16(enc, static_cast<uint16_t>(d)));
+    }
+    uint8_t bad[] = {5, 1, 2};  // a block that runs past the end
+    TEST_ASSERT_EQUAL_INT16(-1, cobs_decode(bad, 3));
+    uint8_t zero[] = {3, 0, 1};
+    TEST_ASSERT_EQUAL_INT16(-1, cobs_decode(zero, 3));
+}
+
+// ---- telemetry -------------------------------------------------------------------
+
+static void test_boot_hello_carries_the_schema(void) {
+    run(1);
+    collect();
+    const Frame* h = find(kFrameHello);
+    TEST_ASSERT_NOT_NULL(h);
+    TEST_ASSERT_EQUAL_INT16(6 + 19, h->len);
+    TEST_ASSERT_EQUAL_UINT8(0, h->body[1]);  // the first frame
+    TEST_ASSERT_EQUAL_UINT8(kLinkProtocol, h->body[6]);
+    uint32_t schema;
+    memcpy(&schema, h->body + 7, 4);
+    TEST_ASSERT_EQUAL_HEX32(0xA5A55A5AUL, schema);
+}
+
+static void test_samples_batch_with_time_and_sequence(void) {
+    store<uint32_t>(sv + 0, 7);
+    run(1);  // hello, and the first Sensors sample goes to the batch store
+    store<uint32_t>(sv + 0, 8);
+    run(1);  // second sample: a frame of two
+    collect();
+    const Frame* f = find(kFrameSample | 0);
+    TEST_ASSERT_NOT_NULL(f);
+    TEST_ASSERT_EQUAL_INT16(6 + 16, f->len);
+    uint32_t t0;
+    memcpy(&t0, f->body + 2, 4);
+    TEST_ASSERT_EQUAL_UINT32(1000, t0);  // the first sample's time
+    TEST_ASSERT_EQUAL_UINT32(7, load<uint32_t>(f->body + 6));
+    TEST_ASSERT_EQUAL_UINT32(8, load<uint32_t>(f->body + 14));
+    // sequence numbers count every frame sent
+    for (uint8_t i = 0; i < n_frames; ++i) TEST_ASSERT_EQUAL_UINT8(i, frames[i].body[1]);
+}
+
+static void test_health_reports_tasks_and_counters(void) {
+    run(10);
+    collect();
+    const Frame* h = find(kFrameHealth);
+    TEST_ASSERT_NOT_NULL(h);
+    TEST_ASSERT_EQUAL_INT16(6 + 33 + 6 * 2, h->len);
+    TEST_ASSERT_EQUAL_UINT32(9, load<uint32_t>(h->body + 6 + 12));  // executor cycles so far
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, h->body[6 + 33]);         // task 0 mode
+}
+
+static void test_full_uart_drops_and_counts_never_blocks(void) {
+    native::console_model_uart(9600, 16);  // a slow link with a tiny buffer
+    run(200);
+    TEST_ASSERT_EQUAL_UINT32(0, native::console_overruns());  // never wrote past the space
+    TEST_ASSERT_TRUE(link.n.dropped > 0);
+    native::console_model_uart(0, 0);
+    // what was sent is a gap-free sequence of verified frames
+    collect();
+    for (uint8_t i = 1; i < n_frames; ++i) {
+        if (frames[i].len < 0) continue;
+        TEST_ASSERT_TRUE(frames[i].len >= 6);
+    }
+}
+
+// ---- uplink --------------------------------------------------------------------
+
+static void test_writable_element_is_written(void) {
+    run(1);
+    const uint8_t args[] = {4, 0, 0x34, 0x12};  // level = 0x1234
+    send_cmd(kOpSet, 1, args, 4);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckOk, ack_status(1));
+    TEST_ASSERT_EQUAL_INT16(0x1234, load<int16_t>(sv + 10));
+    const uint8_t b[] = {3, 0, 7};  // bool stored as 1
+    send_cmd(kOpSet, 2, b, 3);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckOk, ack_status(2));
+    TEST_ASSERT_EQUAL_UINT8(1, sv[9]);
+    TEST_ASSERT_EQUAL_UINT16(2, link.n.rx_ok);
+}
+
+static void test_every_other_element_is_refused(void) {
+    run(1);
+    uint16_t seq = 1;
+    for (uint16_t idx = 0; idx < 300; ++idx) {
+        if (idx == 3 || idx == 4 || idx == 5) continue;
+        const uint8_t args[] = {static_cast<uint8_t>(idx), static_cast<uint8_t>(idx >> 8), 1, 2, 3, 4};
+        memset(sv, 0, sizeof sv);
+        send_cmd(kOpSet, seq, args, 6);
+        run(1);
+        TEST_ASSERT_EQUAL(kAckNotWritable, ack_status(seq));
+        for (uint8_t i = 0; i < sizeof sv; ++i) {
+            if (i != 8) TEST_ASSERT_EQUAL_UINT8(0, sv[i]);  // 8: the telemetry task's mode
+        }
+        ++seq;
+    }
+    TEST_ASSERT_EQUAL_UINT16(0, link.n.rx_ok);
+}
+
+static void test_wrong_length_is_refused(void) {
+    run(1);
+    const uint8_t args[] = {5, 0, 1, 2, 3};  // gain is F64: 8 bytes, not 3
+    send_cmd(kOpSet, 1, args, 5);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckBadLength, ack_status(1));
+    TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_malformed);
+}
+
+static void test_replayed_frame_is_refused(void) {
+    run(1);
+    const uint8_t args[] = {4, 0, 1, 0};
+    send_cmd(kOpSet, 5, args, 4);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckOk, ack_status(5));
+    sv[10] = 0;
+    send_cmd(kOpSet, 5, args, 4);  // the same frame again
+    run(1);
+    TEST_ASSERT_EQUAL(kAckReplay, ack_status(5));
+    send_cmd(kOpSet, 3, args, 4);  // an older one
+    run(1);
+    TEST_ASSERT_EQUAL(kAckReplay, ack_status(3));
+    TEST_ASSERT_EQUAL_UINT8(0, sv[10]);
+    TEST_ASSERT_EQUAL_UINT16(2, link.n.rx_replayed);
+}
+
+static void test_mode_commands(void) {
+    run(1);
+    const uint8_t safe[] = {1, kModeSafed};
+    send_cmd(kOpMode, 1, safe, 2);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckOk, ack_status(1));
+    TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[8]);  // the telemetry task's mode element
+    const uint8_t lock[] = {0, kModeDisabled};  // the uplink task itself
+    send_cmd(kOpMode, 2, lock, 2);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckLocked, ack_status(2));
+    const uint8_t bad_task[] = {2, kModeEnabled};
+    send_cmd(kOpMode, 3, bad_task, 2);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckBadTask, ack_status(3));
+    const uint8_t bad_mode[] = {1, 3};
+    send_cmd(kOpMode, 4, bad_mode, 2);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckBadMode, ack_status(4));
+    TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[8]);
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, executor_task_mode(ex, 0));
+}
+
+static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
+    run(1);
+    // CRC error: a valid SET with one bit flipped
+    uint8_t raw[64];
+    CobsEncoder e;
+    cobs_begin(e, raw);
+    cobs_put(e, kOpSet);
+    cobs_put_u16(e, 1);
+    const uint8_t args[] = {4, 0, 9, 9};
+    cobs_put_bytes(e, args, 4);
+    uint16_t len = cobs_end(e);
+    raw[2] ^= 0x10;  // the sequence number's low byte
+    native::console_feed(raw, len);
+    // truncated: the first half of a frame, then a delimiter
+    send_cmd(kOpSet, 2, args, 4);  // a good frame between the bad ones
+    uint8_t cut[] = {0x05, 0x04, 0x02, 0x00};
+    native::console_feed(cut, 4);
+    // oversized: 40 non-zero bytes then a delimiter
+    uint8_t big[41];
+    memset(big, 0x11, 40);
+    big[40] = 0;
+    native::console_feed(big, 41);
+    // garbage: zeros and noise
+    const uint8_t noise[] = {0, 0, 0x80, 0xFF, 0x01, 0};
+    native::console_feed(noise, sizeof noise);
+    run(3);
+    TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_crc);
+    TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_oversized);
+    TEST_ASSERT_TRUE(link.n.rx_malformed >= 2);
+    TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_ok);  // only the well-formed SET of seq 2
+    TEST_ASSERT_EQUAL_INT16(0x0909, load<int16_t>(sv + 10));
+}
+
+static void test_ping_hello_snapshot(void) {
+    run(1);
+    collect();
+    send_cmd(kOpPing, 1, 0, 0);
+    send_cmd(kOpHello, 2, 0, 0);
+    send_cmd(kOpSnapshot, 3, 0, 0);
+    run(2);
+    collect();
+    uint8_t acks = 0, hellos = 0;
+    uint16_t covered = 0;
+    for (uint8_t i = 0; i < n_frames; ++i) {
+        if (frames[i].len < 0) continue;
+        if (frames[i].body[0] == kFrameAck) ++acks;
+        if (frames[i].body[0] == kFrameHello) ++hellos;
+        if (frames[i].body[0] == kFrameSnapshot) {
+            TEST_ASSERT_EQUAL_UINT16(covered, load<uint16_t>(frames[i].body + 6));
+            covered = static_cast<uint16_t>(covered + frames[i].len - 8);
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT8(3, acks);
+    TEST_ASSERT_EQUAL_UINT8(1, hellos);
+    TEST_ASSERT_EQUAL_UINT16(20, covered);
+}
+
+static void test_bad_config_is_refused(void) {
+    static const LinkStream kBad[1] FSW_FLASH = {{16, 8, 1, 1, 0}};  // runs past the state vector
+    static const LinkConfig kBadCfg FSW_FLASH = {sv, kBad, states, 0, &ex, now_fn, tx, 0, 115200UL, 20, 96,
+                                                 10, 20, 1, 0, 3, 0, false};
+    Link l;
+    TEST_ASSERT_EQUAL(kErrConfig, link_begin(l, &kBadCfg));
+}
+
+static void run_all(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_crc_is_ccitt_false);
+    RUN_TEST(test_cobs_roundtrip_and_limits);
+    RUN_TEST(test_boot_hello_carries_the_schema);
+    RUN_TEST(test_samples_batch_with_time_and_sequence);
+    RUN_TEST(test_health_reports_tasks_and_counters);
+    RUN_TEST(test_full_uart_drops_and_counts_never_blocks);
+    RUN_TEST(test_writable_element_is_written);
+    RUN_TEST(test_every_other_element_is_refused);
+    RUN_TEST(test_wrong_length_is_refused);
+    RUN_TEST(test_replayed_frame_is_refused);
+    RUN_TEST(test_mode_commands);
+    RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
+    RUN_TEST(test_ping_hello_snapshot);
+    RUN_TEST(test_bad_config_is_refused);
+}
+
+FSW_TEST_MAIN(run_all)

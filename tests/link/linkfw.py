@@ -1,0 +1,76 @@
+"""Helpers for the link tests: the tank example built for the host, run on
+a pseudo-terminal (a serial port for the ground tools) or on the simulated
+clock with its link bytes captured."""
+
+from __future__ import annotations
+
+import os
+import pty
+import shutil
+import subprocess
+import tty
+from pathlib import Path
+
+from conftest import EXAMPLES, run_fsw
+
+TANK = EXAMPLES / "tank"
+
+
+def build_native(project: Path, out: Path) -> Path:
+    r = run_fsw("build", str(project), "--board", "native", "--out", str(out))
+    assert r.code == 0, r.err
+    return out / "tank"
+
+
+def tank_layout(project: Path = TANK):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.build import load
+    from fswkit.link.layout import from_app
+
+    return from_app(load(str(project), Diagnostics()))
+
+
+def volts_psi(raw: int) -> float:
+    """tank.aio's calibration in binary64 (the native build's R)."""
+    return raw * 5.0 / 1023.0 * 250.0 + -125.0
+
+
+class PtyTarget:
+    """The host build of the firmware with its console on a pty: the pty's
+    slave path is the port the ground tools open."""
+
+    def __init__(self, exe: Path, *args: str):
+        master, slave = pty.openpty()
+        tty.setraw(slave)
+        self.port = os.ttyname(slave)
+        self._slave = slave
+        self.proc = subprocess.Popen([str(exe), *args], stdin=master, stdout=master, stderr=subprocess.DEVNULL)
+        os.close(master)
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(timeout=5)
+
+    def close(self) -> None:
+        self.stop()
+        os.close(self._slave)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def needs_cxx():
+    import pytest
+
+    return pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
+
+
+def simulated_link(exe: Path, cycles: int, *args: str) -> bytes:
+    """The link bytes of `cycles` executor cycles on the simulated clock."""
+    r = subprocess.run([str(exe), str(cycles), "--link", *args], capture_output=True, check=True)
+    assert b"console overruns: 0" in r.stderr, r.stderr
+    return r.stdout

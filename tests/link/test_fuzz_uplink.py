@@ -1,0 +1,19 @@
+"""A short run of the uplink parser's libFuzzer target (ASan + UBSan) with
+the invariants of docs/security.md; `make fuzz` runs 10,000,000 inputs."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+
+import pytest
+
+from conftest import ROOT
+
+
+@pytest.mark.skipif(shutil.which("clang++") is None, reason="clang is not installed (make setup installs it)")
+def test_uplink_fuzz_short_run():
+    r = subprocess.run(["make", "--no-print-directory", "-C", str(ROOT), "fuzz-uplink", "FUZZ_RUNS=200000"],
+                       capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0 and "uplink fuzz: 1 passed, 0 failed" in r.stdout, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "stat::number_of_executed_units: 200000" in r.stdout

@@ -249,6 +249,14 @@ def cmd_build(args) -> int:
     return EXIT_OK
 
 
+# ---- fsw sim ------------------------------------------------------------------------------
+
+def cmd_sim(args) -> int:
+    from fswkit.sim import main as sim_main
+
+    return sim_main(args)
+
+
 # ---- the serial link: fsw monitor / cmd / log2csv / replay / plot ----------------------
 
 def _link_layout(project: str, command: str):
@@ -392,6 +400,16 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--board", help="build for this board instead of the one the .app names")
     b.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
     b.set_defaults(func=cmd_build)
+
+    sm = sub.add_parser("sim", help="build and run the firmware on a simulated board, UART0 on a pty")
+    sm.add_argument("project", metavar="PROJECT", help="a folder with one .app, the .app file, or a firmware .elf")
+    sm.add_argument("--board", help="simulate this board (uno, mega2560, ...) instead of the one the .app names")
+    sm.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this much simulated time")
+    sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
+    sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
+    sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")
+    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    sm.set_defaults(func=cmd_sim)
 
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
     s.add_argument("machine", metavar="MACHINE.sm")

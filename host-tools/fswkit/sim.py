@@ -1,0 +1,698 @@
+"""The simulated board: a firmware ELF running on simavr, driven from Python.
+
+`SimBoard` starts the harness (`sim_harness.c`, compiled with the host's gcc
+against libsimavr on first use and cached like the native runner) and speaks
+its control protocol (docs/sim.md): advance simulated time in lock-step or let
+the board run free, set analog inputs in volts, read and drive digital pins,
+timestamp pin edges in cycles, read PWM duty, exchange UART bytes through the
+control channel or a pseudo-terminal, and read simulated time and cycles.
+
+    with SimBoard("examples/tank/build/uno/tank.elf", "uno") as b:
+        b.set_analog("A0", 3.7)          # 800 psi
+        b.run_for(0.1)                   # simulated seconds
+        assert b.digital(4)              # the vent valve is open
+
+`fsw sim` (`main`) builds a project, bridges UART0 to a pty and runs the
+board in real time until Ctrl-C or `--duration`.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+
+from fswkit.autocode.board import Board, BoardError, load_board
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+HARNESS_SRC = os.path.join(HERE, "sim_harness.c")
+CC = os.environ.get("CC", "gcc")
+CFLAGS = ["-std=gnu11", "-O2", "-Wall", "-Wextra"]  # the tests add -Werror
+LIBS = ["-lsimavr", "-lutil"]
+SIMAVR_HEADER = "/usr/include/simavr/sim_avr.h"
+ARDUINO = "/usr/share/arduino/hardware/arduino/avr"
+PROTO_VERSION = 1
+
+# AVR ELF e_flags architecture numbers (binutils' EF_AVR_MACH) of the MCUs
+# the boards use: an ELF built for another MCU class is refused up front.
+AVR_ARCH = {"atmega328p": 5, "atmega168": 5, "atmega2560": 6, "atmega1280": 5}
+AVR_ARCH_NAMES = {2: "avr2", 25: "avr25", 3: "avr3", 31: "avr31", 35: "avr35", 4: "avr4", 5: "avr5",
+                  51: "avr51", 6: "avr6", 100: "avrtiny", 102: "avrxmega2", 104: "avrxmega4",
+                  106: "avrxmega6"}
+
+# PWM outputs of the Arduino timers: timer channel (as pins_arduino.h names
+# it) -> (TCCRnA data address, its COMnx1 bit, OCRnx data address). The
+# addresses are those of the ATmega328P and ATmega2560 datasheets (equal
+# where both MCUs have the timer).
+TIMER_CHANNELS = {
+    "TIMER0A": (0x44, 7, 0x47), "TIMER0B": (0x44, 5, 0x48),
+    "TIMER1A": (0x80, 7, 0x88), "TIMER1B": (0x80, 5, 0x8A), "TIMER1C": (0x80, 3, 0x8C),
+    "TIMER2A": (0xB0, 7, 0xB3), "TIMER2B": (0xB0, 5, 0xB4),
+    "TIMER3A": (0x90, 7, 0x98), "TIMER3B": (0x90, 5, 0x9A), "TIMER3C": (0x90, 3, 0x9C),
+    "TIMER4A": (0xA0, 7, 0xA8), "TIMER4B": (0xA0, 5, 0xAA), "TIMER4C": (0xA0, 3, 0xAC),
+    "TIMER5A": (0x120, 7, 0x128), "TIMER5B": (0x120, 5, 0x12A), "TIMER5C": (0x120, 3, 0x12C),
+}
+
+STOP_REASONS = ("target", "sim-limit", "wall-limit", "done", "crashed", "interrupted")
+
+
+class SimError(Exception):
+    """The board cannot be simulated as asked (a message for the user)."""
+
+
+# ---- the harness ------------------------------------------------------------------
+
+def cache_dir() -> str:
+    base = os.environ.get("FSW_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "fswkit")
+    return os.path.join(base, "sim")
+
+
+def harness() -> str:
+    """The harness executable, compiled on first use and cached by the hash
+    of its source and compiler command."""
+    with open(HARNESS_SRC, "rb") as f:
+        src = f.read()
+    h = hashlib.sha256(src + "\0".join([CC] + CFLAGS + LIBS).encode()).hexdigest()[:20]
+    out = os.path.join(cache_dir(), h)
+    exe = os.path.join(out, "simboard")
+    if os.path.exists(exe):
+        return exe
+    if shutil.which(CC) is None:
+        raise SimError(f"no host C compiler `{CC}` to build the simulated board (install gcc, or set CC)")
+    if not os.path.exists(SIMAVR_HEADER):
+        raise SimError("simavr's development files are missing: install libsimavr-dev (`make setup`)")
+    tmp = out + f".tmp{os.getpid()}"
+    try:
+        os.makedirs(tmp, exist_ok=True)
+    except OSError as e:
+        raise SimError(f"cannot create the simulated board's cache folder {tmp}: {e.strerror or e} "
+                       "(set FSW_CACHE_DIR to a writable folder)") from None
+    r = subprocess.run([CC] + CFLAGS + [HARNESS_SRC, "-o", os.path.join(tmp, "simboard")] + LIBS,
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise SimError("the simulated board did not compile against this machine's simavr:\n" + r.stderr[-3000:])
+    try:
+        os.replace(tmp, out)
+    except OSError:  # another process built it first
+        shutil.rmtree(tmp, ignore_errors=True)
+    return exe
+
+
+# ---- boards and pins ----------------------------------------------------------------
+
+def sim_board(board: str | Board) -> Board:
+    """A board that has a simulated MCU; SimError otherwise."""
+    if isinstance(board, str):
+        try:
+            board = load_board(board)
+        except BoardError as e:
+            raise SimError(str(e)) from None
+    if not board.raw.get("sim", {}).get("simavr_mcu"):
+        raise SimError(f"board `{board.name}` has no simulated MCU (its [sim] simavr_mcu is empty): "
+                       "simulate an AVR board such as uno or mega2560")
+    return board
+
+
+@dataclass(frozen=True)
+class PinMap:
+    """Where a board's Arduino pins are on the MCU, from the Arduino core's
+    pins_arduino.h for the board's variant (the table the firmware is built
+    with)."""
+
+    digital: dict[int, tuple[str, int]]  # pin -> (port letter, bit)
+    timers: dict[int, str]  # PWM pin -> timer channel (TIMER0A ...)
+    analog: dict[str, int]  # "A0" -> ADC channel
+
+    def pin_of(self, port: str, bit: int) -> int | None:
+        for p, pb in self.digital.items():
+            if pb == (port, bit):
+                return p
+        return None
+
+
+def _array(text: str, name: str) -> list[str]:
+    m = re.search(r"\b" + name + r"\s*\[\s*\]\s*=\s*\{(.*?)\}\s*;", text, re.S)
+    if not m:
+        raise SimError(f"pins_arduino.h has no {name}")
+    body = re.sub(r"/\*.*?\*/", "", m.group(1), flags=re.S)
+    body = re.sub(r"//[^\n]*", "", body)
+    return [t.strip() for t in body.split(",") if t.strip()]
+
+
+@functools.lru_cache(maxsize=None)
+def _variant_tables(mcu: str, variant: str) -> tuple[tuple, tuple, tuple]:
+    vdir = os.path.join(ARDUINO, "variants", variant)
+    if not os.path.isfile(os.path.join(vdir, "pins_arduino.h")):
+        raise SimError(f"the Arduino core's variant `{variant}` is not installed ({vdir}): run `make setup`")
+    if shutil.which("avr-gcc") is None:
+        raise SimError("`avr-gcc` is not installed: run `make setup` (or tools/bootstrap.sh)")
+    # Conditionals resolved for this MCU, macros left as written.
+    r = subprocess.run(["avr-gcc", "-E", "-fdirectives-only", f"-mmcu={mcu}", "-DARDUINO_MAIN", "-I", vdir,
+                        "-I", os.path.join(ARDUINO, "cores", "arduino"), "-x", "c++", "-"],
+                       input="#include <pins_arduino.h>\n", capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SimError(f"cannot read the pin table of variant `{variant}`: {r.stderr.strip()[-500:]}")
+    return (tuple(_array(r.stdout, "digital_pin_to_port_PGM")), tuple(_array(r.stdout, "digital_pin_to_bit_mask_PGM")),
+            tuple(_array(r.stdout, "digital_pin_to_timer_PGM")))
+
+
+def pin_map(board: Board) -> PinMap:
+    ports, masks, timers = _variant_tables(board.raw["sim"]["simavr_mcu"],
+                                           board.raw.get("arduino", {}).get("variant") or "standard")
+    digital, pwm = {}, {}
+    for pin, (port, mask) in enumerate(zip(ports, masks)):
+        pm = re.fullmatch(r"P([A-L])", port)
+        bm = re.fullmatch(r"_BV\(\s*(\d)\s*\)", mask)
+        if pm is None or bm is None:  # NOT_A_PORT and the like
+            continue
+        digital[pin] = (pm.group(1), int(bm.group(1)))
+        if pin < len(timers) and timers[pin] in TIMER_CHANNELS:
+            pwm[pin] = timers[pin]
+    analog = {}
+    for name in board.analog_pins:
+        m = re.fullmatch(r"A(\d+)", name)
+        if m:
+            analog[name] = int(m.group(1))
+    return PinMap(digital, pwm, analog)
+
+
+# ---- ELF checks -----------------------------------------------------------------------
+
+def check_elf(path: str, mcu: str) -> None:
+    """SimError unless `path` is an AVR ELF executable for `mcu`'s class."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(52)
+    except FileNotFoundError:
+        raise SimError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise SimError(f"{path}: a folder, not a firmware ELF") from None
+    except OSError as e:
+        raise SimError(f"{path}: {e.strerror or e}") from None
+    if len(head) < 52 or head[:4] != b"\x7fELF":
+        raise SimError(f"{path}: not an ELF file (a firmware .elf from `fsw build` is needed)")
+    if head[4] != 1 or head[5] != 1:
+        raise SimError(f"{path}: not a 32-bit little-endian ELF, so not AVR firmware")
+    e_type, e_machine = struct.unpack_from("<HH", head, 16)
+    (e_flags,) = struct.unpack_from("<I", head, 36)
+    if e_machine != 83:
+        raise SimError(f"{path}: an ELF for another processor (machine {e_machine}), not AVR firmware")
+    if e_type != 2:
+        raise SimError(f"{path}: an AVR object file, not a linked firmware executable")
+    arch = e_flags & 0x7F
+    want = AVR_ARCH.get(mcu)
+    if want is not None and arch and arch != want:
+        raise SimError(f"{path}: built for {AVR_ARCH_NAMES.get(arch, f'AVR architecture {arch}')}, "
+                       f"not for the {mcu} ({AVR_ARCH_NAMES[want]}): build it for this board")
+
+
+# ---- the board ------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class RunResult:
+    """Where a run stopped: the cycle, simulated seconds, the CPU's state
+    (running, sleeping, done, crashed) and why (one of STOP_REASONS)."""
+
+    cycle: int
+    time: float
+    state: str
+    stop: str
+
+
+@dataclass(frozen=True)
+class Edge:
+    cycle: int
+    pin: int | None  # Arduino pin number (None: a port bit no pin maps to)
+    port: str
+    bit: int
+    level: bool
+
+
+def _fields(line: str) -> dict[str, str]:
+    return dict(t.split("=", 1) for t in line.split()[1:] if "=" in t)
+
+
+class SimBoard:
+    """A simulated board running one firmware ELF (see the module docstring).
+
+    uart: "control" (bytes through `uart_read`/`uart_write`), "pty" (a
+    pseudo-terminal whose path is `port`) or "none". sim_limit / wall_limit:
+    seconds of simulated time / of wall-clock time since start after which
+    every run stops (None: no limit). analog: initial volts per analog pin,
+    set before the first instruction runs. link: with a pty, also make this
+    path a symbolic link to it.
+    """
+
+    def __init__(self, elf: str, board: str | Board = "uno", *, uart: str = "control",
+                 sim_limit: float | None = None, wall_limit: float | None = None,
+                 analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None):
+        self.board = sim_board(board)
+        self.mcu = self.board.raw["sim"]["simavr_mcu"]
+        self.f_cpu = int(f_cpu or self.board.f_cpu)
+        self.pins = pin_map(self.board)
+        if uart not in ("control", "pty", "none"):
+            raise ValueError(f"uart must be control, pty or none, not {uart!r}")
+        self.uart = uart
+        check_elf(elf, self.mcu)
+        self.elf = elf
+        args = [harness(), "-c", "-m", self.mcu, "-f", str(self.f_cpu), "-u", uart]
+        if sim_limit is not None:
+            args += ["-t", repr(float(sim_limit))]
+        if wall_limit is not None:
+            args += ["-w", repr(float(wall_limit))]
+        if link:
+            args += ["-l", link]
+        for pin, volts in (analog or {}).items():
+            args += ["-a", f"{self.adc_channel(pin)}={self._millivolts(volts)}"]
+        self._err = tempfile.TemporaryFile()
+        try:
+            self._proc = subprocess.Popen(args + [elf], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                          stderr=self._err, bufsize=0, preexec_fn=_ignore_sigint)
+        except OSError as e:
+            self._err.close()
+            raise SimError(f"cannot start the simulated board: {e.strerror or e}") from None
+        self._out = self._proc.stdout
+        self._closed = False
+        try:
+            f = _fields(self._read())
+            if f.get("proto") != str(PROTO_VERSION):
+                raise SimError(f"the simulated board speaks protocol {f.get('proto')}, not {PROTO_VERSION}")
+        except BaseException:
+            self.close()
+            raise
+        self.port: str | None = f.get("port")
+        self.cycle = 0
+
+    # -- plumbing --
+    def _stderr(self) -> str:
+        try:
+            self._err.seek(0)
+            return self._err.read().decode(errors="replace").strip()
+        except (OSError, ValueError):
+            return ""
+
+    def _read(self) -> str:
+        """The next response; SimError for an `err` response."""
+        text = self._read_line()
+        if text.startswith("err"):
+            raise SimError(text[4:])
+        return text
+
+    def _read_line(self) -> str:
+        line = self._out.readline()
+        if not line:
+            code = self._proc.wait()
+            msg = self._stderr() or f"the simulated board exited (status {code})"
+            self._closed = True
+            raise SimError(msg.replace("simboard: ", "", 1) if msg.startswith("simboard: ") else msg)
+        return line.decode(errors="replace").rstrip("\n")
+
+    def _send(self, text: str) -> None:
+        if self._closed:
+            raise SimError("the simulated board has stopped")
+        try:
+            self._proc.stdin.write(text.encode())
+        except (BrokenPipeError, OSError):
+            self._read()  # raises with the board's last words
+            raise SimError("the simulated board went away")
+
+    def command(self, line: str) -> str:
+        """Sends one protocol command; returns its `ok ...` response."""
+        self._send(line + "\n")
+        return self._read()
+
+    def exchange(self, lines: list[str]) -> list[str]:
+        """Sends several commands in one write and reads their responses:
+        one pipe round trip for a whole co-simulation step."""
+        self._send("".join(line + "\n" for line in lines))
+        out = [self._read_line() for _ in lines]  # all of them, so the channel stays in step
+        for line in out:
+            if line.startswith("err"):
+                raise SimError(line[4:])
+        return out
+
+    def _run_result(self, line: str) -> RunResult:
+        f = _fields(line)
+        self.cycle = int(f["cycle"])
+        return RunResult(self.cycle, float(f["time"]), f["state"], f["stop"])
+
+    # -- time --
+    @property
+    def time(self) -> float:
+        """Simulated seconds since reset (as of the last run)."""
+        return self.cycle / self.f_cpu
+
+    def cycles_for(self, seconds: float) -> int:
+        return int(round(seconds * self.f_cpu))
+
+    def step(self, cycles: int, analog: dict[str, float] | None = None) -> RunResult:
+        """Sets analog inputs (volts), then runs `cycles` more cycles, in one round trip."""
+        lines = [f"adc {self.adc_channel(p)} {self._millivolts(v)}" for p, v in (analog or {}).items()]
+        lines.append(f"step {int(cycles)}")
+        return self._run_result(self.exchange(lines)[-1])
+
+    def until(self, cycle: int) -> RunResult:
+        """Runs until the absolute cycle count `cycle`."""
+        return self._run_result(self.command(f"until {int(cycle)}"))
+
+    def run_for(self, seconds: float) -> RunResult:
+        return self.step(self.cycles_for(seconds))
+
+    def go(self, until: float | None = None, realtime: bool = True) -> RunResult:
+        """Runs free, paced to the wall clock unless realtime=False, until
+        simulated second `until` (None: no end), a limit, or Ctrl-C
+        (stop="interrupted")."""
+        target = self.cycles_for(until) if until is not None else 0
+        if until is not None and target == 0:
+            target = 1
+        self._send(f"go {target} {'realtime' if realtime else 'fast'}\n")
+        try:
+            return self._run_result(self._read())
+        except KeyboardInterrupt:
+            # Ask the board to stop; it answers the `go`, then the `stop`.
+            self._send("stop\n")
+            result = None
+            while True:
+                line = self._read()
+                if " stop=" in line:
+                    result = self._run_result(line)
+                elif line.strip() == "ok":
+                    break
+            return result or self._run_result(self.command("step 0"))
+
+    def info(self) -> dict[str, str]:
+        return _fields(self.command("info"))
+
+    # -- analog inputs --
+    def adc_channel(self, pin: str | int) -> int:
+        """The ADC channel of an analog pin (`A0`, or its pin number)."""
+        if isinstance(pin, int) or (isinstance(pin, str) and pin.isdigit()):
+            names = [n for n, p in self.board.analog_pins.items() if p == int(pin)]
+            pin = names[0] if names else f"pin {pin}"
+        if pin not in self.pins.analog:
+            known = ", ".join(self.pins.analog)
+            raise SimError(f"board `{self.board.name}` has no analog input {pin} (it has {known})")
+        return self.pins.analog[pin]
+
+    def _millivolts(self, volts: float) -> int:
+        """Volts at an analog pin as the ADC sees them: clamped to 0..vref
+        (the converter saturates there), in millivolts."""
+        v = float(volts)
+        if v != v:
+            raise ValueError("analog input volts must be a number, not NaN")
+        return int(round(min(max(v, 0.0), self.board.adc_vref) * 1000))
+
+    def set_analog(self, pin: str | int, volts: float) -> None:
+        self.command(f"adc {self.adc_channel(pin)} {self._millivolts(volts)}")
+
+    # -- digital pins --
+    def _port_bit(self, pin: int) -> tuple[str, int]:
+        if pin not in self.pins.digital:
+            raise SimError(f"board `{self.board.name}` has no digital pin {pin}")
+        return self.pins.digital[pin]
+
+    def ports(self) -> dict[str, tuple[int, int, int]]:
+        """Every I/O port's (PORT, DDR, PIN) registers."""
+        out = {}
+        for tok in self.command("ports").split()[1:]:
+            name, regs = tok.split("=")
+            out[name] = tuple(int(x, 16) for x in regs.split(":"))
+        return out
+
+    def levels(self) -> dict[int, bool]:
+        """Every digital pin's level: the driven level of an output, the
+        sensed level of an input."""
+        regs = self.ports()
+        out = {}
+        for pin, (port, bit) in self.pins.digital.items():
+            if port in regs:
+                p, ddr, pin_reg = regs[port]
+                out[pin] = bool(((p if ddr >> bit & 1 else pin_reg) >> bit) & 1)
+        return out
+
+    def digital(self, pin: int) -> bool:
+        port, bit = self._port_bit(pin)
+        p, ddr, pin_reg = self.ports()[port]
+        return bool(((p if ddr >> bit & 1 else pin_reg) >> bit) & 1)
+
+    def is_output(self, pin: int) -> bool:
+        port, bit = self._port_bit(pin)
+        return bool(self.ports()[port][1] >> bit & 1)
+
+    def set_digital(self, pin: int, level: bool) -> None:
+        """Drives an input pin from outside (a switch, a plant's sensor)."""
+        port, bit = self._port_bit(pin)
+        self.command(f"din {port} {bit} {1 if level else 0}")
+
+    def watch(self, pin: int) -> None:
+        """Records this pin's edges, timestamped in cycles (see `edges`)."""
+        port, bit = self._port_bit(pin)
+        self.command(f"watch {port} {bit}")
+
+    def edges(self) -> list[Edge]:
+        """The edges of watched pins since the last call, oldest first."""
+        toks = self.command("edges").split()[1:]
+        f = dict(t.split("=", 1) for t in toks[:2])
+        if f.get("overflow") == "1":
+            raise SimError("more than 1,048,576 edges since the last read: read edges more often")
+        out = []
+        for t in toks[2:]:
+            where, rest = t.split("@")
+            cycle, level = rest.split("=")
+            port, bit = where[0], int(where[1:])
+            out.append(Edge(int(cycle), self.pins.pin_of(port, bit), port, bit, level == "1"))
+        return out
+
+    def pwm(self, pin: int) -> float:
+        """The duty (0..1) a pin outputs: OCR/255 while its timer drives it
+        (`analogWrite(pin, v)` with 0 < v < 255 gives v/255), else its digital
+        level (0 or 1)."""
+        timer = self.pins.timers.get(pin)
+        if timer is None:
+            raise SimError(f"pin {pin} of board `{self.board.name}` has no PWM")
+        tccr, com_bit, ocr = TIMER_CHANNELS[timer]
+        if self.peek(tccr, 1)[0] >> com_bit & 1:
+            return self.peek(ocr, 1)[0] / 255.0
+        return 1.0 if self.digital(pin) else 0.0
+
+    # -- UART0 --
+    def uart_read(self) -> bytes:
+        """Bytes the firmware sent since the last call (uart="control")."""
+        return bytes.fromhex(self.command("uart")[3:])
+
+    def uart_write(self, data: bytes) -> None:
+        """Queues bytes for the firmware's receiver (uart="control"); the
+        UART takes them at its baud rate as simulated time passes."""
+        for i in range(0, len(data), 8192):
+            self.command("send " + data[i:i + 8192].hex())
+
+    # -- memory --
+    def peek(self, address: int, count: int) -> bytes:
+        """`count` bytes of the MCU's data space (registers, I/O, RAM)."""
+        return bytes.fromhex(self.command(f"peek {int(address)} {int(count)}")[3:])
+
+    def symbol(self, name: str) -> tuple[int, int]:
+        """(data address, size) of a variable of the firmware, by its
+        (demangled) name, from the ELF's symbol table."""
+        r = subprocess.run(["avr-nm", "-S", "-C", self.elf], capture_output=True, text=True)
+        for line in r.stdout.splitlines():
+            parts = line.split(None, 3)
+            if len(parts) == 4 and parts[3] == name and parts[2].lower() in "bdgs":
+                addr = int(parts[0], 16)
+                if addr >= 0x800000:
+                    return addr - 0x800000, int(parts[1], 16)
+        raise SimError(f"{self.elf}: no variable `{name}`")
+
+    # -- end --
+    def close(self) -> int:
+        """Stops the board; returns the harness's exit status."""
+        if self._proc.poll() is None:
+            try:
+                if not self._closed:
+                    self._proc.stdin.write(b"quit\n")
+                self._proc.stdin.close()
+            except OSError:
+                pass
+            try:
+                self._proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                self._proc.kill()
+                self._proc.wait()
+        self._closed = True
+        try:
+            self._out.close()
+        except OSError:
+            pass
+        self._err.close()
+        return self._proc.returncode
+
+    def __enter__(self) -> "SimBoard":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self):
+        try:
+            if self._proc.poll() is None:
+                self._proc.kill()
+        except Exception:
+            pass
+
+
+def _ignore_sigint() -> None:
+    """The harness of a SimBoard ignores the terminal's Ctrl-C: its Python
+    owner decides (`go` asks it to stop)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+# ---- fsw sim ----------------------------------------------------------------------------
+
+def _say(text: str) -> None:
+    sys.stderr.write(f"fsw sim: {text}\n")
+    sys.stderr.flush()
+
+
+def _is_elf(path: str) -> bool:
+    try:
+        with open(path, "rb") as f:
+            return f.read(4) == b"\x7fELF"
+    except OSError:
+        return False
+
+
+def _build(args) -> tuple[str, Board] | int:
+    """Generates and builds the project for its (or --board's) board; the ELF
+    and board, or an exit status after saying why."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.build import BuildError, default_out, elf_size, load, make, write_files
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags, args.board)
+    except BuildError as e:
+        _say(str(e))
+        return 2
+    if diags.items:
+        sys.stderr.write(diags.render() + "\n")
+    if app is None:
+        return 2
+    try:
+        board = sim_board(app.board)
+    except SimError as e:
+        _say(str(e))
+        return 2
+    out = args.out or default_out(app)
+    try:
+        write_files(emit_app(app), os.path.join(out, "gen"))
+        elf, proc = make(app, out)
+    except GenError as e:
+        _say(str(e))
+        return 1
+    except BuildError as e:
+        _say(str(e))
+        return 1
+    except OSError as e:
+        _say(f"cannot write {e.filename or out}: {e.strerror or e}")
+        return 1
+    if proc.returncode != 0:
+        sys.stderr.write(proc.stdout[-2000:] + proc.stderr[-6000:])
+        _say("the build failed")
+        return 1
+    try:
+        flash, ram = elf_size(elf)
+    except BuildError as e:
+        _say(str(e))
+        return 1
+    if flash > board.flash or ram > board.ram:
+        _say(f"the firmware does not fit the {board.name} ({flash:,} B flash, {ram:,} B RAM): see `fsw build`")
+        return 1
+    _say(f"built {elf} for {board.name} ({flash:,} B flash, {ram:,} B RAM)")
+    return elf, board
+
+
+def _analog_args(items: list[str], board: Board) -> dict[str, float] | str:
+    """--analog PIN=VOLTS settings, or what is wrong with one."""
+    out = {}
+    for item in items:
+        pin, sep, volts = item.partition("=")
+        pin = pin.strip()
+        if not sep:
+            return f"--analog {item}: expected PIN=VOLTS, e.g. A0=3.2"
+        if pin not in board.analog_pins:
+            return f"--analog {item}: board `{board.name}` has no analog input `{pin}` " \
+                   f"(it has {', '.join(board.analog_pins)})"
+        try:
+            v = float(volts)
+        except ValueError:
+            return f"--analog {item}: `{volts}` is not a number of volts"
+        if not 0.0 <= v <= board.adc_vref:
+            return f"--analog {item}: volts must be between 0 and {board.adc_vref:g}"
+        out[pin] = v
+    return out
+
+
+def main(args) -> int:
+    """`fsw sim PROJECT|FW.elf`: build, start with UART0 on a pty, print the
+    pty's path on standard output, run until Ctrl-C or --duration."""
+    if args.duration is not None and not 0 < args.duration < 1e9:
+        _say("--duration must be a positive number of simulated seconds")
+        return 2
+    if _is_elf(args.project) or args.project.endswith(".elf"):
+        if args.board is None:
+            _say(f"{args.project}: a firmware ELF needs --board (the board it was built for, e.g. uno)")
+            return 2
+        try:
+            board = sim_board(args.board)
+        except SimError as e:
+            _say(str(e))
+            return 2
+        elf = args.project
+    else:
+        built = _build(args)
+        if isinstance(built, int):
+            return built
+        elf, board = built
+    analog = _analog_args(args.analog or [], board)
+    if isinstance(analog, str):
+        _say(analog)
+        return 2
+    try:
+        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link)
+    except SimError as e:
+        _say(str(e))
+        return 1
+    with b:
+        sys.stdout.write(f"{b.port}\n")
+        sys.stdout.flush()
+        pace = "as fast as it can" if args.fast else "in real time"
+        end = f"for {args.duration:g} simulated s" if args.duration else "until Ctrl-C"
+        link = f" (and {args.link})" if args.link else ""
+        _say(f"{board.name} ({b.mcu} at {b.f_cpu / 1e6:g} MHz) runs {pace} {end}; UART0 is {b.port}{link}")
+        t0 = time.monotonic()
+        try:
+            r = b.go(until=args.duration, realtime=not args.fast)
+        except SimError as e:
+            _say(str(e))
+            return 1
+        wall = time.monotonic() - t0
+        why = {"target": "duration reached", "interrupted": "stopped", "done": "the firmware stopped itself",
+               "crashed": "the firmware crashed", "sim-limit": "simulated-time limit",
+               "wall-limit": "wall-clock limit"}.get(r.stop, r.stop)
+        _say(f"{why} at {r.time:.6f} s simulated ({r.cycle:,} cycles) after {wall:.2f} s")
+        dropped = int(b.info().get("dropped", "0"))
+        if dropped:
+            _say(f"{dropped:,} UART bytes were sent while no program had the port open")
+    return 1 if r.stop == "crashed" else 0

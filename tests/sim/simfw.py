@@ -1,0 +1,109 @@
+"""Firmware for the simulated-board tests, built into build/sim-tests/
+(kept between runs, so rebuilds are incremental), and the fixtures that
+build it once per session."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+
+import pytest
+
+from conftest import ROOT, run_fsw
+
+OUT = ROOT / "build" / "sim-tests"
+BUILD_MK = ROOT / "mk" / "build.mk"
+BOARD_MAKE = {
+    "uno": ["MCU=atmega328p", "F_CPU=16000000", "VARIANT=standard", "BOARD_DEFINE=ARDUINO_AVR_UNO"],
+    "mega2560": ["MCU=atmega2560", "F_CPU=16000000", "VARIANT=mega", "BOARD_DEFINE=ARDUINO_AVR_MEGA2560"],
+}
+
+# An Arduino sketch that exercises the board's I/O: a banner and an echo on
+# the serial port, PWM on pins 3 and 9, pin 5 driven high, pin 8 mirroring
+# input pin 7.
+PROBE_SKETCH = r"""
+#include <Arduino.h>
+void setup() {
+    Serial.begin(115200);
+    analogWrite(3, 64);
+    analogWrite(9, 200);
+    pinMode(5, OUTPUT);
+    digitalWrite(5, HIGH);
+    pinMode(7, INPUT);
+    pinMode(8, OUTPUT);
+    Serial.print("probe ready\n");
+}
+void loop() {
+    digitalWrite(8, digitalRead(7));
+    int c = Serial.read();
+    if (c >= 0) Serial.write((uint8_t)c);
+}
+"""
+
+SPIN_C = "int main(void) { for (;;) { __asm__ volatile(\"nop\"); } }\n"
+HALT_C = "#include <avr/interrupt.h>\n#include <avr/sleep.h>\n" \
+         "int main(void) { cli(); sleep_enable(); sleep_cpu(); for (;;) {} }\n"
+
+
+def project_elf(project: str, board: str) -> str:
+    """`fsw build PROJECT --board BOARD` into build/sim-tests/; the ELF."""
+    name = os.path.basename(project.rstrip("/"))
+    out = OUT / f"{name}-{board}"
+    r = run_fsw("build", str(project), "--board", board, "--out", str(out))
+    assert r.code == 0, r.err
+    return str(out / f"{name}.elf")
+
+
+def sketch_elf(name: str, source: str, board: str = "uno") -> str:
+    """An Arduino sketch built with mk/build.mk (the Arduino core's flags)."""
+    out = OUT / f"{name}-{board}"
+    gen = out / "src"
+    gen.mkdir(parents=True, exist_ok=True)
+    path = gen / f"{name}.cpp"
+    if not path.exists() or path.read_text() != source:
+        path.write_text(source)
+    r = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
+                        f"NAME={name}", "avr"] + BOARD_MAKE[board], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-4000:]
+    return str(out / f"{name}.elf")
+
+
+def c_elf(name: str, source: str, mcu: str = "atmega328p") -> str:
+    """A bare C program for the MCU, no Arduino core."""
+    OUT.mkdir(parents=True, exist_ok=True)
+    src = OUT / f"{name}.c"
+    elf = OUT / f"{name}-{mcu}.elf"
+    src.write_text(source)
+    r = subprocess.run(["avr-gcc", f"-mmcu={mcu}", "-Os", "-o", str(elf), str(src)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return str(elf)
+
+
+@pytest.fixture(scope="session")
+def tank_uno() -> str:
+    return project_elf(str(ROOT / "examples" / "tank"), "uno")
+
+
+@pytest.fixture(scope="session")
+def tank_mega() -> str:
+    return project_elf(str(ROOT / "examples" / "tank"), "mega2560")
+
+
+@pytest.fixture(scope="session")
+def toggle_uno() -> str:
+    return project_elf(str(ROOT / "tests" / "sim" / "toggle"), "uno")
+
+
+@pytest.fixture(scope="session")
+def probe_uno() -> str:
+    return sketch_elf("probe", PROBE_SKETCH)
+
+
+@pytest.fixture(scope="session")
+def spin_uno() -> str:
+    return c_elf("spin", SPIN_C)
+
+
+@pytest.fixture(scope="session")
+def halt_uno() -> str:
+    return c_elf("halt", HALT_C)

@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup test test-python fuzz bench clean
+.PHONY: all setup test test-python fuzz fuzz-uplink bench clean
 
 include mk/firmware.mk
 
@@ -28,13 +28,34 @@ test-python: setup
 	$(PY) -m pytest tests
 
 ## fuzz: long property-based runs of the front end (1,000,000 cases)
-fuzz: setup
+fuzz: setup fuzz-uplink
 	FSW_FUZZ_EXAMPLES=$${FSW_FUZZ_EXAMPLES:-1000000} $(PY) -m pytest -q -p no:cacheprovider tests/fuzz
+
+## fuzz-uplink: the firmware's uplink parser under libFuzzer with ASan + UBSan
+## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run)
+FUZZ_RUNS ?= 10000000
+FUZZ_UPLINK := $(BUILD)/fuzz/uplink/fuzz_uplink
+FUZZ_UPLINK_SRCS := tests/fuzz/uplink/fuzz_uplink.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp,$(wildcard firmware/src/*.cpp))
+$(FUZZ_UPLINK): $(FUZZ_UPLINK_SRCS) $(wildcard firmware/src/*.h)
+	@mkdir -p $(@D)
+	clang++ -std=c++11 -g -O1 -fno-exceptions -fno-rtti -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=all -Ifirmware/src -o $@ $(FUZZ_UPLINK_SRCS)
+fuzz-uplink: $(FUZZ_UPLINK)
+	@mkdir -p $(BUILD)/fuzz/uplink/corpus
+	@cp -n tests/fuzz/uplink/seeds/* $(BUILD)/fuzz/uplink/corpus/ 2>/dev/null || true
+	@$(FUZZ_UPLINK) -runs=$(FUZZ_RUNS) -seed=1 -max_len=512 -print_final_stats=1 \
+	    -artifact_prefix=$(BUILD)/fuzz/uplink/ \
+	    $(BUILD)/fuzz/uplink/corpus 2>$(BUILD)/fuzz/uplink/log.txt; st=$$?; \
+	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|invariant" $(BUILD)/fuzz/uplink/log.txt; \
+	  if [ $$st -eq 0 ]; then echo "uplink fuzz: 1 passed, 0 failed"; else tail -30 $(BUILD)/fuzz/uplink/log.txt; \
+	  echo "uplink fuzz: 0 passed, 1 failed"; fi; exit $$st
 
 ## bench: measured numbers against targets.md (deterministic counts)
 bench: setup
 	$(PY) tools/bench.py
 	$(PY) tools/bench_firmware.py
+	$(PY) tools/bench_sim.py
+	$(PY) tools/bench_link.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -12,6 +12,9 @@
 
 namespace fsw {
 
+static_assert(offsetof(LinkCounters, dropped) == offsetof(LinkCounters, frames) + 4, "health frame layout");
+static_assert(offsetof(LinkCounters, last_seq) == offsetof(LinkCounters, rx_ok) + 12, "health frame layout");
+
 namespace {
 
 enum Pending : uint8_t { kPendAck = 1, kPendHello = 2, kPendHealth = 4 };
@@ -140,18 +143,13 @@ void send_health(Link& l, const LinkConfig& c) {
     CobsEncoder e;
     frame_begin(l, e, kFrameHealth, static_cast<uint32_t>(t));
     cobs_put_u32(e, static_cast<uint32_t>(t >> 32));
-    cobs_put_u32(e, l.n.frames);
-    cobs_put_u32(e, l.n.dropped);
+    // frames, dropped (u32) as they lie in LinkCounters (little-endian targets)
+    cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&l.n.frames), 8);
     cobs_put_u32(e, c.ex != 0 ? c.ex->cycles : 0);
     cobs_put_u16(e, c.ex != 0 ? c.ex->late : 0);
     cobs_put(e, reset_cause_of(c));
-    cobs_put_u16(e, l.n.rx_ok);
-    cobs_put_u16(e, l.n.rx_crc);
-    cobs_put_u16(e, l.n.rx_malformed);
-    cobs_put_u16(e, l.n.rx_oversized);
-    cobs_put_u16(e, l.n.rx_replayed);
-    cobs_put_u16(e, l.n.rx_refused);
-    cobs_put_u16(e, l.n.last_seq);
+    // rx_ok .. last_seq: seven u16, in order
+    cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&l.n.rx_ok), 14);
     const uint8_t n_tasks = c.ex != 0 ? c.ex->cfg.n_tasks : 0;
     for (uint8_t i = 0; i < n_tasks; ++i) {
         const TaskStats& s = c.ex->cfg.stats[i];

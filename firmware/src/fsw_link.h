@@ -103,7 +103,8 @@ struct LinkConfig {
     bool lock;                        // state vector `lock` option
 };
 
-// Counters reported in health frames (saturating where 16-bit).
+// Counters reported in health frames (saturating where 16-bit). Health
+// frames send frames..dropped and rx_ok..last_seq as they lie in memory.
 struct LinkCounters {
     uint32_t frames;        // frames sent: the next frame's full sequence number
     uint32_t dropped;       // frames not sent because the transmit buffer was busy

@@ -29,7 +29,7 @@ def summary(session: Session) -> str:
     st, ws = session.stats, session.deframer.stats
     h = session.health or {}
     return (f"link: {st.frames} frames, {ws.bytes} bytes, {st.lost} lost in {st.gaps} gaps, "
-            f"{ws.crc_errors} CRC errors, {ws.framing_errors} framing errors, {st.invalid} invalid, "
+            f"{ws.crc_errors} CRC errors, {ws.framing_errors} framing errors, {ws.invalid} invalid, "
             f"target dropped {h.get('dropped', '?')}")
 
 

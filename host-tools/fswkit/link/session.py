@@ -38,7 +38,6 @@ class LinkStats:
     frames: int = 0  # frames accepted (verified and consistent with the layout)
     lost: int = 0  # frames missing from the sequence
     gaps: int = 0  # places where frames were missing
-    invalid: int = 0  # verified frames inconsistent with the layout (wrong type or length)
     undecoded: int = 0  # frames before the schema was confirmed
     restarts: int = 0  # target resets seen (frame counter went back)
     samples: int = 0
@@ -51,7 +50,7 @@ class SchemaMismatch(Exception):
 class Session:
     def __init__(self, layout: Layout, ignore_schema: bool = False):
         self.layout = layout
-        self.deframer = wire.Deframer()
+        self.deframer = wire.Deframer(self.consistent)
         self.stats = LinkStats()
         self.ignore_schema = ignore_schema
         self.schema_ok: bool | None = True if ignore_schema else None
@@ -128,6 +127,28 @@ class Session:
 
     # ---- frames ---------------------------------------------------------------------
 
+    def consistent(self, ftype: int, body: bytes) -> bool:
+        """Whether a verified frame body (header + payload + CRC) has a type
+        and length this layout allows: a second check after the CRC."""
+        n = len(body) - wire.HEADER - 2
+        lay = self.layout
+        if ftype & 0x80:
+            si = ftype & 0x7F
+            if si >= len(lay.streams):
+                return False
+            stream = lay.streams[si]
+            size = stream.region.size
+            return size > 0 and n % size == 0 and 1 <= n // size <= stream.batch
+        if ftype == wire.HELLO:
+            return n == _HELLO.size
+        if ftype == wire.HEALTH:
+            return n == lay.health_payload
+        if ftype == wire.ACK:
+            return n == _ACK.size
+        if ftype == wire.SNAPSHOT:
+            return n >= 2 and _U16.unpack_from(body, wire.HEADER)[0] + n - 2 <= lay.sv_size
+        return False
+
     def _extend_time(self, t32: int) -> int:
         ref = self.t_ref
         if ref is None:
@@ -142,38 +163,9 @@ class Session:
     def _frame(self, ftype, s8, t32, payload, host_time) -> Event | None:
         lay = self.layout
         n = len(payload)
-        # the layout decides whether a verified frame makes sense
         if ftype & 0x80:
-            si = ftype & 0x7F
-            if si >= len(lay.streams):
-                self.stats.invalid += 1
-                return None
-            stream = lay.streams[si]
-            size = stream.region.size
-            k = n // size if size else 0
-            if k * size != n or not 1 <= k <= stream.batch:
-                self.stats.invalid += 1
-                return None
-        elif ftype == wire.HELLO:
-            if n != _HELLO.size:
-                self.stats.invalid += 1
-                return None
-        elif ftype == wire.HEALTH:
-            if n != lay.health_payload:
-                self.stats.invalid += 1
-                return None
-        elif ftype == wire.ACK:
-            if n != _ACK.size:
-                self.stats.invalid += 1
-                return None
-        elif ftype == wire.SNAPSHOT:
-            if n < 2 or _U16.unpack_from(payload)[0] + n - 2 > lay.sv_size:
-                self.stats.invalid += 1
-                return None
-        else:
-            self.stats.invalid += 1
-            return None
-
+            stream = lay.streams[ftype & 0x7F]
+            k = n // stream.region.size
         st = self.stats
         st.frames += 1
         self._recent.append(host_time)

@@ -114,6 +114,7 @@ class WireStats:
     crc_errors: int = 0  # decoded, CRC mismatch
     framing_errors: int = 0  # not a COBS block chain, or shorter than a header + CRC
     leading: int = 0  # bytes before the first delimiter that were not a frame (joined mid-frame)
+    invalid: int = 0  # verified, but of a type or length the schema does not allow
 
 
 class Deframer:
@@ -121,8 +122,9 @@ class Deframer:
     payload). A corrupted frame costs only itself: decoding resumes at the
     next delimiter."""
 
-    def __init__(self):
+    def __init__(self, accept=None):
         self.stats = WireStats()
+        self._accept = accept  # (type, body) -> bool: a verified frame the schema allows
         self._tail = b""
         self._synced = False  # bytes before the first delimiter are a partial frame
 
@@ -148,6 +150,7 @@ class Deframer:
         out = []
         append = out.append
         unpack = _U32.unpack_from
+        accept = self._accept
         for enc, body in zip(encs, bodies):
             if not enc:
                 first = False
@@ -162,6 +165,9 @@ class Deframer:
                 first = False
                 continue
             first = False
+            if accept is not None and not accept(body[0], body):
+                st.invalid += 1
+                continue
             append((body[0], body[1], unpack(body, 2)[0], body[HEADER:-2]))
         st.frames += len(out)
         return out
@@ -198,7 +204,7 @@ def _bulk_decode(buf: bytes, end: int):
         pos[act] = p
         act = act[p < ends[act]]
         rounds += 1
-        if rounds == 64:
+        if rounds == 256:
             slow[act] = True
             break
     bad = (pos != ends) & (ends > starts)  # a block ran past the delimiter

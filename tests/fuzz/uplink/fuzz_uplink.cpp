@@ -83,15 +83,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     memcpy(before, sv, sizeof sv);
 
     size_t at = 0;
-    for (int cycle = 0; cycle < 4000 && (at < size || cycle < 4); ++cycle) {
+    for (int cycle = 0; cycle < 4000 && (at < size || cycle < 2); ++cycle) {
         const size_t n = size - at < 24 ? size - at : 24;
         native::console_feed(data + at, static_cast<uint16_t>(n));
         at += n;
         const uint16_t ok_before = link.n.rx_ok;
         executor_run_cycle(ex);
-        for (int k = 0; k < 10; ++k) {
-            clock_ms += 1;
-            native::sim_advance_us(1000);
+        for (int k = 0; k < 2; ++k) {  // loop() between cycles
+            clock_ms += 5;
+            native::sim_advance_us(5000);
             link_poll(link);
         }
         // invariants 1 and 2: compare against the last state

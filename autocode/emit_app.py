@@ -133,11 +133,6 @@ def _app_cpp(app: Application) -> str:
     else:
         c.append("// Runs a cycle when one is due.")
         c.append("void poll() { (void)fsw::executor_poll(ex); }")
-    c.append("// Microseconds until the next cycle is due (hosts: sleep between cycles).")
-    c.append("uint64_t idle_us() {")
-    c.append("    const uint64_t now = fsw::pal::micros64();")
-    c.append("    return ex.next_due_us > now ? ex.next_due_us - now : 0;")
-    c.append("}")
     c.append("// Runs one cycle now (hosts: simulations and tests).")
     c.append("void run_cycle() { fsw::executor_run_cycle(ex); }")
     c.append("")
@@ -255,10 +250,11 @@ def _native_main(app: Application) -> list[str]:
     c = ['#include <stdio.h>',
          '#include <stdlib.h>',
          '#include <string.h>',
+         '#include <time.h>',
          '#include <unistd.h>',
          '#include "psl_native.h"',
          '// Host build:',
-         '//   app [PINS]             follows the real clock; the serial link on stdin/stdout',
+         '//   app [PINS]             runs in step with the wall clock; the link on stdin/stdout',
          '//   app CYCLES [PINS]      runs CYCLES cycles on the simulated clock, then prints',
          '//                          the state vector as hex (link output discarded)',
          '//   app CYCLES --link [--uart BAUD] [PINS]',
@@ -293,15 +289,28 @@ def _native_main(app: Application) -> list[str]:
          '    if (baud != 0) fsw::native::console_model_uart(static_cast<uint32_t>(baud), 64);',
          '    if (!fsw_gen::begin()) { fprintf(stderr, "the runtime refused a table\\n"); return 3; }',
          '    if (!simulated) {',
+         '        // Paced by the wall clock, timed by the simulated one: cycle k runs at',
+         '        // simulated time k periods, so G grows by exactly a period a cycle even',
+         '        // when the host is slow (a late cycle runs late, never early or twice).',
          '        fsw::native::console_use_stdin(true);',
-         '        fsw::native::use_real_time(true);',
-         '        for (;;) {',
-         '            fsw_gen::poll();',
-         '            const uint64_t idle = fsw_gen::idle_us();',
-         '            if (idle > 200) usleep(static_cast<useconds_t>(idle > 2000 ? 1000 : idle - 100));',
-         '        }',
-         '    }',
-         '    for (unsigned long i = 0; i < cycles; ++i) {',
+         '        timespec t0;',
+         '        clock_gettime(CLOCK_MONOTONIC, &t0);',
+         '        for (uint64_t k = 1;; ++k) {',
+         '            fsw_gen::run_cycle();',
+         '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs);',
+         '            for (;;) {',
+         '                timespec t;',
+         '                clock_gettime(CLOCK_MONOTONIC, &t);',
+         '                const int64_t ahead = static_cast<int64_t>(k * fsw_gen::kPeriodUs) -',
+         '                    ((t.tv_sec - t0.tv_sec) * 1000000LL + (t.tv_nsec - t0.tv_nsec) / 1000);']
+    if has_link:
+        c += ['                fsw::link_poll(fsw_gen::link);']
+    c += ['                if (ahead <= 0) break;',
+          '                usleep(static_cast<useconds_t>(ahead > 1000 ? 1000 : ahead));',
+          '            }',
+          '        }',
+          '    }',
+          '    for (unsigned long i = 0; i < cycles; ++i) {',
          '        fsw_gen::run_cycle();']
     if has_link:
         c += ['        for (uint32_t t = 0; t < fsw_gen::kPeriodUs; t += 50) {  // loop() between cycles',

@@ -204,6 +204,9 @@ def cmd_gen(args) -> int:
     app = _load_app(args, "gen")
     if app is None:
         return EXIT_CONFIG
+    if args.sketch:
+        from fswkit.sketch import export
+        return export(app, args.sketch)
     out = args.out or os.path.join(default_out(app), "gen")
     files = _generate(app, out, "gen")
     if files is None:
@@ -257,6 +260,52 @@ def cmd_sim(args) -> int:
     return sim_main(args)
 
 
+# ---- fsw flash / fsw ports / fsw new ------------------------------------------------------
+
+def _port_or_only(port: str | None, command: str) -> str | None:
+    """The port named, else the only candidate (said on standard error);
+    None after a message when there is none or several."""
+    from fswkit.ports import PortError, default_port
+
+    try:
+        device, listing = default_port(port, command)
+    except PortError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    if port is None:
+        sys.stderr.write(f"fsw {command}: using {listing.label() if listing else device}, "
+                         "the only serial port found\n")
+    return device
+
+
+def cmd_flash(args) -> int:
+    from fswkit.flash import main as flash_main
+
+    return flash_main(args)
+
+
+def cmd_ports(args) -> int:
+    from fswkit.ports import PortError, format_table, list_ports
+
+    try:
+        ports = list_ports(include_all=args.all)
+    except PortError as e:
+        sys.stderr.write(f"fsw ports: {e}\n")
+        return EXIT_FAIL
+    if not ports:
+        sys.stderr.write("fsw ports: no serial port found" + ("" if args.all else " (connect a board by USB; "
+                         "--all lists built-in ports too)") + "\n")
+        return EXIT_FAIL
+    sys.stdout.write(format_table(ports))
+    return EXIT_OK
+
+
+def cmd_new(args) -> int:
+    from fswkit.scaffold import main as new_main
+
+    return new_main(args)
+
+
 # ---- the serial link: fsw monitor / cmd / log2csv / replay / plot ----------------------
 
 def _link_layout(project: str, command: str):
@@ -295,7 +344,10 @@ def cmd_monitor(args) -> int:
     layout = _link_layout(args.project, "monitor")
     if layout is None:
         return EXIT_CONFIG
-    return _ground("monitor", monitor, layout, args.project, args.port, args.baud, args.log, args.headless,
+    port = _port_or_only(args.port, "monitor")
+    if port is None:
+        return EXIT_FAIL
+    return _ground("monitor", monitor, layout, args.project, port, args.baud, args.log, args.headless,
                    args.ignore_schema, args.duration, args.frames)
 
 
@@ -392,7 +444,9 @@ def parser() -> argparse.ArgumentParser:
     gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
     gn.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
     gn.add_argument("--board", help="build for this board instead of the one the .app names")
-    gn.add_argument("--out", help="where to write (default PROJECT/build/BOARD/gen)")
+    gn_out = gn.add_mutually_exclusive_group()
+    gn_out.add_argument("--out", help="where to write (default PROJECT/build/BOARD/gen)")
+    gn_out.add_argument("--sketch", metavar="DIR", help="write an Arduino sketch folder for arduino-cli instead")
     gn.set_defaults(func=cmd_gen)
 
     b = sub.add_parser("build", help="build an application's firmware (.elf/.hex, or a host executable)")
@@ -411,6 +465,26 @@ def parser() -> argparse.ArgumentParser:
     sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
     sm.set_defaults(func=cmd_sim)
 
+    fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")
+    fl.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    fl.add_argument("--port", help="the board's serial port (default: the only serial port connected)")
+    fl.add_argument("--board", help="flash for this board instead of the one the .app names")
+    fl.add_argument("--via", choices=("avrdude", "pio"), default="avrdude",
+                    help="upload with avrdude (default) or with `pio run -t upload`")
+    fl.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    fl.add_argument("--force", action="store_true", help="flash even when the port's USB IDs say another board")
+    fl.add_argument("-v", "--verbose", action="store_true", help="show avrdude's output as it runs")
+    fl.set_defaults(func=cmd_flash)
+
+    po = sub.add_parser("ports", help="list serial ports, with the board each one seems to be")
+    po.add_argument("--all", action="store_true", help="also ports without USB IDs (built-in UARTs)")
+    po.set_defaults(func=cmd_ports)
+
+    nw = sub.add_parser("new", help="scaffold a new project that builds as it stands")
+    nw.add_argument("name", metavar="NAME", help="the project's folder; its name names the files and machine")
+    nw.add_argument("--board", default="uno", help="the board it runs on (default uno)")
+    nw.set_defaults(func=cmd_new)
+
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
     s.add_argument("machine", metavar="MACHINE.sm")
     s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
@@ -420,7 +494,8 @@ def parser() -> argparse.ArgumentParser:
 
     m = sub.add_parser("monitor", help="decode a target's telemetry live (docs/telemetry.md)")
     m.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (folder or .app)")
-    m.add_argument("--port", required=True, help="serial device (/dev/ttyACM0, a pty) or pyserial URL")
+    m.add_argument("--port", help="serial device (/dev/ttyACM0, a pty) or pyserial URL "
+                   "(default: the only serial port connected)")
     m.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
     m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE")
     m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")

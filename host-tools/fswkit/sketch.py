@@ -1,0 +1,77 @@
+"""`fsw gen PROJECT --sketch DIR`: a project as an Arduino sketch folder
+that arduino-cli (or the Arduino IDE) builds with the fswkit library
+installed. arduino-cli compiles every .cpp in a sketch's top folder beside
+the .ino, so the folder holds the generated files as they are, a near-empty
+DIR.ino that names the headers (which is how arduino-cli finds the library),
+and a sketch.yaml with the board's FQBN."""
+
+from __future__ import annotations
+
+import os
+import re
+
+from fswkit.autocode.app import Application
+
+# Arduino's sketch name rules: letters, digits, `_`, `-`, `.`; not starting
+# with `-` or `.`; at most 63 characters.
+SKETCH_NAME = re.compile(r"[0-9A-Za-z_][0-9A-Za-z_.-]{0,62}\Z")
+
+
+class SketchError(Exception):
+    pass
+
+
+def sketch_name(folder: str) -> str:
+    """The sketch's name: its folder's, which the .ino must share."""
+    name = os.path.basename(os.path.normpath(folder))
+    if not SKETCH_NAME.match(name):
+        raise SketchError(f"`{name}` cannot name an Arduino sketch (the folder names the sketch): use "
+                          "letters, digits, `_`, `-` and `.`, starting with a letter or digit, "
+                          "at most 63 characters")
+    return name
+
+
+def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict[str, str]:
+    """The sketch folder's files: the generated ones, NAME.ino and sketch.yaml."""
+    fqbn = app.board.raw.get("arduino", {}).get("fqbn", "")
+    if not app.board.is_avr or not fqbn:
+        raise SketchError(f"board `{app.board.name}` is not an Arduino board: export a sketch for "
+                          "one (--board uno, nano, mega2560)")
+    project = os.path.basename(app.path)
+    headers = sorted(n for n in generated if n.endswith(".h"))
+    ino = [f"// {name}: the fswkit application {project} for the {app.board.name}, exported by",
+           "// `fsw gen --sketch`. The application is the generated code beside this",
+           "// file (app.gen.cpp holds setup() and loop()): change the configs and",
+           "// export again rather than editing it. Needs the fswkit library",
+           "// (docs/arduino-cli.md).",
+           "#include <fswkit.h>"]
+    ino += [f'#include "{h}"' for h in headers]
+    files = dict(generated)
+    files[name + ".ino"] = "\n".join(ino) + "\n"
+    files["sketch.yaml"] = (f"# arduino-cli: `arduino-cli compile` in this folder builds for the {app.board.name}.\n"
+                            f"default_fqbn: {fqbn}\n")
+    return files
+
+
+def export(app: Application, folder: str) -> int:
+    """`fsw gen PROJECT --sketch DIR`: writes the sketch folder; returns the exit status."""
+    import sys
+
+    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.build import write_files
+
+    try:
+        name = sketch_name(folder)
+        files = sketch_files(app, emit_app(app), name)
+    except (SketchError, GenError) as e:
+        sys.stderr.write(f"fsw gen: {e}\n")
+        return 2 if isinstance(e, SketchError) else 1
+    try:
+        write_files(files, folder)
+    except OSError as e:
+        sys.stderr.write(f"fsw gen: cannot write {e.filename or folder}: {e.strerror or e}\n")
+        return 1
+    fqbn = app.board.raw["arduino"]["fqbn"]
+    sys.stderr.write(f"fsw gen: sketch {name} for the {app.board.name} in {folder} ({len(files)} files); "
+                     f"build it with: arduino-cli compile -b {fqbn} {folder}\n")
+    return 0

@@ -11,10 +11,10 @@ environment's section of platformio.ini:
     custom_fsw_board   = uno             ; the kit's board (boards/*.toml);
                                          ; default: the one the .app names
 
-With Debian's avr-gcc 5.4 as the toolchain it also defines
-DECIMAL_DIG=__DECIMAL_DIG__, which that compiler's <float.h> leaves
-undefined in C++ and the Arduino core's WString.cpp needs; toolchains that
-define it (PlatformIO's avr-gcc 7.3) are left as they are.
+When the environment's avr-g++ leaves DECIMAL_DIG undefined in C++ (Debian's
+avr-gcc 5.4 does; Debian's Arduino core's WString.cpp needs it), the hook
+defines DECIMAL_DIG=__DECIMAL_DIG__; a toolchain that defines it is left as
+it is.
 
 PlatformIO runs this file with SCons, which provides `Import`,
 `COMMAND_LINE_TARGETS` and the build environment `env`.
@@ -99,7 +99,7 @@ def generate(env):
 
 def needs_decimal_dig(cxx):
     """True when this C++ compiler's <float.h> leaves DECIMAL_DIG undefined
-    under -std=gnu++11 (GCC before 6: Debian's avr-gcc 5.4)."""
+    under -std=gnu++11 (Debian's avr-gcc 5.4 does)."""
     try:
         r = subprocess.run([cxx, "-std=gnu++11", "-x", "c++", "-E", "-dM", "-"], input="#include <float.h>\n",
                            capture_output=True, text=True, timeout=30)

@@ -281,7 +281,7 @@ Run these in this folder:
     fsw build .                  # firmware, with flash and RAM against the board's budget
     fsw flash .                  # build and upload (the board on the only serial port, or --port)
     fsw monitor .                # live telemetry from the board
-    fsw cmd set controlMode 1    # safe the control task from the ground
+    fsw cmd mode control safed --port PORT   # safe the control task from the ground
 
 With PlatformIO instead: `pio run`, `pio run -t upload`.
 

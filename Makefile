@@ -32,8 +32,10 @@ fuzz: setup fuzz-uplink
 	FSW_FUZZ_EXAMPLES=$${FSW_FUZZ_EXAMPLES:-1000000} $(PY) -m pytest -q -p no:cacheprovider tests/fuzz
 
 ## fuzz-uplink: the firmware's uplink parser under libFuzzer with ASan + UBSan
-## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run)
+## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run),
+## FUZZ_SECONDS a time limit (0: none)
 FUZZ_RUNS ?= 10000000
+FUZZ_SECONDS ?= 0
 FUZZ_UPLINK := $(BUILD)/fuzz/uplink/fuzz_uplink
 FUZZ_UPLINK_SRCS := tests/fuzz/uplink/fuzz_uplink.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp,$(wildcard firmware/src/*.cpp))
 $(FUZZ_UPLINK): $(FUZZ_UPLINK_SRCS) $(wildcard firmware/src/*.h)
@@ -43,7 +45,7 @@ $(FUZZ_UPLINK): $(FUZZ_UPLINK_SRCS) $(wildcard firmware/src/*.h)
 fuzz-uplink: $(FUZZ_UPLINK)
 	@mkdir -p $(BUILD)/fuzz/uplink/corpus
 	@cp -n tests/fuzz/uplink/seeds/* $(BUILD)/fuzz/uplink/corpus/ 2>/dev/null || true
-	@$(FUZZ_UPLINK) -runs=$(FUZZ_RUNS) -seed=1 -max_len=512 -print_final_stats=1 \
+	@$(FUZZ_UPLINK) -runs=$(FUZZ_RUNS) -max_total_time=$(FUZZ_SECONDS) -seed=1 -max_len=512 -print_final_stats=1 \
 	    -artifact_prefix=$(BUILD)/fuzz/uplink/ \
 	    $(BUILD)/fuzz/uplink/corpus 2>$(BUILD)/fuzz/uplink/log.txt; st=$$?; \
 	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|invariant" $(BUILD)/fuzz/uplink/log.txt; \

@@ -211,18 +211,19 @@ def log2csv(path: str, out, ignore_schema: bool) -> int:
     w = csv.writer(out, lineterminator="\n")
     w.writerow(["seq", "sample", "time", "host_time", "frame"] + names)
     rows = 0
+    known = {n: None for n in names}  # the values as of the row being written
     for ev in events:
         if ev.kind == "sample":
             region = lay.streams[ev.stream].region
             for i, (t, vals) in enumerate(ev.samples):
-                known = dict(session.values)
                 known.update(zip(region.names, vals))
                 w.writerow([ev.seq, i, _num(t), f"{ev.host_time:.6f}", region.name]
                            + [_cell(known[n]) for n in names])
                 rows += 1
         elif ev.kind == "snapshot" and ev.info["complete"]:
+            known.update(ev.info["values"])
             w.writerow([ev.seq, 0, _num(ev.time), f"{ev.host_time:.6f}", "snapshot"]
-                       + [_cell(session.values[n]) for n in names])
+                       + [_cell(known[n]) for n in names])
             rows += 1
     if reader.truncated:
         sys.stderr.write(f"fsw log2csv: {path}: the last record is cut short (the recording stopped mid-write)\n")

@@ -78,7 +78,7 @@ class Session:
         n_streams = len(streams)
         st = self.stats
         values = self.values
-        recent = self._recent
+        n_fast = n_samples = 0
         for ftype, s8, t32, payload in self.deframer.feed(data):
             # the common case inline: a one-sample frame of a known stream, in
             # sequence, its time within the current 2^32 window
@@ -93,23 +93,21 @@ class Session:
                 if ref is not None and size and (n == size or (n % size == 0 and n <= size * stream.batch)):
                     t = (ref & ~0xFFFFFFFF) | t32
                     if abs(t - ref) < 0x40000000:
-                        st.frames += 1
-                        recent.append(host_time)
+                        n_fast += 1
                         self.last_seq = seq = last + 1
                         if t > ref:
                             self.t_ref = t
                         if n == size:
                             vals = region.decode(payload)
                             samples = [(t, vals)]
-                            st.samples += 1
+                            n_samples += 1
                         else:
                             period = stream.period
                             rows = region.decode_all(payload)
                             samples = [(t + i * period, v) for i, v in enumerate(rows)]
                             vals = rows[-1]
-                            st.samples += len(rows)
-                        for e, v in zip(region.names, vals):
-                            values[e] = v
+                            n_samples += len(rows)
+                        values.update(zip(region.names, vals))
                         if host_time:
                             self._delay(samples[-1][0], host_time)
                         append(Event("sample", seq, t, host_time, stream.index, samples))
@@ -117,13 +115,17 @@ class Session:
             ev = self._frame(ftype, s8, t32, payload, host_time)
             if ev is not None:
                 append(ev)
+        st.frames += n_fast
+        st.samples += n_samples
+        if n_fast:
+            self._recent.append((host_time, n_fast))
         return out
 
     def frames_per_second(self, now: float, window: float = 2.0) -> float:
         r = self._recent
-        while r and r[0] < now - window:
+        while r and r[0][0] < now - window:
             r.popleft()
-        return len(r) / window
+        return sum(n for _, n in r) / window
 
     # ---- frames ---------------------------------------------------------------------
 
@@ -168,7 +170,7 @@ class Session:
             k = n // stream.region.size
         st = self.stats
         st.frames += 1
-        self._recent.append(host_time)
+        self._recent.append((host_time, 1))
         # sequence: 8 bits on the wire, extended; hello and health carry all 32
         if self.last_seq is None:
             seq = s8
@@ -282,11 +284,14 @@ class Session:
             if self._snap_at == self.layout.sv_size:
                 complete = True
                 self._snap_at = -1
+                snap = {}
                 for r in self.layout.regions:
-                    for e, v in zip(r.elements, r.decode(bytes(self._snap), r.offset)):
-                        self.values[e.name] = v
-        return Event("snapshot", seq, time, host_time,
-                     info={"offset": off, "length": len(data), "complete": complete})
+                    snap.update(zip(r.names, r.decode(bytes(self._snap), r.offset)))
+                self.values.update(snap)
+        info = {"offset": off, "length": len(data), "complete": complete}
+        if complete:
+            info["values"] = snap
+        return Event("snapshot", seq, time, host_time, info=info)
 
 
 def describe(ev: Event, layout: Layout) -> str:

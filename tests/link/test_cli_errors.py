@@ -103,3 +103,24 @@ def test_layout_round_trips_through_json():
     again = from_dict(lay.raw)
     assert again.schema == lay.schema and again.streams[0].batch == lay.streams[0].batch
     assert again.states == lay.states
+
+
+def test_live_view_renders_every_element_and_the_link():
+    from rich.console import Console
+
+    from fswkit.link.session import Session
+    from fswkit.monitor import render
+
+    lay = tank_layout()
+    s = Session(lay)
+    hello = (bytes((1,)) + lay.schema.to_bytes(4, "little") + bytes(4) + bytes(4) + bytes((0, 1, 0, 0))
+             + bytes(2))
+    import struct
+    sensors = struct.pack("<QId", 20, 2, 815.5)
+    s.feed(wire.downlink(wire.HELLO, 0, 0, hello) + wire.downlink(0x80, 1, 20, sensors), 1.0)
+    con = Console(width=120, record=True)
+    con.print(render(s, 1.0, "tank"))
+    text = con.export_text()
+    for name in ("time", "state", "tankPressure", "valveOpen", "frames/s", "CRC errors", "schema"):
+        assert name in text
+    assert "2 (Abort)" in text and "815.5" in text and "pin A0" in text

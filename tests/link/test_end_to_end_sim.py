@@ -1,10 +1,12 @@
 """End to end on the simulated Uno (simavr, fswkit.sim): the tank firmware
 built for the board streams telemetry over UART0; the ground decodes the
-value the harness put on A0, bit for bit as the ATmega computes it, and a
-command sent over the link changes what the firmware does."""
+value the harness put on A0, bit for bit as the ATmega computes it, a
+command sent over the link changes what the firmware does, and faults
+injected between the board and the ground are refused and counted exactly."""
 
 from __future__ import annotations
 
+import random
 import shutil
 import struct
 
@@ -42,9 +44,16 @@ def test_uno_streams_what_the_pin_reads_and_obeys_commands(elf):
     lay = tank_layout()
     s = Session(lay)
     raw = int(VOLTS * 1000 * 1023 // 5000)
+    captured = bytearray()
+
+    def uart(b):
+        data = b.uart_read()
+        captured.extend(data)
+        return data
+
     with sim.SimBoard(elf, "uno", analog={"A0": VOLTS}, sim_limit=120, wall_limit=120) as b:
         b.run_for(2.0)
-        evs = s.feed(b.uart_read())
+        evs = s.feed(uart(b))
         assert s.hello is not None and s.hello["schema_ok"], "no hello with the configs' schema"
         assert s.values["tankPressure"] == psi_f32(raw)
         assert s.values["state"] == 1 and s.values["valveOpen"] is True
@@ -59,7 +68,7 @@ def test_uno_streams_what_the_pin_reads_and_obeys_commands(elf):
         b.uart_write(wire.uplink(wire.OP_SET, last + 2, struct.pack("<HB", valve, 0)))  # close the valve
         b.uart_write(wire.uplink(wire.OP_SET, last + 3, struct.pack("<HI", lay.element("state").index, 3)))
         b.run_for(0.5)
-        s.feed(b.uart_read())
+        s.feed(uart(b))
         acks = {a["cmd_seq"]: a["status_name"] for a in s.acks}
         assert acks == {last + 1: "OK", last + 2: "OK", last + 3: "NOT_WRITABLE"}
         assert s.values["valveOpen"] is False and not b.digital(4)  # the ground's write holds
@@ -67,10 +76,17 @@ def test_uno_streams_what_the_pin_reads_and_obeys_commands(elf):
 
         b.uart_write(wire.uplink(wire.OP_MODE, last + 4, bytes((control, 2))))
         b.run_for(0.5)
-        s.feed(b.uart_read())
+        s.feed(uart(b))
         assert s.values["valveOpen"] is True and b.digital(4)  # the controller opened it again
 
         b.run_for(20.0)  # a clean link for a while longer: nothing lost, nothing dropped
-        s.feed(b.uart_read())
+        s.feed(uart(b))
         assert s.stats.lost == 0 and s.health["dropped"] == 0 and s.deframer.stats.crc_errors == 0
         assert s.health["rx_ok"] == 3 and s.health["rx_refused"] == 1
+
+    # faults injected between the simulated board and the ground: bit errors,
+    # dropped bytes, garbage at boot
+    from test_fault_injection import check_faults
+
+    for seed in (1, 2):
+        assert check_faults(bytes(captured), lay, random.Random(seed)) > 50

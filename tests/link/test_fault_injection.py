@@ -57,7 +57,14 @@ def corrupt(data: bytes, rnd: random.Random, ber: float, drop: float) -> tuple[b
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_bit_errors_dropped_bytes_and_boot_garbage(clean, seed):
-    rnd = random.Random(seed)
+    lost = check_faults(clean, tank_layout(), random.Random(seed))
+    assert lost > 1000  # the faults did bite (about a quarter of the frames)
+
+
+def check_faults(clean: bytes, layout, rnd: random.Random) -> int:
+    """Corrupts a clean capture that starts at the target's boot (frame i
+    has sequence number i) and checks the ground against what the faults
+    destroyed; returns the number of frames lost."""
     spans = frame_spans(clean)
     noisy, intact = corrupt(clean, rnd, ber=1e-3, drop=2e-4)
     garbage = bytes(rnd.randrange(256) for _ in range(rnd.randrange(1, 400)))
@@ -74,7 +81,7 @@ def test_bit_errors_dropped_bytes_and_boot_garbage(clean, seed):
         survived = survived[1:]  # the boot garbage runs into the first frame
     expect_seqs = set(survived)
     # what the ground gets, in pieces of random size as a serial port delivers them
-    s = Session(tank_layout())
+    s = Session(layout)
     stream = garbage + noisy
     at = 0
     while at < len(stream):
@@ -87,7 +94,7 @@ def test_bit_errors_dropped_bytes_and_boot_garbage(clean, seed):
     for i in survived:
         a, b = spans[i]
         expect_bodies[i] = wire.cobs_decode(clean[a:b])
-    d = wire.Deframer(Session(tank_layout()).consistent)  # the session's own acceptance
+    d = wire.Deframer(Session(layout).consistent)  # the session's own acceptance
     bodies = [(t, sq, tm, p) for t, sq, tm, p in d.feed(stream)]
     assert len(bodies) == len(survived), "a corrupted frame was accepted, or a good one refused"
     for (t, sq, tm, p), i in zip(bodies, survived):
@@ -99,5 +106,4 @@ def test_bit_errors_dropped_bytes_and_boot_garbage(clean, seed):
     assert s.stats.lost == (last - first + 1) - len(survived)
     assert s.deframer.stats.invalid == 0
     assert s.last_seq == last
-    lost_frames = len(spans) - len(survived)
-    assert lost_frames > 1000  # the faults did bite (about a quarter of the frames)
+    return len(spans) - len(survived)

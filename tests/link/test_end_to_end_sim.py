@@ -90,3 +90,49 @@ def test_uno_streams_what_the_pin_reads_and_obeys_commands(elf):
 
     for seed in (1, 2):
         assert check_faults(bytes(captured), lay, random.Random(seed)) > 50
+
+
+def test_fsw_monitor_and_cmd_on_the_simulated_uno(elf, tmp_path):
+    """The tools a person uses: `fsw sim` puts UART0 on a pty, `fsw monitor
+    --headless` decodes it, `fsw cmd` changes what the firmware does."""
+    import re
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from conftest import run_fsw
+
+    fsw = Path(sys.executable).parent / "fsw"
+    out = tmp_path / "sim.out"
+    with open(out, "w") as f:
+        proc = subprocess.Popen([str(fsw), "sim", str(TANK), "--board", "uno", "--analog", f"A0={VOLTS}",
+                                 "--duration", "30", "--out", str(Path(elf).parent)],
+                                stdout=f, stderr=subprocess.DEVNULL)
+    try:
+        port = None
+        deadline = time.monotonic() + 120
+        while port is None and time.monotonic() < deadline and proc.poll() is None:
+            m = re.search(r"^(/dev/\S+)$", out.read_text(), re.M)
+            port = m.group(1) if m else None
+            time.sleep(0.2)
+        assert port, out.read_text()
+        r = run_fsw("monitor", str(TANK), "--port", port, "--headless", "--duration", "1.5")
+        assert r.code == 0, r.err
+        raw = int(VOLTS * 1000 * 1023 // 5000)
+        shown = set(re.findall(r"tankPressure=(\S+)", r.out))
+        assert shown == {f"{psi_f32(raw):.6g}"}, shown
+        assert "valveOpen=true" in r.out
+        assert run_fsw("cmd", "mode", "control", "safed", "--port", port, "-p", str(TANK)).code == 0
+        assert run_fsw("cmd", "set", "valveOpen", "false", "--port", port, "-p", str(TANK)).code == 0
+        r = run_fsw("monitor", str(TANK), "--port", port, "--headless", "--duration", "1")
+        assert r.code == 0 and set(re.findall(r"valveOpen=(\S+)", r.out)) == {"false"}, r.out[-500:]
+    finally:
+        import signal
+
+        proc.send_signal(signal.SIGINT)  # Ctrl-C: fsw sim stops its board
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=10)

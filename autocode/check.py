@@ -673,6 +673,7 @@ def _options_pos(src: Source):
     """Where a missing option belongs: the `[options]` header, else 1:1."""
     for n, text in enumerate(src.lines, 1):
         code = text.split("#", 1)[0]
-        if code.replace(" ", "").replace("\t", "") == "[options]":
+        # `[opt ions]` is no header (and has no "options" to point at)
+        if code.replace(" ", "").replace("\t", "") == "[options]" and "options" in code:
             return n, visual_col(text, code.index("options"))
     return 1, 1

@@ -109,15 +109,33 @@ def real_check(fname: str, real: Real) -> str:
             f"build with FSW_REAL_IS_FLOAT={flag}\");\n")
 
 
+def parens(cond: str) -> str:
+    """`cond` as the parenthesised condition of an `if`, with no second pair
+    around one that has its own (clang -Wall warns about `if ((a == b))`)."""
+    if cond.startswith("("):
+        depth = 0
+        for i, ch in enumerate(cond):
+            depth += ch == "("
+            depth -= ch == ")"
+            if depth == 0:
+                if i == len(cond) - 1:
+                    return cond
+                break
+    return f"({cond})"
+
+
 def basename(path: str) -> str:
     return path.replace("\\", "/").rsplit("/", 1)[-1]
 
 
 # ---- state vector ---------------------------------------------------------------
 
-def emit_sv(sv: M.StateVector) -> dict[str, str]:
-    h = [banner([sv.path], sv), "#ifndef FSW_GEN_SV_H", "#define FSW_GEN_SV_H", "",
-         '#include "fswkit.h"', "", "namespace fsw_gen {", "",
+def emit_sv(sv: M.StateVector, ns: str = "fsw_gen") -> dict[str, str]:
+    """`sv.gen.h`/`sv.gen.cpp` in namespace `ns` (another `ns` lets several
+    generated projects share one program, as the differential tests do)."""
+    guard = f"{ns.upper()}_SV_H"
+    h = [banner([sv.path], sv), f"#ifndef {guard}", f"#define {guard}", "",
+         '#include "fswkit.h"', "", f"namespace {ns} {{", "",
          f"// The state vector: {len(sv.regions)} regions, {sv.size} bytes, packed, little-endian.",
          f"static const uint16_t kSvSize = {max(sv.size, 1)};",
          f"static const uint32_t kSchemaHash = 0x{schema_hash(sv):08x}UL;",
@@ -134,11 +152,11 @@ def emit_sv(sv: M.StateVector) -> dict[str, str]:
     for r in sv.regions:
         h.append(f"    R_{r.name}_off = {r.offset}, R_{r.name}_size = {r.size},")
     h.append("};")
-    h += ["", "}  // namespace fsw_gen", "", "#endif  // FSW_GEN_SV_H", ""]
+    h += ["", f"}}  // namespace {ns}", "", f"#endif  // {guard}", ""]
     c = [banner([sv.path], sv), '#include "sv.gen.h"', "", version_check("sv.gen.cpp"),
-         f"static_assert(fsw_gen::kSvSize == {max(sv.size, 1)}, \"state vector size\");", "",
-         "namespace fsw_gen {", "", "uint8_t sv[kSvSize];  // every element starts at zero", "",
-         "}  // namespace fsw_gen", ""]
+         f"static_assert({ns}::kSvSize == {max(sv.size, 1)}, \"state vector size\");", "",
+         f"namespace {ns} {{", "", "uint8_t sv[kSvSize];  // every element starts at zero", "",
+         f"}}  // namespace {ns}", ""]
     return {"sv.gen.h": "\n".join(h), "sv.gen.cpp": "\n".join(c)}
 
 
@@ -148,8 +166,9 @@ class ExprEmitter:
     """C++ for model expressions of one machine (or of a script over it)."""
 
     def __init__(self, m: M.Machine, real: Real, scriptable: bool, prefix: str = "",
-                 windows: str = "w"):
+                 windows: str = "w", ns: str = "fsw_gen"):
         self.m = m
+        self.ns = ns  # the state vector's namespace (qualifies elements from outside)
         self.real = real
         self.scriptable = scriptable
         self.prefix = prefix  # qualifies the machine's names from outside (scripts)
@@ -167,7 +186,7 @@ class ExprEmitter:
 
     def ptr(self, v: M.Var) -> str:
         if v.kind == M.ELEMENT:
-            return f"fsw_gen::sv + fsw_gen::E_{v.name}" if self.prefix else f"sv + E_{v.name}"
+            return f"{self.ns}::sv + {self.ns}::E_{v.name}" if self.prefix else f"sv + E_{v.name}"
         return f"{self.prefix}loc + {self.prefix}L_{v.name}"
 
     def read(self, i: int) -> str:
@@ -250,6 +269,12 @@ class ExprEmitter:
             return None
         nan_result = compare(op, 0.0, cv)  # a NaN element reads as 0
         bits = 64 if v.type.size == 8 else 32
+        if all(isinstance(t, bool) for _, t in terms):
+            # The same for every value (`x > 1e39` in binary32: never), so
+            # also for 0, which is what a NaN reads as: a constant.
+            value = all(t != neg for neg, t in terms) != negate
+            assert value == nan_result
+            return "true" if value else "false"
         parts = []
         for neg, t in terms:
             if isinstance(t, bool):
@@ -430,10 +455,12 @@ def _window_type(w: M.Window) -> str:
     return f"fsw::Roll{kind}N<{w.size}>"
 
 
-def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str, str]:
+def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
+                 ns: str = "fsw_gen") -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
     keeps every local in memory, for a state script that writes locals;
-    otherwise locals that never change are folded into the code."""
+    otherwise locals that never change are folded into the code. `ns` is
+    the outer namespace (the state vector's, see emit_sv)."""
     name = c_ident(m.name)
     src = basename(m.path)
     ex = ExprEmitter(m, real, scriptable)
@@ -445,9 +472,9 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
         offsets[v.index] = size
         size += v.type.size
     init_bytes = b"".join(_bytes(v.type, values[v.index]) for v in stored)
-    guard = f"FSW_GEN_{name.upper()}_H"
+    guard = f"{ns.upper()}_{name.upper()}_H"
     h = [banner([m.path, m.sv.path], m.sv), f"#ifndef {guard}", f"#define {guard}", "",
-         '#include "fswkit.h"', "", "namespace fsw_gen {", f"namespace {name} {{", "",
+         '#include "fswkit.h"', "", f"namespace {ns} {{", f"namespace {name} {{", "",
          f"// State ids of {src}, in file order.", "enum : uint32_t {"]
     for st in m.states:
         h.append(f"    S_{st.name} = {st.id},")
@@ -466,11 +493,11 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
     h.append("FSW_MUST_CHECK fsw::Result step();")
     h.append("// Back to the state before the first step, starting in `initial`.")
     h.append("void reset(uint32_t initial);")
-    h += ["", f"}}  // namespace {name}", "}  // namespace fsw_gen", "", f"#endif  // {guard}", ""]
+    h += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", "", f"#endif  // {guard}", ""]
 
     c = [banner([m.path, m.sv.path], m.sv), f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
          version_check(f"{name}.gen.cpp"), real_check(src, real),
-         "namespace fsw_gen {", f"namespace {name} {{", "",
+         f"namespace {ns} {{", f"namespace {name} {{", "",
          f"fsw::Machine machine = FSW_MACHINE_INIT({m.states[0].id});"]
     if stored:
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
@@ -512,7 +539,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
         c.append(f"    if (machine.entering != 0) fsw::store<uint32_t>(sv + E_{s.name}, machine.state);")
     for w in m.windows:
         c.append(f"    w{w.index}.push({ex.value(w.arg)});  // {src}:{w.line}")
-    c.append("    uint32_t next = 0;")
+    if any(st.entry or st.step for st in m.states):  # else nothing can transition
+        c.append("    uint32_t next = 0;")
     c.append("    switch (machine.state) {")
     for st in m.states:
         c.append(f"    case S_{st.name}:")
@@ -540,7 +568,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False) -> dict[str
     for w in m.windows:
         c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
     c.append("}")
-    c += ["", f"}}  // namespace {name}", "}  // namespace fsw_gen", ""]
+    c += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", ""]
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}
 
 
@@ -561,7 +589,7 @@ def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.M
             out.append(f"{indent}return S_{m.states[st.state].name};  // {src}:{st.line}")
             return
         else:
-            out.append(f"{indent}if ({ex.cond(st.cond)}) {{  // {src}:{st.line}")
+            out.append(f"{indent}if {parens(ex.cond(st.cond))} {{  // {src}:{st.line}")
             _block(st.then, ex, indent + "    ", out, src, m, can_transition)
             if st.orelse:
                 out.append(f"{indent}}} else {{")
@@ -577,23 +605,30 @@ def script_writes_locals(script: M.Script) -> bool:
                for sec in script.sections for g in sec.inputs for a in g.inputs)
 
 
-def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
+def emit_script(script: M.Script, real: Real, source_line, ns: str = "fsw_gen",
+                entry: str = "main") -> dict[str, str]:
     """`script_main.cpp`: runs the script against the generated machine and
     prints the report `fsw test` prints, byte for byte. With a file name as
     its argument it also writes a binary trace: after every step, every
-    variable in report order as 8 bytes (int64, uint64 or binary64 bits)."""
+    variable in report order as 8 bytes (int64, uint64 or binary64 bits).
+    `ns` is the generated code's outer namespace (see emit_sv); with an
+    `entry` other than `main` the runner is `int <ns>::<entry>(argc, argv)`,
+    so that many runners link into one program."""
     from fswkit.script import failure_diagnostics
 
     m = script.machine
     name = c_ident(m.name)
-    ns = f"fsw_gen::{name}::"
-    ex = ExprEmitter(m, real, script_writes_locals(script), prefix=ns, windows="sw")
+    outer = ns
+    ns = f"{outer}::{name}::"
+    ex = ExprEmitter(m, real, script_writes_locals(script), prefix=ns, windows="sw", ns=outer)
     order = sorted(m.vars, key=lambda v: v.display.encode())
     folded = {i: _bytes(m.vars[i].type, to_type(m.vars[i].type, x)) for i, x in ex.consts.items()}
-    checks: list = []
     c = [banner([script.path, m.path, m.sv.path], m.sv), "#include <inttypes.h>", "#include <stdio.h>", "",
          '#include "fswkit.h"', '#include "sv.gen.h"', f'#include "{name}.gen.h"', "",
-         version_check("script_main.cpp"), real_check(basename(script.path), real), "namespace {", ""]
+         version_check("script_main.cpp"), real_check(basename(script.path), real)]
+    if entry != "main":
+        c.append(f"namespace {outer} {{")
+    c += ["namespace {", ""]
     for w in script.windows:
         c.append(f"{_window_type(w)} sw{w.index};  // {basename(script.path)}:{w.line}")
     c.append("")
@@ -662,65 +697,10 @@ def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
     c.append("")
     c.append("}  // namespace")
     c.append("")
-    c.append("int main(int argc, char** argv) {")
+    c.append(f"int {entry}(int argc, char** argv) {{")
     c.append("    FILE* trace = argc > 1 ? fopen(argv[1], \"wb\") : 0;")
     c.append("    if (argc > 1 && trace == 0) { fprintf(stderr, \"cannot write trace %s\\n\", argv[1]); return 3; }")
-    c.append(f"    {ns}reset({m.states[script.init_state].id});")
-    c.append("    uint64_t g = 0, steps = 0, asserts = 0;")
-    c.append("    int outcome = -1;  // -1 running, 0 passed, 1 assert failed, 2 max_steps, 3 step error")
-    c.append("    int failed_assert = -1;")
-    ncheck = sum(len(grp.checks) for sec in script.sections for grp in sec.checks)
-    c.append(f"    int rem[{max(ncheck, 1)}];")
-    c.append("    while (outcome < 0) {")
-    c.append(f"        if (steps >= {script.max_steps}ULL) {{ outcome = 2; break; }}")
-    c.append(f"        fsw::store<uint64_t>(fsw_gen::sv + fsw_gen::E_{m.vars[m.g].name}, g);")
-    c.append(f"        fsw::store<uint32_t>(fsw_gen::sv + fsw_gen::E_{m.vars[m.s].name}, {ns}machine.state);")
-    c.append(f"        {ns}machine.t = {ns}machine.pending != 0 ? 0 : g - {ns}machine.entry_g;")
-    for w in script.windows:
-        c.append(f"        sw{w.index}.push({ex.value(w.arg)});")
-    c.append(f"        const uint32_t state = {ns}machine.state;")
-    c.append("        int nrem = 0;")
-    assert_ids: dict[int, int] = {}
-    for sec in script.sections:
-        ind = "        "
-        if sec.state is not None:
-            c.append(f"        if (state == {m.states[sec.state].id}) {{")
-            ind = "            "
-        for grp in sec.inputs:
-            c.append(f"{ind}if ({ex.cond(grp.guard)}) {{")
-            for a in grp.inputs:
-                c.append(f"{ind}    {ex.assign(a.var, a.expr)}  // {basename(script.path)}:{a.line}")
-            c.append(f"{ind}}}")
-        for grp in sec.checks:
-            ids = []
-            for chk in grp.checks:
-                ids.append(len(checks))
-                checks.append(chk)
-            c.append(f"{ind}if ({ex.cond(grp.guard)}) {{")
-            c.append(f"{ind}    " + " ".join(f"rem[nrem++] = {i};" for i in ids))
-            c.append(f"{ind}}}")
-        if sec.state is not None:
-            c.append("        }")
-    c.append(f"        if ({ns}step() != fsw::kOk) {{ ++steps; outcome = 3; break; }}")
-    c.append("        ++steps;")
-    c.append("        if (trace) write_trace(trace);")
-    c.append("        for (int k = 0; k < nrem && outcome < 0; ++k) {")
-    c.append("            switch (rem[k]) {")
-    na = 0
-    for i, chk in enumerate(checks):
-        if isinstance(chk, M.Stop):
-            c.append(f"            case {i}: outcome = 0; break;")
-        else:
-            assert_ids[i] = na
-            c.append(f"            case {i}: if ({ex.cond(chk.expr)}) ++asserts; "
-                     f"else {{ outcome = 1; failed_assert = {na}; }} break;")
-            na += 1
-    c.append("            default: break;")
-    c.append("            }")
-    c.append("        }")
-    c.append("        if (outcome >= 0) break;")
-    c.append(f"        g += {script.delta_t}ULL;")
-    c.append("    }")
+    c += _script_loop(script, ex, outer, ns, "        if (trace) write_trace(trace);")
     c.append("    if (trace) fclose(trace);")
     c.append("    printf(\"state script ran for %\" PRIu64 \" step%s\\n\", steps, steps == 1 ? \"\" : \"s\");")
     c.append("    printf(\"%\" PRIu64 \" assert%s passed\\n\", asserts, asserts == 1 ? \"\" : \"s\");")
@@ -737,15 +717,152 @@ def emit_script(script: M.Script, real: Real, source_line) -> dict[str, str]:
     c.append("    }")
     c.append("    return outcome == 0 ? 0 : 1;")
     c.append("}")
+    if entry != "main":
+        c.append(f"}}  // namespace {outer}")
     c.append("")
     return {"script_main.cpp": "\n".join(c)}
 
 
-def script_files(script: M.Script, real: Real, source_line) -> dict[str, str]:
+def _script_loop(script: M.Script, ex: ExprEmitter, outer: str, ns: str, trace: str) -> list[str]:
+    """The run loop of spec §5 shared by the script runners: declares `g`,
+    `steps`, `asserts`, `outcome` and `failed_assert`, and leaves them set;
+    `trace` is the statement that records a step."""
+    m = script.machine
+    c: list[str] = []
+    checks: list = []
+    c.append(f"    {ns}reset({m.states[script.init_state].id});")
+    c.append("    uint64_t g = 0, steps = 0, asserts = 0;")
+    c.append("    int outcome = -1;  // -1 running, 0 passed, 1 assert failed, 2 max_steps, 3 step error")
+    c.append("    int failed_assert = -1;")
+    ncheck = sum(len(grp.checks) for sec in script.sections for grp in sec.checks)
+    c.append(f"    int rem[{max(ncheck, 1)}];")
+    c.append("    while (outcome < 0) {")
+    c.append(f"        if (steps >= {script.max_steps}ULL) {{ outcome = 2; break; }}")
+    c.append(f"        fsw::store<uint64_t>({outer}::sv + {outer}::E_{m.vars[m.g].name}, g);")
+    c.append(f"        fsw::store<uint32_t>({outer}::sv + {outer}::E_{m.vars[m.s].name}, {ns}machine.state);")
+    c.append(f"        {ns}machine.t = {ns}machine.pending != 0 ? 0 : g - {ns}machine.entry_g;")
+    for w in script.windows:
+        c.append(f"        sw{w.index}.push({ex.value(w.arg)});")
+    if any(sec.state is not None for sec in script.sections):
+        c.append(f"        const uint32_t state = {ns}machine.state;")
+    c.append("        int nrem = 0;")
+    assert_ids: dict[int, int] = {}
+    for sec in script.sections:
+        ind = "        "
+        if sec.state is not None:
+            c.append(f"        if (state == {m.states[sec.state].id}) {{")
+            ind = "            "
+        for grp in sec.inputs:
+            c.append(f"{ind}if {parens(ex.cond(grp.guard))} {{")
+            for a in grp.inputs:
+                c.append(f"{ind}    {ex.assign(a.var, a.expr)}  // {basename(script.path)}:{a.line}")
+            c.append(f"{ind}}}")
+        for grp in sec.checks:
+            ids = []
+            for chk in grp.checks:
+                ids.append(len(checks))
+                checks.append(chk)
+            c.append(f"{ind}if {parens(ex.cond(grp.guard))} {{")
+            c.append(f"{ind}    " + " ".join(f"rem[nrem++] = {i};" for i in ids))
+            c.append(f"{ind}}}")
+        if sec.state is not None:
+            c.append("        }")
+    c.append(f"        if ({ns}step() != fsw::kOk) {{ ++steps; outcome = 3; break; }}")
+    c.append("        ++steps;")
+    c.append(trace)
+    c.append("        for (int k = 0; k < nrem && outcome < 0; ++k) {")
+    c.append("            switch (rem[k]) {")
+    na = 0
+    for i, chk in enumerate(checks):
+        if isinstance(chk, M.Stop):
+            c.append(f"            case {i}: outcome = 0; break;")
+        else:
+            assert_ids[i] = na
+            c.append(f"            case {i}: if {parens(ex.cond(chk.expr))} ++asserts; "
+                     f"else {{ outcome = 1; failed_assert = {na}; }} break;")
+            na += 1
+    c.append("            default: break;")
+    c.append("            }")
+    c.append("        }")
+    c.append("        if (outcome >= 0) break;")
+    c.append(f"        g += {script.delta_t}ULL;")
+    c.append("    }")
+    return c
+
+
+def emit_script_avr(script: M.Script, real: Real, ns: str = "fsw_gen", entry: str = "run_script") -> dict[str, str]:
+    """`script_avr.cpp`: the same run as emit_script's runner for a board
+    without stdio (the differential tests run it on a simulated AVR). It
+    writes only the trace and the outcome, through a byte sink the board
+    code defines, `void fsw_trace_write(const uint8_t* data, uint16_t len)`:
+    after every step `R` and the row of emit_script's binary trace (every
+    variable in report order as 8 bytes: int64, uint64 or binary64 bits,
+    F32 widened in software), at the end `E`, the outcome (1 byte: 0
+    passed, 1 assert failed, 2 max_steps, 3 step error), the failed assert's
+    number (int16, -1 for none), steps and asserts passed (uint64 each).
+    All little-endian. The runner is `int <ns>::<entry>()`, returning 0 when
+    the script passed."""
+    import struct
+
+    m = script.machine
+    name = c_ident(m.name)
+    outer = ns
+    ns = f"{outer}::{name}::"
+    ex = ExprEmitter(m, real, script_writes_locals(script), prefix=ns, windows="sw", ns=outer)
+    order = sorted(m.vars, key=lambda v: v.display.encode())
+    src = basename(script.path)
+    c = [banner([script.path, m.path, m.sv.path], m.sv),
+         '#include "fswkit.h"', '#include "sv.gen.h"', f'#include "{name}.gen.h"', "",
+         version_check("script_avr.cpp"), real_check(src, real),
+         "// The board's byte sink (a UART): the trace and the outcome leave through it.",
+         "void fsw_trace_write(const uint8_t* data, uint16_t len);", "",
+         f"namespace {outer} {{", "namespace {", ""]
+    for w in script.windows:
+        c.append(f"{_window_type(w)} sw{w.index};  // {src}:{w.line}")
+    c += ["", "void put64(uint64_t v) { fsw_trace_write(reinterpret_cast<const uint8_t*>(&v), 8); }", "",
+          "// One row: every variable in report order, 8 bytes each.",
+          "void trace_row() {", "    const uint8_t mark = 'R';", "    fsw_trace_write(&mark, 1);"]
+    for v in order:
+        t = v.type
+        if v.kind == M.TIME_IN_STATE:
+            c.append(f"    put64({ns}machine.t);  // T")
+            continue
+        if v.index in ex.consts:  # folded into the code: its value, widened now
+            x = to_type(t, ex.consts[v.index])
+            if t.is_float:
+                row = struct.unpack("<Q", struct.pack("<d", float(x)))[0]
+            else:
+                row = int(x) & ((1 << 64) - 1)
+            c.append(f"    put64(0x{row:016x}ULL);  // {v.display} (folded)")
+            continue
+        p = ex.ptr(v)
+        if t.is_bool:
+            c.append(f"    put64(fsw::load_bool({p}) ? 1u : 0u);  // {v.display}")
+        elif t.is_float and t.size == 4:
+            c.append(f"    put64(fsw::f64_bits_from_f32(fsw::load<float>({p})));  // {v.display}")
+        elif t.is_float or t.size == 8:
+            c.append(f"    fsw_trace_write({p}, 8);  // {v.display}")
+        elif t.signed:
+            c.append(f"    put64(static_cast<uint64_t>(static_cast<int64_t>(fsw::load<int{t.size * 8}_t>({p}))));"
+                     f"  // {v.display}")
+        else:
+            c.append(f"    put64(fsw::load<uint{t.size * 8}_t>({p}));  // {v.display}")
+    c += ["}", "", "}  // namespace", "", f"int {entry}() {{"]
+    c += _script_loop(script, ex, outer, ns, "        trace_row();")
+    c += ["    uint8_t end[20];", "    end[0] = 'E';", "    end[1] = static_cast<uint8_t>(outcome);",
+          "    const int16_t failed = static_cast<int16_t>(failed_assert);",
+          "    memcpy(end + 2, &failed, 2);", "    memcpy(end + 4, &steps, 8);", "    memcpy(end + 12, &asserts, 8);",
+          "    fsw_trace_write(end, sizeof end);", "    return outcome == 0 ? 0 : 1;", "}",
+          f"}}  // namespace {outer}", ""]
+    return {"script_avr.cpp": "\n".join(c)}
+
+
+def script_files(script: M.Script, real: Real, source_line, ns: str = "fsw_gen",
+                 entry: str = "main") -> dict[str, str]:
     """Everything `fsw test --native` compiles: state vector, machine,
-    runner."""
+    runner (`ns` and `entry`: see emit_script)."""
     files = {}
-    files.update(emit_sv(script.machine.sv))
-    files.update(emit_machine(script.machine, real, scriptable=script_writes_locals(script)))
-    files.update(emit_script(script, real, source_line))
+    files.update(emit_sv(script.machine.sv, ns))
+    files.update(emit_machine(script.machine, real, scriptable=script_writes_locals(script), ns=ns))
+    files.update(emit_script(script, real, source_line, ns, entry))
     return files

@@ -1,0 +1,205 @@
+"""Generated machines and scripts on a simulated ATmega2560 (simavr):
+binary32 R with avr-libc's and libgcc's own float code, the way a board runs
+them. Each case is the machine's generated C++ plus emit_script_avr's
+runner; several cases link into one ELF, whose `main` runs them in turn and
+sends everything over UART0 at 2 Mbaud:
+
+    'C' key(uint16)   a case starts
+    'R' row           after each step: every variable, 8 bytes (see emit_script_avr)
+    'E' outcome(1) failed_assert(int16) steps(uint64) asserts(uint64)
+    'Z'               all cases done (then the firmware sleeps, interrupts off)
+
+tests/differential/avr/diffsim.c runs the ELF and copies those bytes out."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import struct
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+from fswkit import native
+from fswkit.autocode import model as M
+from fswkit.autocode.emit_cpp import emit_machine, emit_script_avr, emit_sv, script_writes_locals
+from fswkit.autocode.numeric import F32MODE
+
+from harness import JOBS, cache_dir
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+MCU = "atmega2560"
+AVR_CXX = os.environ.get("AVR_CXX", "avr-g++")
+AVR_FLAGS = ["-mmcu=" + MCU, "-DF_CPU=16000000L", "-DARDUINO=10819", "-DARDUINO_AVR_MEGA2560",
+             "-DARDUINO_ARCH_AVR", "-std=gnu++11", "-Os", "-ffp-contract=off", "-fno-exceptions", "-fno-rtti",
+             "-fno-threadsafe-statics", "-ffunction-sections", "-fdata-sections",
+             "-Wall", "-Wextra", "-Werror", "-Wno-unused-function"]
+# The runtime files a machine and its runner use (no PSL: no Arduino core).
+RUNTIME_FILES = ("fsw_convert.cpp", "fsw_f64.cpp", "fsw_window.cpp")
+
+
+def available() -> str | None:
+    """None when the AVR toolchain and simavr are here, else what is missing."""
+    for tool in (AVR_CXX, "avr-ar", "avr-size", "gcc"):
+        if shutil.which(tool) is None:
+            return f"{tool} not installed"
+    if not os.path.exists("/usr/include/simavr/sim_avr.h"):
+        return "libsimavr-dev not installed"
+    return None
+
+
+def _run(cmd: list[str]) -> str:
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise native.NativeError(" ".join(cmd) + "\n" + r.stderr[-6000:])
+    return r.stdout
+
+
+def diffsim() -> str:
+    """The simavr harness, built once (cached by its source's hash)."""
+    src = os.path.join(HERE, "avr", "diffsim.c")
+    with open(src, "rb") as f:
+        h = hashlib.sha256(f.read()).hexdigest()[:16]
+    exe = os.path.join(cache_dir(), f"diffsim-{h}")
+    if not os.path.exists(exe):
+        os.makedirs(cache_dir(), exist_ok=True)
+        _run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", exe + ".tmp", src, "-lsimavr"])
+        os.replace(exe + ".tmp", exe)
+    return exe
+
+
+def _cached_object(text: str, name: str, workdir: str, include: list[str], key: bytes) -> str:
+    h = hashlib.sha256(key + text.encode() + " ".join([AVR_CXX] + AVR_FLAGS).encode()).hexdigest()[:24]
+    obj = os.path.join(cache_dir(), "avr", h + ".o")
+    if os.path.exists(obj):
+        return obj
+    os.makedirs(os.path.dirname(obj), exist_ok=True)
+    src = os.path.join(workdir, name)
+    with open(src, "w") as f:
+        f.write(text)
+    _run([AVR_CXX] + AVR_FLAGS + ["-I", native.RUNTIME] + [x for d in include for x in ("-I", d)]
+         + ["-c", src, "-o", obj + ".tmp"])
+    os.replace(obj + ".tmp", obj)
+    return obj
+
+
+def _runtime_key() -> bytes:
+    h = hashlib.sha256()
+    for n in sorted(os.listdir(native.RUNTIME)):
+        with open(os.path.join(native.RUNTIME, n), "rb") as f:
+            h.update(n.encode() + b"\0" + f.read())
+    return h.digest()
+
+
+@dataclass
+class AvrOutcome:
+    rows: bytes  # the trace rows, concatenated (emit_script's raw trace format)
+    outcome: int  # 0 passed, 1 assert failed, 2 max_steps, 3 step error
+    failed_assert: int
+    steps: int
+    asserts: int
+
+
+def _main_cpp(keys: list[int]) -> str:
+    c = ["#include <avr/interrupt.h>", "#include <avr/io.h>", "#include <avr/sleep.h>", "#include <stdint.h>", "",
+         "void fsw_trace_write(const uint8_t* data, uint16_t len) {",
+         "    for (uint16_t i = 0; i < len; ++i) {",
+         "        while ((UCSR0A & (1 << UDRE0)) == 0) {}",
+         "        UDR0 = data[i];",
+         "    }",
+         "}", ""]
+    c += [f"namespace fsw_c{k} {{ int run_script(); }}" for k in keys]
+    c += ["", "static void begin_case(uint16_t key) {",
+          "    uint8_t b[3] = {'C', static_cast<uint8_t>(key), static_cast<uint8_t>(key >> 8)};",
+          "    fsw_trace_write(b, 3);", "}", "",
+          "int main() {",
+          "    UBRR0 = 0;  // 2 Mbaud at 16 MHz with U2X0",
+          "    UCSR0A = 1 << U2X0;",
+          "    UCSR0B = 1 << TXEN0;",
+          "    UCSR0C = 3 << UCSZ00;"]
+    for k in keys:
+        c += [f"    begin_case({k});", f"    fsw_c{k}::run_script();"]
+    c += ["    const uint8_t z[4] = {'Z', 0, 0, 0};  // the padding leaves while the Z is on the wire",
+          "    fsw_trace_write(z, 4);",
+          "    cli();", "    sleep_enable();", "    sleep_cpu();", "    return 0;", "}", ""]
+    return "\n".join(c)
+
+
+def build_elf(workdir: str, items: list[tuple[int, M.Script]], pool: ThreadPoolExecutor,
+              per_tu: int = 4) -> str:
+    """One ELF running every case of `items` in turn."""
+    key = _runtime_key()
+    rt = [pool.submit(_cached_object, open(os.path.join(native.RUNTIME, n)).read(), "rt_" + n, workdir,
+                      [native.RUNTIME], key) for n in RUNTIME_FILES]
+    tus = []
+    for start in range(0, len(items), per_tu):
+        lines, tkey = [], hashlib.sha256(key)
+        for k, script in items[start:start + per_tu]:
+            m = script.machine
+            files = {}
+            files.update(emit_sv(m.sv, f"fsw_c{k}"))
+            files.update(emit_machine(m, F32MODE, scriptable=script_writes_locals(script), ns=f"fsw_c{k}"))
+            files.update(emit_script_avr(script, F32MODE, ns=f"fsw_c{k}"))
+            d = os.path.join(workdir, f"c{k}")
+            os.makedirs(d, exist_ok=True)
+            for name in sorted(files):
+                with open(os.path.join(d, name), "w") as f:
+                    f.write(files[name])
+                tkey.update(f"c{k}/{name}\0".encode() + files[name].encode())
+            machine = [n for n in sorted(files) if n.endswith(".gen.cpp") and n != "sv.gen.cpp"][0]
+            lines += [f'#include "c{k}/sv.gen.cpp"', f'#include "c{k}/{machine}"', f'#include "c{k}/script_avr.cpp"']
+        tus.append(pool.submit(_cached_object, "\n".join(lines) + "\n", f"tu{start}.cpp", workdir, [workdir],
+                               tkey.digest()))
+    main = pool.submit(_cached_object, _main_cpp([k for k, _ in items]), "main.cpp", workdir, [], b"")
+    objs = [f.result() for f in tus] + [main.result()]
+    lib = os.path.join(workdir, "libfsw.a")
+    if os.path.exists(lib):
+        os.remove(lib)
+    _run(["avr-ar", "rcs", lib] + [f.result() for f in rt])
+    elf = os.path.join(workdir, "cases.elf")
+    _run([AVR_CXX, "-mmcu=" + MCU, "-Os", "-Wl,--gc-sections", "-o", elf] + objs + [lib])
+    return elf
+
+
+def memory(elf: str) -> tuple[int, int]:
+    """(flash, RAM) bytes of an ELF: text + data, data + bss."""
+    out = _run(["avr-size", "-A", elf])
+    sizes = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0].startswith(".") and parts[1].isdigit():
+            sizes[parts[0]] = int(parts[1])
+    return sizes.get(".text", 0) + sizes.get(".data", 0), sizes.get(".data", 0) + sizes.get(".bss", 0)
+
+
+def run_elf(elf: str, items: list[tuple[int, M.Script]], wall: float = 120) -> dict[int, AvrOutcome]:
+    """Runs the ELF under simavr; each case's outcome, decoded."""
+    path = elf + ".uart"
+    r = subprocess.run([diffsim(), "-o", path, "-m", MCU, "-t", "600", "-w", str(wall), elf], capture_output=True)
+    if r.returncode != 0:
+        raise native.NativeError(f"simavr run failed (status {r.returncode}): {r.stderr.decode()[-2000:]}")
+    with open(path, "rb") as f:
+        data = f.read()
+    pos = 0
+    nvars = {k: len(s.machine.vars) for k, s in items}
+    out: dict[int, AvrOutcome] = {}
+    while True:
+        tag = data[pos:pos + 1]
+        if tag == b"Z":
+            break
+        if tag != b"C":
+            raise native.NativeError(f"bad AVR output at byte {pos}: {data[pos:pos + 16]!r}")
+        k = struct.unpack_from("<H", data, pos + 1)[0]
+        pos += 3
+        size = 8 * nvars[k]
+        rows = bytearray()
+        while data[pos:pos + 1] == b"R":
+            rows += data[pos + 1:pos + 1 + size]
+            pos += 1 + size
+        if data[pos:pos + 1] != b"E":
+            raise native.NativeError(f"case {k}: no end record at byte {pos}: {data[pos:pos + 16]!r}")
+        outcome, failed, steps, asserts = struct.unpack_from("<BhQQ", data, pos + 1)
+        pos += 20
+        out[k] = AvrOutcome(bytes(rows), outcome, failed, steps, asserts)
+    return out

@@ -373,6 +373,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             err(rt, f"unknown region `{rt.text}`")
             continue
         opts = _kv(toks, 1, src, diags)
+        unknown = [kt for k, (kt, _) in opts.items() if k != "rate"]
+        for kt in unknown:
+            err(kt, f"unknown stream setting `{kt.text}`: a stream takes `rate=HZ`")
+        if unknown:
+            continue
         if "rate" not in opts:
             err(rt, f"region `{rt.text}` needs `rate=HZ`")
             continue

@@ -98,6 +98,7 @@ def test_valid_project_checks_clean(fsw, tmp_path):
     ("app", "reset_cause resetCause", "reset_cause heater", "`reset_cause` needs a U8 element; `heater` is F32"),
     ("app", "rate 100", "rate 3", "`rate` must be a whole number of cycles per second that divides 1000000"),
     ("app", "[uplink]", "[downlink]", "unknown section `[downlink]`"),
+    ("app", "[uplink]\n", "[telemetry]\nSensors rate=10 batch=4\n[uplink]\n", "unknown stream setting `batch`: a stream takes `rate=HZ`"),
     ("aio", "i A0", "i A7", "I/O config error @ {p}/rig.aio:1:3:\n  | i A7 pressure scale=250 offset=-125\n  |   ^ board `uno` has no pin `A7`"),
     ("aio", "o 3 heater", "o 4 heater", "pin `4` of `uno` cannot drive PWM (PWM pins: 3, 5, 6, 9, 10, 11)"),
     ("aio", "i A0 pressure", "i A0 button", "analog channels need an F32 or F64 element; `button` is bool"),

@@ -535,6 +535,24 @@ def machine_warnings(m: M.Machine, f: S.SmFile, src: Source, diags: Diagnostics,
             warn(d.line, d.name_col, f"element `{v.name}` is listed but never used")
 
 
+def assigned_vars(m: M.Machine) -> set[int]:
+    """Every variable some statement of the machine assigns."""
+    out: set[int] = set()
+
+    def walk(stmts):
+        for st in stmts:
+            if isinstance(st, M.Assign):
+                out.add(st.var)
+            elif isinstance(st, M.If):
+                walk(st.then)
+                walk(st.orelse)
+
+    for st in m.states:
+        for block in (st.entry, st.step, st.exit):
+            walk(block)
+    return out
+
+
 def gotos(stmts):
     """Every transition in a statement list, nested ones included."""
     for st in stmts:

@@ -12,6 +12,7 @@ import re
 
 from . import model as M
 from .diagnostics import Diagnostic, SS
+from .check import assigned_vars
 from .evaluate import NotConstant, compare, evaluate, local_values
 from .numeric import Real, f32, to_type
 from .schema import schema_hash
@@ -22,24 +23,6 @@ RUNTIME_MAJOR, RUNTIME_MINOR = (int(x) for x in __version__.split(".")[:2])
 
 def _no_reads(i: int):
     raise NotConstant(None)
-
-
-def assigned_vars(m: M.Machine) -> set[int]:
-    """Every variable some statement of the machine assigns."""
-    out: set[int] = set()
-
-    def walk(stmts):
-        for st in stmts:
-            if isinstance(st, M.Assign):
-                out.add(st.var)
-            elif isinstance(st, M.If):
-                walk(st.then)
-                walk(st.orelse)
-
-    for st in m.states:
-        for block in (st.entry, st.step, st.exit):
-            walk(block)
-    return out
 
 
 # ---- small pieces -------------------------------------------------------------

@@ -31,7 +31,7 @@ from collections import deque
 from dataclasses import dataclass, field, replace
 
 from fswkit.autocode import model as M
-from fswkit.autocode.check import fold, model_children
+from fswkit.autocode.check import assigned_vars, fold, model_children
 from fswkit.autocode.evaluate import NotConstant, compare, evaluate, local_values
 from fswkit.autocode.numeric import F64MODE, to_type, truthy
 from fswkit.autocode.types import TYPES
@@ -967,19 +967,7 @@ def _taken_before(p: Plan, k: int) -> set[int]:
 
 def _sensors(m: M.Machine) -> list[int]:
     """Elements the machine reads and never writes (its inputs), G and S aside."""
-    assigned: set[int] = set()
-
-    def walk(stmts):
-        for s in stmts:
-            if isinstance(s, M.Assign):
-                assigned.add(s.var)
-            elif isinstance(s, M.If):
-                walk(s.then)
-                walk(s.orelse)
-
-    for st in m.states:
-        for b in (st.entry, st.step, st.exit):
-            walk(b)
+    assigned = assigned_vars(m)
     return [v.index for v in m.vars if v.kind == M.ELEMENT and v.index not in (m.g, m.s)
             and v.index not in assigned]
 

@@ -139,7 +139,19 @@ class _F32(Real):
         d = float(text)
         if d == 0.0 or d == INF:
             return d  # underflows or overflows binary64: binary32 too
-        return f32_from_fraction(Fraction(text))
+        parts = decimal_parts(text)
+        if parts is None:  # pragma: no cover - an exponent of a billion digits
+            return f32(d)
+        digits, e = parts
+        if len(digits) > 200:
+            # Keep 200 significant digits and a sticky 1 for the rest: no
+            # binary32 value or midpoint needs more than 113 digits, so none
+            # lies between the literal and this shorter one, and both round
+            # alike (and a 100,000-digit literal costs no quadratic int()).
+            e += len(digits) - 201
+            digits = digits[:200] + "1"
+        n = int(digits)
+        return f32_from_fraction(Fraction(n * 10**e) if e >= 0 else Fraction(n, 10**-e))
 
 
 F64MODE = _F64()
@@ -175,10 +187,32 @@ def format_value(t: ElemType, v) -> str:
     return "%.6f" % v
 
 
+def decimal_parts(text: str) -> tuple[str, int] | None:
+    """A numeric literal as (significant digits without leading or trailing
+    zeros, power of ten): its value is int(digits) * 10**power ("" for 0).
+    None when the exponent has more than 9 digits. Never converts a long
+    digit string to int (Python refuses over 4300 digits, and is slow)."""
+    mant, _, exp = text.lower().partition("e")
+    whole, _, frac = mant.partition(".")
+    sign = -1 if exp.startswith("-") else 1
+    exp = exp.lstrip("+-").lstrip("0")
+    if len(exp) > 9:
+        return None
+    digits = (whole + frac).lstrip("0")
+    significant = digits.rstrip("0")
+    return significant, sign * int(exp or "0") - len(frac) + len(digits) - len(significant)
+
+
 def exact_literal(text: str) -> Fraction | None:
     """The exact value of a numeric literal, or None when it is absurdly
-    large or small (exponent beyond ±4000)."""
-    mant, _, exp = text.lower().partition("e")
-    if exp and abs(int(exp)) > 4000:
+    large or small (beyond 10^±4000) or long (over 4000 significant digits)."""
+    parts = decimal_parts(text)
+    if parts is None:
         return None
-    return Fraction(text)
+    digits, e = parts
+    if not digits:
+        return Fraction(0)
+    if len(digits) > 4000 or abs(e + len(digits)) > 4000:
+        return None
+    n = int(digits)
+    return Fraction(n * 10**e) if e >= 0 else Fraction(n, 10**-e)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+import shlex
 import shutil
 import struct
 import subprocess
@@ -91,6 +92,25 @@ def run_interpreter(script: M.Script, real: Real, source_line, trace_path: str) 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
+def prune_cache(max_bytes: int = 400 << 20) -> None:
+    """Drops the least recently used objects until the cache holds at most
+    `max_bytes` (every emitter change makes a new set)."""
+    objs = []
+    for sub in ("obj", "avr"):
+        d = os.path.join(cache_dir(), sub)
+        if os.path.isdir(d):
+            for n in os.listdir(d):
+                p = os.path.join(d, n)
+                st = os.stat(p)
+                objs.append((st.st_mtime, st.st_size, p))
+    total = sum(size for _, size, _ in objs)
+    for _, size, p in sorted(objs):
+        if total <= max_bytes:
+            break
+        os.remove(p)
+        total -= size
+
+
 def scratch_dir(fallback: str) -> str:
     """A fresh directory for one run's thousands of small files: in memory
     (/dev/shm) where there is one, else under `fallback`."""
@@ -128,9 +148,10 @@ def flags(real: Real, opt: str = "-O0", cxx: str = native.CXX) -> list[str]:
 
 
 def default_cxx() -> str:
-    """$FSW_DIFF_CXX, else clang++ where installed (at -O0 it compiles the
-    batches in less than half g++'s time; `fsw test --native` and
-    test_examples.py build with g++ -O2), else native.CXX."""
+    """$FSW_DIFF_CXX (a command, flags allowed), else clang++ where
+    installed (at -O0 it compiles the script runners in less than half of
+    g++'s time; `fsw test --native` and test_examples.py build with g++
+    -O2), else native.CXX."""
     env = os.environ.get("FSW_DIFF_CXX")
     if env:
         return env
@@ -144,13 +165,14 @@ def _compile_cached(src_text: str, name: str, cmd_flags: list[str], include: lis
     h = hashlib.sha256(key + src_text.encode() + " ".join([cxx] + cmd_flags).encode()).hexdigest()[:24]
     obj = os.path.join(cache_dir(), "obj", h + ".o")
     if os.path.exists(obj):
+        os.utime(obj)  # recently used: kept by prune_cache
         return obj
     os.makedirs(os.path.dirname(obj), exist_ok=True)
     src = os.path.join(workdir, name)
     with open(src, "w") as f:
         f.write(src_text)
     tmp = obj + f".tmp{os.getpid()}.{threading.get_ident()}"
-    _cc([cxx] + cmd_flags + ["-I", native.RUNTIME] + [x for d in include for x in ("-I", d)]
+    _cc(shlex.split(cxx) + cmd_flags + ["-I", native.RUNTIME] + [x for d in include for x in ("-I", d)]
         + ["-c", src, "-o", tmp])
     os.replace(tmp, obj)
     return obj
@@ -226,7 +248,7 @@ class Batch:
                 one = os.path.join(self.dir, f"one{k}.cpp")
                 with open(one, "w") as f:
                     f.write("\n".join(lines[i:i + 3]) + "\n")
-                r = subprocess.run([self.cxx] + self.flags + ["-I", native.RUNTIME, "-I", self.dir,
+                r = subprocess.run(shlex.split(self.cxx) + self.flags + ["-I", native.RUNTIME, "-I", self.dir,
                                                                "-fsyntax-only", one], capture_output=True, text=True)
                 if r.returncode != 0:
                     raise CompileFailure(k, r.stderr[-6000:]) from None
@@ -273,7 +295,7 @@ class Batch:
                                              self.cxx))
         objs = [f.result() for f in self.objects]
         exe = os.path.join(self.dir, "runner")
-        _cc([self.cxx] + objs + ["-o", exe])
+        _cc(shlex.split(self.cxx) + objs + ["-o", exe])
         return exe
 
     def run(self) -> dict[int, Outcome]:
@@ -545,24 +567,45 @@ def run_cases(cases: list[Case], modes: list[str], workdir: str, opt: str = "-O0
 
 
 def main(argv: list[str]) -> int:
-    """python harness.py SEED N [f64|f32|both] [K...]: runs cases, prints mismatches."""
-    import tempfile
+    """python harness.py SEED N [f64|f32|both] [K...]: runs script cases
+    (all N, or only cases K...) and prints every mismatch. With N written
+    `raw:N` it runs raw-input machine cases instead. FSW_DIFF_CXX and
+    FSW_DIFF_OPT pick the compiler and the optimisation level."""
     import gen_programs as gp
+    from fswkit.autocode.numeric import MODES
 
-    seed, n = int(argv[0]), int(argv[1])
+    seed, raw, n = int(argv[0]), argv[1].startswith("raw:"), int(argv[1].split(":")[-1])
     modes = ["f64", "f32"] if len(argv) < 3 or argv[2] == "both" else [argv[2]]
-    only = [int(x) for x in argv[3:]]
-    cs = [gp.case(seed, k) for k in (only or range(n))]
-    work = tempfile.mkdtemp(prefix="fswdiff")
+    keys = [int(x) for x in argv[3:]] or list(range(n))
+    opt = os.environ.get("FSW_DIFF_OPT", "-O0")
+    work = scratch_dir("/tmp")
     bad = 0
     t0 = time.monotonic()
-    for mode, c, it, nat in run_cases(cs, modes, work, opt=os.environ.get("FSW_DIFF_OPT", "-O0")):
-        d = first_difference(it, nat) if nat is not None else "no native result"
-        if d:
-            bad += 1
-            print(f"== {mode} case {c.index}: {d}")
-    print(f"{len(cs)} cases x {len(modes)} modes, {bad} mismatches, {time.monotonic() - t0:.1f}s")
-    shutil.rmtree(work, ignore_errors=True)
+    try:
+        if not raw:
+            for mode, c, it, nat in run_cases([gp.case(seed, k) for k in keys], modes, work, opt=opt):
+                d = first_difference(it, nat) if nat is not None else "no native result"
+                if d:
+                    bad += 1
+                    print(f"== {mode} case {c.index}: {d}\n{c.repro()}")
+        else:
+            cs = [gp.machine_case(seed, k) for k in keys]
+            ms = [load_machine(c) for c in cs]
+            with ThreadPoolExecutor(JOBS) as pool:
+                for mode in modes:
+                    b = RawBatch(work, MODES[mode], pool, opt=opt)
+                    for c, m in zip(cs, ms):
+                        b.add_machine(c.index, c, m)
+                    nat = b.run_raw()
+                    for c, m in zip(cs, ms):
+                        d = raw_difference(c, m, interpret_machine(c, m, MODES[mode]), nat[c.index])
+                        if d:
+                            bad += 1
+                            print(f"== {mode} raw case {c.index}: {d}\n{c.repro()}")
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print(f"{len(keys)} {'raw ' if raw else ''}cases x {len(modes)} modes, {bad} mismatches, "
+          f"{time.monotonic() - t0:.1f}s")
     return 1 if bad else 0
 
 

@@ -8,14 +8,15 @@ integers) and compares everything the machine writes after every step.
 
 Deterministic: the seed is fixed. FSW_DIFF_CASES (default 1000) and
 FSW_DIFF_RAW_CASES (default 300) set how many per mode, FSW_DIFF_SEED the
-seed (`make fuzz` runs many more). On a mismatch the failure message holds
-the configs of the case (.sv/.sm/.ss) to reproduce it with `fsw test
---native`. docs/differential.md says what is covered and what was found."""
+seed (for long runs). On a mismatch the failure message holds the configs
+of the case (.sv/.sm/.ss) to reproduce it with `fsw test --native`.
+docs/differential.md says what is covered and what was found."""
 
 from __future__ import annotations
 
 import os
 import re
+import shlex
 import shutil
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -31,9 +32,8 @@ RAW_CASES = int(os.environ.get("FSW_DIFF_RAW_CASES", "300"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))
 SHOW = 3  # mismatches printed in full
 
-needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
-
-
+needs_cxx = pytest.mark.skipif(shutil.which(shlex.split(H.default_cxx())[0]) is None,
+                               reason="no host C++ compiler")
 CHUNK = 2000  # cases per program (bounds memory and disk on long runs)
 
 
@@ -52,6 +52,7 @@ def runs(tmp_path_factory):
                        [gp.machine_case(SEED, k) for k in range(start, min(start + CHUNK, RAW_CASES))])
         finally:
             shutil.rmtree(work, ignore_errors=True)
+    H.prune_cache()
     out["seconds"] = time.monotonic() - t0
     return out
 

@@ -428,8 +428,31 @@ def stored(t: str):
 inputs = st.fixed_dictionaries({t: stored(t) for t in _TYPES})
 
 
+@st.composite
+def deep_model_exprs(draw):
+    """An expression nested 30 to 90 levels deep (past the depth where the
+    interpreter hands subtrees to the tree walker)."""
+    e = draw(model_exprs(1))
+    for _ in range(draw(st.integers(30, 90))):
+        k = draw(st.integers(0, 5)) if draw(st.integers(0, 19)) == 0 else draw(st.integers(0, 4))
+        other = draw(model_exprs(0))
+        if k == 0:
+            e = M.Neg(e, 0, 0)
+        elif k == 1:
+            e = M.Not(e, 0, 0)
+        elif k == 2:
+            e = M.Arith(draw(st.sampled_from(T.ARITH)), *draw(st.permutations([e, other])), 0, 0)
+        elif k == 3:
+            e = M.Logic(draw(st.sampled_from(("and", "or"))), *draw(st.permutations([e, other])), 0, 0)
+        elif k == 4:
+            e = M.ChainCmp((other, e, other), ("<=", "<"), 0, 0)
+        else:
+            e = M.Roll(draw(st.sampled_from(("avg", "max", "range"))), e, 2, -1, 0, 0)
+    return e
+
+
 @cases(300)
-@given(model_exprs(), st.lists(inputs, min_size=1, max_size=4))
+@given(st.one_of(model_exprs(), deep_model_exprs()), st.lists(inputs, min_size=1, max_size=4))
 def test_expressions_match_tree_walk(e, steps):
     """One machine assigns the expression to an element of every type and
     branches on it; after every step both runs hold the same bits."""
@@ -451,7 +474,8 @@ def test_expressions_match_tree_walk(e, steps):
 
 
 @cases(300)
-@given(model_exprs(), inputs, st.lists(st.one_of(any_floats, st.just(math.nan)), min_size=8, max_size=8))
+@given(st.one_of(model_exprs(), deep_model_exprs()), inputs,
+       st.lists(st.one_of(any_floats, st.just(math.nan)), min_size=40, max_size=40))
 def test_compiled_values_match_evaluate(e, values, wv):
     """The raw R value (before any conversion) and the truth of a condition."""
     windows: list = []
@@ -575,9 +599,11 @@ def near_midpoints(draw) -> str:
     b = np.nextafter(a, np.float32(np.inf))
     mid = (Fraction(float(a)) + Fraction(float(b))) / 2
     side = draw(st.sampled_from([1, -1]))
-    q = mid + side * mid / 10**30
+    # 60 digits, or 400 (past the 200 that rounding keeps, the rest sticky)
+    prec, off = draw(st.sampled_from([(60, 30), (400, 300), (400, 10)]))
+    q = mid + side * mid / 10**off
     with decimal.localcontext() as c:
-        c.prec = 60
+        c.prec = prec
         text = str(decimal.Decimal(q.numerator) / decimal.Decimal(q.denominator))
     return text.replace("E+", "e").replace("E", "e")
 

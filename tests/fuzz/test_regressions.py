@@ -33,3 +33,47 @@ def test_missing_delta_t_points_at_the_options_header(tmp_path):
     r = run_fsw("check", str(ss))
     assert r.code == 1
     assert f"{os.path.basename(ss)}:2:5:" in r.err and "missing option `delta_t`" in r.err
+
+
+TANK_SS = (EXAMPLES / "tank" / "tank.ss").read_text()
+
+
+def test_option_with_5000_digits(tmp_path):
+    """`delta_t 1000…0` (5,001 digits): the exact value went through
+    Fraction(text), and Python refuses int() of over 4,300 digits
+    (ValueError, exit 3). Now: too long to be a count, a located error."""
+    ss = project(tmp_path, TANK_SS.replace("delta_t 10", "delta_t 1" + "0" * 5000))
+    r = run_fsw("check", str(ss))
+    assert r.code == 1 and "internal error" not in r.err
+    assert "`delta_t` must be a positive integer" in r.err
+
+
+def test_option_with_5000_zeros_is_exact(tmp_path):
+    ss = project(tmp_path, TANK_SS.replace("delta_t 10", "delta_t 10." + "0" * 5000))
+    r = run_fsw("test", str(ss))
+    assert r.code == 0, r.err
+    assert r.out.startswith("state script ran for 101 steps\n")
+
+
+def test_binary32_literal_with_5000_digits(tmp_path):
+    """A 5,000-digit literal in binary32 mode: rounding it exactly went
+    through Fraction(text) (ValueError, exit 3). It is 2 when rounded."""
+    sm = TANK_SM.replace("F64 pi                  = 3.14159", "F64 pi = 1." + "9" * 5000 + "5")
+    ss = project(tmp_path, TANK_SS, sm=sm)
+    for real in ("f32", "f64"):
+        r = run_fsw("test", str(ss), "--real", real)
+        assert r.code == 0, r.err
+        assert "  pi = 2.000000\n" in r.out
+
+
+def test_binary32_literal_of_a_million_digits_is_quick(tmp_path):
+    """Rounding keeps 200 significant digits and a sticky one: no quadratic
+    int() of the whole literal (which took minutes)."""
+    import time
+
+    from fswkit.autocode.numeric import F32MODE
+
+    t = time.process_time()
+    assert F32MODE.literal("0." + "3" * 1_000_000) == F32MODE.literal("0.33333334")
+    assert F32MODE.literal("1" + "0" * 100_000 + "e-100000") == 1.0
+    assert time.process_time() - t < 1.0

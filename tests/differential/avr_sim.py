@@ -73,6 +73,7 @@ def _cached_object(text: str, name: str, workdir: str, include: list[str], key: 
     h = hashlib.sha256(key + text.encode() + " ".join([AVR_CXX] + AVR_FLAGS).encode()).hexdigest()[:24]
     obj = os.path.join(cache_dir(), "avr", h + ".o")
     if os.path.exists(obj):
+        os.utime(obj)  # recently used: kept by harness.prune_cache
         return obj
     os.makedirs(os.path.dirname(obj), exist_ok=True)
     src = os.path.join(workdir, name)

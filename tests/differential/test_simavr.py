@@ -81,7 +81,7 @@ def test_generated_cases_on_simavr(tmp_path, monkeypatch):
     cases = gp.cases(SEED, AVR_CASES)
     loaded = [(c, *H.load(c)) for c in cases]
     work = str(tmp_path)
-    outcomes = {}
+    outcomes, sizes = {}, []
     with ThreadPoolExecutor(H.JOBS) as pool:
         for start in range(0, len(loaded), PER_ELF):
             chunk = loaded[start:start + PER_ELF]
@@ -91,6 +91,7 @@ def test_generated_cases_on_simavr(tmp_path, monkeypatch):
             elf = A.build_elf(d, items, pool)
             flash, ram = A.memory(elf)
             assert flash < 240 * 1024 and ram < 7 * 1024, (flash, ram)  # ATmega2560: 256 KB, 8 KB
+            sizes.append(f"{flash} B flash, {ram} B RAM")
             outcomes.update(A.run_elf(elf, items))
     built = time.monotonic() - t0
     bad, documented = [], []
@@ -115,8 +116,8 @@ def test_generated_cases_on_simavr(tmp_path, monkeypatch):
         if d is not None:
             (documented if quotients.n else bad).append((c, d))
     assert not bad, "\n\n".join(f"=== case {c.index} (binary32, simavr): {d}\n{c.repro()}" for c, d in bad[:3])
-    print(f"\nsimavr: {len(loaded)} cases, {len(documented)} differing only through a subnormal quotient, "
-          f"{time.monotonic() - t0:.1f}s ({built:.1f}s building and simulating)")
+    print(f"\nsimavr: {len(loaded)} cases ({'; '.join(sizes)}), {len(documented)} differing only through "
+          f"a subnormal quotient, {time.monotonic() - t0:.1f}s ({built:.1f}s building and simulating)")
 
 
 # ---- the float library itself ---------------------------------------------------------

@@ -31,6 +31,9 @@ test-python: setup
 ## about an hour; crashing inputs land in build/fuzz/), then the uplink parser
 fuzz: setup fuzz-uplink
 	$(PY) tools/fuzz_frontend.py --cases $${FSW_FUZZ_EXAMPLES:-1000000} --out $(BUILD)/fuzz/frontend
+	FSW_DIFF_SEED=$${FSW_DIFF_SEED:-2} FSW_DIFF_CASES=$${FSW_DIFF_CASES:-20000} \
+	  FSW_DIFF_RAW_CASES=$${FSW_DIFF_RAW_CASES:-5000} FSW_DIFF_AVR_CASES=$${FSW_DIFF_AVR_CASES:-400} \
+	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py
 
 ## fuzz-uplink: the firmware's uplink parser under libFuzzer with ASan + UBSan
 ## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run),

@@ -173,11 +173,20 @@ def format_number(v) -> str:
 def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     """The value of a window size expression: literals and locals' initial
     values only (spec §4.4); None after reporting why not."""
-    errors = len(res.diags.errors)
+    # Counted on `items` (a resolver reports only errors): `errors` builds a
+    # list, and one per window made many windows with errors quadratic.
+    reported = len(res.diags.items)
+    todo = [n]
+    while todo:  # a call inside the size has no window to resolve it with
+        x = todo.pop()
+        if isinstance(x, S.Call):
+            res.error(x.line, x.col, "window size must be a constant: literals and locals' initial values")
+            return None
+        todo.extend(_children(x))
     sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None)
     me = sub.expr(n)
     res.used |= sub.used
-    if len(res.diags.errors) != errors:
+    if len(res.diags.items) != reported:
         return None
     if _has(me, (M.Roll,)) or any(vars_[i].kind != M.LOCAL for i in _refs(me)):
         res.error(n.line, n.col, "window size must be a constant: literals and locals' initial values")

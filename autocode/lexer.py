@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from .diagnostics import Diagnostics, Source, visual_col
+from .diagnostics import Columns, Diagnostics, Source
 
 KEYWORDS = frozenset({"if", "else", "and", "or", "not", "true", "false"})
 ANNOTATIONS = frozenset({"@read_only", "@alias", "@assert", "@stop"})
@@ -47,20 +47,20 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
     toks: list[Tok] = []
     pos, end = 0, len(text)
     match = _TOKEN.match
-    tabs = "\t" in text
+    cols = Columns(text) if "\t" in text else None
     bad_end = -1  # a run of unexpected characters is reported once, at its start
     while pos < end:
         m = match(text, pos)
         if m is None:
             if pos != bad_end:
-                col = visual_col(text, pos) if tabs else pos + 1
+                col = cols(pos) if cols else pos + 1
                 diags.lexical_error(src, lang, n, col, f"unexpected {describe(text[pos])}")
             pos += 1
             bad_end = pos
             continue
         kind = m.lastgroup
         s = m.group()
-        col = visual_col(text, pos) if tabs else pos + 1
+        col = cols(pos) if cols else pos + 1
         pos = m.end()
         if kind == "ws" or kind == "comment":
             continue

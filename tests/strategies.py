@@ -189,9 +189,9 @@ def _exprs(draw, ctx: Ctx, depth: int) -> S.Expr:
         n = draw(_ints(2, 4))
         ops = tuple(draw(_one_of(RELATIONAL)) for _ in range(n))
         return S.Chain(0, 0, tuple(draw(sub) for _ in range(n + 1)), ops)
-    if ctx.loose:
-        func = draw(st.one_of(_one_of(ROLL), names))
-        return S.Call(0, 0, func, tuple(draw(st.lists(sub, max_size=3))))
+    if ctx.loose:  # mostly roll_* with two arguments, the second anything
+        func = draw(_one_of(ROLL)) if draw(_ints(0, 3)) else draw(names)
+        return S.Call(0, 0, func, tuple(draw(sub) for _ in range(draw(_one_of((0, 1, 2, 2, 2, 3))))))
     if not ctx.calls or not ctx.window_sizes:
         return S.Binary(0, 0, draw(_one_of(ARITH)), draw(sub), draw(sub))
     return S.Call(0, 0, draw(_one_of(ROLL)), (draw(sub), draw(_one_of(ctx.window_sizes))))

@@ -8,10 +8,11 @@ duplications and swaps, byte flips, truncation, inserted brackets,
 operators, keywords, huge numbers, deep nesting, long lines, tabs, CR, NUL,
 non-UTF-8, random bytes), and runs it through every loader in-process:
 `load_sv`, `load_machine` (with `fsw check`'s warnings), `load_script`, a
-bounded run of a script that compiles in binary64 and binary32, and now and
-then `fsw check` / `fsw test` themselves. The invariants (spec §8): nothing
-raises, nothing hangs, every diagnostic is located inside its file and its
-caret line renders, and the commands exit 0, 1 or 2.
+bounded run of a script that compiles (in binary64 or binary32), and every
+100th case `fsw check` / `fsw test` themselves. The invariants (spec §8):
+nothing raises, nothing hangs (a case has 10 s), every diagnostic is
+located inside its file and its caret line renders, a loader returns a
+model exactly when it reported no error, and the commands exit 0, 1 or 2.
 
 Cases are numbered; case i is a pure function of (seed, i), so any case can
 be rebuilt from its number. Failing inputs go to build/fuzz/crashes/.
@@ -167,6 +168,9 @@ SPECIALS = [
     lambda r: b"\n" * r.choice((100, 3000)),
     lambda r: bytes(r.randrange(256) for _ in range(r.randrange(1, 40))),
     lambda r: b"[" + b"A" * r.choice((1, 300)) + b"]\n.entry\n",
+    lambda r: b"\t" + b"a + " * r.choice((100, 10000)),  # many tokens after a tab
+    lambda r: b"1a " * r.choice((10, 500)),  # many diagnostics on one line
+    lambda r: b"x = roll_avg(zz, 3)\n" * r.choice((10, 2000)),  # many windows with errors
 ]
 
 EDGE_NUMBERS = [s.encode() for s in (
@@ -371,10 +375,8 @@ def run_case(files: tuple[bytes, bytes, bytes], workdir: str, cli: bool = False,
 
 def _decode(data: bytes) -> str:
     """A file's text as the loaders see it."""
-    try:
-        from fswkit.autocode.diagnostics import decode
-    except ImportError:  # an older front end
-        return data.decode("utf-8", errors="replace")
+    from fswkit.autocode.diagnostics import decode
+
     return decode(data)
 
 
@@ -484,36 +486,42 @@ def fuzz(cases: int, seed: int = 1, workers: int = 2, timeout: float = 10.0, out
     seen = [(-2, time.monotonic())] * workers
     signatures: dict[str, int] = {}
     last_report = time.monotonic()
+
     def drain():
         while not sigs.empty():
             s = sigs.get()
             signatures[s] = signatures.get(s, 0) + 1
 
-    while any(p.is_alive() for p in procs):
-        time.sleep(0.2)
-        drain()
-        now = time.monotonic()
-        for w, p in enumerate(procs):
-            if not p.is_alive():
-                continue
-            cur = current[w]
-            if cur != seen[w][0]:
-                seen[w] = (cur, now)
-            elif now - seen[w][1] > stall:  # stuck where the alarm cannot reach
+    try:
+        while any(p.is_alive() for p in procs):
+            time.sleep(0.2)
+            drain()
+            now = time.monotonic()
+            for w, p in enumerate(procs):
+                if not p.is_alive():
+                    continue
+                cur = current[w]
+                if cur != seen[w][0]:
+                    seen[w] = (cur, now)
+                elif now - seen[w][1] > stall:  # stuck where the alarm cannot reach
+                    p.kill()
+                    p.join()
+                    base[2 * w] += counts[2 * w]
+                    base[2 * w + 1] += counts[2 * w + 1] + 1
+                    _record(out, cur, make_case(projects, seed, cur)[0], "hang",
+                            f"seed {seed} case {cur}: worker stuck for {now - seen[w][1]:.0f} s\n")
+                    signatures[f"hang (worker killed): case {cur}"] = 1
+                    procs[w] = spawn(w, cur + workers)
+                    seen[w] = (-2, now)
+            if progress and now - last_report >= 15:
+                last_report = now
+                done = sum(counts) + sum(base)
+                progress(f"fuzz: {done}/{cases} cases, {sum(counts[1::2]) + sum(base[1::2])} failed, "
+                         f"{now - start:.0f} s")
+    finally:  # interrupted or terminated: no worker outlives the run
+        for p in procs:
+            if p.is_alive():
                 p.kill()
-                p.join()
-                base[2 * w] += counts[2 * w]
-                base[2 * w + 1] += counts[2 * w + 1] + 1
-                _record(out, cur, make_case(projects, seed, cur)[0], "hang",
-                        f"seed {seed} case {cur}: worker stuck for {now - seen[w][1]:.0f} s\n")
-                signatures[f"hang (worker killed): case {cur}"] = 1
-                procs[w] = spawn(w, cur + workers)
-                seen[w] = (-2, now)
-        if progress and now - last_report >= 15:
-            last_report = now
-            done = sum(counts) + sum(base)
-            progress(f"fuzz: {done}/{cases} cases, {sum(counts[1::2]) + sum(base[1::2])} failed, "
-                     f"{now - start:.0f} s")
     for p in procs:
         p.join()
     drain()
@@ -549,6 +557,7 @@ def main(argv=None) -> int:
         print("1 passed, 0 failed")
         return 0
     shutil.rmtree(args.out, ignore_errors=True)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # so that the workers are stopped too
     o = fuzz(args.cases, args.seed, args.workers, args.timeout, args.out, args.cli_every,
              projects=projects, progress=say)
     rate = o.cases / o.seconds if o.seconds else 0.0

@@ -26,7 +26,7 @@ from fswkit.autocode import model as M
 from fswkit.autocode.emit_cpp import emit_machine, emit_script_avr, emit_sv, script_writes_locals
 from fswkit.autocode.numeric import F32MODE
 
-from harness import JOBS, cache_dir
+from harness import cache_dir
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MCU = "atmega2560"

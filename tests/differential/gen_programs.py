@@ -28,6 +28,9 @@ and at the edges of the evaluation type R (spec §4.5):
   that may fail), and stop at a fixed `G`; now and then `G` grows by a huge
   `delta_t` (so `G` and `T` leave R's exact integers, or wrap: a step
   error), or `max_steps` ends the run first.
+
+`machine_case(seed, k)` draws a machine driven instead by raw element
+bytes, for the values no script can store (see the section at the end).
 """
 
 from __future__ import annotations
@@ -141,7 +144,6 @@ class Var:
     role: str = ""  # "G", "S" or ""
     alias: str = ""  # another name the machine gives it
     init: str = "0"  # locals: the initial value's text
-    value: float = 0.0  # locals: the initial value, roughly (window sizes)
 
     @property
     def kind(self) -> str:
@@ -187,12 +189,6 @@ class Gen:
         if v.role:
             return v.role
         return v.alias if v.alias and self.chance(0.5) else v.name
-
-    def var(self, name: str) -> Var | None:
-        for v in self.vars:
-            if v.name == name or v.role == name:
-                return v
-        return None
 
     def of_kind(self, *kinds: str, writable: bool | None = None) -> list[Var]:
         return [v for v in self.vars if v.kind in kinds and v.role == ""
@@ -337,7 +333,7 @@ class Gen:
 
 # ---- machine ---------------------------------------------------------------------------
 
-def gen_sv(g: Gen, name: str) -> tuple[str, list[Var]]:
+def gen_sv(g: Gen) -> tuple[str, list[Var]]:
     r = g.r
     lines = []
     if r.random() < 0.1:
@@ -396,21 +392,21 @@ def gen_sm(g: Gen, elems: list[Var], read_only_share: float = 0.3, probes: bool 
         earlier = [v for v in g.vars if not v.elem]
         pick = r.random()
         if t in FLOAT_TYPES and pick < 0.3:  # zeros of both signs, infinities, NaN (stored as 0)
-            init, val = r.choice(("-0", "0 * -1", "0", "1/0", "-1/0", "0/0")), 0.0
+            init = r.choice(("-0", "0 * -1", "0", "1/0", "-1/0", "0/0"))
         elif pick < 0.25:
-            init, val = str(r.randint(1, 5)), 0.0
+            init = str(r.randint(1, 5))
         elif pick < 0.5 and t in INT_TYPES:
             n = int_constants(r, t)
-            init, val = int_text(n), float(n)
+            init = int_text(n)
         elif pick < 0.7:
-            init, val = g.literal(), 0.0
+            init = g.literal()
         elif earlier and pick < 0.85:
-            init, val = f"{r.choice(earlier).name} {r.choice(('+', '-', '*'))} {g.literal('int')}", 0.0
+            init = f"{r.choice(earlier).name} {r.choice(('+', '-', '*'))} {g.literal('int')}"
         else:
-            init, val = g.special_value(), 0.0
+            init = g.special_value()
         ro = r.random() < 0.3
         mode = "ro" if ro else ("never" if r.random() < 0.4 else "assigned")
-        v = Var(name, t, False, mode == "assigned", init=init, value=val)
+        v = Var(name, t, False, mode == "assigned", init=init)
         g.vars.append(v)
         lines.append(f"{t} {name} = {init}{' @read_only' if ro else ''}")
     nst = r.randint(1, 4)
@@ -599,7 +595,7 @@ def case(seed: int, k: int) -> Case:
     rng = random.Random(seed * 1_000_003 + k)
     g = Gen(rng)
     name = f"m{k}"
-    sv, elems = gen_sv(g, name)
+    sv, elems = gen_sv(g)
     sm = gen_sm(g, elems)
     ss = gen_ss(g, rng.randint(15, 60))
     return Case(seed, k, name, sv, sm, ss)
@@ -735,7 +731,7 @@ def machine_case(seed: int, k: int, steps: int = 24) -> MachineCase:
     rng = random.Random(seed * 1_000_033 + k + 7)
     g = Gen(rng)
     name = f"r{k}"
-    sv, elems = gen_sv(g, name)
+    sv, elems = gen_sv(g)
     sm = gen_sm(g, elems, read_only_share=0.55, probes=True)
     inputs = [v for v in g.vars if v.elem and v.role == "" and not v.machine_writes]
     delta_t = rng.choice((1, 10, 250, (1 << 23) + 1, (1 << 52) + 1))

@@ -398,7 +398,7 @@ class RawBatch(Batch):
         locs = {mm.group(1): int(mm.group(2)) for mm in re.finditer(r"^    L_(\w+) = (\d+),", header, re.M)}
         loc_size = int(re.search(r"kLocSize = (\d+)", header).group(1)) if locs else 0
         width = sum(m.var(n).type.size for n, _ in case.input_types)
-        d = [f'#include <stdio.h>', f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
+        d = ['#include <stdio.h>', f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
              f"namespace fsw_r{k} {{", "int drive(FILE* in, FILE* out) {",
              f"    {name}::reset({case.init_state + 1});",
              f"    uint8_t buf[{max(width, 1)}];",

@@ -13,7 +13,8 @@
   conversions are C's, saturated as spec §4.5 says; binary32 literals and
   integers are correctly rounded; rolling windows hold the last N samples.
 
-FSW_PROPERTY_SCALE (default 1) multiplies every example count.
+FSW_PROPERTY_SCALE (default 1) multiplies every example count;
+FSW_PROPERTY_SHRINK=1 shrinks failing programs (slow) before reporting.
 """
 
 from __future__ import annotations
@@ -61,8 +62,9 @@ NO_SHRINK = {} if SHRINK else {"phases": [Phase.explicit, Phase.reuse, Phase.gen
 
 def cases(n: int, **kw):
     return settings(max_examples=max(1, int(n * SCALE)), deadline=None, database=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.large_base_example,
-                                           HealthCheck.filter_too_much], **kw)
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                           HealthCheck.large_base_example, HealthCheck.filter_too_much],
+                    **kw)
 
 
 def parse(kind: str, text: str, path: str | None = None):
@@ -127,6 +129,20 @@ def test_round_trip_of_any_calls(p):
     assert not d.items, d.render() + "\n" + text
     assert T.strip(back) == T.strip(p.sm)
     assert unparse.sm_file(back) == text
+
+
+@cases(60)
+@given(T.programs(loose=True))
+def test_programs_calling_anything_check_to_diagnostics(p):
+    """Calls of any function, any number of arguments, calls in window
+    sizes: the checker reports, never raises."""
+    sources = {f"p.{k}": getattr(p, f"{k}_text") for k in ("sv", "sm", "ss")}
+    (svf, svs, d1), (smf, sms, d2), (ssf, sss, d3) = (parse(k, sources[f"p.{k}"]) for k in ("sv", "sm", "ss"))
+    d = Diagnostics()
+    m = check_sm(smf, sms, check_sv(svf, svs, d), d, warnings=True)
+    if m is not None:
+        check_ss(ssf, sss, m, d)
+    fuzz.check_diagnostics(d, sources)
 
 
 @cases(300)
@@ -195,6 +211,19 @@ def test_pathological_inputs_give_only_diagnostics(special):
             files = list(tank.files)
             files[i] = files[i][:at] + fuzz.SPECIALS[special](random.Random(special)) + files[i][at:]
             _run(files)
+
+
+@cases(300)
+@given(st.text(st.sampled_from("ab \t\r\n\x0b\u00e9"), max_size=60), st.lists(st.integers(0, 60), max_size=12))
+def test_incremental_columns_are_visual_columns(text, indices):
+    """The lexer's linear-time columns equal `visual_col` (tabs expanded as
+    `str.expandtabs` does, CR included), at increasing or any indices."""
+    from fswkit.autocode.diagnostics import Columns, visual_col
+
+    cols = Columns(text)
+    for i in sorted(indices) + indices:
+        i = min(i, len(text))
+        assert cols(i) == visual_col(text, i), (text, i)
 
 
 # ---- the tree walk: spec §4.6 and §5 written out plainly ----------------------------------------

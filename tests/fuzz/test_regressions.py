@@ -77,3 +77,56 @@ def test_binary32_literal_of_a_million_digits_is_quick(tmp_path):
     assert F32MODE.literal("0." + "3" * 1_000_000) == F32MODE.literal("0.33333334")
     assert F32MODE.literal("1" + "0" * 100_000 + "e-100000") == 1.0
     assert time.process_time() - t < 1.0
+
+
+def _cpu(f) -> float:
+    import time
+
+    t = time.process_time()
+    f()
+    return time.process_time() - t
+
+
+def test_long_line_with_a_tab_lexes_in_linear_time():
+    """Every token's column came from `visual_col`, which expands the line
+    up to the token: quadratic, 28 s for a 160 KB line with a tab."""
+    from fswkit.autocode.diagnostics import Diagnostics, Source
+    from fswkit.autocode.lexer import lex
+
+    text = "[S]\n.step\n\tx = " + " + ".join(["a"] * 40000) + "\n"
+    toks: list = []
+    assert _cpu(lambda: toks.extend(lex(Source.from_text("p.sm", text), Diagnostics(), "sm"))) < 3
+    assert toks[2][0].col == 9 and toks[2][-1].col == 8 + len(text.split("\n")[2]) - 1
+
+
+def test_many_window_sizes_with_errors_check_in_linear_time(tmp_path):
+    """Each `roll_*` call counted the errors so far by building their list:
+    20,000 calls with an unknown name took 26 s."""
+    sm = TANK_SM.replace("    counter = 0\n", "    counter = 0\n" + "".join(
+        f"    counter = roll_avg(zz{i}, 3)\n" for i in range(20000)), 1)
+    (tmp_path / "p.sv").write_text(TANK_SV)
+    (tmp_path / "p.sm").write_text(sm)
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.project import load_machine
+
+    d = Diagnostics()
+    assert _cpu(lambda: load_machine(str(tmp_path / "p.sm"), d)) < 8
+    assert len(d.errors) == 20000
+
+
+def test_call_inside_a_window_size(tmp_path):
+    """`roll_avg(x, roll_max(1, 3))`: the size was resolved without a way to
+    resolve calls (TypeError, exit 3). Now: the nested call is not a
+    constant, located at the call; in a script too."""
+    (tmp_path / "machine").mkdir()
+    (tmp_path / "script").mkdir()
+    sm = TANK_SM.replace("        counter = counter + 1",
+                         "        counter = roll_avg(tankPressure, 1 + roll_max(1, 3))")
+    project(tmp_path / "machine", TANK_SS, sm=sm)
+    ss = TANK_SS.replace("true: @assert", "roll_min(G, roll_avg(2, 2)) >= 0: @assert")
+    path = project(tmp_path / "script", ss)
+    for where, at in (("machine", "p.sm:19:46:"), ("script", "p.ss:15:13:")):
+        r = run_fsw("check", str(tmp_path / where))
+        assert r.code == 1 and "internal error" not in r.err, r.err
+        assert at in r.err and r.err.count("window size must be a constant") == 1, r.err
+    assert run_fsw("test", str(path)).code == 2

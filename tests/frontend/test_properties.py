@@ -105,7 +105,7 @@ def assert_same_values(a: list, b: list, m: M.Machine, where: str) -> None:
 
 # ---- round trip --------------------------------------------------------------------
 
-@cases(100, **NO_SHRINK)
+@cases(80, **NO_SHRINK)
 @given(T.programs(), st.randoms(use_true_random=False))
 def test_round_trip_and_other_spellings(p, r):
     for kind, tree, spell in (("sv", p.sv, T.spell_sv), ("sm", p.sm, T.spell_sm), ("ss", p.ss, T.spell_ss)):
@@ -339,7 +339,7 @@ any_floats = st.one_of(edge_floats, st.floats(), st.floats(width=32),
                        st.integers(-(2**65), 2**65).map(float))
 
 
-@cases(100, **NO_SHRINK)
+@cases(80, **NO_SHRINK)
 @given(T.programs(), st.data())
 def test_machine_steps_match_tree_walk(p, data):
     """Random inputs, then a step, in both modes: every variable, the
@@ -364,7 +364,7 @@ def test_machine_steps_match_tree_walk(p, data):
             assert [same(x, y) for x, y in zip(fast.wv, slow.wv)] == [True] * len(m.windows), where
 
 
-@cases(100, **NO_SHRINK)
+@cases(80, **NO_SHRINK)
 @given(T.programs())
 def test_script_runs_match_tree_walk(p):
     m, script = compile_program(p)
@@ -480,8 +480,9 @@ def deep_model_exprs(draw):
     return e
 
 
-@cases(300)
-@given(st.one_of(model_exprs(), deep_model_exprs()), st.lists(inputs, min_size=1, max_size=4))
+@cases(200)
+@given(st.one_of(model_exprs(), model_exprs(), model_exprs(), deep_model_exprs()),  # a quarter deep
+       st.lists(inputs, min_size=1, max_size=4))
 def test_expressions_match_tree_walk(e, steps):
     """One machine assigns the expression to an element of every type and
     branches on it; after every step both runs hold the same bits."""
@@ -502,8 +503,8 @@ def test_expressions_match_tree_walk(e, steps):
             assert_same_values(fast.v, slow.v, m, f"{real} step {k + 1}: {unparse.model_expr(e, m)}")
 
 
-@cases(300)
-@given(st.one_of(model_exprs(), deep_model_exprs()), inputs,
+@cases(200)
+@given(st.one_of(model_exprs(), model_exprs(), model_exprs(), deep_model_exprs()), inputs,
        st.lists(st.one_of(any_floats, st.just(math.nan)), min_size=40, max_size=40))
 def test_compiled_values_match_evaluate(e, values, wv):
     """The raw R value (before any conversion) and the truth of a condition."""

@@ -71,23 +71,23 @@ def cmd_check(args) -> int:
 
 # ---- fsw test -------------------------------------------------------------------
 
+def _scripts(paths: list[str]) -> list[str] | None:
+    """The scripts named, a folder standing for every `.ss` in it."""
+    out: list[str] = []
+    for p in paths:
+        if os.path.isdir(p):
+            found = sorted(os.path.join(p, n) for n in os.listdir(p) if n.endswith(".ss"))
+            if not found:
+                sys.stderr.write(f"fsw test: {p}: no state scripts (.ss) in this folder\n")
+                return None
+            out += found
+        else:
+            out.append(p)
+    return out
+
+
 def cmd_test(args) -> int:
     from fswkit.autocode.numeric import MODES
-    from fswkit.autocode.project import load_script, source_of
-    from fswkit.script import run
-
-    diags = Diagnostics()
-    script = load_script(args.script, diags, args.sm, args.sv)
-    if script is None:
-        _print_diags(diags)
-        return EXIT_CONFIG
-    _print_diags(diags)  # warnings only
-    sources: dict[str, object] = {}
-
-    def line_of(path: str, n: int) -> str:
-        if path not in sources:
-            sources[path] = source_of(path)
-        return sources[path].line(n)
 
     real_name = args.real
     if args.board is not None:
@@ -103,25 +103,107 @@ def cmd_test(args) -> int:
             return EXIT_CONFIG
         real_name = board.real
     real = MODES[real_name or "f64"]
+    if args.coverage and args.native:
+        sys.stderr.write("fsw test: --coverage follows the interpreter's run: leave out --native\n")
+        return EXIT_CONFIG
+    scripts = _scripts(args.script)
+    if scripts is None:
+        return EXIT_CONFIG
+    if args.trace and len(scripts) > 1:
+        sys.stderr.write("fsw test: --trace writes one script's run: name one script\n")
+        return EXIT_CONFIG
+    codes = []
+    coverage: dict[str, list] = {}  # machine path -> [machine, taken, visited]
+    for path in scripts:
+        if len(scripts) > 1:
+            sys.stdout.write(f"== {path}\n")
+            sys.stdout.flush()
+        code, result = _test_one(path, args, real)
+        codes.append(code)
+        if result is not None and args.coverage:
+            m = result[0]
+            entry = coverage.setdefault(os.path.abspath(m.path), [m, set(), set()])
+            entry[1] |= result[1].taken
+            entry[2] |= result[1].visited
+    incomplete = _report_coverage(coverage) if args.coverage else False
+    if len(scripts) > 1:
+        passed = codes.count(EXIT_OK)
+        sys.stdout.write(f"{_plural(len(scripts), 'script')}: {passed} passed, {len(scripts) - passed} failed\n")
+    if EXIT_CONFIG in codes:
+        return EXIT_CONFIG
+    if EXIT_INTERNAL in codes:
+        return EXIT_INTERNAL
+    return EXIT_FAIL if EXIT_FAIL in codes or incomplete else EXIT_OK
+
+
+def _test_one(path: str, args, real):
+    """Runs one script; (exit code, (machine, result) for coverage or None)."""
+    from fswkit.autocode.project import load_script, source_of
+    from fswkit.script import run
+
+    diags = Diagnostics()
+    script = load_script(path, diags, args.sm, args.sv)
+    if script is None:
+        _print_diags(diags)
+        return EXIT_CONFIG, None
+    _print_diags(diags)  # warnings only
+    sources: dict[str, object] = {}
+
+    def line_of(p: str, n: int) -> str:
+        if p not in sources:
+            sources[p] = source_of(p)
+        return sources[p].line(n)
+
     if args.native:
         from fswkit import native
         try:
             code, report = native.run(script, real, line_of, trace_path=args.trace)
         except native.NativeError as e:
             sys.stderr.write(f"fsw test: {e}\n")
-            return EXIT_INTERNAL
+            return EXIT_INTERNAL, None
         except OSError as e:
             sys.stderr.write(f"fsw test: {e.filename or ''}: {e.strerror or e}\n")
-            return EXIT_FAIL
+            return EXIT_FAIL, None
         sys.stdout.write(report)
-        return EXIT_OK if code == 0 else EXIT_FAIL
+        sys.stdout.flush()
+        return (EXIT_OK if code == 0 else EXIT_FAIL), None
     try:
-        result = run(script, real, trace_path=args.trace, source_line=line_of)
+        result = run(script, real, trace_path=args.trace, source_line=line_of, cover=args.coverage)
     except OSError as e:
         sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
-        return EXIT_FAIL
+        return EXIT_FAIL, None
     sys.stdout.write(result.report())
-    return EXIT_OK if result.passed else EXIT_FAIL
+    sys.stdout.flush()
+    return (EXIT_OK if result.passed else EXIT_FAIL), (script.machine, result)
+
+
+def _report_coverage(coverage: dict) -> bool:
+    """Prints, per machine, the states and transitions the scripts reached
+    and each one they missed; True when something was missed."""
+    from fswkit.autocode.check import gotos
+
+    missed_any = False
+    for key in sorted(coverage):
+        m, taken, visited = coverage[key]
+        name = os.path.basename(m.path)
+        moves = []
+        for st in m.states:
+            for label in ("entry", "step", "exit"):
+                for g in gotos(getattr(st, label)):
+                    moves.append((st, g))
+        hit = sum(1 for _, g in moves if (g.line, g.col) in taken)
+        sys.stdout.write(f"coverage of {name}: {len(visited)}/{len(m.states)} states, "
+                         f"{hit}/{len(moves)} transitions\n")
+        for st in m.states:
+            if st.index not in visited:
+                missed_any = True
+                sys.stdout.write(f"  {name}:{st.line}: state {st.name} never entered\n")
+        for st, g in moves:
+            if (g.line, g.col) not in taken:
+                missed_any = True
+                sys.stdout.write(f"  {name}:{g.line}:{g.col}: transition {st.name} -> "
+                                 f"{m.states[g.state].name} never taken\n")
+    return missed_any
 
 
 # ---- fsw graph / fsw skeleton ---------------------------------------------------------
@@ -423,7 +505,8 @@ def parser() -> argparse.ArgumentParser:
     c.set_defaults(func=cmd_check)
 
     t = sub.add_parser("test", help="run a state script against its machine")
-    t.add_argument("script", metavar="SCRIPT.ss")
+    t.add_argument("script", metavar="SCRIPT.ss", nargs="+",
+                   help="state scripts, or folders standing for every .ss in them")
     t.add_argument("--sm", help="the machine (default: the .sm beside the script)")
     t.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     t.add_argument("--real", choices=("f64", "f32"), default=None,
@@ -432,6 +515,8 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument("--native", action="store_true",
                    help="run the generated C++ compiled for this host instead of the interpreter")
     t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
+    t.add_argument("--coverage", action="store_true",
+                   help="report the states and transitions the scripts never reached, and fail if any")
     t.set_defaults(func=cmd_test)
 
     g = sub.add_parser("graph", help="a machine as Graphviz DOT or Mermaid")

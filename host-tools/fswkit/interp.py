@@ -44,6 +44,7 @@ class _Emitter:
         self.consts: dict[str, float] = {}
         self.depth = 0
         self.deep: list = []  # `_deep[k]` of the generated code: see DEEP
+        self.cover = False  # record each transition taken: `_C(line, col)` before it
 
     def walk(self, e: M.Expr) -> str:
         self.deep.append(_walker(e, self.vars, self.real))
@@ -146,6 +147,8 @@ class _Emitter:
             if t is M.Assign:
                 out.append(indent + self.assign(st.var, st.expr))
             elif t is M.Goto:
+                if self.cover:
+                    out.append(f"{indent}_C(({st.line}, {st.col}))")
                 out.append(f"{indent}return {st.state}")
                 return  # nothing after a transition can run
             else:
@@ -172,8 +175,12 @@ def build(source: str, name: str, extra: dict | None = None) -> dict:
 class MachineRun:
     """One machine executing: its variables and its state bookkeeping."""
 
-    def __init__(self, m: M.Machine, real: Real, init_state: int = 0):
+    def __init__(self, m: M.Machine, real: Real, init_state: int = 0, cover: bool = False):
+        """`cover`: keep the (line, col) of every transition taken, and
+        every state entered, in `taken` and `visited` (fsw test --coverage)."""
         self.m = m
+        self.taken: set[tuple[int, int]] = set()
+        self.visited: set[int] = {init_state}
         self.real = real
         self.v: list = [0] * len(m.vars)
         for var in m.vars:
@@ -189,6 +196,7 @@ class MachineRun:
         self.entry_time = 0
         self.prev_g = None
         em = _Emitter(m.vars, real)
+        em.cover = cover
         src = ["def update(v, wv, W):"]
         for w in m.windows:
             src.append(f"    wv[{w.index}] = W[{w.index}]({em.value(w.arg)})")
@@ -198,7 +206,7 @@ class MachineRun:
                 src.append(f"def s{st.index}_{label}(v, wv):")
                 em.block(getattr(st, label), "    ", src)
                 src.append("    return -1")
-        ns = build("\n".join(src) + "\n", m.name, {"_deep": em.deep})
+        ns = build("\n".join(src) + "\n", m.name, {"_deep": em.deep, "_C": self.taken.add})
         self._update = ns["update"]
         self._push = [w.push for w in self.windows]
         self._entry = [ns[f"s{i}_entry"] for i in range(len(m.states))]
@@ -238,6 +246,7 @@ class MachineRun:
             self._exit[st](v, wv)
             self.state = k
             self.first = True
+            self.visited.add(k)
         return OK
 
     def values(self) -> list[tuple[str, str]]:

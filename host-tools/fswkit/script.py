@@ -23,6 +23,8 @@ class Result:
     asserts: int
     failure: Diagnostic | None
     values: list[tuple[str, str]]
+    taken: frozenset = frozenset()    # (line, col) of the transitions taken (cover=True)
+    visited: frozenset = frozenset()  # indexes of the states entered (cover=True)
 
     def report(self) -> str:
         lines = [f"state script ran for {self.steps} step{'' if self.steps == 1 else 's'}",
@@ -100,11 +102,13 @@ def failure_diagnostics(script: M.Script, source_line) -> dict:
     }
 
 
-def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None) -> Result:
+def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None,
+        cover: bool = False) -> Result:
     """Runs a checked script. `source_line(path, line)` gives the text of a
-    script line for the failure diagnostic."""
+    script line for the failure diagnostic. `cover`: the result names the
+    transitions taken and the states entered."""
     m = script.machine
-    run_ = MachineRun(m, real, script.init_state)
+    run_ = MachineRun(m, real, script.init_state, cover=cover)
     ns, checks = _compile(script, real)
     pre, update = ns["pre"], ns["update"]
     check = [ns[f"check_{k}"] for k in range(len(checks))]
@@ -158,7 +162,8 @@ def run(script: M.Script, real: Real, trace_path: str | None = None, source_line
     finally:
         if tracer:
             tracer.close()
-    return Result(passed and failure is None, steps, asserts, failure, run_.values())
+    return Result(passed and failure is None, steps, asserts, failure, run_.values(),
+                  frozenset(run_.taken), frozenset(run_.visited))
 
 
 class _Tracer:

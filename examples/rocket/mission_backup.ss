@@ -1,0 +1,39 @@
+# A stuck barometer and a motor whose burnout the accelerometer never shows:
+# the burn ends by BURN_MAX, the drogue fires by the backup timer
+# APOGEE_BACKUP after launch, and with the altitude stuck at the pad's the
+# main follows at once (better open high than not at all).
+
+[options]
+delta_t    10
+init_state Safe
+max_steps  5000
+
+[all_states]
+G == 0 {
+    accel     = 1
+    altitude  = 0                         # stuck at the pad value all flight
+    armSwitch = true
+    abortCmd  = false
+}
+G == 1000: accel = 6                      # ignition; the reading stays high
+
+[Boost]
+T == 0: @assert G == launchAt and G >= 1000 and G <= 1060
+
+[Coast]
+T == 0: @assert G - launchAt == BURN_MAX + 10   # by time, not burnout
+true: @assert not drogue and not main
+
+[Apogee]
+T == 0: @assert G - launchAt == APOGEE_BACKUP + 10
+T < PULSE: @assert drogue
+
+[Drogue]
+true: @assert T == 0 and not drogue       # one step: 0 m is below MAIN_ALT
+
+[Main]
+T < PULSE: @assert main
+
+[Landed]
+true: @assert buzzer
+true: @stop

@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup test test-python fuzz fuzz-uplink bench clean
+.PHONY: all setup demo test test-python fuzz fuzz-uplink bench clean
 
 include mk/firmware.mk
 
@@ -19,6 +19,14 @@ $(STAMP): pyproject.toml tools/bootstrap.sh
 	touch $@
 
 setup: $(STAMP)
+
+## demo: the example rocket's firmware built for an Uno from its configs,
+## flown in closed loop on the simulated board (a 1-D rocket model at 1 kHz),
+## its telemetry streamed over the simulated serial link; prints the flight
+## summary and where the plot, logs and CSV are (build/demo/)
+DEMO_SEED ?= 1
+demo: setup
+	$(FSW) sim examples/rocket --plant rocket --seed $(DEMO_SEED) --out $(BUILD)/demo
 
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P

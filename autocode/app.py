@@ -81,6 +81,8 @@ class Application:
     telemetry: tuple[Stream, ...]
     writable: tuple[M.Element, ...]
     reset_cause: M.Element | None = None  # U8: the MCU's reset cause at boot
+    flash_budget: int | None = None  # [budget] flash: bytes of program memory at most
+    ram_budget: int | None = None  # [budget] ram: data + bss + the stack's high-water mark
 
 
 def _kv(toks, start, src, diags):
@@ -122,7 +124,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     pre, sections = split_sections(src, lines, diags, APP)
     for toks in pre:
         err(toks[0], f"unexpected {show(toks[0])} before the first section")
-    known = ("application", "configs", "time", "tasks", "telemetry", "uplink")
+    known = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget")
     body: dict[str, list] = {}
     for header, rows in sections:
         if header.name == "<malformed>":
@@ -424,13 +426,39 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         elif reset_cause.type is not U8:
             err(rt, f"`reset_cause` needs a U8 element; `{rt.text}` is {reset_cause.type}")
 
+    # [budget]
+    budget: dict[str, int] = {}
+    for toks in body.get("budget", []):
+        key = toks[0]
+        if key.text not in ("flash", "ram"):
+            err(key, f"unknown budget `{key.text}`: expected `flash` or `ram` (bytes)")
+            continue
+        if key.text in budget:
+            err(key, f"`{key.text}` is given twice")
+            continue
+        if len(toks) != 2:
+            err(toks[2] if len(toks) > 2 else key, f"`{key.text}` takes one value, a number of bytes")
+            continue
+        q = _positive(toks[1], src, diags, f"`{key.text}`")
+        if q is None:
+            continue
+        if q.denominator != 1:
+            err(toks[1], f"`{key.text}` is a whole number of bytes, found `{toks[1].text}`")
+            continue
+        limit = None if board is None else (board.flash if key.text == "flash" else board.ram)
+        if limit is not None and q > limit:
+            err(toks[1], f"a {key.text} budget of {int(q):,} B is more than the {board.name} has "
+                         f"({limit:,} B)")
+            continue
+        budget[key.text] = int(q)
+
     if len(diags.errors) != before or board is None or time_element is None:
         if time_element is None and not machines and len(diags.errors) == before:
             diags.error(src, APP, 1, 1, "an application needs at least one `machine` in [configs]")
         return None
     return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
                        tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable),
-                       reset_cause)
+                       reset_cause, budget.get("flash"), budget.get("ram"))
 
 
 def _col_index(line: str, col: int) -> int:

@@ -32,3 +32,7 @@ Outputs  rate=10
 
 [uplink]
 abortCmd
+
+[budget]               # fsw build fails above these; fsw sim adds the stack's
+flash 12288            # measured high-water mark to the RAM
+ram   1024

@@ -74,6 +74,7 @@ class Size:
     ram: int  # .data + .bss
     flash_budget: int
     ram_budget: int
+    owner: str = ""  # whose budget: the board's name, or "the application's"
 
     @property
     def fits(self) -> bool:
@@ -83,8 +84,20 @@ class Size:
         def row(name, used, budget, note=""):
             pct = 100.0 * used / budget if budget else 0.0
             return f"  {name:<6}{used:>8,} / {budget:>8,} B  {pct:5.1f} %{note}"
-        return "\n".join([row("flash", self.flash, self.flash_budget),
-                          row("RAM", self.ram, self.ram_budget, "  (data + bss; the stack uses the rest)")])
+        note = f"  ({self.owner} budget)" if self.owner else ""
+        ram_note = ("  (data + bss; the budget counts the stack too: fsw sim measures it)" if self.owner
+                    else "  (data + bss; the stack uses the rest)")
+        return "\n".join([row("flash", self.flash, self.flash_budget, note),
+                          row("RAM", self.ram, self.ram_budget, ram_note)])
+
+
+def size_of(app, flash: int, ram: int) -> Size:
+    """The firmware's size against its budget: the application's `[budget]`
+    where it sets one, else the board's memory."""
+    b = app.board
+    mine = app.flash_budget is not None or app.ram_budget is not None
+    return Size(flash, ram, app.flash_budget or b.flash, app.ram_budget or b.ram,
+                "the application's" if mine else "")
 
 
 def elf_size(elf: str) -> tuple[int, int]:

@@ -298,7 +298,7 @@ def cmd_gen(args) -> int:
 
 
 def cmd_build(args) -> int:
-    from fswkit.build import BuildError, Size, default_out, elf_size, make
+    from fswkit.build import BuildError, default_out, elf_size, make, size_of
 
     app = _load_app(args, "build")
     if app is None:
@@ -325,11 +325,12 @@ def cmd_build(args) -> int:
     except BuildError as e:
         sys.stderr.write(f"fsw build: {e}\n")
         return EXIT_FAIL
-    size = Size(flash, ram, b.flash, b.ram)
+    size = size_of(app, flash, ram)
     print(size.table())
     print(f"  {artifact}\n  {artifact[:-4]}.hex")
     if not size.fits:
-        sys.stderr.write(f"fsw build: the firmware does not fit the {b.name}\n")
+        whose = "the application's [budget]" if size.owner else f"the {b.name}"
+        sys.stderr.write(f"fsw build: the firmware does not fit {whose}\n")
         return EXIT_FAIL
     return EXIT_OK
 

@@ -31,12 +31,16 @@ Result io_analog_begin(const AnalogTable* table) {
     return kOk;
 }
 
-Result io_analog_task(void* ctx) {
+namespace {
+
+template <bool kAnyF64>
+Result analog_task(void* ctx) {
     AnalogTable tab;
     flash_read(&tab, ctx, sizeof tab);
     for (uint8_t i = 0; i < tab.n; ++i) {
         AnalogChannel c;
         flash_read(&c, &tab.ch[i], sizeof c);
+        if (!kAnyF64 && c.type != kF32) return kErrConfig;
         uint8_t* p = tab.sv + c.off;
         if (c.dir == kIoIn) {
             // Read (slow: ~100 us on AVR) before taking the lock.
@@ -45,17 +49,22 @@ Result io_analog_task(void* ctx) {
             const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
             // Analog elements are F32 or F64 (checked at begin): no general
             // dispatch, which would link every type's conversions.
-            if (c.type == kF64) write_F64(p, v); else write_F32(p, v);
+            if (kAnyF64 && c.type == kF64) write_F64(p, v); else write_F32(p, v);
             if (tab.lock) pal::critical_exit(saved);
         } else {
             const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
-            const Real volts = c.type == kF64 ? read_F64(p) : read_F32(p);
+            const Real volts = (kAnyF64 && c.type == kF64) ? read_F64(p) : read_F32(p);
             if (tab.lock) pal::critical_exit(saved);
             pal::analog_write(c.pin, pwm_duty_from_volts(volts, tab.vref));
         }
     }
     return kOk;
 }
+
+}  // namespace
+
+Result io_analog_task(void* ctx) { return analog_task<true>(ctx); }
+Result io_analog_task_f32(void* ctx) { return analog_task<false>(ctx); }
 
 Result io_digital_begin(const DigitalTable* table) {
     DigitalTable tab;

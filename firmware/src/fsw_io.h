@@ -50,6 +50,9 @@ FSW_MUST_CHECK Result io_digital_begin(const DigitalTable* table);
 
 // Executor task steps; ctx is the FSW_FLASH table. One pass over the table.
 Result io_analog_task(void* ctx);
+// The same for a table whose elements are all F32 (the generator picks it):
+// it links no binary64 conversion, which AVR does in software.
+Result io_analog_task_f32(void* ctx);
 Result io_digital_task(void* ctx);
 
 // The conversions the analog task applies (exposed for tests and docs).

@@ -60,6 +60,36 @@ static void test_analog_task_reads_and_writes(void) {
     ASSERT_REAL_SAME(Real(-125), read_F32(sv + 0));
 }
 
+// An all-F32 table through the task that links no binary64 code: the same
+// values as the general task; an F64 row is refused, not written as F32.
+static const AnalogChannel kAnalogF32[2] FSW_FLASH = {
+    {Real(250), Real(-125), 0, 14, kIoIn, kF32},
+    {Real(8), Real(-20), 4, 15, kIoIn, kF32},
+};
+static const AnalogTable kAnalogF32Table FSW_FLASH = {kAnalogF32, sv, Real(5), 2, 10, false};
+
+static void test_analog_f32_task_matches_the_general_task(void) {
+    TEST_ASSERT_EQUAL(kOk, io_analog_begin(&kAnalogF32Table));
+    for (uint16_t raw = 0; raw <= 1023; raw += 31) {
+        native::sim_set_analog(14, raw);
+        native::sim_set_analog(15, static_cast<uint16_t>(1023 - raw));
+        TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogF32Table)));
+        const Real a = read_F32(sv + 0), b = read_F32(sv + 4);
+        write_F32(sv + 0, Real(-1));
+        write_F32(sv + 4, Real(-1));
+        TEST_ASSERT_EQUAL(kOk, io_analog_task_f32(const_cast<AnalogTable*>(&kAnalogF32Table)));
+        ASSERT_REAL_SAME(a, read_F32(sv + 0));
+        ASSERT_REAL_SAME(b, read_F32(sv + 4));
+        uint8_t expect[4];
+        write_F32(expect, analog_value_from_raw(raw, 5, 10, 250, -125));  // rounded to binary32
+        ASSERT_REAL_SAME(read_F32(expect), a);
+    }
+    uint8_t before[sizeof sv];
+    memcpy(before, sv, sizeof sv);
+    TEST_ASSERT_EQUAL(kErrConfig, io_analog_task_f32(const_cast<AnalogTable*>(&kAnalogTable)));
+    TEST_ASSERT_EQUAL_MEMORY(before + 4, sv + 4, 8);  // the F64 row was not touched
+}
+
 static void test_digital_task_mirrors_pins(void) {
     TEST_ASSERT_EQUAL(kOk, io_digital_begin(&kDigitalTable));
     TEST_ASSERT_EQUAL_UINT8(pal::kInputPullup, native::sim_pin_mode(2));
@@ -95,6 +125,7 @@ static void run(void) {
     RUN_TEST(test_pwm_duty_from_volts);
 #if FSW_PLATFORM_NATIVE
     RUN_TEST(test_analog_task_reads_and_writes);
+    RUN_TEST(test_analog_f32_task_matches_the_general_task);
     RUN_TEST(test_digital_task_mirrors_pins);
     RUN_TEST(test_begin_refuses_bad_tables);
 #endif

@@ -113,6 +113,44 @@
 #  define FSW_CONSOLE_BAUD 115200UL
 #endif
 
+// Console driver on Arduino: 1 = the core's `Serial` (HardwareSerial: any
+// board, and sketches that print with Serial themselves), 0 = the kit's own
+// interrupt-driven UART0 driver (AVR only: 0.66 KB less flash and 43 B less
+// RAM for the tank example; it defines the USART0 interrupts, so a sketch
+// that also uses Serial must set 1).
+#ifndef FSW_CONSOLE_ARDUINO_SERIAL
+#  if defined(__AVR__)
+#    define FSW_CONSOLE_ARDUINO_SERIAL 0
+#  else
+#    define FSW_CONSOLE_ARDUINO_SERIAL 1
+#  endif
+#endif
+#if !FSW_CONSOLE_ARDUINO_SERIAL && FSW_PLATFORM_ARDUINO && !defined(__AVR__)
+#  error "fswkit: the built-in UART driver is for AVR boards: set FSW_CONSOLE_ARDUINO_SERIAL=1"
+#endif
+// Ring buffers of the built-in UART0 driver, bytes (powers of two, 4..256).
+// Transmit: the link keeps one whole frame in its own buffer and hands it on
+// as this ring drains; a sample that finds that frame buffer still busy is
+// dropped, so the ring also absorbs what a busy cycle sends beyond what the
+// UART carries in one period (at 115200 baud and 100 Hz, ~117 bytes: a
+// sample frame, hello and health together are more). 64 bytes buffer as
+// much as HardwareSerial did; measured on the simulated Uno, 32 drops
+// samples when the ground's commands and the frames they ask for crowd a
+// cycle. Receive: a burst of commands from the ground waits here for the
+// next run of the uplink task (up to ~117 bytes arrive in a 10 ms cycle at
+// 115200 baud; one command is at most 24).
+#ifndef FSW_CONSOLE_TX_SIZE
+#  define FSW_CONSOLE_TX_SIZE 64
+#endif
+#ifndef FSW_CONSOLE_RX_SIZE
+#  define FSW_CONSOLE_RX_SIZE 64
+#endif
+#if (FSW_CONSOLE_TX_SIZE & (FSW_CONSOLE_TX_SIZE - 1)) != 0 || FSW_CONSOLE_TX_SIZE < 4 || \
+    FSW_CONSOLE_TX_SIZE > 256 || (FSW_CONSOLE_RX_SIZE & (FSW_CONSOLE_RX_SIZE - 1)) != 0 || \
+    FSW_CONSOLE_RX_SIZE < 4 || FSW_CONSOLE_RX_SIZE > 256
+#  error "fswkit: FSW_CONSOLE_TX_SIZE and FSW_CONSOLE_RX_SIZE must be powers of two, 4..256"
+#endif
+
 // Elements and regions are little-endian in memory (spec 2); typed access
 // copies bytes straight into locals, so the host must be little-endian too.
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

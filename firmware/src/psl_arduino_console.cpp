@@ -1,5 +1,7 @@
-// Arduino PSL, Console: the serial port. Its own file so that a build that
-// never uses the console does not link HardwareSerial (157 B of RAM on AVR).
+// Arduino PSL, Console: the serial port. On AVR, a small interrupt-driven
+// UART0 driver (two rings, two interrupts); elsewhere, or with
+// FSW_CONSOLE_ARDUINO_SERIAL=1, the core's Serial. Its own file so that a
+// build that never uses the console links neither.
 #include "fsw_config.h"
 
 #if FSW_PLATFORM_ARDUINO
@@ -7,6 +9,8 @@
 #include <Arduino.h>
 
 #include "fsw_pal.h"
+
+#if FSW_CONSOLE_ARDUINO_SERIAL
 
 namespace fsw {
 namespace pal {
@@ -18,5 +22,99 @@ uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableFo
 
 }  // namespace pal
 }  // namespace fsw
+
+#else  // the built-in UART0 driver (AVR)
+
+#if defined(USART_RX_vect)  // ATmega328P (Uno, Nano)
+#define FSW_UART_RX_VECT USART_RX_vect
+#define FSW_UART_UDRE_VECT USART_UDRE_vect
+#elif defined(USART0_RX_vect)  // ATmega2560 (Mega)
+#define FSW_UART_RX_VECT USART0_RX_vect
+#define FSW_UART_UDRE_VECT USART0_UDRE_vect
+#else
+#error "fswkit: no USART0 on this MCU: set FSW_CONSOLE_ARDUINO_SERIAL=1"
+#endif
+
+namespace {
+
+const uint8_t kTxMask = FSW_CONSOLE_TX_SIZE - 1;
+const uint8_t kRxMask = FSW_CONSOLE_RX_SIZE - 1;
+
+// One free slot tells a full ring from an empty one. Each index has one
+// writer: the heads belong to the writer of the ring, the tails to its reader.
+uint8_t g_tx[FSW_CONSOLE_TX_SIZE];
+uint8_t g_rx[FSW_CONSOLE_RX_SIZE];
+volatile uint8_t g_tx_head, g_tx_tail, g_rx_head, g_rx_tail;
+
+}  // namespace
+
+// A received byte into the ring; dropped when it is full (the uplink's CRC
+// and COBS checks then refuse the frame it belonged to).
+ISR(FSW_UART_RX_VECT) {
+    const uint8_t b = UDR0;
+    const uint8_t h = g_rx_head;
+    const uint8_t next = static_cast<uint8_t>((h + 1u) & kRxMask);
+    if (next != g_rx_tail) {
+        g_rx[h] = b;
+        g_rx_head = next;
+    }
+}
+
+// The data register is free: the next byte, and the interrupt off once the
+// ring is empty (console_write turns it back on).
+ISR(FSW_UART_UDRE_VECT) {
+    uint8_t t = g_tx_tail;
+    if (t != g_tx_head) {
+        UDR0 = g_tx[t];
+        t = static_cast<uint8_t>((t + 1u) & kTxMask);
+        g_tx_tail = t;
+    }
+    if (t == g_tx_head) UCSR0B = static_cast<uint8_t>(UCSR0B & ~_BV(UDRIE0));
+}
+
+namespace fsw {
+namespace pal {
+
+// 8N1 with double speed, the divisor rounded as the Arduino core does
+// (115200 baud at 16 MHz: UBRR 16, 117,647 baud, +2.1 %).
+void console_begin(uint32_t baud) {
+    const uint16_t ubrr = static_cast<uint16_t>((F_CPU / 4u / baud - 1u) / 2u);
+    UBRR0 = ubrr;
+    UCSR0A = _BV(U2X0);
+    UCSR0C = static_cast<uint8_t>(_BV(UCSZ01) | _BV(UCSZ00));
+    UCSR0B = static_cast<uint8_t>(_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0));
+}
+
+// Never waits: bytes that do not fit are dropped (callers stay within
+// console_write_space()).
+void console_write(const uint8_t* data, uint16_t len) {
+    uint8_t h = g_tx_head;
+    while (len != 0) {
+        const uint8_t next = static_cast<uint8_t>((h + 1u) & kTxMask);
+        if (next == g_tx_tail) break;
+        g_tx[h] = *data++;
+        h = next;
+        --len;
+    }
+    g_tx_head = h;
+    // Read-modify-write against the interrupt clearing UDRIE0: at worst it
+    // fires once more on an empty ring and turns itself off.
+    UCSR0B = static_cast<uint8_t>(UCSR0B | _BV(UDRIE0));
+}
+
+int16_t console_read() {
+    const uint8_t t = g_rx_tail;
+    if (t == g_rx_head) return -1;
+    const uint8_t b = g_rx[t];
+    g_rx_tail = static_cast<uint8_t>((t + 1u) & kRxMask);
+    return b;
+}
+
+uint16_t console_write_space() { return static_cast<uint8_t>((g_tx_tail - g_tx_head - 1u) & kTxMask); }
+
+}  // namespace pal
+}  // namespace fsw
+
+#endif  // FSW_CONSOLE_ARDUINO_SERIAL
 
 #endif  // FSW_PLATFORM_ARDUINO

@@ -97,15 +97,19 @@ def _app_cpp(app: Application) -> str:
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
     if has_link:
         c += _link(app)
+    steps = {}
     for t in app.tasks:
-        c += _task_fn(app, t, tables)
+        steps[t.name] = _direct_step(t, tables)
+        if steps[t.name] is None:
+            c += _task_fn(app, t, tables)
     c.append(f"const fsw::Task kTasks[{max(n, 1)}] FSW_FLASH = {{")
     for t in app.tasks:
         mode = f"E_{t.mode.name}" if t.mode is not None else "fsw::kNoElement"
         over = f"E_{t.overruns.name}" if t.overruns is not None else "fsw::kNoElement"
         worst = f"E_{t.worst_us.name}" if t.worst_us is not None else "fsw::kNoElement"
-        c.append(f"    {{task_{t.name}, 0, 0, {t.divider}, 0, {mode}, {over}, {worst}, "
-                 f"{MODES[t.start]}}},  // {basename(app.path)}:{t.line} {t.name}")
+        step, ctx = steps[t.name] or (f"task_{t.name}", "0")
+        c.append(f"    {{{step}, 0, {ctx}, {t.divider}, 0, {mode}, {over}, {worst}, "
+                 f"{MODES[t.start]}}},  // {basename(app.path)}:{t.line} {t.name} ({t.kind})")
     if not app.tasks:
         c.append("    {0, 0, 0, 1, 0, fsw::kNoElement, fsw::kNoElement, fsw::kNoElement, 0},")
     c.append("};")
@@ -120,7 +124,8 @@ def _app_cpp(app: Application) -> str:
     for (kind, d), tag in tables.items():
         c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
     if has_link:
-        c.append("    if (fsw::link_begin(link, &kLinkConfig) != fsw::kOk) return false;")
+        c.append(f"    fsw::pal::console_begin({app.baud}UL);")
+        c.append("    fsw::link_begin(link, &kLinkConfig);  // its tables are checked where they are defined")
     c.append("    return true;")
     c.append("}")
     c.append("")
@@ -151,6 +156,23 @@ def _app_cpp(app: Application) -> str:
     c.append("#endif")
     c.append("")
     return "\n".join(c)
+
+
+def _direct_step(t: Task, tables) -> tuple[str, str] | None:
+    """(step function, context) of a task that is one runtime call: the task
+    table points at the runtime's function itself, so no generated wrapper
+    copies it (LTO would inline each runtime task into its wrapper)."""
+    if t.kind == "telemetry":
+        return "fsw::link_telemetry_task", "&link"
+    if t.kind == "uplink":
+        return "fsw::link_uplink_task", "&link"
+    if t.kind in ("inputs", "outputs"):
+        d = "i" if t.kind == "inputs" else "o"
+        calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
+        if len(calls) == 1:
+            kind, tag = calls[0]
+            return f"fsw::io_{kind}_task", f"const_cast<void*>(static_cast<const void*>(&{tag}))"
+    return None
 
 
 def _task_fn(app: Application, t: Task, tables) -> list[str]:
@@ -216,11 +238,19 @@ def _link(app: Application) -> list[str]:
         c.append(f"fsw::LinkStreamState link_streams[{len(plan.streams)}];")
     index = {e.name: i for i, e in enumerate(app.sv.elements)}
     rows = sorted(plan.writable, key=lambda e: index[e.name])
+    for s in plan.streams:
+        st = next(x for x in app.telemetry if x.region is s.region)
+        c.append(f"static_assert(fsw::link_stream_ok(R_{s.region.name}_off, R_{s.region.name}_size, {s.every}, "
+                 f"{s.batch}, {'true' if s.batch > 1 else 'false'}, kSvSize, kLinkTxSize), "
+                 f"\"{name}:{st.line}: stream {s.region.name} does not fit the link's buffers\");")
     if rows:
         c.append(f"const fsw::LinkWritable kLinkWritable[{len(rows)}] FSW_FLASH = {{")
         for e in rows:
             c.append(f"    {{{index[e.name]}, E_{e.name}, {ELEM_CODE[e.type.name]}}},  // {e.name} ({e.type.name})")
         c.append("};")
+        for e in rows:
+            c.append(f"static_assert(fsw::link_writable_ok(E_{e.name}, {ELEM_CODE[e.type.name]}, kSvSize), "
+                     f"\"writable element {e.name} lies outside the state vector\");")
     c.append(f"uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, {app.time_unit}")
     hz = float(plan.health_every and app.tasks[plan.telemetry_task].rate / plan.health_every)
     load += hz * encoded_health(plan) + hz / max(plan.hello_every, 1) * 27
@@ -233,9 +263,11 @@ def _link(app: Application) -> list[str]:
     up = plan.uplink_task if plan.uplink_task is not None else 0xFF
     c.append("const fsw::LinkConfig kLinkConfig FSW_FLASH = {")
     c.append(f"    sv, {'kLinkStreams' if plan.streams else '0'}, {'link_streams' if plan.streams else '0'}, "
-             f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, {app.baud}UL, kSvSize,")
+             f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
              f"{plan.hello_every}, {up}, kSvLock}};")
+    c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
+             f"{len(app.tasks)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")
     c.append("")
     return c

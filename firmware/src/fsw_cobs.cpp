@@ -13,7 +13,7 @@ void cobs_begin(CobsEncoder& e, uint8_t* out) {
     e.crc = kCrcInit;
 }
 
-static void put_raw(CobsEncoder& e, uint8_t b) {
+FSW_NOINLINE FSW_NOCLONE static void put_raw(CobsEncoder& e, uint8_t b) {
     if (b == 0) {
         e.out[e.code_at] = e.code;
         e.code_at = e.len++;

@@ -12,19 +12,34 @@
 
 namespace fsw {
 
+// Health and ack frames send these fields as they lie in memory
+// (little-endian targets, fsw_config.h).
 static_assert(offsetof(LinkCounters, dropped) == offsetof(LinkCounters, frames) + 4, "health frame layout");
 static_assert(offsetof(LinkCounters, last_seq) == offsetof(LinkCounters, rx_ok) + 12, "health frame layout");
+static_assert(offsetof(Executor, late) == offsetof(Executor, cycles) + 4 &&
+                  offsetof(Executor, reset_cause) == offsetof(Executor, cycles) + 6,
+              "health frame layout");
+static_assert(offsetof(Link, ack_op) == offsetof(Link, ack_seq) + 2 &&
+                  offsetof(Link, ack_status) == offsetof(Link, ack_seq) + 3,
+              "ack frame layout");
 
 namespace {
 
 enum Pending : uint8_t { kPendAck = 1, kPendHello = 2, kPendHealth = 4 };
 const uint16_t kNoSnapshot = 0xFFFFu;
 
-inline void inc16(uint16_t& c) {
+void inc16(uint16_t& c) {
     if (c != 0xFFFFu) ++c;
 }
 
-inline void read_config(const Link& l, LinkConfig& c) { flash_read(&c, l.cfg, sizeof c); }
+void read_config(const Link& l, LinkConfig& c) { flash_read(&c, l.cfg, sizeof c); }
+
+// Copies state vector bytes, atomically when the `lock` option is on.
+void sv_move(const LinkConfig& c, void* dst, const void* src, uint16_t n) {
+    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    memcpy(dst, src, n);
+    if (c.lock) pal::critical_exit(saved);
+}
 
 // Hands as much of the transmit buffer to the console as it takes now.
 void pump(Link& l) {
@@ -32,46 +47,49 @@ void pump(Link& l) {
     uint16_t n = static_cast<uint16_t>(l.tx_len - l.tx_pos);
     const uint16_t space = pal::console_write_space();
     if (n > space) n = space;
-    if (n != 0) {
-        pal::console_write(l.tx + l.tx_pos, n);
-        l.tx_pos = static_cast<uint16_t>(l.tx_pos + n);
-    }
+    pal::console_write(l.tx + l.tx_pos, n);
+    l.tx_pos = static_cast<uint16_t>(l.tx_pos + n);
     if (l.tx_pos >= l.tx_len) l.tx_len = l.tx_pos = 0;
 }
 
-inline bool tx_free(Link& l) {
+bool tx_free(Link& l) {
     pump(l);
     return l.tx_len == 0;
 }
 
-void frame_begin(Link& l, CobsEncoder& e, uint8_t type, uint32_t time32) {
-    cobs_begin(e, l.tx);
-    cobs_put(e, type);
-    cobs_put(e, static_cast<uint8_t>(l.n.frames));
-    cobs_put_u32(e, time32);
+// The frame being composed. A frame is composed whole within one call, so
+// one encoder serves every link; the helpers below keep each field of a
+// frame to one short call.
+CobsEncoder g_enc;
+
+FSW_NOINLINE void put(uint8_t b) { cobs_put(g_enc, b); }
+FSW_NOINLINE void put_u16(uint16_t v) { cobs_put_u16(g_enc, v); }
+FSW_NOINLINE void put_u32(uint32_t v) { cobs_put_u32(g_enc, v); }
+FSW_NOINLINE void put_bytes(const void* p, uint16_t n) {
+    cobs_put_bytes(g_enc, static_cast<const uint8_t*>(p), n);
 }
 
-void frame_end(Link& l, CobsEncoder& e) {
-    l.tx_len = cobs_end(e);
+// The header: type, the frame counter's low byte, the low 32 bits of the
+// time (`time` points at its little-endian bytes).
+FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
+    cobs_begin(g_enc, l.tx);
+    put(type);
+    put(static_cast<uint8_t>(l.n.frames));
+    put_bytes(time, 4);
+}
+
+void frame_end(Link& l) {
+    l.tx_len = cobs_end(g_enc);
     l.tx_pos = 0;
     ++l.n.frames;
     pump(l);
 }
 
 // State vector bytes into the frame, atomically when the lock is on.
-void put_sv(CobsEncoder& e, const LinkConfig& c, uint16_t off, uint16_t n) {
-    if (c.lock) {
-        SvGuard<true> g;
-        cobs_put_bytes(e, c.sv + off, n);
-    } else {
-        cobs_put_bytes(e, c.sv + off, n);
-    }
-}
-
-void copy_sv(const LinkConfig& c, uint16_t off, uint16_t n, uint8_t* dst) {
-    const StateVector sv = {c.sv, c.sv_size, c.lock};
-    const Result r = sv_copy_out(sv, off, n, dst);  // link_begin checked every span
-    (void)r;
+void put_sv(const LinkConfig& c, uint16_t off, uint16_t n) {
+    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    put_bytes(c.sv + off, n);
+    if (c.lock) pal::critical_exit(saved);
 }
 
 // Sends the open batch of stream i (and the current region when `with_now`).
@@ -83,18 +101,15 @@ void send_batch(Link& l, const LinkConfig& c, const LinkStream& s, LinkStreamSta
         ++l.n.dropped;
         return;
     }
-    CobsEncoder e;
-    frame_begin(l, e, static_cast<uint8_t>(kFrameSample | i), st.t0);
-    cobs_put_bytes(e, s.store, static_cast<uint16_t>(stored * s.size));
-    if (with_now) put_sv(e, c, s.off, s.size);
-    frame_end(l, e);
+    frame_begin(l, static_cast<uint8_t>(kFrameSample | i), &st.t0);
+    put_bytes(s.store, static_cast<uint16_t>(stored * s.size));
+    if (with_now) put_sv(c, s.off, s.size);
+    frame_end(l);
 }
 
-void take_sample(Link& l, const LinkConfig& c, uint8_t i, uint32_t now32) {
-    LinkStream s;
-    flash_read(&s, &c.streams[i], sizeof s);
+void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, uint32_t now32) {
     LinkStreamState& st = c.stream_state[i];
-    const uint16_t late = c.ex != 0 ? c.ex->late : 0;
+    const uint16_t late = c.ex->late;
     // Samples of a frame are evenly spaced: a batch the executor broke by
     // skipping cycles goes out as it is.
     if (st.count != 0 && late != st.late0) send_batch(l, c, s, st, i, false);
@@ -103,94 +118,76 @@ void take_sample(Link& l, const LinkConfig& c, uint8_t i, uint32_t now32) {
         st.late0 = late;
     }
     if (static_cast<uint8_t>(st.count + 1u) < s.batch) {
-        copy_sv(c, s.off, s.size, s.store + st.count * s.size);
+        sv_move(c, s.store + st.count * s.size, c.sv + s.off, s.size);
         ++st.count;
         return;
     }
     send_batch(l, c, s, st, i, true);
 }
 
-void send_ack(Link& l, const LinkConfig& c) {
-    CobsEncoder e;
-    frame_begin(l, e, kFrameAck, static_cast<uint32_t>(c.now()));
-    cobs_put_u16(e, l.ack_seq);
-    cobs_put(e, l.ack_op);
-    cobs_put(e, l.ack_status);
-    cobs_put_u16(e, l.n.last_seq);
-    frame_end(l, e);
-}
-
-uint8_t reset_cause_of(const LinkConfig& c) { return c.ex != 0 ? c.ex->reset_cause : pal::reset_cause(); }
-
-void send_hello(Link& l, const LinkConfig& c) {
+// One control frame: `type` is kFrameAck, kFrameHello, kFrameHealth or
+// kFrameSnapshot.
+FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     const uint64_t t = c.now();
-    CobsEncoder e;
-    frame_begin(l, e, kFrameHello, static_cast<uint32_t>(t));
-    cobs_put(e, kLinkProtocol);
-    cobs_put_u32(e, c.schema);
-    cobs_put_u32(e, static_cast<uint32_t>(t >> 32));
-    cobs_put_u32(e, l.n.frames);
-    cobs_put(e, FSW_RUNTIME_VERSION_MAJOR);
-    cobs_put(e, FSW_RUNTIME_VERSION_MINOR);
-    cobs_put(e, FSW_RUNTIME_VERSION_PATCH);
-    cobs_put(e, reset_cause_of(c));
-    cobs_put_u16(e, l.n.last_seq);
-    frame_end(l, e);
-}
-
-void send_health(Link& l, const LinkConfig& c) {
-    const uint64_t t = c.now();
-    CobsEncoder e;
-    frame_begin(l, e, kFrameHealth, static_cast<uint32_t>(t));
-    cobs_put_u32(e, static_cast<uint32_t>(t >> 32));
-    // frames, dropped (u32) as they lie in LinkCounters (little-endian targets)
-    cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&l.n.frames), 8);
-    cobs_put_u32(e, c.ex != 0 ? c.ex->cycles : 0);
-    cobs_put_u16(e, c.ex != 0 ? c.ex->late : 0);
-    cobs_put(e, reset_cause_of(c));
-    // rx_ok .. last_seq: seven u16, in order
-    cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&l.n.rx_ok), 14);
-    const uint8_t n_tasks = c.ex != 0 ? c.ex->cfg.n_tasks : 0;
-    for (uint8_t i = 0; i < n_tasks; ++i) {
-        const TaskStats& s = c.ex->cfg.stats[i];
-        cobs_put(e, executor_task_mode(*c.ex, i));
-        cobs_put(e, static_cast<uint8_t>(s.faults > 0xFFu ? 0xFFu : s.faults));
-        cobs_put_u16(e, s.overruns);
-        cobs_put_u16(e, static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us));
+    uint8_t tb[8];  // t, little-endian: the header takes the low half, hello and health the high half
+    memcpy(tb, &t, sizeof tb);
+    frame_begin(l, type, tb);
+    const Executor& ex = *c.ex;
+    if (type == kFrameAck) {
+        put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
+        put_u16(l.n.last_seq);
+    } else if (type == kFrameHello) {
+        put(kLinkProtocol);
+        put_u32(c.schema);
+        put_bytes(tb + 4, 4);
+        put_u32(l.n.frames);
+        put(FSW_RUNTIME_VERSION_MAJOR);
+        put(FSW_RUNTIME_VERSION_MINOR);
+        put(FSW_RUNTIME_VERSION_PATCH);
+        put(ex.reset_cause);
+        put_u16(l.n.last_seq);
+    } else if (type == kFrameHealth) {
+        put_bytes(tb + 4, 4);
+        put_bytes(&l.n.frames, 8);   // frames, dropped
+        put_bytes(&ex.cycles, 7);    // cycles, late, reset_cause
+        put_bytes(&l.n.rx_ok, 14);   // rx_ok .. last_seq
+        for (uint8_t i = 0; i < ex.cfg.n_tasks; ++i) {
+            const TaskStats& s = ex.cfg.stats[i];
+            put(executor_task_mode(ex, i));
+            put(static_cast<uint8_t>(s.faults > 0xFFu ? 0xFFu : s.faults));
+            put_u16(s.overruns);
+            put_u16(static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us));
+        }
+    } else {
+        const uint16_t off = l.snapshot_at;
+        uint16_t n = static_cast<uint16_t>(c.sv_size - off);
+        if (n > c.snapshot_chunk) n = c.snapshot_chunk;
+        put_u16(off);
+        put_sv(c, off, n);
+        l.snapshot_at = static_cast<uint16_t>(off + n) >= c.sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
-    frame_end(l, e);
-}
-
-void send_snapshot(Link& l, const LinkConfig& c) {
-    const uint16_t off = l.snapshot_at;
-    uint16_t n = static_cast<uint16_t>(c.sv_size - off);
-    if (n > c.snapshot_chunk) n = c.snapshot_chunk;
-    CobsEncoder e;
-    frame_begin(l, e, kFrameSnapshot, static_cast<uint32_t>(c.now()));
-    cobs_put_u16(e, off);
-    put_sv(e, c, off, n);
-    frame_end(l, e);
-    l.snapshot_at = static_cast<uint16_t>(off + n) >= c.sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
+    frame_end(l);
 }
 
 // Sends waiting control frames while the transmit buffer is free:
 // acknowledgements first, then hello, health, snapshot chunks.
 void service(Link& l, const LinkConfig& c) {
     while (tx_free(l)) {
-        if (l.pending & kPendAck) {
-            l.pending = static_cast<uint8_t>(l.pending & ~kPendAck);
-            send_ack(l, c);
-        } else if (l.pending & kPendHello) {
-            l.pending = static_cast<uint8_t>(l.pending & ~kPendHello);
-            send_hello(l, c);
-        } else if (l.pending & kPendHealth) {
-            l.pending = static_cast<uint8_t>(l.pending & ~kPendHealth);
-            send_health(l, c);
+        const uint8_t p = l.pending;
+        uint8_t type;
+        if (p & kPendAck) {
+            type = kFrameAck;
+        } else if (p & kPendHello) {
+            type = kFrameHello;
+        } else if (p & kPendHealth) {
+            type = kFrameHealth;
         } else if (l.snapshot_at != kNoSnapshot) {
-            send_snapshot(l, c);
+            type = kFrameSnapshot;
         } else {
             return;
         }
+        l.pending = static_cast<uint8_t>(p & (p - 1u));  // the lowest bit: the one sent (none for a snapshot)
+        send_control(l, c, type);
     }
 }
 
@@ -198,47 +195,37 @@ void service(Link& l, const LinkConfig& c) {
 
 uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
     if (alen < 2) return kAckBadLength;
-    const uint16_t index = static_cast<uint16_t>(a[0] | (a[1] << 8));
+    const uint16_t index = load<uint16_t>(a);
     for (uint8_t k = 0; k < c.n_writable; ++k) {
         LinkWritable w;
         flash_read(&w, &c.writable[k], sizeof w);
         if (w.index != index) continue;
         const uint8_t size = elem_size(w.type);
-        if (size == 0 || alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
+        if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
         uint8_t v[8];
         memcpy(v, a + 2, size);
         if (w.type == kBool) v[0] = v[0] != 0 ? 1 : 0;
-        const StateVector sv = {c.sv, c.sv_size, c.lock};
-        return sv_copy_in(sv, w.off, size, v) == kOk ? kAckOk : kAckNotWritable;
+        sv_move(c, c.sv + w.off, v, size);
+        return kAckOk;
     }
     return kAckNotWritable;
 }
 
-uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
-    switch (op) {
-        case kOpPing:
-            return alen == 0 ? kAckOk : kAckBadLength;
-        case kOpHello:
-            if (alen != 0) return kAckBadLength;
-            l.pending |= kPendHello;
-            return kAckOk;
-        case kOpSnapshot:
-            if (alen != 0) return kAckBadLength;
-            l.snapshot_at = 0;
-            return kAckOk;
-        case kOpSet:
-            return apply_set(c, a, alen);
-        case kOpMode: {
-            if (alen != 2) return kAckBadLength;
-            if (c.ex == 0 || a[0] >= c.ex->cfg.n_tasks) return kAckBadTask;
-            if (a[1] > kModeEnabled) return kAckBadMode;
-            if (a[0] == c.uplink_task && a[1] != kModeEnabled) return kAckLocked;
-            executor_set_task_mode(*c.ex, a[0], a[1]);
-            return kAckOk;
-        }
-        default:
-            return kAckUnknownOp;
+FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
+    if (op == kOpSet) return apply_set(c, a, alen);
+    if (op == kOpMode) {
+        if (alen != 2) return kAckBadLength;
+        if (a[0] >= c.ex->cfg.n_tasks) return kAckBadTask;
+        if (a[1] > kModeEnabled) return kAckBadMode;
+        if (a[0] == c.uplink_task && a[1] != kModeEnabled) return kAckLocked;
+        executor_set_task_mode(*c.ex, a[0], a[1]);
+        return kAckOk;
     }
+    if (op < kOpPing || op > kOpSnapshot) return kAckUnknownOp;
+    if (alen != 0) return kAckBadLength;
+    if (op == kOpHello) l.pending |= kPendHello;
+    if (op == kOpSnapshot) l.snapshot_at = 0;
+    return kAckOk;
 }
 
 // One received frame (COBS-encoded, delimiter stripped): decode, verify,
@@ -254,7 +241,7 @@ void handle_frame(Link& l, const LinkConfig& c) {
         return;
     }
     const uint8_t op = l.rx[0];
-    const uint16_t seq = static_cast<uint16_t>(l.rx[1] | (l.rx[2] << 8));
+    const uint16_t seq = load<uint16_t>(l.rx + 1);
     const uint16_t ahead = static_cast<uint16_t>(seq - l.n.last_seq);
     uint8_t status;
     if (ahead == 0 || ahead >= 0x8000u) {
@@ -275,42 +262,25 @@ void handle_frame(Link& l, const LinkConfig& c) {
 
 }  // namespace
 
-Result link_begin(Link& l, const LinkConfig* cfg) {
+void link_begin(Link& l, const LinkConfig* cfg) {
     memset(&l, 0, sizeof l);
     l.cfg = cfg;
     LinkConfig c;
     read_config(l, c);
-    if (c.sv == 0 || c.tx == 0 || c.now == 0 || c.tx_cap < cobs_max_encoded(kLinkHeader + 2u + 19u) ||
-        (c.n_streams != 0 && (c.streams == 0 || c.stream_state == 0)) ||
-        (c.n_writable != 0 && c.writable == 0) || c.snapshot_chunk == 0 || c.n_streams > 128) {
-        return kErrConfig;
-    }
     for (uint8_t i = 0; i < c.n_streams; ++i) {
         LinkStream s;
         flash_read(&s, &c.streams[i], sizeof s);
-        if (s.every == 0 || s.batch == 0 || (s.batch > 1 && s.store == 0) ||
-            static_cast<uint32_t>(s.off) + s.size > c.sv_size ||
-            cobs_max_encoded(static_cast<uint16_t>(kLinkHeader + 2u + s.batch * s.size)) > c.tx_cap) {
-            return kErrConfig;
-        }
         LinkStreamState& st = c.stream_state[i];
         memset(&st, 0, sizeof st);
-        st.countdown = static_cast<uint16_t>(i % s.every);  // spread streams over runs
-    }
-    for (uint8_t k = 0; k < c.n_writable; ++k) {
-        LinkWritable w;
-        flash_read(&w, &c.writable[k], sizeof w);
-        if (elem_size(w.type) == 0 || static_cast<uint32_t>(w.off) + elem_size(w.type) > c.sv_size) {
-            return kErrConfig;
-        }
+        uint16_t first = i;  // i mod every: streams of equal rate take turns
+        while (first >= s.every) first = static_cast<uint16_t>(first - s.every);
+        st.countdown = first;
     }
     l.tx = c.tx;
     l.snapshot_at = kNoSnapshot;
     l.health_countdown = c.health_every;
     l.hello_countdown = c.hello_every;
     l.pending = kPendHello;
-    pal::console_begin(c.baud);
-    return kOk;
 }
 
 Result link_telemetry_task(void* p) {
@@ -328,7 +298,7 @@ Result link_telemetry_task(void* p) {
         LinkStream s;
         flash_read(&s, &c.streams[i], sizeof s);
         st.countdown = static_cast<uint16_t>(s.every - 1u);
-        take_sample(l, c, i, now32);
+        take_sample(l, c, s, i, now32);
     }
     if (c.health_every != 0 && --l.health_countdown == 0) {
         l.health_countdown = c.health_every;

@@ -87,11 +87,10 @@ struct LinkConfig {
     const LinkStream* streams;        // n_streams rows
     LinkStreamState* stream_state;    // n_streams records
     const LinkWritable* writable;     // n_writable rows
-    Executor* ex;                     // task health and modes
+    Executor* ex;                     // task health and modes (required)
     LinkClockFn now;                  // the time `G` is written from
     uint8_t* tx;                      // transmit buffer of tx_cap bytes
     uint32_t schema;                  // schema hash of layout + link configuration
-    uint32_t baud;
     uint16_t sv_size;
     uint16_t tx_cap;                  // >= the longest encoded frame
     uint16_t health_every;            // telemetry runs between health frames (0: none)
@@ -135,15 +134,49 @@ struct Link {
     uint8_t rx[FSW_LINK_RX_CAP];
 };
 
-// Validates the configuration, opens the console at cfg->baud and queues
-// the boot hello. `cfg` points at an FSW_FLASH object.
-FSW_MUST_CHECK Result link_begin(Link& link, const LinkConfig* cfg);
+// Starts the link: zeroes its records and queues the boot hello. The caller
+// opens the console first (pal::console_begin: generated code passes the
+// baud rate as a constant, so the divisor is computed when compiling). `cfg` points at an FSW_FLASH object whose tables
+// were checked when they were compiled (link_*_ok below): nothing is
+// checked at run time.
+void link_begin(Link& link, const LinkConfig* cfg);
 // Executor task steps (ctx = the Link): never block, never fault.
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
 // From loop(), between cycles: sends waiting control frames and feeds the
 // transmit buffer to the console as it drains.
 void link_poll(Link& link);
+
+// ---- compile-time checks of the tables -------------------------------------
+// The generator emits a static_assert of each for its tables; a hand-written
+// configuration should do the same. Sizes are computed in 32 bits.
+
+// Encoded size bound of a frame whose body is `body` bytes (COBS of body +
+// CRC, delimiter included): cobs_max_encoded without its 16-bit limit.
+constexpr uint32_t link_encoded_max(uint32_t body) { return body + 2u + (body + 2u) / 254u + 2u; }
+
+// A stream: sampled at least every run, at least one sample per frame, a
+// batch store when it batches, a region inside the state vector, and its
+// longest frame fits the transmit buffer.
+constexpr bool link_stream_ok(uint16_t off, uint16_t size, uint16_t every, uint8_t batch, bool has_store,
+                              uint16_t sv_size, uint16_t tx_cap) {
+    return every != 0 && batch != 0 && (batch == 1 || has_store) && static_cast<uint32_t>(off) + size <= sv_size &&
+           link_encoded_max(kLinkHeader + static_cast<uint32_t>(batch) * size) <= tx_cap;
+}
+
+// A writable element: a known type, inside the state vector.
+constexpr bool link_writable_ok(uint16_t off, uint8_t type, uint16_t sv_size) {
+    return elem_size(type) != 0 && static_cast<uint32_t>(off) + elem_size(type) <= sv_size;
+}
+
+// The rest: at most 128 streams, snapshot chunks of at least one byte, and a
+// transmit buffer that holds a hello (the longest control frame but
+// health), a health frame for `n_tasks` tasks and a snapshot chunk.
+constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks) {
+    return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 19u) <= tx_cap &&
+           link_encoded_max(kLinkHeader + 33u + 6u * n_tasks) <= tx_cap &&
+           link_encoded_max(kLinkHeader + 2u + snapshot_chunk) <= tx_cap;
+}
 
 }  // namespace fsw
 

@@ -20,6 +20,15 @@
 // each caller: flash matters more than a call on the slow path).
 #define FSW_NOINLINE __attribute__((noinline))
 
+// Keeps the compiler from specialising a function for a constant argument
+// (on AVR a clone for one object's address turns its short pointer-relative
+// accesses into 4-byte absolute ones). GCC only.
+#if defined(__GNUC__) && !defined(__clang__)
+#define FSW_NOCLONE __attribute__((noclone))
+#else
+#define FSW_NOCLONE
+#endif
+
 // Marks a constant table that lives in flash on AVR (read with flash_read).
 #if FSW_USE_PROGMEM
 #define FSW_FLASH PROGMEM
@@ -52,13 +61,17 @@ enum ElemType : uint8_t {
     kF32 = 8, kF64 = 9, kBool = 10,
 };
 
-// Size in bytes of an element type (0 for an unknown type).
-inline uint8_t elem_size(uint8_t t) {
-    return t == kI8 || t == kU8 || t == kBool ? 1
-         : t == kI16 || t == kU16             ? 2
-         : t == kI32 || t == kU32 || t == kF32 ? 4
-         : t == kI64 || t == kU64 || t == kF64 ? 8 : 0;
+// Size in bytes of an element type (0 for an unknown type): a power of two
+// from the type's code (I8..I64 and U8..U64 are 1, 2, 4, 8 in order), a
+// shift rather than a chain of compares.
+constexpr uint8_t elem_size(uint8_t t) {
+    return static_cast<uint8_t>(t > kBool ? 0u : t == kBool ? 1u : 1u << (t >= kF32 ? t - 6u : t & 3u));
 }
+static_assert(elem_size(kI8) == 1 && elem_size(kI16) == 2 && elem_size(kI32) == 4 && elem_size(kI64) == 8 &&
+                  elem_size(kU8) == 1 && elem_size(kU16) == 2 && elem_size(kU32) == 4 && elem_size(kU64) == 8 &&
+                  elem_size(kF32) == 4 && elem_size(kF64) == 8 && elem_size(kBool) == 1 && elem_size(11) == 0 &&
+                  elem_size(255) == 0,
+              "element sizes (spec 2)");
 
 // Offsets into the state vector are 16 bits; this one means "no element".
 typedef uint16_t ElemOff;

@@ -35,7 +35,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             115200UL, 20, 96, 10, 20, 2, 3, 3, 0, false};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -47,7 +47,8 @@ void setUp(void) {
     native::console_capture(out, sizeof out, &out_len);
     const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 2, false};
     TEST_ASSERT_EQUAL(kOk, executor_begin(ex, cfg));
-    TEST_ASSERT_EQUAL(kOk, link_begin(link, &kConfig));
+    pal::console_begin(115200UL);
+    link_begin(link, &kConfig);
 }
 void tearDown(void) {}
 
@@ -342,12 +343,35 @@ static void test_ping_hello_snapshot(void) {
     TEST_ASSERT_EQUAL_UINT16(20, covered);
 }
 
-static void test_bad_config_is_refused(void) {
-    static const LinkStream kBad[1] FSW_FLASH = {{16, 8, 1, 1, 0}};  // runs past the state vector
-    static const LinkConfig kBadCfg FSW_FLASH = {sv, kBad, states, 0, &ex, now_fn, tx, 0, 115200UL, 20, 96,
-                                                 10, 20, 1, 0, 3, 0, false};
-    Link l;
-    TEST_ASSERT_EQUAL(kErrConfig, link_begin(l, &kBadCfg));
+// The tables are checked when they are compiled: the checks the generator
+// emits as static_asserts, at both sides of each boundary.
+static_assert(link_stream_ok(0, 8, 1, 2, true, 20, 96) && link_stream_ok(8, 12, 4, 1, false, 20, 96),
+              "this suite's streams");
+static_assert(link_writable_ok(12, kF64, 20) && link_config_ok(96, 20, 2, 2), "this suite's tables");
+static_assert(!link_stream_ok(16, 8, 1, 1, false, 20, 96), "a region past the state vector is refused");
+
+static void test_bad_tables_do_not_pass_the_compile_time_checks(void) {
+    // a stream: the region ends at the state vector's end / one byte past it
+    TEST_ASSERT_TRUE(link_stream_ok(12, 8, 1, 1, false, 20, 96));
+    TEST_ASSERT_FALSE(link_stream_ok(13, 8, 1, 1, false, 20, 96));
+    TEST_ASSERT_FALSE(link_stream_ok(0xFFFF, 2, 1, 1, false, 0xFFFF, 96));  // no 16-bit wrap
+    // its longest frame: 6 + 8 x 10 + 2 bytes encode into 90, not 89
+    TEST_ASSERT_TRUE(link_stream_ok(0, 10, 1, 8, true, 80, 90));
+    TEST_ASSERT_FALSE(link_stream_ok(0, 10, 1, 8, true, 80, 89));
+    TEST_ASSERT_FALSE(link_stream_ok(0, 8, 0, 1, false, 20, 96));   // every 0
+    TEST_ASSERT_FALSE(link_stream_ok(0, 8, 1, 0, false, 20, 96));   // batch 0
+    TEST_ASSERT_FALSE(link_stream_ok(0, 8, 1, 2, false, 20, 96));   // a batch without its store
+    // a writable element: an F64 at the end / one byte past it; an unknown type
+    TEST_ASSERT_TRUE(link_writable_ok(12, kF64, 20));
+    TEST_ASSERT_FALSE(link_writable_ok(13, kF64, 20));
+    TEST_ASSERT_FALSE(link_writable_ok(0, 11, 20));
+    // control frames: a health frame of 2 tasks is 6 + 33 + 12 + 2 bytes, 55 encoded
+    TEST_ASSERT_TRUE(link_config_ok(55, 20, 2, 2));
+    TEST_ASSERT_FALSE(link_config_ok(54, 20, 2, 2));
+    TEST_ASSERT_FALSE(link_config_ok(55, 45, 2, 2));  // a snapshot chunk of 45 needs 57
+    TEST_ASSERT_FALSE(link_config_ok(96, 0, 2, 2));   // chunks of no byte
+    TEST_ASSERT_FALSE(link_config_ok(96, 20, 129, 2));
+    TEST_ASSERT_EQUAL_UINT32(cobs_max_encoded(90), link_encoded_max(88));
 }
 
 static void run_all(void) {
@@ -365,7 +389,7 @@ static void run_all(void) {
     RUN_TEST(test_mode_commands);
     RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
     RUN_TEST(test_ping_hello_snapshot);
-    RUN_TEST(test_bad_config_is_refused);
+    RUN_TEST(test_bad_tables_do_not_pass_the_compile_time_checks);
 }
 
 FSW_TEST_MAIN(run_all)

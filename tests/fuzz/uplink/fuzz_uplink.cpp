@@ -37,8 +37,12 @@ const Task kTasks[3] = {
 };
 const LinkStream kStreams[2] = {{0, 8, 1, 2, store0}, {8, 13, 3, 1, 0}};
 const LinkWritable kWritable[3] = {{4, 10, kBool}, {5, 11, kI16}, {6, 13, kF64}};
-const LinkConfig kConfig = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0x12345678UL, 115200UL, 21, 96, 5,
+const LinkConfig kConfig = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0x12345678UL, 21, 96, 5,
                             21, 2, 3, 2, 0, false};
+
+static_assert(link_stream_ok(0, 8, 1, 2, true, 21, 96) && link_stream_ok(8, 13, 3, 1, false, 21, 96) &&
+                  link_writable_ok(13, kF64, 21) && link_config_ok(96, 21, 2, 3),
+              "the tables are valid");
 
 uint8_t out[8192];
 uint16_t out_len;
@@ -78,7 +82,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool slow = size > 0 && (data[0] & 1);
     if (slow) native::console_model_uart(115200, 64);
     const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false};
-    if (executor_begin(ex, cfg) != kOk || link_begin(link, &kConfig) != kOk) fail("begin");
+    if (executor_begin(ex, cfg) != kOk) fail("begin");
+    pal::console_begin(115200UL);
+    link_begin(link, &kConfig);
     uint8_t before[sizeof sv];
     memcpy(before, sv, sizeof sv);
 

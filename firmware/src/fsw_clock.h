@@ -12,12 +12,19 @@ struct Clock64 {
     uint32_t high;  // wraps seen so far
 };
 
+static_assert(sizeof(Clock64) == 8, "Clock64: two packed words");
+
 // Extends a new 32-bit reading; a reading below the previous one is a wrap.
 // Not re-entrant: call from one context (the executor's loop).
 inline uint64_t clock64_extend(Clock64& c, uint32_t now32) {
     if (now32 < c.last) ++c.high;
     c.last = now32;
-    return (static_cast<uint64_t>(c.high) << 32) | now32;
+    // (high << 32) | now32 is the record itself on a little-endian target
+    // (fsw_config.h), read without the 64-bit shift an 8-bit MCU calls a
+    // library routine for.
+    uint64_t t;
+    memcpy(&t, &c, sizeof t);
+    return t;
 }
 
 }  // namespace fsw

@@ -22,6 +22,30 @@ extern "C" void fsw_capture_mcusr(void) {
     MCUSR = 0;
     wdt_disable();
 }
+
+#if FSW_STACK_PAINT
+// Paints the free RAM, from the end of the static data (`_end`, after .data,
+// .bss and .noinit) to RAMEND, with FSW_STACK_PAINT_BYTE. .init3 runs after
+// avr-libc has set the stack pointer to RAMEND (.init2) and before anything
+// is pushed: naked, no call, only r24, r25 and Z, which nothing before
+// .init4 (data copy, bss clear) expects to keep. .noinit is left alone.
+extern "C" void fsw_paint_stack(void) __attribute__((naked, used, section(".init3")));
+extern "C" void fsw_paint_stack(void) {
+    __asm__ __volatile__(
+        "ldi r30, lo8(_end)\n\t"
+        "ldi r31, hi8(_end)\n\t"
+        "ldi r24, %[paint]\n\t"
+        "ldi r25, hi8(%[top])\n\t"
+        "1: cpi r30, lo8(%[top])\n\t"
+        "cpc r31, r25\n\t"
+        "brsh 2f\n\t"
+        "st Z+, r24\n\t"
+        "rjmp 1b\n\t"
+        "2:\n\t" ::[paint] "M"(FSW_STACK_PAINT_BYTE),
+        [top] "i"(RAMEND + 1)
+        : "r24", "r25", "r30", "r31", "memory");
+}
+#endif  // FSW_STACK_PAINT
 #endif
 
 namespace fsw {

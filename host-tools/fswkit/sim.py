@@ -239,6 +239,23 @@ class Edge:
     level: bool
 
 
+@dataclass(frozen=True)
+class RamUsage:
+    """RAM of the firmware in bytes: its static data (.data, .bss, .noinit),
+    the deepest the stack has reached so far, their sum, and the MCU's RAM."""
+
+    static: int
+    stack: int
+    total: int
+    ram: int
+
+
+# The byte fswkit firmware paints its free RAM with at boot
+# (FSW_STACK_PAINT_BYTE, firmware/src/psl_arduino.cpp).
+STACK_PAINT = 0xC5
+PEEK_MAX = 4096  # bytes per `peek` command
+
+
 def _fields(line: str) -> dict[str, str]:
     return dict(t.split("=", 1) for t in line.split()[1:] if "=" in t)
 
@@ -514,6 +531,54 @@ class SimBoard:
                     return addr - 0x800000, int(parts[1], 16)
         raise SimError(f"{self.elf}: no variable `{name}`")
 
+    # -- stack and RAM --
+    @functools.cached_property
+    def _ram_layout(self) -> tuple[int, int, int]:
+        """(start of RAM, end of the static data, top of RAM + 1) as data
+        addresses: `_end` (after .data, .bss and .noinit) and `__stack`
+        (RAMEND) from the ELF's symbols, the start from the board's RAM size.
+        Fails for firmware that does not paint its free RAM at boot
+        (FSW_STACK_PAINT)."""
+        r = subprocess.run(["avr-nm", self.elf], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise SimError(f"{self.elf}: avr-nm failed: {r.stderr.strip()}")
+        syms = {}
+        for line in r.stdout.splitlines():
+            parts = line.split()
+            if len(parts) == 3:
+                syms[parts[2]] = int(parts[0], 16) & 0xFFFF  # data addresses carry 0x800000
+        if "fsw_paint_stack" not in syms:
+            raise SimError(f"{self.elf}: this firmware does not paint its stack at boot "
+                           "(fswkit firmware built with FSW_STACK_PAINT=1 does)")
+        missing = [n for n in ("_end", "__stack") if n not in syms]
+        if missing:
+            raise SimError(f"{self.elf}: no {', '.join(missing)} symbol: not an avr-libc program")
+        top = syms["__stack"] + 1
+        return top - self.board.ram, syms["_end"], top
+
+    def stack_high_water(self) -> int:
+        """Bytes of stack used at the deepest point so far (interrupts
+        included): the top of RAM minus the lowest address, scanning up from
+        the end of the static data, whose boot-time paint was overwritten.
+        A pushed byte that happens to equal the paint byte at the very bottom
+        reads as unused, so the figure can be low by a byte or two."""
+        _, end, top = self._ram_layout
+        addr = end
+        while addr < top:
+            n = min(PEEK_MAX, top - addr)
+            chunk = self.peek(addr, n)
+            for i, b in enumerate(chunk):
+                if b != STACK_PAINT:
+                    return top - (addr + i)
+            addr += n
+        return 0
+
+    def ram_usage(self) -> RamUsage:
+        """Static data, stack high-water mark and their total (RamUsage)."""
+        start, end, top = self._ram_layout
+        stack = self.stack_high_water()
+        return RamUsage(end - start, stack, end - start + stack, top - start)
+
     # -- end --
     def close(self) -> int:
         """Stops the board; returns the harness's exit status."""
@@ -695,4 +760,10 @@ def main(args) -> int:
         dropped = int(b.info().get("dropped", "0"))
         if dropped:
             _say(f"{dropped:,} UART bytes were sent while no program had the port open")
+        try:
+            ram = b.ram_usage()
+            _say(f"stack high-water {ram.stack:,} B; RAM {ram.static:,} B static + {ram.stack:,} B stack = "
+                 f"{ram.total:,} of {ram.ram:,} B")
+        except SimError as e:
+            _say(f"stack not measured: {e}")
     return 1 if r.stop == "crashed" else 0

@@ -40,6 +40,30 @@ void loop() {
 }
 """
 
+# A sketch that recurses DEPTH levels, 32 bytes of locals a level, then
+# stops itself: its stack high-water mark grows by one frame a level.
+DIVE_SKETCH = r"""
+#include <Arduino.h>
+#include <avr/sleep.h>
+#include "fswkit.h"
+volatile uint8_t sink;
+__attribute__((noinline)) static uint8_t dive(uint8_t n) {
+    volatile uint8_t local[32];
+    local[0] = n;
+    local[31] = n;
+    const uint8_t below = n == 0 ? 0 : dive(static_cast<uint8_t>(n - 1));
+    return static_cast<uint8_t>(below + local[0] + local[31]);
+}
+void setup() {
+    fsw::pal::begin();  // links the fswkit platform layer, and with it the boot-time stack paint
+    sink = dive(DEPTH);
+    cli();
+    sleep_enable();
+    sleep_cpu();
+}
+void loop() {}
+"""
+
 SPIN_C = "int main(void) { for (;;) { __asm__ volatile(\"nop\"); } }\n"
 HALT_C = "#include <avr/interrupt.h>\n#include <avr/sleep.h>\n" \
          "int main(void) { cli(); sleep_enable(); sleep_cpu(); for (;;) {} }\n"
@@ -97,6 +121,12 @@ def toggle_uno() -> str:
 @pytest.fixture(scope="session")
 def probe_uno() -> str:
     return sketch_elf("probe", PROBE_SKETCH)
+
+
+@pytest.fixture(scope="session")
+def dive_uno() -> dict[int, str]:
+    """The recursion sketch at two depths: {depth: ELF}."""
+    return {d: sketch_elf(f"dive{d}", DIVE_SKETCH.replace("DEPTH", str(d))) for d in (8, 16)}
 
 
 @pytest.fixture(scope="session")

@@ -19,7 +19,7 @@ import pytest
 import serial
 
 from conftest import EXAMPLES, ROOT
-from simfw import OUT, halt_uno, probe_uno, spin_uno, tank_mega, tank_uno, toggle_uno  # noqa: F401
+from simfw import OUT, dive_uno, halt_uno, probe_uno, spin_uno, tank_mega, tank_uno, toggle_uno  # noqa: F401
 
 from fswkit.sim import SimBoard, SimError, harness, pin_map, sim_board
 
@@ -209,6 +209,10 @@ def test_fsw_sim_prints_the_port_and_stops_after_the_duration():
     err = p.stderr.read()
     assert code == 0, err
     assert "duration reached at 2.000000 s simulated" in err
+    m = re.search(r"stack high-water (\d+) B; RAM ([\d,]+) B static \+ \d+ B stack = ([\d,]+) of 2,048 B", err)
+    assert m, err
+    stack, static, total = int(m.group(1)), int(m.group(2).replace(",", "")), int(m.group(3).replace(",", ""))
+    assert 64 <= stack and static == _static_bytes(str(out / "tank.elf")) and total == static + stack
 
 
 def test_fsw_sim_stops_on_ctrl_c(probe_uno):
@@ -232,6 +236,52 @@ def test_fsw_sim_stops_on_ctrl_c(probe_uno):
     err = p.stderr.read()
     assert code == 0, err
     assert "stopped at" in err and "Traceback" not in err
+
+
+# ---- stack and RAM ---------------------------------------------------------------------
+
+def _static_bytes(elf: str) -> int:
+    """.data + .bss + .noinit of an ELF, as avr-size counts them."""
+    out = subprocess.run(["avr-size", "-A", elf], capture_output=True, text=True, check=True).stdout
+    sizes = {p[0]: int(p[1]) for p in (line.split() for line in out.splitlines())
+             if len(p) == 3 and p[0].startswith(".")}
+    return sum(sizes.get(name, 0) for name in (".data", ".bss", ".noinit"))
+
+
+def test_stack_high_water_grows_one_frame_a_level(dive_uno):
+    marks = {}
+    for depth, elf in dive_uno.items():
+        with SimBoard(elf, "uno", sim_limit=1) as b:
+            assert b.step(50 * MS).state == "done"  # it recursed, then stopped itself
+            marks[depth] = b.stack_high_water()
+    grown = marks[16] - marks[8]
+    frame = grown // 8
+    assert grown == 8 * frame  # the same frame each level
+    assert 34 <= frame <= 40  # 32 bytes of locals + the return address (+ a saved frame pointer)
+    assert marks[8] >= 8 * frame
+
+
+def test_tank_stack_and_ram_on_a_simulated_uno(tank_uno):
+    with SimBoard(tank_uno, "uno", analog={"A0": 3.76}, sim_limit=5) as b:
+        b.run_for(1.0)
+        first = b.ram_usage()
+        b.run_for(1.0)
+        later = b.ram_usage()
+    assert first.ram == 2048
+    assert first.static == _static_bytes(tank_uno)
+    assert 64 <= first.stack < first.ram - first.static  # used, and never reached the static data
+    assert first.total == first.static + first.stack
+    assert later.stack >= first.stack  # a high-water mark
+    with SimBoard(tank_uno, "uno", analog={"A0": 3.76}, sim_limit=5) as b:
+        b.run_for(1.0)
+        assert b.stack_high_water() == first.stack  # simulated time is deterministic
+
+
+def test_firmware_that_does_not_paint_its_stack(spin_uno):
+    with SimBoard(spin_uno, "uno", sim_limit=1) as b:
+        b.step(MS)
+        with pytest.raises(SimError, match="does not paint its stack"):
+            b.stack_high_water()
 
 
 # ---- limits ----------------------------------------------------------------------------

@@ -286,7 +286,7 @@ def main() -> int:
         if fp is not None:
             (f1, r1), (f0, r0) = fp["with"], fp["without"]
             print("\ntelemetry + uplink on the Uno (tank example with and without its link tasks; includes "
-                  "HardwareSerial)")
+                  "the UART0 driver)")
             print(f"  flash +{f1 - f0:,} B ({f0:,} -> {f1:,}), RAM +{r1 - r0:,} B ({r0:,} -> {r1:,}, data + bss)")
         rate = fuzz_rate()
         if rate:

@@ -4,6 +4,7 @@ runs the application."""
 
 from __future__ import annotations
 
+import re
 import shutil
 import struct
 import subprocess
@@ -66,6 +67,34 @@ def test_native_build_runs_the_application(fsw, tmp_path):
     assert struct.unpack("<d", sv[12:20])[0] == -125.0
     assert int.from_bytes(sv[8:12], "little") == 2  # state: Abort
     assert sv[20] == 1  # valveOpen
+
+
+@needs_cxx
+def test_link_tables_the_runtime_cannot_serve_do_not_compile(fsw, tmp_path):
+    """The runtime checks the generated link tables when they are compiled
+    (static_asserts of fsw_link.h's checks), not at boot: a transmit buffer
+    one byte short of the longest frame stops the build."""
+    from conftest import ROOT
+
+    assert fsw("gen", str(TANK), "--out", str(tmp_path)).code == 0
+    app = (tmp_path / "app.gen.cpp").read_text()
+    assert app.count("static_assert(fsw::link_stream_ok(") == 2  # Sensors, Effectors
+    assert "static_assert(fsw::link_writable_ok(E_valveOpen, fsw::kBool, kSvSize)" in app
+    assert "static_assert(fsw::link_config_ok(kLinkTxSize, " in app
+    size = int(re.search(r"const uint16_t kLinkTxSize = (\d+);", app).group(1))
+
+    def compiles(text: str) -> subprocess.CompletedProcess:
+        (tmp_path / "app.gen.cpp").write_text(text)
+        # the host compiler with the Uno's evaluation type (binary32 R, software F64)
+        return subprocess.run(["g++", "-std=gnu++11", "-fsyntax-only", "-DFSW_NO_MAIN", "-DFSW_REAL_IS_FLOAT=1",
+                               "-DFSW_F64_SOFT=1", f"-I{ROOT / 'firmware' / 'src'}", f"-I{tmp_path}",
+                               str(tmp_path / "app.gen.cpp")], capture_output=True, text=True)
+
+    assert compiles(app).returncode == 0
+    r = compiles(app.replace(f"kLinkTxSize = {size};", f"kLinkTxSize = {size - 1};"))
+    assert r.returncode != 0
+    assert "static assertion failed" in r.stderr
+    assert "transmit buffer is too small" in r.stderr  # the health frame is the longest
 
 
 def test_unknown_board_is_a_clear_error(fsw):

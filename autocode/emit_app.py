@@ -59,6 +59,9 @@ def _tables(app: Application, real, out: list[str]) -> dict[str, str]:
             out.append("};")
             out.append(f"const fsw::AnalogTable {tag} FSW_FLASH = {{{tag}Ch, sv, {vref}, {len(chans)}, "
                        f"{app.board.adc_bits}, kSvLock}};")
+            if all(c.element.type.name == "F32" for c in chans):
+                # no binary64 element: the task that links no F64 conversion
+                names[("task", tag)] = "io_analog_task_f32"
         else:
             out.append(f"const fsw::DigitalChannel {tag}Ch[] FSW_FLASH = {{")
             for c in chans:
@@ -122,7 +125,8 @@ def _app_cpp(app: Application) -> str:
     c.append("bool begin() {")
     c.append("    if (fsw::executor_begin(ex, kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
-        c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
+        if kind in ("analog", "digital"):
+            c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
     if has_link:
         c.append(f"    fsw::pal::console_begin({app.baud}UL);")
         c.append("    fsw::link_begin(link, &kLinkConfig);  // its tables are checked where they are defined")
@@ -171,7 +175,8 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
         if len(calls) == 1:
             kind, tag = calls[0]
-            return f"fsw::io_{kind}_task", f"const_cast<void*>(static_cast<const void*>(&{tag}))"
+            fn = tables.get(("task", tag), f"io_{kind}_task")
+            return f"fsw::{fn}", f"const_cast<void*>(static_cast<const void*>(&{tag}))"
     return None
 
 
@@ -192,7 +197,8 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         if not calls:
             out.append("    return fsw::kOk;  // no channels in this direction")
         for k, (kind, tag) in enumerate(calls):
-            call = f"fsw::io_{kind}_task(const_cast<void*>(static_cast<const void*>(&{tag})))"
+            fn = tables.get(("task", tag), f"io_{kind}_task")
+            call = f"fsw::{fn}(const_cast<void*>(static_cast<const void*>(&{tag})))"
             if k == len(calls) - 1:
                 out.append(f"    return {call};")
             else:

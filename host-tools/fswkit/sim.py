@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import io
 import os
 import re
 import shutil
@@ -299,7 +300,9 @@ class SimBoard:
         except OSError as e:
             self._err.close()
             raise SimError(f"cannot start the simulated board: {e.strerror or e}") from None
-        self._out = self._proc.stdout
+        # Responses are read through a buffer: readline on the raw pipe costs a
+        # system call per byte, ten times the round trip itself.
+        self._out = io.BufferedReader(self._proc.stdout, 65536)
         self._closed = False
         try:
             f = _fields(self._read())

@@ -338,6 +338,13 @@ def cmd_build(args) -> int:
 # ---- fsw sim ------------------------------------------------------------------------------
 
 def cmd_sim(args) -> int:
+    if args.plant is not None:
+        from fswkit.plant.run import main as plant_main
+
+        return plant_main(args)
+    if args.params is not None or args.fault is not None or args.seed is not None:
+        sys.stderr.write("fsw sim: --params, --seed and --fault need --plant rocket|tank\n")
+        return EXIT_CONFIG
     from fswkit.sim import main as sim_main
 
     return sim_main(args)
@@ -492,6 +499,16 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _nonneg_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {text!r}")
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {value}")
+    return value
+
+
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="fsw", description="fswkit: flight software from configs.")
     p.add_argument("--version", action="version", version=f"fsw {__version__}")
@@ -548,7 +565,16 @@ def parser() -> argparse.ArgumentParser:
     sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
     sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
     sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")
-    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD); with --plant, the folder the "
+                    "flight's log, CSV, plot and summary go to (default PROJECT/build/BOARD/PLANT-flight)")
+    sm.add_argument("--plant", choices=("rocket", "tank"),
+                    help="fly the firmware in closed loop against this plant model (docs/sim.md)")
+    sm.add_argument("--params", metavar="FILE.toml", help="with --plant: the plant's parameters "
+                    "(default PROJECT/plant.toml)")
+    sm.add_argument("--seed", type=_nonneg_int, metavar="N", help="with --plant: the sensor noise's seed (default 1)")
+    sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro"),
+                    help="with --plant rocket: a sensor fault (stuck-baro: the barometer freezes at ignition; "
+                    "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit)")
     sm.set_defaults(func=cmd_sim)
 
     fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")

@@ -1,0 +1,180 @@
+"""The lock-step loop: the firmware on the simulated board (fswkit.sim)
+and a plant scenario advance together at the scenario's rate. Each step is
+one pipe round trip — the sensors' millivolts and switch levels that
+changed, `until` the step's last cycle, the pyro/valve pins' edges and the
+UART's bytes — then the plant integrates the same interval with the pins as
+they were, to the cycle. The UART's bytes go through the ground's decoder
+(fswkit.link.Session), as `fsw monitor` decodes them, and into a link log
+of the same format."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from fswkit.link.layout import Layout
+from fswkit.link.log import RX, LogWriter
+from fswkit.link.session import Session
+from fswkit.sim import SimBoard, SimError
+
+RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
+
+
+class CosimError(Exception):
+    """The co-simulation could not go on (a message for the user)."""
+
+
+@dataclass(frozen=True)
+class PinEvent:
+    """An output pin's edge, at its exact cycle, with the plant's truth at
+    that instant (interpolated within the plant step)."""
+
+    t: float
+    pin: int
+    role: str
+    level: bool
+    truth: dict
+
+
+@dataclass
+class Run:
+    columns: tuple[str, ...]
+    rows: list[tuple] = field(default_factory=list)  # truth, RECORD_HZ rows a second
+    pin_events: list[PinEvent] = field(default_factory=list)
+    samples: list[tuple[float, dict]] = field(default_factory=list)  # (s, {element: value}) per telemetry sample
+    transitions: list[tuple[float, int, str]] = field(default_factory=list)  # (s, state id, name)
+    session: Session | None = None
+    steps: int = 0
+    sim_s: float = 0.0
+    wall_s: float = 0.0
+    round_trips: int = 0
+    ram: dict = field(default_factory=dict)  # what the board's RAM probes said, if it has them
+
+
+def _edges(line: str, board: SimBoard, f_cpu: int) -> list[tuple[float, int, bool]]:
+    """(seconds, pin, level) from an `edges` response (docs/sim.md)."""
+    toks = line.split()
+    if len(toks) < 3 or toks[2] != "overflow=0":
+        raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to watch")
+    out = []
+    for tok in toks[3:]:
+        where, rest = tok.split("@")
+        cycle, level = rest.split("=")
+        out.append((int(cycle) / f_cpu, board.pins.pin_of(where[0], int(where[1:])), level == "1"))
+    return out
+
+
+def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, *,
+        wall_limit: float = 900.0, log_meta: dict | None = None) -> Run:
+    """Runs the scenario to its end against the firmware; the Run."""
+    rate = scenario.rate
+    f_cpu = int(board.f_cpu)
+    if f_cpu % rate:
+        raise CosimError(f"the plant rate {rate} Hz does not divide the {board.name}'s clock ({f_cpu} Hz)")
+    cycles = f_cpu // rate
+    record_every = max(1, rate // RECORD_HZ)
+    vref = float(board.adc_vref)
+    analog, digital = scenario.inputs(0.0)
+    run = Run(columns=scenario.columns)
+    session = Session(layout)
+    run.session = session
+    state_el = scenario.state_element
+    state_names = layout.states.get(state_el, {})
+    regions = {s.index: s.region for s in layout.streams}
+    per_s = 1000.0 if layout.time_unit == "ms" else 1e6
+    log = LogWriter(log_path, layout, **(log_meta or {})) if log_path else None
+    last_state = None
+    try:
+        b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
+                     analog=analog)
+    except SimError as e:
+        if log:
+            log.close()
+        raise CosimError(str(e)) from None
+    wall0 = time.perf_counter()
+    try:
+        adc = {name: b.adc_channel(name) for name in analog}
+        last_mv = {name: _mv(v, vref) for name, v in analog.items()}
+        din = {pin: b.pins.digital[pin] for pin in digital}
+        last_din: dict[int, bool] = {}
+        setup = [f"watch {b.pins.digital[p][0]} {b.pins.digital[p][1]}" for p in scenario.outputs]
+        b.exchange(setup)
+        k = 0
+        t1 = 0.0
+        while True:
+            t0 = k / rate
+            if k:
+                analog, digital = scenario.inputs(t0)
+            cmds = []
+            for name, v in analog.items():
+                mv = _mv(v, vref)
+                if mv != last_mv[name]:
+                    last_mv[name] = mv
+                    cmds.append(f"adc {adc[name]} {mv}")
+            for pin, level in digital.items():
+                if last_din.get(pin) != level:
+                    last_din[pin] = level
+                    port, bit = din[pin]
+                    cmds.append(f"din {port} {bit} {1 if level else 0}")
+            k += 1
+            cmds += [f"until {k * cycles}", "edges", "uart"]
+            resp = b.exchange(cmds)
+            run.round_trips += 1
+            res = resp[-3]
+            if " stop=target" not in res:
+                stop = res.split("stop=", 1)[-1]
+                why = {"wall-limit": f"the wall-clock limit ({wall_limit:g} s) was reached",
+                       "sim-limit": "the simulated-time limit was reached",
+                       "crashed": "the firmware crashed", "done": "the firmware stopped itself"}.get(stop, stop)
+                raise CosimError(f"{why} at {t0:.3f} s simulated")
+            t1 = k / rate
+            edges = _edges(resp[-2], b, f_cpu) if resp[-2] != "ok n=0 overflow=0" else ()
+            for ev in scenario.advance(t0, t1, edges):
+                run.pin_events.append(ev)
+            data = resp[-1][3:]
+            if data:
+                raw = bytes.fromhex(data)
+                if log:
+                    log.record(RX, round(t1 * 1e9), raw)
+                for ev in session.feed(raw, t1):
+                    if ev.kind == "hello" and not ev.info["schema_ok"]:
+                        raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
+                                         f"0x{layout.schema:08x}: rebuild it")
+                    if ev.kind != "sample":
+                        continue
+                    names = regions[ev.stream].names
+                    for t, vals in ev.samples:
+                        row = dict(zip(names, vals))
+                        ts = t / per_s
+                        run.samples.append((ts, row))
+                        if state_el in row and row[state_el] != last_state:
+                            last_state = row[state_el]
+                            run.transitions.append((ts, int(last_state),
+                                                    state_names.get(int(last_state), str(last_state))))
+            if k % record_every == 0:
+                run.rows.append(scenario.record())
+            if scenario.done(t1, run.transitions[-1][2] if run.transitions else None):
+                break
+        run.steps = k
+        run.sim_s = t1
+        run.wall_s = time.perf_counter() - wall0
+        for probe in ("ram_usage", "stack_high_water"):  # the first the board has
+            fn = getattr(b, probe, None)
+            if callable(fn):
+                try:
+                    run.ram[probe] = fn()
+                except (SimError, TypeError, ValueError) as e:
+                    run.ram[probe] = f"unavailable ({e})"
+                break
+    except SimError as e:
+        raise CosimError(str(e)) from None
+    finally:
+        b.close()
+        if log:
+            log.close()
+    return run
+
+
+def _mv(volts: float, vref: float) -> int:
+    """Millivolts at an analog pin, clamped to 0..vref as the converter saturates."""
+    return int(round(min(max(volts, 0.0), vref) * 1000))

@@ -1,0 +1,240 @@
+"""Plant parameter files (`plant.toml` beside a project): TOML read with
+tomllib, then checked strictly against a schema — unknown tables and keys,
+wrong types and out-of-range values are errors located at their line,
+`plant.toml:12: [motor] propellant_kg: expected a number, found "lots"`,
+every error of the file reported at once.
+
+tomllib keeps no positions, so `locate` maps each `[table]` header and
+`key =` line of the text to its line number.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+
+
+class ParamsError(Exception):
+    """One or more located errors in a parameters file."""
+
+    def __init__(self, errors: list[str]):
+        super().__init__("\n".join(errors))
+        self.errors = errors
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key of a table: its kind (`float`, `int`, `str`, `bool`, `pin`,
+    `curve`: a list of [x, y] pairs, `names`: a list of strings), an
+    inclusive range for numbers, a default (None: required), and what it is."""
+
+    kind: str
+    doc: str
+    default: object = None
+    lo: float | None = None
+    hi: float | None = None
+    above: float | None = None  # exclusive lower bound
+    required: bool = True
+
+    def __post_init__(self):
+        if self.default is not None:
+            object.__setattr__(self, "required", False)
+
+
+@dataclass(frozen=True)
+class Table:
+    doc: str
+    fields: dict[str, Field] = field(default_factory=dict)
+
+
+Schema = dict  # table name ("" for the top level) -> Table
+_STRINGS = re.compile(r"\"(\\.|[^\"\\])*\"|'[^']*'")
+
+
+def locate(text: str) -> dict[tuple[str, str], int]:
+    """(table, key) -> line of `key =` in that table, and (table, "") -> the
+    line of the table's header. Keys before any header are in table ""."""
+    where: dict[tuple[str, str], int] = {("", ""): 1}
+    table = ""
+    header = re.compile(r"\s*\[\s*([A-Za-z0-9_.\-\" ]+?)\s*\]\s*(#.*)?$")
+    key = re.compile(r"\s*([A-Za-z0-9_\-]+|\"[^\"]*\")\s*=")
+    depth = 0  # brackets still open in a multi-line value
+    for n, line in enumerate(text.splitlines(), 1):
+        code = _STRINGS.sub('""', line).split("#", 1)[0]
+        if depth == 0:
+            m = header.match(line)
+            if m and not line.lstrip().startswith("[["):
+                table = m.group(1).replace('"', "").replace(" ", "")
+                where.setdefault((table, ""), n)
+                continue
+            m = key.match(line)
+            if m:
+                where.setdefault((table, m.group(1).strip('"')), n)
+                code = code.split("=", 1)[1]
+            else:
+                continue
+        depth = max(0, depth + code.count("[") - code.count("]"))
+    return where
+
+
+def _kind_of(v) -> str:
+    if isinstance(v, bool):
+        return "a boolean"
+    if isinstance(v, (int, float)):
+        return "a number"
+    if isinstance(v, str):
+        return "a string"
+    if isinstance(v, list):
+        return "a list"
+    if isinstance(v, dict):
+        return "a table"
+    return type(v).__name__
+
+
+def _show(v) -> str:
+    return f'"{v}"' if isinstance(v, str) else str(v).lower() if isinstance(v, bool) else repr(v)
+
+
+def _number(v, f: Field, name: str) -> tuple[object, str | None]:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return None, f"{name}: expected a number, found {_kind_of(v)} {_show(v)}"
+    if f.kind == "int" and not isinstance(v, int):
+        return None, f"{name}: expected a whole number, found {v!r}"
+    x = float(v) if f.kind == "float" else int(v)
+    if isinstance(x, float) and not math.isfinite(x):
+        return None, f"{name}: expected a finite number, found {v}"
+    if f.lo is not None and x < f.lo or f.hi is not None and x > f.hi:
+        lo = "" if f.lo is None else f"{f.lo:g}"
+        hi = "" if f.hi is None else f"{f.hi:g}"
+        rng = f"{lo} to {hi}" if lo and hi else f"at least {lo}" if lo else f"at most {hi}"
+        return None, f"{name}: {v} is out of range ({rng})"
+    if f.above is not None and x <= f.above:
+        return None, f"{name}: {v} is out of range (above {f.above:g})"
+    return x, None
+
+
+def _value(v, f: Field, name: str) -> tuple[object, str | None]:
+    if f.kind in ("float", "int"):
+        return _number(v, f, name)
+    if f.kind == "pin":  # a digital pin number or an analog pin name, as the .dio/.aio write them
+        if isinstance(v, bool) or not isinstance(v, (int, str)):
+            return None, f"{name}: expected a pin (a number such as 5, or a name such as \"A0\"), found {_kind_of(v)}"
+        return v, None
+    if f.kind == "str":
+        if not isinstance(v, str) or not v:
+            return None, f"{name}: expected a non-empty string, found {_kind_of(v)} {_show(v)}"
+        return v, None
+    if f.kind == "bool":
+        if not isinstance(v, bool):
+            return None, f"{name}: expected true or false, found {_kind_of(v)} {_show(v)}"
+        return v, None
+    if f.kind == "names":
+        if not isinstance(v, list) or not v or not all(isinstance(x, str) and x for x in v):
+            return None, f"{name}: expected a list of names such as [\"Safe\", \"Armed\"]"
+        return tuple(v), None
+    if f.kind == "curve":
+        if not isinstance(v, list) or len(v) < 2:
+            return None, f"{name}: expected a list of two or more [seconds, value] points"
+        pts = []
+        for i, p in enumerate(v):
+            if (not isinstance(p, list) or len(p) != 2
+                    or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                               for x in p)):
+                return None, f"{name}: point {i + 1} is not a pair of numbers [seconds, value]: {_show(p)}"
+            pts.append((float(p[0]), float(p[1])))
+        for i, (t, y) in enumerate(pts):
+            if t < 0 or y < 0:
+                return None, f"{name}: point {i + 1} {list(pts[i])}: seconds and values must be >= 0"
+            if i and t <= pts[i - 1][0]:
+                return None, f"{name}: point {i + 1}: times must increase ({pts[i - 1][0]:g} then {t:g})"
+        return tuple(pts), None
+    raise ValueError(f"unknown field kind {f.kind}")
+
+
+def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, list[str]]:
+    """The checked values as {table: {key: value}} (defaults filled in), and
+    the located errors."""
+    errors: list[tuple[int, str]] = []
+    out: dict[str, dict] = {}
+
+    def err(line: int, msg: str) -> None:
+        errors.append((line, msg))
+
+    for tname, table in schema.items():
+        got = data if tname == "" else data.get(tname)
+        tline = where.get((tname, ""), 1)
+        if tname and got is None:
+            if any(f.required for f in table.fields.values()):
+                err(1, f"missing table [{tname}] ({table.doc})")
+            got = {}
+        elif tname and not isinstance(got, dict):
+            err(where.get(("", tname), 1), f"`{tname}` must be a table [{tname}]")
+            got = {}
+        vals = {}
+        for key, f in table.fields.items():
+            label = f"[{tname}] {key}" if tname else key
+            if key not in got:
+                if f.required:
+                    err(tline, f"{label}: missing ({f.doc})")
+                vals[key] = f.default
+                continue
+            v, e = _value(got[key], f, label)
+            if e:
+                err(where.get((tname, key), tline), e)
+            vals[key] = v
+        for key in got:
+            if tname == "" and key in schema and isinstance(got[key], dict):
+                continue
+            if key not in table.fields:
+                label = f"[{tname}] " if tname else ""
+                known = ", ".join(table.fields) or "none"
+                if tname == "" and isinstance(got[key], dict):
+                    err(where.get((key, ""), 1), f"unknown table [{key}] (tables: "
+                        + ", ".join(t for t in schema if t) + ")")
+                else:
+                    err(where.get((tname, key), tline), f"{label}unknown key `{key}` (known: {known})")
+        out[tname] = vals
+    return out, [f"{path}:{line}: {msg}" for line, msg in sorted(errors, key=lambda e: e[0])]
+
+
+def load(path: str, schema: Schema) -> tuple[dict, dict]:
+    """Reads and checks a parameters file; (values, locations). ParamsError
+    with every located error."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        raise ParamsError([f"{path}: no such file (a plant's parameters: see docs/sim.md, Closed-loop flights)"]) \
+            from None
+    except OSError as e:
+        raise ParamsError([f"{path}: {e.strerror or e}"]) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = raw[:e.start].count(b"\n") + 1
+        raise ParamsError([f"{path}:{line}: not UTF-8 text"]) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        msg = str(e)
+        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+        if m:
+            raise ParamsError([f"{path}:{m.group(1)}:{m.group(2)}: {msg[:m.start()].strip()}"]) from None
+        m = re.search(r"\(at end of document\)", msg)
+        line = text.count("\n") + 1
+        raise ParamsError([f"{path}:{line}: {msg[:m.start()].strip() if m else msg}"]) from None
+    where = locate(text)
+    values, errors = check(data, schema, where, path)
+    if errors:
+        raise ParamsError(errors)
+    return values, where
+
+
+def error_at(path: str, where: dict, table: str, key: str, msg: str) -> str:
+    """A located message about a value that passed the schema but not a
+    check across files (a pin the project does not have, ...)."""
+    line = where.get((table, key)) or where.get((table, ""), 1)
+    label = f"[{table}] {key}" if table else key
+    return f"{path}:{line}: {label}: {msg}"

@@ -1,0 +1,146 @@
+"""`fsw sim PROJECT --plant rocket|tank`: build the firmware, fly it in
+closed loop against the plant on the simulated board, write the link log,
+the truth-and-telemetry CSV, the plot and the summary into the output
+folder, print the summary and the checks; exit 1 if a check fails.
+
+`prepare` + `execute` are the same steps for tests and tools (one build,
+many flights)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from dataclasses import dataclass
+
+from fswkit.autocode.diagnostics import Diagnostics
+
+from . import report as reports
+from .cosim import CosimError, Run, fly
+from .params import ParamsError
+from .scenario import FAULTS, PLANTS
+from .scenario import load as load_scenario
+
+FILES = {"log": "telemetry.log", "csv": "flight.csv", "png": "flight.png", "summary": "summary.txt"}
+
+
+class SetupError(Exception):
+    """Bad input (options, configs, parameters): message(s) printed, exit 2."""
+
+
+@dataclass
+class Flight:
+    run: Run
+    report: reports.Report
+    scenario: object
+    files: dict
+
+
+def _say(text: str) -> None:
+    sys.stderr.write(f"fsw sim: {text}\n")
+    sys.stderr.flush()
+
+
+def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 1, fault: str | None = None,
+            board: str | None = None):
+    """(app, layout, scenario) for a project folder and its parameters
+    file; SetupError with located messages for bad input."""
+    from fswkit.build import BuildError, load
+    from fswkit.link.layout import LayoutError, from_app
+
+    if plant not in PLANTS:
+        raise SetupError(f"--plant {plant}: one of {', '.join(PLANTS)}")
+    if fault is not None and fault not in FAULTS:
+        raise SetupError(f"--fault {fault}: one of {', '.join(FAULTS)}")
+    diags = Diagnostics()
+    try:
+        app = load(project, diags, board)
+    except BuildError as e:
+        raise SetupError(str(e)) from None
+    if app is None:
+        raise SetupError(diags.render())
+    try:
+        layout = from_app(app)
+    except LayoutError as e:
+        raise SetupError(str(e)) from None
+    if params is None:
+        params = os.path.join(os.path.dirname(app.path) or ".", "plant.toml")
+    try:
+        sc = load_scenario(plant, params, app, layout, seed, fault)
+    except ParamsError as e:
+        raise SetupError("\n".join(e.errors)) from None
+    return app, layout, sc
+
+
+def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False) -> Flight:
+    """Flies the scenario; writes the files into `out` (None: none). CosimError
+    if the run could not go on."""
+    files = {}
+    if out is not None:
+        os.makedirs(out, exist_ok=True)
+        files = {k: os.path.join(out, v) for k, v in FILES.items()}
+    meta = {"source": f"fsw sim --plant {sc.kind}", "clock": "simulated", "seed": sc.seed, "fault": sc.fault}
+    run = fly(sc, elf, board, layout, files.get("log"), log_meta=meta)
+    rep = reports.rocket(run, sc) if sc.kind == "rocket" else reports.tank(run, sc)
+    if out is not None:
+        reports.write_csv(run, layout, sc.state_element, files["csv"])
+        title = (f"{layout.name}: {sc.kind} plant, seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
+                 + (" — all checks pass" if rep.passed else " — CHECKS FAIL"))
+        reports.plot(run, sc, files["png"], title)
+        with open(files["summary"], "w") as f:
+            f.write(rep.text())
+    return Flight(run, rep, sc, files)
+
+
+def main(args) -> int:
+    """The `fsw sim ... --plant` command."""
+    from fswkit.sim import _build, _is_elf
+
+    for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
+                       ("--analog", bool(args.analog)), ("--link", args.link is not None)):
+        if given:
+            _say(f"{opt} is for the free-running board on a pty; with --plant the scenario drives the run")
+            return 2
+    if args.fault and args.plant != "rocket":
+        _say(f"--fault {args.fault} is a fault of the rocket plant; the tank's scenario has its regulator "
+             "failure built in")
+        return 2
+    if _is_elf(args.project) or args.project.endswith(".elf"):
+        _say(f"{args.project}: --plant needs the project (its folder or .app: the plant reads its machines "
+             "and pins), not a firmware ELF")
+        return 2
+    try:
+        seed = 1 if args.seed is None else args.seed
+        app, layout, sc = prepare(args.project, args.plant, params=args.params, seed=seed, fault=args.fault,
+                                  board=args.board)
+    except SetupError as e:
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
+        return 2
+    from fswkit.build import default_out
+
+    out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        _say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    built = _build(argparse.Namespace(project=args.project, board=args.board, out=None))
+    if isinstance(built, int):
+        return built
+    elf, board = built
+    what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
+    _say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
+         "simulated")
+    try:
+        flight = execute(sc, elf, board, layout, out)
+    except CosimError as e:
+        _say(str(e))
+        return 1
+    except OSError as e:
+        _say(f"cannot write {e.filename or out}: {e.strerror or e}")
+        return 1
+    sys.stdout.write(flight.report.text())
+    sys.stdout.flush()
+    _say("wrote " + ", ".join(flight.files[k] for k in ("log", "csv", "png", "summary")))
+    return 0 if flight.report.passed else 1

@@ -1,0 +1,536 @@
+"""Scenarios: a plant model wired to a project's pins, its sensors' volts
+and noise, the timeline (arming, ignition, a regulator failure), the
+faults, when the run ends, and the parameters file (`plant.toml`) that says
+all of it. `load(kind, path, app, layout, seed, fault)` checks the file and
+its references into the project — the mission machine's states and locals,
+the telemetry elements, the pins of the .dio/.aio — and returns the
+scenario; every problem is a located ParamsError.
+
+The cosim loop calls `inputs(t)` (sensor volts by analog pin, levels of the
+digital inputs the scenario drives), `advance(t0, t1, edges)` (integrate
+the step with the watched pins' edges; returns PinEvents), `record()` (a
+truth row) and `done(t, state)`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fswkit.autocode import model as M
+from fswkit.autocode.evaluate import NotConstant, local_values
+from fswkit.autocode.numeric import MODES
+
+from .atmosphere import G0
+from .cosim import PinEvent
+from .params import Field as F
+from .params import ParamsError, Table, error_at
+from .params import load as load_params
+from .rocket import Chute, Motor, Rocket
+from .tank import PSI, Tank
+
+PLANTS = ("rocket", "tank")
+FAULTS = {
+    "stuck-baro": "the barometer's output freezes at its value at ignition; the drogue must still deploy, "
+                  "by the backup timer",
+    "pinned-accel": "the accelerometer reads full scale (5 V) from boot and the motor is never lit; "
+                    "no pyro channel may fire and the vehicle never leaves its pad states",
+    "pinned-baro": "the barometer reads full scale (5 V) from boot and the motor is never lit; "
+                   "no pyro channel may fire and the vehicle never leaves its pad states",
+}
+
+# ---- parameter schemas ------------------------------------------------------------------
+
+_TOP = Table("the plant and its rate", {
+    "plant": F("str", "which plant model: rocket or tank"),
+    "rate_hz": F("int", "plant steps per simulated second (lock-step with the MCU)", default=1000,
+                 lo=1000, hi=100000),
+})
+
+ROCKET_SCHEMA = {
+    "": _TOP,
+    "vehicle": Table("the vehicle without its propellant", {
+        "dry_mass_kg": F("float", "mass without propellant, kg", above=0, hi=1000),
+        "body_cd_area_m2": F("float", "drag coefficient × reference area of the body, m²", lo=0, hi=10),
+    }),
+    "motor": Table("the motor", {
+        "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0, hi=1000),
+        "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated"),
+        "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
+                        "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
+    }),
+    "drogue": Table("the drogue parachute", {
+        "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
+        "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
+        "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
+    }),
+    "main": Table("the main parachute", {
+        "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
+        "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
+        "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
+    }),
+    "atmosphere": Table("the standard atmosphere", {
+        "pad_altitude_m": F("float", "the pad's altitude above sea level, m", lo=-400, hi=8000),
+    }),
+    "barometer": Table("the analog barometer", {
+        "channel": F("pin", "the analog input it drives, e.g. \"A0\""),
+        "pa_per_volt": F("float", "its slope, Pa per volt", above=0, hi=1e7),
+        "pa_at_0v": F("float", "the pressure that would read 0 V, Pa", lo=-1e7, hi=1e7),
+        "noise_pa": F("float", "Gaussian noise, standard deviation in Pa", lo=0, hi=1e5),
+    }),
+    "accelerometer": Table("the analog accelerometer on the vehicle's axis", {
+        "channel": F("pin", "the analog input it drives, e.g. \"A1\""),
+        "volts_per_g": F("float", "its slope, V per g", above=0, hi=100),
+        "zero_g_volts": F("float", "its output at 0 g, V", lo=0, hi=5),
+        "noise_g": F("float", "Gaussian noise, standard deviation in g", lo=0, hi=100),
+    }),
+    "pins": Table("the flight computer's digital pins the plant uses", {
+        "arm": F("int", "the arming switch (a digital input the scenario drives: high = armed)", lo=0, hi=255),
+        "drogue": F("int", "the drogue's pyro channel (a digital output)", lo=0, hi=255),
+        "main": F("int", "the main's pyro channel (a digital output)", lo=0, hi=255),
+    }),
+    "scenario": Table("the timeline", {
+        "arm_s": F("float", "the arming switch closes at this simulated second", lo=0, hi=3600),
+        "ignition_s": F("float", "the motor is lit at this simulated second", lo=0, hi=3600),
+        "max_s": F("float", "the run stops here whatever happens", above=0, hi=3600),
+        "linger_s": F("float", "simulated seconds run on after the landed state", default=1.0, lo=0, hi=600),
+        "landed_timeout_s": F("float", "after touchdown, give up waiting for the landed state", default=10.0,
+                              lo=0, hi=600),
+        "hold_s": F("float", "pinned-sensor faults: the vehicle sits armed on the pad until this second",
+                    default=20.0, above=0, hi=3600),
+    }),
+    "firmware": Table("where the plant and the checks find things in the project", {
+        "machine": F("str", "the mission machine"),
+        "state_element": F("str", "the telemetry element holding the mission machine's state"),
+        "altitude_element": F("str", "the telemetry element holding the estimated altitude, m above the pad"),
+        "main_altitude": F("str", "the mission machine's local: the main's deployment altitude, m above the pad"),
+        "apogee_backup": F("str", "the mission machine's local: time after launch that fires the drogue anyway"),
+        "apogee_state": F("str", "the state entered at apogee"),
+        "armed_state": F("str", "the state of an armed vehicle on the pad"),
+        "landed_state": F("str", "the state entered on landing"),
+        "pad_states": F("names", "the states of a vehicle on the pad"),
+    }),
+    "checks": Table("pass/fail bounds", {
+        "apogee_window_s": F("float", "apogee detected no later than this after the true apogee", default=1.0,
+                             above=0, hi=60),
+        "drogue_max_drop_m": F("float", "the drogue fires before the vehicle falls this far below apogee",
+                               default=30.0, above=0, hi=10000),
+        "main_tolerance_m": F("float", "the main fires within this of its configured altitude", default=15.0,
+                              above=0, hi=10000),
+        "backup_tolerance_s": F("float", "stuck barometer: the drogue fires within this after the backup time",
+                                default=0.2, above=0, hi=60),
+        "sequence": F("names", "the states of a nominal flight, in order"),
+    }),
+}
+
+TANK_SCHEMA = {
+    "": _TOP,
+    "tank": Table("the tank and its gas", {
+        "volume_l": F("float", "litres", above=0, hi=1e6),
+        "temperature_k": F("float", "the gas's temperature (held constant), K", above=0, hi=2000),
+        "gas_constant_j_kg_k": F("float", "specific gas constant, J/(kg·K) (nitrogen 296.8)", above=0, hi=1e5),
+        "gamma": F("float", "ratio of specific heats (nitrogen 1.4)", above=1, hi=2),
+        "initial_psi": F("float", "gauge pressure at the start, psi", lo=0, hi=1e5),
+    }),
+    "supply": Table("the pressurant supply through the regulator", {
+        "flow_g_s": F("float", "inflow while the regulator works, g/s", lo=0, hi=1e6),
+        "failed_flow_g_s": F("float", "inflow once it has failed, g/s", lo=0, hi=1e6),
+    }),
+    "vent": Table("the vent valve", {
+        "cd_area_mm2": F("float", "discharge coefficient × orifice area, mm²", above=0, hi=1e6),
+        "response_ms": F("float", "the valve's time constant opening and closing, ms", lo=0, hi=10000),
+    }),
+    "transducer": Table("the pressure transducer (gauge)", {
+        "channel": F("pin", "the analog input it drives, e.g. \"A0\""),
+        "psi_per_volt": F("float", "its slope, psi per volt", above=0, hi=1e6),
+        "psi_at_0v": F("float", "the pressure that would read 0 V, psi", lo=-1e6, hi=1e6),
+        "noise_psi": F("float", "Gaussian noise, standard deviation in psi", lo=0, hi=1e5),
+    }),
+    "pins": Table("the rig's digital pins the plant uses", {
+        "valve": F("int", "the vent valve's driver (a digital output: high = open)", lo=0, hi=255),
+    }),
+    "scenario": Table("the timeline", {
+        "failure_s": F("float", "the regulator fails at this simulated second", lo=0, hi=3600),
+        "max_s": F("float", "the run stops here whatever happens", above=0, hi=3600),
+        "linger_s": F("float", "simulated seconds run on after the abort state", default=1.0, lo=0, hi=600),
+    }),
+    "firmware": Table("where the plant and the checks find things in the project", {
+        "machine": F("str", "the vent controller's machine"),
+        "state_element": F("str", "the telemetry element holding the machine's state"),
+        "pressure_element": F("str", "the telemetry element holding the measured pressure"),
+        "vent_psi": F("float", "the pressure above which the machine opens the valve (a literal in the machine)",
+                      lo=-1e6, hi=1e6),
+        "abort_limit": F("str", "the machine's local: the pressure above which it aborts"),
+        "control_state": F("str", "the state that regulates"),
+        "abort_state": F("str", "the state entered on over-pressure"),
+    }),
+    "checks": Table("pass/fail bounds", {
+        "open_within_s": F("float", "the valve opens no later than this after the pressure passes vent_psi",
+                           default=0.05, above=0, hi=60),
+        "abort_within_s": F("float", "the abort state is reached no later than this after the pressure "
+                            "passes the abort limit", default=0.1, above=0, hi=60),
+        "min_cycles": F("int", "the valve opens at least this many times before the failure", default=2,
+                        lo=0, hi=1000000),
+    }),
+}
+
+SCHEMAS = {"rocket": ROCKET_SCHEMA, "tank": TANK_SCHEMA}
+
+
+class Noise:
+    """Gaussian noise of one sensor from its own generator, drawn in blocks."""
+
+    def __init__(self, rng: np.random.Generator, sigma: float, block: int = 4096):
+        self.rng, self.sigma, self.block = rng, sigma, block
+        self.buf: list[float] = []
+        self.i = 0
+
+    def __call__(self) -> float:
+        if not self.sigma:
+            return 0.0
+        if self.i == len(self.buf):
+            self.buf = (self.rng.standard_normal(self.block) * self.sigma).tolist()
+            self.i = 0
+        self.i += 1
+        return self.buf[self.i - 1]
+
+
+class Pyro:
+    """A pyro channel: the charge fires once its pin has been high for `fire_s`."""
+
+    def __init__(self, fire_s: float):
+        self.fire_s = fire_s
+        self.high_since: float | None = None
+        self.fired_at: float | None = None
+
+    def edge(self, t: float, level: bool) -> None:
+        self.high_since = (self.high_since if self.high_since is not None else t) if level else None
+
+    def poll(self, t: float) -> float | None:
+        """The time the charge fired, the first time it has by `t`."""
+        if self.fired_at is None and self.high_since is not None and t - self.high_since >= self.fire_s:
+            self.fired_at = self.high_since + self.fire_s
+            return self.fired_at
+        return None
+
+
+# ---- binding a parameters file to the project --------------------------------------------
+
+class _Binder:
+    """Checks names and pins of the parameters against the project."""
+
+    def __init__(self, path, where, app, layout):
+        self.path, self.where, self.app, self.layout = path, where, app, layout
+        self.errors: list[str] = []
+
+    def err(self, table, key, msg):
+        self.errors.append(error_at(self.path, self.where, table, key, msg))
+
+    def machine(self, name):
+        m = next((m for m in self.app.machines if m.name == name), None)
+        if m is None:
+            self.err("firmware", "machine", f"the project has no machine `{name}` (it has "
+                     + ", ".join(m.name for m in self.app.machines) + ")")
+        return m
+
+    def streamed(self, key, name):
+        streamed = {n for s in self.layout.streams for n in s.region.names}
+        if self.layout.element(name) is None:
+            self.err("firmware", key, f"the project has no element `{name}`")
+        elif name not in streamed:
+            self.err("firmware", key, f"`{name}` is not in any telemetry stream (the ground never sees it)")
+
+    def state(self, m, key, name, table="firmware"):
+        if m is not None and m.state(name) is None:
+            self.err(table, key, f"machine `{m.name}` has no state `{name}` (its states: "
+                     + ", ".join(s.name for s in m.states) + ")")
+
+    def local(self, m, key, name):
+        if m is None:
+            return None
+        v = m.var(name)
+        if v is None or v.kind != M.LOCAL:
+            self.err("firmware", key, f"machine `{m.name}` has no local `{name}`")
+            return None
+        try:
+            values = local_values(m, MODES[self.app.board.real])
+        except NotConstant:
+            self.err("firmware", key, f"the locals of `{m.name}` have no constant initial values")
+            return None
+        value = values[v.index]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.err("firmware", key, f"local `{name}` of `{m.name}` is not a number")
+            return None
+        return float(value)
+
+    def channel(self, table, key, pin, analog, direction):
+        what = ("an analog input" if analog else "a digital input" if direction == "i" else "a digital output")
+        pin_text = str(pin)
+        for c in self.app.channels:
+            if c.pin == pin_text or (not analog and not c.analog and c.pin_number == pin):
+                if c.analog != analog or c.direction != direction:
+                    self.err(table, key, f"pin {pin_text} is not {what} of the project ({c.path}:{c.line} "
+                             f"makes it {'an analog' if c.analog else 'a digital'} "
+                             f"{'input' if c.direction == 'i' else 'output'} for `{c.element.name}`)")
+                return c
+        self.err(table, key, f"pin {pin_text} is not {what} of the project (its I/O tables have no such pin)")
+        return None
+
+
+def load(kind: str, path: str, app, layout, seed: int, fault: str | None):
+    """The scenario of a parameters file, checked against the project."""
+    if kind not in SCHEMAS:
+        raise ValueError(kind)
+    values, where = load_params(path, SCHEMAS[kind])
+    if values[""]["plant"] != kind:
+        raise ParamsError([error_at(path, where, "", "plant", f"this file describes a `{values['']['plant']}` "
+                                    f"plant, not a `{kind}`")])
+    rate = values[""]["rate_hz"]
+    bind = _Binder(path, where, app, layout)
+    if app.board.f_cpu % rate:
+        bind.err("", "rate_hz", f"{rate} Hz does not divide the {app.board.name}'s clock ({app.board.f_cpu} Hz): "
+                 "every plant step must end on a whole CPU cycle")
+    cls = RocketScenario if kind == "rocket" else TankScenario
+    sc = cls(values, bind, seed, fault)
+    if bind.errors:
+        raise ParamsError(bind.errors)
+    return sc
+
+
+def _time_unit_s(app) -> float:
+    return 1e-3 if app.time_unit == "ms" else 1e-6
+
+
+# ---- the rocket -----------------------------------------------------------------------------
+
+class RocketScenario:
+    kind = "rocket"
+    columns = ("time_s", "altitude_m", "velocity_m_s", "accel_m_s2", "specific_force_g", "pressure_pa",
+               "mass_kg", "thrust_n", "cd_area_m2", "drogue_inflation", "main_inflation",
+               "pin_arm", "pin_drogue", "pin_main", "baro_v", "accel_v")
+
+    def __init__(self, p: dict, bind: _Binder, seed: int, fault: str | None):
+        self.p, self.seed, self.fault = p, seed, fault
+        self.rate = p[""]["rate_hz"]
+        fw, sc, pins = p["firmware"], p["scenario"], p["pins"]
+        self.state_element = fw["state_element"]
+        self.altitude_element = fw["altitude_element"]
+        m = bind.machine(fw["machine"])
+        bind.streamed("state_element", fw["state_element"])
+        bind.streamed("altitude_element", fw["altitude_element"])
+        if m is not None and bind.layout.element(fw["state_element"]) is not None \
+                and m.vars[m.s].name != fw["state_element"]:
+            bind.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
+                     f"(that is `{m.vars[m.s].name}`)")
+        for key in ("armed_state", "apogee_state", "landed_state"):
+            bind.state(m, key, fw[key])
+        for name in fw["pad_states"]:
+            bind.state(m, "pad_states", name)
+        for name in p["checks"]["sequence"]:
+            bind.state(m, "sequence", name, table="checks")
+        self.main_alt = bind.local(m, "main_altitude", fw["main_altitude"])
+        backup = bind.local(m, "apogee_backup", fw["apogee_backup"])
+        self.backup_s = None if backup is None else backup * _time_unit_s(bind.app)
+        baro = bind.channel("barometer", "channel", p["barometer"]["channel"], True, "i")
+        accel = bind.channel("accelerometer", "channel", p["accelerometer"]["channel"], True, "i")
+        self.accel_element = accel.element.name if accel is not None else None
+        self.baro_element = baro.element.name if baro is not None else None
+        bind.channel("pins", "arm", pins["arm"], False, "i")
+        bind.channel("pins", "drogue", pins["drogue"], False, "o")
+        bind.channel("pins", "main", pins["main"], False, "o")
+        if len({pins["arm"], pins["drogue"], pins["main"]}) < 3:
+            bind.err("pins", "main", "the arm, drogue and main pins must be three different pins")
+        self.vref = float(bind.app.board.adc_vref)
+        veh, mot = p["vehicle"], p["motor"]
+        baro_rng, accel_rng, motor_rng = (np.random.Generator(np.random.PCG64(s))
+                                          for s in np.random.SeedSequence(seed).spawn(3))
+        nominal = Motor(mot["thrust_curve"])
+        liftoff_weight = (veh["dry_mass_kg"] + mot["propellant_kg"]) * G0
+        if nominal.peak <= liftoff_weight:
+            bind.err("motor", "thrust_curve", f"the peak thrust ({nominal.peak:g} N) never exceeds the "
+                     f"vehicle's weight ({liftoff_weight:.1f} N): it would never leave the pad")
+        # this seed's motor: the nominal curve scaled (the clamp only matters for a draw beyond 2.5 sigma
+        # with the largest impulse_sd allowed)
+        self.motor_factor = max(0.5, 1.0 + mot["impulse_sd"] * float(motor_rng.standard_normal()))
+        self.nominal_impulse = nominal.total
+        self.motor = Motor([(t, f * self.motor_factor) for t, f in mot["thrust_curve"]])
+        if sc["ignition_s"] + self.motor.burn_time >= sc["max_s"]:
+            bind.err("scenario", "max_s", "the run must outlast the motor's burn")
+        self.rocket = Rocket(dry_mass=veh["dry_mass_kg"], propellant_mass=mot["propellant_kg"], motor=self.motor,
+                             body_cd_area=veh["body_cd_area_m2"],
+                             drogue=Chute(p["drogue"]["cd_area_m2"], p["drogue"]["inflate_s"]),
+                             main=Chute(p["main"]["cd_area_m2"], p["main"]["inflate_s"]),
+                             pad_altitude=p["atmosphere"]["pad_altitude_m"])
+        self.pins = {pins["drogue"]: "drogue", pins["main"]: "main"}
+        self.outputs = tuple(self.pins)
+        self.arm_pin = pins["arm"]
+        self.pyros = {pins["drogue"]: Pyro(p["drogue"]["fire_ms"] / 1000),
+                      pins["main"]: Pyro(p["main"]["fire_ms"] / 1000)}
+        self.levels = {pin: False for pin in self.pins}
+        self.baro_noise = Noise(baro_rng, p["barometer"]["noise_pa"])
+        self.accel_noise = Noise(accel_rng, p["accelerometer"]["noise_g"])
+        self.channels = (p["barometer"]["channel"], p["accelerometer"]["channel"])
+        self.ignition_s = None if fault in ("pinned-accel", "pinned-baro") else sc["ignition_s"]
+        self.max_s = sc["hold_s"] if self.ignition_s is None else sc["max_s"]
+        self.frozen_baro: float | None = None
+        self.landed_seen: float | None = None
+        self.t = 0.0
+        self.baro_v = self.accel_v = 0.0
+        self.arm = False
+
+    # -- sensors --
+    def _baro_volts(self) -> float:
+        b = self.p["barometer"]
+        return (self.rocket.static_pressure() + self.baro_noise() - b["pa_at_0v"]) / b["pa_per_volt"]
+
+    def _accel_volts(self) -> float:
+        a = self.p["accelerometer"]
+        g = self.rocket.specific_force() / G0 + self.accel_noise()
+        return a["zero_g_volts"] + g * a["volts_per_g"]
+
+    def inputs(self, t: float):
+        baro = self._baro_volts()
+        accel = self._accel_volts()
+        if self.fault == "pinned-baro":
+            baro = self.vref
+        elif self.fault == "pinned-accel":
+            accel = self.vref
+        elif self.fault == "stuck-baro" and self.ignition_s is not None and t >= self.ignition_s:
+            if self.frozen_baro is None:
+                self.frozen_baro = baro
+            baro = self.frozen_baro
+        self.baro_v = min(max(baro, 0.0), self.vref)
+        self.accel_v = min(max(accel, 0.0), self.vref)
+        self.arm = t >= self.p["scenario"]["arm_s"]
+        return ({self.channels[0]: self.baro_v, self.channels[1]: self.accel_v}, {self.arm_pin: self.arm})
+
+    # -- time --
+    def advance(self, t0: float, t1: float, edges) -> list[PinEvent]:
+        r = self.rocket
+        if self.ignition_s is not None and t1 > self.ignition_s:
+            r.ignite(self.ignition_s)
+        for te, pin, level in edges:
+            if pin in self.pyros:
+                self.levels[pin] = level
+                self.pyros[pin].edge(te, level)
+        for pin, pyro in self.pyros.items():
+            fired = pyro.poll(t1)
+            if fired is not None:
+                r.deploy(self.pins[pin], fired)
+        h0, v0 = r.h, r.v
+        r.t = t0
+        r.advance(t1 - t0)
+        self.t = t1
+        out = []
+        for te, pin, level in edges:
+            f = (te - t0) / (t1 - t0) if t1 > t0 else 1.0
+            out.append(PinEvent(te, pin, self.pins.get(pin, str(pin)), level,
+                                {"altitude": h0 + (r.h - h0) * f, "velocity": v0 + (r.v - v0) * f}))
+        return out
+
+    def record(self) -> tuple:
+        r, t = self.rocket, self.t
+        return (round(t, 6), r.h, r.v, r.a, r.specific_force() / G0, r.static_pressure(), r.mass(t), r.thrust(t),
+                r.cd_area(t), r.inflation("drogue", t), r.inflation("main", t), int(self.arm),
+                int(self.levels[self.p["pins"]["drogue"]]), int(self.levels[self.p["pins"]["main"]]),
+                self.baro_v, self.accel_v)
+
+    def done(self, t: float, state: str | None) -> bool:
+        if t >= self.max_s:
+            return True
+        if self.ignition_s is None:
+            return False
+        if state == self.p["firmware"]["landed_state"]:
+            if self.landed_seen is None:
+                self.landed_seen = t
+            return t >= self.landed_seen + self.p["scenario"]["linger_s"]
+        td = self.rocket.touchdown
+        return td is not None and t >= td + self.p["scenario"]["landed_timeout_s"]
+
+
+# ---- the tank --------------------------------------------------------------------------------
+
+class TankScenario:
+    kind = "tank"
+    columns = ("time_s", "pressure_psi", "pressure_pa_abs", "gas_kg", "inflow_g_s", "outflow_g_s",
+               "regulator_failed", "pin_valve", "valve_opening", "transducer_v")
+
+    def __init__(self, p: dict, bind: _Binder, seed: int, fault: str | None):
+        if fault is not None:
+            raise ParamsError([f"--fault {fault} is a fault of the rocket plant; the tank's scenario has its "
+                               "regulator failure built in"])
+        self.p, self.seed, self.fault = p, seed, fault
+        self.rate = p[""]["rate_hz"]
+        fw, sc = p["firmware"], p["scenario"]
+        self.state_element = fw["state_element"]
+        self.pressure_element = fw["pressure_element"]
+        m = bind.machine(fw["machine"])
+        bind.streamed("state_element", fw["state_element"])
+        bind.streamed("pressure_element", fw["pressure_element"])
+        if m is not None and bind.layout.element(fw["state_element"]) is not None \
+                and m.vars[m.s].name != fw["state_element"]:
+            bind.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
+                     f"(that is `{m.vars[m.s].name}`)")
+        for key in ("control_state", "abort_state"):
+            bind.state(m, key, fw[key])
+        self.abort_psi = bind.local(m, "abort_limit", fw["abort_limit"])
+        self.vent_psi = fw["vent_psi"]
+        bind.channel("transducer", "channel", p["transducer"]["channel"], True, "i")
+        bind.channel("pins", "valve", p["pins"]["valve"], False, "o")
+        if sc["failure_s"] >= sc["max_s"]:
+            bind.err("scenario", "failure_s", "the regulator must fail before the run's end (max_s)")
+        tk = p["tank"]
+        self.tank = Tank(volume=tk["volume_l"] / 1000, temperature=tk["temperature_k"],
+                         gas_constant=tk["gas_constant_j_kg_k"], gamma=tk["gamma"],
+                         initial_pa=tk["initial_psi"] * PSI + 101325.0,
+                         vent_cd_area=p["vent"]["cd_area_mm2"] * 1e-6, valve_time=p["vent"]["response_ms"] / 1000)
+        self.valve_pin = p["pins"]["valve"]
+        self.outputs = (self.valve_pin,)
+        self.vref = float(bind.app.board.adc_vref)
+        (rng,) = (np.random.Generator(np.random.PCG64(s)) for s in np.random.SeedSequence(seed).spawn(1))
+        self.noise = Noise(rng, p["transducer"]["noise_psi"])
+        self.channel = p["transducer"]["channel"]
+        self.max_s = sc["max_s"]
+        self.valve = False
+        self.abort_seen: float | None = None
+        self.t = 0.0
+        self.volts = 0.0
+
+    def inputs(self, t: float):
+        tr = self.p["transducer"]
+        v = (self.tank.gauge_psi + self.noise() - tr["psi_at_0v"]) / tr["psi_per_volt"]
+        self.volts = min(max(v, 0.0), self.vref)
+        return {self.channel: self.volts}, {}
+
+    def inflow(self, t: float) -> float:
+        s = self.p["supply"]
+        return (s["failed_flow_g_s"] if t >= self.p["scenario"]["failure_s"] else s["flow_g_s"]) / 1000
+
+    def advance(self, t0: float, t1: float, edges) -> list[PinEvent]:
+        tank = self.tank
+        out = []
+        at = t0
+        for te, pin, level in edges:  # integrate up to each edge, then on with the new level
+            if te > at:
+                tank.advance(te - at, self.inflow(at), self.valve)
+                at = te
+            if pin == self.valve_pin:
+                self.valve = level
+            out.append(PinEvent(te, pin, "valve", level, {"pressure_psi": tank.gauge_psi}))
+        if t1 > at:
+            tank.advance(t1 - at, self.inflow(at), self.valve)
+        self.t = t1
+        return out
+
+    def record(self) -> tuple:
+        tk, t = self.tank, self.t
+        return (round(t, 6), tk.gauge_psi, tk.pressure, tk.mass, tk.inflow * 1000, tk.outflow * 1000,
+                int(t >= self.p["scenario"]["failure_s"]), int(self.valve), tk.valve, self.volts)
+
+    def done(self, t: float, state: str | None) -> bool:
+        if t >= self.max_s:
+            return True
+        if state == self.p["firmware"]["abort_state"]:
+            if self.abort_seen is None:
+                self.abort_seen = t
+            return t >= self.abort_seen + self.p["scenario"]["linger_s"]
+        return False

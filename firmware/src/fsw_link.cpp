@@ -202,10 +202,11 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
         if (w.index != index) continue;
         const uint8_t size = elem_size(w.type);
         if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
-        uint8_t v[8];
-        memcpy(v, a + 2, size);
-        if (w.type == kBool) v[0] = v[0] != 0 ? 1 : 0;
-        sv_move(c, c.sv + w.off, v, size);
+        uint8_t* const p = c.sv + w.off;
+        const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+        memcpy(p, a + 2, size);
+        if (w.type == kBool) *p = *p != 0 ? 1 : 0;  // a bool is stored as 0 or 1
+        if (c.lock) pal::critical_exit(saved);
         return kAckOk;
     }
     return kAckNotWritable;

@@ -1,7 +1,8 @@
 # A stuck barometer and a motor whose burnout the accelerometer never shows:
 # the burn ends by BURN_MAX, the drogue fires by the backup timer
 # APOGEE_BACKUP after launch, and with the altitude stuck at the pad's the
-# main follows at once (better open high than not at all).
+# main follows at once (better open high than not at all). Launch is called
+# at 1050 ms: the fifth sample over LAUNCH_G is the one at 1040 ms.
 
 [options]
 delta_t    10
@@ -18,14 +19,14 @@ G == 0 {
 G == 1000: accel = 6                      # ignition; the reading stays high
 
 [Boost]
-T == 0: @assert G == launchAt and G >= 1000 and G <= 1060
+T == 0: @assert G == 1050
 
 [Coast]
-T == 0: @assert G - launchAt == BURN_MAX + 10   # by time, not burnout
+T == 0: @assert burnTime == BURN_MAX and G == 1050 + BURN_MAX + 10   # by time, not burnout
 true: @assert not drogue and not main
 
 [Apogee]
-T == 0: @assert G - launchAt == APOGEE_BACKUP + 10
+T == 0: @assert G == 1050 + APOGEE_BACKUP + 20   # one step after each of two transitions
 T < PULSE: @assert drogue
 
 [Drogue]
@@ -33,6 +34,9 @@ true: @assert T == 0 and not drogue       # one step: 0 m is below MAIN_ALT
 
 [Main]
 T < PULSE: @assert main
+
+[Descent]
+true: @assert not main
 
 [Landed]
 true: @assert buzzer

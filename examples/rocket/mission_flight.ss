@@ -1,5 +1,6 @@
 # A nominal flight, step by step: armed on the pad, a 1.5 s burn, coast to
-# apogee near 6 s, drogue at 20 m/s, main at 150 m, landed.
+# apogee near 6 s, drogue at 20 m/s, main at 150 m, 6 m/s under the main,
+# landed.
 
 [options]
 delta_t    10
@@ -42,10 +43,14 @@ true: altitude = altitude - 0.2            # 20 m/s under the drogue
 true: @assert not drogue and not main and altitude >= MAIN_ALT - 0.2
 
 [Main]
-altitude > 0.06: altitude = altitude - 0.06   # 6 m/s under the main
+true: altitude = altitude - 0.06           # 6 m/s under the main
 T < PULSE: @assert main and not drogue
 T == 0: @assert altitude < MAIN_ALT and altitude > MAIN_ALT - 1
-T >= PULSE: @assert not main
+
+[Descent]
+altitude > 0.06: altitude = altitude - 0.06
+true: @assert not main and not drogue and T <= STILL_TIME
+T == 0: @assert still == altitude          # the band restarts where it is
 
 [Landed]
 true: @assert buzzer and not led and not drogue and not main

@@ -56,9 +56,9 @@ class Recording(MachineRun):
 
     fired: list[int] = []
 
-    def __init__(self, m, real, init_state=0):
+    def __init__(self, m, real, init_state=0, cover=False):
         im, self.hit = instrument(m)
-        super().__init__(im, real, init_state)
+        super().__init__(im, real, init_state, cover)
         Recording.fired = []
 
     def step(self):

@@ -25,6 +25,9 @@ class Board:
     reserved: dict[int, str]  # pin -> why it is reserved
     adc_bits: int
     adc_vref: float
+    # pin -> (port letter, bit) on an AVR board's MCU (`arduino.ports`); empty
+    # when the board file does not say (channels then go through pin numbers)
+    ports: dict[int, tuple[str, int]] = field(default_factory=dict, compare=False)
     raw: dict = field(default_factory=dict, compare=False, repr=False)  # the whole definition
 
     def pin(self, text: str) -> int | None:
@@ -85,5 +88,19 @@ def board_from_dict(name: str, d: dict) -> Board:
         reserved={int(r["pin"]): str(r["reason"]) for r in pins.get("reserved", [])},
         adc_bits=int(d["adc"]["bits"]),
         adc_vref=float(d["adc"]["vref"]),
+        ports=_ports(d.get("arduino", {}).get("ports", [])),
         raw=d,
     )
+
+
+def _ports(names: list) -> dict[int, tuple[str, int]]:
+    """`arduino.ports` ("D5": port D, bit 5; "" for a pin with no port) as
+    {pin: (port, bit)}."""
+    out = {}
+    for pin, name in enumerate(names):
+        if name == "":
+            continue
+        if not (isinstance(name, str) and len(name) == 2 and "A" <= name[0] <= "L" and "0" <= name[1] <= "7"):
+            raise ValueError(f"arduino.ports[{pin}] = {name!r}: expected a port letter and a bit, like \"D5\"")
+        out[pin] = (name[0], int(name[1]))
+    return out

@@ -34,8 +34,20 @@ def emit_app(app: Application) -> dict[str, str]:
     return files
 
 
-def _tables(app: Application, real, out: list[str]) -> dict[str, str]:
-    """Channel tables grouped by direction; returns {group: table name}."""
+def _direct_digital(app: Application, chans) -> bool:
+    """Digital channels become one call each, on pins the generator resolved
+    to their port and bit (`FSW_PIN`), when the board file maps every pin."""
+    return all(c.pin_number in app.board.ports for c in chans)
+
+
+def _pin(app: Application, c) -> str:
+    port, bit = app.board.ports[c.pin_number]
+    return f"FSW_PIN({c.pin_number}, {port}, {bit})"
+
+
+def _tables(app: Application, real, out: list[str]) -> dict:
+    """Channel tables grouped by direction; returns {group: table name}, or
+    for digital channels served one call each {group: [channels]}."""
     names = {}
     groups = {
         ("analog", "i"): [c for c in app.channels if c.analog and c.direction == "i"],
@@ -61,7 +73,11 @@ def _tables(app: Application, real, out: list[str]) -> dict[str, str]:
                        f"{app.board.adc_bits}, kSvLock}};")
             if all(c.element.type.name == "F32" for c in chans):
                 # no binary64 element: the task that links no F64 conversion
-                names[("task", tag)] = "io_analog_task_f32"
+                # (nor, for inputs, PWM output)
+                names[("task", tag)] = "io_analog_in_task_f32" if d == "i" else "io_analog_task_f32"
+        elif _direct_digital(app, chans):
+            names[(kind, d)] = chans
+            continue
         else:
             out.append(f"const fsw::DigitalChannel {tag}Ch[] FSW_FLASH = {{")
             for c in chans:
@@ -125,7 +141,13 @@ def _app_cpp(app: Application) -> str:
     c.append("bool begin() {")
     c.append("    if (fsw::executor_begin(ex, kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
-        if kind in ("analog", "digital"):
+        if kind in ("analog", "digital") and isinstance(tag, list):
+            for ch in tag:
+                c.append(f"    fsw::io_pin_begin({_pin(app, ch)}, {'fsw::kIoIn' if d == 'i' else 'fsw::kIoOut'});  "
+                         f"// {basename(ch.path)}:{ch.line} {ch.element.name}")
+        elif kind == "analog" and d == "i" and tables.get(("task", tag)) == "io_analog_in_task_f32":
+            continue  # nothing to set up: the task refuses any row it cannot serve
+        elif kind in ("analog", "digital"):
             c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
     if has_link:
         c.append(f"    fsw::pal::console_begin({app.baud}UL);")
@@ -173,7 +195,7 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
     if t.kind in ("inputs", "outputs"):
         d = "i" if t.kind == "inputs" else "o"
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
-        if len(calls) == 1:
+        if len(calls) == 1 and not isinstance(calls[0][1], list):
             kind, tag = calls[0]
             fn = tables.get(("task", tag), f"io_{kind}_task")
             return f"fsw::{fn}", f"const_cast<void*>(static_cast<const void*>(&{tag}))"
@@ -197,6 +219,14 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         if not calls:
             out.append("    return fsw::kOk;  // no channels in this direction")
         for k, (kind, tag) in enumerate(calls):
+            if isinstance(tag, list):
+                for ch in tag:
+                    fn = "io_digital_in" if d == "i" else "io_digital_out"
+                    out.append(f"    fsw::{fn}({_pin(app, ch)}, sv + E_{ch.element.name});  "
+                               f"// {basename(ch.path)}:{ch.line} pin {ch.pin}")
+                if k == len(calls) - 1:
+                    out.append("    return fsw::kOk;")
+                continue
             fn = tables.get(("task", tag), f"io_{kind}_task")
             call = f"fsw::{fn}(const_cast<void*>(static_cast<const void*>(&{tag})))"
             if k == len(calls) - 1:

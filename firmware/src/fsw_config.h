@@ -95,6 +95,24 @@
 #  define FSW_TASK_TIMING 1
 #endif
 
+// Digital channels of generated code on the port registers (AVR): the
+// generator resolves each channel's pin to a port and bit from the board
+// file (`arduino.ports`, which a test holds to the variant's pins_arduino.h)
+// and `FSW_PIN` hands them to inline code: two instructions a pin, no pin
+// tables, no `digitalWrite`. 0: through the PAL's pin numbers (the core's
+// pinMode/digitalRead/digitalWrite), e.g. for a core whose variant maps pins
+// differently from the board file.
+#ifndef FSW_AVR_PORTS
+#  if defined(__AVR__)
+#    define FSW_AVR_PORTS 1
+#  else
+#    define FSW_AVR_PORTS 0
+#  endif
+#endif
+#if FSW_AVR_PORTS && !defined(__AVR__)
+#  error "fswkit: FSW_AVR_PORTS is for AVR only"
+#endif
+
 // Constant tables (tasks, I/O channels) in flash: AVR copies initialised
 // data to RAM at boot, so read-only tables go to PROGMEM there.
 #ifndef FSW_USE_PROGMEM

@@ -33,7 +33,9 @@ Result io_analog_begin(const AnalogTable* table) {
 
 namespace {
 
-template <bool kAnyF64>
+// kAnyF64: rows may be F64 (else F32 only); kOutputs: rows may be outputs
+// (else inputs only). A row outside what the instance serves is refused.
+template <bool kAnyF64, bool kOutputs>
 Result analog_task(void* ctx) {
     AnalogTable tab;
     flash_read(&tab, ctx, sizeof tab);
@@ -41,8 +43,9 @@ Result analog_task(void* ctx) {
         AnalogChannel c;
         flash_read(&c, &tab.ch[i], sizeof c);
         if (!kAnyF64 && c.type != kF32) return kErrConfig;
+        if (!kOutputs && c.dir != kIoIn) return kErrConfig;
         uint8_t* p = tab.sv + c.off;
-        if (c.dir == kIoIn) {
+        if (!kOutputs || c.dir == kIoIn) {
             // Read (slow: ~100 us on AVR) before taking the lock.
             const Real v = analog_value_from_raw(pal::analog_read(c.pin), tab.vref, tab.adc_bits,
                                                  c.scale, c.offset);
@@ -63,8 +66,9 @@ Result analog_task(void* ctx) {
 
 }  // namespace
 
-Result io_analog_task(void* ctx) { return analog_task<true>(ctx); }
-Result io_analog_task_f32(void* ctx) { return analog_task<false>(ctx); }
+Result io_analog_task(void* ctx) { return analog_task<true, true>(ctx); }
+Result io_analog_task_f32(void* ctx) { return analog_task<false, true>(ctx); }
+Result io_analog_in_task_f32(void* ctx) { return analog_task<false, false>(ctx); }
 
 Result io_digital_begin(const DigitalTable* table) {
     DigitalTable tab;

@@ -3,6 +3,7 @@
 #ifndef FSW_IO_H
 #define FSW_IO_H
 
+#include "fsw_pal.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -53,7 +54,70 @@ Result io_analog_task(void* ctx);
 // The same for a table whose elements are all F32 (the generator picks it):
 // it links no binary64 conversion, which AVR does in software.
 Result io_analog_task_f32(void* ctx);
+// The same for a table of F32 inputs only (the generator groups channels by
+// direction): it links no PWM output either. A row of another type or
+// direction is refused (kErrConfig), not served.
+Result io_analog_in_task_f32(void* ctx);
 Result io_digital_task(void* ctx);
+
+// ---- digital channels, one call each (generated I/O tasks) -----------------
+// `FSW_PIN(n, X, b)` names board pin n, which the generator resolved to bit b
+// of port X. With FSW_AVR_PORTS (AVR) it is that port's registers, so the
+// calls below compile to a few instructions (sbi/cbi, sbis) with nothing
+// looked up at run time, and no PWM turn-off as digitalWrite does: a
+// digital channel's pin is never a PWM output (a pin serves one channel;
+// analog outputs only use PWM pins of their own) and the core's init()
+// connects no timer to a pin. Otherwise it is the pin number, served by the
+// PAL (pal::pin_mode, digital_read, digital_write).
+#if FSW_AVR_PORTS
+struct Pin {
+    volatile uint8_t* in;   // PINx
+    volatile uint8_t* ddr;  // DDRx
+    volatile uint8_t* out;  // PORTx
+    uint8_t mask;           // the pin's bit
+};
+#define FSW_PIN(n, port, bit) (::fsw::Pin{&PIN##port, &DDR##port, &PORT##port, static_cast<uint8_t>(1u << (bit))})
+
+// Sets or clears the pin's bit of a port register: sbi/cbi (atomic) in the
+// low I/O space, else with interrupts off (ATmega2560 ports H..L), as the
+// Arduino core does.
+inline __attribute__((always_inline)) void pin_reg_write(volatile uint8_t* r, uint8_t mask, bool set) {
+    const bool low_io = reinterpret_cast<uintptr_t>(r) < 0x40u + __SFR_OFFSET;
+    const pal::IrqState saved = low_io ? 0 : pal::critical_enter();
+    if (set) {
+        *r = static_cast<uint8_t>(*r | mask);
+    } else {
+        *r = static_cast<uint8_t>(*r & ~mask);
+    }
+    if (!low_io) pal::critical_exit(saved);
+}
+
+// A channel's pin mode at boot: kIoOut an output; kIoIn an input, pull-up
+// off; kIoInPullup an input with the pull-up on (as pinMode).
+inline __attribute__((always_inline)) void io_pin_begin(Pin pin, uint8_t dir) {
+    pin_reg_write(pin.ddr, pin.mask, dir == kIoOut);
+    if (dir != kIoOut) pin_reg_write(pin.out, pin.mask, dir == kIoInPullup);
+}
+// The bool element at `p` mirrors an input pin (1 high, 0 low).
+inline __attribute__((always_inline)) void io_digital_in(Pin pin, uint8_t* p) {
+    *p = (*pin.in & pin.mask) != 0 ? 1 : 0;  // one byte: no lock needed
+}
+// An output pin follows the bool element at `p` (any non-zero byte: high).
+inline __attribute__((always_inline)) void io_digital_out(Pin pin, const uint8_t* p) {
+    pin_reg_write(pin.out, pin.mask, *p != 0);
+}
+#else
+struct Pin {
+    uint8_t n;  // board pin number
+};
+#define FSW_PIN(n, port, bit) (::fsw::Pin{(n)})
+
+inline void io_pin_begin(Pin pin, uint8_t dir) {
+    pal::pin_mode(pin.n, dir == kIoOut ? pal::kOutput : dir == kIoInPullup ? pal::kInputPullup : pal::kInput);
+}
+inline void io_digital_in(Pin pin, uint8_t* p) { *p = pal::digital_read(pin.n) ? 1 : 0; }
+inline void io_digital_out(Pin pin, const uint8_t* p) { pal::digital_write(pin.n, *p != 0); }
+#endif
 
 // The conversions the analog task applies (exposed for tests and docs).
 // volts = raw * vref / (2^bits - 1); value = volts * scale + offset.

@@ -90,6 +90,25 @@ static void test_analog_f32_task_matches_the_general_task(void) {
     TEST_ASSERT_EQUAL_MEMORY(before + 4, sv + 4, 8);  // the F64 row was not touched
 }
 
+// An input-only F32 table through the task that links no PWM output: the
+// same values as the general task; a table with an output row is refused.
+static void test_analog_in_task_matches_the_general_task(void) {
+    native::sim_set_analog(14, 700);
+    native::sim_set_analog(15, 300);
+    TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogF32Table)));
+    const Real a = read_F32(sv + 0), b = read_F32(sv + 4);
+    write_F32(sv + 0, Real(-1));
+    write_F32(sv + 4, Real(-1));
+    TEST_ASSERT_EQUAL(kOk, io_analog_in_task_f32(const_cast<AnalogTable*>(&kAnalogF32Table)));
+    ASSERT_REAL_SAME(a, read_F32(sv + 0));
+    ASSERT_REAL_SAME(b, read_F32(sv + 4));
+    static const AnalogChannel kOut[1] FSW_FLASH = {{Real(1), Real(0), 0, 9, kIoOut, kF32}};
+    static const AnalogTable kOutTable FSW_FLASH = {kOut, sv, Real(5), 1, 10, false};
+    native::sim_set_analog(9, 0);
+    TEST_ASSERT_EQUAL(kErrConfig, io_analog_in_task_f32(const_cast<AnalogTable*>(&kOutTable)));
+    TEST_ASSERT_EQUAL_UINT8(0, native::sim_pwm(9));  // nothing driven
+}
+
 static void test_digital_task_mirrors_pins(void) {
     TEST_ASSERT_EQUAL(kOk, io_digital_begin(&kDigitalTable));
     TEST_ASSERT_EQUAL_UINT8(pal::kInputPullup, native::sim_pin_mode(2));
@@ -119,13 +138,59 @@ static void test_begin_refuses_bad_tables(void) {
 }
 #endif
 
+// Generated tasks drive each digital channel with one call on a pin the
+// generator resolved (FSW_PIN): pin numbers through the PAL on the host,
+// the port registers on AVR.
+static void test_resolved_pins_drive_and_read(void) {
+    uint8_t elems[2] = {1, 0};
+    io_pin_begin(FSW_PIN(13, B, 5), kIoOut);
+    io_pin_begin(FSW_PIN(2, D, 2), kIoInPullup);
+    io_pin_begin(FSW_PIN(3, D, 3), kIoIn);
+#if FSW_AVR_PORTS
+    TEST_ASSERT_TRUE(DDRB & _BV(5));
+    TEST_ASSERT_FALSE(DDRD & _BV(2));
+    TEST_ASSERT_TRUE(PORTD & _BV(2));  // pull-up on
+    TEST_ASSERT_FALSE(DDRD & _BV(3));
+    TEST_ASSERT_FALSE(PORTD & _BV(3));  // pull-up off
+    io_digital_out(FSW_PIN(13, B, 5), &elems[0]);
+    TEST_ASSERT_TRUE(PORTB & _BV(5));
+    io_digital_out(FSW_PIN(13, B, 5), &elems[1]);
+    TEST_ASSERT_FALSE(PORTB & _BV(5));
+    elems[0] = 0x80;  // any non-zero byte is true
+    io_digital_out(FSW_PIN(13, B, 5), &elems[0]);
+    TEST_ASSERT_TRUE(PORTB & _BV(5));
+    TEST_ASSERT_FALSE(PORTB & _BV(4));  // the neighbours are untouched
+    io_digital_in(FSW_PIN(2, D, 2), &elems[1]);
+    TEST_ASSERT_EQUAL_UINT8((PIND & _BV(2)) ? 1 : 0, elems[1]);
+#else
+    TEST_ASSERT_EQUAL_UINT8(pal::kOutput, native::sim_pin_mode(13));
+    TEST_ASSERT_EQUAL_UINT8(pal::kInputPullup, native::sim_pin_mode(2));
+    TEST_ASSERT_EQUAL_UINT8(pal::kInput, native::sim_pin_mode(3));
+    io_digital_out(FSW_PIN(13, B, 5), &elems[0]);
+    TEST_ASSERT_TRUE(native::sim_digital(13));
+    io_digital_out(FSW_PIN(13, B, 5), &elems[1]);
+    TEST_ASSERT_FALSE(native::sim_digital(13));
+    elems[0] = 0x80;
+    io_digital_out(FSW_PIN(13, B, 5), &elems[0]);
+    TEST_ASSERT_TRUE(native::sim_digital(13));
+    native::sim_set_digital(2, true);
+    io_digital_in(FSW_PIN(2, D, 2), &elems[1]);
+    TEST_ASSERT_EQUAL_UINT8(1, elems[1]);
+    native::sim_set_digital(2, false);
+    io_digital_in(FSW_PIN(2, D, 2), &elems[1]);
+    TEST_ASSERT_EQUAL_UINT8(0, elems[1]);
+#endif
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_analog_conversion_formula);
     RUN_TEST(test_pwm_duty_from_volts);
+    RUN_TEST(test_resolved_pins_drive_and_read);
 #if FSW_PLATFORM_NATIVE
     RUN_TEST(test_analog_task_reads_and_writes);
     RUN_TEST(test_analog_f32_task_matches_the_general_task);
+    RUN_TEST(test_analog_in_task_matches_the_general_task);
     RUN_TEST(test_digital_task_mirrors_pins);
     RUN_TEST(test_begin_refuses_bad_tables);
 #endif

@@ -70,6 +70,7 @@ bench: setup
 	$(PY) tools/bench_firmware.py
 	$(PY) tools/bench_sim.py
 	$(PY) tools/bench_link.py
+	$(PY) tools/bench_flights.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -133,13 +133,13 @@ def _app_cpp(app: Application) -> str:
         c.append("    {0, 0, 0, 1, 0, fsw::kNoElement, fsw::kNoElement, fsw::kNoElement, 0},")
     c.append("};")
     cause = f"E_{app.reset_cause.name}" if app.reset_cause is not None else "fsw::kNoElement"
-    c.append(f"const fsw::ExecConfig kConfig = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock}};")
+    c.append(f"const fsw::ExecConfig kConfig FSW_FLASH = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock}};")
     c.append("")
     c.append("}  // namespace")
     c.append("")
     c.append("// Starts the executor and the I/O channels; false on a bad table.")
     c.append("bool begin() {")
-    c.append("    if (fsw::executor_begin(ex, kConfig) != fsw::kOk) return false;")
+    c.append("    if (fsw::executor_begin(ex, &kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
         if kind in ("analog", "digital") and isinstance(tag, list):
             for ch in tag:

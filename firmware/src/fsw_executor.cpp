@@ -6,72 +6,73 @@
 
 namespace fsw {
 
-static void read_task(const Executor& ex, uint8_t i, Task& t) {
-    flash_read(&t, &ex.cfg.tasks[i], sizeof t);
+namespace {
+
+void read_task(const ExecConfig& c, uint8_t i, Task& t) { flash_read(&t, &c.tasks[i], sizeof t); }
+
+// Where a task's mode lives: its U8 element, else its TaskStats.
+uint8_t* mode_byte(const ExecConfig& c, const Task& t, uint8_t i) {
+    return t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
 }
 
-static uint8_t mode_of(const Executor& ex, const Task& t, uint8_t i) {
-    return t.mode_off != kNoElement ? ex.cfg.sv[t.mode_off] : ex.cfg.stats[i].mode;
+void mirror_stats(const ExecConfig& c, const Task& t, const TaskStats& s) {
+    if (t.overruns_off == kNoElement && t.worst_us_off == kNoElement) return;
+    const pal::IrqState saved = c.sv_lock ? pal::critical_enter() : 0;
+    if (t.overruns_off != kNoElement) store<uint16_t>(c.sv + t.overruns_off, s.overruns);
+    if (t.worst_us_off != kNoElement) store<uint32_t>(c.sv + t.worst_us_off, s.worst_us);
+    if (c.sv_lock) pal::critical_exit(saved);
 }
 
-static void set_mode(Executor& ex, const Task& t, uint8_t i, uint8_t mode) {
-    if (t.mode_off != kNoElement) {
-        ex.cfg.sv[t.mode_off] = mode;  // one byte: atomic on every target
-    } else {
-        ex.cfg.stats[i].mode = mode;
-    }
+}  // namespace
+
+ExecConfig executor_config(const Executor& ex) {
+    ExecConfig c;
+    flash_read(&c, ex.cfg, sizeof c);
+    return c;
 }
 
-Result executor_begin(Executor& ex, const ExecConfig& cfg) {
-    if (cfg.period_us == 0 || (cfg.n_tasks != 0 && (cfg.tasks == 0 || cfg.stats == 0))) {
-        return kErrConfig;
-    }
+Result executor_begin(Executor& ex, const ExecConfig* cfg) {
+    ExecConfig c;
+    flash_read(&c, cfg, sizeof c);
+    if (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0))) return kErrConfig;
     ex.cfg = cfg;
-    for (uint8_t i = 0; i < cfg.n_tasks; ++i) {
+    for (uint8_t i = 0; i < c.n_tasks; ++i) {
         Task t;
-        read_task(ex, i, t);
+        read_task(c, i, t);
         if (t.step == 0 || t.divider == 0 || t.phase >= t.divider) return kErrConfig;
-        if (t.mode_off == kNoElement && t.overruns_off == kNoElement &&
-            t.worst_us_off == kNoElement) {
-            // nothing in the state vector: fine
-        } else if (cfg.sv == 0) {
+        if (c.sv == 0 && (t.mode_off != kNoElement || t.overruns_off != kNoElement ||
+                          t.worst_us_off != kNoElement)) {
             return kErrConfig;
         }
-        TaskStats& s = cfg.stats[i];
+        TaskStats& s = c.stats[i];
         memset(&s, 0, sizeof s);
         s.countdown = t.phase;
-        set_mode(ex, t, i, t.init_mode);
+        *mode_byte(c, t, i) = t.init_mode;  // one byte: atomic on every target
     }
     pal::begin();
-    ex.next_due_us = pal::micros64();
+    ex.next_due_us = pal::micros32();
     ex.cycles = 0;
     ex.late = 0;
     ex.reset_cause = pal::reset_cause();
-    if (cfg.reset_cause_off != kNoElement && cfg.sv != 0) cfg.sv[cfg.reset_cause_off] = ex.reset_cause;
+    if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
     return kOk;
 }
 
-static void mirror_stats(Executor& ex, const Task& t, const TaskStats& s) {
-    if (t.overruns_off == kNoElement && t.worst_us_off == kNoElement) return;
-    const pal::IrqState saved = ex.cfg.sv_lock ? pal::critical_enter() : 0;
-    if (t.overruns_off != kNoElement) store<uint16_t>(ex.cfg.sv + t.overruns_off, s.overruns);
-    if (t.worst_us_off != kNoElement) store<uint32_t>(ex.cfg.sv + t.worst_us_off, s.worst_us);
-    if (ex.cfg.sv_lock) pal::critical_exit(saved);
-}
-
 void executor_run_cycle(Executor& ex) {
     pal::watchdog_kick();
-    for (uint8_t i = 0; i < ex.cfg.n_tasks; ++i) {
-        TaskStats& s = ex.cfg.stats[i];
+    const ExecConfig c = executor_config(ex);
+    for (uint8_t i = 0; i < c.n_tasks; ++i) {
+        TaskStats& s = c.stats[i];
         if (s.countdown != 0) {
             --s.countdown;
             continue;
         }
         Task t;
-        read_task(ex, i, t);
+        read_task(c, i, t);
         s.countdown = static_cast<uint16_t>(t.divider - 1u);
-        const uint8_t mode = mode_of(ex, t, i);
+        uint8_t* const mode_at = mode_byte(c, t, i);
+        const uint8_t mode = *mode_at;
         if (mode == kModeDisabled) continue;
 #if FSW_TASK_TIMING
         const uint32_t start = pal::micros32();
@@ -79,51 +80,54 @@ void executor_run_cycle(Executor& ex) {
         if (mode == kModeEnabled) {
             const Result r = t.step(t.ctx);
             if (r != kOk) {
-                set_mode(ex, t, i, kModeSafed);
+                *mode_at = kModeSafed;
                 s.last_fault = r;
-                if (s.faults != 0xFFFFu) ++s.faults;
+                if (s.faults != 0xFFu) ++s.faults;
             }
         } else if (t.safe != 0) {
             t.safe(t.ctx);
         }
-        ++s.runs;
 #if FSW_TASK_TIMING
         const uint32_t took = pal::micros32() - start;
         if (took > s.worst_us) s.worst_us = took;
-        if (took > ex.cfg.period_us * t.divider && s.overruns != 0xFFFFu) ++s.overruns;
+        if (took > c.period_us * t.divider && s.overruns != 0xFFFFu) ++s.overruns;
 #endif
-        mirror_stats(ex, t, s);
+        mirror_stats(c, t, s);
     }
     ++ex.cycles;
 }
 
 bool executor_poll(Executor& ex) {
-    // The idle path decides on 32 bits: the due time is never more than a
-    // period ahead, so the wrap-safe difference of the low words tells. A
-    // short idle pass is what keeps cycle starts close to their due time.
-    const uint32_t due32 = static_cast<uint32_t>(ex.next_due_us & 0xFFFFFFFFu);
-    if (static_cast<int32_t>(pal::micros32() - due32) < 0) return false;
-    const uint64_t now = pal::micros64();
-    if (now < ex.next_due_us) return false;
-    if (now - ex.next_due_us >= ex.cfg.period_us) {
+    // On 32 bits, wrap-safe: the due time is never more than a period ahead,
+    // so the signed difference tells "not yet" from "late by so much" for
+    // any lateness under 2^31 us (35.8 minutes; the watchdog resets an AVR
+    // long before). A short idle pass keeps cycle starts close to their due
+    // time: it reads nothing else.
+    const uint32_t late_by = pal::micros32() - ex.next_due_us;
+    if (static_cast<int32_t>(late_by) < 0) return false;
+    uint32_t period;
+    flash_read(&period, &ex.cfg->period_us, sizeof period);
+    if (late_by >= period) {
         if (ex.late != 0xFFFFu) ++ex.late;
-        ex.next_due_us = now;
+        ex.next_due_us += late_by;  // restart the schedule from now
     }
-    ex.next_due_us += ex.cfg.period_us;
+    ex.next_due_us += period;
     executor_run_cycle(ex);
     return true;
 }
 
 uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
+    const ExecConfig c = executor_config(ex);
     Task t;
-    read_task(ex, i, t);
-    return mode_of(ex, t, i);
+    read_task(c, i, t);
+    return *mode_byte(c, t, i);
 }
 
 void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode) {
+    const ExecConfig c = executor_config(ex);
     Task t;
-    read_task(ex, i, t);
-    set_mode(ex, t, i, mode);
+    read_task(c, i, t);
+    *mode_byte(c, t, i) = mode;
 }
 
 }  // namespace fsw

@@ -30,18 +30,18 @@ struct Task {
     uint8_t init_mode;       // mode set by executor_begin
 };
 
-// Per-task run-time record (RAM, zero-initialised).
+// Per-task run-time record (RAM, zero-initialised): 11 bytes.
 struct TaskStats {
     uint32_t worst_us;       // longest step (or safe) call, microseconds
-    uint32_t runs;           // calls of step or safe
     uint16_t overruns;       // calls longer than the task's period (saturates)
-    uint16_t faults;         // steps that returned a fault (saturates)
     uint16_t countdown;      // base cycles until the next run
+    uint8_t faults;          // steps that returned a fault (saturates at 255)
     uint8_t mode;            // the mode, for a task without a mode element
     uint8_t last_fault;      // the last fault code its step returned
 };
 
-// Executor configuration (copied into the Executor by executor_begin).
+// Executor configuration: constant data (FSW_FLASH on AVR), like the task
+// table it points at; the Executor keeps a pointer to it.
 struct ExecConfig {
     const Task* tasks;       // FSW_FLASH table of n_tasks rows
     TaskStats* stats;        // n_tasks records
@@ -53,8 +53,8 @@ struct ExecConfig {
 };
 
 struct Executor {
-    ExecConfig cfg;
-    uint64_t next_due_us;    // start time of the next cycle
+    const ExecConfig* cfg;   // FSW_FLASH
+    uint32_t next_due_us;    // start of the next cycle: micros32(), which wraps
     uint32_t cycles;         // cycles run
     uint16_t late;           // cycles that started a full period or more late
     uint8_t reset_cause;     // captured at executor_begin
@@ -62,15 +62,20 @@ struct Executor {
 
 // Validates the table (dividers, phases), sets every task's initial mode,
 // starts the platform, arms the watchdog, captures the reset cause. The
-// first cycle is due at once.
-FSW_MUST_CHECK Result executor_begin(Executor& ex, const ExecConfig& cfg);
+// first cycle is due at once. `cfg` points at an FSW_FLASH object that
+// outlives the executor.
+FSW_MUST_CHECK Result executor_begin(Executor& ex, const ExecConfig* cfg);
 // Runs one cycle now: kicks the watchdog, then each due task in order.
 void executor_run_cycle(Executor& ex);
 // Runs a cycle if one is due (call from loop()); true when one ran. A cycle
 // that starts a full period late counts in `late`, and the schedule
-// restarts from now (missed cycles are skipped, not run in a burst).
+// restarts from now (missed cycles are skipped, not run in a burst). Time
+// is micros32(), compared wrap-safe: the due time is never more than a
+// period ahead, so a poll may come up to 2^31 us (35.8 minutes) late.
 bool executor_poll(Executor& ex);
 
+// The configuration the executor runs (a copy of its FSW_FLASH object).
+ExecConfig executor_config(const Executor& ex);
 // A task's current mode (from its element or its TaskStats).
 uint8_t executor_task_mode(const Executor& ex, uint8_t i);
 // Sets a task's mode (ground command, tests).

@@ -151,10 +151,11 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_bytes(&l.n.frames, 8);   // frames, dropped
         put_bytes(&ex.cycles, 7);    // cycles, late, reset_cause
         put_bytes(&l.n.rx_ok, 14);   // rx_ok .. last_seq
-        for (uint8_t i = 0; i < ex.cfg.n_tasks; ++i) {
-            const TaskStats& s = ex.cfg.stats[i];
+        const ExecConfig ec = executor_config(ex);
+        for (uint8_t i = 0; i < ec.n_tasks; ++i) {
+            const TaskStats& s = ec.stats[i];
             put(executor_task_mode(ex, i));
-            put(static_cast<uint8_t>(s.faults > 0xFFu ? 0xFFu : s.faults));
+            put(s.faults);  // saturates at 255
             put_u16(s.overruns);
             put_u16(static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us));
         }
@@ -216,7 +217,7 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
     if (op == kOpSet) return apply_set(c, a, alen);
     if (op == kOpMode) {
         if (alen != 2) return kAckBadLength;
-        if (a[0] >= c.ex->cfg.n_tasks) return kAckBadTask;
+        if (a[0] >= executor_config(*c.ex).n_tasks) return kAckBadTask;
         if (a[1] > kModeEnabled) return kAckBadMode;
         if (a[0] == c.uplink_task && a[1] != kModeEnabled) return kAckLocked;
         executor_set_task_mode(*c.ex, a[0], a[1]);

@@ -24,7 +24,7 @@ uint32_t micros32();
 uint32_t millis32();
 // 64-bit monotonic time, extended from the 32-bit counters (fsw_clock.h).
 // Each must be called at least once per wrap period of its 32-bit source;
-// the executor calls both every cycle.
+// generated machine tasks call the one `G` is written from every cycle.
 uint64_t micros64();
 uint64_t millis64();
 

@@ -60,10 +60,9 @@ static const Task kTasks[3] FSW_FLASH = {
     {step_fn, 0, CTX(2), 3, 1, 2, kNoElement, kNoElement, kModeEnabled},
 };
 
-static ExecConfig config(uint32_t period_us) {
-    ExecConfig c = {kTasks, stats, sv, period_us, 9, 3, false};
-    return c;
-}
+// The executor keeps a pointer to its configuration: constant data, in
+// flash on AVR.
+static const ExecConfig kConfig FSW_FLASH = {kTasks, stats, sv, 1000, 9, 3, false};
 
 void setUp(void) {
     trace_len = 0;
@@ -85,7 +84,7 @@ void tearDown(void) {
 }
 
 static void test_tasks_run_in_order_at_their_dividers_and_phases(void) {
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     for (int c = 0; c < 6; ++c) {
         executor_run_cycle(ex);
         note('|');
@@ -93,14 +92,14 @@ static void test_tasks_run_in_order_at_their_dividers_and_phases(void) {
     // A every cycle; B every 2nd from 0; C every 3rd from cycle 1.
     TEST_ASSERT_EQUAL_STRING("AB|AC|AB|A|ABC|A|", trace);
     TEST_ASSERT_EQUAL_UINT32(6, ex.cycles);
-    TEST_ASSERT_EQUAL_UINT32(6, stats[0].runs);
-    TEST_ASSERT_EQUAL_UINT32(3, stats[1].runs);
-    TEST_ASSERT_EQUAL_UINT32(2, stats[2].runs);
+    TEST_ASSERT_EQUAL_UINT8(6, calls[0]);
+    TEST_ASSERT_EQUAL_UINT8(3, calls[1]);
+    TEST_ASSERT_EQUAL_UINT8(2, calls[2]);
 }
 
 static void test_begin_writes_initial_modes_into_mode_elements(void) {
     sv[0] = sv[1] = sv[2] = 77;
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[0]);
     TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[1]);
     TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[2]);
@@ -108,7 +107,7 @@ static void test_begin_writes_initial_modes_into_mode_elements(void) {
 }
 
 static void test_modes_disabled_safed_enabled(void) {
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     sv[0] = kModeDisabled;
     sv[1] = kModeSafed;
     executor_run_cycle(ex);  // cycle 0: A disabled, B safed -> b
@@ -127,11 +126,11 @@ static void test_modes_disabled_safed_enabled(void) {
 
 static void test_a_faulting_step_safes_its_task(void) {
     fail_on_call[0] = 2;
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     executor_run_cycle(ex);
     executor_run_cycle(ex);  // A faults here
     TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[0]);
-    TEST_ASSERT_EQUAL_UINT16(1, stats[0].faults);
+    TEST_ASSERT_EQUAL_UINT8(1, stats[0].faults);
     TEST_ASSERT_EQUAL_UINT8(kErrFault, stats[0].last_fault);
     trace_len = 0;
     executor_run_cycle(ex);  // cycle 2: A safed -> a, B
@@ -142,7 +141,7 @@ static void test_a_faulting_step_safes_its_task(void) {
 static void test_overrun_and_worst_step_time(void) {
     busy_us[0] = 1500;  // longer than its 1000 us period
     busy_us[1] = 1500;  // shorter than its 2000 us period
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     executor_run_cycle(ex);
     executor_run_cycle(ex);
     TEST_ASSERT_EQUAL_UINT16(2, stats[0].overruns);
@@ -158,7 +157,7 @@ static void test_overrun_and_worst_step_time(void) {
 static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
 #if FSW_PLATFORM_NATIVE
     native::sim_set_time_us(5000);
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     TEST_ASSERT_TRUE(executor_poll(ex));     // due at once (t=5000)
     TEST_ASSERT_FALSE(executor_poll(ex));
     native::sim_advance_us(999);
@@ -180,7 +179,7 @@ static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
     TEST_ASSERT_EQUAL_UINT32(6, native::watchdog_kicks());
     TEST_ASSERT_TRUE(native::watchdog_armed());
 #else
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     TEST_ASSERT_TRUE((WDTCSR & _BV(WDE)) != 0);  // watchdog armed
     const uint32_t start = micros();
     uint16_t ran = 0;
@@ -193,7 +192,7 @@ static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
 }
 
 static void test_reset_cause_is_captured(void) {
-    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, config(1000)));
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     TEST_ASSERT_EQUAL_UINT8(pal::reset_cause(), ex.reset_cause);
     TEST_ASSERT_EQUAL_UINT8(ex.reset_cause, sv[9]);
 #if FSW_PLATFORM_NATIVE
@@ -205,18 +204,42 @@ static const Task kBadDivider[1] FSW_FLASH = {{step_fn, 0, CTX(0), 0, 0, kNoElem
 static const Task kBadPhase[1] FSW_FLASH = {{step_fn, 0, CTX(0), 2, 2, kNoElement, kNoElement, kNoElement, 2}};
 static const Task kNoStep[1] FSW_FLASH = {{0, 0, CTX(0), 1, 0, kNoElement, kNoElement, kNoElement, 2}};
 
+static const ExecConfig kBadDividerConfig FSW_FLASH = {kBadDivider, stats, sv, 1000, 9, 1, false};
+static const ExecConfig kBadPhaseConfig FSW_FLASH = {kBadPhase, stats, sv, 1000, 9, 1, false};
+static const ExecConfig kNoStepConfig FSW_FLASH = {kNoStep, stats, sv, 1000, 9, 1, false};
+static const ExecConfig kNoPeriodConfig FSW_FLASH = {kTasks, stats, sv, 0, 9, 3, false};
+
 static void test_begin_refuses_bad_tables(void) {
-    ExecConfig c = config(1000);
-    c.n_tasks = 1;
-    c.tasks = kBadDivider;
-    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
-    c.tasks = kBadPhase;
-    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
-    c.tasks = kNoStep;
-    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
-    c = config(0);
-    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, c));
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kBadDividerConfig));
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kBadPhaseConfig));
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kNoStepConfig));
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kNoPeriodConfig));
 }
+
+#if FSW_PLATFORM_NATIVE
+// The schedule runs on micros32(), which wraps every 71.6 minutes: across
+// the wrap the rate holds, and a poll that comes half an hour late (under
+// 2^31 us) counts as late, once.
+static void test_poll_across_the_32_bit_wrap(void) {
+    native::sim_set_time_us(0xFFFFFFFFull - 1500);  // 1.5 ms before the wrap
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
+    TEST_ASSERT_TRUE(executor_poll(ex));
+    uint16_t ran = 1;
+    for (uint16_t k = 0; k < 5000; ++k) {  // 5 ms in 1 us steps
+        native::sim_advance_us(1);
+        if (executor_poll(ex)) ++ran;
+    }
+    TEST_ASSERT_EQUAL_UINT16(6, ran);  // due at -1.5, -0.5, +0.5, ... +3.5 ms
+    TEST_ASSERT_EQUAL_UINT16(0, ex.late);
+    TEST_ASSERT_FALSE(executor_poll(ex));
+    native::sim_advance_us(2000000000UL);  // 33 minutes without a poll
+    TEST_ASSERT_TRUE(executor_poll(ex));
+    TEST_ASSERT_EQUAL_UINT16(1, ex.late);
+    TEST_ASSERT_FALSE(executor_poll(ex));
+    native::sim_advance_us(1000);
+    TEST_ASSERT_TRUE(executor_poll(ex));
+}
+#endif
 
 static void run(void) {
     UNITY_BEGIN();
@@ -228,6 +251,9 @@ static void run(void) {
     RUN_TEST(test_poll_keeps_the_rate_and_counts_late_cycles);
     RUN_TEST(test_reset_cause_is_captured);
     RUN_TEST(test_begin_refuses_bad_tables);
+#if FSW_PLATFORM_NATIVE
+    RUN_TEST(test_poll_across_the_32_bit_wrap);
+#endif
     (void)UNITY_END();
 }
 

@@ -81,8 +81,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     native::console_capture(out, sizeof out, &out_len);
     const bool slow = size > 0 && (data[0] & 1);
     if (slow) native::console_model_uart(115200, 64);
-    const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false};
-    if (executor_begin(ex, cfg) != kOk) fail("begin");
+    static const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false};
+    if (executor_begin(ex, &cfg) != kOk) fail("begin");
     pal::console_begin(115200UL);
     link_begin(link, &kConfig);
     uint8_t before[sizeof sv];

@@ -1,8 +1,8 @@
 # A stuck barometer and a motor whose burnout the accelerometer never shows:
 # the burn ends by BURN_MAX, the drogue fires by the backup timer
 # APOGEE_BACKUP after launch, and with the altitude stuck at the pad's the
-# main follows at once (better open high than not at all). Launch is called
-# at 1050 ms: the fifth sample over LAUNCH_G is the one at 1040 ms.
+# main waits for its own backup timer, MAIN_BACKUP under the drogue. Launch
+# is called at 1050 ms: the fifth sample over LAUNCH_G is the one at 1040 ms.
 
 [options]
 delta_t    10
@@ -30,9 +30,10 @@ T == 0: @assert G == 1050 + APOGEE_BACKUP + 20   # one step after each of two tr
 T < PULSE: @assert drogue
 
 [Drogue]
-true: @assert T == 0 and not drogue       # one step: 0 m is below MAIN_ALT
+true: @assert not drogue and not main and not high and T <= MAIN_BACKUP
 
 [Main]
+T == 0: @assert G == 1050 + APOGEE_BACKUP + PULSE + MAIN_BACKUP + 40
 T < PULSE: @assert main
 
 [Descent]

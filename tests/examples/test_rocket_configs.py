@@ -34,7 +34,7 @@ def test_script_passes(fsw, script, mode):
 def test_scripts_cover_every_state_and_transition(fsw):
     r = fsw("test", "--coverage", str(ROCKET))
     assert r.code == 0, r.out + r.err
-    assert "coverage of mission.sm: 10/10 states, 14/14 transitions" in r.out
+    assert "coverage of mission.sm: 10/10 states, 15/15 transitions" in r.out
     assert "coverage of nav.sm: 1/1 states, 0/0 transitions" in r.out
     assert f"{len(SCRIPTS)} scripts: {len(SCRIPTS)} passed, 0 failed" in r.out
 
@@ -42,10 +42,11 @@ def test_scripts_cover_every_state_and_transition(fsw):
 def test_coverage_names_what_one_script_misses(fsw):
     r = fsw("test", "--coverage", str(ROCKET / "mission_flight.ss"))
     assert r.code == 1
-    assert "coverage of mission.sm: 9/10 states, 9/14 transitions" in r.out
-    assert "mission.sm:104: state Abort never entered" in r.out
+    assert "coverage of mission.sm: 9/10 states, 9/15 transitions" in r.out
+    assert "mission.sm:114: state Abort never entered" in r.out
     assert "transition Safe -> Abort never taken" in r.out
     assert "transition Coast -> Apogee never taken" in r.out  # the backup timer's
+    assert "mission.sm:92:23: transition Drogue -> Main never taken" in r.out  # and the main's
     # one report, unchanged, for one script
     assert r.out.startswith("state script ran for 4348 steps\n")
 

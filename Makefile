@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup demo test test-python fuzz fuzz-uplink bench clean
+.PHONY: all setup demo docs-img test test-python fuzz fuzz-uplink bench clean
 
 include mk/firmware.mk
 
@@ -27,6 +27,12 @@ setup: $(STAMP)
 DEMO_SEED ?= 1
 demo: setup
 	$(FSW) sim examples/rocket --plant rocket --seed $(DEMO_SEED) --out $(BUILD)/demo
+
+## docs-img: the demo flight's plot shown in README.md (a test checks that
+## docs/img/rocket-flight.png is this tree's seed-1 flight)
+docs-img: setup
+	$(FSW) sim examples/rocket --plant rocket --seed 1 --out $(BUILD)/docs-img
+	mkdir -p docs/img && cp $(BUILD)/docs-img/flight.png docs/img/rocket-flight.png
 
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P

@@ -364,7 +364,12 @@ def _cell(v) -> str:
     return str(v)
 
 
-def plot(run: Run, sc, path: str, title: str) -> None:
+DIGEST_KEY = "fswkit-flight-csv-sha256"  # a PNG text chunk: the data the plot shows
+
+
+def plot(run: Run, sc, path: str, title: str, csv_digest: str | None = None) -> None:
+    """The PNG; `csv_digest`, the SHA-256 of the flight's CSV, goes into a
+    text chunk, so a copy of the plot can be told current or stale."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -411,5 +416,24 @@ def plot(run: Run, sc, path: str, title: str) -> None:
     axes[-1, 0].set_xlabel("simulated time (s)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, metadata={DIGEST_KEY: csv_digest} if csv_digest else None)
     plt.close(fig)
+
+
+def png_text(path: str) -> dict[str, str]:
+    """The tEXt chunks of a PNG file."""
+    import struct
+
+    out = {}
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError(f"{path}: not a PNG file")
+    i = 8
+    while i + 8 <= len(data):
+        n, kind = struct.unpack(">I4s", data[i:i + 8])
+        if kind == b"tEXt":
+            key, _, value = data[i + 8:i + 8 + n].partition(b"\0")
+            out[key.decode("latin-1")] = value.decode("latin-1")
+        i += 12 + n
+    return out

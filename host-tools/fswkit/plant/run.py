@@ -9,6 +9,7 @@ many flights)."""
 from __future__ import annotations
 
 import argparse
+import hashlib
 import os
 import sys
 from dataclasses import dataclass
@@ -72,6 +73,32 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
     return app, layout, sc
 
 
+def budget_checks(app, elf: str, run: Run) -> list[reports.Check]:
+    """The application's [budget] against the flown firmware: flash from the
+    ELF, RAM as static data plus the stack's high-water mark measured on the
+    board during this run. None set: the board's memory."""
+    from fswkit.build import BuildError, elf_size
+
+    out = []
+    try:
+        flash, _ram = elf_size(elf)
+    except BuildError as e:
+        return [reports.Check("the firmware's size", False, str(e))]
+    whose = "the application's [budget]" if app.flash_budget is not None else f"the {app.board.name}'s memory"
+    limit = app.flash_budget or app.board.flash
+    out.append(reports.Check(f"flash within {whose}", flash <= limit, f"{flash:,} of {limit:,} B"))
+    ram = run.ram.get("ram_usage")
+    whose = "the application's [budget]" if app.ram_budget is not None else f"the {app.board.name}'s memory"
+    limit = app.ram_budget or app.board.ram
+    if ram is None or isinstance(ram, str):
+        out.append(reports.Check(f"RAM within {whose}", False, f"the stack was not measured: {ram}"))
+    else:
+        out.append(reports.Check(f"RAM within {whose}, stack included", ram.total <= limit,
+                                 f"{ram.static:,} B static + {ram.stack:,} B stack high-water = "
+                                 f"{ram.total:,} of {limit:,} B"))
+    return out
+
+
 def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False) -> Flight:
     """Flies the scenario; writes the files into `out` (None: none). CosimError
     if the run could not go on."""
@@ -82,11 +109,14 @@ def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False
     meta = {"source": f"fsw sim --plant {sc.kind}", "clock": "simulated", "seed": sc.seed, "fault": sc.fault}
     run = fly(sc, elf, board, layout, files.get("log"), log_meta=meta)
     rep = reports.rocket(run, sc) if sc.kind == "rocket" else reports.tank(run, sc)
+    rep.checks += budget_checks(sc.app, elf, run)
     if out is not None:
         reports.write_csv(run, layout, sc.state_element, files["csv"])
         title = (f"{layout.name}: {sc.kind} plant, seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
                  + (" — all checks pass" if rep.passed else " — CHECKS FAIL"))
-        reports.plot(run, sc, files["png"], title)
+        with open(files["csv"], "rb") as f:
+            digest = hashlib.sha256(f.read()).hexdigest()
+        reports.plot(run, sc, files["png"], title, digest)
         with open(files["summary"], "w") as f:
             f.write(rep.text())
     return Flight(run, rep, sc, files)

@@ -293,6 +293,7 @@ def load(kind: str, path: str, app, layout, seed: int, fault: str | None):
     sc = cls(values, bind, seed, fault)
     if bind.errors:
         raise ParamsError(bind.errors)
+    sc.app = app  # its [budget] is checked after the run
     return sc
 
 

@@ -9,32 +9,31 @@ static const int64_t kI64Min = -kI64Max - 1;
 static const uint64_t kU64Max = 0xFFFFFFFFFFFFFFFFULL;
 
 // Magnitude -> Real, correctly rounded (to nearest, ties to even).
-static Real real_from_magnitude(uint64_t m) {
+FSW_NOINLINE static Real real_from_magnitude(uint64_t m) {
 #if FSW_REAL_IS_FLOAT
     // Done in 32-bit halves: no 64-bit shifts on 8-bit MCUs, and no reliance
     // on a 64-bit conversion routine that might round twice. Shift the value
     // right until it fits 32 bits, folding every dropped bit into bit 0
     // (sticky): binary32 keeps 24 bits, so rounding that 32-bit value rounds
     // the original exactly; then scale back by 2^s, which is exact (the
-    // result is at most 2^64: always finite).
-    const uint32_t hi = static_cast<uint32_t>(m >> 32);
-    const uint32_t lo = static_cast<uint32_t>(m);
+    // result is at most 2^64: always finite). Values under 2^32 (T for 49
+    // days in ms) are one conversion; the shift is a bit at a time, a short
+    // loop rather than fast code for a path that is rarely taken.
+    uint32_t hi = static_cast<uint32_t>(m >> 32);
+    uint32_t lo = static_cast<uint32_t>(m);
     if (hi == 0) return static_cast<Real>(lo);
     uint8_t s = 0;
-    for (uint32_t h = hi; h != 0; h >>= 1) ++s;  // bits in hi: 1..32
-    uint32_t reduced;
-    uint32_t dropped;
-    if (s == 32) {
-        reduced = hi;
-        dropped = lo;
-    } else {
-        reduced = (lo >> s) | (hi << (32 - s));
-        dropped = lo & ((static_cast<uint32_t>(1) << s) - 1u);
-    }
-    if (dropped != 0) reduced |= 1u;
-    // reduced >= 2^31, so its binary32 value is normal: scaling by 2^s is
+    uint8_t sticky = 0;
+    do {
+        sticky = static_cast<uint8_t>(sticky | (lo & 1u));
+        lo = (lo >> 1) | (hi << 31);
+        hi >>= 1;
+        ++s;
+    } while (hi != 0);
+    lo |= sticky;
+    // lo >= 2^31, so its binary32 value is normal: scaling by 2^s is
     // adding s to the exponent field (no multiply routine pulled in).
-    const float f = static_cast<float>(reduced);
+    const float f = static_cast<float>(lo);
     uint32_t bits;
     memcpy(&bits, &f, sizeof bits);
     bits += static_cast<uint32_t>(s) << 23;

@@ -4,6 +4,29 @@
 
 namespace fsw {
 
+#if defined(__AVR__)
+static_assert(sizeof(Real) == sizeof(uint32_t), "AVR evaluates in binary32");
+
+// A binary32 pattern is a NaN when its exponent is all ones and its
+// fraction is not zero: the same test as `v == v` fails on, on the bits.
+static bool f32_bits_nan(uint32_t u) { return (u & 0x7FFFFFFFu) > 0x7F800000u; }
+
+Real read_F32(const uint8_t* p) {
+    uint32_t u = load<uint32_t>(p);
+    if (f32_bits_nan(u)) u = 0;  // NaN reads as +0 (real_from_F32)
+    Real r;
+    memcpy(&r, &u, sizeof r);
+    return r;
+}
+
+void write_F32(uint8_t* p, Real r) {
+    uint32_t u;
+    memcpy(&u, &r, sizeof u);
+    if (f32_bits_nan(u)) u = 0;  // NaN is stored as +0 (F32_from_real)
+    store<uint32_t>(p, u);
+}
+#endif
+
 Real read_elem(const uint8_t* p, uint8_t type) {
     switch (type) {
         case kI8: return read_I8(p);

@@ -70,7 +70,7 @@ MUTANTS = {
     "round24_ties_up": lambda: patch_runtime("fsw_convert.cpp",
                                              "if (low > half || (low == half && (m & unit) != 0))",
                                              "if (low >= half)"),
-    "u64_no_sticky": lambda: patch_runtime("fsw_convert.cpp", "if (dropped != 0) reduced |= 1u;", "(void)dropped;"),
+    "u64_no_sticky": lambda: patch_runtime("fsw_convert.cpp", "lo |= sticky;", "(void)sticky;"),
     "f64_soft_ties_away": lambda: patch_runtime("fsw_f64.cpp",
                                                 "if (guard != 0 && (sticky || (sig & 1u) != 0)) ++sig;",
                                                 "if (guard != 0 && (sticky || (sig & 1u) != 0 || true)) ++sig;"),

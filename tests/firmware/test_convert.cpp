@@ -55,6 +55,31 @@ static void test_reads_of_64_bit_integers_round_once_to_nearest_even(void) {
 #endif
 }
 
+// F32 elements by pointer (out of line on AVR, with the NaN test on the
+// bits): the same as the value forms for every class of binary32 pattern.
+static void test_f32_element_access_matches_the_value_forms(void) {
+    static const uint32_t kPatterns[] = {
+        0x00000000UL, 0x80000000UL, 0x3FC00000UL, 0xBF800000UL,  // +-0, 1.5, -1
+        0x00000001UL, 0x807FFFFFUL, 0x00800000UL,                // subnormals, smallest normal
+        0x7F7FFFFFUL, 0xFF7FFFFFUL, 0x7F800000UL, 0xFF800000UL,  // +-max, +-inf
+        0x7F800001UL, 0x7FC00000UL, 0x7FFFFFFFUL,                // NaNs: signalling, quiet, all ones
+        0xFF800001UL, 0xFFC00000UL, 0xFFFFFFFFUL,                // negative NaNs
+    };
+    for (size_t i = 0; i < sizeof kPatterns / sizeof kPatterns[0]; ++i) {
+        uint8_t elem[4];
+        memcpy(elem, &kPatterns[i], 4);
+        float v;
+        memcpy(&v, &kPatterns[i], 4);
+        const bool nan = (kPatterns[i] & 0x7FFFFFFFUL) > 0x7F800000UL;
+        ASSERT_REAL_SAME(real_from_F32(v), read_F32(elem));
+        ASSERT_REAL_SAME(nan ? Real(0) : static_cast<Real>(v), read_F32(elem));
+        uint8_t out[4] = {0xAA, 0xAA, 0xAA, 0xAA};
+        write_F32(out, static_cast<Real>(v));
+        const uint32_t want = nan ? 0UL : kPatterns[i];
+        TEST_ASSERT_EQUAL_HEX32(want, load<uint32_t>(out));
+    }
+}
+
 static void test_reads_of_floats_turn_nan_into_zero(void) {
     ASSERT_REAL_SAME(Real(0), real_from_F32(static_cast<float>(nan_real())));
     ASSERT_REAL_SAME(Real(1.5), real_from_F32(1.5f));
@@ -312,6 +337,7 @@ static void run(void) {
     RUN_TEST(test_reads_of_integers_are_exact_where_R_holds_them);
     RUN_TEST(test_reads_of_64_bit_integers_round_once_to_nearest_even);
     RUN_TEST(test_reads_of_floats_turn_nan_into_zero);
+    RUN_TEST(test_f32_element_access_matches_the_value_forms);
     RUN_TEST(test_assign_u8_saturates_and_truncates);
     RUN_TEST(test_assign_signed_small_types);
     RUN_TEST(test_assign_32_bit_bounds);

@@ -46,6 +46,14 @@ _TOP = Table("the plant and its rate", {
                  lo=1000, hi=100000),
 })
 
+def _chute(what: str) -> Table:
+    return Table(what, {
+        "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
+        "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
+        "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
+    })
+
+
 ROCKET_SCHEMA = {
     "": _TOP,
     "vehicle": Table("the vehicle without its propellant", {
@@ -58,16 +66,8 @@ ROCKET_SCHEMA = {
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
     }),
-    "drogue": Table("the drogue parachute", {
-        "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
-        "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
-        "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
-    }),
-    "main": Table("the main parachute", {
-        "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
-        "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
-        "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
-    }),
+    "drogue": _chute("the drogue parachute"),
+    "main": _chute("the main parachute"),
     "atmosphere": Table("the standard atmosphere", {
         "pad_altitude_m": F("float", "the pad's altitude above sea level, m", lo=-400, hi=8000),
     }),

@@ -232,6 +232,17 @@ class _Binder:
                      + ", ".join(m.name for m in self.app.machines) + ")")
         return m
 
+    def machine_with_state(self, fw):
+        """The `[firmware]` machine, its state element checked: streamed, and
+        that machine's `S`."""
+        m = self.machine(fw["machine"])
+        self.streamed("state_element", fw["state_element"])
+        if m is not None and self.layout.element(fw["state_element"]) is not None \
+                and m.vars[m.s].name != fw["state_element"]:
+            self.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
+                     f"(that is `{m.vars[m.s].name}`)")
+        return m
+
     def streamed(self, key, name):
         streamed = {n for s in self.layout.streams for n in s.region.names}
         if self.layout.element(name) is None:
@@ -315,13 +326,8 @@ class RocketScenario:
         fw, sc, pins = p["firmware"], p["scenario"], p["pins"]
         self.state_element = fw["state_element"]
         self.altitude_element = fw["altitude_element"]
-        m = bind.machine(fw["machine"])
-        bind.streamed("state_element", fw["state_element"])
+        m = bind.machine_with_state(fw)
         bind.streamed("altitude_element", fw["altitude_element"])
-        if m is not None and bind.layout.element(fw["state_element"]) is not None \
-                and m.vars[m.s].name != fw["state_element"]:
-            bind.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
-                     f"(that is `{m.vars[m.s].name}`)")
         for key in ("armed_state", "apogee_state", "landed_state"):
             bind.state(m, key, fw[key])
         for name in fw["pad_states"]:
@@ -464,13 +470,8 @@ class TankScenario:
         fw, sc = p["firmware"], p["scenario"]
         self.state_element = fw["state_element"]
         self.pressure_element = fw["pressure_element"]
-        m = bind.machine(fw["machine"])
-        bind.streamed("state_element", fw["state_element"])
+        m = bind.machine_with_state(fw)
         bind.streamed("pressure_element", fw["pressure_element"])
-        if m is not None and bind.layout.element(fw["state_element"]) is not None \
-                and m.vars[m.s].name != fw["state_element"]:
-            bind.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
-                     f"(that is `{m.vars[m.s].name}`)")
         for key in ("control_state", "abort_state"):
             bind.state(m, key, fw[key])
         self.abort_psi = bind.local(m, "abort_limit", fw["abort_limit"])

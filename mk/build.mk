@@ -12,7 +12,7 @@
 # (shared register save/restore) and linker relaxation (short calls and
 # jumps where they reach); together about 4 % of a firmware's flash.
 
-THIS_MK  := $(lastword $(MAKEFILE_LIST))  # a change of flags rebuilds everything
+THIS_MK  := $(lastword $(MAKEFILE_LIST))
 RUNTIME  ?= $(dir $(THIS_MK))../firmware/src
 ARDUINO  ?= /usr/share/arduino/hardware/arduino/avr
 CORE_DIR := $(ARDUINO)/cores/arduino
@@ -20,6 +20,8 @@ VAR_DIR  := $(ARDUINO)/variants/$(VARIANT)
 
 AVR_CC   ?= avr-gcc
 AVR_CXX  ?= avr-g++
+AVR_AR   ?= avr-gcc-ar
+AVR_OBJCOPY ?= avr-objcopy
 HOST_CXX ?= g++
 
 GEN_SRCS := $(sort $(wildcard $(GEN)/*.cpp))
@@ -35,46 +37,91 @@ CFLAGS   := -std=gnu11 $(OPT) $(DEFS) $(INCS)
 CXXFLAGS := -std=gnu++11 $(OPT) -fno-exceptions -fno-rtti -fno-threadsafe-statics \
             -DDECIMAL_DIG=__DECIMAL_DIG__ $(DEFS) $(INCS)
 WARN     := -Wall -Wextra
+DEPS     := -MMD -MP
+LDFLAGS  := -mmcu=$(MCU) -Os $(SIZE_OPT) -g -flto -fuse-linker-plugin -Wl,--gc-sections -Wl,--relax
+NATIVE_FLAGS := -std=gnu++11 -O2 -ffp-contract=off -fno-exceptions -fno-rtti $(WARN)
 
 CORE_OBJS := $(patsubst $(CORE_DIR)/%,$(OUT)/core/%.o,$(CORE_SRCS))
 RT_OBJS   := $(patsubst $(RUNTIME)/%.cpp,$(OUT)/rt/%.o,$(RT_SRCS))
 GEN_OBJS  := $(patsubst $(GEN)/%.cpp,$(OUT)/gen/%.o,$(GEN_SRCS))
+NATIVE_SRCS := $(filter-out %/psl_arduino.cpp,$(sort $(wildcard $(RUNTIME)/*.cpp)))
+
+# ---- what decides a rebuild ----------------------------------------------------
+# Every object depends on a stamp of the whole build configuration: the
+# board (MCU, clock, variant, board define), every flag, the source folders
+# and their file lists, and each tool's path and version (`tool_id`). The
+# stamp is rewritten only when the configuration changes, so a build for
+# another board, with other flags or another compiler rebuilds everything
+# and an unchanged one rebuilds nothing. Headers are decided per object by
+# the compiler's dependency files (-MMD -MP), the Arduino core's included.
+tool_id = $(shell p=$$(command -v $(1)) && echo "$$p=$$(readlink -f "$$p") $$(stat -Lc '%s %Y' "$$p")" \
+              "$$($(1) --version 2>&1 | head -n 1)")
+file_id = $(shell f=$$($(1)) && echo "$$f $$(stat -Lc '%s %Y' "$$f" 2>/dev/null)")
+
+GOALS      := $(or $(MAKECMDGOALS),avr)
+AVR_STAMP  := $(OUT)/.config-avr
+NATIVE_STAMP := $(OUT)/.config-native
+ifneq ($(filter-out native $(OUT)/$(NAME),$(GOALS)),)
+AVR_CONFIG := mcu=$(MCU) f_cpu=$(F_CPU) variant=$(VARIANT) board=$(BOARD_DEFINE) \
+    arduino=$(realpath $(ARDUINO)) runtime=$(realpath $(RUNTIME)) gen=$(realpath $(GEN)) \
+    cflags=$(CFLAGS) cxxflags=$(CXXFLAGS) warn=$(WARN) ldflags=$(LDFLAGS) \
+    cc=$(call tool_id,$(AVR_CC)) cxx=$(call tool_id,$(AVR_CXX)) ar=$(call tool_id,$(AVR_AR)) \
+    objcopy=$(call tool_id,$(AVR_OBJCOPY)) libc=$(call file_id,$(AVR_CC) -mmcu=$(MCU) -print-file-name=libc.a) \
+    sources=$(notdir $(CORE_SRCS) $(RT_SRCS) $(GEN_SRCS))
+ifneq ($(file <$(AVR_STAMP)),$(AVR_CONFIG))
+$(shell mkdir -p $(OUT))
+$(file >$(AVR_STAMP),$(AVR_CONFIG))
+endif
+endif
+ifneq ($(filter native $(OUT)/$(NAME),$(GOALS)),)
+NATIVE_CONFIG := runtime=$(realpath $(RUNTIME)) gen=$(realpath $(GEN)) flags=$(NATIVE_FLAGS) \
+    cxx=$(call tool_id,$(HOST_CXX)) sources=$(notdir $(NATIVE_SRCS) $(GEN_SRCS))
+ifneq ($(file <$(NATIVE_STAMP)),$(NATIVE_CONFIG))
+$(shell mkdir -p $(OUT))
+$(file >$(NATIVE_STAMP),$(NATIVE_CONFIG))
+endif
+endif
+CONFIG := $(AVR_STAMP) $(THIS_MK)
 
 .PHONY: avr native
 avr: $(OUT)/$(NAME).hex
 
-$(OUT)/core/%.c.o: $(CORE_DIR)/%.c $(THIS_MK)
+$(OUT)/core/%.c.o: $(CORE_DIR)/%.c $(CONFIG)
 	@mkdir -p $(@D)
-	$(AVR_CC) $(CFLAGS) -w -c $< -o $@
-$(OUT)/core/%.cpp.o: $(CORE_DIR)/%.cpp $(THIS_MK)
+	$(AVR_CC) $(CFLAGS) $(DEPS) -w -c $< -o $@
+$(OUT)/core/%.cpp.o: $(CORE_DIR)/%.cpp $(CONFIG)
 	@mkdir -p $(@D)
-	$(AVR_CXX) $(CXXFLAGS) -w -c $< -o $@
-$(OUT)/core/%.S.o: $(CORE_DIR)/%.S $(THIS_MK)
+	$(AVR_CXX) $(CXXFLAGS) $(DEPS) -w -c $< -o $@
+$(OUT)/core/%.S.o: $(CORE_DIR)/%.S $(CONFIG)
 	@mkdir -p $(@D)
-	$(AVR_CC) $(DEFS) $(INCS) -x assembler-with-cpp -c $< -o $@
-$(OUT)/core.a: $(CORE_OBJS)
-	rm -f $@ && avr-gcc-ar rcs $@ $^
+	$(AVR_CC) $(DEFS) $(INCS) $(DEPS) -x assembler-with-cpp -c $< -o $@
+$(OUT)/core.a: $(CORE_OBJS) $(CONFIG)
+	rm -f $@ && $(AVR_AR) rcs $@ $(CORE_OBJS)
 
-$(OUT)/rt/%.o: $(RUNTIME)/%.cpp $(RT_HDRS) $(THIS_MK)
+$(OUT)/rt/%.o: $(RUNTIME)/%.cpp $(CONFIG)
 	@mkdir -p $(@D)
-	$(AVR_CXX) $(CXXFLAGS) $(WARN) -I$(RUNTIME) -c $< -o $@
-$(OUT)/libfswkit.a: $(RT_OBJS)
-	rm -f $@ && avr-gcc-ar rcs $@ $^
+	$(AVR_CXX) $(CXXFLAGS) $(WARN) $(DEPS) -I$(RUNTIME) -c $< -o $@
+$(OUT)/libfswkit.a: $(RT_OBJS) $(CONFIG)
+	rm -f $@ && $(AVR_AR) rcs $@ $(RT_OBJS)
 
-$(OUT)/gen/%.o: $(GEN)/%.cpp $(wildcard $(GEN)/*.h) $(RT_HDRS) $(THIS_MK)
+$(OUT)/gen/%.o: $(GEN)/%.cpp $(CONFIG)
 	@mkdir -p $(@D)
-	$(AVR_CXX) $(CXXFLAGS) $(WARN) -I$(RUNTIME) -I$(GEN) -c $< -o $@
+	$(AVR_CXX) $(CXXFLAGS) $(WARN) $(DEPS) -I$(RUNTIME) -I$(GEN) -c $< -o $@
 
-$(OUT)/$(NAME).elf: $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a $(THIS_MK)
-	$(AVR_CC) -mmcu=$(MCU) -Os $(SIZE_OPT) -g -flto -fuse-linker-plugin -Wl,--gc-sections -Wl,--relax -o $@ \
-	    $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a -lm
+$(OUT)/$(NAME).elf: $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a $(CONFIG)
+	$(AVR_CC) $(LDFLAGS) -o $@ $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a -lm
 $(OUT)/$(NAME).hex: $(OUT)/$(NAME).elf
-	avr-objcopy -O ihex -R .eeprom $< $@
+	$(AVR_OBJCOPY) -O ihex -R .eeprom $< $@
+
+# The same link, kept although it does not fit the MCU's memory, for a
+# report of what uses it (`fsw build` asks for it when the link overflows).
+$(OUT)/$(NAME).overflow.elf: $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a $(CONFIG)
+	$(AVR_CC) $(LDFLAGS) -Wl,--noinhibit-exec -o $@ $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a -lm
+
+-include $(CORE_OBJS:.o=.d) $(RT_OBJS:.o=.d) $(GEN_OBJS:.o=.d)
 
 # ---- host executable ----------------------------------------------------------
-NATIVE_SRCS := $(filter-out %/psl_arduino.cpp,$(sort $(wildcard $(RUNTIME)/*.cpp)))
 native: $(OUT)/$(NAME)
-$(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_SRCS) $(wildcard $(GEN)/*.h) $(RT_HDRS)
+$(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_SRCS) $(wildcard $(GEN)/*.h) $(RT_HDRS) $(NATIVE_STAMP) $(THIS_MK)
 	@mkdir -p $(@D)
-	$(HOST_CXX) -std=gnu++11 -O2 -ffp-contract=off -fno-exceptions -fno-rtti $(WARN) \
-	    -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_SRCS) -pthread
+	$(HOST_CXX) $(NATIVE_FLAGS) -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_SRCS) -pthread

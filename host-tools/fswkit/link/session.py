@@ -47,10 +47,18 @@ class SchemaMismatch(Exception):
     pass
 
 
+def max_frame(layout: Layout) -> int:
+    """The longest encoded frame the layout allows (hello, health, a whole
+    snapshot chunk or a stream's full batch), without its delimiter."""
+    payload = max([_HELLO.size, layout.health_payload, 2 + layout.sv_size]
+                  + [s.region.size * s.batch for s in layout.streams])
+    return wire.encoded_size(wire.HEADER + payload)
+
+
 class Session:
     def __init__(self, layout: Layout, ignore_schema: bool = False):
         self.layout = layout
-        self.deframer = wire.Deframer(self.consistent)
+        self.deframer = wire.Deframer(self.consistent, max_frame(layout))
         self.stats = LinkStats()
         self.ignore_schema = ignore_schema
         self.schema_ok: bool | None = True if ignore_schema else None
@@ -60,6 +68,9 @@ class Session:
         self.health: dict | None = None
         self.acks: list[dict] = []
         self.last_seq: int | None = None
+        # whether last_seq is the target's whole frame counter (from a hello or
+        # health frame), or only extended from the first frame's 8 bits
+        self.seq_known = False
         self.t_ref: int | None = None
         self.delay_min: float | None = None
         self.latency: float | None = None  # seconds above the least delay seen
@@ -182,17 +193,21 @@ class Session:
             full = struct.unpack_from("<I", payload, 9 if ftype == wire.HELLO else 4)[0]
             time_hi = struct.unpack_from("<I", payload, 5 if ftype == wire.HELLO else 0)[0]
             restarted = False
-            if self.last_seq is not None and full <= self.last_seq:
+            if self.seq_known and full <= self.last_seq:
                 restarted = True  # the counter went back: the target was reset
-            if self.last_seq is not None and not restarted:
+            if self.seq_known and not restarted:
                 if full > seq:
                     st.lost += full - seq  # whole wraps of the 8-bit number went missing
                     if gap == 0:
                         st.gaps += 1
+            # Joined mid-stream, the ground numbered its first frame with its
+            # 8 bits alone: the whole counter renumbers the frames seen so far,
+            # and only the gaps between them (counted above) were lost.
             if restarted:
                 st.restarts += 1
                 gap = 0
             seq = full
+            self.seq_known = True
             self.t_ref = (time_hi << 32) | t32
             time = self.t_ref
         else:

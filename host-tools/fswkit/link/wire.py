@@ -28,7 +28,8 @@ STATUS = {
     4: ("NOT_WRITABLE", "the element is not in the application's [uplink] list"),
     5: ("BAD_TASK", "no such task"),
     6: ("BAD_MODE", "mode must be 0 disabled, 1 safed or 2 enabled"),
-    7: ("LOCKED", "the uplink task's own mode cannot be changed over the link"),
+    7: ("LOCKED", "the executor keeps it: the uplink task's own mode, a task's mode, overruns or worst_us "
+                  "element, the reset cause (modes change only by `mode`)"),
 }
 
 _U32 = struct.Struct("<I")
@@ -115,38 +116,69 @@ class WireStats:
     framing_errors: int = 0  # not a COBS block chain, or shorter than a header + CRC
     leading: int = 0  # bytes before the first delimiter that were not a frame (joined mid-frame)
     invalid: int = 0  # verified, but of a type or length the schema does not allow
+    oversized: int = 0  # runs of bytes without a delimiter longer than any frame: dropped unread
+
+
+def encoded_size(body: int) -> int:
+    """The most bytes a frame body of `body` bytes takes on the wire, CRC
+    and COBS included, without its delimiter."""
+    n = body + 2
+    return n + n // 254 + 1
 
 
 class Deframer:
     """Bytes in (any chunking), verified frame bodies out: (type, seq, time32,
     payload). A corrupted frame costs only itself: decoding resumes at the
-    next delimiter."""
+    next delimiter. The bytes held between two delimiters are bounded by
+    `max_frame` (the longest encoded frame): a longer run is no frame, and
+    is dropped up to the next delimiter and counted (`oversized`), so the
+    work stays proportional to the bytes fed, whatever they are."""
 
-    def __init__(self, accept=None):
+    def __init__(self, accept=None, max_frame: int = 1 << 16):
         self.stats = WireStats()
         self._accept = accept  # (type, body) -> bool: a verified frame the schema allows
+        self._max = max_frame
         self._tail = b""
         self._synced = False  # bytes before the first delimiter are a partial frame
+        self._skipping = False  # inside an oversized run: drop up to the next delimiter
 
     def feed(self, data: bytes) -> list[tuple[int, int, int, bytes]]:
         self.stats.bytes += len(data)
+        if self._skipping:
+            z = data.find(b"\0")
+            if z < 0:
+                return []
+            self._skipping = False
+            self._synced = True  # the next byte starts a frame
+            data = data[z + 1:]
         buf = self._tail + data if self._tail else data
         end = buf.rfind(b"\0")
         if end < 0:
             self._tail = buf
+            self._bound()
             return []
         self._tail = buf[end + 1:]
+        first = not self._synced
+        self._synced = True
+        self._bound()
         if end >= BULK:
             encs, bodies = _bulk_decode(buf, end)
         else:
             encs = buf[:end].split(b"\0")
             bodies = [cobs_decode(e) if e else b"" for e in encs]
-        return self._verify(encs, bodies)
+        return self._verify(encs, bodies, first)
 
-    def _verify(self, encs, bodies) -> list[tuple[int, int, int, bytes]]:
+    def _bound(self) -> None:
+        if len(self._tail) > self._max:
+            if self._synced:
+                self.stats.oversized += 1
+            else:  # joined in the middle of something: as a partial first frame
+                self.stats.leading += 1
+            self._tail = b""
+            self._skipping = True
+
+    def _verify(self, encs, bodies, first: bool) -> list[tuple[int, int, int, bytes]]:
         st = self.stats
-        first = not self._synced
-        self._synced = True
         out = []
         append = out.append
         unpack = _U32.unpack_from

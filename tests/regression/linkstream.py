@@ -1,0 +1,76 @@
+"""A target's clean downlink, made frame by frame as the firmware makes it
+(tests/regression helpers): samples of the tank's streams, health frames
+with the full 32-bit frame counter, a hello every ten of them; and the
+tank project, with or without its uplink."""
+
+from __future__ import annotations
+
+import shutil
+import struct
+from pathlib import Path
+
+from conftest import EXAMPLES
+
+from fswkit.link import wire
+
+TANK = EXAMPLES / "tank"
+
+
+def tank_copy(tmp: Path, uplink: bool = True) -> Path:
+    """The tank project copied into `tmp` (without its build folder)."""
+    out = tmp / "tank"
+    shutil.copytree(TANK, out, ignore=shutil.ignore_patterns("build"))
+    if not uplink:
+        app = (out / "tank.app").read_text().replace("uplink   uplink        rate=100\n", "")
+        (out / "tank.app").write_text(app.replace("[uplink]               # elements the ground may write\n"
+                                                  "valveOpen\n", ""))
+    return out
+
+
+def layout_of(project: Path):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.build import load
+    from fswkit.link.layout import from_app
+
+    return from_app(load(str(project), Diagnostics()))
+
+
+def hello(layout, full: int, t: int) -> bytes:
+    payload = struct.pack("<BIIIBBBBH", wire.PROTOCOL, layout.schema, t >> 32, full, 1, 0, 0, 0, 0)
+    return wire.downlink(wire.HELLO, full, t, payload)
+
+
+def health(layout, full: int, t: int) -> bytes:
+    head = struct.pack("<IIIIHBHHHHHHH", t >> 32, full, 0, full, 0, 0, 0, 0, 0, 0, 0, 0, 0)
+    tasks = b"".join(struct.pack("<BBHH", 2, 0, 0, 10) for _ in layout.tasks)
+    payload = head + tasks
+    assert len(payload) == layout.health_payload
+    return wire.downlink(wire.HEALTH, full, t, payload)
+
+
+def sample(layout, full: int, t: int, stream: int = 0) -> bytes:
+    st = layout.streams[stream]
+    one = bytes((full + i) & 0xFF or 1 for i in range(st.region.size))
+    return wire.downlink(0x80 | stream, full, t, one)
+
+
+def stream(layout, first: int, count: int, skip=(), hello_first: bool = False) -> list[bytes]:
+    """`count` frames of a clean link whose frame counter starts at `first`
+    (a ground that attaches mid-stream sees these): samples, a health frame
+    every 25 frames, a hello every 250; the frames numbered in `skip` are
+    left out (lost on the link)."""
+    out = []
+    for k in range(count):
+        full = first + k
+        t = 10 * full
+        if k == 0 and hello_first:
+            f = hello(layout, full, t)
+        elif full % 250 == 0:
+            f = hello(layout, full, t)
+        elif full % 25 == 0:
+            f = health(layout, full, t)
+        else:
+            f = sample(layout, full, t)
+        if full not in skip:
+            out.append(f)
+    return out

@@ -1,12 +1,21 @@
 """`fsw gen` and `fsw build`: an application's configs to generated C++,
 and the generated C++ to firmware (`.elf`/`.hex` for a board, an
-executable for `native`) with a flash/RAM table against the board."""
+executable for `native`) with a flash/RAM table against the board. A
+build holds its folder (`build_lock`), keeps the compiler's output in
+`build.log` there, and explains a failure: firmware that does not fit says
+what uses the memory, line by line of the configs; anything else the
+compiler refuses is an internal error to report."""
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import os
+import re
 import shutil
 import subprocess
+import sys
+import time
 from dataclasses import dataclass
 
 from fswkit.autocode.app import Application, load_app
@@ -15,6 +24,7 @@ from fswkit.autocode.emit_app import emit_app
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUILD_MK = os.path.join(ROOT, "mk", "build.mk")
+ARDUINO = "/usr/share/arduino/hardware/arduino/avr"  # mk/build.mk's default, Debian's arduino-core-avr
 
 
 class BuildError(Exception):
@@ -113,8 +123,73 @@ def elf_size(elf: str) -> tuple[int, int]:
     return sec.get(".text", 0) + sec.get(".data", 0), sec.get(".data", 0) + sec.get(".bss", 0)
 
 
-def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.CompletedProcess]:
-    """Runs mk/build.mk for the application; returns (artifact, process)."""
+# ---- one build of a folder at a time ---------------------------------------------------
+
+LOCK_TIMEOUT_S = 600.0  # how long a build waits for another build of its folder
+_held: dict[str, int] = {}  # folders this process holds: {real path: depth}
+
+
+@contextlib.contextmanager
+def build_lock(out: str, command: str = "build"):
+    """Holds the build folder `out` (an exclusive lock on `out/.lock`, which
+    the system drops when its holder exits, however it exits). A second
+    build of the folder waits, saying for which process, and gives up after
+    LOCK_TIMEOUT_S. Reentrant within a process (`fsw flash` builds, then
+    uploads, under one hold)."""
+    os.makedirs(out, exist_ok=True)
+    key = os.path.realpath(out)
+    if key in _held:
+        _held[key] += 1
+        try:
+            yield
+        finally:
+            _held[key] -= 1
+        return
+    fd = os.open(os.path.join(out, ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if not _try_lock(fd):
+            holder = _holder(fd)
+            sys.stderr.write(f"fsw {command}: waiting for another build of {out} (pid {holder})\n")
+            sys.stderr.flush()
+            deadline = time.monotonic() + LOCK_TIMEOUT_S
+            while not _try_lock(fd):
+                if time.monotonic() > deadline:
+                    raise BuildError(f"another build of {out} (pid {_holder(fd)}) has held it for over "
+                                     f"{LOCK_TIMEOUT_S:g} s: let it finish, or build into another folder (--out)")
+                time.sleep(0.05)
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        _held[key] = 0
+        try:
+            yield
+        finally:
+            del _held[key]
+    finally:
+        os.close(fd)  # and with it the lock
+
+
+def _try_lock(fd: int) -> bool:
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True
+
+
+def _holder(fd: int) -> str:
+    """The process id the holder of a lock file wrote into it."""
+    for _ in range(20):  # the holder writes it right after taking the lock
+        text = os.pread(fd, 32, 0).decode(errors="replace").strip()
+        if text.isdigit():
+            return text
+        time.sleep(0.01)
+    return "unknown"
+
+
+# ---- make ------------------------------------------------------------------------------
+
+def make_args(app: Application, out: str, jobs: int = 2) -> tuple[str, list[str]]:
+    """(artifact, command) of mk/build.mk for the application."""
     gen = os.path.join(out, "gen")
     b = app.board
     name = os.path.splitext(os.path.basename(app.path))[0]
@@ -122,9 +197,12 @@ def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.Com
             f"NAME={name}"]
     if b.is_avr:
         ard = b.raw.get("arduino", {})
-        for tool in ("avr-g++", "avr-gcc", "avr-size", "make"):
+        for tool in ("avr-g++", "avr-gcc", "avr-size", "avr-nm", "make"):
             if shutil.which(tool) is None:
                 raise BuildError(f"`{tool}` is not installed: run `make setup` (or tools/bootstrap.sh)")
+        if not os.path.isfile(os.path.join(ARDUINO, "cores", "arduino", "Arduino.h")):
+            raise BuildError(f"the Arduino core is not installed ({ARDUINO}, Debian package arduino-core-avr): "
+                             "run `make setup` (or tools/bootstrap.sh)")
         args += ["avr", f"MCU={b.mcu}", f"F_CPU={b.f_cpu}", f"VARIANT={ard.get('variant', 'standard')}",
                  f"BOARD_DEFINE={ard.get('board_define', 'ARDUINO_AVR_UNO')}"]
         artifact = os.path.join(out, name + ".elf")
@@ -133,5 +211,219 @@ def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.Com
             raise BuildError("`g++` and `make` are needed for native builds: run `make setup`")
         args += ["native"]
         artifact = os.path.join(out, name)
-    proc = subprocess.run(args, capture_output=True, text=True)
+    return artifact, args
+
+
+def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.CompletedProcess]:
+    """Runs mk/build.mk for the application, holding its folder; returns
+    (artifact, process). The compiler's whole output goes to `out/build.log`."""
+    artifact, args = make_args(app, out, jobs)
+    with build_lock(out):
+        proc = subprocess.run(args, capture_output=True, text=True)
+        with open(log_path(out), "w") as f:
+            f.write(" ".join(args) + "\n" + proc.stdout + proc.stderr)
     return artifact, proc
+
+
+def log_path(out: str) -> str:
+    return os.path.join(out, "build.log")
+
+
+# ---- why a build failed -----------------------------------------------------------------
+
+# The linker's words for memory that is too small (GNU ld).
+OVERFLOW = re.compile(r"region [`']?(\w+)'? overflowed by (\d+) bytes|will not fit in region|"
+                      r"is not within region")
+ERROR_LINE = re.compile(r"error:|static assertion failed|undefined reference")
+
+
+def overflows(proc: subprocess.CompletedProcess) -> bool:
+    return OVERFLOW.search(proc.stdout + proc.stderr) is not None
+
+
+def explain_failure(app: Application, out: str, proc: subprocess.CompletedProcess) -> tuple[bool, str]:
+    """Why a build failed: (the firmware does not fit, the message). A
+    linker that runs out of the MCU's memory is answered with what uses it
+    (`size_report`); anything else that fails on a checked configuration is
+    a defect of the kit, reported with the build log."""
+    log = log_path(out)
+    if app.board.is_avr and overflows(proc):
+        report = overflow_report(app, out)
+        if report is not None:
+            return True, report
+    output = (proc.stdout + proc.stderr).splitlines()
+    lines = [line.strip() for line in output if ERROR_LINE.search(line)] or [line.strip() for line in output[-3:]]
+    shown = [("  " + line[:300] + (" ..." if len(line) > 300 else "")) for line in lines[:6]]
+    more = f"\n  ... and {len(lines) - 6} more" if len(lines) > 6 else ""
+    return False, ("internal error: the generated code did not build for the "
+                   f"{app.board.name}, although the configuration is valid: a defect of fswkit, please report "
+                   f"it with {log}" + ("\n" + "\n".join(shown) + more if shown else ""))
+
+
+def overflow_report(app: Application, out: str) -> str | None:
+    """Links the firmware although it does not fit (`NAME.overflow.elf`,
+    removed after) and says what uses the memory; None when that fails."""
+    artifact, args = make_args(app, out)
+    elf = artifact[:-4] + ".overflow.elf"
+    args = [a for a in args if a != "avr"] + [elf]
+    try:
+        r = subprocess.run(args, capture_output=True, text=True)
+        if r.returncode != 0 or not os.path.exists(elf):
+            return None
+        flash, ram = elf_size(elf)
+        return size_report(app, elf, size_of(app, flash, ram))
+    except BuildError:
+        return None
+    finally:
+        if os.path.exists(elf):
+            os.remove(elf)
+
+
+# ---- what uses the memory ------------------------------------------------------------------
+
+RAM_BASE, EEPROM_BASE = 0x800000, 0x810000  # avr-gcc's address spaces
+CLONE = re.compile(r" \[clone [^\]]*\]|\.(?:lto_priv|constprop|isra|part)\.\d+")
+
+
+def elf_symbols(elf: str) -> list[tuple[int, int, str, str]]:
+    """(address, size, nm type, demangled name) of an ELF's sized symbols."""
+    r = subprocess.run(["avr-nm", "-S", "-C", elf], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise BuildError(f"avr-nm failed: {r.stderr.strip()}")
+    out = []
+    for line in r.stdout.splitlines():
+        parts = line.split(" ", 3)
+        if len(parts) == 4:
+            try:
+                out.append((int(parts[0], 16), int(parts[1], 16), parts[2], CLONE.sub("", parts[3])))
+            except ValueError:
+                continue
+    return out
+
+
+@dataclass
+class Use:
+    """A part of the firmware's flash or RAM, named by what in the configs it
+    comes from; `detail` breaks it down further."""
+    label: str
+    size: int = 0
+    detail: list[tuple[int, str]] | None = None
+
+
+def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
+    """{"flash": [...], "RAM": [...]}, largest first: every generated symbol
+    of the ELF attributed to the config line it comes from (the state
+    vector's regions from the model), the rest as the runtime's."""
+    from fswkit.autocode.emit_cpp import basename, c_ident
+
+    a = basename(app.path)
+    sv = basename(app.sv.path)
+    machines = {c_ident(m.name): m for m in app.machines}
+    task_of = {t.machine: t for t in app.tasks if t.kind == "machine"}
+    tele = next((t for t in app.tasks if t.kind == "telemetry"), None)
+    uses: dict[tuple[str, str], Use] = {}
+
+    def add(space: str, key: str, label: str, size: int, detail=None) -> None:
+        u = uses.setdefault((space, key), Use(label, 0, detail))
+        u.size += size
+
+    def owner(name: str, data: bool) -> tuple[str, str] | None:
+        """(key, label) of a generated symbol."""
+        m = re.match(r"fsw_gen::(?:\(anonymous namespace\)::)?(.*)", name)
+        if not m:
+            return None
+        rest = m.group(1)
+        if rest == "sv":
+            return "sv", f"the state vector, {sv} ({len(app.sv.elements)} elements)"
+        head, sep, inner = rest.partition("::")
+        if sep and head in machines:
+            mach = machines[head]
+            src = basename(mach.path)
+            inner = inner.removeprefix("(anonymous namespace)::")
+            w = re.fullmatch(r"w(\d+)", inner)
+            if w and int(w.group(1)) < len(mach.windows):
+                win = mach.windows[int(w.group(1))]
+                return (f"w:{head}:{win.index}",
+                        f"roll_{win.func} window of {win.size}, {src}:{win.line} (machine {mach.name})")
+            if inner in ("loc", "kLocInit"):
+                return f"loc:{head}", f"the locals of machine {mach.name}, {src} [local]"
+            if data:
+                return f"m:{head}", f"machine {mach.name}, {src}: its state"
+            return f"m:{head}", f"machine {mach.name}, {src}: its states' code"
+        task = re.match(r"task_(\w+)", rest)
+        if task:
+            t = next((t for t in app.tasks if t.name == task.group(1)), None)
+            if t is not None and t.kind == "machine":
+                mach = app.machines[t.machine]
+                return f"m:{c_ident(mach.name)}", f"machine {mach.name}, {basename(mach.path)}: its states' code"
+            if t is not None:
+                return f"t:{t.name}", f"task {t.name} ({t.kind}), {a}:{t.line}"
+        store = re.fullmatch(r"link_store_(\d+)", rest)
+        if store and int(store.group(1)) < len(app.telemetry):
+            s = app.telemetry[int(store.group(1))]
+            return f"store:{s.region.name}", f"samples of stream {s.region.name} batched per frame, {a}:{s.line}"
+        if rest == "link_tx":
+            where = f"{a}:{tele.line}" if tele is not None else a
+            return "link_tx", f"the telemetry transmit buffer (the longest frame), {where}"
+        if rest.startswith(("link", "kLink")):
+            return "link", f"the serial link's state and tables, {a} [telemetry] [uplink]"
+        if rest in ("stats", "kTasks", "kConfig", "ex"):
+            return "tasks", f"the executor and its {len(app.tasks)} tasks, {a} [tasks]"
+        if re.match(r"k(Analog|Digital)(In|Out)", rest):
+            files = ", ".join(sorted({basename(c.path) for c in app.channels}))
+            return "io", f"the I/O channel tables, {files}"
+        return "gen", "other generated code and data"
+
+    for addr, size, kind, name in elf_symbols(elf):
+        if size == 0 or kind in "aAuUN" or addr >= EEPROM_BASE:
+            continue
+        data = addr >= RAM_BASE
+        who = owner(name, data)
+        key, label = who if who is not None else ("", "")
+        if data:
+            if who is not None:
+                add("RAM", key, label, size)
+            if kind in "dD":  # initialised data: its initial value is in flash too
+                add("flash", key, label, size) if who is not None else None
+        elif who is not None:
+            add("flash", key, label, size)
+    regions = sorted(app.sv.regions, key=lambda r: -r.size)
+    sv_detail = [(r.size, f"region {r.name}, {basename(app.sv.path)}:{r.line} ({len(r.elements)} elements)")
+                 for r in regions]
+    if ("RAM", "sv") in uses:
+        uses[("RAM", "sv")].detail = sv_detail
+    return {space: sorted((u for (s, _), u in uses.items() if s == space), key=lambda u: -u.size)
+            for space in ("flash", "RAM")}
+
+
+def size_report(app: Application, elf: str, size: Size, top: int = 8) -> str:
+    """What does not fit, by how much, and what uses that memory: the
+    largest parts first, each named by the config line it comes from."""
+    b = app.board
+    whose = "the application's [budget]" if size.owner else f"the {b.name} ({b.mcu})"
+    over = [(what, used, budget) for what, used, budget in (("flash", size.flash, size.flash_budget),
+                                                            ("RAM", size.ram, size.ram_budget)) if used > budget]
+    lines = [f"the firmware does not fit {whose}: " +
+             "; ".join(f"{what} {used:,} B of {budget:,} B, {used - budget:,} B over" for what, used, budget in over),
+             size.table()]
+    try:
+        users = memory_users(app, elf)
+    except BuildError:
+        return "\n".join(lines)
+    for what, used, _ in over:
+        parts = users[what]
+        runtime = used - sum(u.size for u in parts)
+        lines.append(f"what uses {what}, largest first:")
+        for u in parts[:top]:
+            lines.append(f"  {u.size:>9,} B  {u.label}")
+            for n, text in (u.detail or [])[:5]:
+                lines.append(f"  {'':>11}  {n:>7,} B  {text}")
+        rest = sum(u.size for u in parts[top:])
+        if rest:
+            lines.append(f"  {rest:>9,} B  {len(parts) - top} smaller part(s) of the generated code")
+        if runtime > 0:
+            lines.append(f"  {runtime:>9,} B  the fswkit runtime, the Arduino core and the C library"
+                         + (" (serial buffers, the clock)" if what == "RAM" else ""))
+    if any(what == "RAM" for what, _, _ in over):
+        lines.append("(RAM must also leave room for the stack)")
+    return "\n".join(lines)

@@ -298,40 +298,46 @@ def cmd_gen(args) -> int:
 
 
 def cmd_build(args) -> int:
-    from fswkit.build import BuildError, default_out, elf_size, make, size_of
+    from fswkit.build import BuildError, build_lock, default_out
 
     app = _load_app(args, "build")
     if app is None:
         return EXIT_CONFIG
     out = args.out or default_out(app)
-    if _generate(app, os.path.join(out, "gen"), "build") is None:
-        return EXIT_FAIL
     try:
-        artifact, proc = make(app, out)
+        with build_lock(out, "build"):
+            return _build_locked(app, out)
     except BuildError as e:
         sys.stderr.write(f"fsw build: {e}\n")
         return EXIT_FAIL
-    if proc.returncode != 0:
-        sys.stderr.write(proc.stdout[-2000:] + proc.stderr[-6000:])
-        sys.stderr.write("fsw build: the build failed\n")
+    except OSError as e:
+        sys.stderr.write(f"fsw build: cannot write {e.filename or out}: {e.strerror or e}\n")
         return EXIT_FAIL
+
+
+def _build_locked(app, out: str) -> int:
+    """`fsw build` once it holds its folder."""
+    from fswkit.build import elf_size, explain_failure, make, size_of, size_report
+
+    if _generate(app, os.path.join(out, "gen"), "build") is None:
+        return EXIT_FAIL
+    artifact, proc = make(app, out)
+    if proc.returncode != 0:
+        too_big, message = explain_failure(app, out, proc)
+        sys.stderr.write(f"fsw build: {message}\n")
+        return EXIT_FAIL if too_big else EXIT_INTERNAL
     b = app.board
     print(f"fsw build: {os.path.basename(app.path)} for {b.name} ({b.mcu})")
     if not b.is_avr:
         print(f"  {artifact}")
         return EXIT_OK
-    try:
-        flash, ram = elf_size(artifact)
-    except BuildError as e:
-        sys.stderr.write(f"fsw build: {e}\n")
-        return EXIT_FAIL
+    flash, ram = elf_size(artifact)
     size = size_of(app, flash, ram)
+    if not size.fits:
+        sys.stderr.write(f"fsw build: {size_report(app, artifact, size)}\n")
+        return EXIT_FAIL
     print(size.table())
     print(f"  {artifact}\n  {artifact[:-4]}.hex")
-    if not size.fits:
-        whose = "the application's [budget]" if size.owner else f"the {b.name}"
-        sys.stderr.write(f"fsw build: the firmware does not fit {whose}\n")
-        return EXIT_FAIL
     return EXIT_OK
 
 

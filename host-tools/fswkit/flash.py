@@ -233,7 +233,7 @@ def upload_pio(app, port: str) -> int:
 # ---- the command -----------------------------------------------------------------------
 
 def main(args) -> int:
-    from fswkit.build import default_out
+    from fswkit.build import BuildError, build_lock, default_out
     from fswkit.cli import _load_app, cmd_build
     from fswkit.ports import PortError, default_port
 
@@ -256,11 +256,15 @@ def main(args) -> int:
         if args.via == "pio":
             return upload_pio(app, port)
         out = args.out or default_out(app)
-        code = cmd_build(argparse.Namespace(project=args.project, board=args.board, out=out))
-        if code != EXIT_OK:
-            return code
-        name = os.path.splitext(os.path.basename(app.path))[0]
-        return upload_avrdude(board, os.path.join(out, name + ".hex"), port, args.verbose)
+        with build_lock(out, "flash"):  # no other build rewrites the image between building and uploading it
+            code = cmd_build(argparse.Namespace(project=args.project, board=args.board, out=out))
+            if code != EXIT_OK:
+                return code
+            name = os.path.splitext(os.path.basename(app.path))[0]
+            return upload_avrdude(board, os.path.join(out, name + ".hex"), port, args.verbose)
+    except BuildError as e:
+        sys.stderr.write(f"fsw flash: {e}\n")
+        return EXIT_FAIL
     except PortError as e:
         sys.stderr.write(f"fsw flash: {e}\n")
         return EXIT_FAIL

@@ -645,7 +645,8 @@ def _build(args) -> tuple[str, Board] | int:
     and board, or an exit status after saying why."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.emit_app import GenError, emit_app
-    from fswkit.build import BuildError, default_out, elf_size, load, make, write_files
+    from fswkit.build import (BuildError, build_lock, default_out, elf_size, explain_failure, load, make,
+                              size_of, size_report, write_files)
 
     diags = Diagnostics()
     try:
@@ -664,8 +665,17 @@ def _build(args) -> tuple[str, Board] | int:
         return 2
     out = args.out or default_out(app)
     try:
-        write_files(emit_app(app), os.path.join(out, "gen"))
-        elf, proc = make(app, out)
+        with build_lock(out, "sim"):  # one build of a folder at a time (fsw build, fsw flash, fsw sim)
+            write_files(emit_app(app), os.path.join(out, "gen"))
+            elf, proc = make(app, out)
+            if proc.returncode != 0:
+                too_big, message = explain_failure(app, out, proc)
+                _say(message)
+                return 1 if too_big else 3
+            flash, ram = elf_size(elf)
+            if flash > board.flash or ram > board.ram:
+                _say(size_report(app, elf, size_of(app, flash, ram)))
+                return 1
     except GenError as e:
         _say(str(e))
         return 1
@@ -674,18 +684,6 @@ def _build(args) -> tuple[str, Board] | int:
         return 1
     except OSError as e:
         _say(f"cannot write {e.filename or out}: {e.strerror or e}")
-        return 1
-    if proc.returncode != 0:
-        sys.stderr.write(proc.stdout[-2000:] + proc.stderr[-6000:])
-        _say("the build failed")
-        return 1
-    try:
-        flash, ram = elf_size(elf)
-    except BuildError as e:
-        _say(str(e))
-        return 1
-    if flash > board.flash or ram > board.ram:
-        _say(f"the firmware does not fit the {board.name} ({flash:,} B flash, {ram:,} B RAM): see `fsw build`")
         return 1
     _say(f"built {elf} for {board.name} ({flash:,} B flash, {ram:,} B RAM)")
     return elf, board

@@ -94,7 +94,7 @@ def _now(app: Application) -> str:
     """C++ for the value of `G` now."""
     if app.time_source == "cycle":
         per_cycle = (1000 if app.time_unit == "ms" else 1000000) // app.rate
-        return f"static_cast<uint64_t>(ex.cycles) * {per_cycle}u"
+        return f"fsw::executor_cycles(ex) * {per_cycle}u"
     return "fsw::pal::millis64()" if app.time_unit == "ms" else "fsw::pal::micros64()"
 
 
@@ -329,8 +329,11 @@ def _native_main(app: Application) -> list[str]:
          "//                          the same, with the link's bytes on stdout instead of the",
          "//                          hex; --uart models the UART's speed on the simulated clock",
          '//   PINS: aPIN=RAW sets an ADC reading, dPIN=0|1 a digital input level.',
+         '//   --first-cycle N        starts the cycle count at N (with `[time] source cycle`,',
+         '//                          G too): a long run\'s 2^32 wrap without the wait',
          'int main(int argc, char** argv) {',
          '    unsigned long cycles = 0, baud = 0;',
+         '    unsigned long long first_cycle = 0;',
          '    bool simulated = false, link_out = false;',
          '    for (int i = 1; i < argc; ++i) {',
          '        unsigned pin = 0, value = 0;',
@@ -339,6 +342,8 @@ def _native_main(app: Application) -> list[str]:
          '            link_out = true;',
          '        } else if (strcmp(argv[i], "--uart") == 0 && i + 1 < argc) {',
          '            baud = strtoul(argv[++i], 0, 10);',
+         '        } else if (strcmp(argv[i], "--first-cycle") == 0 && i + 1 < argc) {',
+         '            first_cycle = strtoull(argv[++i], 0, 10);',
          '        } else if (sscanf(argv[i], "a%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 65536) {',
          '            fsw::native::sim_set_analog(static_cast<uint8_t>(pin), static_cast<uint16_t>(value));',
          '        } else if (sscanf(argv[i], "d%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 2) {',
@@ -347,7 +352,8 @@ def _native_main(app: Application) -> list[str]:
          '            cycles = strtoul(argv[i], 0, 10);',
          '            simulated = true;',
          '        } else {',
-         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [aPIN=RAW] [dPIN=0|1]\\n", argv[0]);',
+         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [--first-cycle N] [aPIN=RAW] [dPIN=0|1]\\n",',
+         '                    argv[0]);',
          '            return 2;',
          '        }',
          '    }',
@@ -356,6 +362,8 @@ def _native_main(app: Application) -> list[str]:
          '    if (simulated && !link_out) fsw::native::console_capture(discard, 0, &discarded);',
          '    if (baud != 0) fsw::native::console_model_uart(static_cast<uint32_t>(baud), 64);',
          '    if (!fsw_gen::begin()) { fprintf(stderr, "the runtime refused a table\\n"); return 3; }',
+         '    fsw_gen::ex.cycles = static_cast<uint32_t>(first_cycle);',
+         '    fsw_gen::ex.cycles_high = static_cast<uint32_t>(first_cycle >> 32);',
          '    if (!simulated) {',
          '        // Paced by the wall clock, timed by the simulated one: cycle k runs at',
          '        // simulated time k periods, so G grows by exactly a period a cycle even',

@@ -52,6 +52,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     pal::begin();
     ex.next_due_us = pal::micros32();
     ex.cycles = 0;
+    ex.cycles_high = 0;
     ex.late = 0;
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
@@ -94,7 +95,7 @@ void executor_run_cycle(Executor& ex) {
 #endif
         mirror_stats(c, t, s);
     }
-    ++ex.cycles;
+    if (++ex.cycles == 0) ++ex.cycles_high;
 }
 
 bool executor_poll(Executor& ex) {

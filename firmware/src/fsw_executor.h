@@ -30,6 +30,10 @@ struct Task {
     uint8_t init_mode;       // mode set by executor_begin
 };
 
+static_assert(offsetof(Task, overruns_off) == offsetof(Task, mode_off) + sizeof(ElemOff) &&
+                  offsetof(Task, worst_us_off) == offsetof(Task, overruns_off) + sizeof(ElemOff),
+              "a task's element offsets are adjacent (the link reads them as one)");
+
 // Per-task run-time record (RAM, zero-initialised): 11 bytes.
 struct TaskStats {
     uint32_t worst_us;       // longest step (or safe) call, microseconds
@@ -55,10 +59,22 @@ struct ExecConfig {
 struct Executor {
     const ExecConfig* cfg;   // FSW_FLASH
     uint32_t next_due_us;    // start of the next cycle: micros32(), which wraps
-    uint32_t cycles;         // cycles run
+    uint32_t cycles;         // cycles run, low 32 bits (health frames carry these)
     uint16_t late;           // cycles that started a full period or more late
     uint8_t reset_cause;     // captured at executor_begin
+    uint32_t cycles_high;    // cycles run, high 32 bits: wraps of `cycles`
 };
+
+// Cycles run, all 64 bits: `[time] source cycle` keeps counting past the
+// 2^32nd cycle (49.7 days at 1 kHz) instead of starting again from 0.
+inline uint64_t executor_cycles(const Executor& ex) {
+    // (high << 32) | low, read without the 64-bit shift an 8-bit MCU calls a
+    // library routine for (little-endian targets, fsw_config.h)
+    const uint32_t words[2] = {ex.cycles, ex.cycles_high};
+    uint64_t n;
+    memcpy(&n, words, sizeof n);
+    return n;
+}
 
 // Validates the table (dividers, phases), sets every task's initial mode,
 // starts the platform, arms the watchdog, captures the reset cause. The

@@ -194,6 +194,20 @@ void service(Link& l, const LinkConfig& c) {
 
 // ---- uplink ----------------------------------------------------------------
 
+// Whether the element at `off` is one the executor writes: a task's mode,
+// overruns or worst_us, the reset cause. Modes change only by MODE, and the
+// executor's records never by the ground, whatever the writable table lists.
+FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
+    const ExecConfig ec = executor_config(*c.ex);
+    if (off == ec.reset_cause_off) return true;
+    for (uint8_t i = 0; i < ec.n_tasks; ++i) {
+        ElemOff own[3];  // mode, overruns, worst_us: adjacent in a Task row
+        flash_read(own, &ec.tasks[i].mode_off, sizeof own);
+        if (off == own[0] || off == own[1] || off == own[2]) return true;
+    }
+    return false;
+}
+
 uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
     if (alen < 2) return kAckBadLength;
     const uint16_t index = load<uint16_t>(a);
@@ -203,6 +217,7 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
         if (w.index != index) continue;
         const uint8_t size = elem_size(w.type);
         if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
+        if (executor_owns(c, w.off)) return kAckLocked;
         uint8_t* const p = c.sv + w.off;
         const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
         memcpy(p, a + 2, size);

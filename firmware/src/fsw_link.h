@@ -40,7 +40,8 @@ enum LinkStatus : uint8_t {
     kAckNotWritable = 4,  // the element is not in the application's [uplink] list
     kAckBadTask = 5,      // no such task
     kAckBadMode = 6,      // mode not 0, 1 or 2
-    kAckLocked = 7,       // the uplink task's own mode cannot be changed over the link
+    kAckLocked = 7,       // the executor's: the uplink task's mode, or a SET of a task's mode,
+                          // overruns or worst_us element or of the reset cause
 };
 
 static const uint8_t kLinkHeader = 6;  // type, sequence number, time (low 32 bits)

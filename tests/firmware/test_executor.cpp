@@ -200,6 +200,24 @@ static void test_reset_cause_is_captured(void) {
 #endif
 }
 
+// The cycle count is 64 bits: it keeps counting past the 2^32nd cycle
+// (`[time] source cycle` derives G from it), and health frames still carry
+// its low 32 bits where they always lay.
+static void test_cycle_count_across_the_32_bit_wrap(void) {
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
+    TEST_ASSERT_EQUAL_UINT32(0, static_cast<uint32_t>(executor_cycles(ex) >> 32));
+    ex.cycles = 0xFFFFFFFEUL;
+    uint64_t last = executor_cycles(ex);
+    for (uint8_t k = 0; k < 4; ++k) {
+        executor_run_cycle(ex);
+        TEST_ASSERT_TRUE(executor_cycles(ex) == last + 1);
+        last = executor_cycles(ex);
+    }
+    TEST_ASSERT_TRUE(executor_cycles(ex) == 0x100000002ULL);
+    TEST_ASSERT_EQUAL_UINT32(2, ex.cycles);
+    TEST_ASSERT_EQUAL_UINT32(1, ex.cycles_high);
+}
+
 static const Task kBadDivider[1] FSW_FLASH = {{step_fn, 0, CTX(0), 0, 0, kNoElement, kNoElement, kNoElement, 2}};
 static const Task kBadPhase[1] FSW_FLASH = {{step_fn, 0, CTX(0), 2, 2, kNoElement, kNoElement, kNoElement, 2}};
 static const Task kNoStep[1] FSW_FLASH = {{0, 0, CTX(0), 1, 0, kNoElement, kNoElement, kNoElement, 2}};
@@ -250,6 +268,7 @@ static void run(void) {
     RUN_TEST(test_overrun_and_worst_step_time);
     RUN_TEST(test_poll_keeps_the_rate_and_counts_late_cycles);
     RUN_TEST(test_reset_cause_is_captured);
+    RUN_TEST(test_cycle_count_across_the_32_bit_wrap);
     RUN_TEST(test_begin_refuses_bad_tables);
 #if FSW_PLATFORM_NATIVE
     RUN_TEST(test_poll_across_the_32_bit_wrap);

@@ -286,6 +286,30 @@ static void test_mode_commands(void) {
     TEST_ASSERT_EQUAL_UINT8(kModeEnabled, executor_task_mode(ex, 0));
 }
 
+// A writable table that lists the telemetry task's mode element (a
+// hand-written one; the generator never emits it): SET is LOCKED, the mode
+// changes only by MODE.
+static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
+static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false};
+
+static void test_set_of_a_mode_element_is_locked(void) {
+    link_begin(link, &kConfigMode);
+    run(1);
+    const uint8_t off[] = {2, 0, kModeDisabled};
+    send_cmd(kOpSet, 1, off, 3);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckLocked, ack_status(1));
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[8]);
+    const uint8_t level[] = {4, 0, 0x34, 0x12};  // its neighbour still writable
+    send_cmd(kOpSet, 2, level, 4);
+    run(1);
+    TEST_ASSERT_EQUAL(kAckOk, ack_status(2));
+    TEST_ASSERT_EQUAL_INT16(0x1234, load<int16_t>(sv + 10));
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, sv[8]);
+    TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_refused);
+}
+
 static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
     run(1);
     // CRC error: a valid SET with one bit flipped
@@ -387,6 +411,7 @@ static void run_all(void) {
     RUN_TEST(test_wrong_length_is_refused);
     RUN_TEST(test_replayed_frame_is_refused);
     RUN_TEST(test_mode_commands);
+    RUN_TEST(test_set_of_a_mode_element_is_locked);
     RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
     RUN_TEST(test_ping_hello_snapshot);
     RUN_TEST(test_bad_tables_do_not_pass_the_compile_time_checks);

@@ -31,7 +31,7 @@ from fractions import Fraction
 from . import model as M
 from .board import Board, BoardError, load_board
 from .check import check_sm, check_sv
-from .diagnostics import APP, Diagnostics, Source, read_source
+from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
 from .lexer import ID, NUM, OP, lex
 from .numeric import exact_literal
@@ -176,9 +176,19 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
                 rate = int(q)
     baud = 115200
     if "baud" in settings:
-        q = _positive(settings["baud"], src, diags, "`baud`")
-        if q is not None and q.denominator == 1:
+        bt = settings["baud"]
+        q = _positive(bt, src, diags, "`baud`")
+        if q is not None and q.denominator != 1:
+            near = round(q)
+            made = _uart_rate(board, near) if board is not None and near > 0 else None
+            err(bt, f"`baud` must be a whole number of bits per second, found `{bt.text}`"
+                    + (f" (for {near} the {board.name}'s UART makes {float(made):,.0f} baud, {_percent(made, near)})"
+                       if made is not None else ""))
+        elif q is not None:
             baud = int(q)
+            problem = _baud_problem(board, baud) if board is not None else None
+            if problem is not None:
+                err(bt, problem)
 
     # [configs]
     sv_tok = None
@@ -210,6 +220,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
     machines: list[M.Machine] = []
     machine_names: dict[str, int] = {}
+    machine_srcs: dict[str, Source] = {}  # by machine name: where its writes are reported
     for key, tok, mpath in machine_toks:
         msrc = read_source(mpath, diags, APP)
         if msrc is None:
@@ -221,6 +232,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             err(tok, f"two machines are named `{m.name}`")
             continue
         machine_names[m.name] = len(machines)
+        machine_srcs[m.name] = msrc
         machines.append(m)
     channels: list[Channel] = []
     if board is not None:
@@ -263,6 +275,8 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     tasks: list[Task] = []
     task_lines: dict[str, int] = {}
     machine_tasks: dict[int, int] = {}
+    link_tasks: dict[str, Task] = {}  # kinds that drive the one serial link: the first of each
+    task_opts: dict[str, dict] = {}  # by task name: its `key=value` tokens
     for toks in body.get("tasks", []):
         tname = toks[0]
         if tname.kind != ID:
@@ -276,6 +290,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             err(t, f"expected what the task runs: one of {', '.join(TASK_KINDS)}")
             continue
         kind = toks[1].text
+        if kind in link_tasks:
+            first = link_tasks[kind]
+            err(toks[1], f"a second `{kind}` task: task `{first.name}` on line {first.line} already drives "
+                         f"the serial link (at most one `{kind}` task)")
+            continue
         i = 2
         midx = None
         if kind == "machine":
@@ -346,8 +365,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
                 continue
             start = st.text
         task_lines[tname.text] = tname.line
+        task_opts[tname.text] = opts
         tasks.append(Task(tname.text, kind, midx, task_rate, int(divider), mode_el, start, tname.line,
                           stat_elems.get("overruns"), stat_elems.get("worst_us")))
+        if kind in ("telemetry", "uplink"):
+            link_tasks[kind] = tasks[-1]
     for name_, idx in machine_names.items():
         if idx not in machine_tasks:
             tok = next(t for k, t, p in machine_toks if os.path.splitext(os.path.basename(p))[0] == name_)
@@ -357,13 +379,6 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         if t.kind == "machine" and t.rate > per_second:
             diags.error(src, APP, t.line, 1, f"task `{t.name}` runs at {t.rate} Hz but `G` counts in {time_unit}: "
                                              "`G` would not increase between its steps (use `unit us`)")
-    mode_owner: dict[str, int] = {}
-    for t in tasks:
-        if t.mode is not None:
-            if t.mode.name in mode_owner:
-                diags.error(src, APP, t.line, 1, f"mode element `{t.mode.name}` is already the mode of "
-                                                 f"the task on line {mode_owner[t.mode.name]}")
-            mode_owner[t.mode.name] = t.line
 
     # [telemetry]
     streams: list[Stream] = []
@@ -400,6 +415,12 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     writable: list[M.Element] = []
     owners = {m.vars[m.g].name: f"`G` of machine `{m.name}`" for m in machines}
     owners.update({m.vars[m.s].name: f"`S` of machine `{m.name}`" for m in machines})
+    for t in tasks:  # what the executor writes: modes change only by MODE
+        for what, el in (("mode", t.mode), ("overruns", t.overruns), ("worst_us", t.worst_us)):
+            if el is not None:
+                owners.setdefault(el.name, f"the {what} of task `{t.name}`")
+    if "reset_cause" in settings:
+        owners.setdefault(settings["reset_cause"].text, "the reset cause")
     inputs = {c.element.name: f"input channel {c.path}:{c.line}" for c in channels if c.direction == "i"}
     for toks in body.get("uplink", []):
         et = toks[0]
@@ -425,6 +446,9 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             err(rt, f"unknown element `{rt.text}`")
         elif reset_cause.type is not U8:
             err(rt, f"`reset_cause` needs a U8 element; `{rt.text}` is {reset_cause.type}")
+
+    _one_writer(diags, src, err, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause,
+                machines, machine_srcs)
 
     # [budget]
     budget: dict[str, int] = {}
@@ -459,6 +483,110 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
                        tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable),
                        reset_cause, budget.get("flash"), budget.get("ram"))
+
+
+def _assigned(stmts, out: list) -> list:
+    """(var index, line, col) of every assignment in `stmts`, nested blocks
+    included, in source order."""
+    for st in stmts:
+        if isinstance(st, M.Assign):
+            out.append((st.var, st.line, st.col))
+        elif isinstance(st, M.If):
+            _assigned(st.then, out)
+            _assigned(st.orelse, out)
+    return out
+
+
+def _one_writer(diags, src, err, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs):
+    """Every element has at most one writer among the input channels, the
+    executor (each task's mode, overruns and worst_us; the reset cause) and
+    the machines (their assignments and their own `S`); a second writer is
+    reported where it is written, naming the first. (`G` is the executor's
+    by construction: every machine declares it read-only. The uplink is no
+    writer of this kind: see its own check.)"""
+    writers: dict[str, str] = {}
+
+    def write(name: str, who: str, report) -> None:
+        if name in writers:
+            report(f"element `{name}` is already written by {writers[name]}: {who} cannot write it too")
+        else:
+            writers[name] = who
+
+    for c in channels:
+        if c.direction == "i":  # two input channels: check_table's own error
+            writers.setdefault(c.element.name, f"input channel {c.path}:{c.line}")
+    for t in tasks:
+        for key, el in (("mode", t.mode), ("overruns", t.overruns), ("worst_us", t.worst_us)):
+            if el is not None:
+                tok = task_opts[t.name][key][1]
+                write(el.name, f"the executor (the {key} of task `{t.name}`)", lambda msg, tok=tok: err(tok, msg))
+    if reset_el is not None and reset_el.type is U8:
+        write(reset_el.name, "the executor (the reset cause)", lambda msg: err(reset_tok, msg))
+    for m in machines:
+        msrc = machine_srcs[m.name]
+        s = m.vars[m.s]
+        write(s.name, f"machine `{m.name}` (its `S`)", lambda msg: diags.error(msrc, SM, s.line, 1, msg))
+        seen = set()
+        for st in m.states:
+            for var, line, col in _assigned(st.entry + st.step + st.exit, []):
+                v = m.vars[var]
+                if v.kind != M.ELEMENT or v.name in seen:
+                    continue
+                seen.add(v.name)
+                write(v.name, f"machine `{m.name}` ({os.path.basename(m.path)}:{line})",
+                      lambda msg, line=line, col=col: diags.error(msrc, SM, line, col, msg))
+
+
+# The UART's error a serial link allows: 8N1 frames tolerate about 4.5 %
+# between the two ends in all; half of it is the target's (the Arduino
+# standard, 115200 baud from 16 MHz, is +2.12 %).
+BAUD_TOLERANCE = Fraction(25, 1000)
+UBRR_MAX = 4095  # the divisor register's 12 bits
+
+
+def _ubrr(f_cpu: int, baud: int) -> int:
+    """The divisor the runtime programs (psl_arduino_console.cpp, as the
+    Arduino core: double speed, U2X), before it is cut to 16 bits; negative
+    where the C expression underflows."""
+    return (f_cpu // 4 // baud - 1) // 2
+
+
+def _uart_rate(board: Board, baud: int) -> Fraction | None:
+    """The rate the board's UART makes when asked for `baud`; None without a
+    UART clock (the host build) or outside the divisor's range."""
+    if not board.f_cpu:
+        return None
+    ubrr = _ubrr(board.f_cpu, baud)
+    if not 0 <= ubrr <= UBRR_MAX:
+        return None
+    return Fraction(board.f_cpu, 8 * (ubrr + 1))
+
+
+def _percent(made: Fraction, baud: int) -> str:
+    return f"{float(made / baud - 1) * 100:+.2f} %"
+
+
+def _baud_problem(board: Board, baud: int) -> str | None:
+    """Why the board's UART cannot run at `baud` within BAUD_TOLERANCE, or
+    None (as avr-libc's <util/setbaud.h> computes it, for the divisor the
+    runtime uses)."""
+    if not board.f_cpu:
+        return None
+    mhz = f"{board.f_cpu / 1e6:g} MHz, double speed"
+    ubrr = _ubrr(board.f_cpu, baud)
+    if ubrr < 0:
+        fastest = Fraction(board.f_cpu, 8)
+        return (f"`baud {baud}` is faster than the {board.name}'s UART can run ({mhz}): "
+                f"the fastest it makes is {float(fastest):,.0f} baud, {_percent(fastest, baud)}")
+    if ubrr > UBRR_MAX:
+        slowest = Fraction(board.f_cpu, 8 * (UBRR_MAX + 1))
+        return (f"`baud {baud}` is slower than the {board.name}'s UART can run ({mhz}, a 12-bit divisor): "
+                f"the slowest it makes is {float(slowest):,.0f} baud, {_percent(slowest, baud)}")
+    made = Fraction(board.f_cpu, 8 * (ubrr + 1))
+    if abs(made / baud - 1) > BAUD_TOLERANCE:
+        return (f"`baud {baud}`: the {board.name}'s UART makes {float(made):,.0f} baud ({mhz}, UBRR {ubrr}), "
+                f"{_percent(made, baud)}, more than the ±{float(BAUD_TOLERANCE) * 100:g} % a serial link allows")
+    return None
 
 
 def _col_index(line: str, col: int) -> int:

@@ -1,15 +1,24 @@
 """`fsw test --native`: the generated C++ of a machine and its state script,
 compiled with the host compiler against the runtime and run. Builds are
-cached by the hash of everything that goes into them."""
+cached by the hash of everything that goes into them, the compiler's
+identity included. A compile happens in a temporary folder beside the
+cache entry, moved into place when complete and removed however the
+compile ends; those of processes that died mid-compile are swept away."""
 
 from __future__ import annotations
 
+import atexit
+import contextlib
 import hashlib
 import os
+import re
 import shutil
+import signal
 import struct
 import subprocess
 import sys
+import threading
+import time
 
 from fswkit.autocode import model as M
 from fswkit.autocode.emit_cpp import script_files
@@ -46,8 +55,31 @@ def runtime_sources() -> list[str]:
                   if n.endswith(".cpp") and n != "psl_arduino.cpp")
 
 
+_versions: dict[tuple, str] = {}
+
+
+def compiler_identity(cxx: str) -> str:
+    """The compiler's path, its size and date, and its version: another
+    compiler, or the same one upgraded, is another build."""
+    path = shutil.which(cxx) or cxx
+    real = os.path.realpath(path)
+    try:
+        st = os.stat(real)
+    except OSError:
+        return real
+    key = (path, real, st.st_size, st.st_mtime_ns)
+    if key not in _versions:
+        try:
+            r = subprocess.run([path, "--version"], capture_output=True, text=True, timeout=60)
+            _versions[key] = r.stdout.split("\n", 1)[0]
+        except (OSError, subprocess.TimeoutExpired):
+            _versions[key] = ""
+    return f"{path}={real} {st.st_size} {st.st_mtime_ns} {_versions[key]}"
+
+
 def _key(files: dict[str, str], real: Real) -> str:
     h = hashlib.sha256()
+    h.update(compiler_identity(CXX).encode() + b"\0")
     for path in runtime_sources() + sorted(os.path.join(RUNTIME, n) for n in os.listdir(RUNTIME) if n.endswith(".h")):
         with open(path, "rb") as f:
             h.update(path.encode() + b"\0" + f.read())
@@ -67,22 +99,92 @@ def build(script: M.Script, real: Real, source_line) -> str:
     exe = os.path.join(out, "runner")
     if os.path.exists(exe):
         return exe
+    sweep(cache_dir())
     tmp = out + f".tmp{os.getpid()}"
-    os.makedirs(tmp, exist_ok=True)
-    for name, text in files.items():
-        with open(os.path.join(tmp, name), "w") as f:
-            f.write(text)
-    cpp = [os.path.join(tmp, n) for n in sorted(files) if n.endswith(".cpp")]
-    cmd = [CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp + \
-        runtime_sources() + ["-o", os.path.join(tmp, "runner")]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        raise NativeError("the generated code did not compile (a bug in fswkit):\n" + r.stderr[-4000:])
-    try:
-        os.replace(tmp, out)
-    except OSError:  # another process built the same runner first
-        shutil.rmtree(tmp, ignore_errors=True)
+    with _removed_when_done(tmp):
+        os.makedirs(tmp, exist_ok=True)
+        for name, text in files.items():
+            with open(os.path.join(tmp, name), "w") as f:
+                f.write(text)
+        cpp = [os.path.join(tmp, n) for n in sorted(files) if n.endswith(".cpp")]
+        cmd = [CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp + \
+            runtime_sources() + ["-o", os.path.join(tmp, "runner")]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise NativeError("the generated code did not compile (a bug in fswkit):\n" + r.stderr[-4000:])
+        try:
+            os.replace(tmp, out)
+        except OSError:  # another process built the same runner first
+            pass
     return exe
+
+
+# ---- temporary folders ----------------------------------------------------------------
+
+TMP_NAME = re.compile(r"^[0-9a-f]{20}\.tmp(\d+)$")
+STALE_S = 24 * 3600.0  # no compile takes a day: older temporary folders are leftovers
+_mine: set[str] = set()  # this process's temporary folders, removed at exit at the latest
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def sweep(cache: str) -> None:
+    """Removes the temporary folders of compiles whose process is gone
+    (killed mid-compile), and any older than a day."""
+    try:
+        names = os.listdir(cache)
+    except OSError:
+        return
+    now = time.time()
+    for name in names:
+        m = TMP_NAME.match(name)
+        if not m or int(m.group(1)) == os.getpid():
+            continue
+        path = os.path.join(cache, name)
+        try:
+            old = now - os.stat(path).st_mtime > STALE_S
+        except OSError:
+            continue
+        if old or not _alive(int(m.group(1))):
+            shutil.rmtree(path, ignore_errors=True)
+
+
+def _exit_on_signal(signum, frame):
+    raise SystemExit(128 + signum)
+
+
+@contextlib.contextmanager
+def _removed_when_done(tmp: str):
+    """Removes `tmp` however the block ends: an error, Ctrl-C, SIGTERM or
+    SIGHUP (made an exit meanwhile, where no one else handles them), or
+    the interpreter's exit."""
+    _mine.add(tmp)
+    restore = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(sig) == signal.SIG_DFL:
+                restore[sig] = signal.signal(sig, _exit_on_signal)
+    try:
+        yield
+    finally:
+        for sig, handler in restore.items():
+            signal.signal(sig, handler)
+        shutil.rmtree(tmp, ignore_errors=True)
+        _mine.discard(tmp)
+
+
+@atexit.register
+def _remove_mine() -> None:
+    for tmp in list(_mine):
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def run(script: M.Script, real: Real, source_line, trace_path: str | None = None) -> tuple[int, str]:

@@ -122,3 +122,25 @@ def test_a_changed_header_rebuilds_the_objects_that_include_it(sketch):
         for user in users:
             assert after[user] != before[user], f"{header.name} changed, {user} not rebuilt"
         assert after["core/WMath.cpp.o"] == before["core/WMath.cpp.o"], f"{header.name} does not concern WMath.cpp"
+
+
+@pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
+def test_another_host_compiler_is_another_native_build(fsw, tmp_path, monkeypatch):
+    """`fsw test --native` caches its compiled runners: the compiler's
+    identity is part of the cache key, so an upgraded compiler at the
+    same path compiles anew."""
+    from fswkit import native
+
+    cxx = tmp_path / "bin" / "g++"
+    cxx.parent.mkdir()
+    monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(native, "CXX", str(cxx))
+    script = str(TANK / "tank.ss")
+    runners = []
+    for version in ("12.1", "12.2.0"):
+        cxx.write_text(f'#!/bin/sh\n[ "$1" = --version ] && {{ echo "g++ {version}"; exit 0; }}\nexec g++ "$@"\n')
+        cxx.chmod(0o755)
+        r = fsw("test", "--native", script)
+        assert r.code == 0, r.err
+        runners.append(sorted(p.parent.name for p in (tmp_path / "cache").rglob("runner")))
+    assert len(runners[0]) == 1 and len(runners[1]) == 2

@@ -36,9 +36,11 @@ const Task kTasks[3] = {
     {link_telemetry_task, 0, &link, 1, 0, kNoElement, kNoElement, kNoElement, kModeEnabled},
 };
 const LinkStream kStreams[2] = {{0, 8, 1, 2, store0}, {8, 13, 3, 1, 0}};
-const LinkWritable kWritable[3] = {{4, 10, kBool}, {5, 11, kI16}, {6, 13, kF64}};
+// The two mode elements are listed too, as no generated table lists them:
+// the target must refuse their SET (LOCKED) whatever the table says.
+const LinkWritable kWritable[5] = {{2, 8, kU8}, {3, 9, kU8}, {4, 10, kBool}, {5, 11, kI16}, {6, 13, kF64}};
 const LinkConfig kConfig = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0x12345678UL, 21, 96, 5,
-                            21, 2, 3, 2, 0, false};
+                            21, 2, 5, 2, 0, false};
 
 static_assert(link_stream_ok(0, 8, 1, 2, true, 21, 96) && link_stream_ok(8, 13, 3, 1, false, 21, 96) &&
                   link_writable_ok(13, kF64, 21) && link_config_ok(96, 21, 2, 3),

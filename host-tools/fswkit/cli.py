@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import sys
 
@@ -217,15 +218,13 @@ def _machine_or_exit(args):
     return m
 
 
-def _write(text: str, out: str | None) -> int:
-    if out is None or out == "-":
-        sys.stdout.write(text)
-        return EXIT_OK
+def _write(text: str, out: str | None, command: str, inputs=()) -> int:
+    from fswkit.outputs import OutputError, write_text
+
     try:
-        with open(out, "w") as f:
-            f.write(text)
-    except OSError as e:
-        sys.stderr.write(f"fsw: cannot write {out}: {e.strerror or e}\n")
+        write_text(out, text, inputs)
+    except OutputError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
         return EXIT_FAIL
     return EXIT_OK
 
@@ -236,7 +235,8 @@ def cmd_graph(args) -> int:
     m = _machine_or_exit(args)
     if m is None:
         return EXIT_CONFIG
-    return _write(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output)
+    return _write(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output, "graph",
+                  (args.machine, args.sv))
 
 
 def cmd_skeleton(args) -> int:
@@ -245,7 +245,7 @@ def cmd_skeleton(args) -> int:
     m = _machine_or_exit(args)
     if m is None:
         return EXIT_CONFIG
-    return _write(skeleton(m, delta_t=args.delta_t), args.output)
+    return _write(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, args.sv))
 
 
 # ---- fsw gen / fsw build ---------------------------------------------------------------
@@ -426,10 +426,11 @@ def _ground(command: str, fn, *a) -> int:
     from fswkit.link.log import LogError
     from fswkit.link.port import PortError
     from fswkit.monitor import GroundError
+    from fswkit.outputs import OutputError
 
     try:
         return fn(*a)
-    except (GroundError, PortError, LogError, LayoutError) as e:
+    except (GroundError, PortError, LogError, LayoutError, OutputError) as e:
         sys.stderr.write(f"fsw {command}: {e}\n")
         return EXIT_FAIL
 
@@ -444,7 +445,7 @@ def cmd_monitor(args) -> int:
     if port is None:
         return EXIT_FAIL
     return _ground("monitor", monitor, layout, args.project, port, args.baud, args.log, args.headless,
-                   args.ignore_schema, args.duration, args.frames)
+                   args.ignore_schema, args.duration, args.frames, args.force)
 
 
 def cmd_cmd(args) -> int:
@@ -459,16 +460,13 @@ def cmd_cmd(args) -> int:
 
 def cmd_log2csv(args) -> int:
     from fswkit.monitor import log2csv
+    from fswkit.outputs import output
 
-    if args.output in (None, "-"):
-        return _ground("log2csv", log2csv, args.log, sys.stdout, args.ignore_schema)
-    try:
-        f = open(args.output, "w", newline="")
-    except OSError as e:
-        sys.stderr.write(f"fsw log2csv: cannot write {args.output}: {e.strerror or e}\n")
-        return EXIT_FAIL
-    with f:
-        return _ground("log2csv", log2csv, args.log, f, args.ignore_schema)
+    def run() -> int:
+        with output(args.output, [args.log], newline="", what="CSV") as f:
+            return log2csv(args.log, f, args.ignore_schema)
+
+    return _ground("log2csv", run)
 
 
 def cmd_replay(args) -> int:
@@ -481,6 +479,17 @@ def cmd_plot(args) -> int:
     from fswkit.monitor import plot
 
     return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)
+
+
+def _replay_speed(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    if value != 0 and not 1e-3 <= value <= 1e6:
+        raise argparse.ArgumentTypeError(f"expected 0 (as fast as possible) or a speed from 0.001 to 1000000, "
+                                         f"found {text}")
+    return value
 
 
 def _nonneg_float(text: str) -> float:
@@ -615,7 +624,8 @@ def parser() -> argparse.ArgumentParser:
     m.add_argument("--port", help="serial device (/dev/ttyACM0, a pty) or pyserial URL "
                    "(default: the only serial port connected)")
     m.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
-    m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE")
+    m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE (a new file)")
+    m.add_argument("--force", action="store_true", help="let --log replace an existing FILE")
     m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")
     m.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
     m.add_argument("--duration", type=_nonneg_float, metavar="S", help="stop after S seconds")
@@ -641,7 +651,8 @@ def parser() -> argparse.ArgumentParser:
     rp = sub.add_parser("replay", help="the monitor's view of a link log")
     rp.add_argument("log", metavar="LOG")
     rp.add_argument("--headless", action="store_true", help="print decoded frames as lines")
-    rp.add_argument("--speed", type=_nonneg_float, default=1.0, help="1 = as recorded, 0 = as fast as possible")
+    rp.add_argument("--speed", type=_replay_speed, default=1.0,
+                    help="1 = as recorded, 2 twice as fast (0.001 to 1000000), 0 = as fast as possible")
     rp.add_argument("--ignore-schema", action="store_true")
     rp.set_defaults(func=cmd_replay)
 
@@ -654,14 +665,52 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
+def _quiet_stdout() -> None:
+    """Points standard output at /dev/null after it failed, so that the
+    interpreter's last flush does not fail again on its way out."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
+        pass
+
+
+def _stdout_failed() -> bool:
+    try:
+        sys.stdout.flush()
+    except OSError:
+        return True
+    except ValueError:  # closed
+        return False
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
+    from fswkit.outputs import OutputError
+
     args = parser().parse_args(argv)
     try:
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a full or closed standard output fails here, not after exit
+        return code
     except KeyboardInterrupt:
         return 130
-    except BrokenPipeError:
+    except BrokenPipeError:  # the reader went away (`fsw ... | head`): not a failure
+        _quiet_stdout()
         return EXIT_OK
+    except OutputError as e:
+        sys.stderr.write(f"fsw {args.command}: {e}\n")
+        _quiet_stdout()
+        return EXIT_FAIL
+    except OSError as e:  # an input or output the command could not use: its system error
+        if _stdout_failed():
+            sys.stderr.write(f"fsw {args.command}: cannot write standard output: {e.strerror or e}\n")
+            _quiet_stdout()
+        else:
+            where = f"{e.filename}: " if e.filename else ""
+            sys.stderr.write(f"fsw {args.command}: {where}{e.strerror or e}\n")
+        return EXIT_FAIL
     except RecursionError:
         sys.stderr.write("fsw: input nested too deeply to process\n")
         return EXIT_INTERNAL

@@ -5,9 +5,11 @@ fswkit.link (one decoder); the live view uses rich."""
 from __future__ import annotations
 
 import csv
+import os
 import sys
 import time
 
+from fswkit import outputs
 from fswkit.link import wire
 from fswkit.link.layout import Layout
 from fswkit.link.session import Event, Session, describe
@@ -29,8 +31,8 @@ def summary(session: Session) -> str:
     st, ws = session.stats, session.deframer.stats
     h = session.health or {}
     return (f"link: {st.frames} frames, {ws.bytes} bytes, {st.lost} lost in {st.gaps} gaps, "
-            f"{ws.crc_errors} CRC errors, {ws.framing_errors} framing errors, {ws.invalid} invalid, "
-            f"target dropped {h.get('dropped', '?')}")
+            f"{ws.crc_errors} CRC errors, {ws.framing_errors} framing errors, {ws.oversized} oversized, "
+            f"{ws.invalid} invalid, target dropped {h.get('dropped', '?')}")
 
 
 # ---- the live view ---------------------------------------------------------------------
@@ -66,6 +68,7 @@ def render(session: Session, now: float, title: str):
     for k, v in (("schema", schema), ("frames/s", f"{session.frames_per_second(now):.1f}"),
                  ("frames", st.frames), ("lost (sequence gaps)", f"{st.lost} in {st.gaps}"),
                  ("CRC errors", ws.crc_errors), ("framing errors", ws.framing_errors),
+                 ("oversized (no delimiter)", ws.oversized),
                  ("latency (above least)", lat)):
         link.add_row(k, str(v))
     h = session.health
@@ -93,7 +96,7 @@ class View:
         self.session = session
         self.headless = headless
         self.title = title
-        self.out = out or sys.stdout
+        self.out = out or outputs.stdout()
         self._live = None
         self._last = 0.0
 
@@ -129,15 +132,23 @@ class View:
 # ---- fsw monitor -----------------------------------------------------------------
 
 def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: str | None, headless: bool,
-            ignore_schema: bool, duration: float | None, max_frames: int | None) -> int:
+            ignore_schema: bool, duration: float | None, max_frames: int | None, force: bool = False) -> int:
     from fswkit.link.client import Ground, LinkTimeout
-    from fswkit.link.log import LogWriter
+    from fswkit.link.log import LogError, LogWriter
     from fswkit.link.port import open_port, port_errors
 
     session = Session(layout, ignore_schema=ignore_schema)
-    port = open_port(port_name, baud)
-    log = LogWriter(log_path, layout, port=port_name, project=project) if log_path else None
+    # the log is checked first and takes its name only once the target is known
+    # to be the right one: a refused session leaves an old recording as it was
+    log = LogWriter(log_path, layout, force=force, port=port_name, project=project) if log_path else None
+    try:
+        port = open_port(port_name, baud)
+    except BaseException:
+        if log is not None:
+            log.close(keep=False)
+        raise
     ground = Ground(port, session, log)
+    refused = False
     view = View(session, headless, f"{layout.name} on {port_name}")
     start = time.monotonic()
     status = 0
@@ -151,6 +162,8 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
                                       "(--ignore-schema decodes without one)") from None
             if session.hello is not None and not session.hello["schema_ok"] and not ignore_schema:
                 raise GroundError(schema_message(session, project))
+            if log is not None:
+                log.commit()
             if layout.has_uplink:
                 try:
                     ground.command(wire.OP_SNAPSHOT, timeout=1.0, on_event=view.event)
@@ -170,12 +183,18 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
         status = 0
     except BrokenPipeError:  # our standard output was closed (`| head`)
         status = 0
+    except GroundError:
+        refused = True
+        raise
+    except (LogError, outputs.OutputError) as e:  # a full disk is not the port's fault
+        sys.stderr.write(f"fsw monitor: {e}\n")
+        status = 1
     except port_errors() as e:
         sys.stderr.write(f"fsw monitor: {port_name}: the port went away ({e})\n")
         status = 1
     finally:
         if log is not None:
-            log.close()
+            log.close(keep=not refused)
         try:
             port.close()
         except Exception:  # noqa: BLE001 - closing a port that went away
@@ -256,14 +275,36 @@ def replay(path: str, headless: bool, speed: float, ignore_schema: bool) -> int:
                     first_host, first_wall = ev.host_time, time.monotonic()
                 wait = (ev.host_time - first_host) / speed - (time.monotonic() - first_wall)
                 if wait > 0:
-                    time.sleep(wait)
+                    time.sleep(min(wait, 3600.0))
             view.event(ev)
             view.update(ev.host_time)
     sys.stderr.write(summary(session) + "\n")
     return 0
 
 
+def image_format(out: str) -> str:
+    """The image format an output's extension names, checked before any work
+    (matplotlib would write `out.png` for `out`, and refuses `.txt` only once
+    the figure is drawn)."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise GroundError("matplotlib is not installed: run `make setup` (or pip install matplotlib)") from None
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    known = Figure().canvas.get_supported_filetypes()
+    ext = os.path.splitext(out)[1][1:].lower()
+    if ext not in known:
+        what = f"`.{ext}` is not an image format it writes" if ext else "it has no extension to say the image format"
+        raise GroundError(f"-o {out}: {what}: name it .png, .svg or .pdf (or "
+                          + ", ".join(f".{e}" for e in sorted(known) if e not in ("png", "svg", "pdf")) + ")")
+    return ext
+
+
 def plot(path: str, elements: list[str], out: str, ignore_schema: bool) -> int:
+    fmt = image_format(out)
+    outputs.check(out, [path], what="plot")
     reader, session, events = _log_session(path, ignore_schema)
     lay = reader.layout
     missing = [e for e in elements if lay.element(e) is None]
@@ -289,11 +330,6 @@ def plot(path: str, elements: list[str], out: str, ignore_schema: bool) -> int:
                     if s in last_state:
                         transitions.append((t, s, lay.states[s].get(int(row[s]), str(row[s]))))
                     last_state[s] = row[s]
-    try:
-        import matplotlib
-    except ImportError:
-        raise GroundError("matplotlib is not installed: run `make setup` (or pip install matplotlib)") from None
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(len(elements), 1, sharex=True, figsize=(10, 2.6 * len(elements)), squeeze=False)
@@ -312,10 +348,12 @@ def plot(path: str, elements: list[str], out: str, ignore_schema: bool) -> int:
     axes[-1, 0].set_xlabel(f"target time ({lay.time_unit})")
     fig.suptitle(f"{lay.name}: {path}")
     fig.tight_layout()
-    try:
-        fig.savefig(out)
-    except OSError as e:
-        raise GroundError(f"cannot write {out}: {e.strerror or e}") from None
+    with outputs.output(out, [path], binary=True, what="plot") as f:
+        try:
+            fig.savefig(f.raw, format=fmt)
+        except OSError as e:
+            raise GroundError(f"cannot write {out}: {e.strerror or e}") from None
+    plt.close(fig)
     sys.stderr.write(f"fsw plot: {out}: {sum(len(v[0]) for v in series.values())} points, "
                      f"{len(transitions)} state transitions\n")
     return 0

@@ -74,3 +74,70 @@ def stream(layout, first: int, count: int, skip=(), hello_first: bool = False) -
         if full not in skip:
             out.append(f)
     return out
+
+
+class PtyStream:
+    """A target on a pseudo-terminal that streams `frames` over and over
+    (renumbered past the last) until stopped: the port a monitor opens."""
+
+    def __init__(self, layout, first: int = 5000, hello_first: bool = False, schema: int | None = None):
+        import os
+        import pty
+        import threading
+        import tty
+
+        self.layout = layout
+        self._master, self._slave = pty.openpty()
+        tty.setraw(self._slave)
+        tty.setraw(self._master)
+        self.port = os.ttyname(self._slave)
+        self._stop = threading.Event()
+        self._first, self._hello_first, self._schema = first, hello_first, schema
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        import os
+        import select
+
+        lay = self.layout
+        if self._schema is not None:
+            import dataclasses
+            lay = dataclasses.replace(lay, schema=self._schema)
+        n = self._first
+        first = True
+        while not self._stop.is_set():
+            frames = stream(lay, n, 50, hello_first=first and self._hello_first)
+            first = False
+            n += 50
+            data = b"".join(frames)
+            while data and not self._stop.is_set():
+                _, w, _ = select.select([], [self._master], [], 0.05)
+                if w:
+                    try:
+                        k = os.write(self._master, data[:512])
+                    except OSError:
+                        return
+                    data = data[k:]
+                # whatever the ground sends is read and dropped
+                r, _, _ = select.select([self._master], [], [], 0)
+                if r:
+                    try:
+                        os.read(self._master, 4096)
+                    except OSError:
+                        return
+            self._stop.wait(0.02)
+
+    def close(self) -> None:
+        import os
+
+        self._stop.set()
+        self._thread.join(timeout=5)
+        os.close(self._master)
+        os.close(self._slave)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import os
 import struct
+import tempfile
 
 from .layout import Layout, LayoutError, from_dict
 
@@ -27,26 +28,63 @@ class LogError(Exception):
 
 
 class LogWriter:
-    def __init__(self, path: str, layout: Layout, **meta):
+    """A new log. An existing file at `path` is never truncated unless
+    `force`; the log is written into a temporary file beside `path` and
+    takes its name at `commit()` (the monitor commits once the target is
+    known to be the right one) or at `close()`, so a refused or failed
+    start leaves whatever was at `path` as it was. A write that fails (a
+    full disk) is a LogError saying so."""
+
+    def __init__(self, path: str, layout: Layout, *, force: bool = False, **meta):
+        from fswkit.outputs import _direct
+
+        self.path = path
+        self._fd = None
+        self._tmp = None
+        if os.path.isdir(path):
+            raise LogError(f"cannot write {path}: it is a folder")
+        if os.path.lexists(path) and not force:
+            raise LogError(f"{path} exists: a log is never overwritten unless asked (--force replaces it); "
+                           "choose another name")
         try:
-            self._fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_APPEND, 0o644)
+            if _direct(path):  # a device or a pipe: written in place
+                self._fd = os.open(path, os.O_WRONLY | os.O_APPEND)
+            else:
+                target = os.path.realpath(path) if os.path.islink(path) else path
+                fd, self._tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".part",
+                                                 dir=os.path.dirname(os.path.abspath(target)))
+                self._target = target
+                os.fchmod(fd, 0o644)
+                self._fd = fd
         except OSError as e:
             raise LogError(f"cannot write {path}: {e.strerror or e}") from None
-        self.path = path
         head = json.dumps({"format": 1, "layout": layout.raw, **meta}, sort_keys=True).encode()
         self._write(MAGIC + struct.pack("<I", len(head)) + head)
 
     def _write(self, data: bytes) -> None:
         view = memoryview(data)
-        while view:
-            n = os.write(self._fd, view)
-            view = view[n:]
+        try:
+            while view:
+                n = os.write(self._fd, view)
+                view = view[n:]
+        except OSError as e:
+            raise LogError(f"cannot write the log {self.path}: {e.strerror or e}") from None
 
     def record(self, direction: int, host_time_ns: int, data: bytes) -> None:
         if data and self._fd is not None:
             self._write(_REC.pack(direction, host_time_ns, len(data)) + data)
 
-    def close(self) -> None:
+    def commit(self) -> None:
+        """Gives the log its name (replacing what was there, when forced)."""
+        if self._tmp is not None:
+            try:
+                os.replace(self._tmp, self._target)
+            except OSError as e:
+                raise LogError(f"cannot write {self.path}: {e.strerror or e}") from None
+            self._tmp = None
+
+    def close(self, keep: bool = True) -> None:
+        """Ends the log: committed when `keep`, else (never committed) removed."""
         if self._fd is not None:
             try:
                 os.fsync(self._fd)
@@ -54,6 +92,15 @@ class LogWriter:
                 pass
             os.close(self._fd)
             self._fd = None
+        if self._tmp is not None:
+            if keep:
+                self.commit()
+            else:
+                try:
+                    os.unlink(self._tmp)
+                except OSError:
+                    pass
+                self._tmp = None
 
 
 class LogReader:

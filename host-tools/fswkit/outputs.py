@@ -1,0 +1,178 @@
+"""Where a command's output goes: standard output, or a file that appears
+whole or not at all. Every command that writes a file goes through `output`:
+the path is checked before any work (not one of the command's inputs, not a
+link log, which is a recording and never overwritten, a folder that
+exists), the text goes to a temporary file beside it that replaces the path
+only once everything is written, and a failed write — a full disk, a closed
+pipe, /dev/full — is an OutputError naming the file, never a traceback or a
+half-written file where the old one was."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import sys
+import tempfile
+
+LOG_MAGIC = b"FSWLOG1\n"  # fswkit.link.log.MAGIC: the head of a recording
+
+
+class OutputError(Exception):
+    """An output that cannot be written: message printed, exit 1."""
+
+
+def same_file(a: str, b: str) -> bool:
+    """Whether two paths name one file (links followed)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def is_recording(path: str) -> bool:
+    """Whether `path` is a link log (`fsw monitor --log`, `fsw sim --plant`)."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(len(LOG_MAGIC)) == LOG_MAGIC
+    except OSError:
+        return False
+
+
+def _direct(path: str) -> bool:
+    """Paths written in place: devices, FIFOs, /dev/stdout and the like."""
+    if path.startswith(("/dev/", "/proc/")):
+        return True
+    try:
+        st = os.stat(path)
+    except OSError:
+        return False
+    return not stat.S_ISREG(st.st_mode)
+
+
+def check(path: str, inputs=(), *, force: bool = False, what: str = "output") -> None:
+    """Refuses an output path before any work is done: OutputError."""
+    for i in inputs:
+        if i is not None and os.path.exists(path) and same_file(path, i):
+            raise OutputError(f"{path}: the {what} would overwrite an input of this command: "
+                              "choose another name")
+    if os.path.isdir(path):
+        raise OutputError(f"cannot write {path}: it is a folder (name a file for the {what})")
+    if _direct(path):
+        return
+    if os.path.lexists(path) and not force and is_recording(path):
+        raise OutputError(f"{path}: a link log (a recording) is there: it is never overwritten; "
+                          "choose another name, or move it away first")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OutputError(f"cannot write {path}: no such folder {folder}")
+
+
+class Stream:
+    """A text stream whose write errors are OutputErrors naming it (a pipe
+    closed by its reader stays a BrokenPipeError: `fsw ... | head` is not a
+    failure)."""
+
+    def __init__(self, f, name: str):
+        self._f, self.name = f, name
+
+    @property
+    def raw(self):
+        """The file itself, for writers that take a file (its errors are OSErrors)."""
+        return self._f
+
+    def _fail(self, e: OSError):
+        if isinstance(e, BrokenPipeError):
+            raise e
+        raise OutputError(f"cannot write {self.name}: {e.strerror or e}") from None
+
+    def write(self, text) -> int:
+        try:
+            return self._f.write(text)
+        except OSError as e:
+            self._fail(e)
+
+    def flush(self) -> None:
+        try:
+            self._f.flush()
+        except OSError as e:
+            self._fail(e)
+
+
+def stdout() -> Stream:
+    return Stream(sys.stdout, "standard output")
+
+
+@contextlib.contextmanager
+def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | None = None,
+           force: bool = False, what: str = "output"):
+    """A stream for the command's output: standard output for None or "-",
+    else a temporary file beside `path` that replaces it when the block
+    ends without an exception (and is removed when it raises)."""
+    if path is None or path == "-":
+        out = stdout()
+        yield out
+        out.flush()
+        return
+    check(path, inputs, force=force, what=what)
+    if _direct(path):
+        try:
+            f = open(path, "wb" if binary else "w", **({} if binary else {"newline": newline}))
+        except OSError as e:
+            raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+        s = Stream(f, path)
+        try:
+            yield s
+            s.flush()
+        finally:
+            with contextlib.suppress(OSError):
+                f.close()
+        return
+    with replacing(path) as tmp:
+        try:
+            f = open(tmp, "wb" if binary else "w", **({} if binary else {"newline": newline}))
+        except OSError as e:
+            raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+        with f:
+            s = Stream(f, path)
+            yield s
+            s.flush()
+            try:
+                os.fsync(f.fileno())
+            except OSError as e:
+                raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+
+
+@contextlib.contextmanager
+def replacing(path: str):
+    """The name of a new temporary file beside `path` (a symbolic link's
+    target, if it is one), moved onto `path` when the block ends without an
+    exception, removed otherwise."""
+    target = os.path.realpath(path) if os.path.islink(path) else path
+    folder = os.path.dirname(os.path.abspath(target))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".part", dir=folder)
+    except OSError as e:
+        raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+    os.close(fd)
+    try:
+        try:  # the mode a new file would have had (mkstemp makes 0600)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode) if os.path.exists(target) else 0o666 & ~umask)
+        except OSError:
+            pass
+        yield tmp
+        try:
+            os.replace(tmp, target)
+        except OSError as e:
+            raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def write_text(path: str | None, text: str, inputs=(), *, what: str = "output") -> None:
+    with output(path, inputs, what=what) as f:
+        f.write(text)

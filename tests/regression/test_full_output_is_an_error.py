@@ -1,0 +1,80 @@
+"""Output that cannot be written — a full standard output, `-o /dev/full`,
+a full disk under a link log — is a clear message naming what could not be
+written and a non-zero exit, for every command that writes (one output
+path for all of them): never a traceback, an "internal error", or a full
+disk reported as the serial port going away."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+import pytest
+from conftest import run_fsw
+from linkstream import TANK, PtyStream, layout_of, stream, tank_copy
+
+from fswkit.link.log import RX, LogWriter
+
+FULL = "/dev/full"
+
+
+def run_into_full_stdout(*argv: str):
+    from fswkit.cli import main
+
+    err = io.StringIO()
+    full = open(FULL, "w")
+    try:
+        with contextlib.redirect_stdout(full), contextlib.redirect_stderr(err):
+            try:
+                code = main(list(argv))
+            except SystemExit as e:
+                code = e.code
+    finally:
+        with contextlib.suppress(OSError):
+            full.close()
+    return code, err.getvalue()
+
+
+def clean_failure(code, err):
+    assert code == 1, err
+    assert "No space left on device" in err, err
+    assert "Traceback" not in err and "internal error" not in err, err
+
+
+@pytest.fixture(scope="module")
+def log(tmp_path_factory):
+    path = tmp_path_factory.mktemp("full") / "clean.log"
+    layout = layout_of(TANK)
+    w = LogWriter(str(path), layout)
+    for i, f in enumerate(stream(layout, 0, 3000, hello_first=True)):
+        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
+    w.close()
+    return str(path)
+
+
+def _commands(log):
+    sm = str(TANK / "tank.sm")
+    return [("log2csv", log), ("replay", log, "--headless", "--speed", "0"), ("graph", sm), ("skeleton", sm),
+            ("test", str(TANK / "tank.ss"))]
+
+
+def test_full_standard_output(log):
+    for argv in _commands(log):
+        clean_failure(*run_into_full_stdout(*argv))
+
+
+@pytest.mark.parametrize("command", ["log2csv", "graph", "skeleton"])
+def test_output_file_on_a_full_device(log, command):
+    src = log if command == "log2csv" else str(TANK / "tank.sm")
+    r = run_fsw(command, src, "-o", FULL)
+    clean_failure(r.code, r.err)
+    assert FULL in r.err
+
+
+def test_monitor_log_on_a_full_disk_is_not_the_port(tmp_path):
+    project = tank_copy(tmp_path, uplink=False)
+    with PtyStream(layout_of(project)) as target:
+        r = run_fsw("monitor", str(project), "--port", target.port, "--headless", "--frames", "200",
+                    "--log", FULL, "--force")
+    clean_failure(r.code, r.err)
+    assert "the port went away" not in r.err and f"cannot write the log {FULL}" in r.err

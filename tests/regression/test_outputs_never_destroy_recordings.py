@@ -1,0 +1,102 @@
+"""No command truncates or replaces a recording it was not asked to: an
+output path equal to one of the command's inputs is refused, a link log is
+never overwritten by another output, `fsw monitor --log` refuses an
+existing file unless `--force` and even then replaces it only once the
+target has proved to be the right one, and every output file is written
+beside its path and renamed into place, so a failed write leaves the old
+file whole."""
+
+from __future__ import annotations
+
+import resource
+import signal
+
+import pytest
+from conftest import run_fsw
+from linkstream import TANK, PtyStream, layout_of, stream, tank_copy
+
+from fswkit.link.log import RX, LogWriter
+
+
+def _log(path, first=0, n=400):
+    layout = layout_of(TANK)
+    w = LogWriter(str(path), layout)
+    for i, f in enumerate(stream(layout, first, n, hello_first=True)):
+        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
+    w.close()
+    return path.read_bytes()
+
+
+def _no_parts(folder):
+    assert not [p.name for p in folder.iterdir() if p.name.endswith(".part")]
+
+
+def test_log2csv_onto_its_own_log_is_refused(tmp_path):
+    log = tmp_path / "x.log"
+    before = _log(log)
+    r = run_fsw("log2csv", str(log), "-o", str(log))
+    assert r.code == 1 and "overwrite an input" in r.err, r.err
+    assert log.read_bytes() == before
+    other = tmp_path / "other.log"
+    kept = _log(other, first=77)
+    r = run_fsw("log2csv", str(log), "-o", str(other))
+    assert r.code == 1 and "a link log (a recording) is there" in r.err, r.err
+    assert other.read_bytes() == kept
+    _no_parts(tmp_path)
+
+
+def test_graph_and_skeleton_onto_their_machine_are_refused(tmp_path):
+    project = tank_copy(tmp_path)
+    sm = project / "tank.sm"
+    before = sm.read_bytes()
+    for command in ("graph", "skeleton"):
+        r = run_fsw(command, str(sm), "-o", str(sm))
+        assert r.code == 1 and "overwrite an input" in r.err, r.err
+        assert sm.read_bytes() == before
+
+
+def test_monitor_log_keeps_an_existing_recording(tmp_path):
+    old = tmp_path / "old.log"
+    before = _log(old)
+    # without --force: refused before the port is even opened
+    r = run_fsw("monitor", str(TANK), "--port", "/dev/no-such-port", "--log", str(old), "--headless")
+    assert r.code == 1 and "never overwritten unless asked" in r.err, r.err
+    assert old.read_bytes() == before
+    # with --force, a target of other configs is refused: the old recording stays
+    project = tank_copy(tmp_path, uplink=False)
+    layout = layout_of(project)
+    with PtyStream(layout, schema=layout.schema ^ 1, hello_first=True) as target:
+        r = run_fsw("monitor", str(project), "--port", target.port, "--headless", "--frames", "100",
+                    "--log", str(old), "--force")
+    assert r.code == 1 and "schema mismatch" in r.err, r.err
+    assert old.read_bytes() == before
+    _no_parts(tmp_path)
+    # with --force and the right target, it is replaced by the new recording
+    with PtyStream(layout, hello_first=True) as target:
+        r = run_fsw("monitor", str(project), "--port", target.port, "--headless", "--frames", "100",
+                    "--log", str(old), "--force")
+    assert r.code == 0, r.err
+    assert old.read_bytes() != before and old.read_bytes().startswith(b"FSWLOG1\n")
+    _no_parts(tmp_path)
+
+
+@pytest.fixture
+def file_size_limit():
+    """Writes past 64 KB fail (EFBIG), as on a full disk."""
+    old = resource.getrlimit(resource.RLIMIT_FSIZE)
+    old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    yield lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (65536, old[1]))
+    resource.setrlimit(resource.RLIMIT_FSIZE, old)
+    signal.signal(signal.SIGXFSZ, old_sig)
+
+
+def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
+    log = tmp_path / "x.log"
+    _log(log, n=3000)
+    csv = tmp_path / "x.csv"
+    csv.write_text("the previous export\n")
+    file_size_limit()
+    r = run_fsw("log2csv", str(log), "-o", str(csv))
+    assert r.code == 1 and "File too large" in r.err and "Traceback" not in r.err, r.err
+    assert csv.read_text() == "the previous export\n"
+    _no_parts(tmp_path)

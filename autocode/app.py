@@ -189,6 +189,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             problem = _baud_problem(board, baud) if board is not None else None
             if problem is not None:
                 err(bt, problem)
+    elif board is not None and _baud_problem(board, baud) is not None:
+        at = board_tok if board_tok is not None and board_override is None else None
+        diags.error(src, APP, at.line if at else 1, at.col if at else 1,
+                    f"{_baud_problem(board, baud)}; `baud` is not set, so it is the default: set `baud` in "
+                    "[application]")
 
     # [configs]
     sv_tok = None

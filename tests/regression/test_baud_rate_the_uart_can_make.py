@@ -85,3 +85,21 @@ def test_the_error_is_the_boards_own(fsw, tmp_path):
     assert r.code == 0, r.err
     r, _ = check(fsw, tmp_path, "230400.5", board="native")
     assert r.code != 0 and "`baud` must be a whole number of bits per second" in r.err, r.err
+
+
+def test_the_default_rate_is_checked_too(fsw, tmp_path, monkeypatch):
+    # a board clocked at 8 MHz makes 111,111 baud of the default 115200
+    import dataclasses
+
+    from fswkit.autocode import app as A
+
+    real = A.load_board
+    monkeypatch.setattr(A, "load_board", lambda name: dataclasses.replace(real(name), f_cpu=8_000_000))
+    r, p = check(fsw, tmp_path, "57600")
+    assert r.code == 0, r.err
+    (p).write_text(p.read_text().replace("baud 57600\n", ""))
+    r = fsw("check", str(p))
+    assert r.code != 0
+    assert f"application config error @ {p}:2:7:" in r.err, r.err
+    assert ("`baud 115200`: the uno's UART makes 111,111 baud (8 MHz, double speed, UBRR 8), -3.55 %, more than "
+            "the ±2.5 % a serial link allows; `baud` is not set, so it is the default") in r.err, r.err

@@ -368,7 +368,8 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
         if rest.startswith(("link", "kLink")):
             return "link", f"the serial link's state and tables, {a} [telemetry] [uplink]"
         if rest in ("stats", "kTasks", "kConfig", "ex"):
-            return "tasks", f"the executor and its {len(app.tasks)} tasks, {a} [tasks]"
+            n = len(app.tasks)
+            return "tasks", f"the executor and its {n} task{'' if n == 1 else 's'}, {a} [tasks]"
         if re.match(r"k(Analog|Digital)(In|Out)", rest):
             files = ", ".join(sorted({basename(c.path) for c in app.channels}))
             return "io", f"the I/O channel tables, {files}"
@@ -387,13 +388,72 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
                 add("flash", key, label, size) if who is not None else None
         elif who is not None:
             add("flash", key, label, size)
+    if any(space == "flash" and key.startswith("m:") for space, key in uses):
+        lines = config_lines_code(elf)
+        for m in app.machines:
+            u = uses.get(("flash", f"m:{c_ident(m.name)}"))
+            src = basename(m.path)
+            rows = sorted(((n, line) for (f, line), n in lines.items() if f == src), key=lambda x: (-x[0], x[1]))
+            if u is not None and rows:
+                u.detail = [(n, f"{src}:{line}  {_source_line(m.path, line)}") for n, line in rows]
     regions = sorted(app.sv.regions, key=lambda r: -r.size)
-    sv_detail = [(r.size, f"region {r.name}, {basename(app.sv.path)}:{r.line} ({len(r.elements)} elements)")
+    sv_detail = [(r.size, f"region {r.name}, {basename(app.sv.path)}:{r.line} ({len(r.elements)} element{'' if len(r.elements) == 1 else 's'})")
                  for r in regions]
     if ("RAM", "sv") in uses:
         uses[("RAM", "sv")].detail = sv_detail
     return {space: sorted((u for (s, _), u in uses.items() if s == space), key=lambda u: -u.size)
             for space in ("flash", "RAM")}
+
+
+MARKER = re.compile(r"^(/.*\.gen\.cpp):(\d+)(?: \(discriminator \d+\))?$|^/.*:\d+(?: \(discriminator \d+\))?$")
+INSN = re.compile(r"^\s+[0-9a-f]+:\t((?:[0-9a-f]{2} )+)")
+CONFIG_LINE = re.compile(r"// ([^\s:]+):(\d+)\b")
+
+
+def config_lines_code(elf: str) -> dict[tuple[str, int], int]:
+    """Bytes of machine code per config line: {(config file, line): bytes}.
+    The disassembly's line table places each instruction on a line of the
+    generated C++, whose comment names the config line it comes from."""
+    r = subprocess.run(["avr-objdump", "-d", "-l", elf], capture_output=True, text=True)
+    if r.returncode != 0:
+        return {}
+    by_gen: dict[tuple[str, int], int] = {}
+    where = None
+    for line in r.stdout.splitlines():
+        m = MARKER.match(line)
+        if m:
+            where = (m.group(1), int(m.group(2))) if m.group(1) else None
+            continue
+        m = INSN.match(line)
+        if m and where is not None:
+            by_gen[where] = by_gen.get(where, 0) + len(m.group(1).split())
+    out: dict[tuple[str, int], int] = {}
+    texts: dict[str, list[str]] = {}
+    for (path, n), size in by_gen.items():
+        if path not in texts:
+            try:
+                with open(path) as f:
+                    texts[path] = f.read().splitlines()
+            except OSError:
+                texts[path] = []
+        text = texts[path][n - 1] if 0 < n <= len(texts[path]) else ""
+        c = CONFIG_LINE.search(text)
+        if c:
+            key = (c.group(1), int(c.group(2)))
+            out[key] = out.get(key, 0) + size
+    return out
+
+
+def _source_line(path: str, n: int, width: int = 60) -> str:
+    try:
+        with open(path, errors="replace") as f:
+            for i, text in enumerate(f, 1):
+                if i == n:
+                    text = " ".join(text.split())
+                    return text if len(text) <= width else text[:width - 3] + "..."
+    except OSError:
+        pass
+    return ""
 
 
 def size_report(app: Application, elf: str, size: Size, top: int = 8) -> str:
@@ -415,9 +475,12 @@ def size_report(app: Application, elf: str, size: Size, top: int = 8) -> str:
         runtime = used - sum(u.size for u in parts)
         lines.append(f"what uses {what}, largest first:")
         for u in parts[:top]:
-            lines.append(f"  {u.size:>9,} B  {u.label}")
+            lines.append(f"  {u.size:>9,} B  {u.label}" + (", the costliest lines:" if what == "flash" and u.detail
+                                                             else ""))
             for n, text in (u.detail or [])[:5]:
                 lines.append(f"  {'':>11}  {n:>7,} B  {text}")
+            if what == "flash" and u.detail and len(u.detail) > 5:
+                lines.append(f"  {'':>11}  {sum(n for n, _ in u.detail):>7,} B  in all {len(u.detail)} lines with code")
         rest = sum(u.size for u in parts[top:])
         if rest:
             lines.append(f"  {rest:>9,} B  {len(parts) - top} smaller part(s) of the generated code")

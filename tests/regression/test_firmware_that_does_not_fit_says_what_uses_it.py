@@ -91,7 +91,12 @@ def test_machine_code_too_big_for_the_flash_is_reported_by_machine(fsw, tmp_path
     used, over = _over(r.err, "flash", 32256)
     assert over == used - 32256 > 0
     rows = _rows(r.err, "flash")
-    assert rows[0][1] == "machine big, big.sm: its states' code" and rows[0][0] > over
+    assert rows[0][1].startswith("machine big, big.sm: its states' code") and rows[0][0] > over
+    costliest = re.findall(r"^ {13,}([\d,]+) B  big\.sm:(\d+)  (.*)$", r.err, re.M)
+    assert len(costliest) == 5
+    sm_lines = (tmp_path / "big.sm").read_text().splitlines()
+    for size, line, text in costliest:  # a statement of big.sm, shown as written
+        assert int(size.replace(",", "")) > 0 and sm_lines[int(line) - 1].strip() == text
     assert sum(n for n, _ in rows) == used
     assert not (tmp_path / "out" / "big.overflow.elf").exists()
 

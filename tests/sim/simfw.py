@@ -80,25 +80,31 @@ def project_elf(project: str, board: str) -> str:
 
 def sketch_elf(name: str, source: str, board: str = "uno") -> str:
     """An Arduino sketch built with mk/build.mk (the Arduino core's flags)."""
+    from fswkit.build import build_lock
+
     out = OUT / f"{name}-{board}"
     gen = out / "src"
-    gen.mkdir(parents=True, exist_ok=True)
-    path = gen / f"{name}.cpp"
-    if not path.exists() or path.read_text() != source:
-        path.write_text(source)
-    r = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
-                        f"NAME={name}", "avr"] + BOARD_MAKE[board], capture_output=True, text=True)
+    with build_lock(str(out), "test"):  # another test session may build the same sketch
+        gen.mkdir(parents=True, exist_ok=True)
+        path = gen / f"{name}.cpp"
+        if not path.exists() or path.read_text() != source:
+            path.write_text(source)
+        r = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
+                            f"NAME={name}", "avr"] + BOARD_MAKE[board], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-4000:]
     return str(out / f"{name}.elf")
 
 
 def c_elf(name: str, source: str, mcu: str = "atmega328p") -> str:
     """A bare C program for the MCU, no Arduino core."""
-    OUT.mkdir(parents=True, exist_ok=True)
+    from fswkit.build import build_lock
+
     src = OUT / f"{name}.c"
     elf = OUT / f"{name}-{mcu}.elf"
-    src.write_text(source)
-    r = subprocess.run(["avr-gcc", f"-mmcu={mcu}", "-Os", "-o", str(elf), str(src)], capture_output=True, text=True)
+    with build_lock(str(OUT), "test"):
+        src.write_text(source)
+        r = subprocess.run(["avr-gcc", f"-mmcu={mcu}", "-Os", "-o", str(elf), str(src)], capture_output=True,
+                           text=True)
     assert r.returncode == 0, r.stderr
     return str(elf)
 

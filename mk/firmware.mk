@@ -53,6 +53,39 @@ FW_AVR_CXXFLAGS := -std=gnu++11 $(FW_AVR_OPT) $(FW_CXXSTD) -fno-threadsafe-stati
 FW_AVR_CFLAGS := -std=gnu11 $(FW_AVR_OPT) $(FW_AVR_DEFS) $(FW_AVR_CORE_INC)
 FW_AVR_LDFLAGS := -mmcu=$(FW_AVR_MCU) -Os -Wl,--gc-sections
 
+# ---- what decides a rebuild ---------------------------------------------------
+# As in mk/build.mk: each set of objects depends on a stamp of its flags and
+# compilers (path, size, date, version), rewritten only when they change,
+# and each object on the headers it includes (the compiler's -MMD files).
+fw_tool_id = $(shell p=$$(command -v $(1)) && echo "$$p=$$(readlink -f "$$p") $$(stat -Lc '%s %Y' "$$p")" \
+                 "$$($(1) --version 2>&1 | head -n 1)")
+FW_DEPS       := -MMD -MP
+FW_STAMP_f64  := $(FW_BUILD)/native-f64/.config
+FW_STAMP_f32  := $(FW_BUILD)/native-f32/.config
+FW_STAMP_avr  := $(FW_BUILD)/avr/.config
+ifneq ($(filter test-firmware test-firmware-native test-firmware-avr bench-firmware $(FW_BUILD)/%,$(MAKECMDGOALS)),)
+FW_HOST_ID    := cxx=$(call fw_tool_id,$(FW_HOST_CXX)) cc=$(call fw_tool_id,$(FW_HOST_CC))
+FW_CONFIG_f64 := $(FW_HOST_ID) flags=$(FW_HOST_FLAGS) $(FW_MODE_f64) $(FW_RT_WARN) $(FW_WARN) $(FW_UNITY)
+FW_CONFIG_f32 := $(FW_HOST_ID) flags=$(FW_HOST_FLAGS) $(FW_MODE_f32) $(FW_RT_WARN) $(FW_WARN) $(FW_UNITY)
+FW_CONFIG_avr := cxx=$(call fw_tool_id,$(FW_AVR_CXX)) cc=$(call fw_tool_id,$(FW_AVR_CC)) \
+                 cxxflags=$(FW_AVR_CXXFLAGS) cflags=$(FW_AVR_CFLAGS) ldflags=$(FW_AVR_LDFLAGS) $(FW_RT_WARN) \
+                 arduino=$(realpath $(FW_ARDUINO))
+ifneq ($(file <$(FW_STAMP_f64)),$(FW_CONFIG_f64))
+$(shell mkdir -p $(dir $(FW_STAMP_f64)))
+$(file >$(FW_STAMP_f64),$(FW_CONFIG_f64))
+endif
+ifneq ($(file <$(FW_STAMP_f32)),$(FW_CONFIG_f32))
+$(shell mkdir -p $(dir $(FW_STAMP_f32)))
+$(file >$(FW_STAMP_f32),$(FW_CONFIG_f32))
+endif
+ifneq ($(file <$(FW_STAMP_avr)),$(FW_CONFIG_avr))
+$(shell mkdir -p $(dir $(FW_STAMP_avr)))
+$(file >$(FW_STAMP_avr),$(FW_CONFIG_avr))
+endif
+endif
+$(FW_STAMP_f64) $(FW_STAMP_f32) $(FW_STAMP_avr):
+	@mkdir -p $(@D) && touch $@
+
 .PHONY: test-firmware test-firmware-native test-firmware-avr bench-firmware fw-unity fw-check-version
 
 # Both sets, then one total line (CI reads `N passed, N failed`). A suite
@@ -86,21 +119,23 @@ FW_NDIR_$(1) := $(FW_BUILD)/native-$(1)
 FW_NRT_OBJS_$(1) := $$(patsubst $(FW_SRC)/%.cpp,$(FW_BUILD)/native-$(1)/rt/%.o,$(FW_RT_SRCS))
 FW_NBINS_$(1) := $$(patsubst %,$(FW_BUILD)/native-$(1)/test_%,$(FW_SUITES))
 
-$(FW_BUILD)/native-$(1)/rt/%.o: $(FW_SRC)/%.cpp $(FW_RT_HDRS)
+$(FW_BUILD)/native-$(1)/rt/%.o: $(FW_SRC)/%.cpp $(FW_RT_HDRS) $(FW_STAMP_$(1))
 	@mkdir -p $$(@D)
-	$(FW_HOST_CXX) $(FW_HOST_FLAGS) $(FW_MODE_$(1)) $(FW_RT_WARN) -c $$< -o $$@
+	$(FW_HOST_CXX) $(FW_HOST_FLAGS) $(FW_MODE_$(1)) $(FW_RT_WARN) $(FW_DEPS) -c $$< -o $$@
 
-$(FW_BUILD)/native-$(1)/obj/%.o: $(FW_TESTS)/%.cpp $(FW_RT_HDRS) $(FW_TEST_HDRS) $(FW_UNITY_SRC)
+$(FW_BUILD)/native-$(1)/obj/%.o: $(FW_TESTS)/%.cpp $(FW_RT_HDRS) $(FW_TEST_HDRS) $(FW_UNITY_SRC) $(FW_STAMP_$(1))
 	@mkdir -p $$(@D)
-	$(FW_HOST_CXX) $(FW_HOST_FLAGS) $(FW_MODE_$(1)) $(FW_WARN) -c $$< -o $$@
+	$(FW_HOST_CXX) $(FW_HOST_FLAGS) $(FW_MODE_$(1)) $(FW_WARN) $(FW_DEPS) -c $$< -o $$@
 
-$(FW_BUILD)/native-$(1)/obj/unity.o: $(FW_UNITY_SRC) $(FW_TESTS)/unity_config.h
+$(FW_BUILD)/native-$(1)/obj/unity.o: $(FW_UNITY_SRC) $(FW_TESTS)/unity_config.h $(FW_STAMP_$(1))
 	@mkdir -p $$(@D)
-	$(FW_HOST_CC) -std=c99 -O2 -g $(FW_INC) $(FW_SAN) -c $$< -o $$@
+	$(FW_HOST_CC) -std=c99 -O2 -g $(FW_INC) $(FW_SAN) $(FW_DEPS) -c $$< -o $$@
 
 $(FW_BUILD)/native-$(1)/test_%: $(FW_BUILD)/native-$(1)/obj/test_%.o $(FW_BUILD)/native-$(1)/obj/test_support.o \
-		$(FW_BUILD)/native-$(1)/obj/unity.o $$(FW_NRT_OBJS_$(1))
-	$(FW_HOST_CXX) $(FW_SAN) -pthread -o $$@ $$^
+		$(FW_BUILD)/native-$(1)/obj/unity.o $$(FW_NRT_OBJS_$(1)) $(FW_STAMP_$(1))
+	$(FW_HOST_CXX) $(FW_SAN) -pthread -o $$@ $$(filter %.o,$$^)
+
+-include $$(wildcard $(FW_BUILD)/native-$(1)/rt/*.d $(FW_BUILD)/native-$(1)/obj/*.d)
 endef
 $(eval $(call FW_NATIVE_MODE,f64))
 $(eval $(call FW_NATIVE_MODE,f32))
@@ -131,38 +166,39 @@ FW_ART_OBJS   := $(patsubst $(FW_SRC)/%.cpp,$(FW_ADIR)/rt/%.o,$(FW_RT_SRCS))
 FW_ABINS      := $(patsubst %,$(FW_ADIR)/test_%.elf,$(FW_AVR_SUITES))
 FW_SIMRUN     := $(FW_BUILD)/simrun
 
-$(FW_ADIR)/core/%.c.o: $(FW_ARDUINO)/cores/arduino/%.c
+$(FW_ADIR)/core/%.c.o: $(FW_ARDUINO)/cores/arduino/%.c $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CC) $(FW_AVR_CFLAGS) -c $< -o $@
-$(FW_ADIR)/core/%.cpp.o: $(FW_ARDUINO)/cores/arduino/%.cpp
+	$(FW_AVR_CC) $(FW_AVR_CFLAGS) $(FW_DEPS) -c $< -o $@
+$(FW_ADIR)/core/%.cpp.o: $(FW_ARDUINO)/cores/arduino/%.cpp $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) -c $< -o $@
-$(FW_ADIR)/core/%.S.o: $(FW_ARDUINO)/cores/arduino/%.S
+	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) $(FW_DEPS) -c $< -o $@
+$(FW_ADIR)/core/%.S.o: $(FW_ARDUINO)/cores/arduino/%.S $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CC) $(FW_AVR_DEFS) $(FW_AVR_CORE_INC) -x assembler-with-cpp -c $< -o $@
-$(FW_ADIR)/core.a: $(FW_CORE_OBJS)
-	rm -f $@ && avr-ar rcs $@ $^
+	$(FW_AVR_CC) $(FW_AVR_DEFS) $(FW_AVR_CORE_INC) $(FW_DEPS) -x assembler-with-cpp -c $< -o $@
+$(FW_ADIR)/core.a: $(FW_CORE_OBJS) $(FW_STAMP_avr)
+	rm -f $@ && avr-ar rcs $@ $(FW_CORE_OBJS)
 # The runtime links as an archive, as the Arduino IDE does with
 # dot_a_linkage=true: only the PSL parts a build uses are pulled in.
-$(FW_ADIR)/libfswkit.a: $(FW_ART_OBJS)
-	rm -f $@ && avr-ar rcs $@ $^
+$(FW_ADIR)/libfswkit.a: $(FW_ART_OBJS) $(FW_STAMP_avr)
+	rm -f $@ && avr-ar rcs $@ $(FW_ART_OBJS)
 
-$(FW_ADIR)/rt/%.o: $(FW_SRC)/%.cpp $(FW_RT_HDRS)
+$(FW_ADIR)/rt/%.o: $(FW_SRC)/%.cpp $(FW_RT_HDRS) $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) $(FW_RT_WARN) -c $< -o $@
-$(FW_ADIR)/obj/%.o: $(FW_TESTS)/%.cpp $(FW_RT_HDRS) $(FW_TEST_HDRS) $(FW_UNITY_SRC)
+	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) $(FW_RT_WARN) $(FW_DEPS) -c $< -o $@
+$(FW_ADIR)/obj/%.o: $(FW_TESTS)/%.cpp $(FW_RT_HDRS) $(FW_TEST_HDRS) $(FW_UNITY_SRC) $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) -I$(FW_SRC) -I$(FW_TESTS) -I$(FW_UNITY) -DUNITY_INCLUDE_CONFIG_H $(FW_WARN) -c $< -o $@
-$(FW_ADIR)/obj/unity.o: $(FW_UNITY_SRC) $(FW_TESTS)/unity_config.h
+	$(FW_AVR_CXX) $(FW_AVR_CXXFLAGS) -I$(FW_SRC) -I$(FW_TESTS) -I$(FW_UNITY) -DUNITY_INCLUDE_CONFIG_H $(FW_WARN) $(FW_DEPS) -c $< -o $@
+$(FW_ADIR)/obj/unity.o: $(FW_UNITY_SRC) $(FW_TESTS)/unity_config.h $(FW_STAMP_avr)
 	@mkdir -p $(@D)
-	$(FW_AVR_CC) $(FW_AVR_CFLAGS) -I$(FW_TESTS) -I$(FW_UNITY) -DUNITY_INCLUDE_CONFIG_H -c $< -o $@
+	$(FW_AVR_CC) $(FW_AVR_CFLAGS) -I$(FW_TESTS) -I$(FW_UNITY) -DUNITY_INCLUDE_CONFIG_H $(FW_DEPS) -c $< -o $@
 $(FW_ADIR)/test_%.elf: $(FW_ADIR)/obj/test_%.o $(FW_ADIR)/obj/test_support.o $(FW_ADIR)/obj/unity.o \
-		$(FW_ADIR)/libfswkit.a $(FW_ADIR)/core.a
-	$(FW_AVR_CXX) $(FW_AVR_LDFLAGS) -o $@ $^
+		$(FW_ADIR)/libfswkit.a $(FW_ADIR)/core.a $(FW_STAMP_avr)
+	$(FW_AVR_CXX) $(FW_AVR_LDFLAGS) -o $@ $(filter-out $(FW_STAMP_avr),$^)
 	@avr-size -C --mcu=$(FW_AVR_MCU) $@ | grep -E 'Program|Data' | sed 's|^|  $(notdir $@) |'
 
 .SECONDARY: $(FW_CORE_OBJS) $(FW_ART_OBJS) \
     $(patsubst %,$(FW_ADIR)/obj/%.o,$(addprefix test_,$(FW_AVR_SUITES)) test_support unity)
+-include $(wildcard $(FW_ADIR)/core/*.d $(FW_ADIR)/rt/*.d $(FW_ADIR)/obj/*.d)
 
 $(FW_SIMRUN): $(FW_TESTS)/avr/simrun.c
 	@mkdir -p $(@D)

@@ -111,7 +111,13 @@ def build(script: M.Script, real: Real, source_line) -> str:
             runtime_sources() + ["-o", os.path.join(tmp, "runner")]
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
-            raise NativeError("the generated code did not compile (a bug in fswkit):\n" + r.stderr[-4000:])
+            log = out + ".log"
+            with open(log, "w") as f:
+                f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+            errors = [line.strip()[:300] for line in r.stderr.splitlines() if "error:" in line]
+            raise NativeError("internal error: the generated code did not compile, although the script and "
+                              f"its machine are valid: a defect of fswkit, please report it with {log}" +
+                              "".join("\n  " + e for e in errors[:6]))
         try:
             os.replace(tmp, out)
         except OSError:  # another process built the same runner first

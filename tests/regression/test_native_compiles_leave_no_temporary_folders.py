@@ -1,12 +1,14 @@
 """An interrupted `fsw test --native` left its `.tmpPID` compile folder in
-the cache for good, as did a compile that failed. A compile's temporary
-folder is now removed however the compile ends (an error, Ctrl-C, SIGTERM,
-SIGHUP), and those of processes that died mid-compile are swept away by
-the next compile."""
+the cache for good, as did a compile that failed (which also printed up to
+4 KB of raw compiler output). A compile's temporary folder is now removed
+however the compile ends (an error, Ctrl-C, SIGTERM, SIGHUP), those of
+processes that died mid-compile are swept away by the next compile, and a
+failed compile is an internal error naming its log."""
 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -70,7 +72,10 @@ def test_a_failed_compile_leaves_no_temporary_folder(fsw, tmp_path, monkeypatch)
 
     monkeypatch.setattr(native, "script_files", script_files)
     r = fsw("test", "--native", SCRIPT)
-    assert r.code == 3 and "did not compile" in r.err
+    assert r.code == 3 and "internal error: the generated code did not compile" in r.err
+    assert "expected primary-expression" in r.err and len(r.err.splitlines()) <= 8, r.err
+    log = re.search(r"please report it with (\S+\.log)", r.err).group(1)
+    assert "int broken = ;" in open(log).read()
     assert _leftovers(tmp_path) == []
 
 

@@ -24,6 +24,7 @@ from fswkit.autocode.emit_app import emit_app
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BUILD_MK = os.path.join(ROOT, "mk", "build.mk")
+RUNTIME = os.path.join(ROOT, "firmware", "src")
 ARDUINO = "/usr/share/arduino/hardware/arduino/avr"  # mk/build.mk's default, Debian's arduino-core-avr
 
 
@@ -188,13 +189,21 @@ def _holder(fd: int) -> str:
 
 # ---- make ------------------------------------------------------------------------------
 
+def firmware_name(app: Application) -> str:
+    """The firmware's file name without extension: the application file's
+    name, with any character Make cannot take in a file name (spaces, `$`,
+    `%`, `:`, quotes...) replaced by `_`."""
+    return re.sub(r"[^A-Za-z0-9_.+-]", "_", os.path.splitext(os.path.basename(app.path))[0])
+
+
 def make_args(app: Application, out: str, jobs: int = 2) -> tuple[str, list[str]]:
-    """(artifact, command) of mk/build.mk for the application."""
-    gen = os.path.join(out, "gen")
+    """(artifact, command) of mk/build.mk for the application. The command
+    runs in `out` and names the build's own files relative to it, so a
+    folder whose path Make cannot take (a space, `:`) builds all the same."""
     b = app.board
-    name = os.path.splitext(os.path.basename(app.path))[0]
-    args = ["make", "--no-print-directory", f"-j{jobs}", "-f", BUILD_MK, f"GEN={gen}", f"OUT={out}",
-            f"NAME={name}"]
+    name = firmware_name(app)
+    args = ["make", "--no-print-directory", f"-j{jobs}", "-f", BUILD_MK, "GEN=gen", "OUT=.", f"NAME={name}",
+            f"RUNTIME={RUNTIME}"]
     if b.is_avr:
         ard = b.raw.get("arduino", {})
         for tool in ("avr-g++", "avr-gcc", "avr-size", "avr-nm", "make"):
@@ -219,7 +228,7 @@ def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.Com
     (artifact, process). The compiler's whole output goes to `out/build.log`."""
     artifact, args = make_args(app, out, jobs)
     with build_lock(out):
-        proc = subprocess.run(args, capture_output=True, text=True)
+        proc = subprocess.run(args, capture_output=True, text=True, cwd=out)
         with open(log_path(out), "w") as f:
             f.write(" ".join(args) + "\n" + proc.stdout + proc.stderr)
     return artifact, proc
@@ -265,9 +274,9 @@ def overflow_report(app: Application, out: str) -> str | None:
     removed after) and says what uses the memory; None when that fails."""
     artifact, args = make_args(app, out)
     elf = artifact[:-4] + ".overflow.elf"
-    args = [a for a in args if a != "avr"] + [elf]
+    args = [a for a in args if a != "avr"] + [os.path.basename(elf)]
     try:
-        r = subprocess.run(args, capture_output=True, text=True)
+        r = subprocess.run(args, capture_output=True, text=True, cwd=out)
         if r.returncode != 0 or not os.path.exists(elf):
             return None
         flash, ram = elf_size(elf)

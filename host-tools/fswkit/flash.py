@@ -233,7 +233,7 @@ def upload_pio(app, port: str) -> int:
 # ---- the command -----------------------------------------------------------------------
 
 def main(args) -> int:
-    from fswkit.build import BuildError, build_lock, default_out
+    from fswkit.build import BuildError, build_lock, default_out, firmware_name
     from fswkit.cli import _load_app, cmd_build
     from fswkit.ports import PortError, default_port
 
@@ -260,10 +260,12 @@ def main(args) -> int:
             code = cmd_build(argparse.Namespace(project=args.project, board=args.board, out=out))
             if code != EXIT_OK:
                 return code
-            name = os.path.splitext(os.path.basename(app.path))[0]
-            return upload_avrdude(board, os.path.join(out, name + ".hex"), port, args.verbose)
+            return upload_avrdude(board, os.path.join(out, firmware_name(app) + ".hex"), port, args.verbose)
     except BuildError as e:
         sys.stderr.write(f"fsw flash: {e}\n")
+        return EXIT_FAIL
+    except OSError as e:  # the build folder cannot be made or locked
+        sys.stderr.write(f"fsw flash: {e.filename or ''}: {e.strerror or e}\n")
         return EXIT_FAIL
     except PortError as e:
         sys.stderr.write(f"fsw flash: {e}\n")

@@ -124,8 +124,98 @@ def _region(name, offset, size, elems) -> Region:
                   tuple(i for i, e in enumerate(elems) if e.type == "bool"), tuple(e.name for e in elems))
 
 
+def _field(where: str, v, want: str) -> str:
+    return f"field `{where}`: expected {want}, found {type(v).__name__} {json_text(v)}"
+
+
+def json_text(v) -> str:
+    import json
+
+    text = json.dumps(v)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _is_int(v, lo: int = 0, hi: int = 2**64) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool) and lo <= v <= hi
+
+
+def _is_num(v) -> bool:
+    import math
+
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _fraction(v) -> bool:
+    try:
+        return isinstance(v, (str, int)) and not isinstance(v, bool) and Fraction(v) > 0
+    except (ValueError, ZeroDivisionError):
+        return False
+
+
+def check_dict(d) -> None:
+    """LayoutError naming the first field of a layout's JSON form (a log
+    header: anyone may have written it) whose type or value a decoder cannot
+    use."""
+    def need(ok: bool, where: str, v, want: str) -> None:
+        if not ok:
+            raise LayoutError(_field(where, v, want))
+
+    need(isinstance(d, dict), "layout", d, "an object")
+    spec = {"schema": (lambda v: _is_int(v, 0, 2**32 - 1), "a 32-bit unsigned number"),
+            "name": (lambda v: isinstance(v, str), "a string"),
+            "sv_size": (lambda v: _is_int(v, 0, 1 << 20), "a size in bytes"),
+            "time_unit": (lambda v: v in ("ms", "us"), '"ms" or "us"'),
+            "rate": (lambda v: _is_int(v, 1, 1 << 20), "a rate in Hz"),
+            "health_payload": (lambda v: _is_int(v, 0, 1 << 16), "a size in bytes"),
+            "elements": (lambda v: isinstance(v, list), "a list"),
+            "regions": (lambda v: isinstance(v, list), "a list"),
+            "streams": (lambda v: isinstance(v, list), "a list"),
+            "tasks": (lambda v: isinstance(v, list), "a list"),
+            "writable": (lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of names"),
+            "states": (lambda v: isinstance(v, dict), "an object"),
+            "analog": (lambda v: isinstance(v, dict), "an object")}
+    for key, (ok, want) in spec.items():
+        if key not in d:
+            raise LayoutError(f"field `layout.{key}` is missing")
+        need(ok(d[key]), f"layout.{key}", d[key], want)
+    items = {"elements": {"name": (lambda v: isinstance(v, str), "a string"),
+                          "type": (lambda v: v in FORMATS, "one of " + " ".join(FORMATS)),
+                          "offset": (lambda v: _is_int(v, 0, 1 << 20), "an offset in bytes"),
+                          "region": (lambda v: isinstance(v, str), "a region name")},
+             "regions": {"name": (lambda v: isinstance(v, str), "a string"),
+                         "offset": (lambda v: _is_int(v, 0, 1 << 20), "an offset in bytes"),
+                         "size": (lambda v: _is_int(v, 0, 1 << 20), "a size in bytes")},
+             "streams": {"region": (lambda v: isinstance(v, str), "a region name"),
+                         "rate": (_fraction, "a positive rate such as \"50\" or \"25/2\""),
+                         "batch": (lambda v: _is_int(v, 1, 1 << 16), "a whole number of samples >= 1"),
+                         "period": (_fraction, "a positive period such as \"20\"")},
+             "tasks": {"name": (lambda v: isinstance(v, str), "a string"),
+                       "kind": (lambda v: isinstance(v, str), "a string")}}
+    for key, fields in items.items():
+        for i, item in enumerate(d[key]):
+            where = f"layout.{key}[{i}]"
+            need(isinstance(item, dict), where, item, "an object")
+            for name, (ok, want) in fields.items():
+                if name not in item:
+                    raise LayoutError(f"field `{where}.{name}` is missing")
+                need(ok(item[name]), f"{where}.{name}", item[name], want)
+    for el, names in d["states"].items():
+        need(isinstance(names, dict) and all(isinstance(n, str) for n in names.values()), f"layout.states.{el}",
+             names, "an object of state names")
+        for k in names:
+            need(k.lstrip("-").isdigit(), f"layout.states.{el}", k, "state ids")
+    for el, cal in d["analog"].items():
+        need(isinstance(cal, dict), f"layout.analog.{el}", cal, "an object")
+        for name in ("scale", "offset"):
+            need(_is_num(cal.get(name)), f"layout.analog.{el}.{name}", cal.get(name), "a number")
+        need(isinstance(cal.get("pin"), (str, int)) and not isinstance(cal.get("pin"), bool),
+             f"layout.analog.{el}.pin", cal.get("pin"), "a pin")
+
+
 def from_dict(d: dict) -> Layout:
-    """A layout from its JSON form (a log header)."""
+    """A layout from its JSON form (a log header); LayoutError naming the
+    field that is wrong."""
+    check_dict(d)
     try:
         elements = tuple(Element(i, e["name"], e["type"], e["offset"], e["region"])
                          for i, e in enumerate(d["elements"]))

@@ -119,9 +119,17 @@ class LogReader:
         start = len(MAGIC) + 4
         try:
             self.header = json.loads(data[start:start + n].decode())
+        except ValueError as e:  # JSONDecodeError and UnicodeDecodeError alike
+            raise LogError(f"{path}: not a valid log: its header is not JSON ({e})") from None
+        if not isinstance(self.header, dict) or "layout" not in self.header:
+            raise LogError(f"{path}: not a valid log: its header has no `layout` object")
+        if self.header.get("format") != 1:
+            raise LogError(f"{path}: not a valid log: field `format`: expected 1, found "
+                           f"{json.dumps(self.header.get('format'))[:40]}")
+        try:
             self.layout = from_dict(self.header["layout"])
-        except (ValueError, KeyError, TypeError, LayoutError) as e:
-            raise LogError(f"{path}: damaged log header ({e})") from None
+        except LayoutError as e:
+            raise LogError(f"{path}: not a valid log: {e}") from None
         self._data = data
         self._at = start + n
         self.path = path

@@ -6,6 +6,7 @@ log decodes without the configs."""
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 from fractions import Fraction
@@ -140,8 +141,6 @@ def _is_int(v, lo: int = 0, hi: int = 2**64) -> bool:
 
 
 def _is_num(v) -> bool:
-    import math
-
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
@@ -286,9 +285,17 @@ def encode_value(el: Element, text: str) -> bytes:
             x = float(text)
         except ValueError:
             raise LayoutError(f"`{el.name}` is {t}: `{text}` is not a number") from None
-        if t == "F32" and abs(x) != float("inf") and x == x and abs(x) > 3.4028234663852886e38:
-            raise LayoutError(f"`{el.name}` is F32: {text} is out of its range")
-        return struct.pack("<" + FORMATS[t], x)
+        # a finite number is in range when it rounds to a finite value of the
+        # type (binary32: below 2^128 - 2^103, which 3.4028235e38 is); only
+        # `inf` itself stands for infinity
+        limit = "±3.4028235e38" if t == "F32" else "±1.7976931348623157e308"
+        literal_inf = text.strip().lstrip("+-").lower() in ("inf", "infinity")
+        if math.isinf(x) and not literal_inf:
+            raise LayoutError(f"`{el.name}` is {t}: {text} is out of its range ({limit}, or inf)")
+        try:
+            return struct.pack("<" + FORMATS[t], x)
+        except OverflowError:
+            raise LayoutError(f"`{el.name}` is {t}: {text} is out of its range ({limit}, or inf)") from None
     try:
         v = int(text, 0)
     except ValueError:

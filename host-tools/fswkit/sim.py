@@ -257,6 +257,28 @@ STACK_PAINT = 0xC5
 PEEK_MAX = 4096  # bytes per `peek` command
 
 
+def link_problem(path: str) -> str | None:
+    """What forbids making `path` the symbolic link to the board's pty, or
+    None. Only a path with nothing there, or a stale link of a simulated
+    board (a symbolic link to a pseudo-terminal that is gone), may be used:
+    whatever else is there is never removed."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        return f"--link {path}: no such folder {folder}"
+    if not os.path.lexists(path):
+        return None
+    if os.path.islink(path):
+        target = os.readlink(path)
+        if re.fullmatch(r"/dev/pts/[0-9]+", target):
+            if not os.path.exists(target):
+                return None  # a link a board left behind: its pty is gone
+            return (f"--link {path}: it links to {target}, a pseudo-terminal that is open (another simulated "
+                    "board's?): stop that board, or remove the link if it is stale")
+        return f"--link {path}: a symbolic link to {target} is there: it is never replaced; choose another path"
+    what = "a folder" if os.path.isdir(path) else "a file"
+    return f"--link {path}: {what} is there: it is never replaced; choose another path"
+
+
 def _fields(line: str) -> dict[str, str]:
     return dict(t.split("=", 1) for t in line.split()[1:] if "=" in t)
 
@@ -290,6 +312,9 @@ class SimBoard:
         if wall_limit is not None:
             args += ["-w", repr(float(wall_limit))]
         if link:
+            problem = link_problem(link)
+            if problem is not None:
+                raise SimError(problem)
             args += ["-l", link]
         for pin, volts in (analog or {}).items():
             args += ["-a", f"{self.adc_channel(pin)}={self._millivolts(volts)}"]
@@ -715,6 +740,9 @@ def main(args) -> int:
     pty's path on standard output, run until Ctrl-C or --duration."""
     if args.duration is not None and not 0 < args.duration < 1e9:
         _say("--duration must be a positive number of simulated seconds")
+        return 2
+    if args.link is not None and link_problem(args.link) is not None:
+        _say(link_problem(args.link))
         return 2
     if _is_elf(args.project) or args.project.endswith(".elf"):
         if args.board is None:

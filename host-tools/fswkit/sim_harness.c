@@ -45,6 +45,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -230,7 +231,10 @@ static int pty_open(void) {
     close(slave); /* until someone opens it, the master reports a hang-up */
     fcntl(pty_master, F_SETFL, fcntl(pty_master, F_GETFL) | O_NONBLOCK);
     if (pty_link[0]) {
-        unlink(pty_link);
+        /* only a symbolic link (a stale one of a board: the caller checked)
+           is ever replaced; a file is never removed */
+        struct stat st;
+        if (lstat(pty_link, &st) == 0 && S_ISLNK(st.st_mode)) unlink(pty_link);
         if (symlink(pty_name, pty_link) != 0) {
             fprintf(stderr, "simboard: cannot link %s to %s: %s\n", pty_link, pty_name, strerror(errno));
             pty_link[0] = 0;
@@ -764,6 +768,13 @@ int main(int argc, char** argv) {
                 wall_now() - wall_start);
         if (!strcmp(why, "crashed")) status = 1;
     }
-    if (pty_link[0]) unlink(pty_link);
+    if (pty_link[0]) { /* our own link only: still pointing at our pty */
+        char to[sizeof pty_name];
+        ssize_t n = readlink(pty_link, to, sizeof to - 1);
+        if (n > 0) {
+            to[n] = 0;
+            if (!strcmp(to, pty_name)) unlink(pty_link);
+        }
+    }
     return status;
 }

@@ -130,6 +130,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
     regions = {s.index: s.region for s in layout.streams}
     per_s = 1000.0 if layout.time_unit == "ms" else 1e6
     log = LogWriter(log_path, layout, **(log_meta or {})) if log_path else None
+    if log:
+        log.commit()  # named from the start: a run killed outright still leaves its log
     last_state = None
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,

@@ -9,9 +9,12 @@ many flights)."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import hashlib
 import os
+import shutil
 import sys
+import tempfile
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
@@ -99,18 +102,43 @@ def budget_checks(app, elf: str, run: Run) -> list[reports.Check]:
     return out
 
 
+INCOMPLETE = "incomplete"  # OUT/incomplete: the files of the last run that did not finish
+
+
+class Interrupted(Exception):
+    """A run stopped before its end (its partial files are kept apart)."""
+
+
 def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False) -> Flight:
     """Flies the scenario; writes the files into `out` (None: none). CosimError
-    if the run could not go on."""
-    files = {}
-    if out is not None:
-        os.makedirs(out, exist_ok=True)
-        files = {k: os.path.join(out, v) for k, v in FILES.items()}
+    if the run could not go on.
+
+    A run's files are one set: they are written into a fresh folder inside
+    `out` and moved into place only once all of them are (the summary last,
+    after the previous summary is gone), so `out` never holds one run's log
+    beside another's summary. A run that does not finish (an error, Ctrl-C)
+    leaves the previous set as it was and its own partial files in
+    `out/incomplete/`, with a note saying so."""
+    if out is None:
+        return _execute(sc, elf, board, layout, None)
+    os.makedirs(out, exist_ok=True)
+    stage = tempfile.mkdtemp(prefix=".run-", dir=out)
+    try:
+        flight = _execute(sc, elf, board, layout, stage)
+    except BaseException as e:
+        _set_aside(stage, out, e)
+        raise
+    flight.files = _install(stage, out)
+    return flight
+
+
+def _execute(sc, elf, board, layout, folder: str | None) -> Flight:
+    files = {k: os.path.join(folder, v) for k, v in FILES.items()} if folder is not None else {}
     meta = {"source": f"fsw sim --plant {sc.kind}", "clock": "simulated", "seed": sc.seed, "fault": sc.fault}
     run = fly(sc, elf, board, layout, files.get("log"), log_meta=meta)
     rep = reports.rocket(run, sc) if sc.kind == "rocket" else reports.tank(run, sc)
     rep.checks += budget_checks(sc.app, elf, run)
-    if out is not None:
+    if folder is not None:
         reports.write_csv(run, layout, sc.state_element, files["csv"])
         title = (f"{layout.name}: {sc.kind} plant, seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
                  + (" — all checks pass" if rep.passed else " — CHECKS FAIL"))
@@ -120,6 +148,33 @@ def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False
         with open(files["summary"], "w") as f:
             f.write(rep.text())
     return Flight(run, rep, sc, files)
+
+
+def _install(stage: str, out: str) -> dict:
+    """Moves a finished run's files from `stage` into `out`: the old summary
+    goes first and the new one comes last, so a summary always describes
+    the files beside it."""
+    files = {k: os.path.join(out, v) for k, v in FILES.items()}
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(files["summary"])
+    for k in ("log", "csv", "png", "summary"):
+        os.replace(os.path.join(stage, FILES[k]), files[k])
+    shutil.rmtree(stage, ignore_errors=True)
+    return files
+
+
+def _set_aside(stage: str, out: str, why: BaseException) -> None:
+    """A run that did not finish: its files to `out/incomplete/`, with a note."""
+    reason = "interrupted (Ctrl-C)" if isinstance(why, KeyboardInterrupt) else f"stopped: {why}"
+    try:
+        with open(os.path.join(stage, "INCOMPLETE.txt"), "w") as f:
+            f.write(f"This run did not finish ({reason}): its files are partial, and it has no summary.\n"
+                    f"The files in {out} are those of the last run that finished.\n")
+        target = os.path.join(out, INCOMPLETE)
+        shutil.rmtree(target, ignore_errors=True)
+        os.replace(stage, target)
+    except OSError:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def main(args) -> int:
@@ -162,13 +217,18 @@ def main(args) -> int:
     what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
     _say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
          "simulated")
+    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
+                  "still the last finished run's")
     try:
         flight = execute(sc, elf, board, layout, out)
+    except KeyboardInterrupt:
+        _say("interrupted" + incomplete)
+        raise
     except CosimError as e:
-        _say(str(e))
+        _say(str(e) + incomplete)
         return 1
     except OSError as e:
-        _say(f"cannot write {e.filename or out}: {e.strerror or e}")
+        _say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
         return 1
     sys.stdout.write(flight.report.text())
     sys.stdout.flush()

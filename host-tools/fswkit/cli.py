@@ -281,7 +281,9 @@ def _generate(app, out: str, command: str):
 
 
 def cmd_gen(args) -> int:
-    from fswkit.build import default_out
+    import contextlib
+
+    from fswkit.build import BuildError, build_lock, default_out
 
     app = _load_app(args, "gen")
     if app is None:
@@ -290,7 +292,13 @@ def cmd_gen(args) -> int:
         from fswkit.sketch import export
         return export(app, args.sketch)
     out = args.out or os.path.join(default_out(app), "gen")
-    files = _generate(app, out, "gen")
+    try:
+        # the default folder is the build's own: not rewritten while a build compiles it
+        with build_lock(os.path.dirname(out), "gen") if not args.out else contextlib.nullcontext():
+            files = _generate(app, out, "gen")
+    except (BuildError, OSError) as e:
+        sys.stderr.write(f"fsw gen: {e.strerror if isinstance(e, OSError) and e.strerror else e}\n")
+        return EXIT_FAIL
     if files is None:
         return EXIT_FAIL
     sys.stderr.write(f"fsw gen: {len(files)} files in {out}\n")

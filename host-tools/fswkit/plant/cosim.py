@@ -217,6 +217,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
                 break
     except SimError as e:
         raise CosimError(str(e)) from None
+    except ArithmeticError as e:  # the plant's state overflowed: parameters that pass the schema, flown too far
+        raise CosimError(f"the {getattr(scenario, 'kind', 'plant')} plant's state is no longer a finite number at "
+                         f"{t1:.3f} s simulated ({e}): check its parameters (docs/sim.md)") from None
     finally:
         b.close()
         if log:
@@ -226,4 +229,6 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
 
 def _mv(volts: float, vref: float) -> int:
     """Millivolts at an analog pin, clamped to 0..vref as the converter saturates."""
+    if volts != volts:
+        raise FloatingPointError("a sensor's volts are not a number")
     return int(round(min(max(volts, 0.0), vref) * 1000))

@@ -37,6 +37,7 @@ class Field:
     hi: float | None = None
     above: float | None = None  # exclusive lower bound
     required: bool = True
+    x_hi: float | None = None  # curves: the largest first value (seconds); `hi` bounds the second
 
     def __post_init__(self):
         if self.default is not None:
@@ -147,6 +148,10 @@ def _value(v, f: Field, name: str) -> tuple[object, str | None]:
         for i, (t, y) in enumerate(pts):
             if t < 0 or y < 0:
                 return None, f"{name}: point {i + 1} {list(pts[i])}: seconds and values must be >= 0"
+            if f.x_hi is not None and t > f.x_hi:
+                return None, f"{name}: point {i + 1} {list(pts[i])}: {t:g} s is out of range (at most {f.x_hi:g})"
+            if f.hi is not None and y > f.hi:
+                return None, f"{name}: point {i + 1} {list(pts[i])}: {y:g} is out of range (at most {f.hi:g})"
             if i and t <= pts[i - 1][0]:
                 return None, f"{name}: point {i + 1}: times must increase ({pts[i - 1][0]:g} then {t:g})"
         return tuple(pts), None

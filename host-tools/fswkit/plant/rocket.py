@@ -13,6 +13,7 @@ comes back to the ground. Integration: classical Runge-Kutta, fixed step.
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass
 
 from .atmosphere import G0, density_fn, pressure
@@ -162,6 +163,9 @@ class Rocket:
         a4 = f(t1 - eps, h + v3 * dt, v4, cda)
         h += dt * (v + 2 * v2 + 2 * v3 + v4) / 6
         v += dt * (a1 + 2 * a2 + 2 * a3 + a4) / 6
+        if not (math.isfinite(h) and math.isfinite(v)):
+            raise FloatingPointError(f"the rocket's altitude or velocity overflowed at {t1:.6g} s "
+                                     f"(thrust {self.thrust(t):.6g} N, mass {self.mass(t):.6g} kg)")
         self.t = t1
         if self.apogee_t is None and h <= 0.0:  # thrust barely above the weight: still on the rail's foot
             h, v = 0.0, max(v, 0.0)

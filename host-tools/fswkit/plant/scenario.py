@@ -57,12 +57,13 @@ def _chute(what: str) -> Table:
 ROCKET_SCHEMA = {
     "": _TOP,
     "vehicle": Table("the vehicle without its propellant", {
-        "dry_mass_kg": F("float", "mass without propellant, kg", above=0, hi=1000),
+        "dry_mass_kg": F("float", "mass without propellant, kg", lo=0.01, hi=1000),
         "body_cd_area_m2": F("float", "drag coefficient × reference area of the body, m²", lo=0, hi=10),
     }),
     "motor": Table("the motor", {
         "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0, hi=1000),
-        "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated"),
+        "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated", x_hi=600,
+                          hi=1e6),
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
     }),
@@ -73,13 +74,13 @@ ROCKET_SCHEMA = {
     }),
     "barometer": Table("the analog barometer", {
         "channel": F("pin", "the analog input it drives, e.g. \"A0\""),
-        "pa_per_volt": F("float", "its slope, Pa per volt", above=0, hi=1e7),
+        "pa_per_volt": F("float", "its slope, Pa per volt", lo=1, hi=1e7),
         "pa_at_0v": F("float", "the pressure that would read 0 V, Pa", lo=-1e7, hi=1e7),
         "noise_pa": F("float", "Gaussian noise, standard deviation in Pa", lo=0, hi=1e5),
     }),
     "accelerometer": Table("the analog accelerometer on the vehicle's axis", {
         "channel": F("pin", "the analog input it drives, e.g. \"A1\""),
-        "volts_per_g": F("float", "its slope, V per g", above=0, hi=100),
+        "volts_per_g": F("float", "its slope, V per g", lo=1e-4, hi=100),
         "zero_g_volts": F("float", "its output at 0 g, V", lo=0, hi=5),
         "noise_g": F("float", "Gaussian noise, standard deviation in g", lo=0, hi=100),
     }),
@@ -125,9 +126,9 @@ ROCKET_SCHEMA = {
 TANK_SCHEMA = {
     "": _TOP,
     "tank": Table("the tank and its gas", {
-        "volume_l": F("float", "litres", above=0, hi=1e6),
-        "temperature_k": F("float", "the gas's temperature (held constant), K", above=0, hi=2000),
-        "gas_constant_j_kg_k": F("float", "specific gas constant, J/(kg·K) (nitrogen 296.8)", above=0, hi=1e5),
+        "volume_l": F("float", "litres", lo=0.001, hi=1e6),
+        "temperature_k": F("float", "the gas's temperature (held constant), K", lo=20, hi=2000),
+        "gas_constant_j_kg_k": F("float", "specific gas constant, J/(kg·K) (nitrogen 296.8)", lo=1, hi=1e5),
         "gamma": F("float", "ratio of specific heats (nitrogen 1.4)", above=1, hi=2),
         "initial_psi": F("float", "gauge pressure at the start, psi", lo=0, hi=1e5),
     }),
@@ -141,7 +142,7 @@ TANK_SCHEMA = {
     }),
     "transducer": Table("the pressure transducer (gauge)", {
         "channel": F("pin", "the analog input it drives, e.g. \"A0\""),
-        "psi_per_volt": F("float", "its slope, psi per volt", above=0, hi=1e6),
+        "psi_per_volt": F("float", "its slope, psi per volt", lo=1e-3, hi=1e6),
         "psi_at_0v": F("float", "the pressure that would read 0 V, psi", lo=-1e6, hi=1e6),
         "noise_psi": F("float", "Gaussian noise, standard deviation in psi", lo=0, hi=1e5),
     }),

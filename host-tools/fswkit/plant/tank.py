@@ -62,5 +62,7 @@ class Tank:
         m_mid = self.mass + (inflow - out1) * dt / 2
         out = self.vent_flow(m_mid * self.rt / self.volume, self.valve)
         self.mass = max(0.0, self.mass + (inflow - out) * dt)
+        if not math.isfinite(self.mass) or not math.isfinite(self.pressure):
+            raise FloatingPointError(f"the tank's gas mass or pressure overflowed at {self.t + dt:.6g} s")
         self.inflow, self.outflow = inflow, out
         self.t += dt

@@ -275,10 +275,20 @@ class _Binder:
         return float(value)
 
     def channel(self, table, key, pin, analog, direction):
+        """The project's channel on `pin`, named as the I/O tables name pins
+        (`"A0"`) or by the board's pin number (14, "14"), or None after an
+        error."""
         what = ("an analog input" if analog else "a digital input" if direction == "i" else "a digital output")
         pin_text = str(pin)
+        board = self.app.board
+        number = board.pin(pin_text)
+        if number is None:
+            forms = ", ".join(f'"{n}" or {p}' for n, p in board.analog_pins.items())
+            self.err(table, key, f"board `{board.name}` has no pin {pin_text}: name a pin as the I/O tables do, "
+                     f"or by its number ({'analog inputs: ' + forms if analog else 'digital pins: numbers'})")
+            return None
         for c in self.app.channels:
-            if c.pin == pin_text or (not analog and not c.analog and c.pin_number == pin):
+            if c.pin_number == number:
                 if c.analog != analog or c.direction != direction:
                     self.err(table, key, f"pin {pin_text} is not {what} of the project ({c.path}:{c.line} "
                              f"makes it {'an analog' if c.analog else 'a digital'} "
@@ -342,6 +352,9 @@ class RocketScenario:
         accel = bind.channel("accelerometer", "channel", p["accelerometer"]["channel"], True, "i")
         self.accel_element = accel.element.name if accel is not None else None
         self.baro_element = baro.element.name if baro is not None else None
+        if baro is not None and accel is not None and baro.pin_number == accel.pin_number:
+            bind.err("accelerometer", "channel", "the barometer and the accelerometer must drive two different "
+                     f"analog inputs (both name pin {baro.pin})")
         bind.channel("pins", "arm", pins["arm"], False, "i")
         bind.channel("pins", "drogue", pins["drogue"], False, "o")
         bind.channel("pins", "main", pins["main"], False, "o")
@@ -376,7 +389,9 @@ class RocketScenario:
         self.levels = {pin: False for pin in self.pins}
         self.baro_noise = Noise(baro_rng, p["barometer"]["noise_pa"])
         self.accel_noise = Noise(accel_rng, p["accelerometer"]["noise_g"])
-        self.channels = (p["barometer"]["channel"], p["accelerometer"]["channel"])
+        # the ADC channels by the names the I/O tables give them, whatever form plant.toml used
+        self.channels = (baro.pin if baro is not None else p["barometer"]["channel"],
+                         accel.pin if accel is not None else p["accelerometer"]["channel"])
         self.ignition_s = None if fault in ("pinned-accel", "pinned-baro") else sc["ignition_s"]
         self.max_s = sc["hold_s"] if self.ignition_s is None else sc["max_s"]
         self.frozen_baro: float | None = None
@@ -477,7 +492,7 @@ class TankScenario:
             bind.state(m, key, fw[key])
         self.abort_psi = bind.local(m, "abort_limit", fw["abort_limit"])
         self.vent_psi = fw["vent_psi"]
-        bind.channel("transducer", "channel", p["transducer"]["channel"], True, "i")
+        transducer = bind.channel("transducer", "channel", p["transducer"]["channel"], True, "i")
         bind.channel("pins", "valve", p["pins"]["valve"], False, "o")
         if sc["failure_s"] >= sc["max_s"]:
             bind.err("scenario", "failure_s", "the regulator must fail before the run's end (max_s)")
@@ -491,7 +506,7 @@ class TankScenario:
         self.vref = float(bind.app.board.adc_vref)
         (rng,) = (np.random.Generator(np.random.PCG64(s)) for s in np.random.SeedSequence(seed).spawn(1))
         self.noise = Noise(rng, p["transducer"]["noise_psi"])
-        self.channel = p["transducer"]["channel"]
+        self.channel = transducer.pin if transducer is not None else p["transducer"]["channel"]
         self.max_s = sc["max_s"]
         self.valve = False
         self.abort_seen: float | None = None

@@ -42,7 +42,7 @@ def test_two_builds_into_one_folder_both_succeed_with_the_same_firmware(tmp_path
     try:
         first = _start("build", str(TANK), "--out", str(out))
         second = _start("build", str(TANK), "--out", str(out))
-        time.sleep(0.7)
+        time.sleep(0.5)
     finally:
         holder.stdin.close()
         holder.wait()

@@ -155,27 +155,43 @@ def _test_one(path: str, args, real):
             sources[p] = source_of(p)
         return sources[p].line(n)
 
-    if args.native:
-        from fswkit import native
+    trace = None
+    if args.trace:  # written beside its path and renamed into place once whole
+        from fswkit.outputs import OutputError, Replacement, check
         try:
-            code, report = native.run(script, real, line_of, trace_path=args.trace)
-        except native.NativeError as e:
+            check(args.trace, [path, script.machine.path], what="trace")
+            trace = Replacement(args.trace)
+        except OutputError as e:
             sys.stderr.write(f"fsw test: {e}\n")
-            return EXIT_INTERNAL, None
-        except OSError as e:
-            sys.stderr.write(f"fsw test: {e.filename or ''}: {e.strerror or e}\n")
             return EXIT_FAIL, None
-        sys.stdout.write(report)
-        sys.stdout.flush()
-        return (EXIT_OK if code == 0 else EXIT_FAIL), None
+    ok = False
     try:
-        result = run(script, real, trace_path=args.trace, source_line=line_of, cover=args.coverage)
-    except OSError as e:
-        sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
-        return EXIT_FAIL, None
-    sys.stdout.write(result.report())
-    sys.stdout.flush()
-    return (EXIT_OK if result.passed else EXIT_FAIL), (script.machine, result)
+        if args.native:
+            from fswkit import native
+            try:
+                code, report = native.run(script, real, line_of, trace_path=trace and trace.path)
+            except native.NativeError as e:
+                sys.stderr.write(f"fsw test: {e}\n")
+                return EXIT_INTERNAL, None
+            except OSError as e:
+                sys.stderr.write(f"fsw test: {e.filename or ''}: {e.strerror or e}\n")
+                return EXIT_FAIL, None
+            ok = True
+            sys.stdout.write(report)
+            sys.stdout.flush()
+            return (EXIT_OK if code == 0 else EXIT_FAIL), None
+        try:
+            result = run(script, real, trace_path=trace and trace.path, source_line=line_of, cover=args.coverage)
+        except OSError as e:
+            sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
+            return EXIT_FAIL, None
+        ok = True
+        sys.stdout.write(result.report())
+        sys.stdout.flush()
+        return (EXIT_OK if result.passed else EXIT_FAIL), (script.machine, result)
+    finally:
+        if trace is not None:
+            trace.finish(ok)
 
 
 def _report_coverage(coverage: dict) -> bool:

@@ -143,6 +143,17 @@ def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | 
                 raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
 
 
+def _new_file_mode(tmp: str, target: str) -> None:
+    """The mode the output would have had (mkstemp makes 0600): the old
+    file's, or a new file's under the umask."""
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode) if os.path.exists(target) else 0o666 & ~umask)
+    except OSError:
+        pass
+
+
 @contextlib.contextmanager
 def replacing(path: str):
     """The name of a new temporary file beside `path` (a symbolic link's
@@ -156,12 +167,7 @@ def replacing(path: str):
         raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
     os.close(fd)
     try:
-        try:  # the mode a new file would have had (mkstemp makes 0600)
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode) if os.path.exists(target) else 0o666 & ~umask)
-        except OSError:
-            pass
+        _new_file_mode(tmp, target)
         yield tmp
         try:
             os.replace(tmp, target)
@@ -171,6 +177,39 @@ def replacing(path: str):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+class Replacement:
+    """`replacing` for writers that take a path: `path` is where to write
+    (a temporary file beside the output, or the output itself for a device),
+    `finish(True)` moves it into place, `finish(False)` removes it."""
+
+    def __init__(self, target: str):
+        self.target = target
+        if _direct(target):
+            self.path, self._final = target, None
+            return
+        self._final = os.path.realpath(target) if os.path.islink(target) else target
+        try:
+            fd, self.path = tempfile.mkstemp(prefix=f".{os.path.basename(self._final)}.", suffix=".part",
+                                             dir=os.path.dirname(os.path.abspath(self._final)))
+        except OSError as e:
+            raise OutputError(f"cannot write {target}: {e.strerror or e}") from None
+        os.close(fd)
+        _new_file_mode(self.path, self._final)
+
+    def finish(self, ok: bool) -> None:
+        if self._final is None:
+            return
+        try:
+            if ok:
+                os.replace(self.path, self._final)
+            else:
+                os.unlink(self.path)
+        except OSError as e:
+            if ok:
+                raise OutputError(f"cannot write {self.target}: {e.strerror or e}") from None
+        self._final = None
 
 
 def write_text(path: str | None, text: str, inputs=(), *, what: str = "output") -> None:

@@ -253,7 +253,7 @@ def test_unwritable_output(fsw, tmp_path):
     r = fsw("graph", str(TANK / "tank.sm"), "-o", str(target))
     assert r.code == 1
     assert r.out == ""
-    assert r.err.startswith(f"fsw: cannot write {target}: ")
+    assert r.err.startswith(f"fsw graph: cannot write {target}: ")
     assert "Traceback" not in r.err
 
 

@@ -324,7 +324,7 @@ def test_unwritable_output(fsw, tmp_path):
     target = tmp_path / "no_such_dir" / "x.ss"
     r = fsw("skeleton", str(TANK / "tank.sm"), "-o", str(target))
     assert r.code == 1
-    assert r.err.startswith(f"fsw: cannot write {target}: ")
+    assert r.err.startswith(f"fsw skeleton: cannot write {target}: ")
     assert "Traceback" not in r.err
     assert not target.exists()
 

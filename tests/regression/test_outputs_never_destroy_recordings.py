@@ -100,3 +100,17 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
     assert r.code == 1 and "File too large" in r.err and "Traceback" not in r.err, r.err
     assert csv.read_text() == "the previous export\n"
     _no_parts(tmp_path)
+
+
+def test_test_trace_onto_its_script_or_machine_is_refused(tmp_path):
+    project = tank_copy(tmp_path)
+    for victim in ("tank.ss", "tank.sm"):
+        f = project / victim
+        before = f.read_bytes()
+        r = run_fsw("test", str(project / "tank.ss"), "--trace", str(f))
+        assert r.code == 1 and "overwrite an input" in r.err, r.err
+        assert f.read_bytes() == before
+    trace = project / "trace.csv"
+    r = run_fsw("test", str(project / "tank.ss"), "--trace", str(trace))
+    assert r.code == 0 and trace.read_text().startswith("step"), r.err
+    _no_parts(project)

@@ -406,8 +406,8 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
             if u is not None and rows:
                 u.detail = [(n, f"{src}:{line}  {_source_line(m.path, line)}") for n, line in rows]
     regions = sorted(app.sv.regions, key=lambda r: -r.size)
-    sv_detail = [(r.size, f"region {r.name}, {basename(app.sv.path)}:{r.line} ({len(r.elements)} element{'' if len(r.elements) == 1 else 's'})")
-                 for r in regions]
+    sv_detail = [(r.size, f"region {r.name}, {basename(app.sv.path)}:{r.line} "
+                          f"({len(r.elements)} element{'' if len(r.elements) == 1 else 's'})") for r in regions]
     if ("RAM", "sv") in uses:
         uses[("RAM", "sv")].detail = sv_detail
     return {space: sorted((u for (s, _), u in uses.items() if s == space), key=lambda u: -u.size)

@@ -101,7 +101,7 @@ def build(script: M.Script, real: Real, source_line) -> str:
         return exe
     sweep(cache_dir())
     tmp = out + f".tmp{os.getpid()}"
-    with _removed_when_done(tmp):
+    with removed_when_done(tmp):
         os.makedirs(tmp, exist_ok=True)
         for name, text in files.items():
             with open(os.path.join(tmp, name), "w") as f:
@@ -168,7 +168,7 @@ def _exit_on_signal(signum, frame):
 
 
 @contextlib.contextmanager
-def _removed_when_done(tmp: str):
+def removed_when_done(tmp: str):
     """Removes `tmp` however the block ends: an error, Ctrl-C, SIGTERM or
     SIGHUP (made an exit meanwhile, where no one else handles them), or
     the interpreter's exit."""

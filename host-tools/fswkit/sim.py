@@ -80,10 +80,13 @@ def cache_dir() -> str:
 
 def harness() -> str:
     """The harness executable, compiled on first use and cached by the hash
-    of its source and compiler command."""
+    of its source, compiler (its identity) and command. The compile runs in
+    a temporary folder removed however it ends (native.removed_when_done)."""
+    from fswkit.native import compiler_identity, removed_when_done, sweep
+
     with open(HARNESS_SRC, "rb") as f:
         src = f.read()
-    h = hashlib.sha256(src + "\0".join([CC] + CFLAGS + LIBS).encode()).hexdigest()[:20]
+    h = hashlib.sha256(src + "\0".join([compiler_identity(CC), CC] + CFLAGS + LIBS).encode()).hexdigest()[:20]
     out = os.path.join(cache_dir(), h)
     exe = os.path.join(out, "simboard")
     if os.path.exists(exe):
@@ -92,21 +95,22 @@ def harness() -> str:
         raise SimError(f"no host C compiler `{CC}` to build the simulated board (install gcc, or set CC)")
     if not os.path.exists(SIMAVR_HEADER):
         raise SimError("simavr's development files are missing: install libsimavr-dev (`make setup`)")
+    sweep(cache_dir())
     tmp = out + f".tmp{os.getpid()}"
-    try:
-        os.makedirs(tmp, exist_ok=True)
-    except OSError as e:
-        raise SimError(f"cannot create the simulated board's cache folder {tmp}: {e.strerror or e} "
-                       "(set FSW_CACHE_DIR to a writable folder)") from None
-    r = subprocess.run([CC] + CFLAGS + [HARNESS_SRC, "-o", os.path.join(tmp, "simboard")] + LIBS,
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise SimError("the simulated board did not compile against this machine's simavr:\n" + r.stderr[-3000:])
-    try:
-        os.replace(tmp, out)
-    except OSError:  # another process built it first
-        shutil.rmtree(tmp, ignore_errors=True)
+    with removed_when_done(tmp):
+        try:
+            os.makedirs(tmp, exist_ok=True)
+        except OSError as e:
+            raise SimError(f"cannot create the simulated board's cache folder {tmp}: {e.strerror or e} "
+                           "(set FSW_CACHE_DIR to a writable folder)") from None
+        r = subprocess.run([CC] + CFLAGS + [HARNESS_SRC, "-o", os.path.join(tmp, "simboard")] + LIBS,
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            raise SimError("the simulated board did not compile against this machine's simavr:\n" + r.stderr[-3000:])
+        try:
+            os.replace(tmp, out)
+        except OSError:  # another process built it first
+            pass
     return exe
 
 

@@ -1,5 +1,6 @@
-"""An interrupted `fsw test --native` left its `.tmpPID` compile folder in
-the cache for good, as did a compile that failed (which also printed up to
+"""An interrupted `fsw test --native` (or the first `fsw sim`, which
+compiles the simulated board) left its `.tmpPID` compile folder in the
+cache for good, as did a compile that failed (which also printed up to
 4 KB of raw compiler output). A compile's temporary folder is now removed
 however the compile ends (an error, Ctrl-C, SIGTERM, SIGHUP), those of
 processes that died mid-compile are swept away by the next compile, and a
@@ -23,28 +24,39 @@ SCRIPT = str(EXAMPLES / "tank" / "tank.ss")
 needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
 
 
-def _leftovers(cache) -> list[str]:
-    native = cache / "native"
-    return sorted(n for n in os.listdir(native) if ".tmp" in n) if native.is_dir() else []
+def _leftovers(cache, kind: str = "native") -> list[str]:
+    folder = cache / kind
+    return sorted(n for n in os.listdir(folder) if ".tmp" in n) if folder.is_dir() else []
 
 
 def _slow_compiler(tmp_path) -> str:
     """A compiler that takes its time: long enough to be interrupted."""
-    cxx = tmp_path / "slow-g++"
-    cxx.write_text('#!/bin/sh\n[ "$1" = --version ] && { echo "slow-g++ 1.0"; exit 0; }\nsleep 60\n')
+    cxx = tmp_path / "slow-cc"
+    cxx.write_text('#!/bin/sh\n[ "$1" = --version ] && { echo "slow-cc 1.0"; exit 0; }\nsleep 60\n')
     cxx.chmod(0o755)
     return str(cxx)
 
 
+# The two compiles the kit caches: `fsw test --native`'s runner, and the
+# simulated board's harness (`fsw sim`).
+COMPILES = {
+    "native": (["-m", "fswkit.cli", "test", "--native", SCRIPT], "CXX"),
+    "sim": (["-c", "from fswkit.sim import harness; harness()"], "CC"),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(COMPILES))
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-def test_an_interrupted_compile_leaves_no_temporary_folder(tmp_path, sig):
+def test_an_interrupted_compile_leaves_no_temporary_folder(tmp_path, sig, kind):
+    if kind == "sim" and not os.path.exists("/usr/include/simavr/sim_avr.h"):
+        pytest.skip("simavr's development files are not installed")
     cache = tmp_path / "cache"
-    env = dict(os.environ, FSW_CACHE_DIR=str(cache), CXX=_slow_compiler(tmp_path))
-    p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "test", "--native", SCRIPT], env=env,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    argv, compiler = COMPILES[kind]
+    env = dict(os.environ, FSW_CACHE_DIR=str(cache), **{compiler: _slow_compiler(tmp_path)})
+    p = subprocess.Popen([sys.executable, *argv], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 30
-        while not _leftovers(cache):
+        while not _leftovers(cache, kind):
             assert p.poll() is None and time.monotonic() < deadline, "the compile never started"
             time.sleep(0.02)
         time.sleep(0.2)  # the compiler runs
@@ -54,7 +66,7 @@ def test_an_interrupted_compile_leaves_no_temporary_folder(tmp_path, sig):
         p.kill()
         p.communicate()
     assert p.returncode != 0
-    assert _leftovers(cache) == []
+    assert _leftovers(cache, kind) == []
 
 
 @needs_cxx

@@ -117,7 +117,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     src = read_source(path, diags, APP)
     if src is None:
         return None
-    before = len(diags.errors)
+    before = diags.error_count
     err = lambda t, msg: diags.error(src, APP, t.line, t.col, msg)  # noqa: E731
     folder = os.path.dirname(path)
     lines = lex(src, diags, APP)
@@ -481,8 +481,8 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             continue
         budget[key.text] = int(q)
 
-    if len(diags.errors) != before or board is None or time_element is None:
-        if time_element is None and not machines and len(diags.errors) == before:
+    if diags.error_count != before or board is None or time_element is None:
+        if time_element is None and not machines and diags.error_count == before:
             diags.error(src, APP, 1, 1, "an application needs at least one `machine` in [configs]")
         return None
     return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),

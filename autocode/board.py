@@ -7,6 +7,8 @@ import os
 import tomllib
 from dataclasses import dataclass, field
 
+from .diagnostics import read_input
+
 BOARDS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "boards")
 
 
@@ -63,8 +65,7 @@ def load_board(name: str) -> Board:
         known = ", ".join(board_names()) or "none"
         raise BoardError(f"unknown board `{name}` (known boards: {known})")
     try:
-        with open(path, "rb") as f:
-            d = tomllib.load(f)
+        d = tomllib.loads(read_input(path).decode("utf-8"))
         return board_from_dict(name, d)
     except (OSError, tomllib.TOMLDecodeError, KeyError, TypeError, ValueError) as e:
         raise BoardError(f"board definition {path} is unreadable: {e}") from e

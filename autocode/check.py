@@ -173,9 +173,9 @@ def format_number(v) -> str:
 def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     """The value of a window size expression: literals and locals' initial
     values only (spec §4.4); None after reporting why not."""
-    # Counted on `items` (a resolver reports only errors): `errors` builds a
-    # list, and one per window made many windows with errors quadratic.
-    reported = len(res.diags.items)
+    # Counted on `error_count`: `errors` builds a list, and one per window
+    # made many windows with errors quadratic.
+    reported = res.diags.error_count
     todo = [n]
     while todo:  # a call inside the size has no window to resolve it with
         x = todo.pop()
@@ -186,7 +186,7 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None)
     me = sub.expr(n)
     res.used |= sub.used
-    if len(res.diags.items) != reported:
+    if res.diags.error_count != reported:
         return None
     if _has(me, (M.Roll,)) or any(vars_[i].kind != M.LOCAL for i in _refs(me)):
         res.error(n.line, n.col, "window size must be a constant: literals and locals' initial values")
@@ -203,7 +203,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
              warnings: bool = False) -> M.Machine | None:
     """The typed machine, or None when it has errors (all reported)."""
     lang = SM
-    before = len(diags.errors)
+    before = diags.error_count
     err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
     vars_: list[M.Var] = []
     names: dict[str, int] = {}
@@ -291,7 +291,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
 
     # local values, for window sizes and constant folding
     consts: dict[int, object] = {}
-    if len(diags.errors) == before:
+    if diags.error_count == before:
         probe = M.Machine(src.path, "", sv, tuple(vars_), (), (), 0, 0, t_idx)
         try:
             consts = local_values(probe, F64MODE)
@@ -332,7 +332,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
         states.append(M.State(idx, idx + 1, st.header.name, st.header.line,
                               blocks["entry"], blocks["step"], blocks["exit"]))
 
-    if len(diags.errors) != before or g is None or s is None:
+    if diags.error_count != before or g is None or s is None:
         return None
     name = src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
     m = M.Machine(src.path, name, sv, tuple(vars_), tuple(states), tuple(windows), g, s, t_idx)
@@ -576,7 +576,7 @@ def gotos(stmts):
 
 def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
     lang = SS
-    before = len(diags.errors)
+    before = diags.error_count
     err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
     delta_t = init_state = max_steps = None
     seen: dict[str, int] = {}
@@ -677,7 +677,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         n = len(src.lines)
         last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
         err(last, 1, "the state script has no `@stop`: it would never end")
-    if len(diags.errors) != before:
+    if diags.error_count != before:
         return None
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,

@@ -4,10 +4,19 @@ caret under the reported column. Every front-end stage reports through a
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 from dataclasses import dataclass, field
 
 TAB = 8
+SHOWN = 160  # columns of a source line a diagnostic shows (the rest is cut, `...`)
+
+# What one run shows; the rest is counted ("N more errors not shown"), so a
+# hostile file (a 40 KB line of `$a`, megabytes of random bytes) costs output
+# and memory bounded by these, not by the square of its size.
+PER_LINE = 10  # diagnostics of one severity shown for one line
+PER_FILE = 100  # diagnostics of one severity shown for one file
 
 # The first words of a diagnostic name the language it is about (spec §8).
 SV = "state vector config"
@@ -24,6 +33,20 @@ def display_line(text: str) -> str:
     if text.isprintable():
         return text
     return "".join(c if c.isprintable() else "?" for c in text)
+
+
+def clip(shown: str, at: int) -> tuple[str, int]:
+    """A displayed line longer than `SHOWN` columns cut to the `SHOWN`
+    columns around column index `at`, `...` marking each cut; (text, the
+    caret's index in it). A diagnostic about a 40 KB line shows 160 columns,
+    not 40 KB."""
+    if len(shown) <= SHOWN:
+        return shown, at
+    start = min(max(at - SHOWN // 2, 0), len(shown) - SHOWN)
+    end = start + SHOWN
+    head = "..." if start > 0 else ""
+    tail = "..." if end < len(shown) else ""
+    return head + shown[start:end] + tail, at - start + len(head)
 
 
 def visual_col(text: str, index: int) -> int:
@@ -96,8 +119,8 @@ class Diagnostic:
 
     def render(self) -> str:
         head = self.title or f"{self.lang} {self.severity}"
-        shown = display_line(self.source_line)
-        caret = " " * (max(self.col, 1) - 1) + "^"
+        shown, at = clip(display_line(self.source_line), max(self.col, 1) - 1)
+        caret = " " * at + "^"
         return f"{head} @ {self.path}:{self.line}:{self.col}:\n  | {shown}\n  | {caret} {self.message}"
 
     @property
@@ -107,30 +130,53 @@ class Diagnostic:
 
 @dataclass
 class Diagnostics:
-    """Collects the diagnostics of one run, in the order they were found."""
+    """Collects the diagnostics of one run, in the order they were found.
+    At most `PER_LINE` per line and `PER_FILE` per file of each severity are
+    kept; the others are only counted (`hidden`). Code that asks "did this
+    add an error?" compares `error_count`, which counts both."""
 
     items: list[Diagnostic] = field(default_factory=list)
+
+    def __post_init__(self):
+        self._seen: set[Diagnostic] = set()
+        self._lexical: set[tuple[str, int]] = set()
+        self._per_line: dict[tuple[str, int, str], int] = {}
+        self._per_file: dict[tuple[str, str], int] = {}
+        self.hidden: dict[tuple[str, str], int] = {}  # (path, severity) -> not kept
+        self.error_count = self.warning_count = 0
+        for d in self.items:  # given at construction: kept as they are
+            self._seen.add(d)
+            self._count(d.severity, 1)
+
+    def _count(self, severity: str, n: int) -> None:
+        if severity == "error":
+            self.error_count += n
+        else:
+            self.warning_count += n
+
+    def _keep(self, d: Diagnostic) -> None:
+        if d in self._seen:
+            return
+        self._count(d.severity, 1)
+        file_key, line_key = (d.path, d.severity), (d.path, d.line, d.severity)
+        if self._per_file.get(file_key, 0) >= PER_FILE or self._per_line.get(line_key, 0) >= PER_LINE:
+            self.hidden[file_key] = self.hidden.get(file_key, 0) + 1
+            return
+        self._per_file[file_key] = self._per_file.get(file_key, 0) + 1
+        self._per_line[line_key] = self._per_line.get(line_key, 0) + 1
+        self._seen.add(d)
+        self.items.append(d)
 
     def add(self, src: Source, lang: str, line: int, col: int, message: str,
             severity: str = "error") -> None:
         if (src.path, line) in self._lexical:
             return  # the line's lexical error said it: what follows is its echo
-        d = Diagnostic(lang, severity, src.path, line, col, message, src.line(line))
-        if d not in self._seen:
-            self._seen.add(d)
-            self.items.append(d)
-
-    def __post_init__(self):
-        self._seen: set[Diagnostic] = set()
-        self._lexical: set[tuple[str, int]] = set()
+        self._keep(Diagnostic(lang, severity, src.path, line, col, message, src.line(line)))
 
     def lexical_error(self, src: Source, lang: str, line: int, col: int, message: str) -> None:
         """A lexical error: reported, and no later diagnostic about the same
         line is (the tokens it left are not what the user meant)."""
-        d = Diagnostic(lang, "error", src.path, line, col, message, src.line(line))
-        if d not in self._seen:
-            self._seen.add(d)
-            self.items.append(d)
+        self._keep(Diagnostic(lang, "error", src.path, line, col, message, src.line(line)))
         self._lexical.add((src.path, line))
 
     def error(self, src: Source, lang: str, line: int, col: int, message: str) -> None:
@@ -141,12 +187,14 @@ class Diagnostics:
 
     def extend(self, other: "Diagnostics") -> None:
         for d in other.items:
-            if d not in self._seen:
-                self._seen.add(d)
-                self.items.append(d)
+            self._keep(d)
+        for (path, severity), n in other.hidden.items():
+            self.hidden[path, severity] = self.hidden.get((path, severity), 0) + n
+            self._count(severity, n)
 
     @property
     def errors(self) -> list[Diagnostic]:
+        """The errors kept (`error_count` counts the hidden ones too)."""
         return [d for d in self.items if d.severity == "error"]
 
     @property
@@ -162,7 +210,25 @@ class Diagnostics:
         return sorted(self.items, key=lambda d: (first[d.path], d.line, d.col))
 
     def render(self) -> str:
-        return "\n".join(d.render() for d in self.in_order())
+        out: list[str] = []
+        path = None
+        for d in self.in_order():
+            if d.path != path:
+                if path is not None:
+                    out += self._not_shown(path)
+                path = d.path
+            out.append(d.render())
+        if path is not None:
+            out += self._not_shown(path)
+        return "\n".join(out)
+
+    def _not_shown(self, path: str) -> list[str]:
+        parts = [f"{n} more {severity}{'' if n == 1 else 's'}"
+                 for severity in ("error", "warning") if (n := self.hidden.get((path, severity)))]
+        if not parts:
+            return []
+        return [f"{path}: {' and '.join(parts)} not shown (at most {PER_LINE} a line "
+                f"and {PER_FILE} a file of each are)"]
 
 
 class ConfigError(Exception):
@@ -173,11 +239,59 @@ class ConfigError(Exception):
         self.diagnostics = diagnostics
 
 
+# The largest config, board, state script or plant file the tools read:
+# 1 MiB, some 25,000 lines, far beyond any vehicle's (the rocket's largest
+# file is 5 KB), and a bound on what a hostile file costs the front end.
+MAX_INPUT = 1 << 20
+
+
+class InputError(OSError):
+    """A user's file that is not read: not a regular file, or too large.
+    An OSError, so every reader's `except OSError` reports it."""
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.strerror = message
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
+def read_input(path: str, limit: int = MAX_INPUT) -> bytes:
+    """The bytes of a file the user named (config, board, state script,
+    plant parameters): the one place the tools read them. A FIFO, device or
+    folder is refused without reading (opened non-blocking, so a FIFO with
+    no writer does not hang), and so is a file over `limit` bytes (read at
+    most `limit` + 1 bytes, so a file growing meanwhile cannot exhaust
+    memory). OSError (InputError for those two) on failure."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    with os.fdopen(fd, "rb", buffering=0) as f:
+        mode = os.fstat(fd).st_mode
+        if stat.S_ISDIR(mode):
+            raise InputError("is a folder, not a file")
+        if not stat.S_ISREG(mode):
+            kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) \
+                else "a socket" if stat.S_ISSOCK(mode) else "not a regular file"
+            raise InputError(f"not a regular file ({kind}): configs are read from regular files only")
+        if os.fstat(fd).st_size > limit:
+            raise InputError(f"file too large: {os.fstat(fd).st_size:,} bytes, over the {limit:,} "
+                             "the tools read from one file")
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = f.read(limit + 1 - size)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    if size > limit:
+        raise InputError(f"file too large: over the {limit:,} bytes the tools read from one file")
+    return b"".join(chunks)
+
+
 def read_source(path: str, diags: Diagnostics, lang: str) -> Source | None:
     """Reads a config file; an unreadable file is a located error at 1:1."""
     try:
-        with open(path, "rb") as f:
-            data = f.read()
+        data = read_input(path)
     except OSError as e:
         src = Source.from_text(path, "")
         diags.error(src, lang, 1, 1, f"cannot read file: {e.strerror or e}")

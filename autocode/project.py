@@ -7,7 +7,7 @@ import os
 
 from . import model as M
 from .check import check_sm, check_ss, check_sv
-from .diagnostics import SM, SS, Diagnostics, Source, decode, read_source
+from .diagnostics import SM, SS, Diagnostics, Source, decode, read_input, read_source
 from .parser import parse_sm, parse_ss, parse_sv
 
 
@@ -89,5 +89,4 @@ def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
 
 def source_of(path: str) -> Source:
     """A file's text for rendering a diagnostic after the fact."""
-    with open(path, "rb") as fh:
-        return Source.from_text(path, decode(fh.read()))
+    return Source.from_text(path, decode(read_input(path)))

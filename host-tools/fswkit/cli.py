@@ -62,7 +62,7 @@ def cmd_check(args) -> int:
         else:
             load_script(f, diags, args.sm, args.sv)
     _print_diags(diags)
-    errors, warnings = len(diags.errors), len(diags.warnings)
+    errors, warnings = diags.error_count, diags.warning_count
     sys.stderr.write(f"fsw check: {_plural(len(files), 'file')}, {_plural(errors, 'error')}, "
                      f"{_plural(warnings, 'warning')}\n")
     if errors or (args.strict and warnings):

@@ -15,6 +15,8 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 
+from fswkit.autocode.diagnostics import read_input
+
 
 class ParamsError(Exception):
     """One or more located errors in a parameters file."""
@@ -208,8 +210,7 @@ def load(path: str, schema: Schema) -> tuple[dict, dict]:
     """Reads and checks a parameters file; (values, locations). ParamsError
     with every located error."""
     try:
-        with open(path, "rb") as f:
-            raw = f.read()
+        raw = read_input(path)
     except FileNotFoundError:
         raise ParamsError([f"{path}: no such file (a plant's parameters: see docs/sim.md, Closed-loop flights)"]) \
             from None

@@ -243,6 +243,7 @@ def log_path(out: str) -> str:
 # The linker's words for memory that is too small (GNU ld).
 OVERFLOW = re.compile(r"region [`']?(\w+)'? overflowed by (\d+) bytes|will not fit in region|"
                       r"is not within region")
+OVERFLOW_BY = re.compile(r"region [`']?\w+'? overflowed by \d+ bytes")
 ERROR_LINE = re.compile(r"error:|static assertion failed|undefined reference")
 
 
@@ -256,11 +257,15 @@ def explain_failure(app: Application, out: str, proc: subprocess.CompletedProces
     (`size_report`); anything else that fails on a checked configuration is
     a defect of the kit, reported with the build log."""
     log = log_path(out)
+    output = (proc.stdout + proc.stderr).splitlines()
     if app.board.is_avr and overflows(proc):
         report = overflow_report(app, out)
         if report is not None:
             return True, report
-    output = (proc.stdout + proc.stderr).splitlines()
+        said = sorted({m.group(0) for line in output for m in [OVERFLOW_BY.search(line)] if m})
+        return True, (f"the firmware does not fit the {app.board.name} ({app.board.mcu}): "
+                      + ("; ".join(said) if said else "the linker ran out of memory")
+                      + f" (the linker's output: {log})")
     lines = [line.strip() for line in output if ERROR_LINE.search(line)] or [line.strip() for line in output[-3:]]
     shown = [("  " + line[:300] + (" ..." if len(line) > 300 else "")) for line in lines[:6]]
     more = f"\n  ... and {len(lines) - 6} more" if len(lines) > 6 else ""
@@ -276,11 +281,12 @@ def overflow_report(app: Application, out: str) -> str | None:
     elf = artifact[:-4] + ".overflow.elf"
     args = [a for a in args if a != "avr"] + [os.path.basename(elf)]
     try:
-        r = subprocess.run(args, capture_output=True, text=True, cwd=out)
-        if r.returncode != 0 or not os.path.exists(elf):
-            return None
-        flash, ram = elf_size(elf)
-        return size_report(app, elf, size_of(app, flash, ram))
+        with build_lock(out):
+            r = subprocess.run(args, capture_output=True, text=True, cwd=out)
+            if r.returncode != 0 or not os.path.exists(elf):
+                return None
+            flash, ram = elf_size(elf)
+            return size_report(app, elf, size_of(app, flash, ram))
     except BuildError:
         return None
     finally:
@@ -473,7 +479,8 @@ def size_report(app: Application, elf: str, size: Size, top: int = 8) -> str:
     over = [(what, used, budget) for what, used, budget in (("flash", size.flash, size.flash_budget),
                                                             ("RAM", size.ram, size.ram_budget)) if used > budget]
     lines = [f"the firmware does not fit {whose}: " +
-             "; ".join(f"{what} {used:,} B of {budget:,} B, {used - budget:,} B over" for what, used, budget in over),
+             ("; ".join(f"{what} {used:,} B of {budget:,} B, {used - budget:,} B over" for what, used, budget in over)
+              or "the linker ran out of one of its memories"),
              size.table()]
     try:
         users = memory_users(app, elf)

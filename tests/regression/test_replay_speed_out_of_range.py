@@ -18,7 +18,7 @@ def log(tmp_path_factory):
     layout = layout_of(TANK)
     w = LogWriter(str(path), layout)
     for i, f in enumerate(stream(layout, 0, 60, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 1_000_000, f)
+        w.record(RX, 1_000_000_000 + i * 1_000, f)  # 1 µs apart: 0.06 s at the slowest speed
     w.close()
     return str(path)
 

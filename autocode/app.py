@@ -31,8 +31,10 @@ from fractions import Fraction
 from . import model as M
 from .board import Board, BoardError, load_board
 from .check import check_sm, check_sv
+from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
+from .limits import U8_COUNT, check_limits
 from .lexer import ID, NUM, OP, lex
 from .numeric import exact_literal
 from .parser import parse_sm, parse_sv, show, split_sections
@@ -236,6 +238,13 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         if m.name in machine_names:
             err(tok, f"two machines are named `{m.name}`")
             continue
+        clash = next((machines[i].name for i, j in machine_clashes([x.name for x in machines] + [m.name])
+                      if j == len(machines)), None)
+        if clash is not None:
+            err(tok, f"machines `{clash}` and `{m.name}` would generate the same C++ files "
+                     f"(`{machine_ident(m.name)}.gen.h`; file names that differ only in case are one file "
+                     "on some file systems): rename one")
+            continue
         machine_names[m.name] = len(machines)
         machine_srcs[m.name] = msrc
         machines.append(m)
@@ -438,6 +447,8 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             err(et, f"element `{et.text}` is written by {inputs[et.text]}: an uplink write would be lost")
         elif e in writable:
             err(et, f"element `{et.text}` is listed twice")
+        elif len(writable) == U8_COUNT:
+            err(et, f"element `{et.text}` is writable element {U8_COUNT + 1}: the uplink writes at most {U8_COUNT}")
         else:
             writable.append(e)
             if len(toks) > 1:
@@ -485,9 +496,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         if time_element is None and not machines and diags.error_count == before:
             diags.error(src, APP, 1, 1, "an application needs at least one `machine` in [configs]")
         return None
-    return Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
-                       tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable),
-                       reset_cause, budget.get("flash"), budget.get("ram"))
+    app = Application(path, name, board, rate, baud, sv, tuple(machines), tuple(channels),
+                      tuple(tasks), time_element, time_source, time_unit, tuple(streams), tuple(writable),
+                      reset_cause, budget.get("flash"), budget.get("ram"))
+    toks = {os.path.splitext(os.path.basename(p))[0]: t for _, t, p in machine_toks}
+    return app if check_limits(app, src, diags, sv_tok[1], toks) else None
 
 
 def _assigned(stmts, out: list) -> list:

@@ -14,6 +14,8 @@ from .numeric import F64MODE, exact_literal, truthy
 from .types import TYPES, U32, U64
 
 MAX_WINDOW = 100000
+MAX_SV_SIZE = 65535  # bytes: the generated offsets and sizes are uint16_t
+MAX_LOCALS_SIZE = 65535  # bytes of a machine's locals: the same
 ROLL = {"roll_avg": "avg", "roll_median": "median", "roll_min": "min",
         "roll_max": "max", "roll_range": "range"}
 DEFAULT_MAX_STEPS = 1000000
@@ -69,6 +71,10 @@ def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
                 continue
             elem_lines[d.name] = d.line
             e = M.Element(d.name, t, h.name, offset, d.line)
+            if offset <= MAX_SV_SIZE < offset + t.size:
+                diags.error(src, lang, d.line, d.name_col,
+                            f"the state vector would grow past {MAX_SV_SIZE:,} B with `{d.name}` (ending at byte "
+                            f"{offset + t.size:,}): element offsets and sizes are 16-bit")
             offset += t.size
             mine.append(e)
         elements.extend(mine)
@@ -267,6 +273,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
     windows: list[M.Window] = []
     local_decls: dict[str, S.LocalDecl] = {d.name: d for d in reversed(f.locals)}
     init_used: set[int] = set()
+    local_bytes = 0
     for d in f.locals:
         t = TYPES.get(d.type)
         if t is None:
@@ -282,6 +289,10 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
         init = _resolve_init(init_resolver, d, local_decls, vars_)
         init_used |= init_resolver.used
         idx = len(vars_)
+        if local_bytes <= MAX_LOCALS_SIZE < local_bytes + t.size:
+            err(d.line, d.name_col, f"the machine's locals would grow past {MAX_LOCALS_SIZE:,} B with `{d.name}`: "
+                                    "local offsets are 16-bit")
+        local_bytes += t.size
         vars_.append(M.Var(idx, M.LOCAL, d.name, None, t, d.read_only, d.line, init))
         names[d.name] = idx
         name_lines[d.name] = d.line

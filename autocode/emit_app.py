@@ -5,7 +5,10 @@ a project made only of configs builds into complete firmware."""
 from __future__ import annotations
 
 from .app import MODES, Application, Task
-from .emit_cpp import basename, banner, c_ident, emit_machine, emit_sv, real_check, real_literal, version_check
+from .cnames import comment
+from .emit_cpp import (basename, banner, c_ident, c_string, emit_machine, emit_sv, real_check, real_literal,
+                       version_check)
+from .limits import link_load
 from .numeric import MODES as REALS
 from .schema import app_schema_hash, link_plan
 
@@ -105,7 +108,7 @@ def _app_cpp(app: Application) -> str:
     for m in app.machines:
         c.append(f'#include "{c_ident(m.name)}.gen.h"')
     c += ["", version_check("app.gen.cpp"), real_check(basename(app.path), real),
-          f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz.",
+          comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz."),
           "namespace fsw_gen {", "namespace {", ""]
     tables = _tables(app, real, c)
     n = len(app.tasks)
@@ -256,10 +259,7 @@ def _link(app: Application) -> list[str]:
          f"const uint32_t kLinkSchema = 0x{app_schema_hash(app):08x}UL;",
          f"const uint16_t kLinkTxSize = {plan.tx_cap};  // the longest encoded frame",
          "uint8_t link_tx[kLinkTxSize];"]
-    load = 0.0
     for s in plan.streams:
-        frame = s.batch * s.region.size + 8 + 2 + (s.batch * s.region.size + 8) // 254
-        load += float(s.rate) / s.batch * frame
         if s.batch > 1:
             c.append(f"uint8_t link_store_{s.index}[{(s.batch - 1) * s.region.size}];  "
                      f"// the first {s.batch - 1} sample(s) of a {s.region.name} frame")
@@ -276,9 +276,9 @@ def _link(app: Application) -> list[str]:
     rows = sorted(plan.writable, key=lambda e: index[e.name])
     for s in plan.streams:
         st = next(x for x in app.telemetry if x.region is s.region)
+        why = c_string(f"{name}:{st.line}: stream {s.region.name} does not fit the link's buffers")
         c.append(f"static_assert(fsw::link_stream_ok(R_{s.region.name}_off, R_{s.region.name}_size, {s.every}, "
-                 f"{s.batch}, {'true' if s.batch > 1 else 'false'}, kSvSize, kLinkTxSize), "
-                 f"\"{name}:{st.line}: stream {s.region.name} does not fit the link's buffers\");")
+                 f"{s.batch}, {'true' if s.batch > 1 else 'false'}, kSvSize, kLinkTxSize), {why});")
     if rows:
         c.append(f"const fsw::LinkWritable kLinkWritable[{len(rows)}] FSW_FLASH = {{")
         for e in rows:
@@ -288,9 +288,7 @@ def _link(app: Application) -> list[str]:
             c.append(f"static_assert(fsw::link_writable_ok(E_{e.name}, {ELEM_CODE[e.type.name]}, kSvSize), "
                      f"\"writable element {e.name} lies outside the state vector\");")
     c.append(f"uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, {app.time_unit}")
-    hz = float(plan.health_every and app.tasks[plan.telemetry_task].rate / plan.health_every)
-    load += hz * encoded_health(plan) + hz / max(plan.hello_every, 1) * 27
-    capacity = app.baud / 10
+    load, capacity = link_load(app)  # the checker refuses a link that cannot carry it (autocode/limits.py)
     c.append(f"// Link load: about {round(load)} B/s of {round(capacity)} B/s at {app.baud} baud "
              f"({100 * load / capacity:.0f} %).")
     if load > capacity:

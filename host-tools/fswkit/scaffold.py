@@ -179,8 +179,8 @@ Sensors    rate=10
 Effectors  rate=10
 Status     rate=1
 
-[uplink]                 # elements the ground may write (fsw cmd set)
-controlMode
+[uplink]                 # elements the ground may write (fsw cmd set); none yet:
+                         # a task's mode changes only by `fsw cmd mode`
 """
 
     out[f"{name}.ss"] = _skeleton(name, out)

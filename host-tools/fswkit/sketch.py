@@ -11,6 +11,7 @@ import os
 import re
 
 from fswkit.autocode.app import Application
+from fswkit.autocode.cnames import comment
 
 # Arduino's sketch name rules: letters, digits, `_`, `-`, `.`; not starting
 # with `-` or `.`; at most 63 characters.
@@ -37,7 +38,7 @@ def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict
     if not app.board.is_avr or not fqbn:
         raise SketchError(f"board `{app.board.name}` is not an Arduino board: export a sketch for "
                           "one (--board uno, nano, mega2560)")
-    project = os.path.basename(app.path)
+    project = comment(os.path.basename(app.path))  # a file name in a comment: autocode/cnames.py
     headers = sorted(n for n in generated if n.endswith(".h"))
     ino = [f"// {name}: the fswkit application {project} for the {app.board.name}, exported by",
            "// `fsw gen --sketch`. The application is the generated code beside this",

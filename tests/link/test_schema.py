@@ -50,4 +50,6 @@ def test_generated_code_carries_the_same_schema(tmp_path):
 def test_streams_the_link_cannot_carry_are_refused(tmp_path):
     slow = variant(tmp_path, "slow", "rate  100\n", "rate  100\nbaud  2400\n")
     r = run_fsw("gen", str(slow), "--out", str(tmp_path / "gen"))
-    assert r.code == 1 and "the link carries" in r.err and "Traceback" not in r.err
+    assert r.code == 2 and "the link carries" in r.err and "Traceback" not in r.err
+    r = run_fsw("check", str(slow / "tank.app"))  # the checker refuses it: not only the generator
+    assert r.code == 1 and "tank.app:24:1:" in r.err and "the link carries 240 B/s at 2400 baud" in r.err

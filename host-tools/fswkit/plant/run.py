@@ -18,6 +18,7 @@ import tempfile
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.link.log import LogError
 
 from . import report as reports
 from .cosim import CosimError, Run, fly
@@ -224,7 +225,7 @@ def main(args) -> int:
     except KeyboardInterrupt:
         _say("interrupted" + incomplete)
         raise
-    except CosimError as e:
+    except (CosimError, LogError) as e:  # LogError: the log could not be written (a full disk)
         _say(str(e) + incomplete)
         return 1
     except OSError as e:

@@ -735,10 +735,10 @@ def _script_loop(script: M.Script, ex: ExprEmitter, outer: str, ns: str, trace: 
             c.append(f"        if (state == {m.states[sec.state].id}) {{")
             ind = "            "
         for grp in sec.inputs:
-            c.append(f"{ind}if {parens(ex.cond(grp.guard))} {{")
-            for a in grp.inputs:
+            for a in grp.inputs:  # the guard again before each input: an earlier one may change it (spec §5)
+                c.append(f"{ind}if {parens(ex.cond(grp.guard))} {{")
                 c.append(f"{ind}    {ex.assign(a.var, a.expr)}  // {basename(script.path)}:{a.line}")
-            c.append(f"{ind}}}")
+                c.append(f"{ind}}}")
         for grp in sec.checks:
             ids = []
             for chk in grp.checks:

@@ -57,8 +57,8 @@ def _compile(script: M.Script, real: Real):
             ind = "        "
         body_start = len(src)
         for g in sec.inputs:
-            src.append(f"{ind}if {sem.cond(g.guard)}:")
-            for a in g.inputs:
+            for a in g.inputs:  # the guard again before each input: an earlier one may change it (spec §5)
+                src.append(f"{ind}if {sem.cond(g.guard)}:")
                 src.append(f"{ind}    {sem.assign(a.var, a.expr)}")
         for g in sec.checks:
             ids = []

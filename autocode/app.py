@@ -30,13 +30,13 @@ from fractions import Fraction
 
 from . import model as M
 from .board import Board, BoardError, load_board
-from .check import check_sm, check_sv
+from .check import check_literals, check_sm, check_sv, machine_exprs
 from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
 from .limits import U8_COUNT, check_limits
 from .lexer import ID, NUM, OP, lex
-from .numeric import exact_literal
+from .numeric import MODES as REALS, exact_literal
 from .parser import parse_sm, parse_sv, show, split_sections
 from .types import U8
 
@@ -108,7 +108,10 @@ def _kv(toks, start, src, diags):
 def _positive(tok, src, diags, what) -> Fraction | None:
     q = exact_literal(tok.text) if tok.kind == NUM else None
     if q is None or q <= 0 or q > 10**9:
-        diags.error(src, APP, tok.line, tok.col, f"{what} must be a positive number, found `{tok.text}`")
+        text = tok.text if len(tok.text) <= 40 else tok.text[:37] + "..."
+        big = q > 10**9 if q is not None else tok.kind == NUM and float(tok.text) > 1  # None: beyond 10^±4000
+        limit = " no greater than 1,000,000,000" if big else ""
+        diags.error(src, APP, tok.line, tok.col, f"{what} must be a positive number{limit}, found `{text}`")
         return None
     return q
 
@@ -235,6 +238,8 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         m = check_sm(parse_sm(msrc, diags), msrc, sv, diags)
         if m is None:
             continue
+        if board is not None:  # an error, and the machine still known to the rest of the file
+            check_literals(machine_exprs(m), REALS[board.real], msrc, diags, SM, f"the {board.name}'s")
         if m.name in machine_names:
             err(tok, f"two machines are named `{m.name}`")
             continue

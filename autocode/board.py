@@ -3,6 +3,7 @@ generator and the build need to know about a board."""
 
 from __future__ import annotations
 
+import math
 import os
 import tomllib
 from dataclasses import dataclass, field
@@ -71,24 +72,51 @@ def load_board(name: str) -> Board:
         raise BoardError(f"board definition {path} is unreadable: {e}") from e
 
 
+U32_MAX = (1 << 32) - 1
+
+
+def _int(v, where: str, lo: int, hi: int) -> int:
+    """A whole-number field of a definition, in range: TOML integers have no
+    bound and a float or `true` is no count (ValueError naming the field)."""
+    if type(v) is not int or not lo <= v <= hi:
+        raise ValueError(f"`{where}` must be an integer from {lo:,} to {hi:,}, found {v!r}")
+    return v
+
+
+def _volts(v, where: str) -> float:
+    """A voltage field: a finite positive number (TOML floats include `inf`,
+    `nan` and `1e400`, which reads as infinity)."""
+    if type(v) not in (int, float) or not math.isfinite(v) or not 0 < v <= 1000:
+        raise ValueError(f"`{where}` must be a number of volts above 0 and at most 1000, found {v!r}")
+    return float(v)
+
+
 def board_from_dict(name: str, d: dict) -> Board:
-    """A Board from a parsed definition (fields: docs/boards.md)."""
+    """A Board from a parsed definition (fields: docs/boards.md); every
+    number range-checked (ValueError naming the field)."""
     pins = d["pins"]
     b = d["board"]
+    mem = d["memory"]
+    real = d["eval"]["R"]
+    if real not in ("f32", "f64"):
+        raise ValueError(f"`eval.R` must be \"f32\" or \"f64\", found {real!r}")
+    if "baud" in d.get("upload", {}):
+        _int(d["upload"]["baud"], "upload.baud", 0, 10_000_000)  # 0: nothing to upload (native)
+    pin = lambda v, where: _int(v, where, 0, 255)  # noqa: E731
     return Board(
         name=b.get("name", name),
         mcu=b["mcu"],
-        f_cpu=int(b["f_cpu"]),
-        flash=int(d["memory"].get("flash_usable", d["memory"]["flash"])),
-        ram=int(d["memory"]["ram"]),
-        eeprom=int(d["memory"].get("eeprom", 0)),
-        real=d["eval"]["R"],
-        digital_pins=frozenset(int(p) for p in pins["digital"]),
-        analog_pins={k: int(v) for k, v in pins["analog"].items()},
-        pwm_pins=frozenset(int(p) for p in pins.get("pwm", [])),
-        reserved={int(r["pin"]): str(r["reason"]) for r in pins.get("reserved", [])},
-        adc_bits=int(d["adc"]["bits"]),
-        adc_vref=float(d["adc"]["vref"]),
+        f_cpu=_int(b["f_cpu"], "board.f_cpu", 0, U32_MAX),
+        flash=_int(mem.get("flash_usable", mem["flash"]), "memory.flash_usable", 0, U32_MAX),
+        ram=_int(mem["ram"], "memory.ram", 0, U32_MAX),
+        eeprom=_int(mem.get("eeprom", 0), "memory.eeprom", 0, U32_MAX),
+        real=real,
+        digital_pins=frozenset(pin(p, "pins.digital") for p in pins["digital"]),
+        analog_pins={k: pin(v, f"pins.analog.{k}") for k, v in pins["analog"].items()},
+        pwm_pins=frozenset(pin(p, "pins.pwm") for p in pins.get("pwm", [])),
+        reserved={pin(r["pin"], "pins.reserved.pin"): str(r["reason"]) for r in pins.get("reserved", [])},
+        adc_bits=_int(d["adc"]["bits"], "adc.bits", 1, 16),
+        adc_vref=_volts(d["adc"]["vref"], "adc.vref"),
         ports=_ports(d.get("arduino", {}).get("ports", [])),
         raw=d,
     )

@@ -4,6 +4,7 @@ certainly a mistake (`fsw check`)."""
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 from . import model as M
@@ -472,6 +473,61 @@ def model_children(n: M.Expr):
     if isinstance(n, M.Roll):
         return (n.arg,)
     return ()
+
+
+# ---- literals in the run's evaluation type -----------------------------------
+
+def _stmt_exprs(stmts):
+    for st in stmts:
+        if isinstance(st, M.Assign):
+            yield st.expr
+        elif isinstance(st, M.If):
+            yield st.cond
+            yield from _stmt_exprs(st.then)
+            yield from _stmt_exprs(st.orelse)
+
+
+def machine_exprs(m: M.Machine):
+    """Every expression of a machine: locals' initial values and blocks."""
+    for v in m.vars:
+        if v.init is not None:
+            yield v.init
+    for st in m.states:
+        for block in (st.entry, st.step, st.exit):
+            yield from _stmt_exprs(block)
+
+
+def script_exprs(s: M.Script):
+    """Every expression of a script's own sections (not its machine's)."""
+    for sec in s.sections:
+        for g in sec.inputs:
+            yield g.guard
+            for a in g.inputs:
+                yield a.expr
+        for g in sec.checks:
+            yield g.guard
+            for c in g.checks:
+                if isinstance(c, M.Assert):
+                    yield c.expr
+
+
+def check_literals(exprs, real, src: Source, diags: Diagnostics, lang: str, whose: str = "this run's") -> bool:
+    """Every literal of `exprs` is finite in the evaluation type `real`
+    (the parser already holds them to binary64): `1e39` is infinity in
+    binary32, so on a board whose `R` is binary32 it is an error where it
+    stands. False after reporting any."""
+    before = diags.error_count
+    todo = list(exprs)
+    while todo:
+        n = todo.pop()
+        if isinstance(n, M.Const):
+            if n.text not in ("true", "false") and math.isinf(real.literal(n.text)):
+                most = "3.4028235e38" if real.bits == 32 else "1.7976931348623157e308"
+                diags.error(src, lang, n.line, n.col, f"number is outside the representable range of "
+                                                      f"binary{real.bits}, {whose} evaluation type R (at most {most})")
+        else:
+            todo.extend(model_children(n))
+    return diags.error_count == before
 
 
 # ---- warnings -----------------------------------------------------------------

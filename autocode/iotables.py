@@ -3,13 +3,14 @@ per line, checked against the board and the state vector."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from . import model as M
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
 from .lexer import ID, NUM, OP, lex
-from .numeric import exact_literal
+from .numeric import MODES
 
 
 @dataclass(frozen=True)
@@ -25,8 +26,10 @@ class Channel:
     line: int
 
 
-def _parse_value(toks, i, src, diags, what):
-    """A signed number at toks[i:]; returns (value, next index)."""
+def _parse_value(toks, i, src, diags, what, real: str):
+    """A signed number at toks[i:]; returns (value, next index). It must be
+    finite as binary64 and as the board's evaluation type `real` (the
+    firmware computes in it: `scale=1e39` is infinity in binary32)."""
     neg = False
     if i < len(toks) and toks[i].kind == OP and toks[i].text == "-":
         neg, i = True, i + 1
@@ -34,12 +37,13 @@ def _parse_value(toks, i, src, diags, what):
         t = toks[i] if i < len(toks) else toks[-1]
         diags.error(src, IO, t.line, t.col, f"expected a number after `{what}=`")
         return None, len(toks)
-    q = exact_literal(toks[i].text)
-    if q is None:
-        diags.error(src, IO, toks[i].line, toks[i].col, f"`{what}` is out of range")
+    v = float(toks[i].text)
+    if not (math.isfinite(v) and math.isfinite(MODES[real].literal(repr(v)))):  # as emit_app converts it
+        most = "binary32: 3.4028235e38" if real == "f32" else "binary64: 1.7976931348623157e308"
+        diags.error(src, IO, toks[i].line, toks[i].col,
+                    f"`{what}` is outside the representable range of the board's numbers ({most} at most)")
         return None, len(toks)
-    v = float(-q if neg else q)
-    return v, i + 1
+    return (-v if neg else v), i + 1
 
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
@@ -87,7 +91,7 @@ def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
                     bad = True
                     break
                 seen_opt.add(t.text)
-                v, i = _parse_value(toks, i + 2, src, diags, t.text)
+                v, i = _parse_value(toks, i + 2, src, diags, t.text, board.real)
                 if v is None:
                     bad = True
                     break

@@ -6,6 +6,8 @@ next line, so one run reports every independent error. Nesting is bounded
 
 from __future__ import annotations
 
+import math
+
 from .diagnostics import SM, SS, SV, Diagnostics, Source
 from .lexer import ANNOT, EOF, ID, KW, LABEL, NL, NUM, OP, Tok, lex
 from . import syntax as S
@@ -231,6 +233,8 @@ class Parser:
         t = self.peek()
         if t.kind == NUM:
             self.next()
+            if float(t.text) == math.inf:  # every literal must be a finite binary64 (401 digits is not)
+                raise ParseError(t, "number is outside the representable range")
             return S.Num(t.line, t.col, t.text)
         if t.kind == KW and t.text in ("true", "false"):
             self.next()
@@ -383,7 +387,11 @@ class Parser:
         if nxt.kind == KW and nxt.text == "if":
             return (self.sm_statement(),), False
         if self.brace_ahead():
-            return self.sm_braced(), True
+            open_ = self.i
+            body = self.sm_braced()
+            if all(k.kind == NL for k in self.toks[open_ + 1:self.i - 1]):  # `else { }`: no statement inside
+                raise ParseError(t, "expected logic after else")
+            return body, True
         if nxt.kind in (NL, EOF) or (nxt.kind == OP and nxt.text == "}"):
             # `else` then `if` on the next line chains too.
             j = self.i

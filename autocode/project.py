@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from . import model as M
-from .check import check_sm, check_ss, check_sv
+from .check import check_literals, check_sm, check_ss, check_sv, machine_exprs, script_exprs
 from .diagnostics import SM, SS, Diagnostics, Source, decode, read_input, read_source
 from .parser import parse_sm, parse_ss, parse_sv
 
@@ -68,7 +68,10 @@ def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
 
 
 def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
-                sv_path: str | None = None) -> M.Script | None:
+                sv_path: str | None = None, real=None) -> M.Script | None:
+    """The checked script, or None with every error in `diags`. `real`: the
+    evaluation type the script will run in; its literals and its machine's
+    must be finite there too."""
     src = read_source(ss_path, diags, SS)
     if src is None:
         return None
@@ -83,6 +86,9 @@ def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
     mine = Diagnostics()
     f = parse_ss(src, mine)
     script = check_ss(f, src, m, mine) if m is not None else None
+    if script is not None and real is not None:
+        check_literals(machine_exprs(m), real, source_of(m.path), mine, SM)
+        check_literals(script_exprs(script), real, src, mine, SS)
     diags.extend(mine)
     return script if not mine.errors else None
 

@@ -143,7 +143,7 @@ def _test_one(path: str, args, real):
     from fswkit.script import run
 
     diags = Diagnostics()
-    script = load_script(path, diags, args.sm, args.sv)
+    script = load_script(path, diags, args.sm, args.sv, real=real)
     if script is None:
         _print_diags(diags)
         return EXIT_CONFIG, None

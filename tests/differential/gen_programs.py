@@ -297,9 +297,11 @@ class Gen:
 
     # -- assignments --
     def special_value(self) -> str:
+        # `1e308 * 10`: a literal beyond binary64 (`1e400`) is an error. (`1e39` is one too where R is
+        # binary32, when a board or `--real f32` is named; these cases go to the checker directly.)
         return self.pick(("0/0", "1/0", "-1/0", "-0", "0 * -1", "-(0/0)", "1e39", "-1e39", "3.4028235e38 * 2",
                           "18446744073709551615", "18446744073709551616", "9007199254740993",
-                          "16777217", "-9223372036854775809", "1e400", "1e-400", "-1e-46", "2.5", "-2.9",
+                          "16777217", "-9223372036854775809", "1e308 * 10", "1e-400", "-1e-46", "2.5", "-2.9",
                           "300", "-129", "65535.9", "4294967295.5"))
 
     def assignment(self, target: Var, depth: int) -> str:
@@ -460,10 +462,11 @@ def gen_block(g: Gen, can_goto: bool, depth: int, ind: str, out: list[str]) -> N
             if r.random() < 0.5:
                 out.append(f"{ind}}}")
             elif r.random() < 0.5:
-                out.append(f"{ind}}} else {{")
                 inner = []
                 gen_block(g, can_goto, depth - 1, ind + "    ", inner)
-                out += inner
+                if inner:  # `else { }` is an error ("expected logic after else")
+                    out.append(f"{ind}}} else {{")
+                    out += inner
                 out.append(f"{ind}}}")
             else:
                 out.append(f"{ind}}}")

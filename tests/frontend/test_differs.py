@@ -338,3 +338,70 @@ def test_state_vector_and_local_sections_come_before_states(tmp_path):
     (tmp_path / "d.sm").write_text("[Run]\n\n" + ELEMENTS)
     r = run_fsw("check", "d.sm", cwd=tmp_path)
     assert "^ `[state_vector]` must come before the first state\n" in r.err
+
+
+# ---- refused here, quietly accepted by the reference (docs/languages.md 10-15) ------------
+
+REFUSED = [
+    # (what, machine body or None, script body or None, file:line:col, exact message)
+    ("prefix operator", "[A]\n.step\n    pick = + pick 1\n", None, "d.sm:16:12",
+     "expected an expression, found `+`"),
+    ("prefix operator in a script", "[A]\n.step\n    pick = 1\n", "true: pick = + pick 1\n", "d.ss:5:14",
+     "expected an expression, found `+`"),
+    ("guard with nothing after `:`", "[A]\n.step\n    x > 1:\n", None, "d.sm:16:11",
+     "expected a statement after `:`"),
+    ("script guard with nothing after `:`", "[A]\n.step\n    pick = 1\n", "G == 100:\n", "d.ss:5:10",
+     "expected a statement after `:`"),
+    ("statement after `}`", "[A]\n.step\n    x > 1 {\n        pick = 1\n    } pick = 2\n", None, "d.sm:18:7",
+     "unexpected `pick` after the statement"),
+    ("statement after `}` on a one-line block", "[A]\n.step\n    x > 1 { pick = 1 } pick = 2\n", None,
+     "d.sm:16:24", "unexpected `pick` after the statement"),
+]
+
+
+@pytest.mark.parametrize("what,sm,ss,where,message", REFUSED, ids=[r[0] for r in REFUSED])
+def test_refused_where_the_reference_quietly_accepts(tmp_path, what, sm, ss, where, message):
+    script = "[options]\ndelta_t 10\n\n[all_states]\n" + (ss or "") + "G == 100: @stop\n"
+    project(tmp_path, sm, script)
+    r = run_fsw("check", "d.ss" if ss else "d.sm", cwd=tmp_path)
+    assert r.code == 1
+    assert f" error @ {where}:\n" in r.err and f"^ {message}\n" in r.err, r.err
+    assert r.err.count(" error @ ") == 1
+    assert message.replace("`pick`", "`n`") in DOC  # the reference lists each message, with `n` for the name
+
+
+DOC = (Path(__file__).resolve().parents[2] / "docs" / "languages.md").read_text()
+
+
+def test_an_alias_equal_to_an_earlier_name_is_refused(tmp_path):
+    (tmp_path / "d.sv").write_text(SV)
+    (tmp_path / "d.sm").write_text(ELEMENTS.replace("U8 pick\n", "U8 pick @alias a\n") + "\n[A]\n.step\n    pick = 1\n")
+    r = run_fsw("check", "d.sm", cwd=tmp_path)
+    assert r.code == 1
+    assert "d.sm:12:16:\n  | U8 pick @alias a\n  |                ^ reuse of name `a` (previously used on line 6)\n" in r.err
+    assert "reuse of name `n` (previously used on line N)" in DOC
+
+
+@pytest.mark.parametrize("decl,where,message", [
+    ("U8 pick @alias T", "d.sm:12:16", "`T` is the built-in time in state and cannot name an element"),
+    ("U8 T", "d.sm:12:4", "`T` is the built-in time in state and cannot name an element"),
+    ("U8 pick\n\n[local]\nU8 T = 1", "d.sm:15:4", "`T` is the built-in time in state and cannot name a local"),
+])
+def test_t_cannot_be_a_name(tmp_path, decl, where, message):
+    (tmp_path / "d.sv").write_text(SV + "U8 T\n")
+    (tmp_path / "d.sm").write_text(ELEMENTS.replace("U8 pick\n", decl + "\n") + "\n[A]\n.step\n    x = 1\n")
+    r = run_fsw("check", "d.sm", cwd=tmp_path)
+    assert r.code == 1 and f" error @ {where}:\n" in r.err and f"^ {message}\n" in r.err, r.err
+    assert message.split(" cannot")[0] in DOC
+
+
+@pytest.mark.parametrize("option,value", [("delta_t", "20"), ("init_state", "A"), ("max_steps", "5")])
+def test_a_repeated_script_option_is_refused(tmp_path, option, value):
+    first = "" if option == "delta_t" else f"{option} {value}\n"
+    ss = f"[options]\ndelta_t 10\n{first}{option} {value}\n\n[all_states]\nG == 100: @stop\n"
+    project(tmp_path, "[A]\n.step\n    pick = 1\n", ss)
+    r = run_fsw("check", "d.ss", cwd=tmp_path)
+    line = 3 if option == "delta_t" else 4
+    assert r.code == 1
+    assert f"d.ss:{line}:1:\n" in r.err and f"^ duplicate option `{option}` (previously on line {line - 1})\n" in r.err
+    assert "duplicate option `delta_t` (previously on line N)" in DOC

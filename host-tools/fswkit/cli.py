@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import io
 import os
 import sys
 
@@ -690,14 +689,9 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _quiet_stdout() -> None:
-    """Points standard output at /dev/null after it failed, so that the
-    interpreter's last flush does not fail again on its way out."""
-    try:
-        fd = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(fd, sys.stdout.fileno())
-        os.close(fd)
-    except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
-        pass
+    from fswkit.outputs import discard_stdout
+
+    discard_stdout()
 
 
 def _stdout_failed() -> bool:

@@ -102,10 +102,13 @@ class View:
 
     def __enter__(self):
         if not self.headless:
+            from rich.console import Console
             from rich.live import Live
 
+            # the live view writes through the same stream: a full terminal or pipe
+            # is an output error, not the port going away
             self._live = Live(render(self.session, time.time(), self.title), refresh_per_second=8,
-                              screen=False, auto_refresh=False)
+                              screen=False, auto_refresh=False, console=Console(file=self.out))
             self._live.__enter__()
         return self
 
@@ -188,6 +191,8 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
         raise
     except (LogError, outputs.OutputError) as e:  # a full disk is not the port's fault
         sys.stderr.write(f"fsw monitor: {e}\n")
+        if isinstance(e, outputs.OutputError):
+            outputs.discard_stdout()
         status = 1
     except port_errors() as e:
         sys.stderr.write(f"fsw monitor: {port_name}: the port went away ({e})\n")

@@ -10,6 +10,7 @@ half-written file where the old one was."""
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import stat
 import sys
@@ -76,6 +77,9 @@ class Stream:
     def __init__(self, f, name: str):
         self._f, self.name = f, name
 
+    def __getattr__(self, name):  # isatty, fileno, encoding...: the file's own
+        return getattr(self._f, name)
+
     @property
     def raw(self):
         """The file itself, for writers that take a file (its errors are OSErrors)."""
@@ -97,6 +101,18 @@ class Stream:
             self._f.flush()
         except OSError as e:
             self._fail(e)
+
+
+def discard_stdout() -> None:
+    """Points standard output at /dev/null once it failed (its failure said),
+    so that later flushes, the interpreter's last one included, do not fail
+    again."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
+        pass
 
 
 def stdout() -> Stream:

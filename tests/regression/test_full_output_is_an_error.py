@@ -78,3 +78,13 @@ def test_monitor_log_on_a_full_disk_is_not_the_port(tmp_path):
                     "--log", FULL, "--force")
     clean_failure(r.code, r.err)
     assert "the port went away" not in r.err and f"cannot write the log {FULL}" in r.err
+
+
+@pytest.mark.parametrize("view", ["--headless", "--live"])
+def test_monitor_view_on_a_full_standard_output(tmp_path, view):
+    project = tank_copy(tmp_path, uplink=False)
+    argv = ["monitor", str(project), "--frames", "200"] + (["--headless"] if view == "--headless" else [])
+    with PtyStream(layout_of(project)) as target:
+        code, err = run_into_full_stdout(*argv, "--port", target.port)
+    clean_failure(code, err)
+    assert "the port went away" not in err and err.count("cannot write standard output") == 1, err

@@ -25,6 +25,11 @@ MAX_STREAMS = 128  # a sample frame's type is 0x80 | the stream's number
 _WINDOW_BYTES_AVR = {"avg": 4, "median": 8, "min": 6, "max": 6, "range": 12}
 
 
+def hz(q) -> str:
+    """A rate as the config spells one: `100`, `0.0015625`."""
+    return str(q.numerator) if q.denominator == 1 else repr(float(q))
+
+
 def window_bytes_avr(w: M.Window) -> int:
     return _WINDOW_BYTES_AVR[w.func] * w.size
 
@@ -59,7 +64,7 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
             at(t.line, 1, f"task `{t.name}` runs every {t.divider:,} executor cycles: at most every "
                           f"{U16_MAX:,} (a task's rate must be at least the executor rate {app.rate} Hz / {U16_MAX:,})")
         if t.kind == "telemetry" and t.rate > U16_MAX:
-            at(t.line, 1, f"telemetry task `{t.name}` runs at {t.rate} Hz: at most {U16_MAX:,} Hz "
+            at(t.line, 1, f"telemetry task `{t.name}` runs at {hz(t.rate)} Hz: at most {U16_MAX:,} Hz "
                           "(its once-a-second health frame is counted in its runs, a 16-bit count)")
     if len(app.telemetry) > MAX_STREAMS:
         s = app.telemetry[MAX_STREAMS]
@@ -69,9 +74,9 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
     for s in app.telemetry:
         every = tele.rate / s.rate if tele is not None else 1
         if every > U16_MAX:
-            at(s.line, 1, f"stream `{s.region.name}` at {s.rate} Hz samples every {every} telemetry runs: at most "
-                          f"every {U16_MAX:,} (a stream's rate must be at least the telemetry task's "
-                          f"{tele.rate} Hz / {U16_MAX:,})")
+            at(s.line, 1, f"stream `{s.region.name}` at {hz(s.rate)} Hz samples every {hz(every)} telemetry runs: "
+                          f"at most every {U16_MAX:,} (a stream's rate must be at least the telemetry task's "
+                          f"{hz(tele.rate)} Hz / {U16_MAX:,})")
     if diags.error_count != before:
         return False  # the link plan below assumes the counts fit
 

@@ -104,6 +104,18 @@ def projects(draw) -> dict:
     sv_text += f"[{region}]\nU8 {mode}\n" + "".join(f"U32 {s}\n" for s in s_elems) + \
         "".join(f"{t} {n}\n" for t, n in plain) + "".join(f"F64 {region}_{i}\n" for i in range(bulk))
     files = {"p.sv": sv_text, f"{stems[0]}.sm": sm_text}
+    io = []  # channels on elements with drawn names: an analog input, digital ones both ways
+    if draw(st.booleans()):
+        ain, din, dout = take(), take(), take()
+        sv_text += f"F32 {ain}\nbool {din}\nbool {dout}\n"
+        files["p.sv"] = sv_text
+        io_stem = draw(names)
+        files[f"{io_stem}.aio"] = f"i A0 {ain} scale={draw(st.sampled_from(('250', '1e30', '0.001')))} offset=-1\n"
+        files[f"{io_stem}.dio"] = f"i 2 {din}\no 13 {dout}\n"
+        io = [f"io {io_stem}.aio", f"io {io_stem}.dio"]
+        tasks_io = [f"{take()} inputs", f"{take()} outputs"]
+    else:
+        tasks_io = []
     for k in range(extra_machines):
         local, a, b = take(), take(), take()
         files[f"{stems[k + 1]}.sm"] = (
@@ -130,7 +142,7 @@ def projects(draw) -> dict:
     if draw(st.booleans()):
         tasks.append(f"{take()} uplink rate={_decimal(task_rate())}")
     n_out = draw(st.sampled_from((0, 0, 1, 3, 253, 260)))
-    tasks += [f"{take() if i < 3 else f'o{i}'} outputs" for i in range(n_out)]
+    tasks += [f"{take() if i < 3 else f'o{i}'} outputs" for i in range(n_out)] + tasks_io
     tasks = draw(st.permutations(tasks))
 
     telemetry = []
@@ -143,7 +155,7 @@ def projects(draw) -> dict:
     app_name = draw(st.sampled_from(APP_NAMES))
     files[app_name] = (
         f"[application]\nboard {board}\nrate {rate}\n[configs]\nstate_vector p.sv\n"
-        + "".join(f"machine {s}.sm\n" for s in stems)
+        + "".join(f"machine {s}.sm\n" for s in stems) + "".join(f"{line}\n" for line in io)
         + f"[time]\nsource {source}\nunit {unit}\n[tasks]\n" + "\n".join(tasks) + "\n"
         + "[telemetry]\n" + "".join(f"{t}\n" for t in telemetry)
         + "[uplink]\n" + "".join(f"{u}\n" for u in uplink))

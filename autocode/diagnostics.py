@@ -257,25 +257,33 @@ class InputError(OSError):
         return self.strerror
 
 
-def read_input(path: str, limit: int = MAX_INPUT) -> bytes:
-    """The bytes of a file the user named (config, board, state script,
-    plant parameters): the one place the tools read them. A FIFO, device or
-    folder is refused without reading (opened non-blocking, so a FIFO with
-    no writer does not hang), and so is a file over `limit` bytes (read at
-    most `limit` + 1 bytes, so a file growing meanwhile cannot exhaust
-    memory). OSError (InputError for those two) on failure."""
+def _open_regular(path: str):
+    """`path` opened for reading, refused (InputError) unless a regular
+    file. Opened non-blocking, so a FIFO with no writer does not hang."""
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
-    with os.fdopen(fd, "rb", buffering=0) as f:
-        mode = os.fstat(fd).st_mode
+    f = os.fdopen(fd, "rb", buffering=0)
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        f.close()
         if stat.S_ISDIR(mode):
             raise InputError("is a folder, not a file")
-        if not stat.S_ISREG(mode):
-            kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) \
-                else "a socket" if stat.S_ISSOCK(mode) else "not a regular file"
-            raise InputError(f"not a regular file ({kind}): configs are read from regular files only")
-        if os.fstat(fd).st_size > limit:
-            raise InputError(f"file too large: {os.fstat(fd).st_size:,} bytes, over the {limit:,} "
-                             "the tools read from one file")
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) \
+            else "a socket" if stat.S_ISSOCK(mode) else "not a regular file"
+        raise InputError(f"not a regular file ({kind}): the tools read regular files only")
+    return f
+
+
+def read_input(path: str, limit: int = MAX_INPUT) -> bytes:
+    """The bytes of a file the user named (config, board, state script,
+    plant parameters; a recorded log with a larger `limit`): the one place
+    the tools read them. A FIFO, device or folder is refused without
+    reading, and so is a file over `limit` bytes (read at most `limit` + 1
+    bytes, so a file growing meanwhile cannot exhaust memory). OSError
+    (InputError for those two) on failure."""
+    with _open_regular(path) as f:
+        size = os.fstat(f.fileno()).st_size
+        if size > limit:
+            raise InputError(f"file too large: {size:,} bytes, over the {limit:,} the tools read from one file")
         chunks, size = [], 0
         while size <= limit:
             chunk = f.read(limit + 1 - size)
@@ -286,6 +294,13 @@ def read_input(path: str, limit: int = MAX_INPUT) -> bytes:
     if size > limit:
         raise InputError(f"file too large: over the {limit:,} bytes the tools read from one file")
     return b"".join(chunks)
+
+
+def read_head(path: str, n: int) -> bytes:
+    """The first `n` bytes (or fewer) of a file the user named, such as a
+    firmware ELF whose header is checked; refused as `read_input` refuses."""
+    with _open_regular(path) as f:
+        return f.read(n)
 
 
 def read_source(path: str, diags: Diagnostics, lang: str) -> Source | None:

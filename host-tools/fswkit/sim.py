@@ -33,6 +33,7 @@ import time
 from dataclasses import dataclass
 
 from fswkit.autocode.board import Board, BoardError, load_board
+from fswkit.autocode.diagnostics import read_head
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 HARNESS_SRC = os.path.join(HERE, "sim_harness.c")
@@ -197,8 +198,7 @@ def pin_map(board: Board) -> PinMap:
 def check_elf(path: str, mcu: str) -> None:
     """SimError unless `path` is an AVR ELF executable for `mcu`'s class."""
     try:
-        with open(path, "rb") as f:
-            head = f.read(52)
+        head = read_head(path, 52)
     except FileNotFoundError:
         raise SimError(f"{path}: no such file") from None
     except IsADirectoryError:
@@ -663,8 +663,7 @@ def _say(text: str) -> None:
 
 def _is_elf(path: str) -> bool:
     try:
-        with open(path, "rb") as f:
-            return f.read(4) == b"\x7fELF"
+        return read_head(path, 4) == b"\x7fELF"
     except OSError:
         return False
 

@@ -83,3 +83,15 @@ def test_plant_parameters_from_a_fifo_are_refused(tank):
     r = subprocess.run([sys.executable, "-c", code], cwd=tank, capture_output=True, text=True, timeout=30)
     assert r.returncode == 0, r.stderr
     assert "plant.toml: not a regular file (a FIFO)" in r.stdout
+
+
+@pytest.mark.parametrize("argv,expect", [
+    (("log2csv", "x.log", "-o", "x.csv"), "cannot read x.log: not a regular file (a FIFO)"),
+    (("replay", "x.log"), "cannot read x.log: not a regular file (a FIFO)"),
+    (("sim", "x.elf", "--board", "uno"), "x.elf: not a regular file (a FIFO)"),
+])
+def test_a_fifo_log_or_firmware_is_refused_at_once(tmp_path, argv, expect):
+    os.mkfifo(tmp_path / argv[1])
+    r = fsw(*argv, cwd=tmp_path)
+    assert r.returncode != 0 and expect in r.stderr, r.stderr
+    assert not (tmp_path / "x.csv").exists()

@@ -16,9 +16,12 @@ import os
 import struct
 import tempfile
 
+from fswkit.autocode.diagnostics import read_input
+
 from .layout import Layout, LayoutError, from_dict
 
 MAGIC = b"FSWLOG1\n"
+MAX_LOG = 1 << 30  # bytes of a log the tools read: 1 GiB, a day of a link at 115200 baud
 _REC = struct.Struct("<BQI")
 RX, TX = 0, 1
 
@@ -109,8 +112,7 @@ class LogReader:
 
     def __init__(self, path: str):
         try:
-            with open(path, "rb") as f:
-                data = f.read()
+            data = read_input(path, MAX_LOG)
         except OSError as e:
             raise LogError(f"cannot read {path}: {e.strerror or e}") from None
         if not data.startswith(MAGIC) or len(data) < len(MAGIC) + 4:

@@ -37,7 +37,7 @@ class Board:
         """The pin number a table names (`A0`, `4`), or None."""
         if text in self.analog_pins:
             return self.analog_pins[text]
-        if text.isdigit():
+        if text.isdigit() and text.isascii() and len(text) <= 3:  # pins are 0..255 (a 5,000-digit int() raises)
             n = int(text)
             if n in self.digital_pins or n in self.reserved or n in self.analog_pins.values():
                 return n

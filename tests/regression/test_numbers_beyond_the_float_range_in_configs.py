@@ -116,3 +116,11 @@ def test_a_board_number_out_of_range_is_refused(old, new, field):
     d = tomllib.loads(text.replace(old, new, 1))
     with pytest.raises(ValueError, match=f"`{field}`"):
         board_from_dict("uno", d)
+
+
+def test_a_pin_number_of_5000_digits_is_a_located_error(tank):
+    """int() of a pin of over 4,300 digits raised ValueError (exit 3)."""
+    edit(tank / "tank.aio", "A0", "9" * 5000)
+    r = run_fsw("check", "tank.app", cwd=tank)
+    assert r.code == 1 and "internal error" not in r.err
+    assert "I/O config error @ tank.aio:4:8:" in r.err and "has no pin" in r.err

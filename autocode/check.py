@@ -286,7 +286,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
         if d.name in names:
             err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
             continue
-        init_resolver = Resolver(src, diags, lang, dict(names), vars_, [], None)
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)  # no copy: quadratic in locals
         init = _resolve_init(init_resolver, d, local_decls, vars_)
         init_used |= init_resolver.used
         idx = len(vars_)

@@ -143,9 +143,15 @@ class Diagnostics:
         self._per_line: dict[tuple[str, int, str], int] = {}
         self._per_file: dict[tuple[str, str], int] = {}
         self.hidden: dict[tuple[str, str], int] = {}  # (path, severity) -> not kept
+        # Each diagnostic not kept, by its hash (what `_seen` is for the kept
+        # ones): a file reported twice (a machine, then beside its script) is
+        # counted once. An int a diagnostic: memory linear in the input.
+        self._hidden_keys: dict[int, tuple[str, str]] = {}
+        self._seen_keys: set[int] = set()
         self.error_count = self.warning_count = 0
         for d in self.items:  # given at construction: kept as they are
             self._seen.add(d)
+            self._seen_keys.add(hash(d))
             self._count(d.severity, 1)
 
     def _count(self, severity: str, n: int) -> None:
@@ -157,15 +163,24 @@ class Diagnostics:
     def _keep(self, d: Diagnostic) -> None:
         if d in self._seen:
             return
-        self._count(d.severity, 1)
+        key = hash(d)
+        if key in self._hidden_keys:
+            return
         file_key, line_key = (d.path, d.severity), (d.path, d.line, d.severity)
         if self._per_file.get(file_key, 0) >= PER_FILE or self._per_line.get(line_key, 0) >= PER_LINE:
-            self.hidden[file_key] = self.hidden.get(file_key, 0) + 1
+            self._hide(key, file_key)
             return
+        self._count(d.severity, 1)
         self._per_file[file_key] = self._per_file.get(file_key, 0) + 1
         self._per_line[line_key] = self._per_line.get(line_key, 0) + 1
         self._seen.add(d)
+        self._seen_keys.add(key)
         self.items.append(d)
+
+    def _hide(self, key: int, file_key: tuple[str, str]) -> None:
+        self._hidden_keys[key] = file_key
+        self.hidden[file_key] = self.hidden.get(file_key, 0) + 1
+        self._count(file_key[1], 1)
 
     def add(self, src: Source, lang: str, line: int, col: int, message: str,
             severity: str = "error") -> None:
@@ -188,9 +203,9 @@ class Diagnostics:
     def extend(self, other: "Diagnostics") -> None:
         for d in other.items:
             self._keep(d)
-        for (path, severity), n in other.hidden.items():
-            self.hidden[path, severity] = self.hidden.get((path, severity), 0) + n
-            self._count(severity, n)
+        for key, file_key in other._hidden_keys.items():
+            if key not in self._hidden_keys and key not in self._seen_keys:
+                self._hide(key, file_key)
 
     @property
     def errors(self) -> list[Diagnostic]:

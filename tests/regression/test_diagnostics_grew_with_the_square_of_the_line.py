@@ -97,3 +97,20 @@ def test_a_random_file_of_the_largest_size_read_is_fast_and_bounded(tmp_path):
     assert re.search(r"^r\.sm: \d+ more errors not shown", err, re.M)
     assert len(err) < (PER_FILE + 1) * 400
     assert seconds < 60
+
+
+def test_a_file_reported_twice_is_counted_once(tmp_path):
+    """A machine is checked on its own and again beside its script: the
+    diagnostics not shown must not be counted twice."""
+    from conftest import run_fsw
+
+    for name in ("tank.sv", "tank.ss"):
+        shutil.copy(EXAMPLES / "tank" / name, tmp_path / name)
+    (tmp_path / "tank.sm").write_text(hostile())
+    dollars = hostile().count("$")
+    r = run_fsw("check", "tank.sm", "tank.ss", cwd=tmp_path)
+    assert r.code == 1
+    shown = len(diagnostics(r.err))
+    hidden = int(re.search(r"^tank\.sm: (\d+) more errors not shown", r.err, re.M).group(1))
+    assert shown + hidden == dollars
+    assert r.err.endswith(f"fsw check: 2 files, {dollars} errors, 0 warnings\n")

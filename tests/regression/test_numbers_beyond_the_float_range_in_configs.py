@@ -124,3 +124,13 @@ def test_a_pin_number_of_5000_digits_is_a_located_error(tank):
     r = run_fsw("check", "tank.app", cwd=tank)
     assert r.code == 1 and "internal error" not in r.err
     assert "I/O config error @ tank.aio:4:8:" in r.err and "has no pin" in r.err
+
+
+@pytest.mark.parametrize("argv", [("check", "tank.app"), ("gen", "."), ("build", "."), ("sim", ".", "--board", "uno"),
+                                  ("monitor", "--port", "/dev/null", "."), ("flash", ".")])
+def test_every_command_that_reads_the_tables_refuses_the_calibration(tank, argv):
+    edit(tank / "tank.aio", "scale=250", "scale=1e400")
+    r = run_fsw(*argv, cwd=tank)
+    assert r.code in (1, 2) and "internal error" not in r.err, r.err
+    assert "tank.aio:4:34:" in r.err and "`scale` is outside the representable range" in r.err
+    assert not (tank / "build").exists()

@@ -49,6 +49,17 @@ def clip(shown: str, at: int) -> tuple[str, int]:
     return head + shown[start:end] + tail, at - start + len(head)
 
 
+_QUOTED = re.compile(r"`([^`]*)`")
+QUOTED = 60  # characters of a name or token a message quotes (a 40 KB name is cut)
+
+
+def _clip_quoted(m: re.Match) -> str:
+    text = m.group(1)
+    if len(text) <= QUOTED:
+        return m.group()
+    return f"`{text[:QUOTED // 2]}...{text[-QUOTED // 2:]}`"
+
+
 def visual_col(text: str, index: int) -> int:
     """1-based column of character `index` of `text` once tabs are expanded."""
     if "\t" not in text:
@@ -121,7 +132,8 @@ class Diagnostic:
         head = self.title or f"{self.lang} {self.severity}"
         shown, at = clip(display_line(self.source_line), max(self.col, 1) - 1)
         caret = " " * at + "^"
-        return f"{head} @ {self.path}:{self.line}:{self.col}:\n  | {shown}\n  | {caret} {self.message}"
+        message = _QUOTED.sub(_clip_quoted, self.message)
+        return f"{head} @ {self.path}:{self.line}:{self.col}:\n  | {shown}\n  | {caret} {message}"
 
     @property
     def sort_key(self):

@@ -114,3 +114,15 @@ def test_a_file_reported_twice_is_counted_once(tmp_path):
     hidden = int(re.search(r"^tank\.sm: (\d+) more errors not shown", r.err, re.M).group(1))
     assert shown + hidden == dollars
     assert r.err.endswith(f"fsw check: 2 files, {dollars} errors, 0 warnings\n")
+
+
+def test_a_40_kb_name_is_cut_in_the_message_too(tmp_path):
+    from conftest import run_fsw
+
+    (tmp_path / "p.sv").write_text("[R]\nU64 time\nU32 state\n")
+    (tmp_path / "p.sm").write_text("[state_vector]\nU64 time @alias G\nU32 state @alias S\n[A]\n.step\n    "
+                                   + "a" * 40000 + " = 1\n")
+    r = run_fsw("check", "p.sm", cwd=tmp_path)
+    assert r.code == 1
+    assert "^ unknown element `" + "a" * 30 + "..." + "a" * 30 + "`\n" in r.err
+    assert len(r.err) < 1000

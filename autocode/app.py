@@ -490,8 +490,9 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         if q.denominator != 1:
             err(toks[1], f"`{key.text}` is a whole number of bytes, found `{toks[1].text}`")
             continue
+        # A board whose memory is 0 (the native host build) has no limit to hold a budget to.
         limit = None if board is None else (board.flash if key.text == "flash" else board.ram)
-        if limit is not None and q > limit:
+        if limit and q > limit:
             err(toks[1], f"a {key.text} budget of {int(q):,} B is more than the {board.name} has "
                          f"({limit:,} B)")
             continue

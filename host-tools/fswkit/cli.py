@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 
 from fswkit import __version__
@@ -663,6 +664,9 @@ def parser() -> argparse.ArgumentParser:
     cm.add_argument("-p", "--project", default=".", help="the project the firmware was built from (default .)")
     cm.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
     cm.add_argument("--ignore-schema", action="store_true", help="send even when the schema hash differs")
+    # `set x -3.4028235e38`, `-inf`, `-0x7f`: a value, not an unknown option (argparse
+    # takes only `-5` and `-.5` for numbers); no option of `cmd` starts with a digit, `.`, inf or nan
+    cm._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     cm.set_defaults(func=cmd_cmd)
 
     lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")

@@ -61,3 +61,17 @@ def test_cmd_set_documented_f32_maximum():
     r = run_fsw("cmd", "set", "padPressure", "3.4028236e38", "--port", "/dev/no-such-port",
                 "-p", str(EXAMPLES / "rocket"))
     assert r.code == 1 and "out of its range" in r.err and "cannot open" not in r.err, r.err
+
+
+@pytest.mark.parametrize("value", ["-3.4028235e38", "-inf", "-1e-46", "-.5e3", "-Infinity", "-nan", "-0x7f"])
+def test_cmd_set_negative_values_are_values_not_options(value):
+    # the documented minimum of F32 and -inf are values of `set`, not unknown options,
+    # wherever the options stand: before the command or after its arguments
+    for argv in (("cmd", "set", "padPressure", value, "--port", "/dev/no-such-port", "-p", str(EXAMPLES / "rocket")),
+                 ("cmd", "--port", "/dev/no-such-port", "-p", str(EXAMPLES / "rocket"), "set", "padPressure", value)):
+        r = run_fsw(*argv)
+        assert "unrecognized arguments" not in r.err, r.err
+        if value == "-0x7f":  # a hex integer is no F32 value: refused as a value, by fsw cmd
+            assert r.code == 1 and "is not a number" in r.err and "cannot open" not in r.err, r.err
+        else:
+            assert r.code == 1 and "cannot open /dev/no-such-port" in r.err, r.err

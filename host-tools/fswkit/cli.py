@@ -709,11 +709,27 @@ def _stdout_failed() -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from fswkit.outputs import OutputError
+    from fswkit.outputs import Stream
 
     args = parser().parse_args(argv)
+    # every print of every command: a failed write says it was standard output
+    saved = sys.stdout
+    out = sys.stdout = Stream(saved, "standard output")
+    try:
+        return _main(args, out)
+    finally:
+        if sys.stdout is out:
+            sys.stdout = saved
+
+
+def _main(args, out) -> int:
+    from fswkit.outputs import OutputError
+
     try:
         code = args.func(args)
+        if out.failed:  # the command stopped at it and said so
+            _quiet_stdout()
+            return code or EXIT_FAIL
         sys.stdout.flush()  # a full or closed standard output fails here, not after exit
         return code
     except KeyboardInterrupt:
@@ -726,7 +742,7 @@ def main(argv: list[str] | None = None) -> int:
         _quiet_stdout()
         return EXIT_FAIL
     except OSError as e:  # an input or output the command could not use: its system error
-        if _stdout_failed():
+        if out.failed or _stdout_failed():
             sys.stderr.write(f"fsw {args.command}: cannot write standard output: {e.strerror or e}\n")
             _quiet_stdout()
         else:

@@ -74,6 +74,8 @@ class Stream:
     closed by its reader stays a BrokenPipeError: `fsw ... | head` is not a
     failure)."""
 
+    failed = False  # a write or flush failed (its OutputError raised)
+
     def __init__(self, f, name: str):
         self._f, self.name = f, name
 
@@ -88,6 +90,7 @@ class Stream:
     def _fail(self, e: OSError):
         if isinstance(e, BrokenPipeError):
             raise e
+        self.failed = True
         raise OutputError(f"cannot write {self.name}: {e.strerror or e}") from None
 
     def write(self, text) -> int:

@@ -88,3 +88,14 @@ def test_monitor_view_on_a_full_standard_output(tmp_path, view):
         code, err = run_into_full_stdout(*argv, "--port", target.port)
     clean_failure(code, err)
     assert "the port went away" not in err and err.count("cannot write standard output") == 1, err
+
+
+def test_full_standard_output_is_named(tmp_path, log):
+    # said as standard output: not a bare system error, nor the build folder the command wrote into
+    argvs = _commands(log) + [("new", str(tmp_path / "fresh")),
+                              ("build", str(TANK), "--board", "native", "--out", str(tmp_path / "native"))]
+    for argv in argvs:
+        code, err = run_into_full_stdout(*argv)
+        clean_failure(code, err)
+        assert err.count("cannot write standard output: No space left on device") == 1, (argv, err)
+        assert str(tmp_path) not in err, (argv, err)

@@ -49,6 +49,8 @@ CASES = [
     ("layout.schema", -1, "layout.schema"),
     ("layout.health_payload", None, "layout.health_payload"),
     ("layout.elements.0.type", "U9", "layout.elements[0].type"),
+    ("layout.elements.0.type", [], "layout.elements[0].type"),  # not looked up in the table of types
+    ("layout.elements.1.type", {"U8": 1}, "layout.elements[1].type"),
     ("layout.elements.1.offset", 1.5, "layout.elements[1].offset"),
     ("layout.regions.0", [], "layout.regions[0]"),
     ("layout.streams.0.batch", 0, "layout.streams[0].batch"),

@@ -178,7 +178,7 @@ def check_dict(d) -> None:
             raise LayoutError(f"field `layout.{key}` is missing")
         need(ok(d[key]), f"layout.{key}", d[key], want)
     items = {"elements": {"name": (lambda v: isinstance(v, str), "a string"),
-                          "type": (lambda v: v in FORMATS, "one of " + " ".join(FORMATS)),
+                          "type": (lambda v: isinstance(v, str) and v in FORMATS, "one of " + " ".join(FORMATS)),
                           "offset": (lambda v: _is_int(v, 0, 1 << 20), "an offset in bytes"),
                           "region": (lambda v: isinstance(v, str), "a region name")},
              "regions": {"name": (lambda v: isinstance(v, str), "a string"),

@@ -159,7 +159,7 @@ def _test_one(path: str, args, real):
     if args.trace:  # written beside its path and renamed into place once whole
         from fswkit.outputs import OutputError, Replacement, check
         try:
-            check(args.trace, [path, script.machine.path], what="trace")
+            check(args.trace, [path, script.machine.path, script.machine.sv.path], what="trace")
             trace = Replacement(args.trace)
         except OutputError as e:
             sys.stderr.write(f"fsw test: {e}\n")
@@ -252,7 +252,7 @@ def cmd_graph(args) -> int:
     if m is None:
         return EXIT_CONFIG
     return _write(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output, "graph",
-                  (args.machine, args.sv))
+                  (args.machine, m.sv.path))  # the state vector's as found beside the machine too
 
 
 def cmd_skeleton(args) -> int:
@@ -261,7 +261,7 @@ def cmd_skeleton(args) -> int:
     m = _machine_or_exit(args)
     if m is None:
         return EXIT_CONFIG
-    return _write(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, args.sv))
+    return _write(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, m.sv.path))
 
 
 # ---- fsw gen / fsw build ---------------------------------------------------------------

@@ -102,9 +102,21 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
     _no_parts(tmp_path)
 
 
+def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_path):
+    # the .sv is an input too when found beside the machine, not named by --sv
+    project = tank_copy(tmp_path)
+    sv = project / "tank.sv"
+    before = sv.read_bytes()
+    for command in ("graph", "skeleton"):
+        for spelling in (str(sv), "./tank.sv"):
+            r = run_fsw(command, "tank.sm", "-o", spelling, cwd=project)
+            assert r.code == 1 and "overwrite an input" in r.err, r.err
+            assert sv.read_bytes() == before
+
+
 def test_test_trace_onto_its_script_or_machine_is_refused(tmp_path):
     project = tank_copy(tmp_path)
-    for victim in ("tank.ss", "tank.sm"):
+    for victim in ("tank.ss", "tank.sm", "tank.sv"):
         f = project / victim
         before = f.read_bytes()
         r = run_fsw("test", str(project / "tank.ss"), "--trace", str(f))

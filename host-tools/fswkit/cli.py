@@ -428,8 +428,9 @@ def cmd_new(args) -> int:
 
 # ---- the serial link: fsw monitor / cmd / log2csv / replay / plot ----------------------
 
-def _link_layout(project: str, command: str):
-    """The link layout of a project's configs, or None after a message."""
+def _link_layout(project: str, command: str, configs: list | None = None):
+    """The link layout of a project's configs, or None after a message;
+    the configs' paths are added to `configs`."""
     from fswkit.build import BuildError, load
     from fswkit.link.layout import from_app
 
@@ -442,6 +443,8 @@ def _link_layout(project: str, command: str):
     _print_diags(diags)
     if app is None:
         return None
+    if configs is not None:
+        configs += [app.path, app.sv.path] + [m.path for m in app.machines] + [c.path for c in app.channels]
     return from_app(app)
 
 
@@ -462,12 +465,24 @@ def _ground(command: str, fn, *a) -> int:
 def cmd_monitor(args) -> int:
     from fswkit.monitor import monitor
 
-    layout = _link_layout(args.project, "monitor")
+    from fswkit.outputs import OutputError, check
+
+    if args.log == "":
+        sys.stderr.write("fsw monitor: --log needs a file name\n")
+        return EXIT_FAIL
+    configs: list[str] = []
+    layout = _link_layout(args.project, "monitor", configs)
     if layout is None:
         return EXIT_CONFIG
     port = _port_or_only(args.port, "monitor")
     if port is None:
         return EXIT_FAIL
+    if args.log is not None:  # --force replaces an old recording, never a config or the port itself
+        try:
+            check(args.log, configs + [port], force=True, what="log")
+        except OutputError as e:
+            sys.stderr.write(f"fsw monitor: {e}\n")
+            return EXIT_FAIL
     return _ground("monitor", monitor, layout, args.project, port, args.baud, args.log, args.headless,
                    args.ignore_schema, args.duration, args.frames, args.force)
 

@@ -114,6 +114,21 @@ def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_pat
             assert sv.read_bytes() == before
 
 
+def test_monitor_log_onto_its_configs_or_port_is_refused_even_with_force(tmp_path):
+    # --force replaces an old recording, never one of the project's configs nor the port read
+    project = tank_copy(tmp_path)
+    port = tmp_path / "port"
+    port.write_text("a file standing for the port\n")
+    for victim in ("tank.app", "tank.sv", "tank.sm", "tank.aio", "tank.dio", str(port)):
+        f = project / victim
+        before = f.read_bytes()
+        r = run_fsw("monitor", str(project), "--port", str(port), "--headless", "--log", str(f), "--force")
+        assert r.code == 1 and "overwrite an input" in r.err, r.err
+        assert f.read_bytes() == before
+    r = run_fsw("monitor", str(project), "--port", str(port), "--headless", "--log", "")
+    assert r.code == 1 and "--log" in r.err, r.err
+
+
 def test_test_trace_onto_its_script_or_machine_is_refused(tmp_path):
     project = tank_copy(tmp_path)
     for victim in ("tank.ss", "tank.sm", "tank.sv"):

@@ -498,7 +498,9 @@ def machine_exprs(m: M.Machine):
 
 
 def script_exprs(s: M.Script):
-    """Every expression of a script's own sections (not its machine's)."""
+    """Every expression of a script's own sections (not its machine's),
+    the guards of empty blocks included."""
+    yield from s.idle_guards
     for sec in s.sections:
         for g in sec.inputs:
             yield g.guard
@@ -695,6 +697,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
              m.s: ("S", "the current state's ID, written by the machine"),
              m.t: ("T", "the time spent in the current state, kept by the machine")}
     sections = []
+    idle_guards = []
     state_sections: dict[int, int] = {}
     has_stop = False
     for sec in f.sections:
@@ -738,6 +741,8 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
                 inputs.append(M.InputGroup(guard, tuple(ins)))
             if chk:
                 checks.append(M.CheckGroup(guard, tuple(chk)))
+            if not ins and not chk:
+                idle_guards.append(guard)
         if state != -1:
             sections.append(M.ScriptSection(state, tuple(inputs), tuple(checks), h.line))
     if not has_stop and not before:  # after a syntax error, the `@stop` may be in the broken part
@@ -748,7 +753,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         return None
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
-                    tuple(sections), tuple(windows))
+                    tuple(sections), tuple(windows), tuple(idle_guards))
 
 
 def _int_option(o: S.Option, err) -> int | None:

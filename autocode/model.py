@@ -270,3 +270,6 @@ class Script:
     max_steps: int
     sections: tuple[ScriptSection, ...]
     windows: tuple[Window, ...]  # the script's own roll_* windows
+    # Guards of blocks with nothing in them: checked like every guard, never
+    # evaluated (a guard is evaluated only before an input or a check).
+    idle_guards: tuple[Expr, ...] = ()

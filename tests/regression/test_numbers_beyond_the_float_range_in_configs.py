@@ -134,3 +134,13 @@ def test_every_command_that_reads_the_tables_refuses_the_calibration(tank, argv)
     assert r.code in (1, 2) and "internal error" not in r.err, r.err
     assert "tank.aio:4:34:" in r.err and "`scale` is outside the representable range" in r.err
     assert not (tank / "build").exists()
+
+
+def test_a_script_literal_beyond_binary32_in_an_empty_block_is_refused(tank):
+    # A guard whose block is empty is never evaluated, but it is checked like
+    # every guard: a literal is an error wherever it stands.
+    edit(tank / "tank.ss", "G == 1000: @stop", "G == 1000: @stop\nG > 1e39 { }")
+    assert run_fsw("test", "tank.ss", cwd=tank).code == 0  # binary64 holds it
+    r = run_fsw("test", "--real", "f32", "tank.ss", cwd=tank)
+    assert r.code == 2 and "state script error @ tank.ss:13:5:" in r.err, r.err
+    assert f"{OUT} of binary32" in r.err

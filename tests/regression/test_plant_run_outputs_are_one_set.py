@@ -67,3 +67,34 @@ def test_a_first_run_that_does_not_finish_leaves_no_summary(scenario, tmp_path, 
     with pytest.raises(KeyboardInterrupt):
         execute(sc, "unused.elf", None, layout, str(out))
     assert os.listdir(out) == [INCOMPLETE]
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_a_run_stopped_by_a_signal_leaves_the_previous_set(scenario, tmp_path, monkeypatch, signame):
+    # `kill`, a closed terminal, a CI job cancelled: the run ends as by Ctrl-C, not on the spot
+    # with its files in a hidden folder
+    import signal
+
+    sig = getattr(signal, signame)
+    layout, sc = scenario
+    out = tmp_path / "rocket-flight"
+    _previous_run(out)
+
+    def fly(sc, elf, board, layout, log_path, log_meta=None, **kw):
+        log = LogWriter(log_path, layout, **(log_meta or {}))
+        log.commit()
+        log.record(RX, 1, b"\0partial flight\0")
+        log.close()
+        assert signal.getsignal(sig) not in (signal.SIG_DFL, signal.SIG_IGN, None), "the signal would kill the run"
+        signal.raise_signal(sig)
+        raise AssertionError("the signal did not stop the run")
+
+    monkeypatch.setattr(plant_run, "fly", fly)
+    before = signal.getsignal(sig)
+    with pytest.raises(KeyboardInterrupt, match=signame):
+        execute(sc, "unused.elf", None, layout, str(out))
+    assert signal.getsignal(sig) == before
+    for k, data in OLD.items():
+        assert (out / FILES[k]).read_bytes() == data, k
+    assert sorted(os.listdir(out)) == sorted(list(FILES.values()) + [INCOMPLETE])
+    assert f"stopped by {signame}" in (out / INCOMPLETE / "INCOMPLETE.txt").read_text()

@@ -13,8 +13,10 @@ import contextlib
 import hashlib
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import threading
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
@@ -110,6 +112,37 @@ class Interrupted(Exception):
     """A run stopped before its end (its partial files are kept apart)."""
 
 
+class Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGHUP during a run (`kill`, a closed terminal, a cancelled
+    job): the run ends as by Ctrl-C, its files set aside."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def _stopped_by_signals():
+    """SIGTERM and SIGHUP raise Stopped in the run instead of ending the
+    process on the spot (a SIGHUP ignored under nohup stays ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, _frame):
+        raise Stopped(signum)
+
+    saved = {}
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            saved[sig] = signal.signal(sig, stop)
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+
+
 def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False) -> Flight:
     """Flies the scenario; writes the files into `out` (None: none). CosimError
     if the run could not go on.
@@ -117,19 +150,21 @@ def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False
     A run's files are one set: they are written into a fresh folder inside
     `out` and moved into place only once all of them are (the summary last,
     after the previous summary is gone), so `out` never holds one run's log
-    beside another's summary. A run that does not finish (an error, Ctrl-C)
+    beside another's summary. A run that does not finish (an error, Ctrl-C,
+    SIGTERM, SIGHUP)
     leaves the previous set as it was and its own partial files in
     `out/incomplete/`, with a note saying so."""
     if out is None:
         return _execute(sc, elf, board, layout, None)
     os.makedirs(out, exist_ok=True)
     stage = tempfile.mkdtemp(prefix=".run-", dir=out)
-    try:
-        flight = _execute(sc, elf, board, layout, stage)
-    except BaseException as e:
-        _set_aside(stage, out, e)
-        raise
-    flight.files = _install(stage, out)
+    with _stopped_by_signals():
+        try:
+            flight = _execute(sc, elf, board, layout, stage)
+        except BaseException as e:
+            _set_aside(stage, out, e)
+            raise
+        flight.files = _install(stage, out)
     return flight
 
 
@@ -166,7 +201,10 @@ def _install(stage: str, out: str) -> dict:
 
 def _set_aside(stage: str, out: str, why: BaseException) -> None:
     """A run that did not finish: its files to `out/incomplete/`, with a note."""
-    reason = "interrupted (Ctrl-C)" if isinstance(why, KeyboardInterrupt) else f"stopped: {why}"
+    if isinstance(why, Stopped):
+        reason = f"stopped by {why}"
+    else:
+        reason = "interrupted (Ctrl-C)" if isinstance(why, KeyboardInterrupt) else f"stopped: {why}"
     try:
         with open(os.path.join(stage, "INCOMPLETE.txt"), "w") as f:
             f.write(f"This run did not finish ({reason}): its files are partial, and it has no summary.\n"
@@ -222,6 +260,9 @@ def main(args) -> int:
                   "still the last finished run's")
     try:
         flight = execute(sc, elf, board, layout, out)
+    except Stopped as e:
+        _say(f"stopped by {e}" + incomplete)
+        return 128 + e.signum
     except KeyboardInterrupt:
         _say("interrupted" + incomplete)
         raise

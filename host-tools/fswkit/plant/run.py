@@ -134,7 +134,7 @@ def _stopped_by_signals():
 
     saved = {}
     for sig in (signal.SIGTERM, signal.SIGHUP):
-        if signal.getsignal(sig) is not signal.SIG_IGN:
+        if signal.getsignal(sig) not in (signal.SIG_IGN, None):  # None: a handler not set from Python
             saved[sig] = signal.signal(sig, stop)
     try:
         yield

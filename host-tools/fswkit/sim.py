@@ -266,6 +266,8 @@ def link_problem(path: str) -> str | None:
     None. Only a path with nothing there, or a stale link of a simulated
     board (a symbolic link to a pseudo-terminal that is gone), may be used:
     whatever else is there is never removed."""
+    if not path:
+        return "--link needs a path (the symbolic link to make)"
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         return f"--link {path}: no such folder {folder}"

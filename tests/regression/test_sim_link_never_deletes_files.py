@@ -40,6 +40,11 @@ def test_a_folder_or_foreign_link_is_refused(tmp_path):
     _refused(tmp_path, link, lambda: os.readlink(link) == str(target) or pytest.fail("the link changed"))
 
 
+def test_an_empty_link_path_is_refused_not_ignored(tmp_path):
+    assert link_problem("") is not None
+    _refused(tmp_path, "", lambda: None)
+
+
 def test_a_link_to_an_open_pty_is_refused(tmp_path):
     master, slave = pty.openpty()
     try:

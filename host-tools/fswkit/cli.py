@@ -467,9 +467,6 @@ def cmd_monitor(args) -> int:
 
     from fswkit.outputs import OutputError, check
 
-    if args.log == "":
-        sys.stderr.write("fsw monitor: --log needs a file name\n")
-        return EXIT_FAIL
     configs: list[str] = []
     layout = _link_layout(args.project, "monitor", configs)
     if layout is None:
@@ -723,10 +720,26 @@ def _stdout_failed() -> bool:
     return False
 
 
+def _empty_option(p: argparse.ArgumentParser, args) -> str | None:
+    """The long name of an option given as an empty string (a path, a port,
+    a board), or None."""
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction)).choices.get(args.command)
+    for action in sub._actions if sub is not None else ():
+        if action.option_strings and getattr(args, action.dest, None) == "":
+            return max(action.option_strings, key=len)
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     from fswkit.outputs import Stream
 
-    args = parser().parse_args(argv)
+    p = parser()
+    args = p.parse_args(argv)
+    empty = _empty_option(p, args)
+    if empty is not None:  # `--trace ""` is no trace, `--out ""` not the default folder
+        sys.stderr.write(f"fsw {args.command}: {empty}: an empty string names nothing: give a path or name, "
+                         "or leave the option out\n")
+        return EXIT_CONFIG
     # every print of every command: a failed write says it was standard output
     saved = sys.stdout
     out = sys.stdout = Stream(saved, "standard output")

@@ -126,7 +126,22 @@ def test_monitor_log_onto_its_configs_or_port_is_refused_even_with_force(tmp_pat
         assert r.code == 1 and "overwrite an input" in r.err, r.err
         assert f.read_bytes() == before
     r = run_fsw("monitor", str(project), "--port", str(port), "--headless", "--log", "")
-    assert r.code == 1 and "--log" in r.err, r.err
+    assert r.code == 2 and "--log: an empty string" in r.err, r.err
+
+
+@pytest.mark.parametrize("argv", [
+    ("test", "tank.ss", "--trace", ""), ("build", ".", "--out", ""), ("gen", ".", "--out", ""),
+    ("sim", ".", "--plant", "tank", "--out", ""), ("skeleton", "tank.sm", "-o", ""),
+    ("monitor", ".", "--port", "", "--headless"), ("test", "tank.ss", "--sv", ""), ("build", ".", "--board", ""),
+], ids=lambda a: " ".join(a[:1] + a[-2:]))
+def test_an_empty_path_is_refused_not_taken_for_the_default(tmp_path, argv):
+    # `--trace ""` wrote no trace and `--out ""` built into the default folder, with exit status 0
+    project = tank_copy(tmp_path)
+    r = run_fsw(*argv, cwd=project)
+    opt = next(a for a in argv if a.startswith("-") and argv[argv.index(a) + 1] == "")
+    opt = {"-o": "--output"}.get(opt, opt)
+    assert r.code == 2 and f"{opt}: an empty string" in r.err, r.err
+    assert not (project / "build").exists()
 
 
 def test_test_trace_onto_its_script_or_machine_is_refused(tmp_path):

@@ -42,7 +42,8 @@ def test_a_folder_or_foreign_link_is_refused(tmp_path):
 
 def test_an_empty_link_path_is_refused_not_ignored(tmp_path):
     assert link_problem("") is not None
-    _refused(tmp_path, "", lambda: None)
+    r = run_fsw("sim", str(tmp_path / "fw.elf"), "--board", "uno", "--link", "")
+    assert r.code == 2 and "--link: an empty string" in r.err, r.err
 
 
 def test_a_link_to_an_open_pty_is_refused(tmp_path):

@@ -152,14 +152,22 @@ def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | 
             f = open(tmp, "wb" if binary else "w", **({} if binary else {"newline": newline}))
         except OSError as e:
             raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
-        with f:
-            s = Stream(f, path)
+        s = Stream(f, path)
+        done = False
+        try:
             yield s
             s.flush()
             try:
                 os.fsync(f.fileno())
             except OSError as e:
                 raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
+            done = True
+        finally:
+            try:  # after a failed write, closing fails again: the first error is the one said
+                f.close()
+            except OSError as e:
+                if done:
+                    raise OutputError(f"cannot write {path}: {e.strerror or e}") from None
 
 
 def _new_file_mode(tmp: str, target: str) -> None:

@@ -102,6 +102,24 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
     _no_parts(tmp_path)
 
 
+@pytest.mark.parametrize("command", ["graph", "skeleton"])
+def test_a_small_output_that_cannot_be_written_is_named(tmp_path, command):
+    # the whole text fails at the last flush, and again as the file closes: the message still names the file
+    project = tank_copy(tmp_path)
+    out = tmp_path / "out.txt"
+    old = resource.getrlimit(resource.RLIMIT_FSIZE)
+    old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100, old[1]))
+        r = run_fsw(command, str(project / "tank.sm"), "-o", str(out))
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old)
+        signal.signal(signal.SIGXFSZ, old_sig)
+    assert r.code == 1 and f"cannot write {out}: File too large" in r.err, r.err
+    assert not out.exists()
+    _no_parts(tmp_path)
+
+
 def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_path):
     # the .sv is an input too when found beside the machine, not named by --sv
     project = tank_copy(tmp_path)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import tempfile
 
 from fswkit.autocode.board import Board
@@ -312,17 +313,34 @@ def main(args) -> int:
     except (BoardError, ScaffoldError) as e:
         sys.stderr.write(f"fsw new: {e}\n")
         return 2
+    except OSError as e:  # the starter script is made from the machine in a temporary folder
+        sys.stderr.write(f"fsw new: cannot write a temporary file: {e.strerror or e}\n")
+        return 1
     if os.path.exists(target) and (not os.path.isdir(target) or os.listdir(target)):
         sys.stderr.write(f"fsw new: {target} already exists: choose a new folder\n")
         return 1
+    # written into a folder beside it that takes its name once every file is whole:
+    # a full disk or Ctrl-C leaves no half project in the way of the next `fsw new`
+    parent = os.path.dirname(os.path.abspath(target))
+    stage = None
     try:
-        os.makedirs(target, exist_ok=True)
+        stage = tempfile.mkdtemp(prefix=f".{name}.", suffix=".part", dir=parent)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(stage, 0o777 & ~umask)
         for fname in sorted(texts):
-            with open(os.path.join(target, fname), "w") as f:
+            with open(os.path.join(stage, fname), "w") as f:
                 f.write(texts[fname])
+        os.rename(stage, target)  # onto nothing, or onto an empty folder
+        stage = None
     except OSError as e:
-        sys.stderr.write(f"fsw new: cannot write {e.filename or target}: {e.strerror or e}\n")
+        inside = e.filename and stage and os.path.dirname(e.filename) == stage  # one file of the project
+        where = os.path.join(target, os.path.basename(e.filename)) if inside else target
+        sys.stderr.write(f"fsw new: cannot write {where}: {e.strerror or e}\n")
         return 1
+    finally:
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
     print(f"fsw new: {name} for the {board.name} in {target}/")
     for fname in sorted(texts):
         print(f"  {fname}")

@@ -8,6 +8,7 @@ file whole."""
 
 from __future__ import annotations
 
+import os
 import resource
 import signal
 
@@ -118,6 +119,30 @@ def test_a_small_output_that_cannot_be_written_is_named(tmp_path, command):
     assert r.code == 1 and f"cannot write {out}: File too large" in r.err, r.err
     assert not out.exists()
     _no_parts(tmp_path)
+
+
+@pytest.mark.parametrize("limit", [100, 1024])  # fails making the starter script, or writing the project
+def test_new_project_on_a_full_disk_leaves_no_half_project(tmp_path, limit):
+    # a half-written project would stand in the way of the next `fsw new` ("already exists")
+    old = resource.getrlimit(resource.RLIMIT_FSIZE)
+    old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, old[1]))
+        r = run_fsw("new", "probe", cwd=tmp_path)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old)
+        signal.signal(signal.SIGXFSZ, old_sig)
+    assert r.code == 1 and "cannot write" in r.err and "File too large" in r.err, r.err
+    assert os.listdir(tmp_path) == []
+    r = run_fsw("new", "probe", cwd=tmp_path)
+    assert r.code == 0, r.err
+    assert os.listdir(tmp_path) == ["probe"] and (tmp_path / "probe" / "probe.app").is_file()
+    (tmp_path / "empty").mkdir()  # an empty folder may still be the project's
+    r = run_fsw("new", "empty", cwd=tmp_path)
+    assert r.code == 0 and (tmp_path / "empty" / "empty.sm").is_file(), r.err
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (tmp_path / "probe").stat().st_mode & 0o777 == 0o777 & ~umask  # a folder as mkdir makes it
 
 
 def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_path):

@@ -54,6 +54,20 @@ def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict
     return files
 
 
+def _ours(path: str) -> bool:
+    """Whether a sketch's file may be written at `path`: nothing is there, or a
+    file an export wrote (its first line names fswkit, or arduino-cli for
+    sketch.yaml)."""
+    try:
+        with open(path, "rb") as f:
+            first = f.readline(400)
+    except FileNotFoundError:
+        return True
+    except OSError:
+        return not os.path.lexists(path)
+    return b"fswkit" in first or first.startswith(b"# arduino-cli:")
+
+
 def export(app: Application, folder: str) -> int:
     """`fsw gen PROJECT --sketch DIR`: writes the sketch folder; returns the exit status."""
     import sys
@@ -67,6 +81,11 @@ def export(app: Application, folder: str) -> int:
     except (SketchError, GenError) as e:
         sys.stderr.write(f"fsw gen: {e}\n")
         return 2 if isinstance(e, SketchError) else 1
+    foreign = [f for f in sorted(files) if not _ours(os.path.join(folder, f))]
+    if foreign:
+        sys.stderr.write(f"fsw gen: {os.path.join(folder, foreign[0])}: a file not written by fsw gen is there: "
+                         "it is never overwritten; export into another folder, or move it away first\n")
+        return 1
     try:
         write_files(files, folder)
     except OSError as e:

@@ -145,6 +145,22 @@ def test_new_project_on_a_full_disk_leaves_no_half_project(tmp_path, limit):
     assert (tmp_path / "probe").stat().st_mode & 0o777 == 0o777 & ~umask  # a folder as mkdir makes it
 
 
+def test_sketch_export_never_overwrites_a_file_it_did_not_write(tmp_path):
+    project = tank_copy(tmp_path)
+    sketch = tmp_path / "mine"
+    sketch.mkdir()
+    (sketch / "mine.ino").write_text("// my own sketch\nvoid setup() {}\nvoid loop() {}\n")
+    r = run_fsw("gen", str(project), "--sketch", str(sketch))
+    assert r.code == 1 and f"{sketch / 'mine.ino'}" in r.err and "not written by fsw gen" in r.err, r.err
+    assert (sketch / "mine.ino").read_text().startswith("// my own sketch")
+    assert sorted(os.listdir(sketch)) == ["mine.ino"]  # refused before anything is written
+    # a sketch it exported is exported again over itself
+    fresh = tmp_path / "fresh"
+    for _ in range(2):
+        r = run_fsw("gen", str(project), "--sketch", str(fresh))
+        assert r.code == 0, r.err
+
+
 def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_path):
     # the .sv is an input too when found beside the machine, not named by --sv
     project = tank_copy(tmp_path)

@@ -152,11 +152,12 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
         raise
     ground = Ground(port, session, log)
     refused = False
+    verified = False  # the target answered as the right one: the log may replace what was there
     view = View(session, headless, f"{layout.name} on {port_name}")
     start = time.monotonic()
     status = 0
     try:
-        with view:
+        with outputs.stopped_by_signals(), view:
             try:
                 ground.handshake(timeout=3.0 if layout.has_uplink else 12.0, on_event=view.event)
             except LinkTimeout as e:
@@ -165,6 +166,7 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
                                       "(--ignore-schema decodes without one)") from None
             if session.hello is not None and not session.hello["schema_ok"] and not ignore_schema:
                 raise GroundError(schema_message(session, project))
+            verified = True
             if log is not None:
                 log.commit()
             if layout.has_uplink:
@@ -182,8 +184,8 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
                     break
                 if max_frames is not None and session.stats.frames >= max_frames:
                     break
-    except KeyboardInterrupt:
-        status = 0
+    except KeyboardInterrupt as e:  # Ctrl-C: 0; SIGTERM, SIGHUP: 128 + the signal
+        status = 128 + e.signum if isinstance(e, outputs.Stopped) else 0
     except BrokenPipeError:  # our standard output was closed (`| head`)
         status = 0
     except GroundError:
@@ -198,8 +200,8 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
         sys.stderr.write(f"fsw monitor: {port_name}: the port went away ({e})\n")
         status = 1
     finally:
-        if log is not None:
-            log.close(keep=not refused)
+        if log is not None:  # stopped before the target answered: what was at the path stays
+            log.close(keep=not refused and (verified or not os.path.lexists(log_path)))
         try:
             port.close()
         except Exception:  # noqa: BLE001 - closing a port that went away

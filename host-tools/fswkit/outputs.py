@@ -12,9 +12,11 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import signal
 import stat
 import sys
 import tempfile
+import threading
 
 LOG_MAGIC = b"FSWLOG1\n"  # fswkit.link.log.MAGIC: the head of a recording
 
@@ -242,3 +244,34 @@ class Replacement:
 def write_text(path: str | None, text: str, inputs=(), *, what: str = "output") -> None:
     with output(path, inputs, what=what) as f:
         f.write(text)
+
+
+class Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (`kill`, a closed terminal, a cancelled job) while a
+    command writes: it ends as by Ctrl-C, its outputs left consistent."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@contextlib.contextmanager
+def stopped_by_signals():
+    """SIGTERM and SIGHUP raise Stopped in the block instead of ending the
+    process on the spot (a SIGHUP ignored under nohup stays ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, _frame):
+        raise Stopped(signum)
+
+    saved = {}
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        if signal.getsignal(sig) not in (signal.SIG_IGN, None):  # None: a handler not set from Python
+            saved[sig] = signal.signal(sig, stop)
+    try:
+        yield
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)

@@ -173,6 +173,37 @@ def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_pat
             assert sv.read_bytes() == before
 
 
+@pytest.mark.parametrize("stop", ["ctrl-c", "SIGTERM", "SIGHUP"])
+def test_monitor_stopped_before_the_target_answered_keeps_the_old_recording(tmp_path, monkeypatch, stop):
+    # --force replaces the old recording only once the target is known to be the right one:
+    # stopping the monitor while it still waits for the hello keeps it, and leaves no temporary file
+    import pty
+
+    from fswkit.link.client import Ground
+
+    old = tmp_path / "old.log"
+    before = _log(old)
+
+    def handshake(self, *a, **kw):
+        if stop == "ctrl-c":
+            raise KeyboardInterrupt
+        sig = getattr(signal, stop)
+        assert signal.getsignal(sig) not in (signal.SIG_DFL, signal.SIG_IGN, None), "the signal would kill it"
+        signal.raise_signal(sig)
+        raise AssertionError("the signal did not stop the monitor")
+
+    monkeypatch.setattr(Ground, "handshake", handshake)
+    master, slave = pty.openpty()
+    try:
+        r = run_fsw("monitor", str(TANK), "--port", os.ttyname(slave), "--headless", "--log", str(old), "--force")
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert r.code == (0 if stop == "ctrl-c" else 128 + getattr(signal, stop)), r.err
+    assert old.read_bytes() == before
+    _no_parts(tmp_path)
+
+
 def test_monitor_log_onto_its_configs_or_port_is_refused_even_with_force(tmp_path):
     # --force replaces an old recording, never one of the project's configs nor the port read
     project = tank_copy(tmp_path)

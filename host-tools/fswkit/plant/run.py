@@ -13,14 +13,13 @@ import contextlib
 import hashlib
 import os
 import shutil
-import signal
 import sys
 import tempfile
-import threading
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.link.log import LogError
+from fswkit.outputs import Stopped, stopped_by_signals
 
 from . import report as reports
 from .cosim import CosimError, Run, fly
@@ -112,37 +111,6 @@ class Interrupted(Exception):
     """A run stopped before its end (its partial files are kept apart)."""
 
 
-class Stopped(KeyboardInterrupt):
-    """SIGTERM or SIGHUP during a run (`kill`, a closed terminal, a cancelled
-    job): the run ends as by Ctrl-C, its files set aside."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
-@contextlib.contextmanager
-def _stopped_by_signals():
-    """SIGTERM and SIGHUP raise Stopped in the run instead of ending the
-    process on the spot (a SIGHUP ignored under nohup stays ignored)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def stop(signum, _frame):
-        raise Stopped(signum)
-
-    saved = {}
-    for sig in (signal.SIGTERM, signal.SIGHUP):
-        if signal.getsignal(sig) not in (signal.SIG_IGN, None):  # None: a handler not set from Python
-            saved[sig] = signal.signal(sig, stop)
-    try:
-        yield
-    finally:
-        for sig, handler in saved.items():
-            signal.signal(sig, handler)
-
-
 def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False) -> Flight:
     """Flies the scenario; writes the files into `out` (None: none). CosimError
     if the run could not go on.
@@ -158,7 +126,7 @@ def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False
         return _execute(sc, elf, board, layout, None)
     os.makedirs(out, exist_ok=True)
     stage = tempfile.mkdtemp(prefix=".run-", dir=out)
-    with _stopped_by_signals():
+    with stopped_by_signals():
         try:
             flight = _execute(sc, elf, board, layout, stage)
         except BaseException as e:

@@ -731,6 +731,7 @@ def _empty_option(p: argparse.ArgumentParser, args) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from fswkit import outputs
     from fswkit.outputs import Stream
 
     p = parser()
@@ -743,8 +744,16 @@ def main(argv: list[str] | None = None) -> int:
     # every print of every command: a failed write says it was standard output
     saved = sys.stdout
     out = sys.stdout = Stream(saved, "standard output")
+    outputs.stopped_by = None
     try:
-        return _main(args, out)
+        # SIGTERM and SIGHUP stop a command as Ctrl-C does (its temporary files removed,
+        # its outputs whole or as they were), with status 128 + the signal's number
+        try:
+            with outputs.stopped_by_signals():
+                code = _main(args, out)
+        except outputs.Stopped:  # the signal came as the command returned
+            code = EXIT_FAIL
+        return 128 + outputs.stopped_by if outputs.stopped_by else code
     finally:
         if sys.stdout is out:
             sys.stdout = saved

@@ -246,6 +246,9 @@ def write_text(path: str | None, text: str, inputs=(), *, what: str = "output") 
         f.write(text)
 
 
+stopped_by: int | None = None  # the signal a block of `stopped_by_signals` was stopped by, if any
+
+
 class Stopped(KeyboardInterrupt):
     """SIGTERM or SIGHUP (`kill`, a closed terminal, a cancelled job) while a
     command writes: it ends as by Ctrl-C, its outputs left consistent."""
@@ -264,6 +267,8 @@ def stopped_by_signals():
         return
 
     def stop(signum, _frame):
+        global stopped_by
+        stopped_by = signum
         raise Stopped(signum)
 
     saved = {}

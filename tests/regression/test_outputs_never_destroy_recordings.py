@@ -161,6 +161,32 @@ def test_sketch_export_never_overwrites_a_file_it_did_not_write(tmp_path):
         assert r.code == 0, r.err
 
 
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
+def test_an_output_stopped_by_a_signal_leaves_the_old_file(tmp_path, monkeypatch, signame):
+    # `kill` mid-export: as Ctrl-C, the old file stays and no temporary file is left beside it
+    import fswkit.monitor
+
+    sig = getattr(signal, signame)
+    log = tmp_path / "x.log"
+    _log(log)
+    csv = tmp_path / "x.csv"
+    csv.write_text("the previous export\n")
+
+    def log2csv(path, f, ignore_schema):
+        f.write("seq,sample\n1,0\n")
+        assert signal.getsignal(sig) not in (signal.SIG_DFL, signal.SIG_IGN, None), "the signal would kill it"
+        signal.raise_signal(sig)
+        raise AssertionError("the signal did not stop the export")
+
+    monkeypatch.setattr(fswkit.monitor, "log2csv", log2csv)
+    before = signal.getsignal(sig)
+    r = run_fsw("log2csv", str(log), "-o", str(csv))
+    assert r.code == 128 + sig, r.err
+    assert signal.getsignal(sig) == before
+    assert csv.read_text() == "the previous export\n"
+    _no_parts(tmp_path)
+
+
 def test_graph_and_skeleton_onto_the_state_vector_they_found_are_refused(tmp_path):
     # the .sv is an input too when found beside the machine, not named by --sv
     project = tank_copy(tmp_path)

@@ -550,6 +550,20 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _int_upto(hi: int, what: str):
+    """An argparse type: a positive whole number of at most `hi` (what its use can hold)."""
+    def parse(text: str) -> int:
+        value = _positive_int(text)
+        if value > hi:
+            raise argparse.ArgumentTypeError(f"expected {what} of at most {hi:,}, found {text}")
+        return value
+    return parse
+
+
+_baud = _int_upto(10_000_000, "a serial speed")  # what a UART or a USB serial adapter makes
+_delta_t = _int_upto(2**64 - 1, "a time step")  # the script's U64 `delta_t`
+
+
 def _nonneg_int(text: str) -> int:
     try:
         value = int(text)
@@ -651,7 +665,7 @@ def parser() -> argparse.ArgumentParser:
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
     s.add_argument("machine", metavar="MACHINE.sm")
     s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
-    s.add_argument("--delta-t", type=_positive_int, default=10, help="time step of the script (default 10)")
+    s.add_argument("--delta-t", type=_delta_t, default=10, help="time step of the script (default 10)")
     s.add_argument("-o", "--output", help="write here instead of standard output")
     s.set_defaults(func=cmd_skeleton)
 
@@ -659,7 +673,7 @@ def parser() -> argparse.ArgumentParser:
     m.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (folder or .app)")
     m.add_argument("--port", help="serial device (/dev/ttyACM0, a pty) or pyserial URL "
                    "(default: the only serial port connected)")
-    m.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
+    m.add_argument("--baud", type=_baud, default=115200, help="link speed (default 115200)")
     m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE (a new file)")
     m.add_argument("--force", action="store_true", help="let --log replace an existing FILE")
     m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")
@@ -674,7 +688,7 @@ def parser() -> argparse.ArgumentParser:
     cm.add_argument("args", nargs="*", metavar="ARG")
     cm.add_argument("--port", required=True, help="serial device or pyserial URL")
     cm.add_argument("-p", "--project", default=".", help="the project the firmware was built from (default .)")
-    cm.add_argument("--baud", type=_positive_int, default=115200, help="link speed (default 115200)")
+    cm.add_argument("--baud", type=_baud, default=115200, help="link speed (default 115200)")
     cm.add_argument("--ignore-schema", action="store_true", help="send even when the schema hash differs")
     # `set x -3.4028235e38`, `-inf`, `-0x7f`: a value, not an unknown option (argparse
     # takes only `-5` and `-.5` for numbers); no option of `cmd` starts with a digit, `.`, inf or nan

@@ -33,3 +33,21 @@ def test_refused(log, speed):
 def test_accepted(log, speed):
     r = run_fsw("replay", log, "--headless", "--speed", speed)
     assert r.code == 0 and "60 frames" in r.err, r.err
+
+
+# other numbers of the command line, held to what their use can take: refused by the parser
+# (status 2, the option named), never an OverflowError from the serial port or the skeleton
+@pytest.mark.parametrize("argv", [
+    ("skeleton", str(TANK / "tank.sm"), "--delta-t", str(2**64)),
+    ("monitor", str(TANK), "--port", "/dev/no-such-port", "--baud", "99999999999999999999"),
+    ("cmd", "ping", "-p", str(TANK), "--port", "/dev/no-such-port", "--baud", "99999999999999999999"),
+    ("monitor", str(TANK), "--port", "/dev/no-such-port", "--baud", "10000001"),
+], ids=["delta-t", "monitor-baud", "cmd-baud", "baud-above-10M"])
+def test_numbers_beyond_their_use_are_refused(argv):
+    r = run_fsw(*argv)
+    assert r.code == 2 and argv[-2] in r.err and "internal error" not in r.err, r.err
+
+
+def test_largest_delta_t_is_accepted():
+    r = run_fsw("skeleton", str(TANK / "tank.sm"), "--delta-t", str(2**64 - 1))
+    assert r.code == 0 and f"delta_t {2**64 - 1}" in r.out, r.err

@@ -174,9 +174,12 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     if "rate" in settings:
         q = _positive(settings["rate"], src, diags, "`rate`")
         if q is not None:
-            if q.denominator != 1 or q > 100000 or 1000000 % q != 0:
+            if q.denominator != 1 or 1000000 % q != 0:
                 err(settings["rate"], "`rate` must be a whole number of cycles per second that divides "
                                       "1000000 (a whole number of microseconds per cycle)")
+            elif q > 100000:
+                err(settings["rate"], f"`rate` is at most 100000 cycles per second (10 us a cycle), "
+                                      f"found {settings['rate'].text}")
             else:
                 rate = int(q)
     baud = 115200
@@ -441,9 +444,13 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     if "reset_cause" in settings:
         owners.setdefault(settings["reset_cause"].text, "the reset cause")
     inputs = {c.element.name: f"input channel {c.path}:{c.line}" for c in channels if c.direction == "i"}
-    for toks in body.get("uplink", []):
+    uplink_task = next((t for t in tasks if t.kind == "uplink"), None)
+    for n, toks in enumerate(body.get("uplink", [])):
         et = toks[0]
         e = sv.find(et.text)
+        if uplink_task is None and n == 0:  # once: the list is what is idle, not each line
+            diags.warning(src, APP, et.line, et.col, "writable elements without an `uplink` task in [tasks]: "
+                                                     "nothing receives commands, so none is ever written")
         if e is None:
             err(et, f"unknown element `{et.text}`")
         elif et.text in owners:

@@ -429,8 +429,9 @@ def cmd_new(args) -> int:
 # ---- the serial link: fsw monitor / cmd / log2csv / replay / plot ----------------------
 
 def _link_layout(project: str, command: str, configs: list | None = None):
-    """The link layout of a project's configs, or None after a message;
-    the configs' paths are added to `configs`."""
+    """The link layout of a project's configs and the baud rate its firmware
+    runs the link at (the application's `baud`, or the default it gets), or
+    None after a message; the configs' paths are added to `configs`."""
     from fswkit.build import BuildError, load
     from fswkit.link.layout import from_app
 
@@ -445,7 +446,18 @@ def _link_layout(project: str, command: str, configs: list | None = None):
         return None
     if configs is not None:
         configs += [app.path, app.sv.path] + [m.path for m in app.machines] + [c.path for c in app.channels]
-    return from_app(app)
+    return from_app(app), app.baud
+
+
+def _link_baud(asked: int | None, app_baud: int, command: str) -> int:
+    """The rate to open a project's port at: the application's, unless
+    `--baud` asks for another (honoured, with a warning)."""
+    if asked is None:
+        return app_baud
+    if asked != app_baud:
+        sys.stderr.write(f"fsw {command}: warning: --baud {asked}: the application runs its link at "
+                         f"{app_baud} baud\n")
+    return asked
 
 
 def _ground(command: str, fn, *a) -> int:
@@ -468,9 +480,10 @@ def cmd_monitor(args) -> int:
     from fswkit.outputs import OutputError, check
 
     configs: list[str] = []
-    layout = _link_layout(args.project, "monitor", configs)
-    if layout is None:
+    link = _link_layout(args.project, "monitor", configs)
+    if link is None:
         return EXIT_CONFIG
+    layout, app_baud = link
     port = _port_or_only(args.port, "monitor")
     if port is None:
         return EXIT_FAIL
@@ -480,17 +493,20 @@ def cmd_monitor(args) -> int:
         except OutputError as e:
             sys.stderr.write(f"fsw monitor: {e}\n")
             return EXIT_FAIL
-    return _ground("monitor", monitor, layout, args.project, port, args.baud, args.log, args.headless,
+    baud = _link_baud(args.baud, app_baud, "monitor")
+    return _ground("monitor", monitor, layout, args.project, port, baud, args.log, args.headless,
                    args.ignore_schema, args.duration, args.frames, args.force)
 
 
 def cmd_cmd(args) -> int:
     from fswkit.monitor import command
 
-    layout = _link_layout(args.project, "cmd")
-    if layout is None:
+    link = _link_layout(args.project, "cmd")
+    if link is None:
         return EXIT_CONFIG
-    return _ground("cmd", command, layout, args.project, args.port, args.baud, args.what, args.args,
+    layout, app_baud = link
+    baud = _link_baud(args.baud, app_baud, "cmd")
+    return _ground("cmd", command, layout, args.project, args.port, baud, args.what, args.args,
                    args.ignore_schema)
 
 
@@ -673,7 +689,7 @@ def parser() -> argparse.ArgumentParser:
     m.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (folder or .app)")
     m.add_argument("--port", help="serial device (/dev/ttyACM0, a pty) or pyserial URL "
                    "(default: the only serial port connected)")
-    m.add_argument("--baud", type=_baud, default=115200, help="link speed (default 115200)")
+    m.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
     m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE (a new file)")
     m.add_argument("--force", action="store_true", help="let --log replace an existing FILE")
     m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")
@@ -688,7 +704,7 @@ def parser() -> argparse.ArgumentParser:
     cm.add_argument("args", nargs="*", metavar="ARG")
     cm.add_argument("--port", required=True, help="serial device or pyserial URL")
     cm.add_argument("-p", "--project", default=".", help="the project the firmware was built from (default .)")
-    cm.add_argument("--baud", type=_baud, default=115200, help="link speed (default 115200)")
+    cm.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
     cm.add_argument("--ignore-schema", action="store_true", help="send even when the schema hash differs")
     # `set x -3.4028235e38`, `-inf`, `-0x7f`: a value, not an unknown option (argparse
     # takes only `-5` and `-.5` for numbers); no option of `cmd` starts with a digit, `.`, inf or nan

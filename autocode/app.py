@@ -25,6 +25,7 @@ telemetry streams and the elements the ground may write.
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -40,6 +41,7 @@ from .numeric import MODES as REALS, exact_literal
 from .parser import parse_sm, parse_sv, show, split_sections
 from .types import U8
 
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a name, as the lexer reads one
 TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink")
 MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
 
@@ -243,6 +245,11 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             continue
         if board is not None:  # an error, and the machine still known to the rest of the file
             check_literals(machine_exprs(m), REALS[board.real], msrc, diags, SM, f"the {board.name}'s")
+        if not _NAME.fullmatch(m.name):
+            err(tok, f"the machine in `{os.path.basename(mpath)}` is named `{m.name}` after its file, and "
+                     "[tasks] can only name a machine whose name is letters, digits and `_`, not starting "
+                     "with a digit: rename the file")
+            continue
         if m.name in machine_names:
             err(tok, f"two machines are named `{m.name}`")
             continue

@@ -106,13 +106,26 @@ def test_machine_names_are_mangled_by_the_documented_scheme():
         assert machine_ident(stem) == "sm_" + "".join(c if c.isalnum() or c == "_" else "_" for c in stem)
 
 
-@pytest.mark.parametrize("first, second", [("Tank", "TANK"), ("sm_int", "int"), ("sm_a_b", "a-b")])
+@pytest.mark.parametrize("first, second", [("Tank", "TANK"), ("sm_int", "int")])
 def test_machines_with_one_cpp_name_are_refused(tmp_path, first, second):
     path = _project(tmp_path, [first, second])
     app, errors = _load(path, "uno")
     assert app is None
     assert "rig.app:7:9:" in errors, errors
     assert f"machines `{first}` and `{second}` would generate the same C++ files" in errors
+
+
+@pytest.mark.parametrize("stem", ["a-b", "a.b", "a+b", "t ank"])
+def test_a_machine_file_whose_name_tasks_cannot_name_is_refused_where_it_is_listed(tmp_path, stem):
+    # A machine is named after its file, and [tasks] names it: a stem that
+    # is not a name was refused only later, at the task, as an unknown
+    # machine `a` (from `a-b`), or reached the generator when no task named it.
+    path = _project(tmp_path, [stem])
+    app, errors = _load(path, "uno")
+    assert app is None
+    assert "rig.app:6:9:" in errors, errors
+    assert (f"the machine in `{stem}.sm` is named `{stem}` after its file, and [tasks] can only name a machine "
+            "whose name is letters, digits and `_`") in errors, errors
 
 
 def test_tank_beside_Tank_builds(tmp_path):

@@ -116,7 +116,7 @@ class WireStats:
     framing_errors: int = 0  # not a COBS block chain, or shorter than a header + CRC
     leading: int = 0  # bytes before the first delimiter that were not a frame (joined mid-frame)
     invalid: int = 0  # verified, but of a type or length the schema does not allow
-    oversized: int = 0  # runs of bytes without a delimiter longer than any frame: dropped unread
+    oversized: int = 0  # runs of bytes without a delimiter longer than any frame: dropped unread, once each
 
 
 def encoded_size(body: int) -> int:
@@ -131,8 +131,10 @@ class Deframer:
     payload). A corrupted frame costs only itself: decoding resumes at the
     next delimiter. The bytes held between two delimiters are bounded by
     `max_frame` (the longest encoded frame): a longer run is no frame, and
-    is dropped up to the next delimiter and counted (`oversized`), so the
-    work stays proportional to the bytes fed, whatever they are."""
+    is dropped up to the next delimiter and counted (`oversized`) once,
+    wherever it is (the first bytes seen too), so the work stays
+    proportional to the bytes fed, whatever they are. Every count depends
+    on the bytes alone, not on how they were split into calls."""
 
     def __init__(self, accept=None, max_frame: int = 1 << 16):
         self.stats = WireStats()
@@ -161,19 +163,22 @@ class Deframer:
         first = not self._synced
         self._synced = True
         self._bound()
+        mx = self._max
         if end >= BULK:
-            encs, bodies = _bulk_decode(buf, end)
+            encs, bodies = _bulk_decode(buf, end, mx)
         else:
             encs = buf[:end].split(b"\0")
-            bodies = [cobs_decode(e) if e else b"" for e in encs]
+            if end > mx:  # a run longer than any frame may lie between two delimiters: not decoded
+                bodies = [None if len(e) > mx else cobs_decode(e) if e else b"" for e in encs]
+            else:
+                bodies = [cobs_decode(e) if e else b"" for e in encs]
         return self._verify(encs, bodies, first)
 
     def _bound(self) -> None:
+        # a run too long for a frame, even as the first bytes seen (joined
+        # in the middle of text or noise): counted once, dropped to its end
         if len(self._tail) > self._max:
-            if self._synced:
-                self.stats.oversized += 1
-            else:  # joined in the middle of something: as a partial first frame
-                self.stats.leading += 1
+            self.stats.oversized += 1
             self._tail = b""
             self._skipping = True
 
@@ -188,7 +193,9 @@ class Deframer:
                 first = False
                 continue
             if body is None or len(body) < HEADER + 2 or crc_hqx(body, CRC_INIT) != 0:
-                if first:  # the stream may begin mid-frame: not an error
+                if body is None and len(enc) > self._max:  # as _bound counts it when read in pieces
+                    st.oversized += 1
+                elif first:  # the stream may begin mid-frame: not an error
                     st.leading += 1
                 elif body is None or len(body) < HEADER + 2:
                     st.framing_errors += 1
@@ -208,11 +215,11 @@ class Deframer:
 BULK = 8192  # bytes from which a feed decodes its frames with numpy
 
 
-def _bulk_decode(buf: bytes, end: int):
+def _bulk_decode(buf: bytes, end: int, limit: int):
     """The frames of buf[:end] (end: a delimiter) and their COBS decodings,
     all frames at once: the block chains are walked in parallel, one numpy
     step per block; frames with a full 254-byte block, or longer chains,
-    take the plain path."""
+    take the plain path; runs longer than `limit` are not decoded (None)."""
     import numpy as np
 
     arr = np.frombuffer(buf, dtype=np.uint8, count=end + 1)
@@ -252,6 +259,8 @@ def _bulk_decode(buf: bytes, end: int):
         encs.append(enc)
         if a == b:
             bodies.append(b"")
+        elif b - a > limit:
+            bodies.append(None)
         elif slow_l[i]:
             bodies.append(cobs_decode(enc))
         elif bad_l[i]:

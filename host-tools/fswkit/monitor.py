@@ -163,7 +163,7 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
             except LinkTimeout as e:
                 if not ignore_schema:
                     raise GroundError(f"{e}: is the firmware running on {port_name}, at {baud} baud? "
-                                      "(--ignore-schema decodes without one)") from None
+                                      "(--ignore-schema decodes without one)\n  " + summary(session)) from None
             if session.hello is not None and not session.hello["schema_ok"] and not ignore_schema:
                 raise GroundError(schema_message(session, project))
             verified = True
@@ -415,7 +415,8 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
             ground.handshake(timeout=3.0)
         except LinkTimeout as e:
             if not ignore_schema:
-                raise GroundError(f"{e}: is the firmware running on {port_name}, at {baud} baud?") from None
+                raise GroundError(f"{e}: is the firmware running on {port_name}, at {baud} baud?\n  "
+                                  + summary(session)) from None
         if session.hello is not None and not session.hello["schema_ok"] and not ignore_schema:
             raise GroundError(schema_message(session, project))
         sent = time.monotonic()

@@ -93,3 +93,64 @@ def test_pure_text_shows_in_the_summary(layout):
     assert s.stats.frames == 0
     assert s.deframer.stats.oversized >= 1
     assert f"{s.deframer.stats.oversized} oversized" in summary(s)
+
+
+class TextPty:
+    """A board on a pseudo-terminal printing text, no frame at all."""
+
+    def __init__(self):
+        import os
+        import pty
+        import threading
+        import tty
+
+        self.master, self.slave = pty.openpty()
+        tty.setraw(self.master)
+        tty.setraw(self.slave)
+        self.port = os.ttyname(self.slave)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        import os
+        import select
+
+        text = _text(4096)
+        while not self._stop.is_set():
+            r, w, _ = select.select([self.master], [self.master], [], 0.05)
+            try:
+                if r:
+                    os.read(self.master, 4096)  # what the ground sends is dropped
+                if w:
+                    os.write(self.master, text)
+            except OSError:
+                return
+            self._stop.wait(0.005)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        import os
+
+        self._stop.set()
+        self._thread.join(timeout=5)
+        os.close(self.master)
+        os.close(self.slave)
+
+
+@pytest.mark.parametrize("command", ["monitor", "cmd"])
+def test_no_hello_from_a_port_of_text_says_what_was_read(monkeypatch, command):
+    from conftest import run_fsw
+
+    from fswkit.link.client import Ground
+
+    handshake = Ground.handshake
+    monkeypatch.setattr(Ground, "handshake", lambda self, timeout=3.0, on_event=None:
+                        handshake(self, timeout=0.3, on_event=on_event))
+    with TextPty() as board:
+        argv = (["monitor", str(TANK), "--headless"] if command == "monitor" else ["cmd", "ping", "-p", str(TANK)])
+        r = run_fsw(*argv, "--port", board.port)
+    assert r.code == 1 and "no hello from the target" in r.err, r.err
+    assert "0 frames" in r.err and " 0 oversized" not in r.err and "oversized" in r.err, r.err

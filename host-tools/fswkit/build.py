@@ -334,7 +334,6 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
     a = basename(app.path)
     sv = basename(app.sv.path)
     machines = {c_ident(m.name): m for m in app.machines}
-    task_of = {t.machine: t for t in app.tasks if t.kind == "machine"}
     tele = next((t for t in app.tasks if t.kind == "telemetry"), None)
     uses: dict[tuple[str, str], Use] = {}
 

@@ -76,6 +76,19 @@ def stream(layout, first: int, count: int, skip=(), hello_first: bool = False) -
     return out
 
 
+def write_log(path, count: int, first: int = 0, step_ns: int = 10_000_000, project: Path = TANK) -> Path:
+    """A link log at `path` of `count` frames of `project`'s clean link
+    (see `stream`, a hello first), received `step_ns` apart."""
+    from fswkit.link.log import RX, LogWriter
+
+    layout = layout_of(project)
+    w = LogWriter(str(path), layout)
+    for i, f in enumerate(stream(layout, first, count, hello_first=True)):
+        w.record(RX, 1_000_000_000 + i * step_ns, f)
+    w.close()
+    return Path(path)
+
+
 class PtyStream:
     """A target on a pseudo-terminal that streams `frames` over and over
     (renumbered past the last) until stopped: the port a monitor opens."""

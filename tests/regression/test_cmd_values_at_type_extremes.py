@@ -43,7 +43,7 @@ def test_float_extremes(t, accepted, refused):
         got = struct.unpack(fmt, encode_value(_el(t), text))[0]
         assert got == float(text) or got == struct.unpack(fmt, struct.pack(fmt, float(text)))[0], text
     for text in refused:
-        with pytest.raises(LayoutError, match=f"out of its range"):
+        with pytest.raises(LayoutError, match="out of its range"):
             encode_value(_el(t), text)
 
 

@@ -11,9 +11,7 @@ import io
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, PtyStream, layout_of, stream, tank_copy
-
-from fswkit.link.log import RX, LogWriter
+from linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
 
 FULL = "/dev/full"
 
@@ -43,13 +41,7 @@ def clean_failure(code, err):
 
 @pytest.fixture(scope="module")
 def log(tmp_path_factory):
-    path = tmp_path_factory.mktemp("full") / "clean.log"
-    layout = layout_of(TANK)
-    w = LogWriter(str(path), layout)
-    for i, f in enumerate(stream(layout, 0, 3000, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
-    w.close()
-    return str(path)
+    return str(write_log(tmp_path_factory.mktemp("full") / "clean.log", 3000))
 
 
 def _commands(log):

@@ -10,19 +10,14 @@ import struct
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, layout_of, stream
+from linkstream import write_log
 
-from fswkit.link.log import MAGIC, RX, LogWriter
+from fswkit.link.log import MAGIC
 
 
 @pytest.fixture(scope="module")
 def good(tmp_path_factory):
-    path = tmp_path_factory.mktemp("header") / "good.log"
-    layout = layout_of(TANK)
-    w = LogWriter(str(path), layout)
-    for i, f in enumerate(stream(layout, 0, 100, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
-    w.close()
+    path = write_log(tmp_path_factory.mktemp("header") / "good.log", 100)
     data = path.read_bytes()
     (n,) = struct.unpack_from("<I", data, len(MAGIC))
     start = len(MAGIC) + 4

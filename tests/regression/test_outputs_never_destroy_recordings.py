@@ -14,18 +14,11 @@ import signal
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, PtyStream, layout_of, stream, tank_copy
-
-from fswkit.link.log import RX, LogWriter
+from linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
 
 
 def _log(path, first=0, n=400):
-    layout = layout_of(TANK)
-    w = LogWriter(str(path), layout)
-    for i, f in enumerate(stream(layout, first, n, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
-    w.close()
-    return path.read_bytes()
+    return write_log(path, n, first).read_bytes()
 
 
 def _no_parts(folder):

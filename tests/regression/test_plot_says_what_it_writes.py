@@ -7,20 +7,12 @@ from __future__ import annotations
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, layout_of, stream
-
-from fswkit.link.log import RX, LogWriter
+from linkstream import write_log
 
 
 @pytest.fixture(scope="module")
 def log(tmp_path_factory):
-    path = tmp_path_factory.mktemp("plot") / "flight.log"
-    layout = layout_of(TANK)
-    w = LogWriter(str(path), layout)
-    for i, f in enumerate(stream(layout, 0, 300, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 10_000_000, f)
-    w.close()
-    return path
+    return write_log(tmp_path_factory.mktemp("plot") / "flight.log", 300)
 
 
 @pytest.mark.parametrize("name", ["out.txt", "noext", "out.", "out.png.bak"])

@@ -7,20 +7,13 @@ from __future__ import annotations
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, layout_of, stream
-
-from fswkit.link.log import RX, LogWriter
+from linkstream import TANK, write_log
 
 
 @pytest.fixture(scope="module")
 def log(tmp_path_factory):
-    path = tmp_path_factory.mktemp("replay") / "flight.log"
-    layout = layout_of(TANK)
-    w = LogWriter(str(path), layout)
-    for i, f in enumerate(stream(layout, 0, 60, hello_first=True)):
-        w.record(RX, 1_000_000_000 + i * 1_000, f)  # 1 µs apart: 0.06 s at the slowest speed
-    w.close()
-    return str(path)
+    # 1 µs apart: 0.06 s at the slowest speed
+    return str(write_log(tmp_path_factory.mktemp("replay") / "flight.log", 60, step_ns=1_000))
 
 
 @pytest.mark.parametrize("speed", ["1e-300", "0.0009", "-1", "inf", "nan", "1e7", "fast"])

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 
-import pytest
 
 import cxx
 from fswkit.autocode.app import load_app

@@ -44,7 +44,8 @@ test-python: setup
 ## fuzz: the front end's mutation fuzzer (1,000,000 cases on both cores,
 ## about an hour; crashing inputs land in build/fuzz/), the uplink parser, the
 ## differential tests, and 20,000 random applications that the checker must
-## refuse or that must compile for their board and natively (FSW_GEN_CASES)
+## refuse or that must compile for their board and natively (FSW_GEN_CASES),
+## and the front end's property tests at ten times their `make test` count
 fuzz: setup fuzz-uplink
 	$(PY) tools/fuzz_frontend.py --cases $${FSW_FUZZ_EXAMPLES:-1000000} --out $(BUILD)/fuzz/frontend
 	FSW_DIFF_SEED=$${FSW_DIFF_SEED:-2} FSW_DIFF_CASES=$${FSW_DIFF_CASES:-20000} \
@@ -52,6 +53,7 @@ fuzz: setup fuzz-uplink
 	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py
 	FSW_GEN_CASES=$${FSW_GEN_CASES:-20000} $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/regression/test_accepted_configs_build.py
+	FSW_PROPERTY_SCALE=$${FSW_PROPERTY_SCALE:-5} $(PY) -m pytest -q -p no:cacheprovider tests/frontend/test_properties.py
 
 ## fuzz-uplink: the firmware's uplink parser under libFuzzer with ASan + UBSan
 ## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run),

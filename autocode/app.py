@@ -404,10 +404,23 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
             tok = next(t for k, t, p in machine_toks if os.path.splitext(os.path.basename(p))[0] == name_)
             err(tok, f"machine `{name_}` runs in no task: add `NAME machine {name_}` to [tasks]")
     per_second = 1000 if time_unit == "ms" else 1000000
+    # With `source clock`, G is the board's millis()/micros(), which advance
+    # in ticks of the timer that keeps them: on an AVR Arduino core millis()
+    # moves on every 16,384 CPU cycles (1.024 ms at 16 MHz, by 2 at 8 MHz),
+    # so a machine stepping faster than that sometimes sees G stand still,
+    # and a machine whose time does not increase is safed.
+    tick_us = (Fraction(16384 * 1000000, board.f_cpu) if board is not None and board.f_cpu and
+               time_source == "clock" and time_unit == "ms" else None)
     for t in tasks:
         if t.kind == "machine" and t.rate > per_second:
             diags.error(src, APP, t.line, 1, f"task `{t.name}` runs at {t.rate} Hz but `G` counts in {time_unit}: "
                                              "`G` would not increase between its steps (use `unit us`)")
+        elif t.kind == "machine" and tick_us is not None and Fraction(1000000) / t.rate < tick_us:
+            diags.error(src, APP, t.line, 1,
+                        f"task `{t.name}` steps every {float(Fraction(1000000) / t.rate):g} us, but with `source clock` "
+                        f"and `unit ms` the {board.name}'s millis() moves on only every {float(tick_us):g} us: `G` "
+                        f"would sometimes not increase between its steps (use `unit us`, `source cycle`, or a "
+                        f"rate of at most {int(Fraction(1000000) / tick_us)} Hz)")
 
     # [telemetry]
     streams: list[Stream] = []

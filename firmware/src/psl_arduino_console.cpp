@@ -76,11 +76,13 @@ namespace fsw {
 namespace pal {
 
 // 8N1 with double speed, the divisor rounded as the Arduino core does
-// (115200 baud at 16 MHz: UBRR 16, 117,647 baud, +2.1 %).
+// (115200 baud at 16 MHz: UBRR 16, 117,647 baud, +2.1 %). Double speed is
+// set before the divisor: silicon takes either order, but simavr fixes the
+// bit rate when UBRR0 is written, and would run the line at half speed.
 void console_begin(uint32_t baud) {
     const uint16_t ubrr = static_cast<uint16_t>((F_CPU / 4u / baud - 1u) / 2u);
-    UBRR0 = ubrr;
     UCSR0A = _BV(U2X0);
+    UBRR0 = ubrr;
     UCSR0C = static_cast<uint8_t>(_BV(UCSZ01) | _BV(UCSZ00));
     UCSR0B = static_cast<uint8_t>(_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0));
 }

@@ -83,7 +83,9 @@ def avr_cycles() -> tuple[int, int]:
         os.path.join(BENCH, "tank_driver.cpp"), os.path.join(gen, "sv.gen.cpp"), os.path.join(gen, "tank.gen.cpp")]
        + libs + ["-fuse-linker-plugin", "-Wl,--gc-sections", "-o", elf])
     if not os.path.exists(SIMRUN):
-        sh(["make", "--no-print-directory", "-f", os.path.join(ROOT, "mk", "firmware.mk"), SIMRUN], cwd=ROOT)
+        # firmware.mk names its targets relative to the root
+        sh(["make", "--no-print-directory", "-f", os.path.join(ROOT, "mk", "firmware.mk"),
+            os.path.relpath(SIMRUN, ROOT)], cwd=ROOT)
     r = subprocess.run([SIMRUN, "-m", "atmega2560", "-t", "10", "-w", "60", elf], capture_output=True, text=True)
     m = re.search(r"cycles (\d+) worst (\d+) overhead (\d+) state (\d+)", r.stdout + r.stderr)
     if not m:

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import re
 
-# C++11 keywords and alternative tokens.
+# C++11 keywords and alternative tokens, and `typeof`, a keyword of the
+# GNU dialect (-std=gnu++11) the firmware and the native builds use.
 CXX_KEYWORDS = frozenset("""
 alignas alignof and and_eq asm auto bitand bitor bool break case catch char char16_t char32_t
 class compl const constexpr const_cast continue decltype default delete do double dynamic_cast
@@ -29,7 +30,7 @@ else enum explicit export extern false float for friend goto if inline int long 
 new noexcept not not_eq nullptr operator or or_eq private protected public register
 reinterpret_cast return short signed sizeof static static_assert static_cast struct switch
 template this thread_local throw true try typedef typeid typename union unsigned using virtual
-void volatile wchar_t while xor xor_eq
+void volatile wchar_t while xor xor_eq typeof
 """.split())
 
 # Names the generated code and the runtime use in or around namespace

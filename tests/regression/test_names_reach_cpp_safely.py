@@ -30,7 +30,7 @@ from fswkit.autocode.emit_cpp import script_files
 # Machine file stems: keywords, the generated code's and the runtime's own
 # names, C library names, platform macros, mixed case, the mangled form of
 # another name's neighbour.
-STEMS = ["int", "class", "and_eq", "sv", "app", "fsw", "fsw_gen", "std", "begin", "poll", "link", "ex",
+STEMS = ["int", "class", "and_eq", "typeof", "sv", "app", "fsw", "fsw_gen", "std", "begin", "poll", "link", "ex",
          "stats", "main", "setup", "loop", "run_cycle", "memcpy", "uint8_t", "time", "stdin", "sinf", "linux",
          "PORTB", "F_CPU", "HIGH", "PRIu8", "Tank", "tank", "task_x", "w0", "s1_step", "con", "_x", "a__b"]
 # Locals and states whose prefixed C++ names are macros of system headers.

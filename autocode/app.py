@@ -35,7 +35,7 @@ from .check import check_literals, check_sm, check_sv, machine_exprs
 from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
-from .limits import U8_COUNT, check_limits
+from .limits import U8_COUNT, check_limits, hz
 from .lexer import ID, NUM, OP, lex
 from .numeric import MODES as REALS, exact_literal
 from .parser import parse_sm, parse_sv, show, split_sections
@@ -413,7 +413,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
                time_source == "clock" and time_unit == "ms" else None)
     for t in tasks:
         if t.kind == "machine" and t.rate > per_second:
-            diags.error(src, APP, t.line, 1, f"task `{t.name}` runs at {t.rate} Hz but `G` counts in {time_unit}: "
+            diags.error(src, APP, t.line, 1, f"task `{t.name}` runs at {hz(t.rate)} Hz but `G` counts in {time_unit}: "
                                              "`G` would not increase between its steps (use `unit us`)")
         elif t.kind == "machine" and tick_us is not None and Fraction(1000000) / t.rate < tick_us:
             diags.error(src, APP, t.line, 1,
@@ -449,7 +449,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         div = tele.rate / q
         if div.denominator != 1:
             err(opts["rate"][1], f"stream rate {opts['rate'][1].text} Hz must divide the telemetry "
-                                 f"task's rate {tele.rate} Hz")
+                                 f"task's rate {hz(tele.rate)} Hz")
             continue
         streams.append(Stream(region, q, int(div) * tele.divider, rt.line))
 

@@ -12,6 +12,9 @@ are checked where they are declared (autocode/check.py)."""
 
 from __future__ import annotations
 
+from decimal import Decimal, localcontext
+from fractions import Fraction
+
 from . import model as M
 from .diagnostics import APP, Diagnostics, Source
 from .schema import link_plan
@@ -26,8 +29,25 @@ _WINDOW_BYTES_AVR = {"avg": 4, "median": 8, "min": 6, "max": 6, "range": 12}
 
 
 def hz(q) -> str:
-    """A rate as the config spells one: `100`, `0.0015625`."""
-    return str(q.numerator) if q.denominator == 1 else repr(float(q))
+    """A rate as the config spells one: `100`, `0.0015625`; one beyond
+    what a float shows (`1e-400`) or of more than 16 digits in a few
+    significant digits (`1e+402`)."""
+    if q.denominator == 1 and q.numerator < 10 ** 16:
+        return str(q.numerator)
+    f = float(q) if abs(q) < 10 ** 16 else 0.0
+    return repr(f) if f != 0 else _sci(q)
+
+
+def count(n: int) -> str:
+    """A whole number with thousands separators, or in a few significant
+    digits when it has more than 16 (`1e+402`)."""
+    return f"{n:,}" if n < 10 ** 16 else _sci(Fraction(n))
+
+
+def _sci(q) -> str:
+    with localcontext() as ctx:
+        ctx.prec = 6
+        return format((Decimal(q.numerator) / Decimal(q.denominator)).normalize(), "g")
 
 
 def window_bytes_avr(w: M.Window) -> int:
@@ -61,7 +81,7 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
         at(t.line, 1, f"task `{t.name}` is task {U8_COUNT + 1}: an application runs at most {U8_COUNT} tasks")
     for t in app.tasks:
         if t.divider > U16_MAX:
-            at(t.line, 1, f"task `{t.name}` runs every {t.divider:,} executor cycles: at most every "
+            at(t.line, 1, f"task `{t.name}` runs every {count(t.divider)} executor cycles: at most every "
                           f"{U16_MAX:,} (a task's rate must be at least the executor rate {app.rate} Hz / {U16_MAX:,})")
         if t.kind == "telemetry" and t.rate > U16_MAX:
             at(t.line, 1, f"telemetry task `{t.name}` runs at {hz(t.rate)} Hz: at most {U16_MAX:,} Hz "

@@ -183,3 +183,31 @@ def test_script_without_asserts_compiles_natively(tmp_path):
     files = script_files(script, MODES["f64"], lambda p, line: "")
     proc = cxx.compile_each(load_board("native"), cxx.write(files, str(tmp_path / "gen")))
     assert proc.returncode == 0, proc.stderr[-3000:]
+
+
+def test_rates_far_below_the_limits_are_named_as_written(tmp_path):
+    # A rate of 1e-400 Hz is taken exactly: it is refused as too slow, with
+    # the rate as written and the interval in a few digits, not "0.0 Hz"
+    # and a number of 400 digits.
+    _app(tmp_path, rate=100, tasks="slow outputs rate=1e-400\ndown telemetry rate=100\n",
+         telemetry="Main rate=1e-400\n")
+    app, errors = _load(str(tmp_path / "a.app"))
+    assert app is None
+    assert "a.app:11:1:" in errors and "task `slow` runs every 1e+402 executor cycles: at most every 65,535" \
+        in errors, errors
+    assert "a.app:14:1:" in errors and "stream `Main` at 1e-400 Hz samples every 1e+402 telemetry runs" \
+        in errors, errors
+    assert errors.count("error @") == 2 and max(len(line) for line in errors.splitlines()) < 250, errors
+
+
+def test_a_fractional_rate_is_named_as_a_decimal(tmp_path):
+    # Rates are exact fractions inside; a message names them as the config
+    # spells them (`0.5`), never as `1/2`.
+    _app(tmp_path, rate=100000, tasks="down telemetry rate=0.5\n", telemetry="Main rate=50\n")
+    path = tmp_path / "a.app"
+    path.write_text(path.read_text().replace("run machine m", "run machine m rate=1562.5"))
+    app, errors = _load(str(path))
+    assert app is None
+    assert "task `run` runs at 1562.5 Hz but `G` counts in ms" in errors, errors
+    assert "stream rate 50 Hz must divide the telemetry task's rate 0.5 Hz" in errors, errors
+    assert "/2" not in errors, errors

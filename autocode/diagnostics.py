@@ -4,6 +4,7 @@ caret under the reported column. Every front-end stage reports through a
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import stat
@@ -287,7 +288,12 @@ class InputError(OSError):
 def _open_regular(path: str):
     """`path` opened for reading, refused (InputError) unless a regular
     file. Opened non-blocking, so a FIFO with no writer does not hang."""
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError as e:
+        if e.errno == errno.ENXIO and stat.S_ISSOCK(os.stat(path).st_mode):  # a socket cannot be opened
+            raise InputError("not a regular file (a socket): the tools read regular files only") from None
+        raise
     f = os.fdopen(fd, "rb", buffering=0)
     mode = os.fstat(fd).st_mode
     if not stat.S_ISREG(mode):

@@ -52,6 +52,19 @@ def test_a_device_config_is_refused(tank):
     assert "tank.sm:1:1:" in r.stderr and "not a regular file (a device)" in r.stderr
 
 
+@pytest.mark.skipif(not hasattr(__import__("socket"), "AF_UNIX"), reason="no Unix sockets")
+def test_a_socket_config_is_named_as_one(tank):
+    # Opening a Unix socket fails (ENXIO) before the file's kind is known:
+    # the message still says what it is, not "No such device or address".
+    import socket
+    (tank / "tank.sv").unlink()
+    with socket.socket(socket.AF_UNIX) as sock:
+        sock.bind(str(tank / "tank.sv"))
+        r = fsw("check", "tank.sv", cwd=tank)
+    assert r.returncode == 1, r.stderr
+    assert "tank.sv:1:1:" in r.stderr and "not a regular file (a socket)" in r.stderr, r.stderr
+
+
 def test_a_fifo_state_script_is_refused_by_fsw_test(tank):
     (tank / "tank.ss").unlink()
     os.mkfifo(tank / "tank.ss")

@@ -95,3 +95,14 @@ def test_a_state_that_overflows_in_flight_ends_the_run_cleanly(monkeypatch):
     monkeypatch.setattr(cosim, "SimBoard", _Board)
     with pytest.raises(CosimError, match="no longer a finite number"):
         fly(sc, "unused.elf", load_board("uno"), layout)
+
+
+@pytest.mark.parametrize("digits", [4301, 500000])
+def test_an_integer_of_thousands_of_digits_is_a_located_error(tmp_path, digits):
+    # Python's TOML reader refuses an integer of more than 4,300 digits
+    # with a ValueError, not a TOML error: it was an internal error.
+    p, line = _variant(tmp_path, TANK, r"^temperature_k\s*=[^\n]*$", "temperature_k = " + "9" * digits)
+    r = run_fsw("sim", str(TANK), "--plant", "tank", "--params", str(p), "--out", str(tmp_path / "out"))
+    assert r.code == 2, r.err
+    assert f"{p}:{line}:17: an integer of {digits:,} digits" in r.err, r.err
+    assert "Traceback" not in r.err and "internal error" not in r.err and len(r.err) < 500, r.err

@@ -231,6 +231,15 @@ def load(path: str, schema: Schema) -> tuple[dict, dict]:
         m = re.search(r"\(at end of document\)", msg)
         line = text.count("\n") + 1
         raise ParamsError([f"{path}:{line}: {msg[:m.start()].strip() if m else msg}"]) from None
+    except ValueError:  # an integer of more digits than Python converts (4,300), not a TOML error
+        m = re.search(r"(?<![\w.])[+-]?[0-9][0-9_]{4300,}", text)
+        if m is None:
+            raise
+        line = text.count("\n", 0, m.start()) + 1
+        col = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
+        digits = sum(ch.isdigit() for ch in m.group())
+        raise ParamsError([f"{path}:{line}:{col}: an integer of {digits:,} digits: far beyond any parameter "
+                           "(write a number in the physical range, e.g. 1e3)"]) from None
     where = locate(text)
     values, errors = check(data, schema, where, path)
     if errors:

@@ -113,6 +113,10 @@ def _positive(tok, src, diags, what) -> Fraction | None:
         text = tok.text if len(tok.text) <= 40 else tok.text[:37] + "..."
         big = q > 10**9 if q is not None else tok.kind == NUM and float(tok.text) > 1  # None: beyond 10^±4000
         limit = " no greater than 1,000,000,000" if big else ""
+        if q is None and tok.kind == NUM and not big:  # positive, but too long or too small to take exactly
+            diags.error(src, APP, tok.line, tok.col, f"{what} is beyond the numbers the tools take (at most 4,000 "
+                                                     f"significant digits, from 1e-4000 to 1e4000), found `{text}`")
+            return None
         diags.error(src, APP, tok.line, tok.col, f"{what} must be a positive number{limit}, found `{text}`")
         return None
     return q

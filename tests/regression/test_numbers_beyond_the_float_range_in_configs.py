@@ -98,6 +98,16 @@ def test_an_app_number_beyond_binary64_is_a_located_error(tank):
     assert "tank.app:6:7:" in r.err and "no greater than 1,000,000,000" in r.err
 
 
+@pytest.mark.parametrize("rate", ["0." + "9" * 5000, "1e-5000"])
+def test_an_app_number_of_too_many_digits_or_too_small_says_so(tank, rate):
+    # Such a rate is positive: "must be a positive number" was not the reason.
+    edit(tank / "tank.app", "sense    inputs        rate=100", f"sense    inputs        rate={rate}")
+    r = run_fsw("check", "tank.app", cwd=tank)
+    assert r.code == 1 and "internal error" not in r.err
+    assert "tank.app:20:29:" in r.err and "`rate` is beyond the numbers the tools take (at most 4,000 " \
+        "significant digits, from 1e-4000 to 1e4000)" in r.err, r.err
+
+
 @pytest.mark.parametrize("old,new,field", [
     ("vref = 5.0", "vref = inf", "adc.vref"),
     ("vref = 5.0", "vref = nan", "adc.vref"),

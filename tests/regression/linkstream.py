@@ -89,25 +89,54 @@ def write_log(path, count: int, first: int = 0, step_ns: int = 10_000_000, proje
     return Path(path)
 
 
-class PtyStream:
-    """A target on a pseudo-terminal that streams `frames` over and over
-    (renumbered past the last) until stopped: the port a monitor opens."""
+class PtyTarget:
+    """A target on a pseudo-terminal: `port` is its name for the ground;
+    a thread runs `_run`, which talks through `master` until `_stop`."""
 
-    def __init__(self, layout, first: int = 5000, hello_first: bool = False, schema: int | None = None):
+    def __init__(self):
         import os
         import pty
         import threading
         import tty
 
-        self.layout = layout
-        self._master, self._slave = pty.openpty()
-        tty.setraw(self._slave)
-        tty.setraw(self._master)
-        self.port = os.ttyname(self._slave)
+        self.master, self.slave = pty.openpty()
+        tty.setraw(self.slave)
+        tty.setraw(self.master)
+        self.port = os.ttyname(self.slave)
         self._stop = threading.Event()
-        self._first, self._hello_first, self._schema = first, hello_first, schema
         self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def start(self):
         self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        import os
+
+        self._stop.set()
+        self._thread.join(timeout=5)
+        os.close(self.master)
+        os.close(self.slave)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class PtyStream(PtyTarget):
+    """A target on a pseudo-terminal that streams `frames` over and over
+    (renumbered past the last) until stopped: the port a monitor opens."""
+
+    def __init__(self, layout, first: int = 5000, hello_first: bool = False, schema: int | None = None):
+        super().__init__()
+        self.layout = layout
+        self._first, self._hello_first, self._schema = first, hello_first, schema
+        self.start()
 
     def _run(self) -> None:
         import os
@@ -125,32 +154,18 @@ class PtyStream:
             n += 50
             data = b"".join(frames)
             while data and not self._stop.is_set():
-                _, w, _ = select.select([], [self._master], [], 0.05)
+                _, w, _ = select.select([], [self.master], [], 0.05)
                 if w:
                     try:
-                        k = os.write(self._master, data[:512])
+                        k = os.write(self.master, data[:512])
                     except OSError:
                         return
                     data = data[k:]
                 # whatever the ground sends is read and dropped
-                r, _, _ = select.select([self._master], [], [], 0)
+                r, _, _ = select.select([self.master], [], [], 0)
                 if r:
                     try:
-                        os.read(self._master, 4096)
+                        os.read(self.master, 4096)
                     except OSError:
                         return
             self._stop.wait(0.02)
-
-    def close(self) -> None:
-        import os
-
-        self._stop.set()
-        self._thread.join(timeout=5)
-        os.close(self._master)
-        os.close(self._slave)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()

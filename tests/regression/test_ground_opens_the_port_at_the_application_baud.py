@@ -12,7 +12,7 @@ import termios
 
 import pytest
 from conftest import run_fsw
-from linkstream import PtyStream, hello, layout_of, tank_copy
+from linkstream import PtyStream, PtyTarget, hello, layout_of, tank_copy
 
 from fswkit.link import wire
 
@@ -48,7 +48,7 @@ def _monitor(project, *extra):
     layout = layout_of(project)
     with PtyStream(layout, hello_first=True) as target:
         r = run_fsw("monitor", str(project), "--port", target.port, "--headless", "--frames", "5", *extra)
-        return r, _speed(target._slave)
+        return r, _speed(target.slave)
 
 
 def test_monitor_uses_the_application_baud(quiet):
@@ -77,24 +77,14 @@ def test_monitor_explicit_other_baud_is_honoured_with_one_warning(quiet):
     assert r.err.count("the application runs its link at 57600 baud") == 1, r.err
 
 
-class Responder:
+class Responder(PtyTarget):
     """A target with an uplink on a pseudo-terminal: answers a `hello`
     command with a hello frame, and acknowledges every command (OK)."""
 
     def __init__(self, layout):
-        import os
-        import pty
-        import threading
-        import tty
-
+        super().__init__()
         self.layout = layout
-        self.master, self.slave = pty.openpty()
-        tty.setraw(self.master)
-        tty.setraw(self.slave)
-        self.port = os.ttyname(self.slave)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
+        self.start()
 
     def _run(self) -> None:
         import os
@@ -121,14 +111,6 @@ class Responder:
                 out += wire.downlink(wire.ACK, n, 10 * n, struct.pack("<HBBH", cseq, op, 0, cseq))
                 n += 1
                 os.write(self.master, out)
-
-    def close(self) -> None:
-        import os
-
-        self._stop.set()
-        self._thread.join(timeout=5)
-        os.close(self.master)
-        os.close(self.slave)
 
 
 @pytest.mark.parametrize("extra, rate, warned", [((), 19200, False), (("--baud", "9600"), 9600, True),

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from linkstream import TANK, layout_of, stream
+from linkstream import TANK, PtyTarget, layout_of, stream
 
 from fswkit.link import wire
 from fswkit.link.session import Session, max_frame
@@ -95,22 +95,12 @@ def test_pure_text_shows_in_the_summary(layout):
     assert f"{s.deframer.stats.oversized} oversized" in summary(s)
 
 
-class TextPty:
+class TextPty(PtyTarget):
     """A board on a pseudo-terminal printing text, no frame at all."""
 
     def __init__(self):
-        import os
-        import pty
-        import threading
-        import tty
-
-        self.master, self.slave = pty.openpty()
-        tty.setraw(self.master)
-        tty.setraw(self.slave)
-        self.port = os.ttyname(self.slave)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-        self._thread.start()
+        super().__init__()
+        self.start()
 
     def _run(self) -> None:
         import os
@@ -127,17 +117,6 @@ class TextPty:
             except OSError:
                 return
             self._stop.wait(0.005)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        import os
-
-        self._stop.set()
-        self._thread.join(timeout=5)
-        os.close(self.master)
-        os.close(self.slave)
 
 
 @pytest.mark.parametrize("command", ["monitor", "cmd"])

@@ -18,7 +18,8 @@ import sys
 import tempfile
 import threading
 
-LOG_MAGIC = b"FSWLOG1\n"  # fswkit.link.log.MAGIC: the head of a recording
+from fswkit.link.log import MAGIC as LOG_MAGIC  # the head of a recording
+
 
 
 class OutputError(Exception):

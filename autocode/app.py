@@ -31,7 +31,7 @@ from fractions import Fraction
 
 from . import model as M
 from .board import Board, BoardError, load_board
-from .check import check_literals, check_sm, check_sv, machine_exprs
+from .check import assignments, check_literals, check_sm, check_sv, machine_exprs
 from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
@@ -540,18 +540,6 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
     return app if check_limits(app, src, diags, sv_tok[1], toks) else None
 
 
-def _assigned(stmts, out: list) -> list:
-    """(var index, line, col) of every assignment in `stmts`, nested blocks
-    included, in source order."""
-    for st in stmts:
-        if isinstance(st, M.Assign):
-            out.append((st.var, st.line, st.col))
-        elif isinstance(st, M.If):
-            _assigned(st.then, out)
-            _assigned(st.orelse, out)
-    return out
-
-
 def _one_writer(diags, src, err, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs):
     """Every element has at most one writer among the input channels, the
     executor (each task's mode, overruns and worst_us; the reset cause) and
@@ -582,14 +570,13 @@ def _one_writer(diags, src, err, channels, tasks, task_opts, reset_tok, reset_el
         s = m.vars[m.s]
         write(s.name, f"machine `{m.name}` (its `S`)", lambda msg: diags.error(msrc, SM, s.line, 1, msg))
         seen = set()
-        for st in m.states:
-            for var, line, col in _assigned(st.entry + st.step + st.exit, []):
-                v = m.vars[var]
-                if v.kind != M.ELEMENT or v.name in seen:
-                    continue
-                seen.add(v.name)
-                write(v.name, f"machine `{m.name}` ({os.path.basename(m.path)}:{line})",
-                      lambda msg, line=line, col=col: diags.error(msrc, SM, line, col, msg))
+        for a in assignments(m):
+            v = m.vars[a.var]
+            if v.kind != M.ELEMENT or v.name in seen:
+                continue
+            seen.add(v.name)
+            write(v.name, f"machine `{m.name}` ({os.path.basename(m.path)}:{a.line})",
+                  lambda msg, a=a: diags.error(msrc, SM, a.line, a.col, msg))
 
 
 # The UART's error a serial link allows: 8N1 frames tolerate about 4.5 %

@@ -613,22 +613,25 @@ def machine_warnings(m: M.Machine, f: S.SmFile, src: Source, diags: Diagnostics,
             warn(d.line, d.name_col, f"element `{v.name}` is listed but never used")
 
 
-def assigned_vars(m: M.Machine) -> set[int]:
-    """Every variable some statement of the machine assigns."""
-    out: set[int] = set()
-
+def assignments(m: M.Machine):
+    """Every assignment of the machine, nested ones included, state by
+    state and block by block in source order."""
     def walk(stmts):
         for st in stmts:
             if isinstance(st, M.Assign):
-                out.add(st.var)
+                yield st
             elif isinstance(st, M.If):
-                walk(st.then)
-                walk(st.orelse)
+                yield from walk(st.then)
+                yield from walk(st.orelse)
 
     for st in m.states:
         for block in (st.entry, st.step, st.exit):
-            walk(block)
-    return out
+            yield from walk(block)
+
+
+def assigned_vars(m: M.Machine) -> set[int]:
+    """Every variable some statement of the machine assigns."""
+    return {a.var for a in assignments(m)}
 
 
 def gotos(stmts):

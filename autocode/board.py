@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from .diagnostics import read_input
 
-BOARDS_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "boards")
+from .kit import BOARDS as BOARDS_DIR
 
 
 @dataclass(frozen=True)

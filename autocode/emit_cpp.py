@@ -15,7 +15,7 @@ from .check import assigned_vars
 from .evaluate import NotConstant, compare, evaluate, local_values
 from .numeric import Real, f32, to_type
 from .schema import schema_hash
-from ..version import __version__
+from .version import __version__
 
 RUNTIME_MAJOR, RUNTIME_MINOR = (int(x) for x in __version__.split(".")[:2])
 
@@ -595,7 +595,7 @@ def emit_script(script: M.Script, real: Real, source_line, ns: str = "fsw_gen",
     `ns` is the generated code's outer namespace (see emit_sv); with an
     `entry` other than `main` the runner is `int <ns>::<entry>(argc, argv)`,
     so that many runners link into one program."""
-    from fswkit.script import failure_diagnostics
+    from fswkit.run.script import failure_diagnostics
 
     m = script.machine
     name = c_ident(m.name)

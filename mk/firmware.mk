@@ -104,7 +104,7 @@ fw-unity: $(FW_UNITY_SRC)
 
 # ---- version handshake: library.properties, fsw_version.h, version.py agree ----
 fw-check-version:
-	@py=$$(sed -n 's/^__version__ = "\(.*\)"/\1/p' host-tools/fswkit/version.py); \
+	@py=$$(sed -n 's/^__version__ = "\(.*\)"/\1/p' autocode/version.py); \
 	lib=$$(sed -n 's/^version=//p' firmware/library.properties); \
 	hdr=$$(sed -n 's/^#define FSW_RUNTIME_VERSION_STRING "\(.*\)"/\1/p' $(FW_SRC)/fsw_version.h); \
 	parts=$$(sed -n 's/^#define FSW_RUNTIME_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)/\2/p' $(FW_SRC)/fsw_version.h | paste -sd.); \

@@ -88,7 +88,7 @@ def steps_per_second(script_path: Path, real_name: str, runs: int) -> tuple[floa
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.numeric import MODES
     from fswkit.autocode.project import load_script
-    from fswkit.script import run
+    from fswkit.run.script import run
 
     d = Diagnostics()
     script = load_script(str(script_path), d)

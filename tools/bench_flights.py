@@ -37,7 +37,7 @@ def seeds(text: str) -> list[int]:
 
 
 def build() -> tuple[str, object]:
-    from fswkit.sim import _build
+    from fswkit.sim.command import _build
 
     built = _build(argparse.Namespace(project=PROJECT, board=None, out=OUT))
     if isinstance(built, int):

@@ -26,7 +26,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 from conftest import run_fsw  # noqa: E402
 
 from fswkit.autocode.diagnostics import Diagnostics  # noqa: E402
-from fswkit.build import elf_size, load  # noqa: E402
+from fswkit.target.build import elf_size, load  # noqa: E402
 from fswkit.link import wire  # noqa: E402
 from fswkit.link.layout import from_app  # noqa: E402
 from fswkit.link.session import Session  # noqa: E402
@@ -153,7 +153,7 @@ def lost_native(tmp: Path) -> tuple[int, int, int, int]:
 
 def lost_simavr(tmp: Path):
     try:
-        from fswkit import sim
+        from fswkit.sim import board as sim
     except ImportError:
         return None
     if shutil.which("avr-g++") is None:
@@ -258,10 +258,10 @@ def main() -> int:
         sim = None if os.environ.get("FSW_BENCH_NO_SIMAVR") else lost_simavr(tmp)
         if sim is not None:
             f2, l2, d2, e2, wall = sim
-            print(f"  simavr Uno (fswkit.sim), UART0 at 115200: {f2} frames, {l2} lost, {d2} dropped by the target, "
+            print(f"  simavr Uno (fswkit.sim.board), UART0 at 115200: {f2} frames, {l2} lost, {d2} dropped by the target, "
                   f"{e2} rejected   ({wall:.0f} s wall)")
         else:
-            print("  simavr Uno: fswkit.sim or gcc-avr not available here")
+            print("  simavr Uno: fswkit.sim.board or gcc-avr not available here")
 
         tank_stream = link_bytes(native(TANK, tmp / "tank-native"), 60000, "a14=700")
         sent, acc, bad, crc_only = corrupted_accepted(tank_stream, layout_of(TANK), 1_000_000)

@@ -20,7 +20,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "host-tools"))
 
-from fswkit.sim import SimBoard, SimError  # noqa: E402
+from fswkit.sim.board import SimBoard, SimError  # noqa: E402
 
 PROJECT = os.path.join(ROOT, "tests", "sim", "toggle")
 OUT = os.path.join(ROOT, "build", "bench", "sim-toggle")

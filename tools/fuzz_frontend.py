@@ -2,7 +2,7 @@
 """Mutation fuzzer for the front end (`make fuzz`).
 
 Each case takes a project (a `.sv`, a `.sm` and a `.ss`) from the corpus —
-the examples, tests/golden if present, and programs drawn from
+the examples, tests/autocode/golden if present, and programs drawn from
 tests/strategies.py — mutates one or more of its files (token deletions,
 duplications and swaps, byte flips, truncation, inserted brackets,
 operators, keywords, huge numbers, deep nesting, long lines, tabs, CR, NUL,
@@ -121,11 +121,11 @@ def _checked(p: Project) -> Project:
 
 
 def corpus(generated: int = 60) -> list[Project]:
-    """The examples, tests/golden (configs with errors, mostly) and
+    """The examples, tests/autocode/golden (configs with errors, mostly) and
     generated valid programs, each marked valid or not."""
     projects = _projects_in(ROOT / "examples")
-    if (ROOT / "tests" / "golden").is_dir():
-        projects += _projects_in(ROOT / "tests" / "golden")
+    if (ROOT / "tests" / "autocode" / "golden").is_dir():
+        projects += _projects_in(ROOT / "tests" / "autocode" / "golden")
     return [_checked(p) for p in projects + generated_projects(generated)]
 
 
@@ -336,7 +336,7 @@ def run_case(files: tuple[bytes, bytes, bytes], workdir: str, cli: bool = False,
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.numeric import F32MODE, F64MODE
     from fswkit.autocode.project import load_machine, load_script, load_sv
-    from fswkit.script import run
+    from fswkit.run.script import run
 
     paths = [os.path.join(workdir, n) for n in NAMES]
     sources = {}

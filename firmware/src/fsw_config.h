@@ -130,7 +130,7 @@
 // between the end of the static data (`_end`) and the top of RAM is filled
 // with FSW_STACK_PAINT_BYTE; a debugger or the simulated board later finds
 // how deep the stack ever reached (the lowest byte no longer painted; the
-// simulated board, fswkit.sim, expects the default byte). 18 bytes of flash,
+// simulated board, fswkit.sim.board, expects the default byte). 18 bytes of flash,
 // no RAM; at boot 7 cycles a byte of free RAM (under 1 ms on an Uno, ~4 ms on
 // a Mega: well inside the 15 ms a watchdog left armed by a reset allows).
 #ifndef FSW_STACK_PAINT

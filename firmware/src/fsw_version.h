@@ -1,5 +1,5 @@
 // Runtime version, for the `#error` handshake in generated code.
-// Must equal the Python package's version (host-tools/fswkit/version.py);
+// Must equal the Python package's version (autocode/version.py);
 // tests/firmware/check_version.sh checks it and firmware/library.properties.
 #ifndef FSW_VERSION_H
 #define FSW_VERSION_H

@@ -1,5 +1,5 @@
 """fswkit: flight software kit for Arduino-class microcontrollers."""
 
-from fswkit.version import __version__
+from fswkit.autocode.version import __version__
 
 __all__ = ["__version__"]

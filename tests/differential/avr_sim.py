@@ -21,7 +21,7 @@ import subprocess
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
-from fswkit import native
+from fswkit.run import native
 from fswkit.autocode import model as M
 from fswkit.autocode.emit_cpp import emit_machine, emit_script_avr, emit_sv, script_writes_locals
 from fswkit.autocode.numeric import F32MODE

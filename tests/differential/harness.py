@@ -24,14 +24,14 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
-from fswkit import native
+from fswkit.run import native
 from fswkit.autocode import model as M
 from fswkit.autocode.check import check_sm, check_ss, check_sv
 from fswkit.autocode.diagnostics import Diagnostics, Source
 from fswkit.autocode.emit_cpp import emit_machine, emit_sv, script_files
 from fswkit.autocode.numeric import Real
 from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
-from fswkit.script import run as interp_run
+from fswkit.run.script import run as interp_run
 
 from gen_programs import Case
 
@@ -365,7 +365,7 @@ def _same(t, a, b) -> bool:
 def interpret_machine(case, m: M.Machine, real: Real) -> list[dict[int, object]]:
     """The interpreter's variables after each step, the inputs written
     before it (a NaN input as the 0 it reads as: spec §4.5)."""
-    from fswkit.interp import OK, MachineRun
+    from fswkit.run.interp import OK, MachineRun
 
     run = MachineRun(m, real, case.init_state)
     idx = [m.var(name).index for name, _ in case.input_types]

@@ -24,7 +24,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import gen_programs as gp
 import harness as H
-from fswkit import interp, native
+from fswkit.run import interp, native
 from fswkit.autocode import emit_cpp, thresholds
 from fswkit.autocode.numeric import MODES
 

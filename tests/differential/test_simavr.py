@@ -24,9 +24,9 @@ import pytest
 import avr_sim as A
 import gen_programs as gp
 import harness as H
-from fswkit import native, windows
+from fswkit.run import native, windows
 from fswkit.autocode.numeric import F32MODE, f32
-from fswkit.script import failure_diagnostics
+from fswkit.run.script import failure_diagnostics
 
 AVR_CASES = int(os.environ.get("FSW_DIFF_AVR_CASES", "40"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))
@@ -44,7 +44,7 @@ class SubnormalQuotients:
     sum / count and roll_median's (b - a) / 2."""
 
     def __init__(self, monkeypatch):
-        from fswkit import interp
+        from fswkit.run import interp
         self.n = 0
         div = interp.GLOBALS["_div"]
 

@@ -24,7 +24,7 @@ def build_native(project: Path, out: Path) -> Path:
 
 def tank_layout(project: Path = TANK):
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.build import load
+    from fswkit.target.build import load
     from fswkit.link.layout import from_app
 
     return from_app(load(str(project), Diagnostics()))

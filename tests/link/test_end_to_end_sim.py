@@ -1,4 +1,4 @@
-"""End to end on the simulated Uno (simavr, fswkit.sim): the tank firmware
+"""End to end on the simulated Uno (simavr, fswkit.sim.board): the tank firmware
 built for the board streams telemetry over UART0; the ground decodes the
 value the harness put on A0, bit for bit as the ATmega computes it, a
 command sent over the link changes what the firmware does, and faults
@@ -18,7 +18,7 @@ from fswkit.link import wire
 from fswkit.link.session import Session
 from linkfw import TANK, tank_layout
 
-sim = pytest.importorskip("fswkit.sim")
+sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
                                 reason="gcc-avr / simavr not installed")
 VOLTS = 3.76  # 769 counts: 814.7 psi, between 775 and 825: the controller holds the valve open

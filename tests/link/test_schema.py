@@ -8,7 +8,7 @@ import shutil
 from conftest import run_fsw
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.schema import app_schema_hash, link_plan
-from fswkit.build import load
+from fswkit.target.build import load
 from linkfw import TANK
 
 

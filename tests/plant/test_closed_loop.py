@@ -31,7 +31,7 @@ HOLD_S = 6.0  # the pinned-sensor faults sit armed on the pad until then (plant.
 
 
 def _build(project: Path, out: Path):
-    from fswkit.sim import _build as build
+    from fswkit.sim.command import _build as build
 
     built = build(argparse.Namespace(project=str(project), board=None, out=str(out)))
     assert not isinstance(built, int), f"{project} did not build"

@@ -29,7 +29,7 @@ def tank_copy(tmp: Path, uplink: bool = True) -> Path:
 
 def layout_of(project: Path):
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.build import load
+    from fswkit.target.build import load
     from fswkit.link.layout import from_app
 
     return from_app(load(str(project), Diagnostics()))

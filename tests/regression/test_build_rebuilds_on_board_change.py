@@ -137,7 +137,7 @@ def test_another_host_compiler_is_another_native_build(fsw, tmp_path, monkeypatc
     """`fsw test --native` caches its compiled runners: the compiler's
     identity is part of the cache key, so an upgraded compiler at the
     same path compiles anew."""
-    from fswkit import native
+    from fswkit.run import native
 
     cxx = tmp_path / "bin" / "g++"
     cxx.parent.mkdir()

@@ -27,7 +27,7 @@ def _start(*args: str) -> subprocess.Popen:
 def _hold(out) -> subprocess.Popen:
     """A process that holds the build folder `out` until its input closes."""
     holder = subprocess.Popen([sys.executable, "-c", (
-        "import sys, fswkit.build as b\n"
+        "import sys, fswkit.target.build as b\n"
         f"with b.build_lock({str(out)!r}, 'test'):\n"
         "    print('held', flush=True)\n"
         "    sys.stdin.read()\n")], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
@@ -63,7 +63,7 @@ def test_two_builds_into_one_folder_both_succeed_with_the_same_firmware(tmp_path
 def test_a_held_folder_is_waited_for_then_given_up_with_a_message(tmp_path, monkeypatch, capsys):
     """A build that cannot get its folder within the time limit says who
     holds it and exits non-zero; it never builds into it meanwhile."""
-    import fswkit.build as build
+    import fswkit.target.build as build
 
     out = tmp_path / "build"
     holder = _hold(out)

@@ -61,7 +61,7 @@ def test_monitor_uses_the_application_baud(quiet):
 
 def test_monitor_without_baud_in_the_app_uses_the_firmware_default(quiet):
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.build import load
+    from fswkit.target.build import load
 
     _, plain = quiet
     r, speed = _monitor(plain)

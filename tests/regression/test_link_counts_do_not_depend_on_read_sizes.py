@@ -15,7 +15,7 @@ from linkstream import TANK, PtyTarget, layout_of, stream
 
 from fswkit.link import wire
 from fswkit.link.session import Session, max_frame
-from fswkit.monitor import summary
+from fswkit.ground.monitor import summary
 
 
 @pytest.fixture(scope="module")

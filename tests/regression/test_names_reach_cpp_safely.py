@@ -158,7 +158,7 @@ def test_sketch_of_an_application_with_odd_names_compiles(tmp_path):
     """The sketch's .ino names the application's file in a comment and
     includes every machine's header after Arduino.h (as the Arduino
     builder compiles it)."""
-    from fswkit.sketch import sketch_files
+    from fswkit.new.sketch import sketch_files
 
     app, errors = _load(_project(tmp_path / "p", ["int", "PORTB", "HIGH", "tank"], "new\nline.app"), "uno")
     assert app is not None, errors

@@ -41,7 +41,7 @@ def _slow_compiler(tmp_path) -> str:
 # simulated board's harness (`fsw sim`).
 COMPILES = {
     "native": (["-m", "fswkit.cli", "test", "--native", SCRIPT], "CXX"),
-    "sim": (["-c", "from fswkit.sim import harness; harness()"], "CC"),
+    "sim": (["-c", "from fswkit.sim.board import harness; harness()"], "CC"),
 }
 
 
@@ -71,7 +71,7 @@ def test_an_interrupted_compile_leaves_no_temporary_folder(tmp_path, sig, kind):
 
 @needs_cxx
 def test_a_failed_compile_leaves_no_temporary_folder(fsw, tmp_path, monkeypatch):
-    from fswkit import native
+    from fswkit.run import native
 
     monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path))
     real = native.script_files

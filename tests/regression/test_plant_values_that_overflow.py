@@ -18,7 +18,7 @@ from fswkit.plant.cosim import CosimError, fly
 from fswkit.plant.rocket import Chute, Motor, Rocket
 from fswkit.plant.run import prepare
 from fswkit.plant.tank import Tank
-from fswkit.sim import pin_map
+from fswkit.sim.board import pin_map
 
 ROCKET, TANK = EXAMPLES / "rocket", EXAMPLES / "tank"
 

@@ -12,7 +12,7 @@ import pytest
 
 from conftest import run_fsw
 
-from fswkit.native import CXX
+from fswkit.run.native import CXX
 
 SV = "[Vehicle]\nU64 time\nU32 state\nbool a\nU8 b\nU8 c\n"
 SM = ("[state_vector]\nU64 time @alias G\nU32 state @alias S\nbool a\nU8 b\nU8 c\n\n"

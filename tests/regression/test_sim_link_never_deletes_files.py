@@ -14,7 +14,7 @@ import subprocess
 import pytest
 from conftest import run_fsw
 
-from fswkit.sim import harness, link_problem
+from fswkit.sim.board import harness, link_problem
 
 
 def _refused(tmp_path, path, check):

@@ -40,7 +40,7 @@ SIMAVR_BITS_PER_BYTE = 11
 
 @pytest.mark.parametrize("baud, made", [(115200, 117647), (57600, 57143), (9600, 9615)])
 def test_the_console_sends_at_the_rate_it_was_given(baud, made):
-    from fswkit.sim import SimBoard
+    from fswkit.sim.board import SimBoard
 
     elf = sketch_elf(f"flood{baud}", FLOOD_SKETCH.replace("BAUD", f"{baud}UL"))
     seconds = 0.2

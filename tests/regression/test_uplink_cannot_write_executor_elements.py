@@ -104,7 +104,7 @@ def target(tmp_path_factory):
         pytest.skip("no host C++ compiler")
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.emit_app import emit_app
-    from fswkit.build import load, make, write_files
+    from fswkit.target.build import load, make, write_files
     from fswkit.link.layout import from_app
 
     folder = tmp_path_factory.mktemp("forged")

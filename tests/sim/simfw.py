@@ -80,7 +80,7 @@ def project_elf(project: str, board: str) -> str:
 
 def sketch_elf(name: str, source: str, board: str = "uno") -> str:
     """An Arduino sketch built with mk/build.mk (the Arduino core's flags)."""
-    from fswkit.build import build_lock
+    from fswkit.target.build import build_lock
 
     out = OUT / f"{name}-{board}"
     gen = out / "src"
@@ -97,7 +97,7 @@ def sketch_elf(name: str, source: str, board: str = "uno") -> str:
 
 def c_elf(name: str, source: str, mcu: str = "atmega328p") -> str:
     """A bare C program for the MCU, no Arduino core."""
-    from fswkit.build import build_lock
+    from fswkit.target.build import build_lock
 
     src = OUT / f"{name}.c"
     elf = OUT / f"{name}-{mcu}.elf"

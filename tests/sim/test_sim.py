@@ -1,4 +1,4 @@
-"""The simulated board (fswkit.sim, `fsw sim`): firmware ELFs on simavr,
+"""The simulated board (fswkit.sim.board, `fsw sim`): firmware ELFs on simavr,
 driven in lock-step and free-running, with the UART on the control channel
 and on a pty, pins mapped from the Arduino variants, limits, bad input."""
 
@@ -21,7 +21,7 @@ import serial
 from conftest import EXAMPLES, ROOT
 from simfw import OUT, dive_uno, halt_uno, probe_uno, spin_uno, tank_mega, tank_uno, toggle_uno  # noqa: F401
 
-from fswkit.sim import SimBoard, SimError, harness, pin_map, sim_board
+from fswkit.sim.board import SimBoard, SimError, harness, pin_map, sim_board
 
 pytestmark = pytest.mark.skipif(
     shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
@@ -312,7 +312,7 @@ def test_firmware_that_stops_itself(halt_uno):
 
 
 def test_the_harness_compiles_without_warnings(tmp_path):
-    from fswkit import sim
+    from fswkit.sim import board as sim
 
     r = subprocess.run([sim.CC] + sim.CFLAGS + ["-Werror", sim.HARNESS_SRC, "-o", str(tmp_path / "simboard")]
                        + sim.LIBS, capture_output=True, text=True)

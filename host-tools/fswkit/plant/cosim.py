@@ -1,4 +1,4 @@
-"""The lock-step loop: the firmware on the simulated board (fswkit.sim)
+"""The lock-step loop: the firmware on the simulated board (fswkit.sim.board)
 and a plant scenario advance together at the scenario's rate. Each step is
 one pipe round trip — the sensors' millivolts and switch levels that
 changed, `until` the step's last cycle, the pyro/valve pins' edges and the
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from fswkit.link.layout import Layout
 from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session
-from fswkit.sim import SimBoard, SimError
+from fswkit.sim.board import SimBoard, SimError
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
 

@@ -51,7 +51,7 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
             board: str | None = None):
     """(app, layout, scenario) for a project folder and its parameters
     file; SetupError with located messages for bad input."""
-    from fswkit.build import BuildError, load
+    from fswkit.target.build import BuildError, load
     from fswkit.link.layout import LayoutError, from_app
 
     if plant not in PLANTS:
@@ -82,7 +82,7 @@ def budget_checks(app, elf: str, run: Run) -> list[reports.Check]:
     """The application's [budget] against the flown firmware: flash from the
     ELF, RAM as static data plus the stack's high-water mark measured on the
     board during this run. None set: the board's memory."""
-    from fswkit.build import BuildError, elf_size
+    from fswkit.target.build import BuildError, elf_size
 
     out = []
     try:
@@ -186,7 +186,7 @@ def _set_aside(stage: str, out: str, why: BaseException) -> None:
 
 def main(args) -> int:
     """The `fsw sim ... --plant` command."""
-    from fswkit.sim import _build, _is_elf
+    from fswkit.sim.command import _build, _is_elf
 
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
                        ("--analog", bool(args.analog)), ("--link", args.link is not None)):
@@ -209,7 +209,7 @@ def main(args) -> int:
         for line in str(e).splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
         return 2
-    from fswkit.build import default_out
+    from fswkit.target.build import default_out
 
     out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
     try:

@@ -14,7 +14,7 @@ import tempfile
 from fswkit.autocode.board import Board
 from fswkit.autocode.diagnostics import Diagnostics
 
-KIT_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from fswkit.autocode.kit import ROOT as KIT_ROOT
 KEYWORDS = {"if", "else", "and", "or", "not", "true", "false"}
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 LED_PIN = 13  # the on-board LED of the Uno, Nano and Mega
@@ -194,7 +194,7 @@ Status     rate=1
 def _skeleton(name: str, texts: dict[str, str]) -> str:
     """`fsw skeleton` of the starter machine."""
     from fswkit.autocode.project import load_machine
-    from fswkit.skeleton import skeleton
+    from fswkit.new.script import skeleton
 
     with tempfile.TemporaryDirectory(prefix="fsw-new-") as tmp:
         for ext in (".sv", ".sm"):

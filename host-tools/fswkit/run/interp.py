@@ -13,7 +13,7 @@ import math
 from fswkit.autocode import model as M
 from fswkit.autocode.evaluate import evaluate
 from fswkit.autocode.numeric import Real, div, f32, f32_from_int
-from fswkit.windows import make_window
+from fswkit.run.windows import make_window
 
 OK = 0
 ERR_TIME = 1  # G did not increase since the previous step

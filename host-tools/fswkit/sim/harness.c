@@ -8,7 +8,7 @@
    - Control mode (-c): commands on standard input, one response line each on
      standard output, in order (docs/sim.md has the protocol). The caller
      advances simulated time (`step`, `until`) or lets the board run free
-     (`go`). fswkit.sim.SimBoard speaks it; so can a person at a terminal.
+     (`go`). fswkit.sim.board.SimBoard speaks it; so can a person at a terminal.
    - Free run (no -c): runs from reset until a limit, optionally paced to real
      time (-r), then prints a summary on standard error.
 
@@ -740,7 +740,7 @@ int main(int argc, char** argv) {
     sa.sa_handler = on_sigint;
     struct sigaction old;
     /* SIGINT ends a run (no SA_RESTART: a blocked poll returns), unless the
-       caller made the board ignore it, as fswkit.sim.SimBoard does: there
+       caller made the board ignore it, as fswkit.sim.board.SimBoard does: there
        the board's owner decides, and stops a `go` with a `stop` command. */
     if (sigaction(SIGINT, NULL, &old) == 0 && old.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
     wall_start = wall_now();

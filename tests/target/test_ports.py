@@ -10,7 +10,7 @@ from serial.tools import list_ports as lp
 from serial.tools.list_ports_common import ListPortInfo
 
 from conftest import EXAMPLES
-from fswkit import ports
+from fswkit.target import ports
 
 
 def info(device, vid=None, pid=None, description="n/a"):

@@ -35,9 +35,9 @@ from fswkit.autocode.check import assigned_vars, fold, model_children
 from fswkit.autocode.evaluate import NotConstant, compare, evaluate, local_values
 from fswkit.autocode.numeric import F64MODE, to_type, truthy
 from fswkit.autocode.types import TYPES
-from fswkit.graph import Transition, describe, guard_expr, transitions
-from fswkit.interp import MachineRun
-from fswkit.windows import Window
+from fswkit.autocode.graph import Transition, describe, guard_expr, transitions
+from fswkit.run.interp import MachineRun
+from fswkit.run.windows import Window
 
 # Bounds of the search. All count simulated machine steps or searched
 # configurations, so the result never depends on the speed of the machine.

@@ -1,4 +1,4 @@
-"""One version number: host-tools/fswkit/version.py, and every manifest and
+"""One version number: autocode/version.py, and every manifest and
 header that carries it (mk/firmware.mk's fw-check-version checks the first
 two with sed; this checks them all)."""
 
@@ -8,7 +8,7 @@ import json
 import re
 
 from conftest import ROOT
-from fswkit.version import __version__
+from fswkit.autocode.version import __version__
 
 
 def test_version_py_is_a_plain_version():

@@ -20,7 +20,7 @@ AVR_BOARDS = [n for n in board_names() if load_board(n).is_avr]
                     reason="gcc-avr or the Arduino core is not installed")
 @pytest.mark.parametrize("name", AVR_BOARDS)
 def test_ports_match_the_variants_pin_table(name):
-    from fswkit.sim import pin_map
+    from fswkit.sim.board import pin_map
 
     board = load_board(name)
     assert board.ports == pin_map(board).digital

@@ -24,8 +24,7 @@ from fswkit.autocode import model as M
 from fswkit.autocode.emit_cpp import script_files
 from fswkit.autocode.numeric import Real
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-RUNTIME = os.path.join(ROOT, "firmware", "src")
+from fswkit.autocode.kit import ROOT, RUNTIME
 CXX = os.environ.get("CXX", "g++")
 # binary32 builds mirror an AVR: float R and software binary64 conversion.
 FLAGS = {32: ["-DFSW_REAL_IS_FLOAT=1", "-DFSW_F64_SOFT=1"], 64: ["-DFSW_REAL_IS_FLOAT=0", "-DFSW_F64_SOFT=0"]}
@@ -215,7 +214,7 @@ def run(script: M.Script, real: Real, source_line, trace_path: str | None = None
 
 
 def _raw_to_csv(m: M.Machine, raw: str, path: str) -> None:
-    from fswkit.script import _Tracer
+    from fswkit.run.script import _Tracer
 
     order = sorted(m.vars, key=lambda v: v.display.encode())
     fmt = "<" + "".join("q" if (v.type.is_int and v.type.signed) else "d" if v.type.is_float else "Q"

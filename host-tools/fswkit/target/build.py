@@ -22,9 +22,7 @@ from fswkit.autocode.app import Application, load_app
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.emit_app import emit_app
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-BUILD_MK = os.path.join(ROOT, "mk", "build.mk")
-RUNTIME = os.path.join(ROOT, "firmware", "src")
+from fswkit.autocode.kit import BUILD_MK, ROOT, RUNTIME
 ARDUINO = "/usr/share/arduino/hardware/arduino/avr"  # mk/build.mk's default, Debian's arduino-core-avr
 
 

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 from fswkit.autocode import model as M
 from fswkit.autocode.diagnostics import Diagnostic, SS
 from fswkit.autocode.numeric import Real
-from fswkit.interp import ERR_TIME, MachineRun, _Emitter, build
-from fswkit.windows import make_window
+from fswkit.run.interp import ERR_TIME, MachineRun, _Emitter, build
+from fswkit.run.windows import make_window
 
 U64_MOD = 1 << 64
 

@@ -44,9 +44,9 @@ from fswkit.autocode.evaluate import evaluate, local_values
 from fswkit.autocode.numeric import F32MODE, F64MODE, format_value, to_type, truthy
 from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
 from fswkit.autocode.types import TYPES
-from fswkit.interp import ERR_TIME, OK, MachineRun, _Emitter, build
-from fswkit.script import run as run_script
-from fswkit.windows import make_window
+from fswkit.run.interp import ERR_TIME, OK, MachineRun, _Emitter, build
+from fswkit.run.script import run as run_script
+from fswkit.run.windows import make_window
 
 sys.path.insert(0, str(ROOT / "tools"))
 import fuzz_frontend as fuzz  # noqa: E402

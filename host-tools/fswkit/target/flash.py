@@ -81,7 +81,7 @@ def _port_problem(port: str, err: int | None, text: str) -> str:
 
 
 def _connected_hint() -> str:
-    from fswkit.ports import PortError, list_ports
+    from fswkit.target.ports import PortError, list_ports
 
     try:
         ports = list_ports()
@@ -182,7 +182,7 @@ def find_pio_project(app_path: str) -> str:
 
 def pio_env_for(pio: str, ini_dir: str, app) -> str:
     """The platformio.ini environment that builds this project for this board."""
-    from fswkit.build import BuildError, find_app
+    from fswkit.target.build import BuildError, find_app
 
     r = subprocess.run([pio, "project", "config", "-d", ini_dir, "--json-output"],
                        capture_output=True, text=True)
@@ -233,9 +233,9 @@ def upload_pio(app, port: str) -> int:
 # ---- the command -----------------------------------------------------------------------
 
 def main(args) -> int:
-    from fswkit.build import BuildError, build_lock, default_out, firmware_name
+    from fswkit.target.build import BuildError, build_lock, default_out, firmware_name
     from fswkit.cli import _load_app, cmd_build
-    from fswkit.ports import PortError, default_port
+    from fswkit.target.ports import PortError, default_port
 
     app = _load_app(args, "flash")
     if app is None:

@@ -140,7 +140,7 @@ def cmd_test(args) -> int:
 def _test_one(path: str, args, real):
     """Runs one script; (exit code, (machine, result) for coverage or None)."""
     from fswkit.autocode.project import load_script, source_of
-    from fswkit.script import run
+    from fswkit.run.script import run
 
     diags = Diagnostics()
     script = load_script(path, diags, args.sm, args.sv, real=real)
@@ -167,7 +167,7 @@ def _test_one(path: str, args, real):
     ok = False
     try:
         if args.native:
-            from fswkit import native
+            from fswkit.run import native
             try:
                 code, report = native.run(script, real, line_of, trace_path=trace and trace.path)
             except native.NativeError as e:
@@ -246,7 +246,7 @@ def _write(text: str, out: str | None, command: str, inputs=()) -> int:
 
 
 def cmd_graph(args) -> int:
-    from fswkit.graph import to_dot, to_mermaid
+    from fswkit.autocode.graph import to_dot, to_mermaid
 
     m = _machine_or_exit(args)
     if m is None:
@@ -256,7 +256,7 @@ def cmd_graph(args) -> int:
 
 
 def cmd_skeleton(args) -> int:
-    from fswkit.skeleton import skeleton
+    from fswkit.new.script import skeleton
 
     m = _machine_or_exit(args)
     if m is None:
@@ -267,7 +267,7 @@ def cmd_skeleton(args) -> int:
 # ---- fsw gen / fsw build ---------------------------------------------------------------
 
 def _load_app(args, command: str):
-    from fswkit.build import BuildError, load
+    from fswkit.target.build import BuildError, load
 
     diags = Diagnostics()
     try:
@@ -281,7 +281,7 @@ def _load_app(args, command: str):
 
 def _generate(app, out: str, command: str):
     from fswkit.autocode.emit_app import GenError, emit_app
-    from fswkit.build import write_files
+    from fswkit.target.build import write_files
 
     try:
         files = emit_app(app)
@@ -299,13 +299,13 @@ def _generate(app, out: str, command: str):
 def cmd_gen(args) -> int:
     import contextlib
 
-    from fswkit.build import BuildError, build_lock, default_out
+    from fswkit.target.build import BuildError, build_lock, default_out
 
     app = _load_app(args, "gen")
     if app is None:
         return EXIT_CONFIG
     if args.sketch:
-        from fswkit.sketch import export
+        from fswkit.new.sketch import export
         return export(app, args.sketch)
     out = args.out or os.path.join(default_out(app), "gen")
     try:
@@ -322,7 +322,7 @@ def cmd_gen(args) -> int:
 
 
 def cmd_build(args) -> int:
-    from fswkit.build import BuildError, build_lock, default_out
+    from fswkit.target.build import BuildError, build_lock, default_out
 
     app = _load_app(args, "build")
     if app is None:
@@ -341,7 +341,7 @@ def cmd_build(args) -> int:
 
 def _build_locked(app, out: str) -> int:
     """`fsw build` once it holds its folder."""
-    from fswkit.build import elf_size, explain_failure, make, size_of, size_report
+    from fswkit.target.build import elf_size, explain_failure, make, size_of, size_report
 
     if _generate(app, os.path.join(out, "gen"), "build") is None:
         return EXIT_FAIL
@@ -375,7 +375,7 @@ def cmd_sim(args) -> int:
     if args.params is not None or args.fault is not None or args.seed is not None:
         sys.stderr.write("fsw sim: --params, --seed and --fault need --plant rocket|tank\n")
         return EXIT_CONFIG
-    from fswkit.sim import main as sim_main
+    from fswkit.sim.command import main as sim_main
 
     return sim_main(args)
 
@@ -385,7 +385,7 @@ def cmd_sim(args) -> int:
 def _port_or_only(port: str | None, command: str) -> str | None:
     """The port named, else the only candidate (said on standard error);
     None after a message when there is none or several."""
-    from fswkit.ports import PortError, default_port
+    from fswkit.target.ports import PortError, default_port
 
     try:
         device, listing = default_port(port, command)
@@ -399,13 +399,13 @@ def _port_or_only(port: str | None, command: str) -> str | None:
 
 
 def cmd_flash(args) -> int:
-    from fswkit.flash import main as flash_main
+    from fswkit.target.flash import main as flash_main
 
     return flash_main(args)
 
 
 def cmd_ports(args) -> int:
-    from fswkit.ports import PortError, format_table, list_ports
+    from fswkit.target.ports import PortError, format_table, list_ports
 
     try:
         ports = list_ports(include_all=args.all)
@@ -421,7 +421,7 @@ def cmd_ports(args) -> int:
 
 
 def cmd_new(args) -> int:
-    from fswkit.scaffold import main as new_main
+    from fswkit.new.project import main as new_main
 
     return new_main(args)
 
@@ -432,7 +432,7 @@ def _link_layout(project: str, command: str, configs: list | None = None):
     """The link layout of a project's configs and the baud rate its firmware
     runs the link at (the application's `baud`, or the default it gets), or
     None after a message; the configs' paths are added to `configs`."""
-    from fswkit.build import BuildError, load
+    from fswkit.target.build import BuildError, load
     from fswkit.link.layout import from_app
 
     diags = Diagnostics()
@@ -464,7 +464,7 @@ def _ground(command: str, fn, *a) -> int:
     from fswkit.link.layout import LayoutError
     from fswkit.link.log import LogError
     from fswkit.link.port import PortError
-    from fswkit.monitor import GroundError
+    from fswkit.ground.monitor import GroundError
     from fswkit.outputs import OutputError
 
     try:
@@ -475,7 +475,7 @@ def _ground(command: str, fn, *a) -> int:
 
 
 def cmd_monitor(args) -> int:
-    from fswkit.monitor import monitor
+    from fswkit.ground.monitor import monitor
 
     from fswkit.outputs import OutputError, check
 
@@ -499,7 +499,7 @@ def cmd_monitor(args) -> int:
 
 
 def cmd_cmd(args) -> int:
-    from fswkit.monitor import command
+    from fswkit.ground.monitor import command
 
     link = _link_layout(args.project, "cmd")
     if link is None:
@@ -511,7 +511,7 @@ def cmd_cmd(args) -> int:
 
 
 def cmd_log2csv(args) -> int:
-    from fswkit.monitor import log2csv
+    from fswkit.ground.monitor import log2csv
     from fswkit.outputs import output
 
     def run() -> int:
@@ -522,13 +522,13 @@ def cmd_log2csv(args) -> int:
 
 
 def cmd_replay(args) -> int:
-    from fswkit.monitor import replay
+    from fswkit.ground.monitor import replay
 
     return _ground("replay", replay, args.log, args.headless, args.speed, args.ignore_schema)
 
 
 def cmd_plot(args) -> int:
-    from fswkit.monitor import plot
+    from fswkit.ground.monitor import plot
 
     return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)
 
@@ -826,6 +826,3 @@ def _main(args, out) -> int:
                          "  (this is a bug in fswkit; run with FSW_DEBUG=1 for details)\n")
         return EXIT_INTERNAL
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -17,7 +17,7 @@ import pytest
 import serial
 
 from conftest import EXAMPLES
-from fswkit import ports
+from fswkit.target import ports
 
 TANK = EXAMPLES / "tank"
 needs_avr = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")

@@ -12,13 +12,13 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES
-from fswkit import script as script_mod
+from fswkit.run import script as script_mod
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.numeric import F64MODE
 from fswkit.autocode.project import load_machine, load_script
-from fswkit.graph import transitions
-from fswkit.interp import MachineRun
-from fswkit.skeleton import instrument, plan, skeleton, skeleton_runs
+from fswkit.autocode.graph import transitions
+from fswkit.run.interp import MachineRun
+from fswkit.new.script import instrument, plan, skeleton, skeleton_runs
 
 TANK = EXAMPLES / "tank"
 MACHINES = Path(__file__).resolve().parent / "machines"
@@ -124,7 +124,7 @@ def check_machine(sm: Path, tmp_path, fsw, monkeypatch, delta_t: int = 10):
 
 
 def describe_of(m, i):
-    from fswkit.graph import describe
+    from fswkit.autocode.graph import describe
     return describe(transitions(m)[i], m)
 
 

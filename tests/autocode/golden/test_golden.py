@@ -1,6 +1,6 @@
 """Golden files for every diagnostic of the .sv, .sm and .ss front end.
 
-tests/golden/<lang>/ holds one small input per diagnostic (`NAME.sv`,
+tests/autocode/golden/<lang>/ holds one small input per diagnostic (`NAME.sv`,
 `NAME.sm` or `NAME.ss`, after the folder) beside `NAME.expected`: exactly
 what `fsw check NAME.<lang>` writes to standard error, run from that folder.
 Under a `run/` folder the case is a state script run by `fsw test`, and the
@@ -8,7 +8,7 @@ expected text is its report on standard output. Files of another language in
 a folder are the companions the cases share (the .sv beside the .sm cases,
 found by `autocode/project.py find_beside`).
 
-    FSW_UPDATE_GOLDEN=1 pytest tests/frontend/test_golden.py
+    FSW_UPDATE_GOLDEN=1 pytest tests/autocode/golden/test_golden.py
 
 rewrites every .expected file from the current output; review the diff by
 eye before committing: each file is what a user sees.
@@ -26,7 +26,7 @@ import pytest
 
 from conftest import ROOT, run_fsw
 
-GOLDEN = ROOT / "tests" / "golden"
+GOLDEN = Path(__file__).resolve().parent
 LANGS = ("sv", "sm", "ss")
 UPDATE = os.environ.get("FSW_UPDATE_GOLDEN") == "1"
 
@@ -79,7 +79,7 @@ def test_every_expected_file_has_its_input():
 # ---- every message the front end can produce has a golden case -------------
 
 SOURCES = [ROOT / "autocode" / n for n in ("lexer.py", "parser.py", "check.py", "project.py")]
-SOURCES.append(ROOT / "host-tools" / "fswkit" / "script.py")
+SOURCES.append(ROOT / "host-tools" / "fswkit" / "run" / "script.py")
 REPORTERS = {"error", "lexical_error", "warning", "warn", "err", "ParseError", "located"}
 # Messages that no golden case can hold, and where they are tested instead.
 NOT_GOLDEN = {

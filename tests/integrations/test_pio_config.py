@@ -54,7 +54,7 @@ def test_platformio_ini_parses_with_the_environments_of_the_issue(tmp_path):
     assert envs == ["megaatmega2560", "nanoatmega328", "native", "uno"]
     pio = cfg["platformio"]
     assert pio["default_envs"] == ["uno"]
-    assert pio["test_dir"] == str(ROOT / "tests" / "tooling" / "pio")
+    assert pio["test_dir"] == str(ROOT / "tests" / "integrations" / "pio")
     for name in envs:
         env = cfg[f"env:{name}"]
         assert env["extra_scripts"] == ["pre:tools/pio_hook.py"]
@@ -85,8 +85,8 @@ def test_each_board_environment_matches_the_kits_board_and_runs_its_suites_in_si
 
 
 def test_pio_test_folders_are_the_runtime_suites():
-    """tests/tooling/pio/test_X/ includes tests/firmware/test_X.cpp, one per suite."""
-    pio_dir = ROOT / "tests" / "tooling" / "pio"
+    """tests/integrations/pio/test_X/ includes tests/firmware/test_X.cpp, one per suite."""
+    pio_dir = ROOT / "tests" / "integrations" / "pio"
     folders = sorted(p.name for p in pio_dir.iterdir() if p.is_dir() and p.name.startswith("test_"))
     assert folders == sorted("test_" + s for s in make_suites("FW_SUITES"))
     for f in folders:

@@ -73,7 +73,7 @@ def export(app: Application, folder: str) -> int:
     import sys
 
     from fswkit.autocode.emit_app import GenError, emit_app
-    from fswkit.build import write_files
+    from fswkit.target.build import write_files
 
     try:
         name = sketch_name(folder)

@@ -190,6 +190,16 @@
 #  error "fswkit: FSW_CONSOLE_TX_SIZE and FSW_CONSOLE_RX_SIZE must be powers of two, 4..256"
 #endif
 
+// The link's receive buffer, bytes: the longest uplink frame encoded (SET of
+// an 8-byte element: 13 bytes + CRC, one COBS code byte) with room to spare.
+#ifndef FSW_LINK_RX_CAP
+#  define FSW_LINK_RX_CAP 24
+#endif
+// Uplink bytes read per run of the uplink task (bounds its step time).
+#ifndef FSW_LINK_RX_PER_RUN
+#  define FSW_LINK_RX_PER_RUN 64
+#endif
+
 // Elements and regions are little-endian in memory (spec 2); typed access
 // copies bytes straight into locals, so the host must be little-endian too.
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

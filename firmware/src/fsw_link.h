@@ -45,15 +45,7 @@ enum LinkStatus : uint8_t {
 };
 
 static const uint8_t kLinkHeader = 6;  // type, sequence number, time (low 32 bits)
-// Receive buffer: the longest uplink frame encoded (SET of an 8-byte
-// element: 13 bytes + CRC, one COBS code byte) with room to spare.
-#ifndef FSW_LINK_RX_CAP
-#define FSW_LINK_RX_CAP 24
-#endif
-// Uplink bytes read per run of the uplink task (bounds its step time).
-#ifndef FSW_LINK_RX_PER_RUN
-#define FSW_LINK_RX_PER_RUN 64
-#endif
+// FSW_LINK_RX_CAP and FSW_LINK_RX_PER_RUN: fsw_config.h.
 
 // One telemetry stream (FSW_FLASH table row).
 struct LinkStream {

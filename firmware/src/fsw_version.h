@@ -1,6 +1,7 @@
 // Runtime version, for the `#error` handshake in generated code.
-// Must equal the Python package's version (autocode/version.py);
-// tests/firmware/check_version.sh checks it and firmware/library.properties.
+// Must equal the Python package's version (autocode/version.py) and
+// firmware/library.properties: `make fw-check-version` (part of `make test`)
+// and tests/cli/test_version.py check all three.
 #ifndef FSW_VERSION_H
 #define FSW_VERSION_H
 

@@ -37,13 +37,13 @@ from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import Channel, check_table
 from .limits import U8_COUNT, check_limits, hz
 from .lexer import ID, NUM, OP, lex
-from .numeric import MODES as REALS, exact_literal
+from .numeric import REALS, exact_literal
 from .parser import parse_sm, parse_sv, show, split_sections
 from .types import U8
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")  # a name, as the lexer reads one
 TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink")
-MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
+TASK_MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
 
 
 @dataclass(frozen=True)
@@ -390,7 +390,7 @@ def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -
         start = "enabled"
         if "start" in opts:
             st = opts["start"][1]
-            if st.text not in MODES:
+            if st.text not in TASK_MODES:
                 err(st, "`start` is one of: enabled, safed, disabled")
                 continue
             if mode_el is None:

@@ -4,12 +4,12 @@ a project made only of configs builds into complete firmware."""
 
 from __future__ import annotations
 
-from .app import MODES, Application, Task
+from .app import TASK_MODES, Application, Task
 from .cnames import comment
 from .emit_cpp import (basename, banner, c_ident, c_string, emit_machine, emit_sv, real_check, real_literal,
                        version_check)
 from .limits import link_load
-from .numeric import MODES as REALS
+from .numeric import REALS
 from .schema import app_schema_hash, link_plan
 
 TYPE_CODE = {"F32": "fsw::kF32", "F64": "fsw::kF64"}
@@ -131,7 +131,7 @@ def _app_cpp(app: Application) -> str:
         worst = f"E_{t.worst_us.name}" if t.worst_us is not None else "fsw::kNoElement"
         step, ctx = steps[t.name] or (f"task_{t.name}", "0")
         c.append(f"    {{{step}, 0, {ctx}, {t.divider}, 0, {mode}, {over}, {worst}, "
-                 f"{MODES[t.start]}}},  // {basename(app.path)}:{t.line} {t.name} ({t.kind})")
+                 f"{TASK_MODES[t.start]}}},  // {basename(app.path)}:{t.line} {t.name} ({t.kind})")
     if not app.tasks:
         c.append("    {0, 0, 0, 1, 0, fsw::kNoElement, fsw::kNoElement, fsw::kNoElement, 0},")
     c.append("};")

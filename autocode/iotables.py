@@ -10,7 +10,7 @@ from . import model as M
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
 from .lexer import ID, NUM, OP, lex
-from .numeric import MODES
+from .numeric import REALS
 
 
 @dataclass(frozen=True)
@@ -38,7 +38,7 @@ def _parse_value(toks, i, src, diags, what, real: str):
         diags.error(src, IO, t.line, t.col, f"expected a number after `{what}=`")
         return None, len(toks)
     v = float(toks[i].text)
-    if not (math.isfinite(v) and math.isfinite(MODES[real].literal(repr(v)))):  # as emit_app converts it
+    if not (math.isfinite(v) and math.isfinite(REALS[real].literal(repr(v)))):  # as emit_app converts it
         most = "binary32: 3.4028235e38" if real == "f32" else "binary64: 1.7976931348623157e308"
         diags.error(src, IO, toks[i].line, toks[i].col,
                     f"`{what}` is outside the representable range of the board's numbers ({most} at most)")

@@ -156,7 +156,7 @@ class _F32(Real):
 
 F64MODE = _F64()
 F32MODE = _F32()
-MODES = {"f64": F64MODE, "f32": F32MODE}
+REALS = {"f64": F64MODE, "f32": F32MODE}
 
 
 def to_type(t: ElemType, x: float):

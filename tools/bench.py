@@ -86,7 +86,7 @@ def big_machine(folder: Path, states: int = 2000) -> Path:
 
 def steps_per_second(script_path: Path, real_name: str, runs: int) -> tuple[float, int]:
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.numeric import MODES
+    from fswkit.autocode.numeric import REALS
     from fswkit.autocode.project import load_script
     from fswkit.run.script import run
 
@@ -97,7 +97,7 @@ def steps_per_second(script_path: Path, real_name: str, runs: int) -> tuple[floa
     best, steps = float("inf"), 0
     for _ in range(runs):
         t = time.process_time()
-        res = run(script, MODES[real_name])
+        res = run(script, REALS[real_name])
         best = min(best, time.process_time() - t)
         steps = res.steps
         if not res.passed:

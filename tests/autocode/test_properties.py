@@ -52,7 +52,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 import fuzz_frontend as fuzz  # noqa: E402
 
 SCALE = float(os.environ.get("FSW_PROPERTY_SCALE", "0.5"))
-MODES = (F64MODE, F32MODE)
+REAL_MODES = (F64MODE, F32MODE)
 
 
 # Shrinking a whole generated program can take minutes: the program-level
@@ -358,7 +358,7 @@ def test_machine_steps_match_tree_walk(p, data):
     m, script = compile_program(p)
     writable = [v.index for v in m.vars if v.kind != M.TIME_IN_STATE and v.index not in (m.g, m.s)]
     init = data.draw(st.integers(0, len(m.states) - 1))
-    runs = [(MachineRun(m, real, init), TreeMachine(m, real, init)) for real in MODES]
+    runs = [(MachineRun(m, real, init), TreeMachine(m, real, init)) for real in REAL_MODES]
     g = 0
     for step in range(data.draw(st.integers(1, 25))):
         inputs = data.draw(st.lists(st.tuples(st.sampled_from(writable), any_floats), max_size=4)) if writable else []
@@ -379,7 +379,7 @@ def test_machine_steps_match_tree_walk(p, data):
 @given(T.programs())
 def test_script_runs_match_tree_walk(p):
     m, script = compile_program(p)
-    for real in MODES:
+    for real in REAL_MODES:
         res = run_script(script, real)
         assert res.steps <= 61  # the generated stop (strategies.scripts) is always reached
         passed, steps, asserts, failure, tm = tree_script(script, real)
@@ -504,7 +504,7 @@ def test_expressions_match_tree_walk(e, steps):
                   (M.Assign(OUT["bool"], M.Const("0", 0, 0), 0, 0),), 0, 0),)
     state = M.State(0, 1, "A", 0, (), body, ())
     m = M.Machine("p.sm", "p", SV, VARS, (state,), tuple(windows), G_, S_, T_)
-    for real in MODES:
+    for real in REAL_MODES:
         fast, slow = MachineRun(m, real), TreeMachine(m, real)
         for k, values in enumerate(steps):
             for t, x in values.items():
@@ -522,7 +522,7 @@ def test_compiled_values_match_evaluate(e, values, wv):
     windows: list = []
     e = number_windows(e, windows)
     assume(len(windows) <= len(wv))
-    for real in MODES:
+    for real in REAL_MODES:
         v = [0.0 if var.type.kind == "float" else 0 for var in VARS]
         for t, x in values.items():
             v[IN[t]] = x
@@ -672,7 +672,7 @@ def test_binary32_integers_are_correctly_rounded(i):
 @given(st.sampled_from(["min", "max", "range", "median", "avg"]), st.integers(1, 8),
        st.lists(st.one_of(st.floats(-1e6, 1e6), st.sampled_from([0.0, -0.0, math.nan, 1.5, -1.5])),
                 min_size=1, max_size=40),
-       st.sampled_from(MODES))
+       st.sampled_from(REAL_MODES))
 def test_windows_hold_the_last_n_samples(func, n, samples, real):
     w = make_window(func, n, real)
     seen: list[float] = []

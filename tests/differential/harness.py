@@ -544,13 +544,13 @@ def run_cases(cases: list[Case], modes: list[str], workdir: str, opt: str = "-O0
               timeout: float = 300):
     """Every case in every mode through both paths. Yields (mode, case,
     interpreter outcome, native outcome or None)."""
-    from fswkit.autocode.numeric import MODES
+    from fswkit.autocode.numeric import REALS
 
     loaded = [(c, *load(c)) for c in cases]
     with ThreadPoolExecutor(JOBS) as pool:
         batches = {}
         for mode in modes:
-            b = Batch(workdir, MODES[mode], pool, per_tu=per_tu, opt=opt, timeout=timeout)
+            b = Batch(workdir, REALS[mode], pool, per_tu=per_tu, opt=opt, timeout=timeout)
             for c, s, sl in loaded:
                 b.add(c.index, s, sl)
             b._flush()
@@ -558,7 +558,7 @@ def run_cases(cases: list[Case], modes: list[str], workdir: str, opt: str = "-O0
         interp = {}
         for mode in modes:  # while the compiler works
             for c, s, sl in loaded:
-                interp[mode, c.index] = run_interpreter(s, MODES[mode], sl,
+                interp[mode, c.index] = run_interpreter(s, REALS[mode], sl,
                                                         os.path.join(workdir, "trace.csv"))
         for mode in modes:
             nat = batches[mode].run()
@@ -572,7 +572,7 @@ def main(argv: list[str]) -> int:
     `raw:N` it runs raw-input machine cases instead. FSW_DIFF_CXX and
     FSW_DIFF_OPT pick the compiler and the optimisation level."""
     import gen_programs as gp
-    from fswkit.autocode.numeric import MODES
+    from fswkit.autocode.numeric import REALS
 
     seed, raw, n = int(argv[0]), argv[1].startswith("raw:"), int(argv[1].split(":")[-1])
     modes = ["f64", "f32"] if len(argv) < 3 or argv[2] == "both" else [argv[2]]
@@ -593,12 +593,12 @@ def main(argv: list[str]) -> int:
             ms = [load_machine(c) for c in cs]
             with ThreadPoolExecutor(JOBS) as pool:
                 for mode in modes:
-                    b = RawBatch(work, MODES[mode], pool, opt=opt)
+                    b = RawBatch(work, REALS[mode], pool, opt=opt)
                     for c, m in zip(cs, ms):
                         b.add_machine(c.index, c, m)
                     nat = b.run_raw()
                     for c, m in zip(cs, ms):
-                        d = raw_difference(c, m, interpret_machine(c, m, MODES[mode]), nat[c.index])
+                        d = raw_difference(c, m, interpret_machine(c, m, REALS[mode]), nat[c.index])
                         if d:
                             bad += 1
                             print(f"== {mode} raw case {c.index}: {d}\n{c.repro()}")

@@ -26,7 +26,7 @@ import gen_programs as gp
 import harness as H
 from fswkit.run import interp, native
 from fswkit.autocode import emit_cpp, thresholds
-from fswkit.autocode.numeric import MODES
+from fswkit.autocode.numeric import REALS
 
 
 def patch_function(owner, name: str, old: str, new: str) -> None:
@@ -112,12 +112,12 @@ def main(argv: list[str]) -> int:
             ms = [H.load_machine(c) for c in cs]
             with ThreadPoolExecutor(H.JOBS) as pool:
                 for mode in ("f64", "f32"):
-                    b = H.RawBatch(work, MODES[mode], pool, timeout=60)
+                    b = H.RawBatch(work, REALS[mode], pool, timeout=60)
                     for c, m in zip(cs, ms):
                         b.add_machine(c.index, c, m)
                     nat = b.run_raw()
                     for c, m in zip(cs, ms):
-                        if H.raw_difference(c, m, H.interpret_machine(c, m, MODES[mode]), nat[c.index]):
+                        if H.raw_difference(c, m, H.interpret_machine(c, m, REALS[mode]), nat[c.index]):
                             caught.setdefault("raw " + mode, []).append(c.index)
     finally:
         shutil.rmtree(work, ignore_errors=True)

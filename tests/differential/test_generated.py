@@ -25,7 +25,7 @@ import pytest
 
 import gen_programs as gp
 import harness as H
-from fswkit.autocode.numeric import MODES
+from fswkit.autocode.numeric import REALS
 
 CASES = int(os.environ.get("FSW_DIFF_CASES", "1000"))
 RAW_CASES = int(os.environ.get("FSW_DIFF_RAW_CASES", "300"))
@@ -65,26 +65,26 @@ def _run_chunk(out: dict, work: str, cases: list, raw_cases: list) -> None:
         batches, raw_batches = {}, {}
         for mode in modes:  # generated C++ first: it compiles while the interpreter runs
             if loaded:
-                batches[mode] = b = H.Batch(work, MODES[mode], pool)
+                batches[mode] = b = H.Batch(work, REALS[mode], pool)
                 for c, s, sl in loaded:
                     b.add(c.index, s, sl)
                 b._flush()
             if raw_cases:
-                raw_batches[mode] = rb = H.RawBatch(work, MODES[mode], pool)
+                raw_batches[mode] = rb = H.RawBatch(work, REALS[mode], pool)
                 for c, m in zip(raw_cases, machines):
                     rb.add_machine(c.index, c, m)
                 rb._flush()
         interp, raw_interp = {}, {}
         for mode in modes:
             for c, s, sl in loaded:
-                interp[mode, c.index] = it = H.run_interpreter(s, MODES[mode], sl, os.path.join(work, "trace.csv"))
+                interp[mode, c.index] = it = H.run_interpreter(s, REALS[mode], sl, os.path.join(work, "trace.csv"))
                 if mode == "f64":
                     out["steps"] += it.trace.count("\n") - 1
                     out["endings"]["passed"] += it.code == 0
                     for k in ("assertion failed", "not reached", "refused the step"):
                         out["endings"][k] += k in it.report
             for c, m in zip(raw_cases, machines):
-                raw_interp[mode, c.index] = H.interpret_machine(c, m, MODES[mode])
+                raw_interp[mode, c.index] = H.interpret_machine(c, m, REALS[mode])
         for mode in modes:
             if loaded:
                 nat = _native(batches[mode].run, {c.index: c for c in cases})
@@ -186,7 +186,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     monkeypatch.setattr(E, "cond", cond)
     for c in gp.cases(SEED, min(CASES, 1000)):
         script, source_line = H.load(c)
-        files = emit_cpp.script_files(script, MODES["f32"], source_line)
+        files = emit_cpp.script_files(script, REALS["f32"], source_line)
         m = script.machine
         counts["folded local"] += sum(1 for v in m.vars if v.kind == M.LOCAL and f"L_{v.name} =" not in
                                       "".join(files.values()))

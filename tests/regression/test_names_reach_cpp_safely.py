@@ -23,7 +23,7 @@ from fswkit.autocode.board import load_board
 from fswkit.autocode.cnames import machine_ident
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.emit_app import emit_app
-from fswkit.autocode.numeric import MODES
+from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_script
 from fswkit.autocode.emit_cpp import script_files
 
@@ -150,7 +150,7 @@ def test_odd_script_and_machine_names_run_natively(tmp_path):
     assert "0 asserts passed" in r.out
     diags = Diagnostics()
     script = load_script(str(ss), diags)
-    files = script_files(script, MODES["f64"], lambda path, line: "")
+    files = script_files(script, REALS["f64"], lambda path, line: "")
     assert "kAssertText[] = {0};" in files["script_main.cpp"]
 
 

@@ -21,7 +21,7 @@ from fswkit.autocode.board import load_board
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.emit_app import emit_app
 from fswkit.autocode.emit_cpp import script_files
-from fswkit.autocode.numeric import MODES
+from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_machine, load_script, load_sv
 from fswkit.autocode.schema import encoded_max
 
@@ -180,7 +180,7 @@ def test_script_without_asserts_compiles_natively(tmp_path):
     diags = Diagnostics()
     script = load_script(path, diags)
     assert script is not None, _errors(diags)
-    files = script_files(script, MODES["f64"], lambda p, line: "")
+    files = script_files(script, REALS["f64"], lambda p, line: "")
     proc = cxx.compile_each(load_board("native"), cxx.write(files, str(tmp_path / "gen")))
     assert proc.returncode == 0, proc.stderr[-3000:]
 

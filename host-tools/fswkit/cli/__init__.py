@@ -88,7 +88,7 @@ def _scripts(paths: list[str]) -> list[str] | None:
 
 
 def cmd_test(args) -> int:
-    from fswkit.autocode.numeric import MODES
+    from fswkit.autocode.numeric import REALS
 
     real_name = args.real
     if args.board is not None:
@@ -103,7 +103,7 @@ def cmd_test(args) -> int:
                              f"whose evaluation type is {board.real}\n")
             return EXIT_CONFIG
         real_name = board.real
-    real = MODES[real_name or "f64"]
+    real = REALS[real_name or "f64"]
     if args.coverage and args.native:
         sys.stderr.write("fsw test: --coverage follows the interpreter's run: leave out --native\n")
         return EXIT_CONFIG

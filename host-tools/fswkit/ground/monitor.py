@@ -373,7 +373,7 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
     from fswkit.link.client import Ground, LinkTimeout
     from fswkit.link.layout import LayoutError, encode_value
     from fswkit.link.port import open_port, port_errors
-    from fswkit.link.session import MODES
+    from fswkit.autocode.app import TASK_MODES
 
     if not layout.has_uplink:
         raise GroundError(f"{project}: the application has no `uplink` task: the target takes no commands")
@@ -396,7 +396,7 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
         ti = layout.task_index(args[0])
         if ti is None:
             raise GroundError(f"unknown task `{args[0]}`: tasks are " + ", ".join(n for n, _ in layout.tasks))
-        modes = {v: k for k, v in MODES.items()}
+        modes = TASK_MODES
         if args[1] not in modes:
             raise GroundError(f"unknown mode `{args[1]}`: one of disabled, safed, enabled")
         op, payload = wire.OP_MODE, bytes((ti, modes[args[1]]))

@@ -9,6 +9,8 @@ import struct
 from collections import deque
 from dataclasses import dataclass
 
+from fswkit.autocode.app import TASK_MODES
+
 from . import wire
 from .layout import Layout
 
@@ -17,7 +19,7 @@ _HEALTH = struct.Struct("<IIIIHBHHHHHHH")
 _TASK = struct.Struct("<BBHH")
 _ACK = struct.Struct("<HBBH")
 _U16 = struct.Struct("<H")
-MODES = {0: "disabled", 1: "safed", 2: "enabled"}
+TASK_MODE_NAMES = {v: k for k, v in TASK_MODES.items()}  # a task's mode on the wire -> its name
 
 
 class Event:
@@ -280,7 +282,7 @@ class Session:
         tasks = []
         for i, (name, kind) in enumerate(self.layout.tasks):
             mode, faults, over, worst = _TASK.unpack_from(payload, _HEALTH.size + i * _TASK.size)
-            tasks.append({"name": name, "kind": kind, "mode": mode, "mode_name": MODES.get(mode, "safed"),
+            tasks.append({"name": name, "kind": kind, "mode": mode, "mode_name": TASK_MODE_NAMES.get(mode, "safed"),
                           "faults": faults, "overruns": over, "worst_us": worst})
         info["tasks"] = tasks
         self.health = info

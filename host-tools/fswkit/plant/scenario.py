@@ -18,7 +18,7 @@ import numpy as np
 
 from fswkit.autocode import model as M
 from fswkit.autocode.evaluate import NotConstant, local_values
-from fswkit.autocode.numeric import MODES
+from fswkit.autocode.numeric import REALS
 
 from .atmosphere import G0
 from .cosim import PinEvent
@@ -264,7 +264,7 @@ class _Binder:
             self.err("firmware", key, f"machine `{m.name}` has no local `{name}`")
             return None
         try:
-            values = local_values(m, MODES[self.app.board.real])
+            values = local_values(m, REALS[self.app.board.real])
         except NotConstant:
             self.err("firmware", key, f"the locals of `{m.name}` have no constant initial values")
             return None

@@ -11,7 +11,7 @@ Every user-supplied name that reaches generated C++ goes through here:
   few that a system header defines as a macro get a `0` after the prefix,
   which no name can start with;
 - file names and other text reach comments through `comment()` and string
-  literals through `emit_cpp.c_string`, never raw.
+  literals through `emit/common.c_string`, never raw.
 
 Two machines whose names come out the same, or the same but for case (one
 file on a case-insensitive file system), are refused where the machines

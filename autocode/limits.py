@@ -54,10 +54,13 @@ def window_bytes_avr(w: M.Window) -> int:
     return _WINDOW_BYTES_AVR[w.func] * w.size
 
 
+def encoded_health(plan) -> int:
+    """The bytes of a health frame on the wire: payload, header, CRC."""
+    return plan.health_payload + 8 + 2
+
+
 def link_load(app) -> tuple[float, float]:
     """(bytes per second the link must carry, bytes per second it can)."""
-    from .emit_app import encoded_health
-
     plan = link_plan(app)
     load = 0.0
     for s in plan.streams:

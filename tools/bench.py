@@ -134,7 +134,7 @@ def front_end_seconds(sm: Path, runs: int) -> tuple[float, float | None]:
     from fswkit.autocode.project import load_machine
 
     try:
-        from fswkit.autocode.emit_cpp import emit_machine
+        from fswkit.autocode.emit.machine import emit_machine
     except ImportError:
         emit_machine = None
     best_load = best_emit = float("inf")

@@ -16,7 +16,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "host-tools"))
 
 from fswkit.autocode.diagnostics import Diagnostics  # noqa: E402
-from fswkit.autocode.emit_cpp import emit_machine, emit_sv  # noqa: E402
+from fswkit.autocode.emit.machine import emit_machine  # noqa: E402
+from fswkit.autocode.emit.sv import emit_sv  # noqa: E402
 from fswkit.autocode.numeric import F32MODE, F64MODE  # noqa: E402
 from fswkit.autocode.project import load_machine  # noqa: E402
 

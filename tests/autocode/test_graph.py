@@ -12,7 +12,7 @@ import pytest
 from conftest import EXAMPLES
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.project import load_machine
-from fswkit.autocode.graph import dot_string, mermaid_text, to_dot, to_mermaid, transitions
+from fswkit.autocode.emit.graph import dot_string, mermaid_text, to_dot, to_mermaid, transitions
 
 TANK = EXAMPLES / "tank"
 MACHINES = Path(__file__).resolve().parent / "machines"

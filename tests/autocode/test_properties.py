@@ -44,7 +44,7 @@ from fswkit.autocode.evaluate import evaluate, local_values
 from fswkit.autocode.numeric import F32MODE, F64MODE, format_value, to_type, truthy
 from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
 from fswkit.autocode.types import TYPES
-from fswkit.run.interp import ERR_TIME, OK, MachineRun, _Emitter, build
+from fswkit.run.interp import ERR_TIME, OK, MachineRun, _Emitter, compile_functions
 from fswkit.run.script import run as run_script
 from fswkit.run.windows import make_window
 
@@ -530,7 +530,7 @@ def test_compiled_values_match_evaluate(e, values, wv):
         w = [real.rnd(x) for x in wv]
         em = _Emitter(VARS, real)
         src = f"def value(v, wv):\n    return {em.value(e)}\ndef cond(v, wv):\n    return {em.cond(e)}\n"
-        ns = build(src, "prop", {"_deep": getattr(em, "deep", [])})
+        ns = compile_functions(src, "prop", {"_deep": getattr(em, "deep", [])})
         want = evaluate(e, real, lambda i: real.read(VARS[i].type, v[i]), w.__getitem__)
         got = ns["value"](v, w)
         assert same(float(got), want), f"{real}: {got!r} != {want!r}"
@@ -564,7 +564,7 @@ def test_binary32_arithmetic_is_numpy_float32(first, chain, storage):
     got = evaluate(e, F32MODE, lambda i: F32MODE.read(t, stored_[i]))
     assert same(got, want), f"{got!r} != numpy {want!r}"
     em = _Emitter(vars_, F32MODE)
-    ns = build(f"def f(v, wv):\n    return {em.value(e)}\n", "prop", {"_deep": getattr(em, "deep", [])})
+    ns = compile_functions(f"def f(v, wv):\n    return {em.value(e)}\n", "prop", {"_deep": getattr(em, "deep", [])})
     compiled = ns["f"](stored_, [])
     assert same(compiled, want), f"compiled {compiled!r} != numpy {want!r}"
 

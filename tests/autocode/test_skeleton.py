@@ -16,7 +16,7 @@ from fswkit.run import script as script_mod
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.numeric import F64MODE
 from fswkit.autocode.project import load_machine, load_script
-from fswkit.autocode.graph import transitions
+from fswkit.autocode.emit.graph import transitions
 from fswkit.run.interp import MachineRun
 from fswkit.new.script import instrument, plan, skeleton, skeleton_runs
 
@@ -124,7 +124,7 @@ def check_machine(sm: Path, tmp_path, fsw, monkeypatch, delta_t: int = 10):
 
 
 def describe_of(m, i):
-    from fswkit.autocode.graph import describe
+    from fswkit.autocode.emit.graph import describe
     return describe(transitions(m)[i], m)
 
 

@@ -23,7 +23,9 @@ from dataclasses import dataclass
 
 from fswkit.run import native
 from fswkit.autocode import model as M
-from fswkit.autocode.emit_cpp import emit_machine, emit_script_avr, emit_sv, script_writes_locals
+from fswkit.autocode.emit.machine import emit_machine
+from fswkit.autocode.emit.script import emit_script_avr, script_writes_locals
+from fswkit.autocode.emit.sv import emit_sv
 from fswkit.autocode.numeric import F32MODE
 
 from harness import cache_dir

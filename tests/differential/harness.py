@@ -28,7 +28,9 @@ from fswkit.run import native
 from fswkit.autocode import model as M
 from fswkit.autocode.check import check_sm, check_ss, check_sv
 from fswkit.autocode.diagnostics import Diagnostics, Source
-from fswkit.autocode.emit_cpp import emit_machine, emit_sv, script_files
+from fswkit.autocode.emit.machine import emit_machine
+from fswkit.autocode.emit.script import script_files
+from fswkit.autocode.emit.sv import emit_sv
 from fswkit.autocode.numeric import Real
 from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
 from fswkit.run.script import run as interp_run

@@ -25,7 +25,8 @@ from concurrent.futures import ThreadPoolExecutor
 import gen_programs as gp
 import harness as H
 from fswkit.run import interp, native
-from fswkit.autocode import emit_cpp, thresholds
+from fswkit.autocode import thresholds
+from fswkit.autocode.emit import expr
 from fswkit.autocode.numeric import REALS
 
 
@@ -56,7 +57,7 @@ def patch_runtime(file: str, old: str, new: str) -> None:
     native.RUNTIME = copy
 
 
-E = emit_cpp.ExprEmitter
+E = expr.ExprEmitter
 MUTANTS = {
     "int_add_limit": lambda: patch_function(E, "int_add", "- 1 - abs(k)", "+ 1 - abs(k)"),
     "threshold_even": lambda: patch_function(thresholds, "greater", "return (key64(mf), even)",

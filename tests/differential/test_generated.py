@@ -148,14 +148,14 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     them exist), so a regression in any of them shows up as a mismatch."""
     if CASES < 500:
         pytest.skip("too few cases to count on every path")
-    from fswkit.autocode import emit_cpp
+    from fswkit.autocode.emit import expr, script as emit_script
     from fswkit.autocode import model as M
 
     counts = dict.fromkeys(("int_compare", "int_compare folded", "int_add", "int_add slow path",
                             "constant_store", "constant_store NaN/inf/-0", "float_threshold F32",
                             "float_threshold F64", "chain split", "chain lambda", "folded local",
                             "window", "lock"), 0)
-    E = emit_cpp.ExprEmitter
+    E = expr.ExprEmitter
 
     def counting(name, key):
         orig = getattr(E, name)
@@ -186,7 +186,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     monkeypatch.setattr(E, "cond", cond)
     for c in gp.cases(SEED, min(CASES, 1000)):
         script, source_line = H.load(c)
-        files = emit_cpp.script_files(script, REALS["f32"], source_line)
+        files = emit_script.script_files(script, REALS["f32"], source_line)
         m = script.machine
         counts["folded local"] += sum(1 for v in m.vars if v.kind == M.LOCAL and f"L_{v.name} =" not in
                                       "".join(files.values()))

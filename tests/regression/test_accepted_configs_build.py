@@ -33,7 +33,7 @@ from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board
 from fswkit.autocode.cnames import CXX_KEYWORDS, TAKEN
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit_app import emit_app
+from fswkit.autocode.emit.app import emit_app
 from fswkit.autocode.lexer import KEYWORDS
 from strategies import RESERVED, programs
 

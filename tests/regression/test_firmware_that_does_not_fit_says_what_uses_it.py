@@ -103,7 +103,7 @@ def test_machine_code_too_big_for_the_flash_is_reported_by_machine(fsw, tmp_path
 def _broken(monkeypatch, text: str) -> None:
     """Generation that appends `text` to the application's C++: a defect
     of the generator, as the user would meet one."""
-    import fswkit.autocode.emit_app as emit
+    import fswkit.autocode.emit.app as emit
 
     real = emit.emit_app
 

@@ -22,10 +22,10 @@ from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board
 from fswkit.autocode.cnames import machine_ident
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit_app import emit_app
+from fswkit.autocode.emit.app import emit_app
 from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_script
-from fswkit.autocode.emit_cpp import script_files
+from fswkit.autocode.emit.script import script_files
 
 # Machine file stems: keywords, the generated code's and the runtime's own
 # names, C library names, platform macros, mixed case, the mangled form of

@@ -19,8 +19,8 @@ import cxx
 from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit_app import emit_app
-from fswkit.autocode.emit_cpp import script_files
+from fswkit.autocode.emit.app import emit_app
+from fswkit.autocode.emit.script import script_files
 from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_machine, load_script, load_sv
 from fswkit.autocode.schema import encoded_max

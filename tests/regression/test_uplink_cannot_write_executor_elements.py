@@ -103,7 +103,7 @@ def target(tmp_path_factory):
     if shutil.which("g++") is None:
         pytest.skip("no host C++ compiler")
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.emit_app import emit_app
+    from fswkit.autocode.emit.app import emit_app
     from fswkit.target.build import load, make, write_files
     from fswkit.link.layout import from_app
 

@@ -246,7 +246,7 @@ def _write(text: str, out: str | None, command: str, inputs=()) -> int:
 
 
 def cmd_graph(args) -> int:
-    from fswkit.autocode.graph import to_dot, to_mermaid
+    from fswkit.autocode.emit.graph import to_dot, to_mermaid
 
     m = _machine_or_exit(args)
     if m is None:
@@ -280,7 +280,7 @@ def _load_app(args, command: str):
 
 
 def _generate(app, out: str, command: str):
-    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.autocode.emit.app import GenError, emit_app
     from fswkit.target.build import write_files
 
     try:

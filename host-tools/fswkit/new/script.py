@@ -13,7 +13,7 @@ the guard while keeping the transitions that would fire first from firing
 (tried before the single changes when it satisfies every term that does not
 wait on the clock), then inputs one step after entry, then pairs. Every
 transition that fires
-gives an edge to a new configuration. A script follows one path, so runs are
+gives a move to a new configuration. A script follows one path, so runs are
 built greedily: from the start, a breadth-first search over configurations
 finds the nearest transition not yet taken, preferring one after which the
 other untaken transitions stay reachable; a run ends when nothing more can be
@@ -35,7 +35,7 @@ from fswkit.autocode.check import assigned_vars, fold, model_children
 from fswkit.autocode.evaluate import NotConstant, compare, evaluate, local_values
 from fswkit.autocode.numeric import F64MODE, to_type, truthy
 from fswkit.autocode.types import TYPES
-from fswkit.autocode.graph import Transition, describe, guard_expr, transitions
+from fswkit.autocode.emit.graph import Arrow, describe, guard_expr, transitions
 from fswkit.run.interp import MachineRun
 from fswkit.run.windows import Window
 
@@ -63,13 +63,13 @@ class Config:
     g: int
     snap: tuple
     key: tuple
-    edges: dict = field(default_factory=dict)  # transition index -> Edge
+    moves: dict = field(default_factory=dict)  # transition index -> Move
     tried: set = field(default_factory=set)  # transitions already searched for here
     memo: dict = field(default_factory=dict)  # (candidate, wait) -> simulation result
 
 
 @dataclass(frozen=True)
-class Edge:
+class Move:
     """From a configuration: set `inputs` (step offset, ((var, text), ...)),
     step `steps` times; the last step takes transition `t`."""
     t: int
@@ -81,13 +81,13 @@ class Edge:
 @dataclass(frozen=True)
 class Run:
     """One script: the transitions it takes, in order."""
-    edges: tuple[Edge, ...]
+    moves: tuple[Move, ...]
 
     @property
     def taken(self) -> list[int]:
         """Transition indices, each once, in the order first taken."""
         out: list[int] = []
-        for e in self.edges:
+        for e in self.moves:
             if e.t not in out:
                 out.append(e.t)
         return out
@@ -97,7 +97,7 @@ class Run:
 class Plan:
     machine: M.Machine
     delta_t: int
-    transitions: list[Transition]
+    transitions: list[Arrow]
     runs: list[Run]
     not_reached: dict[int, str]  # transition index -> why
     steps_used: int
@@ -165,7 +165,7 @@ def _pairs(e: M.Expr):
 class _Analysis:
     """What the search needs to know about a machine before running it."""
 
-    def __init__(self, m: M.Machine, trans: list[Transition], delta_t: int):
+    def __init__(self, m: M.Machine, trans: list[Arrow], delta_t: int):
         self.m = m
         try:
             self.consts = local_values(m, F64MODE)
@@ -251,7 +251,7 @@ class _Analysis:
                 out.append(c)
         return out
 
-    def closure(self, t: Transition) -> list[int]:
+    def closure(self, t: Arrow) -> list[int]:
         """The variables `t`'s guard reads, then those the machine computes
         them from, and so on."""
         order: list[int] = []
@@ -269,7 +269,7 @@ class _Analysis:
                     todo.append(n)
         return order
 
-    def wait_limit(self, t: Transition) -> int:
+    def wait_limit(self, t: Arrow) -> int:
         """How many steps a candidate for `t` waits: enough for `T` to pass
         every constant it is compared with in `t`'s guard (or in what that
         guard is computed from), and for a counter of the machine to count
@@ -307,7 +307,7 @@ class _Analysis:
         out += [a + (b - a) / 2 for a, b in zip(s, s[1:])]
         return [x for x in out if math.isfinite(x)]
 
-    def _static_reach(self, trans: list[Transition]) -> dict[int, set[int]]:
+    def _static_reach(self, trans: list[Arrow]) -> dict[int, set[int]]:
         """The states each state can reach along transitions (itself included)."""
         nxt: dict[int, set[int]] = {st.index: set() for st in self.m.states}
         for t in trans:
@@ -324,7 +324,7 @@ class _Analysis:
             out[s] = seen
         return out
 
-    def relevant(self, t: Transition, rivals: list[M.Expr]) -> list[int]:
+    def relevant(self, t: Arrow, rivals: list[M.Expr]) -> list[int]:
         """The writable variables that can affect `t`'s guard: those it reads,
         those the machine computes them from, then those read by the guards
         of the `rivals` that would fire before it; most natural first."""
@@ -350,7 +350,7 @@ def _refs_in_order(e: M.Expr) -> list[int]:
     return out
 
 
-def _dead(m: M.Machine, trans: list[Transition], reach0: set[int]) -> dict[int, str]:
+def _dead(m: M.Machine, trans: list[Arrow], reach0: set[int]) -> dict[int, str]:
     """Transitions that can never fire whatever the inputs, and why. Unlike
     the checker's warnings, a read-only local is not a constant here: a
     script may write it."""
@@ -442,7 +442,7 @@ class _Search:
         self.dt = delta_t
         self.budget = budget
         self.trans = transitions(m)
-        self.by_state: dict[int, list[Transition]] = {st.index: [] for st in m.states}
+        self.by_state: dict[int, list[Arrow]] = {st.index: [] for st in m.states}
         for t in self.trans:
             self.by_state[t.source].append(t)
         self.a = _Analysis(m, self.trans, delta_t)
@@ -575,7 +575,7 @@ class _Search:
 
         return evaluate(e, F64MODE, read, lambda w: wv[w])
 
-    def values(self, cfg: Config, var: int, t: Transition) -> list[str]:
+    def values(self, cfg: Config, var: int, t: Arrow) -> list[str]:
         """Texts of the values worth writing to `var`, best first."""
         ck = (id(cfg), var, t.index)
         if ck in self.values_cache:
@@ -640,7 +640,7 @@ class _Search:
         x = (c - f0) / b
         return x if math.isfinite(x) else None
 
-    def _greedy(self, cfg: Config, t: Transition, rel: list[int]) -> tuple[tuple, bool]:
+    def _greedy(self, cfg: Config, t: Arrow, rel: list[int]) -> tuple[tuple, bool]:
         """Inputs chosen one variable at a time to satisfy the most terms of
         `t`'s guard, and to falsify those of its rivals (static evaluation
         at the first step); and whether all terms that do not follow the
@@ -681,7 +681,7 @@ class _Search:
         full = score(static) == sum(_max_score(c, want) for c, want in static)
         return combo, full
 
-    def candidates(self, cfg: Config, t: Transition):
+    def candidates(self, cfg: Config, t: Arrow):
         yield ()
         rel = self.a.relevant(t, self.rivals[t.index])
         combo, full = self._greedy(cfg, t, rel)
@@ -715,25 +715,25 @@ class _Search:
                         if n >= MAX_PAIRS:
                             return
 
-    def outcomes(self, cfg: Config) -> list[Edge]:
+    def outcomes(self, cfg: Config) -> list[Move]:
         """The transitions found to fire from `cfg`, searching for those
         not yet tried here."""
         for t in self.by_state[cfg.state]:
             i = t.index
-            if i in cfg.edges or i in cfg.tried or i in self.dead:
+            if i in cfg.moves or i in cfg.tried or i in self.dead:
                 continue
             if self.failures.get(i, 0) >= GIVE_UP_AFTER:
                 continue
             cfg.tried.add(i)
             for cand in self.candidates(cfg, t):
                 res = self.simulate(cfg, cand, self.wait[i])
-                if res is not None and res[0] not in cfg.edges:
-                    cfg.edges[res[0]] = Edge(res[0], cand, res[1], res[2])
-                if i in cfg.edges:
+                if res is not None and res[0] not in cfg.moves:
+                    cfg.moves[res[0]] = Move(res[0], cand, res[1], res[2])
+                if i in cfg.moves:
                     break
             else:
                 self.failures[i] = self.failures.get(i, 0) + 1
-        return [cfg.edges[i] for i in sorted(cfg.edges)]
+        return [cfg.moves[i] for i in sorted(cfg.moves)]
 
     # -- runs --
 
@@ -741,9 +741,9 @@ class _Search:
         r = self.a.static_reach[state]
         return sum(1 for i in remaining if self.trans[i].source in r)
 
-    def find_path(self, start: Config, remaining: set[int]) -> list[Edge] | None:
+    def find_path(self, start: Config, remaining: set[int]) -> list[Move] | None:
         """Breadth-first over configurations: the shortest path whose last
-        edge takes a transition in `remaining`, preferring one after which the
+        move takes a transition in `remaining`, preferring one after which the
         most of the others stay reachable."""
         best, best_rank = None, None
         level = [(start, [])]
@@ -891,7 +891,7 @@ def _script(p: Plan, k: int) -> str:
     g = 0
     start = {i: None for i in _sensors(m)}
     first_inputs = {}
-    for off, assigns in (run.edges[0].inputs if run.edges else ()):
+    for off, assigns in (run.moves[0].inputs if run.moves else ()):
         if off == 0:
             first_inputs.update(dict(assigns))
     for i in start:
@@ -904,7 +904,7 @@ def _script(p: Plan, k: int) -> str:
     lines0 += [f"{_vname(m, i)} = {text}" for i, text in first_inputs.items()]
     visited = [0]
     steps_total = 0
-    for n, e in enumerate(run.edges):
+    for n, e in enumerate(run.moves):
         t = p.transitions[e.t]
         fire = g + (e.steps - 1) * dt
         events.append(f"# {n + 1}. from G = {g}: {describe(t, m)}; it fires at G = {fire}")

@@ -72,7 +72,7 @@ def export(app: Application, folder: str) -> int:
     """`fsw gen PROJECT --sketch DIR`: writes the sketch folder; returns the exit status."""
     import sys
 
-    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.autocode.emit.app import GenError, emit_app
     from fswkit.target.build import write_files
 
     try:

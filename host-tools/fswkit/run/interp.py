@@ -165,7 +165,9 @@ class _Emitter:
 GLOBALS = {"_f32": f32, "_fi": f32_from_int, "_div": div, "_NAN": math.nan, "_INF": math.inf}
 
 
-def build(source: str, name: str, extra: dict | None = None) -> dict:
+def compile_functions(source: str, name: str, extra: dict | None = None) -> dict:
+    """The namespace of Python source generated from the model (the
+    machine's or a script's functions), with the R helpers it calls."""
     namespace = dict(GLOBALS)
     namespace.update(extra or {})
     exec(compile(source, f"<fswkit:{name}>", "exec"), namespace)  # generated from the model only
@@ -206,7 +208,7 @@ class MachineRun:
                 src.append(f"def s{st.index}_{label}(v, wv):")
                 em.block(getattr(st, label), "    ", src)
                 src.append("    return -1")
-        ns = build("\n".join(src) + "\n", m.name, {"_deep": em.deep, "_C": self.taken.add})
+        ns = compile_functions("\n".join(src) + "\n", m.name, {"_deep": em.deep, "_C": self.taken.add})
         self._update = ns["update"]
         self._push = [w.push for w in self.windows]
         self._entry = [ns[f"s{i}_entry"] for i in range(len(m.states))]

@@ -21,7 +21,7 @@ import threading
 import time
 
 from fswkit.autocode import model as M
-from fswkit.autocode.emit_cpp import script_files
+from fswkit.autocode.emit.script import script_files
 from fswkit.autocode.numeric import Real
 
 from fswkit.autocode.kit import ROOT, RUNTIME
@@ -88,7 +88,7 @@ def _key(files: dict[str, str], real: Real) -> str:
     return h.hexdigest()[:20]
 
 
-def build(script: M.Script, real: Real, source_line) -> str:
+def compile_script(script: M.Script, real: Real, source_line) -> str:
     """Generates and compiles the runner; returns the executable's path."""
     if shutil.which(CXX) is None:
         raise NativeError(f"no host C++ compiler `{CXX}` (install g++, or set CXX)")
@@ -195,7 +195,7 @@ def _remove_mine() -> None:
 def run(script: M.Script, real: Real, source_line, trace_path: str | None = None) -> tuple[int, str]:
     """Runs the native runner: (exit status, report). With `trace_path`,
     writes the same CSV trace as the interpreter."""
-    exe = build(script, real, source_line)
+    exe = compile_script(script, real, source_line)
     raw = None
     args = [exe]
     if trace_path:

@@ -8,9 +8,9 @@ import csv
 from dataclasses import dataclass
 
 from fswkit.autocode import model as M
-from fswkit.autocode.diagnostics import Diagnostic, SS
+from fswkit.autocode.diagnostics import Diagnostic, failure_diagnostics
 from fswkit.autocode.numeric import Real
-from fswkit.run.interp import ERR_TIME, MachineRun, _Emitter, build
+from fswkit.run.interp import ERR_TIME, MachineRun, _Emitter, compile_functions
 from fswkit.run.windows import make_window
 
 U64_MOD = 1 << 64
@@ -76,30 +76,9 @@ def _compile(script: M.Script, real: Real):
             src.append(f"    return {sem.cond(c.expr)}")
         else:
             src.append("    return None")
-    ns = build("\n".join(src) + "\n", script.path, {"_deep": sem.deep})
+    ns = compile_functions("\n".join(src) + "\n", script.path, {"_deep": sem.deep})
     del em
     return ns, checks
-
-
-def failure_diagnostics(script: M.Script, source_line) -> dict:
-    """Every located failure a run of `script` can end with, rendered the
-    same by the interpreter and the native runner: `max_steps`,
-    `step_error`, and `asserts` (one per `@assert`, in section order)."""
-    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
-        text = source_line(script.path, line) if source_line else ""
-        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
-
-    stop = next(c for sec in script.sections for g in sec.checks for c in g.checks if isinstance(c, M.Stop))
-    return {
-        "max_steps": located(stop.line, stop.col, None,
-                             f"`@stop` not reached within {script.max_steps} steps "
-                             "(raise `max_steps` in [options] if the script needs more)"),
-        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
-                                          "(it wrapped around at 2^64: lower `delta_t`)"),
-        "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
-                    for sec in script.sections for g in sec.checks for c in g.checks
-                    if isinstance(c, M.Assert)],
-    }
 
 
 def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None,

@@ -29,7 +29,7 @@ def _build(args) -> tuple[str, Board] | int:
     """Generates and builds the project for its (or --board's) board; the ELF
     and board, or an exit status after saying why."""
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.emit_app import GenError, emit_app
+    from fswkit.autocode.emit.app import GenError, emit_app
     from fswkit.target.build import (BuildError, build_lock, default_out, elf_size, explain_failure, load, make,
                               size_of, size_report, write_files)
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 from fswkit.autocode.app import Application, load_app
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit_app import emit_app
+from fswkit.autocode.emit.app import emit_app
 
 from fswkit.autocode.kit import BUILD_MK, ROOT, RUNTIME
 ARDUINO = "/usr/share/arduino/hardware/arduino/avr"  # mk/build.mk's default, Debian's arduino-core-avr
@@ -327,7 +327,7 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
     """{"flash": [...], "RAM": [...]}, largest first: every generated symbol
     of the ELF attributed to the config line it comes from (the state
     vector's regions from the model), the rest as the runtime's."""
-    from fswkit.autocode.emit_cpp import basename, c_ident
+    from fswkit.autocode.emit.common import basename, c_ident
 
     a = basename(app.path)
     sv = basename(app.sv.path)

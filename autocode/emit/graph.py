@@ -8,13 +8,14 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from fswkit.autocode import model as M
-from fswkit.autocode import unparse
+from .. import model as M
+from .. import unparse
 
 
 @dataclass(frozen=True)
-class Transition:
-    """One `-> State` of a machine and the path of conditions to it."""
+class Arrow:
+    """One `-> State` of a machine (a transition, drawn as an arrow) and the
+    path of conditions to it."""
     index: int  # position in transitions(m): states in order, entry before step
     source: int  # state index
     target: int  # state index
@@ -23,15 +24,15 @@ class Transition:
     goto: M.Goto
 
 
-def transitions(m: M.Machine) -> list[Transition]:
+def transitions(m: M.Machine) -> list[Arrow]:
     """Every transition of the machine, in file order per state, `.entry`
     before `.step` (`.exit` cannot transition)."""
-    out: list[Transition] = []
+    out: list[Arrow] = []
 
     def walk(stmts, st: M.State, block: str, path: tuple) -> None:
         for s in stmts:
             if isinstance(s, M.Goto):
-                out.append(Transition(len(out), st.index, s.state, block, path, s))
+                out.append(Arrow(len(out), st.index, s.state, block, path, s))
             elif isinstance(s, M.If):
                 walk(s.then, st, block, path + ((s.cond, True),))
                 walk(s.orelse, st, block, path + ((s.cond, False),))
@@ -42,7 +43,7 @@ def transitions(m: M.Machine) -> list[Transition]:
     return out
 
 
-def guard_expr(t: Transition) -> M.Expr | None:
+def guard_expr(t: Arrow) -> M.Expr | None:
     """The conjunction of the conditions along the path (an `else` branch
     contributes `not (cond)`), or None for an unconditional transition."""
     out = None
@@ -57,13 +58,13 @@ def guard_expr(t: Transition) -> M.Expr | None:
     return out
 
 
-def guard_text(t: Transition, m: M.Machine) -> str:
+def guard_text(t: Arrow, m: M.Machine) -> str:
     """`counter > 1000 and T > 4000`; empty for an unconditional transition."""
     g = guard_expr(t)
     return "" if g is None else unparse.model_expr(g, m)
 
 
-def label(t: Transition, m: M.Machine) -> str:
+def label(t: Arrow, m: M.Machine) -> str:
     """The edge label: the guard, prefixed `entry: ` for a transition of the
     `.entry` block (it can fire only on the first step in the state)."""
     g = guard_text(t, m)
@@ -72,7 +73,7 @@ def label(t: Transition, m: M.Machine) -> str:
     return g
 
 
-def describe(t: Transition, m: M.Machine) -> str:
+def describe(t: Arrow, m: M.Machine) -> str:
     """`A -> B when guard` (with the label's `entry: ` prefix), or
     `A -> B (unconditional)`: for comments in generated scripts."""
     text = label(t, m)

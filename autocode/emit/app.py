@@ -4,13 +4,14 @@ a project made only of configs builds into complete firmware."""
 
 from __future__ import annotations
 
-from .app import TASK_MODES, Application, Task
-from .cnames import comment
-from .emit_cpp import (basename, banner, c_ident, c_string, emit_machine, emit_sv, real_check, real_literal,
-                       version_check)
-from .limits import link_load
-from .numeric import REALS
-from .schema import app_schema_hash, link_plan
+from ..app import TASK_MODES, Application, Task
+from ..cnames import comment
+from ..limits import link_load
+from ..numeric import REALS
+from ..schema import app_schema_hash, link_plan
+from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
+from .machine import emit_machine
+from .sv import emit_sv
 
 TYPE_CODE = {"F32": "fsw::kF32", "F64": "fsw::kF64"}
 ELEM_CODE = {"I8": "fsw::kI8", "I16": "fsw::kI16", "I32": "fsw::kI32", "I64": "fsw::kI64",
@@ -305,10 +306,6 @@ def _link(app: Application) -> list[str]:
     c.append("fsw::Link link;")
     c.append("")
     return c
-
-
-def encoded_health(plan) -> int:
-    return plan.health_payload + 8 + 2
 
 
 def _native_main(app: Application) -> list[str]:

@@ -1,0 +1,303 @@
+"""C++ for the model's expressions, shared by the machine and the script
+runner: R arithmetic over the runtime, with integer and binary32 fast paths
+that are bit-identical to it (the differential tests hold them to that)."""
+
+from __future__ import annotations
+
+import struct
+
+from .. import model as M
+from ..check import assigned_vars
+from ..cnames import enumerator
+from ..evaluate import NotConstant, compare, evaluate, local_values
+from ..numeric import Real, to_type
+from ..thresholds import tests
+from .common import real_literal
+
+
+def _no_reads(i: int):
+    raise NotConstant(None)
+
+
+class ExprEmitter:
+    """C++ for model expressions of one machine (or of a script over it)."""
+
+    def __init__(self, m: M.Machine, real: Real, scriptable: bool, prefix: str = "",
+                 windows: str = "w", ns: str = "fsw_gen"):
+        self.m = m
+        self.ns = ns  # the state vector's namespace (qualifies elements from outside)
+        self.real = real
+        self.scriptable = scriptable
+        self.prefix = prefix  # qualifies the machine's names from outside (scripts)
+        self.windows = windows
+        self.consts: dict[int, float] = {}
+        values = local_values(m, real)
+        # In firmware only the machine writes its locals: one it never
+        # assigns keeps its initial value, exactly like a @read_only one.
+        # (A state script may write any local, so scripts keep them all.)
+        written = assigned_vars(m)
+        for v in m.vars:
+            if v.kind == M.LOCAL and not scriptable and (v.read_only or v.index not in written):
+                self.consts[v.index] = real.read(v.type, values[v.index])
+        self.sv_lock = m.sv.lock
+
+    def ptr(self, v: M.Var) -> str:
+        if v.kind == M.ELEMENT:
+            return f"{self.ns}::sv + {self.ns}::E_{v.name}" if self.prefix else f"sv + E_{v.name}"
+        return f"{self.prefix}loc + {self.prefix}{enumerator('L_', v.name)}"
+
+    def read(self, i: int) -> str:
+        v = self.m.vars[i]
+        if v.kind == M.TIME_IN_STATE:
+            return f"fsw::real_from_U64({self.prefix}machine.t)"
+        if i in self.consts:
+            return real_literal(self.consts[i], self.real)
+        text = f"fsw::read_{v.type.name}({self.ptr(v)})"
+        if self.sv_lock and v.kind == M.ELEMENT:
+            return f"(fsw::SvGuard<true>(), {text})"
+        return text
+
+    def write(self, i: int, value: str) -> str:
+        v = self.m.vars[i]
+        text = f"fsw::write_{v.type.name}({self.ptr(v)}, {value});"
+        if self.sv_lock and v.kind == M.ELEMENT:
+            return "{ fsw::SvGuard<true> lock; " + text + " }"
+        return text
+
+    def value(self, e: M.Expr) -> str:
+        t = type(e)
+        if t is M.Const:
+            return real_literal(self.real.literal(e.text), self.real)
+        if t is M.Ref:
+            return self.read(e.var)
+        if t is M.Neg:
+            return f"(-{self.value(e.operand)})"
+        if t is M.Arith:
+            return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
+        if t is M.Roll:
+            return f"{self.windows}{e.window}.value()"
+        return f"fsw::real_from_truth({self.cond(e)})"
+
+    def cond(self, e: M.Expr) -> str:
+        t = type(e)
+        if t is M.Cmp:
+            fast = self.int_compare(e.left, e.op, e.right)
+            if fast is None and self.real.bits == 32:
+                fast = self.float_threshold(e.left, e.op, e.right)
+            if fast is not None:
+                return fast
+            return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
+        if t is M.ChainCmp:
+            if all(type(o) in (M.Const, M.Ref) for o in e.operands):
+                # Literals and variables read the same twice: test pair by pair.
+                pairs = [self.cond(M.Cmp(op, e.operands[k], e.operands[k + 1], e.line, e.col))
+                         for k, op in enumerate(e.ops)]
+                return "(" + " && ".join(pairs) + ")"
+            # Each middle operand is evaluated once: a lambda holds them.
+            names = [f"c{k}" for k in range(len(e.operands))]
+            decl = " ".join(f"const fsw::Real {n} = {self.value(o)};" for n, o in zip(names, e.operands))
+            test = " && ".join(f"{names[k]} {op} {names[k + 1]}" for k, op in enumerate(e.ops))
+            return f"([&]() -> bool {{ {decl} return {test}; }}())"
+        if t is M.Logic:
+            op = "&&" if e.op == "and" else "||"
+            return f"({self.cond(e.left)} {op} {self.cond(e.right)})"
+        if t is M.Not:
+            return f"(!{self.cond(e.operand)})"
+        return f"fsw::truthy({self.value(e)})"
+
+    def float_threshold(self, left: M.Expr, op: str, right: M.Expr):
+        """binary32 R: `R(x) op c` for a float variable x and a literal c as
+        integer threshold tests on x's stored bytes (autocode/thresholds.py)."""
+        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+        x, cv = left, self.known(right)
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            x, cv, op = right, self.known(left), flip[op]
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            return None
+        v = self.m.vars[x.var]
+        if v.kind == M.TIME_IN_STATE or v.type.kind != "float":
+            return None
+        if self.sv_lock and v.kind == M.ELEMENT:
+            return None
+        negate = op == "!="
+        terms = tests("==" if negate else op, cv, v.type.size)
+        if terms is None:
+            return None
+        nan_result = compare(op, 0.0, cv)  # a NaN element reads as 0
+        bits = 64 if v.type.size == 8 else 32
+        if all(isinstance(t, bool) for _, t in terms):
+            # The same for every value (`x > 1e39` in binary32: never), so
+            # also for 0, which is what a NaN reads as: a constant.
+            value = all(t != neg for neg, t in terms) != negate
+            assert value == nan_result
+            return "true" if value else "false"
+        parts = []
+        for neg, t in terms:
+            if isinstance(t, bool):
+                test = "true" if t else "false"
+            else:
+                key, inclusive = t
+                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}ULL"
+            parts.append(f"!({test})" if neg else f"({test})")
+        body = " && ".join(parts)
+        if negate:
+            body = f"!({body})"
+        return (f"([&]() -> bool {{ const uint8_t* p = {self.ptr(v)}; "
+                f"if (fsw::f{bits}_is_nan(p)) return {'true' if nan_result else 'false'}; "
+                f"const uint{bits}_t k = fsw::f{bits}_key(p); return {body}; }}())")
+
+    # -- integer fast paths, bit-identical to the R semantics ------------------
+    def assign(self, var: int, e: M.Expr) -> str:
+        """An assignment statement: `x = a + k` / `x = a - k` on integers take
+        an integer path when a range check proves R would be exact."""
+        const = self.constant_store(var, e)
+        if const is not None:
+            return const
+        fast = self.int_add(var, e)
+        return fast if fast is not None else self.write(var, self.value(e))
+
+    def constant_store(self, var: int, e: M.Expr):
+        """`x = <literals only>`: the converted value is known now; store it."""
+        if self.sv_lock and self.m.vars[var].kind == M.ELEMENT:
+            return None
+        try:
+            x = evaluate(e, self.real, _no_reads)
+        except NotConstant:
+            return None
+        t = self.m.vars[var].type
+        value = to_type(t, x)
+        ptr = self.ptr(self.m.vars[var])
+        if t.kind == "bool":
+            return f"fsw::store_bool({ptr}, {'true' if value else 'false'});"
+        if t.kind == "int":
+            ctype = ("int" if t.signed else "uint") + f"{t.size * 8}_t"
+            if t.signed and value == t.lo:
+                literal = f"({t.lo + 1}LL - 1)"  # the minimum has no literal of its own
+            else:
+                literal = f"{value}{'LL' if t.signed else 'ULL'}"
+            return f"fsw::store<{ctype}>({ptr}, static_cast<{ctype}>({literal}));"
+        bits = struct.unpack("<I", struct.pack("<f", value))[0] if t.size == 4 else \
+            struct.unpack("<Q", struct.pack("<d", value))[0]
+        ctype = "uint32_t" if t.size == 4 else "uint64_t"
+        return f"fsw::store<{ctype}>({ptr}, 0x{bits:0{t.size * 2}x}ULL);  // {value!r}"
+
+    def int_add(self, var: int, e: M.Expr):
+        target = self.m.vars[var]
+        if type(e) is not M.Arith or e.op not in ("+", "-") or target.type.kind != "int":
+            return None
+        if self.sv_lock and target.kind == M.ELEMENT:
+            return None
+        a, k = self.int_operand(e.left), self.exact_int_const(e.right)
+        if e.op == "+" and (a is None or k is None):
+            a, k = self.int_operand(e.right), self.exact_int_const(e.left)
+        if a is None or k is None or a[1].kind != "int":
+            return None
+        if e.op == "-":
+            k = -k
+        text, ta = a
+        limit = (1 << (24 if self.real.bits == 32 else 53)) - 1 - abs(k)
+        if limit < 0:
+            return None
+        # |a| <= limit: a, a + k and the result are all exact in R, so the
+        # assignment is the integer a + k clamped to the target's range.
+        tt = target.type
+        ctype = ("int" if tt.signed else "uint") + f"{tt.size * 8}_t"
+        guard = []
+        if ta.signed and -limit > ta.lo:
+            guard.append(f"a >= -{limit}LL")
+        if limit < ta.hi:
+            guard.append(f"a <= {limit}{'LL' if ta.signed else 'ULL'}")
+        r = f"static_cast<int64_t>(a) + ({k}LL)"
+        lo_r = max(ta.lo, -limit) + k
+        hi_r = min(ta.hi, limit) + k
+        if lo_r < tt.lo:
+            r = f"(r < {tt.lo}LL ? {tt.lo}LL : r)" if hi_r <= tt.hi else f"(r < {tt.lo}LL ? {tt.lo}LL : r > {tt.hi}LL ? {tt.hi}LL : r)"
+            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+        elif hi_r > tt.hi:
+            r = f"(r > {tt.hi}LL ? {tt.hi}LL : r)"
+            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+        else:
+            pre = ""
+        ptr = self.ptr(target)
+        fast = f"{pre}fsw::store<{ctype}>({ptr}, static_cast<{ctype}>({r}));"
+        if self.real.bits == 32 and not ta.signed and abs(k) < (1 << 23):
+            # Past the fast range binary32 still only rounds integers: round a
+            # to 24 bits, add k, round again, saturate - with no float code.
+            sat = "over" if tt.hi == (1 << 64) - 1 else f"(over || s > {tt.hi}ULL)"
+            step = f"s += {k}ULL; s = fsw::round_to_f32_precision(s, over);" if k >= 0 else \
+                f"s -= {-k}ULL; s = fsw::round_to_f32_precision(s, over);"
+            slow = (f"bool over = false; uint64_t s = fsw::round_to_f32_precision(a, over); "
+                    f"if (!over) {{ {step} }} "
+                    f"fsw::store<{ctype}>({ptr}, {sat} ? static_cast<{ctype}>({tt.hi}{'LL' if tt.signed else 'ULL'}) "
+                    f": static_cast<{ctype}>(s));")
+        else:
+            slow = self.write(var, f"({self.read_int(text, ta)} {'+' if k >= 0 else '-'} "
+                                   f"{real_literal(float(abs(k)), self.real)})")
+        if not guard:
+            return f"{{ const {self._ctype(ta)} a = {text}; {fast} }}"
+        return (f"{{ const {self._ctype(ta)} a = {text}; if ({' && '.join(guard)}) {{ {fast} }} "
+                f"else {{ {slow} }} }}")
+
+    @staticmethod
+    def _ctype(t) -> str:
+        return ("int" if t.signed else "uint") + f"{t.size * 8}_t"
+
+    def read_int(self, text: str, t) -> str:
+        """`a` (an integer local copy) as an R."""
+        return f"fsw::real_from_{t.name}(a)"
+
+    def int_operand(self, e: M.Expr):
+        """(C++ integer expression, type) when `e` reads an integer or bool
+        variable (or T) without conversion, else None."""
+        if type(e) is not M.Ref or (self.sv_lock and self.m.vars[e.var].kind == M.ELEMENT):
+            return None
+        v = self.m.vars[e.var]
+        if v.kind == M.TIME_IN_STATE:
+            return f"{self.prefix}machine.t", v.type
+        if e.var in self.consts or v.type.kind == "float":
+            return None
+        if v.type.kind == "bool":
+            return f"fsw::load_bool({self.ptr(v)})", v.type
+        ctype = ("int" if v.type.signed else "uint") + f"{v.type.size * 8}_t"
+        return f"fsw::load<{ctype}>({self.ptr(v)})", v.type
+
+    def known(self, e: M.Expr):
+        """The R value of a literal or of a local folded to a constant."""
+        if type(e) is M.Const:
+            return self.real.literal(e.text)
+        if type(e) is M.Ref and e.var in self.consts:
+            return self.consts[e.var]
+        return None
+
+    def exact_int_const(self, e: M.Expr):
+        """The value of a known operand that is an integer of magnitude below
+        2^p (p = 24 or 53), so that every integer near it is exact in R."""
+        x = self.known(e)
+        if x is None:
+            return None
+        if x != x or x in (float("inf"), float("-inf")) or x != int(x):
+            return None
+        c = int(x)
+        return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
+
+    def int_compare(self, left: M.Expr, op: str, right: M.Expr):
+        """`x op c` on the integer itself. Converting an integer to R is
+        monotonic and exact near c, so `R(x) op c` equals `x op c`."""
+        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+        a, c = self.int_operand(left), self.exact_int_const(right)
+        if a is None or c is None:
+            a, c = self.int_operand(right), self.exact_int_const(left)
+            if a is None or c is None:
+                return None
+            op = flip[op]
+        text, t = a
+        lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
+        # Constant over the type's whole range (c outside it, or `x >= 0` on an
+        # unsigned type): fold it, as compilers would warn about the test.
+        points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
+        results = {compare(op, x, c) for x in points}
+        if len(results) == 1:
+            return "true" if results.pop() else "false"
+        if t.kind == "bool":
+            return f"(static_cast<int>({text}) {op} {c})"
+        return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"

@@ -1,0 +1,151 @@
+"""Each machine as straight-line C++ over the runtime: `<name>.gen.h` and
+`<name>.gen.cpp`.
+
+Generation is a pure function: it returns `{relative path: text}` and only
+the CLI writes files. Output is byte-reproducible: no timestamps, sorted
+iteration, stable names. Generated code is tables and straight-line user
+logic; every algorithm lives in the hand-written runtime (firmware/src)."""
+
+from __future__ import annotations
+
+from .. import model as M
+from ..cnames import enumerator
+from ..evaluate import local_values
+from ..numeric import Real
+from .common import banner, basename, c_ident, parens, real_check, value_bytes, version_check, window_type
+from .expr import ExprEmitter
+
+
+def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
+                 ns: str = "fsw_gen") -> dict[str, str]:
+    """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
+    keeps every local in memory, for a state script that writes locals;
+    otherwise locals that never change are folded into the code. `ns` is
+    the outer namespace (the state vector's, see emit_sv)."""
+    name = c_ident(m.name)
+    src = basename(m.path)
+    ex = ExprEmitter(m, real, scriptable)
+    values = local_values(m, real)
+    stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts]
+    offsets: dict[int, int] = {}
+    size = 0
+    for v in stored:
+        offsets[v.index] = size
+        size += v.type.size
+    init_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in stored)
+    guard = f"{ns.upper()}_{name.upper()}_H"
+    h = [banner([m.path, m.sv.path], m.sv), f"#ifndef {guard}", f"#define {guard}", "",
+         '#include "fswkit.h"', "", f"namespace {ns} {{", f"namespace {name} {{", "",
+         f"// State ids of {src}, in file order.", "enum : uint32_t {"]
+    for st in m.states:
+        h.append(f"    S_{st.name} = {st.id},")
+    h += ["};", f"static const uint32_t kStates = {len(m.states)};", "",
+          "extern fsw::Machine machine;  // state, entry time, T"]
+    if stored:
+        h.append("// Locals kept in memory, packed little-endian like elements.")
+        h.append("enum : uint16_t {")
+        for v in stored:
+            h.append(f"    {enumerator('L_', v.name)} = {offsets[v.index]},  // {v.type.name}")
+        h.append("};")
+        h.append(f"static const uint16_t kLocSize = {size};")
+        h.append("extern uint8_t loc[kLocSize];")
+    h.append("")
+    h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
+    h.append("FSW_MUST_CHECK fsw::Result step();")
+    h.append("// Back to the state before the first step, starting in `initial`.")
+    h.append("void reset(uint32_t initial);")
+    h += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", "", f"#endif  // {guard}", ""]
+
+    c = [banner([m.path, m.sv.path], m.sv), f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
+         version_check(f"{name}.gen.cpp"), real_check(src, real),
+         f"namespace {ns} {{", f"namespace {name} {{", "",
+         f"fsw::Machine machine = FSW_MACHINE_INIT({m.states[0].id});"]
+    if stored:
+        c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
+    c += ["", "namespace {", ""]
+    for w in m.windows:
+        c.append(f"{window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
+    if m.windows:
+        c.append("")
+    if stored:
+        c.append(f"const uint8_t kLocInit[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
+        c.append("")
+    for st in m.states:
+        for label in ("entry", "step", "exit"):
+            stmts = getattr(st, label)
+            if not stmts:
+                continue
+            ret = "void" if label == "exit" else "uint32_t"
+            c.append(f"// [{st.name}] .{label}")
+            c.append(f"{ret} s{st.id}_{label}() {{")
+            _block(stmts, ex, "    ", c, src, m, label != "exit")
+            if label != "exit":
+                c.append("    return 0;")
+            c.append("}")
+            c.append("")
+    c.append("}  // namespace")
+    c.append("")
+    g, s = m.vars[m.g], m.vars[m.s]
+    c.append("fsw::Result step() {")
+    if m.sv.lock:
+        c.append("    uint64_t g;")
+        c.append(f"    {{ fsw::SvGuard<true> lock; g = fsw::load<uint64_t>(sv + E_{g.name}); }}")
+        c.append("    if (fsw::machine_begin_step(machine, g) != fsw::kOk) return fsw::kErrTime;")
+        c.append("    if (machine.entering != 0) {")
+        c.append(f"        fsw::SvGuard<true> lock; fsw::store<uint32_t>(sv + E_{s.name}, machine.state);")
+        c.append("    }")
+    else:
+        c.append(f"    if (fsw::machine_begin_step(machine, fsw::load<uint64_t>(sv + E_{g.name})) != fsw::kOk) "
+                 "return fsw::kErrTime;")
+        c.append(f"    if (machine.entering != 0) fsw::store<uint32_t>(sv + E_{s.name}, machine.state);")
+    for w in m.windows:
+        c.append(f"    w{w.index}.push({ex.value(w.arg)});  // {src}:{w.line}")
+    if any(st.entry or st.step for st in m.states):  # else nothing can transition
+        c.append("    uint32_t next = 0;")
+    c.append("    switch (machine.state) {")
+    for st in m.states:
+        c.append(f"    case S_{st.name}:")
+        if st.entry:
+            c.append(f"        if (machine.entering != 0) next = s{st.id}_entry();")
+        if st.step:
+            c.append(f"        if (next == 0) next = s{st.id}_step();" if st.entry else f"        next = s{st.id}_step();")
+        if st.entry or st.step:
+            c.append("        if (next != 0) {")
+            if st.exit:
+                c.append(f"            s{st.id}_exit();")
+            c.append("            fsw::machine_transition(machine, next);")
+            c.append("        }")
+        c.append("        break;")
+    c.append("    default:")
+    c.append("        break;")
+    c.append("    }")
+    c.append("    return fsw::kOk;")
+    c.append("}")
+    c.append("")
+    c.append("void reset(uint32_t initial) {")
+    c.append("    fsw::machine_reset(machine, initial);")
+    if stored:
+        c.append("    memcpy(loc, kLocInit, sizeof loc);")
+    for w in m.windows:
+        c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
+    c.append("}")
+    c += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", ""]
+    return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}
+
+
+def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.Machine,
+           can_transition: bool) -> None:
+    for st in stmts:
+        t = type(st)
+        if t is M.Assign:
+            out.append(f"{indent}{ex.assign(st.var, st.expr)}  // {src}:{st.line}")
+        elif t is M.Goto:
+            out.append(f"{indent}return S_{m.states[st.state].name};  // {src}:{st.line}")
+            return
+        else:
+            out.append(f"{indent}if {parens(ex.cond(st.cond))} {{  // {src}:{st.line}")
+            _block(st.then, ex, indent + "    ", out, src, m, can_transition)
+            if st.orelse:
+                out.append(f"{indent}}} else {{")
+                _block(st.orelse, ex, indent + "    ", out, src, m, can_transition)
+            out.append(f"{indent}}}")

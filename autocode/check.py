@@ -9,7 +9,7 @@ from fractions import Fraction
 
 from . import model as M
 from . import syntax as S
-from .diagnostics import SM, SS, SV, Diagnostics, Source, visual_col
+from .diagnostics import SM, SS, SV, Diagnostic, Diagnostics, Source, visual_col
 from .evaluate import NotConstant, evaluate, local_values
 from .numeric import F64MODE, exact_literal, truthy
 from .types import TYPES, U32, U64
@@ -757,6 +757,27 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
                     tuple(sections), tuple(windows), tuple(idle_guards))
+
+
+def failure_diagnostics(script: M.Script, source_line) -> dict:
+    """Every located failure a run of `script` can end with, rendered the
+    same by the interpreter and the native runner: `max_steps`,
+    `step_error`, and `asserts` (one per `@assert`, in section order)."""
+    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
+        text = source_line(script.path, line) if source_line else ""
+        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
+
+    stop = next(c for sec in script.sections for g in sec.checks for c in g.checks if isinstance(c, M.Stop))
+    return {
+        "max_steps": located(stop.line, stop.col, None,
+                             f"`@stop` not reached within {script.max_steps} steps "
+                             "(raise `max_steps` in [options] if the script needs more)"),
+        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
+                                          "(it wrapped around at 2^64: lower `delta_t`)"),
+        "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
+                    for sec in script.sections for g in sec.checks for c in g.checks
+                    if isinstance(c, M.Assert)],
+    }
 
 
 def _int_option(o: S.Option, err) -> int | None:

@@ -10,8 +10,6 @@ import re
 import stat
 from dataclasses import dataclass, field
 
-from . import model as M
-
 TAB = 8
 SHOWN = 160  # columns of a source line a diagnostic shows (the rest is cut, `...`)
 
@@ -354,24 +352,3 @@ def decode(data: bytes) -> str:
     that are not UTF-8 become U+DC80..U+DCFF, which the lexer reports by
     value (and `display_line` shows as `?`)."""
     return data.decode("utf-8-sig", errors="surrogateescape")
-
-
-def failure_diagnostics(script: M.Script, source_line) -> dict:
-    """Every located failure a run of `script` can end with, rendered the
-    same by the interpreter and the native runner: `max_steps`,
-    `step_error`, and `asserts` (one per `@assert`, in section order)."""
-    def located(line: int, col: int, title: str | None, message: str) -> Diagnostic:
-        text = source_line(script.path, line) if source_line else ""
-        return Diagnostic(SS, "error", script.path, line, col, message, text, title)
-
-    stop = next(c for sec in script.sections for g in sec.checks for c in g.checks if isinstance(c, M.Stop))
-    return {
-        "max_steps": located(stop.line, stop.col, None,
-                             f"`@stop` not reached within {script.max_steps} steps "
-                             "(raise `max_steps` in [options] if the script needs more)"),
-        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
-                                          "(it wrapped around at 2^64: lower `delta_t`)"),
-        "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
-                    for sec in script.sections for g in sec.checks for c in g.checks
-                    if isinstance(c, M.Assert)],
-    }

@@ -8,7 +8,7 @@ from __future__ import annotations
 import struct
 
 from .. import model as M
-from ..diagnostics import failure_diagnostics
+from ..check import failure_diagnostics
 from ..numeric import Real, to_type
 from .common import banner, basename, c_ident, c_string, parens, real_check, value_bytes, version_check, window_type
 from .expr import ExprEmitter

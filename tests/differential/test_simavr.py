@@ -26,7 +26,7 @@ import gen_programs as gp
 import harness as H
 from fswkit.run import native, windows
 from fswkit.autocode.numeric import F32MODE, f32
-from fswkit.autocode.diagnostics import failure_diagnostics
+from fswkit.autocode.check import failure_diagnostics
 
 AVR_CASES = int(os.environ.get("FSW_DIFF_AVR_CASES", "40"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))

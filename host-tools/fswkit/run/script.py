@@ -8,7 +8,8 @@ import csv
 from dataclasses import dataclass
 
 from fswkit.autocode import model as M
-from fswkit.autocode.diagnostics import Diagnostic, failure_diagnostics
+from fswkit.autocode.check import failure_diagnostics
+from fswkit.autocode.diagnostics import Diagnostic
 from fswkit.autocode.numeric import Real
 from fswkit.run.interp import ERR_TIME, MachineRun, _Emitter, compile_functions
 from fswkit.run.windows import make_window

@@ -12,6 +12,10 @@
 # (shared register save/restore) and linker relaxation (short calls and
 # jumps where they reach); together about 4 % of a firmware's flash.
 
+# RUNTIME is the runtime's folder: `fsw build` passes it (fswkit.autocode.kit,
+# which knows where the kit's files are, in a checkout or an installed
+# kit); by hand it defaults to firmware/src beside this file's folder, as
+# both a checkout and an installed kit lay them out.
 THIS_MK  := $(lastword $(MAKEFILE_LIST))
 RUNTIME  ?= $(dir $(THIS_MK))../firmware/src
 ARDUINO  ?= /usr/share/arduino/hardware/arduino/avr

@@ -1,0 +1,112 @@
+"""A non-editable install works: the wheel carries the kit's own files (the
+firmware runtime, the board definitions, the build's makefile, the
+simulated board's harness), and the installed `fsw` builds a project and
+flies it in closed loop from a folder outside the source tree, with every
+kit file taken from the installed package and nothing written into it.
+
+Offline: the wheel is built without build isolation (setuptools from the
+test extras, `make setup`) and installed with --no-index into a fresh venv,
+whose dependencies (numpy, pyserial, ...) come from this venv through a
+path file."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import site
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+import pytest
+
+from conftest import EXAMPLES, ROOT
+
+pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
+SIMAVR = os.path.exists("/usr/include/simavr/sim_avr.h")
+SOURCES = ("pyproject.toml", "README.md", "host-tools", "autocode", "firmware", "boards", "mk")
+
+
+def _run(cmd, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=240, **kw)
+
+
+def _files(folder: Path) -> set[str]:
+    """Every file under the installed package but Python's byte code."""
+    return {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> Path:
+    """A fresh venv with the kit installed from its wheel; its `bin` folder."""
+    tmp = tmp_path_factory.mktemp("install")
+    src = tmp / "src"  # a copy: the wheel's build writes build/ and *.egg-info beside its sources
+    src.mkdir()
+    for name in SOURCES:
+        if (ROOT / name).is_dir():
+            shutil.copytree(ROOT / name, src / name, ignore=shutil.ignore_patterns("__pycache__", "build"))
+        else:
+            shutil.copy2(ROOT / name, src / name)
+    r = _run([sys.executable, "-m", "pip", "wheel", src, "--no-deps", "--no-build-isolation", "--no-index",
+              "-w", tmp / "wheel"])
+    assert r.returncode == 0, ("the wheel did not build (setuptools>=77 comes with the test extras: "
+                               "`make setup`):\n" + r.stdout[-2000:] + r.stderr[-3000:])
+    wheel = next((tmp / "wheel").glob("fswkit-*.whl"))
+    venv = tmp / "venv"
+    r = _run([sys.executable, "-m", "venv", "--without-pip", venv])
+    assert r.returncode == 0, r.stderr
+    r = _run([sys.executable, "-m", "pip", "--python", venv / "bin" / "python", "install", "--no-deps", "--no-index",
+              "--no-compile", wheel])
+    assert r.returncode == 0, r.stdout + r.stderr
+    py = venv / "bin" / "python"
+    purelib = Path(_run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"]).stdout.strip())
+    deps = sorted({sysconfig.get_paths()["purelib"], *site.getsitepackages()})
+    (purelib / "zz_fswkit_test_deps.pth").write_text("\n".join(deps) + "\n")  # after the venv's own
+    return venv
+
+
+def _env(venv: Path) -> dict:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
+    env["PATH"] = f"{venv / 'bin'}{os.pathsep}{env.get('PATH', '')}"
+    return env
+
+
+def test_the_installed_kit_finds_its_files_in_the_package(installed):
+    r = _run([installed / "bin" / "python", "-c",
+              "import fswkit, fswkit.cli, fswkit.autocode.kit as k, fswkit.sim.board as b\n"
+              "print(fswkit.__file__, fswkit.cli.__file__, k.ROOT, k.RUNTIME, k.BOARDS, k.BUILD_MK, b.HARNESS_SRC,"
+              " sep='\\n')"], env=_env(installed), cwd=installed)
+    assert r.returncode == 0, r.stderr
+    package = (installed / "lib").resolve()
+    paths = [Path(p).resolve() for p in r.stdout.split()]
+    assert len(paths) == 7
+    for p in paths:
+        assert package in p.parents and ROOT not in p.parents, p
+        assert p.exists(), p
+    runtime, boards = paths[3], paths[4]
+    assert (runtime / "fswkit.h").is_file() and (runtime / "fsw_executor.cpp").is_file()
+    assert (boards / "uno.toml").is_file() and (boards / "native.toml").is_file()
+
+
+def test_the_installed_fsw_builds_and_flies_outside_the_tree(installed, tmp_path):
+    site_pkg = next((installed / "lib").glob("python*/site-packages/fswkit"))
+    before = _files(site_pkg)
+    work = tmp_path / "work"
+    shutil.copytree(EXAMPLES / "rocket", work / "rocket", ignore=shutil.ignore_patterns("build"))
+    fsw = installed / "bin" / "fsw"
+
+    r = _run([fsw, "build", "rocket", "--out", tmp_path / "out"], env=_env(installed), cwd=work)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "fsw build: rocket.app for uno (atmega328p)" in r.stdout
+    assert (tmp_path / "out" / "rocket.hex").is_file()
+    assert str(site_pkg / "mk" / "build.mk") in (tmp_path / "out" / "build.log").read_text()
+    assert str(ROOT) not in (tmp_path / "out" / "build.log").read_text()
+
+    if SIMAVR:
+        flight = tmp_path / "flight"
+        r = _run([fsw, "sim", "rocket", "--plant", "rocket", "--seed", "1", "--out", flight],
+                 env=_env(installed), cwd=work)
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "checks passed" in r.stdout and (flight / "summary.txt").is_file()
+    assert _files(site_pkg) == before  # builds and caches went elsewhere

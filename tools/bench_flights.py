@@ -37,9 +37,9 @@ def seeds(text: str) -> list[int]:
 
 
 def build() -> tuple[str, object]:
-    from fswkit.sim.command import _build
+    from fswkit.sim.command import build as build_for_sim
 
-    built = _build(argparse.Namespace(project=PROJECT, board=None, out=OUT))
+    built = build_for_sim(PROJECT, out=OUT)
     if isinstance(built, int):
         sys.exit("bench_flights: the rocket's firmware did not build")
     return built

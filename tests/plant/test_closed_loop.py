@@ -8,7 +8,6 @@ results."""
 
 from __future__ import annotations
 
-import argparse
 import csv
 import os
 import shutil
@@ -31,9 +30,9 @@ HOLD_S = 6.0  # the pinned-sensor faults sit armed on the pad until then (plant.
 
 
 def _build(project: Path, out: Path):
-    from fswkit.sim.command import _build as build
+    from fswkit.sim.command import build
 
-    built = build(argparse.Namespace(project=str(project), board=None, out=str(out)))
+    built = build(str(project), out=str(out))
     assert not isinstance(built, int), f"{project} did not build"
     return built
 

@@ -1,14 +1,14 @@
-"""`fsw sim PROJECT --plant rocket|tank`: build the firmware, fly it in
-closed loop against the plant on the simulated board, write the link log,
-the truth-and-telemetry CSV, the plot and the summary into the output
-folder, print the summary and the checks; exit 1 if a check fails.
+"""Closed-loop flights (`fsw sim PROJECT --plant rocket|tank`, whose
+command is fswkit.cli.sim): the firmware flown against the plant on the
+simulated board, the link log, the truth-and-telemetry CSV, the plot and
+the summary written into the output folder as one set, and the checks,
+the application's [budget] among them.
 
-`prepare` + `execute` are the same steps for tests and tools (one build,
-many flights)."""
+`prepare` + `execute` are the same steps for the command (fswkit.cli.sim),
+tests and tools (one build, many flights)."""
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import hashlib
 import os
@@ -18,11 +18,10 @@ import tempfile
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.link.log import LogError
 from fswkit.outputs import Stopped, stopped_by_signals
 
 from . import report as reports
-from .cosim import CosimError, Run, fly
+from .cosim import Run, fly
 from .params import ParamsError
 from .scenario import FAULTS, PLANTS
 from .scenario import load as load_scenario
@@ -79,22 +78,22 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
 
 
 def budget_checks(app, elf: str, run: Run) -> list[reports.Check]:
-    """The application's [budget] against the flown firmware: flash from the
-    ELF, RAM as static data plus the stack's high-water mark measured on the
-    board during this run. None set: the board's memory."""
-    from fswkit.target.build import BuildError, elf_size
+    """The application's [budget] against the flown firmware (the build
+    service's `budget`: the board's memory where it sets none): flash from
+    the ELF, RAM as static data plus the stack's high-water mark measured
+    on the board during this run."""
+    from fswkit.target.build import BuildError, budget, elf_size
 
     out = []
     try:
         flash, _ram = elf_size(elf)
     except BuildError as e:
         return [reports.Check("the firmware's size", False, str(e))]
-    whose = "the application's [budget]" if app.flash_budget is not None else f"the {app.board.name}'s memory"
-    limit = app.flash_budget or app.board.flash
+    limits = budget(app)
+    limit, whose = limits["flash"]
     out.append(reports.Check(f"flash within {whose}", flash <= limit, f"{flash:,} of {limit:,} B"))
     ram = run.ram.get("ram_usage")
-    whose = "the application's [budget]" if app.ram_budget is not None else f"the {app.board.name}'s memory"
-    limit = app.ram_budget or app.board.ram
+    limit, whose = limits["RAM"]
     if ram is None or isinstance(ram, str):
         out.append(reports.Check(f"RAM within {whose}", False, f"the stack was not measured: {ram}"))
     else:
@@ -182,65 +181,3 @@ def _set_aside(stage: str, out: str, why: BaseException) -> None:
         os.replace(stage, target)
     except OSError:
         shutil.rmtree(stage, ignore_errors=True)
-
-
-def main(args) -> int:
-    """The `fsw sim ... --plant` command."""
-    from fswkit.sim.command import _build, _is_elf
-
-    for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
-                       ("--analog", bool(args.analog)), ("--link", args.link is not None)):
-        if given:
-            _say(f"{opt} is for the free-running board on a pty; with --plant the scenario drives the run")
-            return 2
-    if args.fault and args.plant != "rocket":
-        _say(f"--fault {args.fault} is a fault of the rocket plant; the tank's scenario has its regulator "
-             "failure built in")
-        return 2
-    if _is_elf(args.project) or args.project.endswith(".elf"):
-        _say(f"{args.project}: --plant needs the project (its folder or .app: the plant reads its machines "
-             "and pins), not a firmware ELF")
-        return 2
-    try:
-        seed = 1 if args.seed is None else args.seed
-        app, layout, sc = prepare(args.project, args.plant, params=args.params, seed=seed, fault=args.fault,
-                                  board=args.board)
-    except SetupError as e:
-        for line in str(e).splitlines():
-            sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
-        return 2
-    from fswkit.target.build import default_out
-
-    out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as e:
-        _say(f"cannot create the output folder {out}: {e.strerror or e}")
-        return 2
-    built = _build(argparse.Namespace(project=args.project, board=args.board, out=None))
-    if isinstance(built, int):
-        return built
-    elf, board = built
-    what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
-    _say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
-         "simulated")
-    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
-                  "still the last finished run's")
-    try:
-        flight = execute(sc, elf, board, layout, out)
-    except Stopped as e:
-        _say(f"stopped by {e}" + incomplete)
-        return 128 + e.signum
-    except KeyboardInterrupt:
-        _say("interrupted" + incomplete)
-        raise
-    except (CosimError, LogError) as e:  # LogError: the log could not be written (a full disk)
-        _say(str(e) + incomplete)
-        return 1
-    except OSError as e:
-        _say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
-        return 1
-    sys.stdout.write(flight.report.text())
-    sys.stdout.flush()
-    _say("wrote " + ", ".join(flight.files[k] for k in ("log", "csv", "png", "summary")))
-    return 0 if flight.report.passed else 1

@@ -1,10 +1,12 @@
-"""`fsw gen` and `fsw build`: an application's configs to generated C++,
-and the generated C++ to firmware (`.elf`/`.hex` for a board, an
-executable for `native`) with a flash/RAM table against the board. A
-build holds its folder (`build_lock`), keeps the compiler's output in
-`build.log` there, and explains a failure: firmware that does not fit says
-what uses the memory, line by line of the configs; anything else the
-compiler refuses is an internal error to report."""
+"""The build service: an application's configs to generated C++
+(`generate`), and to firmware (`firmware`: generate, make, size, budget)
+for `fsw gen`, `fsw build`, `fsw flash` and `fsw sim` alike. The firmware
+is an `.elf`/`.hex` for a board, an executable for `native`, with its
+flash and RAM against the application's `[budget]` (else the board's
+memory). A build holds its folder (`build_lock`), keeps the compiler's
+output in `build.log` there, and explains a failure: firmware that does
+not fit says what uses the memory, line by line of the configs; anything
+else the compiler refuses is an internal error to report."""
 
 from __future__ import annotations
 
@@ -20,14 +22,20 @@ from dataclasses import dataclass
 
 from fswkit.autocode.app import Application, load_app
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit.app import emit_app
+from fswkit.autocode.kit import BUILD_MK, RUNTIME
 
-from fswkit.autocode.kit import BUILD_MK, ROOT, RUNTIME
 ARDUINO = "/usr/share/arduino/hardware/arduino/avr"  # mk/build.mk's default, Debian's arduino-core-avr
+EXIT_FAIL, EXIT_INTERNAL = 1, 3  # a build's failures: the user's to fix, or a defect of the kit
 
 
 class BuildError(Exception):
-    pass
+    """A build that cannot go on: the message for the user, and the exit
+    status it stands for (EXIT_FAIL, or EXIT_INTERNAL for a defect of the
+    kit: generated code the compiler refuses)."""
+
+    def __init__(self, message: str, code: int = EXIT_FAIL):
+        super().__init__(message)
+        self.code = code
 
 
 def find_app(project: str) -> str:
@@ -100,13 +108,23 @@ class Size:
                           row("RAM", self.ram, self.ram_budget, ram_note)])
 
 
-def size_of(app, flash: int, ram: int) -> Size:
-    """The firmware's size against its budget: the application's `[budget]`
-    where it sets one, else the board's memory."""
+def budget(app: Application) -> dict[str, tuple[int, str]]:
+    """{"flash": (bytes, whose), "RAM": (bytes, whose)}: what the firmware
+    may use of each memory, the application's `[budget]` where it sets one,
+    else the board's memory (RAM: data + bss + the stack)."""
     b = app.board
+
+    def one(mine: int | None, board: int) -> tuple[int, str]:
+        return (mine, "the application's [budget]") if mine is not None else (board, f"the {b.name}'s memory")
+
+    return {"flash": one(app.flash_budget, b.flash), "RAM": one(app.ram_budget, b.ram)}
+
+
+def size_of(app, flash: int, ram: int) -> Size:
+    """The firmware's size against its budget (`budget`)."""
+    limits = budget(app)
     mine = app.flash_budget is not None or app.ram_budget is not None
-    return Size(flash, ram, app.flash_budget or b.flash, app.ram_budget or b.ram,
-                "the application's" if mine else "")
+    return Size(flash, ram, limits["flash"][0], limits["RAM"][0], "the application's" if mine else "")
 
 
 def elf_size(elf: str) -> tuple[int, int]:
@@ -120,6 +138,70 @@ def elf_size(elf: str) -> tuple[int, int]:
         if len(parts) >= 2 and parts[0].startswith(".") and parts[1].isdigit():
             sec[parts[0]] = int(parts[1])
     return sec.get(".text", 0) + sec.get(".data", 0), sec.get(".data", 0) + sec.get(".bss", 0)
+
+
+# ---- the service ------------------------------------------------------------------------
+
+def generate(app: Application, out: str) -> dict[str, str]:
+    """Generates the application's C++ into `out` (`write_files`); returns
+    {file name: text}. BuildError when the generator refuses it or the
+    folder cannot be written."""
+    import fswkit.autocode.emit.app as emit  # looked up per call: a test stands in a generator
+
+    try:
+        files = emit.emit_app(app)
+    except emit.GenError as e:
+        raise BuildError(str(e)) from None
+    try:
+        write_files(files, out)
+    except OSError as e:
+        raise BuildError(f"cannot write {e.filename or out}: {e.strerror or e}") from None
+    return files
+
+
+@dataclass
+class Built:
+    """A finished build: the firmware and, for a board, its size against the
+    budget. Firmware that does not fit is built all the same (`fits` is
+    False, `report` says what uses the memory): the caller refuses it."""
+    app: Application
+    out: str
+    artifact: str  # the ELF for a board, the executable for `native`
+    size: Size | None = None  # None for `native`: the host's memory is not limited
+    report: str | None = None  # what does not fit and what uses it (size_report), when it does not fit
+
+    @property
+    def elf(self) -> str | None:
+        return self.artifact if self.app.board.is_avr else None
+
+    @property
+    def hex(self) -> str | None:
+        return self.artifact[:-4] + ".hex" if self.app.board.is_avr else None
+
+    @property
+    def fits(self) -> bool:
+        return self.size is None or self.size.fits
+
+
+def firmware(app: Application, out: str, *, command: str = "build", jobs: int = 2) -> Built:
+    """Builds the application's firmware in `out`, holding the folder:
+    generate (into out/gen), make, size, budget. BuildError (with its exit
+    status) when it cannot be built; a firmware that does not fit its
+    budget is returned with `fits` False and its `report`. `command` names
+    who waits in the message of a folder another build holds."""
+    try:
+        with build_lock(out, command):
+            generate(app, os.path.join(out, "gen"))
+            artifact, proc = make(app, out, jobs)
+            if proc.returncode != 0:
+                too_big, message = explain_failure(app, out, proc)
+                raise BuildError(message, EXIT_FAIL if too_big else EXIT_INTERNAL)
+            if not app.board.is_avr:
+                return Built(app, out, artifact)
+            size = size_of(app, *elf_size(artifact))
+            return Built(app, out, artifact, size, None if size.fits else size_report(app, artifact, size))
+    except OSError as e:
+        raise BuildError(f"cannot write {e.filename or out}: {e.strerror or e}") from None
 
 
 # ---- one build of a folder at a time ---------------------------------------------------

@@ -1,13 +1,12 @@
-"""`fsw flash PROJECT [--port PORT] [--board NAME] [--via avrdude|pio]`:
-builds the firmware, then uploads it through the board's bootloader with
-avrdude (Debian's package) using the board's upload settings
-(boards/*.toml [upload]), or delegates to `pio run -t upload`. A missing
-port, a busy port, a port without a bootloader or a board other than the
-one named answers with a message saying so, never a traceback."""
+"""Uploading firmware (`fsw flash`, which builds it first with the build
+service): through the board's bootloader with avrdude (Debian's package)
+using the board's upload settings (boards/*.toml [upload]), or by
+delegating to `pio run -t upload`. A missing port, a busy port, a port
+without a bootloader or a board other than the one named raises FlashError
+with a message saying so, never a traceback."""
 
 from __future__ import annotations
 
-import argparse
 import errno
 import json
 import os
@@ -228,48 +227,3 @@ def upload_pio(app, port: str) -> int:
         raise FlashError(f"PlatformIO's upload failed (exit status {code}): its messages are above")
     print(f"fsw flash: {os.path.basename(app.path)} is on the {app.board.name} at {port} (PlatformIO `{env}`)")
     return EXIT_OK
-
-
-# ---- the command -----------------------------------------------------------------------
-
-def main(args) -> int:
-    from fswkit.target.build import BuildError, build_lock, default_out, firmware_name
-    from fswkit.cli import _load_app, cmd_build
-    from fswkit.target.ports import PortError, default_port
-
-    app = _load_app(args, "flash")
-    if app is None:
-        return EXIT_CONFIG
-    board = app.board
-    if not board.is_avr or not board.raw.get("upload", {}).get("tool"):
-        sys.stderr.write(f"fsw flash: board `{board.name}` runs on this computer, there is nothing to "
-                         f"upload (`fsw build --board {board.name}` builds it)\n")
-        return EXIT_CONFIG
-    try:
-        port, listing = default_port(args.port, "flash")
-        if not args.port:
-            sys.stderr.write(f"fsw flash: using {listing.label() if listing else port}, "
-                             "the only serial port found\n")
-        if not args.force:
-            check_board_on_port(board, listing, port)
-        check_port(port, int(board.raw["upload"]["baud"]))
-        if args.via == "pio":
-            return upload_pio(app, port)
-        out = args.out or default_out(app)
-        with build_lock(out, "flash"):  # no other build rewrites the image between building and uploading it
-            code = cmd_build(argparse.Namespace(project=args.project, board=args.board, out=out))
-            if code != EXIT_OK:
-                return code
-            return upload_avrdude(board, os.path.join(out, firmware_name(app) + ".hex"), port, args.verbose)
-    except BuildError as e:
-        sys.stderr.write(f"fsw flash: {e}\n")
-        return EXIT_FAIL
-    except OSError as e:  # the build folder cannot be made or locked
-        sys.stderr.write(f"fsw flash: {e.filename or ''}: {e.strerror or e}\n")
-        return EXIT_FAIL
-    except PortError as e:
-        sys.stderr.write(f"fsw flash: {e}\n")
-        return EXIT_FAIL
-    except FlashError as e:
-        sys.stderr.write(f"fsw flash: {e}\n")
-        return e.code

@@ -1,0 +1,62 @@
+"""What the `fsw` commands share: exit statuses, diagnostics on standard
+error, loading a project's application, the serial port to use, writing an
+output file."""
+
+from __future__ import annotations
+
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+
+EXIT_OK, EXIT_FAIL, EXIT_CONFIG, EXIT_INTERNAL = 0, 1, 2, 3
+
+
+def print_diags(diags: Diagnostics) -> None:
+    if diags.items:
+        sys.stderr.write(diags.render() + "\n")
+
+
+def plural(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def load_app(project: str, board: str | None, command: str):
+    """The project's application for `board` (None: the one it names),
+    its diagnostics printed; None after a message when it cannot be loaded."""
+    from fswkit.target.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(project, diags, board)
+    except BuildError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    print_diags(diags)
+    return app
+
+
+def port_or_only(port: str | None, command: str) -> str | None:
+    """The port named, else the only candidate (said on standard error);
+    None after a message when there is none or several."""
+    from fswkit.target.ports import PortError, default_port
+
+    try:
+        device, listing = default_port(port, command)
+    except PortError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    if port is None:
+        sys.stderr.write(f"fsw {command}: using {listing.label() if listing else device}, "
+                         "the only serial port found\n")
+    return device
+
+
+def write_output(text: str, out: str | None, command: str, inputs=()) -> int:
+    from fswkit.outputs import OutputError, write_text
+
+    try:
+        write_text(out, text, inputs)
+    except OutputError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return EXIT_FAIL
+    return EXIT_OK

@@ -1,0 +1,269 @@
+"""The front end's commands: `fsw check`, `fsw test`, `fsw graph`,
+`fsw skeleton`, `fsw gen` (configs in; diagnostics, script runs, graphs,
+generated C++ out)."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.cli.common import (EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, load_app, plural, print_diags,
+                               write_output)
+
+CONFIG_EXTS = (".sv", ".sm", ".ss", ".app")
+
+
+def collect(paths: list[str], diags: Diagnostics) -> list[str] | None:
+    files: list[str] = []
+    for p in paths:
+        if os.path.isdir(p):
+            for root, dirs, names in os.walk(p):
+                dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+                files += [os.path.normpath(os.path.join(root, n))
+                          for n in sorted(names) if n.endswith(CONFIG_EXTS)]
+        elif p.endswith(CONFIG_EXTS) or not os.path.exists(p):
+            files.append(p)
+        else:
+            sys.stderr.write(f"fsw check: {p}: not a config file (expected {', '.join(CONFIG_EXTS)} or a folder)\n")
+            return None
+    return files
+
+
+# ---- fsw check ----------------------------------------------------------------
+
+def cmd_check(args) -> int:
+    from fswkit.autocode.project import load_machine, load_script, load_sv
+
+    diags = Diagnostics()
+    files = collect(args.paths, diags)
+    if files is None:
+        return EXIT_CONFIG
+    if not files:
+        sys.stderr.write("fsw check: no config files found\n")
+        return EXIT_FAIL
+    for f in files:
+        if f.endswith(".sv"):
+            load_sv(f, diags)
+        elif f.endswith(".sm"):
+            load_machine(f, diags, args.sv, warnings=True)
+        elif f.endswith(".app"):
+            from fswkit.autocode.app import load_app as load_application
+            load_application(f, diags)
+        else:
+            load_script(f, diags, args.sm, args.sv)
+    print_diags(diags)
+    errors, warnings = diags.error_count, diags.warning_count
+    sys.stderr.write(f"fsw check: {plural(len(files), 'file')}, {plural(errors, 'error')}, "
+                     f"{plural(warnings, 'warning')}\n")
+    if errors or (args.strict and warnings):
+        return EXIT_FAIL
+    return EXIT_OK
+
+
+# ---- fsw test -------------------------------------------------------------------
+
+def _scripts(paths: list[str]) -> list[str] | None:
+    """The scripts named, a folder standing for every `.ss` in it."""
+    out: list[str] = []
+    for p in paths:
+        if os.path.isdir(p):
+            found = sorted(os.path.join(p, n) for n in os.listdir(p) if n.endswith(".ss"))
+            if not found:
+                sys.stderr.write(f"fsw test: {p}: no state scripts (.ss) in this folder\n")
+                return None
+            out += found
+        else:
+            out.append(p)
+    return out
+
+
+def cmd_test(args) -> int:
+    from fswkit.autocode.numeric import REALS
+
+    real_name = args.real
+    if args.board is not None:
+        from fswkit.autocode.board import BoardError, load_board
+        try:
+            board = load_board(args.board)
+        except BoardError as e:
+            sys.stderr.write(f"fsw test: {e}\n")
+            return EXIT_CONFIG
+        if real_name is not None and real_name != board.real:
+            sys.stderr.write(f"fsw test: --real {real_name} contradicts board `{board.name}`, "
+                             f"whose evaluation type is {board.real}\n")
+            return EXIT_CONFIG
+        real_name = board.real
+    real = REALS[real_name or "f64"]
+    if args.coverage and args.native:
+        sys.stderr.write("fsw test: --coverage follows the interpreter's run: leave out --native\n")
+        return EXIT_CONFIG
+    scripts = _scripts(args.script)
+    if scripts is None:
+        return EXIT_CONFIG
+    if args.trace and len(scripts) > 1:
+        sys.stderr.write("fsw test: --trace writes one script's run: name one script\n")
+        return EXIT_CONFIG
+    codes = []
+    coverage: dict[str, list] = {}  # machine path -> [machine, taken, visited]
+    for path in scripts:
+        if len(scripts) > 1:
+            sys.stdout.write(f"== {path}\n")
+            sys.stdout.flush()
+        code, result = _test_one(path, args, real)
+        codes.append(code)
+        if result is not None and args.coverage:
+            m = result[0]
+            entry = coverage.setdefault(os.path.abspath(m.path), [m, set(), set()])
+            entry[1] |= result[1].taken
+            entry[2] |= result[1].visited
+    incomplete = _report_coverage(coverage) if args.coverage else False
+    if len(scripts) > 1:
+        passed = codes.count(EXIT_OK)
+        sys.stdout.write(f"{plural(len(scripts), 'script')}: {passed} passed, {len(scripts) - passed} failed\n")
+    if EXIT_CONFIG in codes:
+        return EXIT_CONFIG
+    if EXIT_INTERNAL in codes:
+        return EXIT_INTERNAL
+    return EXIT_FAIL if EXIT_FAIL in codes or incomplete else EXIT_OK
+
+
+def _test_one(path: str, args, real):
+    """Runs one script; (exit code, (machine, result) for coverage or None)."""
+    from fswkit.autocode.project import load_script, source_of
+    from fswkit.run.script import run
+
+    diags = Diagnostics()
+    script = load_script(path, diags, args.sm, args.sv, real=real)
+    if script is None:
+        print_diags(diags)
+        return EXIT_CONFIG, None
+    print_diags(diags)  # warnings only
+    sources: dict[str, object] = {}
+
+    def line_of(p: str, n: int) -> str:
+        if p not in sources:
+            sources[p] = source_of(p)
+        return sources[p].line(n)
+
+    trace = None
+    if args.trace:  # written beside its path and renamed into place once whole
+        from fswkit.outputs import OutputError, Replacement, check
+        try:
+            check(args.trace, [path, script.machine.path, script.machine.sv.path], what="trace")
+            trace = Replacement(args.trace)
+        except OutputError as e:
+            sys.stderr.write(f"fsw test: {e}\n")
+            return EXIT_FAIL, None
+    ok = False
+    try:
+        if args.native:
+            from fswkit.run import native
+            try:
+                code, report = native.run(script, real, line_of, trace_path=trace and trace.path)
+            except native.NativeError as e:
+                sys.stderr.write(f"fsw test: {e}\n")
+                return EXIT_INTERNAL, None
+            except OSError as e:
+                sys.stderr.write(f"fsw test: {e.filename or ''}: {e.strerror or e}\n")
+                return EXIT_FAIL, None
+            ok = True
+            sys.stdout.write(report)
+            sys.stdout.flush()
+            return (EXIT_OK if code == 0 else EXIT_FAIL), None
+        try:
+            result = run(script, real, trace_path=trace and trace.path, source_line=line_of, cover=args.coverage)
+        except OSError as e:
+            sys.stderr.write(f"fsw test: cannot write trace {args.trace}: {e.strerror or e}\n")
+            return EXIT_FAIL, None
+        ok = True
+        sys.stdout.write(result.report())
+        sys.stdout.flush()
+        return (EXIT_OK if result.passed else EXIT_FAIL), (script.machine, result)
+    finally:
+        if trace is not None:
+            trace.finish(ok)
+
+
+def _report_coverage(coverage: dict) -> bool:
+    """Prints, per machine, the states and transitions the scripts reached
+    and each one they missed; True when something was missed."""
+    from fswkit.autocode.check import gotos
+
+    missed_any = False
+    for key in sorted(coverage):
+        m, taken, visited = coverage[key]
+        name = os.path.basename(m.path)
+        moves = []
+        for st in m.states:
+            for label in ("entry", "step", "exit"):
+                for g in gotos(getattr(st, label)):
+                    moves.append((st, g))
+        hit = sum(1 for _, g in moves if (g.line, g.col) in taken)
+        sys.stdout.write(f"coverage of {name}: {len(visited)}/{len(m.states)} states, "
+                         f"{hit}/{len(moves)} transitions\n")
+        for st in m.states:
+            if st.index not in visited:
+                missed_any = True
+                sys.stdout.write(f"  {name}:{st.line}: state {st.name} never entered\n")
+        for st, g in moves:
+            if (g.line, g.col) not in taken:
+                missed_any = True
+                sys.stdout.write(f"  {name}:{g.line}:{g.col}: transition {st.name} -> "
+                                 f"{m.states[g.state].name} never taken\n")
+    return missed_any
+
+
+# ---- fsw graph / fsw skeleton ---------------------------------------------------------
+
+def _machine_or_exit(args):
+    from fswkit.autocode.project import load_machine
+
+    diags = Diagnostics()
+    m = load_machine(args.machine, diags, args.sv)
+    print_diags(diags)
+    return m
+
+
+def cmd_graph(args) -> int:
+    from fswkit.autocode.emit.graph import to_dot, to_mermaid
+
+    m = _machine_or_exit(args)
+    if m is None:
+        return EXIT_CONFIG
+    return write_output(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output, "graph",
+                  (args.machine, m.sv.path))  # the state vector's as found beside the machine too
+
+
+def cmd_skeleton(args) -> int:
+    from fswkit.new.script import skeleton
+
+    m = _machine_or_exit(args)
+    if m is None:
+        return EXIT_CONFIG
+    return write_output(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, m.sv.path))
+
+
+# ---- fsw gen ---------------------------------------------------------------------------
+
+def cmd_gen(args) -> int:
+    import contextlib
+
+    from fswkit.target.build import BuildError, build_lock, default_out, generate
+
+    app = load_app(args.project, args.board, "gen")
+    if app is None:
+        return EXIT_CONFIG
+    if args.sketch:
+        from fswkit.new.sketch import export
+        return export(app, args.sketch)
+    out = args.out or os.path.join(default_out(app), "gen")
+    try:
+        # the default folder is the build's own: not rewritten while a build compiles it
+        with build_lock(os.path.dirname(out), "gen") if not args.out else contextlib.nullcontext():
+            files = generate(app, out)
+    except (BuildError, OSError) as e:
+        sys.stderr.write(f"fsw gen: {e.strerror if isinstance(e, OSError) and e.strerror else e}\n")
+        return EXIT_FAIL
+    sys.stderr.write(f"fsw gen: {len(files)} files in {out}\n")
+    return EXIT_OK

@@ -1,0 +1,115 @@
+"""The ground's commands over the serial link: `fsw monitor`, `fsw cmd`,
+`fsw log2csv`, `fsw replay`, `fsw plot` (fswkit.ground.monitor, on the
+link's layout of the project's configs)."""
+
+from __future__ import annotations
+
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, port_or_only, print_diags
+
+
+def _link_layout(project: str, command: str, configs: list | None = None):
+    """The link layout of a project's configs and the baud rate its firmware
+    runs the link at (the application's `baud`, or the default it gets), or
+    None after a message; the configs' paths are added to `configs`."""
+    from fswkit.target.build import BuildError, load
+    from fswkit.link.layout import from_app
+
+    diags = Diagnostics()
+    try:
+        app = load(project, diags)
+    except BuildError as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return None
+    print_diags(diags)
+    if app is None:
+        return None
+    if configs is not None:
+        configs += [app.path, app.sv.path] + [m.path for m in app.machines] + [c.path for c in app.channels]
+    return from_app(app), app.baud
+
+
+def _link_baud(asked: int | None, app_baud: int, command: str) -> int:
+    """The rate to open a project's port at: the application's, unless
+    `--baud` asks for another (honoured, with a warning)."""
+    if asked is None:
+        return app_baud
+    if asked != app_baud:
+        sys.stderr.write(f"fsw {command}: warning: --baud {asked}: the application runs its link at "
+                         f"{app_baud} baud\n")
+    return asked
+
+
+def _ground(command: str, fn, *a) -> int:
+    from fswkit.link.layout import LayoutError
+    from fswkit.link.log import LogError
+    from fswkit.link.port import PortError
+    from fswkit.ground.monitor import GroundError
+    from fswkit.outputs import OutputError
+
+    try:
+        return fn(*a)
+    except (GroundError, PortError, LogError, LayoutError, OutputError) as e:
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return EXIT_FAIL
+
+
+def cmd_monitor(args) -> int:
+    from fswkit.ground.monitor import monitor
+
+    from fswkit.outputs import OutputError, check
+
+    configs: list[str] = []
+    link = _link_layout(args.project, "monitor", configs)
+    if link is None:
+        return EXIT_CONFIG
+    layout, app_baud = link
+    port = port_or_only(args.port, "monitor")
+    if port is None:
+        return EXIT_FAIL
+    if args.log is not None:  # --force replaces an old recording, never a config or the port itself
+        try:
+            check(args.log, configs + [port], force=True, what="log")
+        except OutputError as e:
+            sys.stderr.write(f"fsw monitor: {e}\n")
+            return EXIT_FAIL
+    baud = _link_baud(args.baud, app_baud, "monitor")
+    return _ground("monitor", monitor, layout, args.project, port, baud, args.log, args.headless,
+                   args.ignore_schema, args.duration, args.frames, args.force)
+
+
+def cmd_cmd(args) -> int:
+    from fswkit.ground.monitor import command
+
+    link = _link_layout(args.project, "cmd")
+    if link is None:
+        return EXIT_CONFIG
+    layout, app_baud = link
+    baud = _link_baud(args.baud, app_baud, "cmd")
+    return _ground("cmd", command, layout, args.project, args.port, baud, args.what, args.args,
+                   args.ignore_schema)
+
+
+def cmd_log2csv(args) -> int:
+    from fswkit.ground.monitor import log2csv
+    from fswkit.outputs import output
+
+    def run() -> int:
+        with output(args.output, [args.log], newline="", what="CSV") as f:
+            return log2csv(args.log, f, args.ignore_schema)
+
+    return _ground("log2csv", run)
+
+
+def cmd_replay(args) -> int:
+    from fswkit.ground.monitor import replay
+
+    return _ground("replay", replay, args.log, args.headless, args.speed, args.ignore_schema)
+
+
+def cmd_plot(args) -> int:
+    from fswkit.ground.monitor import plot
+
+    return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)

@@ -1,0 +1,312 @@
+"""The `fsw` command line: its parser, the dispatch to the command modules
+(one per room: front, target, sim, ground, new), and the exit statuses:
+0 success, 1 a failure, 2 a configuration or usage error, 3 an internal
+error of the kit, 128 + N stopped by signal N, 130 by Ctrl-C."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+
+from fswkit import __version__
+from fswkit.cli import front, ground, new, sim, target
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
+
+# ---- argument types -------------------------------------------------------------------
+
+def _replay_speed(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    if value != 0 and not 1e-3 <= value <= 1e6:
+        raise argparse.ArgumentTypeError(f"expected 0 (as fast as possible) or a speed from 0.001 to 1000000, "
+                                         f"found {text}")
+    return value
+
+
+def _nonneg_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, found {text}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, found {text!r}")
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, found {value}")
+    return value
+
+
+def _int_upto(hi: int, what: str):
+    """An argparse type: a positive whole number of at most `hi` (what its use can hold)."""
+    def parse(text: str) -> int:
+        value = _positive_int(text)
+        if value > hi:
+            raise argparse.ArgumentTypeError(f"expected {what} of at most {hi:,}, found {text}")
+        return value
+    return parse
+
+
+_baud = _int_upto(10_000_000, "a serial speed")  # what a UART or a USB serial adapter makes
+_delta_t = _int_upto(2**64 - 1, "a time step")  # the script's U64 `delta_t`
+
+
+def _nonneg_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {text!r}")
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {value}")
+    return value
+
+
+# ---- the parser -------------------------------------------------------------------
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="fsw", description="fswkit: flight software from configs.")
+    p.add_argument("--version", action="version", version=f"fsw {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    c = sub.add_parser("check", help="check configs (.sv .sm .ss) or folders of them")
+    c.add_argument("paths", nargs="+", metavar="PATH")
+    c.add_argument("--strict", action="store_true", help="warnings fail the check too")
+    c.add_argument("--sv", help="the state vector config to check machines against")
+    c.add_argument("--sm", help="the state machine config to check scripts against")
+    c.set_defaults(func=front.cmd_check)
+
+    t = sub.add_parser("test", help="run a state script against its machine")
+    t.add_argument("script", metavar="SCRIPT.ss", nargs="+",
+                   help="state scripts, or folders standing for every .ss in them")
+    t.add_argument("--sm", help="the machine (default: the .sm beside the script)")
+    t.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    t.add_argument("--real", choices=("f64", "f32"), default=None,
+                   help="evaluation type R: binary64 (hosts, default) or binary32 (AVR boards)")
+    t.add_argument("--board", help="run with this board's evaluation type (e.g. uno: binary32)")
+    t.add_argument("--native", action="store_true",
+                   help="run the generated C++ compiled for this host instead of the interpreter")
+    t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
+    t.add_argument("--coverage", action="store_true",
+                   help="report the states and transitions the scripts never reached, and fail if any")
+    t.set_defaults(func=front.cmd_test)
+
+    g = sub.add_parser("graph", help="a machine as Graphviz DOT or Mermaid")
+    g.add_argument("machine", metavar="MACHINE.sm")
+    g.add_argument("--format", choices=("dot", "mermaid"), default="dot")
+    g.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    g.add_argument("-o", "--output", help="write here instead of standard output")
+    g.set_defaults(func=front.cmd_graph)
+
+    gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
+    gn.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    gn.add_argument("--board", help="build for this board instead of the one the .app names")
+    gn_out = gn.add_mutually_exclusive_group()
+    gn_out.add_argument("--out", help="where to write (default PROJECT/build/BOARD/gen)")
+    gn_out.add_argument("--sketch", metavar="DIR", help="write an Arduino sketch folder for arduino-cli instead")
+    gn.set_defaults(func=front.cmd_gen)
+
+    b = sub.add_parser("build", help="build an application's firmware (.elf/.hex, or a host executable)")
+    b.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    b.add_argument("--board", help="build for this board instead of the one the .app names")
+    b.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    b.set_defaults(func=target.cmd_build)
+
+    sm = sub.add_parser("sim", help="build and run the firmware on a simulated board, UART0 on a pty")
+    sm.add_argument("project", metavar="PROJECT", help="a folder with one .app, the .app file, or a firmware .elf")
+    sm.add_argument("--board", help="simulate this board (uno, mega2560, ...) instead of the one the .app names")
+    sm.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this much simulated time")
+    sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
+    sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
+    sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")
+    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD); with --plant, the folder the "
+                    "flight's log, CSV, plot and summary go to (default PROJECT/build/BOARD/PLANT-flight)")
+    sm.add_argument("--plant", choices=("rocket", "tank"),
+                    help="fly the firmware in closed loop against this plant model (docs/sim.md)")
+    sm.add_argument("--params", metavar="FILE.toml", help="with --plant: the plant's parameters "
+                    "(default PROJECT/plant.toml)")
+    sm.add_argument("--seed", type=_nonneg_int, metavar="N", help="with --plant: the sensor noise's seed (default 1)")
+    sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro"),
+                    help="with --plant rocket: a sensor fault (stuck-baro: the barometer freezes at ignition; "
+                    "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit)")
+    sm.set_defaults(func=sim.cmd_sim)
+
+    fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")
+    fl.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
+    fl.add_argument("--port", help="the board's serial port (default: the only serial port connected)")
+    fl.add_argument("--board", help="flash for this board instead of the one the .app names")
+    fl.add_argument("--via", choices=("avrdude", "pio"), default="avrdude",
+                    help="upload with avrdude (default) or with `pio run -t upload`")
+    fl.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
+    fl.add_argument("--force", action="store_true", help="flash even when the port's USB IDs say another board")
+    fl.add_argument("-v", "--verbose", action="store_true", help="show avrdude's output as it runs")
+    fl.set_defaults(func=target.cmd_flash)
+
+    po = sub.add_parser("ports", help="list serial ports, with the board each one seems to be")
+    po.add_argument("--all", action="store_true", help="also ports without USB IDs (built-in UARTs)")
+    po.set_defaults(func=target.cmd_ports)
+
+    nw = sub.add_parser("new", help="scaffold a new project that builds as it stands")
+    nw.add_argument("name", metavar="NAME", help="the project's folder; its name names the files and machine")
+    nw.add_argument("--board", default="uno", help="the board it runs on (default uno)")
+    nw.set_defaults(func=new.cmd_new)
+
+    s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")
+    s.add_argument("machine", metavar="MACHINE.sm")
+    s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    s.add_argument("--delta-t", type=_delta_t, default=10, help="time step of the script (default 10)")
+    s.add_argument("-o", "--output", help="write here instead of standard output")
+    s.set_defaults(func=front.cmd_skeleton)
+
+    m = sub.add_parser("monitor", help="decode a target's telemetry live (docs/telemetry.md)")
+    m.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (folder or .app)")
+    m.add_argument("--port", help="serial device (/dev/ttyACM0, a pty) or pyserial URL "
+                   "(default: the only serial port connected)")
+    m.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    m.add_argument("--log", metavar="FILE", help="record every byte of the link to FILE (a new file)")
+    m.add_argument("--force", action="store_true", help="let --log replace an existing FILE")
+    m.add_argument("--headless", action="store_true", help="print decoded frames as lines, no live view")
+    m.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
+    m.add_argument("--duration", type=_nonneg_float, metavar="S", help="stop after S seconds")
+    m.add_argument("--frames", type=_positive_int, metavar="N", help="stop after N frames")
+    m.set_defaults(func=ground.cmd_monitor)
+
+    cm = sub.add_parser("cmd", help="send a command over the uplink and wait for its acknowledgement")
+    cm.add_argument("what", choices=("set", "mode", "ping", "hello", "snapshot"), metavar="COMMAND",
+                    help="set ELEMENT VALUE | mode TASK disabled|safed|enabled | ping | hello | snapshot")
+    cm.add_argument("args", nargs="*", metavar="ARG")
+    cm.add_argument("--port", required=True, help="serial device or pyserial URL")
+    cm.add_argument("-p", "--project", default=".", help="the project the firmware was built from (default .)")
+    cm.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    cm.add_argument("--ignore-schema", action="store_true", help="send even when the schema hash differs")
+    # `set x -3.4028235e38`, `-inf`, `-0x7f`: a value, not an unknown option (argparse
+    # takes only `-5` and `-.5` for numbers); no option of `cmd` starts with a digit, `.`, inf or nan
+    cm._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+    cm.set_defaults(func=ground.cmd_cmd)
+
+    lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")
+    lc.add_argument("log", metavar="LOG")
+    lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")
+    lc.add_argument("--ignore-schema", action="store_true")
+    lc.set_defaults(func=ground.cmd_log2csv)
+
+    rp = sub.add_parser("replay", help="the monitor's view of a link log")
+    rp.add_argument("log", metavar="LOG")
+    rp.add_argument("--headless", action="store_true", help="print decoded frames as lines")
+    rp.add_argument("--speed", type=_replay_speed, default=1.0,
+                    help="1 = as recorded, 2 twice as fast (0.001 to 1000000), 0 = as fast as possible")
+    rp.add_argument("--ignore-schema", action="store_true")
+    rp.set_defaults(func=ground.cmd_replay)
+
+    pl = sub.add_parser("plot", help="time series of elements from a link log, state transitions marked")
+    pl.add_argument("log", metavar="LOG")
+    pl.add_argument("-e", "--element", nargs="+", required=True, metavar="ELEMENT")
+    pl.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    pl.add_argument("--ignore-schema", action="store_true")
+    pl.set_defaults(func=ground.cmd_plot)
+    return p
+
+
+# ---- entry point ------------------------------------------------------------------
+
+def _quiet_stdout() -> None:
+    from fswkit.outputs import discard_stdout
+
+    discard_stdout()
+
+
+def _stdout_failed() -> bool:
+    try:
+        sys.stdout.flush()
+    except OSError:
+        return True
+    except ValueError:  # closed
+        return False
+    return False
+
+
+def _empty_option(p: argparse.ArgumentParser, args) -> str | None:
+    """The long name of an option given as an empty string (a path, a port,
+    a board), or None."""
+    sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction)).choices.get(args.command)
+    for action in sub._actions if sub is not None else ():
+        if action.option_strings and getattr(args, action.dest, None) == "":
+            return max(action.option_strings, key=len)
+    return None
+
+
+def main(argv: list[str] | None = None) -> int:
+    from fswkit import outputs
+    from fswkit.outputs import Stream
+
+    p = parser()
+    args = p.parse_args(argv)
+    empty = _empty_option(p, args)
+    if empty is not None:  # `--trace ""` is no trace, `--out ""` not the default folder
+        sys.stderr.write(f"fsw {args.command}: {empty}: an empty string names nothing: give a path or name, "
+                         "or leave the option out\n")
+        return EXIT_CONFIG
+    # every print of every command: a failed write says it was standard output
+    saved = sys.stdout
+    out = sys.stdout = Stream(saved, "standard output")
+    outputs.stopped_by = None
+    try:
+        # SIGTERM and SIGHUP stop a command as Ctrl-C does (its temporary files removed,
+        # its outputs whole or as they were), with status 128 + the signal's number
+        try:
+            with outputs.stopped_by_signals():
+                code = _main(args, out)
+        except outputs.Stopped:  # the signal came as the command returned
+            code = EXIT_FAIL
+        return 128 + outputs.stopped_by if outputs.stopped_by else code
+    finally:
+        if sys.stdout is out:
+            sys.stdout = saved
+
+
+def _main(args, out) -> int:
+    from fswkit.outputs import OutputError
+
+    try:
+        code = args.func(args)
+        if out.failed:  # the command stopped at it and said so
+            _quiet_stdout()
+            return code or EXIT_FAIL
+        sys.stdout.flush()  # a full or closed standard output fails here, not after exit
+        return code
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:  # the reader went away (`fsw ... | head`): not a failure
+        _quiet_stdout()
+        return EXIT_OK
+    except OutputError as e:
+        sys.stderr.write(f"fsw {args.command}: {e}\n")
+        _quiet_stdout()
+        return EXIT_FAIL
+    except OSError as e:  # an input or output the command could not use: its system error
+        if out.failed or _stdout_failed():
+            sys.stderr.write(f"fsw {args.command}: cannot write standard output: {e.strerror or e}\n")
+            _quiet_stdout()
+        else:
+            where = f"{e.filename}: " if e.filename else ""
+            sys.stderr.write(f"fsw {args.command}: {where}{e.strerror or e}\n")
+        return EXIT_FAIL
+    except RecursionError:
+        sys.stderr.write("fsw: input nested too deeply to process\n")
+        return EXIT_INTERNAL
+    except Exception as e:  # a bug of the kit, never the user's input: no traceback
+        if os.environ.get("FSW_DEBUG"):
+            raise
+        sys.stderr.write(f"fsw: internal error: {type(e).__name__}: {e}\n"
+                         "  (this is a bug in fswkit; run with FSW_DEBUG=1 for details)\n")
+        return EXIT_INTERNAL

@@ -1,0 +1,152 @@
+"""`fsw sim`: the firmware on the simulated board, free-running with UART0
+on a pseudo-terminal (`board_run`: fswkit.sim), or flown in closed loop
+against a plant (`--plant`, `plant_run`: fswkit.plant.run). Both build
+with the build service (fswkit.sim.command.build), `[budget]` included."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+from fswkit.cli.common import EXIT_CONFIG
+
+
+def cmd_sim(args) -> int:
+    if args.plant is not None:
+        return plant_run(args)
+    if args.params is not None or args.fault is not None or args.seed is not None:
+        sys.stderr.write("fsw sim: --params, --seed and --fault need --plant rocket|tank\n")
+        return EXIT_CONFIG
+    return board_run(args)
+
+
+def board_run(args) -> int:
+    """`fsw sim PROJECT|FW.elf`: build, start with UART0 on a pty, print the
+    pty's path on standard output, run until Ctrl-C or --duration."""
+    from fswkit.sim.board import SimBoard, SimError, link_problem, sim_board
+    from fswkit.sim.command import analog_args, build, is_elf, say
+
+    if args.duration is not None and not 0 < args.duration < 1e9:
+        say("--duration must be a positive number of simulated seconds")
+        return 2
+    if args.link is not None and link_problem(args.link) is not None:
+        say(link_problem(args.link))
+        return 2
+    if is_elf(args.project) or args.project.endswith(".elf"):
+        if args.board is None:
+            say(f"{args.project}: a firmware ELF needs --board (the board it was built for, e.g. uno)")
+            return 2
+        try:
+            board = sim_board(args.board)
+        except SimError as e:
+            say(str(e))
+            return 2
+        elf = args.project
+    else:
+        built = build(args.project, args.board, args.out)
+        if isinstance(built, int):
+            return built
+        elf, board = built
+    analog = analog_args(args.analog or [], board)
+    if isinstance(analog, str):
+        say(analog)
+        return 2
+    try:
+        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link)
+    except SimError as e:
+        say(str(e))
+        return 1
+    with b:
+        sys.stdout.write(f"{b.port}\n")
+        sys.stdout.flush()
+        pace = "as fast as it can" if args.fast else "in real time"
+        end = f"for {args.duration:g} simulated s" if args.duration else "until Ctrl-C"
+        link = f" (and {args.link})" if args.link else ""
+        say(f"{board.name} ({b.mcu} at {b.f_cpu / 1e6:g} MHz) runs {pace} {end}; UART0 is {b.port}{link}")
+        t0 = time.monotonic()
+        try:
+            r = b.go(until=args.duration, realtime=not args.fast)
+        except SimError as e:
+            say(str(e))
+            return 1
+        wall = time.monotonic() - t0
+        why = {"target": "duration reached", "interrupted": "stopped", "done": "the firmware stopped itself",
+               "crashed": "the firmware crashed", "sim-limit": "simulated-time limit",
+               "wall-limit": "wall-clock limit"}.get(r.stop, r.stop)
+        say(f"{why} at {r.time:.6f} s simulated ({r.cycle:,} cycles) after {wall:.2f} s")
+        dropped = int(b.info().get("dropped", "0"))
+        if dropped:
+            say(f"{dropped:,} UART bytes were sent while no program had the port open")
+        try:
+            ram = b.ram_usage()
+            say(f"stack high-water {ram.stack:,} B; RAM {ram.static:,} B static + {ram.stack:,} B stack = "
+                 f"{ram.total:,} of {ram.ram:,} B")
+        except SimError as e:
+            say(f"stack not measured: {e}")
+    return 1 if r.stop == "crashed" else 0
+
+
+def plant_run(args) -> int:
+    """`fsw sim PROJECT --plant rocket|tank`: build, fly, write the files, print the checks."""
+    from fswkit.link.log import LogError
+    from fswkit.outputs import Stopped
+    from fswkit.plant.cosim import CosimError
+    from fswkit.plant.run import INCOMPLETE, SetupError, execute, prepare
+    from fswkit.sim.command import build, is_elf, say
+    from fswkit.target.build import default_out
+
+    for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
+                       ("--analog", bool(args.analog)), ("--link", args.link is not None)):
+        if given:
+            say(f"{opt} is for the free-running board on a pty; with --plant the scenario drives the run")
+            return 2
+    if args.fault and args.plant != "rocket":
+        say(f"--fault {args.fault} is a fault of the rocket plant; the tank's scenario has its regulator "
+            "failure built in")
+        return 2
+    if is_elf(args.project) or args.project.endswith(".elf"):
+        say(f"{args.project}: --plant needs the project (its folder or .app: the plant reads its machines "
+            "and pins), not a firmware ELF")
+        return 2
+    try:
+        seed = 1 if args.seed is None else args.seed
+        app, layout, sc = prepare(args.project, args.plant, params=args.params, seed=seed, fault=args.fault,
+                                  board=args.board)
+    except SetupError as e:
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
+        return 2
+    out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    built = build(args.project, args.board)  # into the project's build folder; `out` is the flight's
+    if isinstance(built, int):
+        return built
+    elf, board = built
+    what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
+    say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
+        "simulated")
+    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
+                  "still the last finished run's")
+    try:
+        flight = execute(sc, elf, board, layout, out)
+    except Stopped as e:
+        say(f"stopped by {e}" + incomplete)
+        return 128 + e.signum
+    except KeyboardInterrupt:
+        say("interrupted" + incomplete)
+        raise
+    except (CosimError, LogError) as e:  # LogError: the log could not be written (a full disk)
+        say(str(e) + incomplete)
+        return 1
+    except OSError as e:
+        say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
+        return 1
+    sys.stdout.write(flight.report.text())
+    sys.stdout.flush()
+    say("wrote " + ", ".join(flight.files[k] for k in ("log", "csv", "png", "summary")))
+    return 0 if flight.report.passed else 1

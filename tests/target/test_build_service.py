@@ -1,0 +1,83 @@
+"""The one build service (fswkit.target.build.firmware: generate, make,
+size, budget) behind `fsw build`, `fsw flash`, `fsw sim` and the plant
+runs. `fsw sim`, with or without a plant, refuses firmware over the
+application's [budget] with the message `fsw build` gives: which memory, by
+how much, and what uses it, named by the config lines it comes from."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+
+from conftest import EXAMPLES
+
+TANK = EXAMPLES / "tank"
+needs_avr = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
+FLASH_BUDGET = 4096  # the tank's firmware is about 10 KB
+
+
+def _over_budget(tmp_path):
+    project = tmp_path / "tank"
+    shutil.copytree(TANK, project, ignore=shutil.ignore_patterns("build"))
+    with open(project / "tank.app", "a") as f:
+        f.write(f"\n[budget]\nflash {FLASH_BUDGET}\n")
+    return project
+
+
+def _load(project):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.target.build import load
+
+    app = load(str(project), Diagnostics())
+    assert app is not None
+    return app
+
+
+@needs_avr
+def test_the_service_builds_sizes_and_judges_the_budget(tmp_path):
+    from fswkit.target.build import budget, firmware
+
+    app = _load(_over_budget(tmp_path))
+    assert budget(app) == {"flash": (FLASH_BUDGET, "the application's [budget]"),
+                           "RAM": (2048, "the uno's memory")}
+    built = firmware(app, str(tmp_path / "over"))
+    assert built.elf == str(tmp_path / "over" / "tank.elf") and os.path.isfile(built.hex)
+    assert built.size.flash > FLASH_BUDGET == built.size.flash_budget and not built.fits
+    assert built.report.startswith("the firmware does not fit the application's [budget]: flash ")
+    assert "what uses flash, largest first:" in built.report
+    within = firmware(_load(TANK), str(tmp_path / "within"))
+    assert within.fits and within.report is None and within.size.flash_budget == 32256
+
+
+def test_a_native_build_has_no_size_to_judge(tmp_path):
+    if shutil.which("g++") is None:
+        pytest.skip("no host C++ compiler")
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.target.build import firmware, load
+
+    built = firmware(load(str(TANK), Diagnostics(), "native"), str(tmp_path / "native"))
+    assert built.size is None and built.fits and built.elf is None and built.hex is None
+    assert os.access(built.artifact, os.X_OK)
+
+
+@needs_avr
+def test_fsw_sim_honours_the_budget_as_fsw_build_does(fsw, tmp_path):
+    project = _over_budget(tmp_path)
+    out = tmp_path / "out"
+    b = fsw("build", str(project), "--out", str(out))
+    assert b.code == 1, b.err
+    report = b.err.split("fsw build: ", 1)[1]
+    assert report.startswith(f"the firmware does not fit the application's [budget]: flash ")
+    assert f" B of {FLASH_BUDGET:,} B, " in report and "B  machine tank, tank.sm: its states' code" in report
+
+    s = fsw("sim", str(project), "--out", str(out), "--fast", "--duration", "0.1")
+    assert s.code == 1 and s.out == ""
+    assert "fsw sim: " + report in s.err
+
+    flight = tmp_path / "flight"
+    p = fsw("sim", str(project), "--plant", "tank", "--out", str(flight))
+    assert p.code == 1 and p.out == ""
+    assert "fsw sim: " + report.replace(str(out), str(project / "build" / "uno")) in p.err
+    assert not (flight / "summary.txt").exists()

@@ -69,7 +69,7 @@ def test_fsw_sim_honours_the_budget_as_fsw_build_does(fsw, tmp_path):
     b = fsw("build", str(project), "--out", str(out))
     assert b.code == 1, b.err
     report = b.err.split("fsw build: ", 1)[1]
-    assert report.startswith(f"the firmware does not fit the application's [budget]: flash ")
+    assert report.startswith("the firmware does not fit the application's [budget]: flash ")
     assert f" B of {FLASH_BUDGET:,} B, " in report and "B  machine tank, tank.sm: its states' code" in report
 
     s = fsw("sim", str(project), "--out", str(out), "--fast", "--duration", "0.1")

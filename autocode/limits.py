@@ -17,6 +17,7 @@ from fractions import Fraction
 
 from . import model as M
 from .diagnostics import APP, Diagnostics, Source
+from .protocol import CRC, HEADER, HELLO_PAYLOAD, encoded_max
 from .schema import link_plan
 
 U8_COUNT = 255  # tables counted in a uint8_t (0xFF marks "none" for the uplink task)
@@ -55,8 +56,9 @@ def window_bytes_avr(w: M.Window) -> int:
 
 
 def encoded_health(plan) -> int:
-    """The bytes of a health frame on the wire: payload, header, CRC."""
-    return plan.health_payload + 8 + 2
+    """The bytes of a health frame on the wire: payload, header, CRC, the
+    COBS code byte and the delimiter."""
+    return plan.health_payload + HEADER + CRC + 2
 
 
 def link_load(app) -> tuple[float, float]:
@@ -64,11 +66,11 @@ def link_load(app) -> tuple[float, float]:
     plan = link_plan(app)
     load = 0.0
     for s in plan.streams:
-        frame = s.batch * s.region.size + 8 + 2 + (s.batch * s.region.size + 8) // 254
+        frame = encoded_max(s.batch * s.region.size + HEADER + CRC)
         load += float(s.rate) / s.batch * frame
     if plan.telemetry_task is not None and plan.health_every:
         hz = float(app.tasks[plan.telemetry_task].rate / plan.health_every)
-        load += hz * encoded_health(plan) + hz / max(plan.hello_every, 1) * 27
+        load += hz * encoded_health(plan) + hz / max(plan.hello_every, 1) * (HELLO_PAYLOAD.size + HEADER + CRC)
     return load, app.baud / 10
 
 

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from . import model as M
+from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD, PROTOCOL,
+                       SNAPSHOT_OFFSET, encoded_max)
 
 
 def layout_text(sv: M.StateVector) -> str:
@@ -28,23 +30,10 @@ def schema_hash(sv: M.StateVector, extra: str = "") -> int:
 
 # ---- the serial link: what flows over it, decided once for both ends -------------
 
-PROTOCOL = 1  # docs/telemetry.md; the firmware's kLinkProtocol
-HEADER = 6  # type, sequence number, time (low 32 bits)
-CRC = 2
 BATCH_PAYLOAD = 96  # a sample frame batches samples up to this many payload bytes...
 BATCH_MIN_FRAME_HZ = 20  # ...while it still goes out at least this often
-HELLO_PAYLOAD = 19
-HEALTH_FIXED = 33  # + HEALTH_PER_TASK per task
-HEALTH_PER_TASK = 6
-ACK_PAYLOAD = 6
-SNAPSHOT_OFFSET = 2
 HEALTH_HZ = 1  # health frames per second (at most one per telemetry run)
 HELLO_EVERY = 10  # health frames between two unsolicited hellos
-
-
-def encoded_max(n: int) -> int:
-    """Wire bytes of a frame of `n` bytes (body + CRC) at most: COBS + delimiter."""
-    return n + n // 254 + 2
 
 
 @dataclass(frozen=True)
@@ -88,8 +77,8 @@ def link_plan(app) -> LinkPlan:
         every = int(tele_rate / s.rate)
         streams.append(LinkStream(i, s.region, s.rate, every, _batch(s.region.size, s.rate)))
     health_every = max(1, int(app.tasks[tele].rate // HEALTH_HZ)) if tele is not None else 0
-    health_payload = HEALTH_FIXED + HEALTH_PER_TASK * len(app.tasks)
-    bodies = [HELLO_PAYLOAD, ACK_PAYLOAD, health_payload] + [s.batch * s.region.size for s in streams]
+    health_payload = HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks)
+    bodies = [HELLO_PAYLOAD.size, ACK_PAYLOAD.size, health_payload] + [s.batch * s.region.size for s in streams]
     longest = max(bodies)
     sv_size = max(app.sv.size, 1)
     snapshot_chunk = max(1, min(sv_size, longest - SNAPSHOT_OFFSET))

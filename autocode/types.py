@@ -27,6 +27,15 @@ class ElemType:
     def is_bool(self) -> bool:
         return self.kind == "bool"
 
+    @property
+    def fmt(self) -> str:
+        """The `struct` format character of one stored value (pack it with
+        a leading `<`: little-endian, no padding)."""
+        if self.kind == "float":
+            return "f" if self.size == 4 else "d"
+        c = {1: "b", 2: "h", 4: "i", 8: "q"}[self.size]
+        return c if self.signed else c.upper()
+
     def __str__(self) -> str:
         return self.name
 

@@ -9,14 +9,15 @@ from ..cnames import comment
 from ..limits import link_load
 from ..numeric import REALS
 from ..schema import app_schema_hash, link_plan
+from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
 from .machine import emit_machine
 from .sv import emit_sv
 
-TYPE_CODE = {"F32": "fsw::kF32", "F64": "fsw::kF64"}
-ELEM_CODE = {"I8": "fsw::kI8", "I16": "fsw::kI16", "I32": "fsw::kI32", "I64": "fsw::kI64",
-             "U8": "fsw::kU8", "U16": "fsw::kU16", "U32": "fsw::kU32", "U64": "fsw::kU64",
-             "F32": "fsw::kF32", "F64": "fsw::kF64", "bool": "fsw::kBool"}
+# each element type's fsw::ElemType enumerator (firmware/src/fsw_types.h;
+# tests/link/test_protocol_matches_firmware.py holds the two lists equal)
+ELEM_CODE = {name: "fsw::kBool" if name == "bool" else f"fsw::k{name}" for name in TYPES}
+TYPE_CODE = {name: ELEM_CODE[name] for name in ("F32", "F64")}  # the types an analog channel holds
 
 
 class GenError(Exception):

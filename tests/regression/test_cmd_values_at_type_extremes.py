@@ -11,7 +11,8 @@ import struct
 import pytest
 from conftest import EXAMPLES, run_fsw
 
-from fswkit.link.layout import INT_RANGE, Element, LayoutError, encode_value
+from fswkit.autocode.types import TYPES
+from fswkit.link.layout import Element, LayoutError, encode_value
 
 F32_MAX = struct.unpack("<f", b"\xff\xff\x7f\x7f")[0]  # 3.4028234663852886e38
 
@@ -20,9 +21,9 @@ def _el(t):
     return Element(0, "x", t, 0, "R")
 
 
-@pytest.mark.parametrize("t", sorted(INT_RANGE))
+@pytest.mark.parametrize("t", sorted(n for n, t in TYPES.items() if t.is_int))
 def test_integer_extremes(t):
-    lo, hi = INT_RANGE[t]
+    lo, hi = TYPES[t].lo, TYPES[t].hi
     size = {"8": 1, "16": 2, "32": 4, "64": 8}[t[1:]]
     for v in (lo, hi, hex(hi)):
         assert len(encode_value(_el(t), str(v))) == size

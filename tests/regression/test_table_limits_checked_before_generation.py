@@ -23,7 +23,7 @@ from fswkit.autocode.emit.app import emit_app
 from fswkit.autocode.emit.script import script_files
 from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_machine, load_script, load_sv
-from fswkit.autocode.schema import encoded_max
+from fswkit.autocode.protocol import encoded_max
 
 SM = "[state_vector]\nU64 time @alias G\nU32 state @alias S\n\n[Run]\n"
 

@@ -11,13 +11,7 @@ import struct
 from dataclasses import dataclass
 from fractions import Fraction
 
-FORMATS = {"I8": "b", "I16": "h", "I32": "i", "I64": "q", "U8": "B", "U16": "H", "U32": "I", "U64": "Q",
-           "F32": "f", "F64": "d", "bool": "B"}
-SIZES = {"I8": 1, "I16": 2, "I32": 4, "I64": 8, "U8": 1, "U16": 2, "U32": 4, "U64": 8, "F32": 4, "F64": 8,
-         "bool": 1}
-INT_RANGE = {"I8": (-2**7, 2**7 - 1), "I16": (-2**15, 2**15 - 1), "I32": (-2**31, 2**31 - 1),
-             "I64": (-2**63, 2**63 - 1), "U8": (0, 2**8 - 1), "U16": (0, 2**16 - 1), "U32": (0, 2**32 - 1),
-             "U64": (0, 2**64 - 1)}
+from fswkit.autocode.types import TYPES  # element types by name: size, range, struct format
 
 
 class LayoutError(Exception):
@@ -34,7 +28,7 @@ class Element:
 
     @property
     def size(self) -> int:
-        return SIZES[self.type]
+        return TYPES[self.type].size
 
 
 @dataclass(frozen=True)
@@ -118,7 +112,7 @@ class Layout:
 
 
 def _region(name, offset, size, elems) -> Region:
-    fmt = "<" + "".join(FORMATS[e.type] for e in elems)
+    fmt = "<" + "".join(TYPES[e.type].fmt for e in elems)
     if struct.calcsize(fmt) != size:
         raise LayoutError(f"region `{name}`: elements add up to {struct.calcsize(fmt)} bytes, not {size}")
     return Region(name, offset, size, tuple(elems), struct.Struct(fmt),
@@ -178,7 +172,7 @@ def check_dict(d) -> None:
             raise LayoutError(f"field `layout.{key}` is missing")
         need(ok(d[key]), f"layout.{key}", d[key], want)
     items = {"elements": {"name": (lambda v: isinstance(v, str), "a string"),
-                          "type": (lambda v: isinstance(v, str) and v in FORMATS, "one of " + " ".join(FORMATS)),
+                          "type": (lambda v: isinstance(v, str) and v in TYPES, "one of " + " ".join(TYPES)),
                           "offset": (lambda v: _is_int(v, 0, 1 << 20), "an offset in bytes"),
                           "region": (lambda v: isinstance(v, str), "a region name")},
              "regions": {"name": (lambda v: isinstance(v, str), "a string"),
@@ -293,14 +287,14 @@ def encode_value(el: Element, text: str) -> bytes:
         if math.isinf(x) and not literal_inf:
             raise LayoutError(f"`{el.name}` is {t}: {text} is out of its range ({limit}, or inf)")
         try:
-            return struct.pack("<" + FORMATS[t], x)
+            return struct.pack("<" + TYPES[t].fmt, x)
         except OverflowError:
             raise LayoutError(f"`{el.name}` is {t}: {text} is out of its range ({limit}, or inf)") from None
     try:
         v = int(text, 0)
     except ValueError:
         raise LayoutError(f"`{el.name}` is {t}: `{text}` is not a whole number") from None
-    lo, hi = INT_RANGE[t]
+    lo, hi = TYPES[t].lo, TYPES[t].hi
     if not lo <= v <= hi:
         raise LayoutError(f"`{el.name}` is {t}: {v} is outside {lo}..{hi}")
-    return struct.pack("<" + FORMATS[t], v)
+    return struct.pack("<" + TYPES[t].fmt, v)

@@ -10,14 +10,12 @@ from collections import deque
 from dataclasses import dataclass
 
 from fswkit.autocode.app import TASK_MODES
+from fswkit.autocode.protocol import ACK_PAYLOAD, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD
 
 from . import wire
 from .layout import Layout
 
-_HELLO = struct.Struct("<BIIIBBBBH")
-_HEALTH = struct.Struct("<IIIIHBHHHHHHH")
-_TASK = struct.Struct("<BBHH")
-_ACK = struct.Struct("<HBBH")
+_HELLO, _HEALTH, _TASK, _ACK = HELLO_PAYLOAD, HEALTH_PAYLOAD, HEALTH_TASK, ACK_PAYLOAD
 _U16 = struct.Struct("<H")
 TASK_MODE_NAMES = {v: k for k, v in TASK_MODES.items()}  # a task's mode on the wire -> its name
 

@@ -10,27 +10,16 @@ import struct
 from binascii import crc_hqx
 from dataclasses import dataclass
 
-PROTOCOL = 1
-HEADER = 6  # type, sequence number, time (low 32 bits)
-CRC_INIT = 0xFFFF
+# The numbers of the protocol are written once, in autocode (the generator
+# sizes the firmware's buffers from them); the ground tools read them here.
+from fswkit.autocode.protocol import (ACK, CRC, CRC_INIT, HEADER, HEALTH, HELLO, OP_HELLO, OP_MODE, OP_NAMES,
+                                      OP_PING, OP_SET, OP_SNAPSHOT, PROTOCOL, SAMPLE, SNAPSHOT, STATUS,
+                                      encoded_max)
 
-# downlink frame types
-HELLO, HEALTH, ACK, SNAPSHOT, SAMPLE = 0x01, 0x02, 0x03, 0x04, 0x80
-# uplink opcodes
-OP_PING, OP_HELLO, OP_SNAPSHOT, OP_SET, OP_MODE = 0x01, 0x02, 0x03, 0x04, 0x05
-OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode"}
-# acknowledgement status
-STATUS = {
-    0: ("OK", "applied"),
-    1: ("REPLAY", "sequence number not newer than the last accepted command"),
-    2: ("UNKNOWN_OP", "unknown opcode"),
-    3: ("BAD_LENGTH", "arguments of the wrong length"),
-    4: ("NOT_WRITABLE", "the element is not in the application's [uplink] list"),
-    5: ("BAD_TASK", "no such task"),
-    6: ("BAD_MODE", "mode must be 0 disabled, 1 safed or 2 enabled"),
-    7: ("LOCKED", "the executor keeps it: the uplink task's own mode, a task's mode, overruns or worst_us "
-                  "element, the reset cause (modes change only by `mode`)"),
-}
+__all__ = ["ACK", "CRC", "CRC_INIT", "HEADER", "HEALTH", "HELLO", "OP_HELLO", "OP_MODE", "OP_NAMES", "OP_PING",
+           "OP_SET", "OP_SNAPSHOT", "PROTOCOL", "SAMPLE", "SNAPSHOT", "STATUS",
+           "BULK", "Deframer", "WireStats", "cobs_decode", "cobs_encode", "crc16", "downlink", "encoded_size",
+           "frame", "uplink"]
 
 _U32 = struct.Struct("<I")
 
@@ -122,8 +111,7 @@ class WireStats:
 def encoded_size(body: int) -> int:
     """The most bytes a frame body of `body` bytes takes on the wire, CRC
     and COBS included, without its delimiter."""
-    n = body + 2
-    return n + n // 254 + 1
+    return encoded_max(body + CRC) - 1  # no delimiter
 
 
 class Deframer:

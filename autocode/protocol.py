@@ -1,0 +1,45 @@
+"""The link's wire format (docs/telemetry.md), written once for the host:
+the generator sizes the firmware's buffers from it (schema.link_plan) and
+the ground tools (fswkit.link) frame and decode with it. The firmware's own
+copy is firmware/src/fsw_link.h; tests/link/test_protocol_matches_firmware.py
+holds the two equal."""
+
+from __future__ import annotations
+
+import struct
+
+PROTOCOL = 1  # the hello frame's protocol number; the firmware's kLinkProtocol
+HEADER = 6  # type, sequence number, time (low 32 bits)
+CRC = 2  # CRC-16/CCITT-FALSE, high byte first
+CRC_INIT = 0xFFFF
+
+# downlink frame types (a sample frame: SAMPLE | stream index)
+HELLO, HEALTH, ACK, SNAPSHOT, SAMPLE = 0x01, 0x02, 0x03, 0x04, 0x80
+# uplink opcodes
+OP_PING, OP_HELLO, OP_SNAPSHOT, OP_SET, OP_MODE = 0x01, 0x02, 0x03, 0x04, 0x05
+OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode"}
+# acknowledgement status: 0 applied, anything else refused
+STATUS = {
+    0: ("OK", "applied"),
+    1: ("REPLAY", "sequence number not newer than the last accepted command"),
+    2: ("UNKNOWN_OP", "unknown opcode"),
+    3: ("BAD_LENGTH", "arguments of the wrong length"),
+    4: ("NOT_WRITABLE", "the element is not in the application's [uplink] list"),
+    5: ("BAD_TASK", "no such task"),
+    6: ("BAD_MODE", "mode must be 0 disabled, 1 safed or 2 enabled"),
+    7: ("LOCKED", "the executor keeps it: the uplink task's own mode, a task's mode, overruns or worst_us "
+                  "element, the reset cause (modes change only by `mode`)"),
+}
+
+# payloads, little-endian
+HELLO_PAYLOAD = struct.Struct("<BIIIBBBBH")  # protocol, schema, time_hi, frames, version x3, reset cause, last_seq
+HEALTH_PAYLOAD = struct.Struct("<IIIIHBHHHHHHH")  # time_hi, frames, dropped, cycles, late, reset cause, rx counters, last_seq;
+# then one HEALTH_TASK per task
+HEALTH_TASK = struct.Struct("<BBHH")    # mode, faults, overruns, worst_us
+ACK_PAYLOAD = struct.Struct("<HBBH")    # command seq, opcode, status, last_seq
+SNAPSHOT_OFFSET = 2  # a snapshot frame's payload: offset (u16), then state vector bytes
+
+
+def encoded_max(n: int) -> int:
+    """Wire bytes of a frame of `n` bytes (body + CRC) at most: COBS + delimiter."""
+    return n + n // 254 + 2

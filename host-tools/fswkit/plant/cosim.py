@@ -1,9 +1,9 @@
 """The lock-step loop: the firmware on the simulated board (fswkit.sim.board)
 and a plant scenario advance together at the scenario's rate. Each step is
-one pipe round trip — the sensors' millivolts and switch levels that
-changed, `until` the step's last cycle, the pyro/valve pins' edges and the
-UART's bytes — then the plant integrates the same interval with the pins as
-they were, to the cycle. The UART's bytes go through the ground's decoder
+one `SimBoard.batch` — one command and one pipe round trip: the sensors'
+volts and switch levels that changed, a run to the step's last cycle, the
+pyro/valve pins' edges and the UART's bytes — then the plant integrates the
+same interval with the pins as they were, to the cycle. The UART's bytes go through the ground's decoder
 (fswkit.link.Session), as `fsw monitor` decodes them, and into a link log
 of the same format."""
 
@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from fswkit.link.layout import Layout
 from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session
-from fswkit.sim.board import SimBoard, SimError
+from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
 
@@ -92,19 +92,6 @@ def _one_cpu():
             _cpu_users[cpu] -= 1
 
 
-def _edges(line: str, board: SimBoard, f_cpu: int) -> list[tuple[float, int, bool]]:
-    """(seconds, pin, level) from an `edges` response (docs/sim.md)."""
-    toks = line.split()
-    if len(toks) < 3 or toks[2] != "overflow=0":
-        raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to watch")
-    out = []
-    for tok in toks[3:]:
-        where, rest = tok.split("@")
-        cycle, level = rest.split("=")
-        out.append((int(cycle) / f_cpu, board.pins.pin_of(where[0], int(where[1:])), level == "1"))
-    return out
-
-
 def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, *,
         wall_limit: float = 900.0, log_meta: dict | None = None) -> Run:
     """Runs the scenario to its end against the firmware; the Run. The
@@ -142,47 +129,45 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
         raise CosimError(str(e)) from None
     wall0 = time.perf_counter()
     try:
-        adc = {name: b.adc_channel(name) for name in analog}
         last_mv = {name: _mv(v, vref) for name, v in analog.items()}
-        din = {pin: b.pins.digital[pin] for pin in digital}
         last_din: dict[int, bool] = {}
-        setup = [f"watch {b.pins.digital[p][0]} {b.pins.digital[p][1]}" for p in scenario.outputs]
-        b.exchange(setup)
+        for pin in scenario.outputs:
+            b.watch(pin)
         k = 0
         t1 = 0.0
         while True:
             t0 = k / rate
             if k:
                 analog, digital = scenario.inputs(t0)
-            cmds = []
+            set_analog, set_digital = {}, {}  # the inputs that changed
             for name, v in analog.items():
                 mv = _mv(v, vref)
                 if mv != last_mv[name]:
                     last_mv[name] = mv
-                    cmds.append(f"adc {adc[name]} {mv}")
+                    set_analog[name] = v
             for pin, level in digital.items():
                 if last_din.get(pin) != level:
                     last_din[pin] = level
-                    port, bit = din[pin]
-                    cmds.append(f"din {port} {bit} {1 if level else 0}")
+                    set_digital[pin] = level
             k += 1
-            cmds += [f"until {k * cycles}", "edges", "uart"]
-            resp = b.exchange(cmds)
+            try:
+                step = b.batch(k * cycles, set_analog, set_digital)
+            except EdgeOverflow:
+                raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to "
+                                 "watch") from None
             run.round_trips += 1
-            res = resp[-3]
-            if " stop=target" not in res:
-                stop = res.split("stop=", 1)[-1]
+            if step.run.stop != "target":
+                stop = step.run.stop
                 why = {"wall-limit": f"the wall-clock limit ({wall_limit:g} s) was reached",
                        "sim-limit": "the simulated-time limit was reached",
                        "crashed": "the firmware crashed", "done": "the firmware stopped itself"}.get(stop, stop)
                 raise CosimError(f"{why} at {t0:.3f} s simulated")
             t1 = k / rate
-            edges = _edges(resp[-2], b, f_cpu) if resp[-2] != "ok n=0 overflow=0" else ()
+            edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges]
             for ev in scenario.advance(t0, t1, edges):
                 run.pin_events.append(ev)
-            data = resp[-1][3:]
-            if data:
-                raw = bytes.fromhex(data)
+            raw = step.uart
+            if raw:
                 if log:
                     log.record(RX, round(t1 * 1e9), raw)
                 for ev in session.feed(raw, t1):

@@ -27,9 +27,7 @@ import shutil
 import signal
 import struct
 import subprocess
-import sys
 import tempfile
-import time
 from dataclasses import dataclass
 
 from fswkit.autocode.board import Board, BoardError, load_board
@@ -69,6 +67,10 @@ STOP_REASONS = ("target", "sim-limit", "wall-limit", "done", "crashed", "interru
 
 class SimError(Exception):
     """The board cannot be simulated as asked (a message for the user)."""
+
+
+class EdgeOverflow(SimError):
+    """The board recorded more pin edges than it keeps (1,048,576) since they were last read."""
 
 
 # ---- the harness ------------------------------------------------------------------
@@ -245,6 +247,16 @@ class Edge:
 
 
 @dataclass(frozen=True)
+class Batch:
+    """What one `batch` step returns: where the run stopped, the watched
+    pins' edges during it (oldest first) and the UART's bytes."""
+
+    run: RunResult
+    edges: list[Edge]
+    uart: bytes
+
+
+@dataclass(frozen=True)
 class RamUsage:
     """RAM of the firmware in bytes: its static data (.data, .bss, .noinit),
     the deepest the stack has reached so far, their sum, and the MCU's RAM."""
@@ -398,6 +410,21 @@ class SimBoard:
         self.cycle = int(f["cycle"])
         return RunResult(self.cycle, float(f["time"]), f["state"], f["stop"])
 
+    def _edges(self, toks: list[str]) -> list[Edge]:
+        """Edges from the `n=K overflow=F PB@CYCLE=L ...` words of an
+        `edges` or `batch` response; EdgeOverflow if the board lost some."""
+        out = []
+        for t in toks:
+            if t.startswith("overflow="):
+                if t != "overflow=0":
+                    raise EdgeOverflow("more than 1,048,576 edges since the last read: read edges more often")
+            elif "@" in t:
+                where, rest = t.split("@")
+                cycle, level = rest.split("=")
+                port, bit = where[0], int(where[1:])
+                out.append(Edge(int(cycle), self.pins.pin_of(port, bit), port, bit, level == "1"))
+        return out
+
     # -- time --
     @property
     def time(self) -> float:
@@ -419,6 +446,26 @@ class SimBoard:
 
     def run_for(self, seconds: float) -> RunResult:
         return self.step(self.cycles_for(seconds))
+
+    def batch(self, until: int, analog: dict[str, float] | None = None,
+              digital: dict[int, bool] | None = None) -> Batch:
+        """One lock-step of a co-simulation in one command and one round
+        trip: sets analog inputs (volts), then drives digital input pins,
+        runs to the absolute cycle `until`, and returns the run's result with
+        the watched pins' edges and the UART's bytes since the last read
+        (what `set_analog`s, `set_digital`s, `until`, `edges` and
+        `uart_read` do in turn)."""
+        words = [f"batch {int(until)}"]
+        words += [f"{self.adc_channel(p)}={self._millivolts(v)}" for p, v in (analog or {}).items()]
+        for pin, level in (digital or {}).items():
+            port, bit = self._port_bit(pin)
+            words.append(f"{port}{bit}={1 if level else 0}")
+        # ok cycle= time= state= stop= uart=HEX n= overflow= EDGE...
+        toks = self.command(" ".join(words)).split()
+        f = dict(t.split("=", 1) for t in toks[1:8])
+        self.cycle = int(f["cycle"])
+        run = RunResult(self.cycle, float(f["time"]), f["state"], f["stop"])
+        return Batch(run, self._edges(toks[7:]), bytes.fromhex(f["uart"]))
 
     def go(self, until: float | None = None, realtime: bool = True) -> RunResult:
         """Runs free, paced to the wall clock unless realtime=False, until
@@ -448,6 +495,8 @@ class SimBoard:
     # -- analog inputs --
     def adc_channel(self, pin: str | int) -> int:
         """The ADC channel of an analog pin (`A0`, or its pin number)."""
+        if pin in self.pins.analog:
+            return self.pins.analog[pin]
         if isinstance(pin, int) or (isinstance(pin, str) and pin.isdigit()):
             names = [n for n, p in self.board.analog_pins.items() if p == int(pin)]
             pin = names[0] if names else f"pin {pin}"
@@ -513,17 +562,7 @@ class SimBoard:
 
     def edges(self) -> list[Edge]:
         """The edges of watched pins since the last call, oldest first."""
-        toks = self.command("edges").split()[1:]
-        f = dict(t.split("=", 1) for t in toks[:2])
-        if f.get("overflow") == "1":
-            raise SimError("more than 1,048,576 edges since the last read: read edges more often")
-        out = []
-        for t in toks[2:]:
-            where, rest = t.split("@")
-            cycle, level = rest.split("=")
-            port, bit = where[0], int(where[1:])
-            out.append(Edge(int(cycle), self.pins.pin_of(port, bit), port, bit, level == "1"))
-        return out
+        return self._edges(self.command("edges").split()[1:])
 
     def pwm(self, pin: int) -> float:
         """The duty (0..1) a pin outputs: OCR/255 while its timer drives it

@@ -1,24 +1,31 @@
-/* simboard: fswkit's simulated board. Runs an AVR firmware ELF on simavr
-   (libsimavr) with UART0 bridged to a pseudo-terminal, to standard I/O, or to
-   the control channel, analog inputs driven in millivolts and digital pins
-   read, driven and timestamped in cycles.
+/* simboard: fswkit's simulated board, the one simavr program of the kit.
+   Runs an AVR firmware ELF on simavr (libsimavr) with UART0 bridged to a
+   pseudo-terminal, to standard I/O, or to the control channel, analog inputs
+   driven in millivolts and digital pins read, driven and timestamped in
+   cycles.
 
    Two ways to run it:
 
    - Control mode (-c): commands on standard input, one response line each on
-     standard output, in order (docs/sim.md has the protocol). The caller
-     advances simulated time (`step`, `until`) or lets the board run free
-     (`go`). fswkit.sim.board.SimBoard speaks it; so can a person at a terminal.
-   - Free run (no -c): runs from reset until a limit, optionally paced to real
-     time (-r), then prints a summary on standard error.
+     standard output, in order (docs/sim.md has the protocol; `commands[]`
+     below is its table). The caller advances simulated time (`step`, `until`,
+     `batch`) or lets the board run free (`go`). fswkit.sim.board.SimBoard
+     speaks it; so can a person at a terminal.
+   - Free run (no -c): runs from reset until the firmware stops itself or a
+     limit, optionally paced to real time (-r), then prints a summary on
+     standard error. With -u stdout the UART's bytes go to standard output as
+     they come, and -x picks what the exit status says: the firmware test
+     suites (make test-firmware: -x unity) and the differential tests on a
+     simulated AVR (-x done) run their ELFs this way.
 
    usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S]
-                   [-u control|pty|stdio|none] [-l LINK] [-r] [-a CH=MV]... FW.elf
+                   [-u control|pty|stdio|stdout|none] [-l LINK] [-r]
+                   [-x crash|done|unity] [-a CH=MV]... FW.elf
 
    The board stops itself at the simulated-time limit (-t, seconds; 0 = none)
    and the wall-clock limit (-w, seconds since start; 0 = none), and when its
    control channel closes. fswkit builds this file at run time with the host's
-   gcc against -lsimavr (host-tools/fswkit/sim.py); no binary is committed.
+   gcc against -lsimavr (fswkit.sim.board.harness()); no binary is committed.
 
    simavr's own uart_pty part (libsimavrparts) is not used: it prints on
    standard output, which carries the control protocol here, points a fixed
@@ -56,6 +63,7 @@
 #define MAX_WATCH 32
 #define MAX_EDGES (1u << 20)
 #define MAX_PEEK 4096
+#define MAX_ARGS 64                  /* words of one command line */
 
 /* ---- small helpers ------------------------------------------------------------ */
 
@@ -106,8 +114,15 @@ static void sleep_s(double s) {
 
 /* ---- the board ------------------------------------------------------------------ */
 
-enum { UART_NONE, UART_CONTROL, UART_PTY, UART_STDIO };
-static const char* uart_names[] = {"none", "control", "pty", "stdio"};
+enum { UART_NONE, UART_CONTROL, UART_PTY, UART_STDIO, UART_STDOUT };
+static const char* uart_names[] = {"none", "control", "pty", "stdio", "stdout"};
+#define N_UART_MODES 5
+
+/* What a free run's exit status says (-x): 1 only if the firmware crashed;
+   0 only if it stopped itself (1 crashed, 3 a limit or SIGINT ended it); 0
+   only if its UART output held a Unity summary `N passed, 0 failed`, N > 0. */
+enum { EXIT_CRASH, EXIT_DONE, EXIT_UNITY };
+static const char* exit_names[] = {"crash", "done", "unity"};
 
 static avr_t* avr;
 static const char* mcu_name = "atmega328p";
@@ -129,6 +144,10 @@ static char pty_name[128];
 static char pty_link[512];
 static int pty_reader; /* a process has the pty's other end open */
 static int stdio_in_open = 1;
+static int exit_mode = EXIT_CRASH;
+static char unity_line[256]; /* -x unity: the UART line being received */
+static size_t unity_len;
+static long unity_passed = -1, unity_failed = -1;
 
 typedef struct {
     char port;
@@ -152,10 +171,27 @@ static void logger(avr_t* a, const int level, const char* fmt, va_list ap) {
     vfprintf(stderr, fmt, ap);
 }
 
+/* -x unity: remembers the last `N passed, M failed` line the firmware sent. */
+static void unity_scan(char c) {
+    if (c != '\n') {
+        if (unity_len + 1 < sizeof unity_line) unity_line[unity_len++] = c;
+        return;
+    }
+    long p, f;
+    char tail[8];
+    unity_line[unity_len] = 0;
+    if (sscanf(unity_line, "%ld passed, %ld failed%7s", &p, &f, tail) == 2) {
+        unity_passed = p;
+        unity_failed = f;
+    }
+    unity_len = 0;
+}
+
 static void on_uart_out(struct avr_irq_t* irq, uint32_t value, void* param) {
     (void)irq;
     (void)param;
     uint8_t c = (uint8_t)value;
+    if (exit_mode == EXIT_UNITY) unity_scan((char)c);
     if (uart_mode == UART_NONE || (uart_mode == UART_PTY && !pty_reader)) {
         uart_dropped++; /* nobody listening, as on a board with no cable */
         return;
@@ -263,7 +299,7 @@ static void uart_service(void) {
             if (n <= 0) break; /* the reader's buffer is full: later */
             uart_out.head += (size_t)n;
         }
-    } else if (uart_mode == UART_STDIO) {
+    } else if (uart_mode == UART_STDIO || uart_mode == UART_STDOUT) { /* stdout: blocking, nothing read */
         while (bytes_pending(&uart_out)) {
             ssize_t n = write(1, uart_out.buf + uart_out.head, bytes_pending(&uart_out));
             if (n <= 0) {
@@ -274,7 +310,7 @@ static void uart_service(void) {
             }
             uart_out.head += (size_t)n;
         }
-        if (stdio_in_open) {
+        if (uart_mode == UART_STDIO && stdio_in_open) {
             struct pollfd p = {0, POLLIN, 0};
             if (poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLHUP))) {
                 uint8_t buf[512];
@@ -413,11 +449,6 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
     return why;
 }
 
-static void respond_run(const char* why) {
-    fprintf(proto, "ok cycle=%llu time=%.9f state=%s stop=%s\n", (unsigned long long)avr->cycle,
-            (double)avr->cycle / (double)f_cpu, state_name(avr->state), why);
-}
-
 static int parse_u64(const char* s, unsigned long long* out) {
     if (!s || !*s) return -1;
     char* end;
@@ -461,152 +492,291 @@ static int hex_in(const char* s, bytes_t* out) {
     return 0;
 }
 
-/* Handles one command; returns 0 when the board should exit. */
-static int command(char* line) {
-    char* argv[8];
-    int argc = 0;
-    for (char* tok = strtok(line, " \t"); tok && argc < 8; tok = strtok(NULL, " \t")) argv[argc++] = tok;
-    if (argc == 0) return 1; /* empty line: no response */
-    const char* cmd = argv[0];
-    unsigned long long a, b;
+/* ---- the commands ------------------------------------------------------------------- */
+/* Each command is a handler in `commands[]`: it gets the line's words
+   (argv[0] is the command) and prints exactly one response line; it returns
+   0 when the board should exit, else 1. */
 
-    if (!strcmp(cmd, "step") || !strcmp(cmd, "until")) {
-        if (argc != 2 || parse_u64(argv[1], &a)) {
-            fprintf(proto, "err usage: %s CYCLES\n", cmd);
-            return 1;
-        }
-        respond_run(run_until(1, !strcmp(cmd, "step") ? avr->cycle + a : a, 0, 0));
-    } else if (!strcmp(cmd, "go")) {
-        int realtime = 0, ok = argc <= 3;
-        a = 0;
-        if (ok && argc >= 2) ok = !parse_u64(argv[1], &a);
-        if (ok && argc == 3) {
-            realtime = !strcmp(argv[2], "realtime");
-            ok = realtime || !strcmp(argv[2], "fast");
-        }
-        if (!ok) {
-            fprintf(proto, "err usage: go [UNTIL_CYCLE|0] [realtime|fast]\n");
-            return 1;
-        }
-        fflush(proto);
-        respond_run(run_until(a != 0, a, realtime, 1));
-    } else if (!strcmp(cmd, "adc")) {
-        if (argc != 3 || parse_u64(argv[1], &a) || a >= ADC_IRQ_TEMP || parse_u64(argv[2], &b) || b > 1000000) {
-            fprintf(proto, "err usage: adc CHANNEL MILLIVOLTS (channel 0-15)\n");
-            return 1;
-        }
-        avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, (int)a), (uint32_t)b);
-        fprintf(proto, "ok\n");
-    } else if (!strcmp(cmd, "din")) {
-        char port;
-        uint8_t bit;
-        if (argc != 4 || parse_port_bit(argv[1], argv[2], &port, &bit) || parse_u64(argv[3], &a) || a > 1) {
-            fprintf(proto, "err usage: din PORT BIT 0|1 (a port this MCU has)\n");
-            return 1;
-        }
-        avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), (uint32_t)a);
-        fprintf(proto, "ok\n");
-    } else if (!strcmp(cmd, "ports")) {
-        fprintf(proto, "ok");
-        for (char p = 'A'; p <= 'L'; p++) {
-            avr_ioport_state_t st;
-            if (port_state(p, &st) == 0)
-                fprintf(proto, " %c=%02x:%02x:%02x", p, (unsigned)st.port, (unsigned)st.ddr, (unsigned)st.pin);
-        }
-        fprintf(proto, "\n");
-    } else if (!strcmp(cmd, "watch")) {
-        char port;
-        uint8_t bit;
-        if (argc != 3 || parse_port_bit(argv[1], argv[2], &port, &bit)) {
-            fprintf(proto, "err usage: watch PORT BIT (a port this MCU has)\n");
-            return 1;
-        }
-        int free_slot = -1;
-        for (int i = 0; i < MAX_WATCH; i++) {
-            if (watches[i].port == port && watches[i].bit == bit) {
-                free_slot = -2;
-                watches[i].active = 1;
-                break;
-            }
-            if (!watches[i].port && free_slot == -1) free_slot = i;
-        }
-        if (free_slot == -1) {
-            fprintf(proto, "err at most %d pins can be watched\n", MAX_WATCH);
-            return 1;
-        }
-        if (free_slot >= 0) {
-            avr_ioport_state_t st;
-            port_state(port, &st);
-            watch_t* w = &watches[free_slot];
-            w->port = port;
-            w->bit = bit;
-            w->level = (uint8_t)((((st.ddr & (1u << bit)) ? st.port : st.pin) >> bit) & 1u);
-            w->active = 1;
-            avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), on_pin, w);
-        }
-        fprintf(proto, "ok\n");
-    } else if (!strcmp(cmd, "edges")) {
-        fprintf(proto, "ok n=%zu overflow=%d", n_edges, edges_overflow);
-        for (size_t i = 0; i < n_edges; i++)
-            fprintf(proto, " %c%u@%llu=%u", edges[i].port, edges[i].bit, (unsigned long long)edges[i].cycle,
-                    edges[i].level);
-        fprintf(proto, "\n");
-        n_edges = 0;
-        edges_overflow = 0;
-    } else if (!strcmp(cmd, "uart")) {
-        fprintf(proto, "ok ");
-        if (uart_mode == UART_CONTROL) {
-            hex_out(uart_out.buf + uart_out.head, bytes_pending(&uart_out));
-            bytes_clear(&uart_out);
-        }
-        fprintf(proto, "\n");
-    } else if (!strcmp(cmd, "send")) {
-        if (argc != 2 || uart_mode != UART_CONTROL) {
-            fprintf(proto, "err usage: send HEXBYTES (with the UART on the control channel)\n");
-            return 1;
-        }
-        size_t before = uart_in.len;
-        if (hex_in(argv[1], &uart_in)) {
-            uart_in.len = before;
-            fprintf(proto, "err send: not an even number of hex digits\n");
-            return 1;
-        }
-        uart_feed();
-        fprintf(proto, "ok\n");
-    } else if (!strcmp(cmd, "peek")) {
-        if (argc != 3 || parse_u64(argv[1], &a) || parse_u64(argv[2], &b) || b > MAX_PEEK ||
-            a + b > (unsigned long long)avr->ramend + 1) {
-            fprintf(proto, "err usage: peek ADDRESS COUNT (data space 0-0x%x, at most %d bytes)\n",
-                    (unsigned)avr->ramend, MAX_PEEK);
-            return 1;
-        }
-        fprintf(proto, "ok ");
-        hex_out(avr->data + a, (size_t)b);
-        fprintf(proto, "\n");
-    } else if (!strcmp(cmd, "info")) {
-        fprintf(proto, "ok proto=%d mcu=%s f_cpu=%u cycle=%llu time=%.9f state=%s uart=%s", PROTO_VERSION,
-                mcu_name, (unsigned)f_cpu, (unsigned long long)avr->cycle, (double)avr->cycle / (double)f_cpu,
-                state_name(avr->state), uart_names[uart_mode]);
-        if (uart_mode == UART_PTY) fprintf(proto, " port=%s reader=%d", pty_name, pty_reader);
-        fprintf(proto, " dropped=%llu wall=%.3f\n", (unsigned long long)uart_dropped, wall_now() - wall_start);
-    } else if (!strcmp(cmd, "stop")) {
-        fprintf(proto, "ok\n"); /* ends a `go`; idle, it does nothing */
-    } else if (!strcmp(cmd, "quit")) {
-        fprintf(proto, "ok\n");
-        return 0;
-    } else {
-        fprintf(proto, "err unknown command `%s` (info step until go adc din ports watch edges uart send peek stop quit)\n",
-                cmd);
+#define NO_ARGS ((void)argc, (void)argv) /* a command that takes no arguments ignores extra words */
+
+/* An `err` response; returns 1 (the board goes on). */
+__attribute__((format(printf, 1, 2))) static int fail(const char* fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("err ", proto);
+    vfprintf(proto, fmt, ap);
+    fputc('\n', proto);
+    va_end(ap);
+    return 1;
+}
+
+static void put_run(const char* why) {
+    fprintf(proto, "ok cycle=%llu time=%.9f state=%s stop=%s", (unsigned long long)avr->cycle,
+            (double)avr->cycle / (double)f_cpu, state_name(avr->state), why);
+}
+
+/* ` n=K overflow=F` and the edges since the last report, which it forgets. */
+static void put_edges(void) {
+    fprintf(proto, " n=%zu overflow=%d", n_edges, edges_overflow);
+    for (size_t i = 0; i < n_edges; i++)
+        fprintf(proto, " %c%u@%llu=%u", edges[i].port, edges[i].bit, (unsigned long long)edges[i].cycle,
+                edges[i].level);
+    n_edges = 0;
+    edges_overflow = 0;
+}
+
+/* The UART's bytes since the last report in hex (control mode; none otherwise). */
+static void put_uart(void) {
+    if (uart_mode != UART_CONTROL) return;
+    hex_out(uart_out.buf + uart_out.head, bytes_pending(&uart_out));
+    bytes_clear(&uart_out);
+}
+
+static int run_to(int argc, char** argv, int relative) {
+    unsigned long long a;
+    if (argc != 2 || parse_u64(argv[1], &a)) return fail("usage: %s CYCLES", argv[0]);
+    put_run(run_until(1, relative ? avr->cycle + a : a, 0, 0));
+    fputc('\n', proto);
+    return 1;
+}
+
+static int cmd_step(int argc, char** argv) { return run_to(argc, argv, 1); }
+
+static int cmd_until(int argc, char** argv) { return run_to(argc, argv, 0); }
+
+static int cmd_go(int argc, char** argv) {
+    unsigned long long a = 0;
+    int realtime = 0, ok = argc <= 3;
+    if (ok && argc >= 2) ok = !parse_u64(argv[1], &a);
+    if (ok && argc == 3) {
+        realtime = !strcmp(argv[2], "realtime");
+        ok = realtime || !strcmp(argv[2], "fast");
     }
+    if (!ok) return fail("usage: go [UNTIL_CYCLE|0] [realtime|fast]");
+    fflush(proto);
+    put_run(run_until(a != 0, a, realtime, 1));
+    fputc('\n', proto);
+    return 1;
+}
+
+/* One lock-step of a co-simulation: inputs set in the order given, a run to
+   absolute cycle C, then the run's result, the UART's bytes and the edges:
+   what `adc`..., `din`..., `until C`, `uart`, `edges` do, in one line. */
+static int cmd_batch(int argc, char** argv) {
+    static const char usage[] = "usage: batch CYCLE [CH=MV]... [PB=0|1]... (ADC channel 0-15, port A-L bit 0-7)";
+    unsigned long long target, v;
+    if (argc < 2 || parse_u64(argv[1], &target)) return fail("%s", usage);
+    for (int i = 2; i < argc; i++) { /* all checked before any is applied */
+        char* eq = strchr(argv[i], '=');
+        if (!eq) return fail("%s", usage);
+        *eq = 0;
+        char port;
+        uint8_t bit;
+        int bad = (argv[i][0] >= '0' && argv[i][0] <= '9')
+                      ? parse_u64(argv[i], &v) || v >= ADC_IRQ_TEMP || parse_u64(eq + 1, &v) || v > 1000000
+                      : argv[i][0] == 0 || parse_port_bit((char[]){argv[i][0], 0}, argv[i] + 1, &port, &bit) ||
+                            parse_u64(eq + 1, &v) || v > 1;
+        *eq = '=';
+        if (bad) return fail("batch: bad input `%s`; %s", argv[i], usage);
+    }
+    for (int i = 2; i < argc; i++) {
+        char* eq = strchr(argv[i], '=');
+        *eq = 0;
+        unsigned long long value; /* millivolts or a level */
+        parse_u64(eq + 1, &value);
+        if (argv[i][0] >= '0' && argv[i][0] <= '9') {
+            parse_u64(argv[i], &v);
+            avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, (int)v), (uint32_t)value);
+        } else {
+            parse_u64(argv[i] + 1, &v);
+            avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(argv[i][0]), (int)v), (uint32_t)value);
+        }
+    }
+    put_run(run_until(1, target, 0, 0));
+    fputs(" uart=", proto);
+    put_uart();
+    put_edges();
+    fputc('\n', proto);
+    return 1;
+}
+
+static int cmd_adc(int argc, char** argv) {
+    unsigned long long a, b;
+    if (argc != 3 || parse_u64(argv[1], &a) || a >= ADC_IRQ_TEMP || parse_u64(argv[2], &b) || b > 1000000)
+        return fail("usage: adc CHANNEL MILLIVOLTS (channel 0-15)");
+    avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, (int)a), (uint32_t)b);
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
+static int cmd_din(int argc, char** argv) {
+    char port;
+    uint8_t bit;
+    unsigned long long a;
+    if (argc != 4 || parse_port_bit(argv[1], argv[2], &port, &bit) || parse_u64(argv[3], &a) || a > 1)
+        return fail("usage: din PORT BIT 0|1 (a port this MCU has)");
+    avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), (uint32_t)a);
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
+static int cmd_ports(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok");
+    for (char p = 'A'; p <= 'L'; p++) {
+        avr_ioport_state_t st;
+        if (port_state(p, &st) == 0)
+            fprintf(proto, " %c=%02x:%02x:%02x", p, (unsigned)st.port, (unsigned)st.ddr, (unsigned)st.pin);
+    }
+    fprintf(proto, "\n");
+    return 1;
+}
+
+static int cmd_watch(int argc, char** argv) {
+    char port;
+    uint8_t bit;
+    if (argc != 3 || parse_port_bit(argv[1], argv[2], &port, &bit))
+        return fail("usage: watch PORT BIT (a port this MCU has)");
+    int free_slot = -1;
+    for (int i = 0; i < MAX_WATCH; i++) {
+        if (watches[i].port == port && watches[i].bit == bit) {
+            free_slot = -2;
+            watches[i].active = 1;
+            break;
+        }
+        if (!watches[i].port && free_slot == -1) free_slot = i;
+    }
+    if (free_slot == -1) return fail("at most %d pins can be watched", MAX_WATCH);
+    if (free_slot >= 0) {
+        avr_ioport_state_t st;
+        port_state(port, &st);
+        watch_t* w = &watches[free_slot];
+        w->port = port;
+        w->bit = bit;
+        w->level = (uint8_t)((((st.ddr & (1u << bit)) ? st.port : st.pin) >> bit) & 1u);
+        w->active = 1;
+        avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), on_pin, w);
+    }
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
+static int cmd_edges(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok");
+    put_edges();
+    fprintf(proto, "\n");
+    return 1;
+}
+
+static int cmd_uart(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok ");
+    put_uart();
+    fprintf(proto, "\n");
+    return 1;
+}
+
+static int cmd_send(int argc, char** argv) {
+    if (argc != 2 || uart_mode != UART_CONTROL)
+        return fail("usage: send HEXBYTES (with the UART on the control channel)");
+    size_t before = uart_in.len;
+    if (hex_in(argv[1], &uart_in)) {
+        uart_in.len = before;
+        return fail("send: not an even number of hex digits");
+    }
+    uart_feed();
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
+static int cmd_peek(int argc, char** argv) {
+    unsigned long long a, b;
+    if (argc != 3 || parse_u64(argv[1], &a) || parse_u64(argv[2], &b) || b > MAX_PEEK ||
+        a + b > (unsigned long long)avr->ramend + 1)
+        return fail("usage: peek ADDRESS COUNT (data space 0-0x%x, at most %d bytes)", (unsigned)avr->ramend,
+                    MAX_PEEK);
+    fprintf(proto, "ok ");
+    hex_out(avr->data + a, (size_t)b);
+    fprintf(proto, "\n");
+    return 1;
+}
+
+static int cmd_info(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok proto=%d mcu=%s f_cpu=%u cycle=%llu time=%.9f state=%s uart=%s", PROTO_VERSION, mcu_name,
+            (unsigned)f_cpu, (unsigned long long)avr->cycle, (double)avr->cycle / (double)f_cpu,
+            state_name(avr->state), uart_names[uart_mode]);
+    if (uart_mode == UART_PTY) fprintf(proto, " port=%s reader=%d", pty_name, pty_reader);
+    fprintf(proto, " dropped=%llu wall=%.3f\n", (unsigned long long)uart_dropped, wall_now() - wall_start);
+    return 1;
+}
+
+static int cmd_stop(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok\n"); /* ends a `go`; idle, it does nothing */
+    return 1;
+}
+
+static int cmd_quit(int argc, char** argv) {
+    NO_ARGS;
+    fprintf(proto, "ok\n");
+    return 0;
+}
+
+/* The protocol: docs/sim.md has a row for each. */
+static const struct {
+    const char* name;
+    int (*run)(int argc, char** argv);
+} commands[] = {
+    {"info", cmd_info},   {"step", cmd_step},   {"until", cmd_until}, {"go", cmd_go},
+    {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
+    {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
+    {"peek", cmd_peek},   {"stop", cmd_stop},   {"quit", cmd_quit},
+};
+#define N_COMMANDS (sizeof commands / sizeof commands[0])
+
+/* Splits a line into words and runs its command; returns 0 when the board should exit. */
+static int command(char* line) {
+    char* argv[MAX_ARGS];
+    int argc = 0;
+    for (char* tok = strtok(line, " \t"); tok; tok = strtok(NULL, " \t")) {
+        if (argc == MAX_ARGS) return fail("more than %d words in one command", MAX_ARGS);
+        argv[argc++] = tok;
+    }
+    if (argc == 0) return 1; /* empty line: no response */
+    for (size_t i = 0; i < N_COMMANDS; i++)
+        if (!strcmp(argv[0], commands[i].name)) return commands[i].run(argc, argv);
+    fprintf(proto, "err unknown command `%s` (", argv[0]);
+    for (size_t i = 0; i < N_COMMANDS; i++) fprintf(proto, i ? " %s" : "%s", commands[i].name);
+    fprintf(proto, ")\n");
     return 1;
 }
 
 /* ---- start --------------------------------------------------------------------------- */
 
+/* A free run's exit status (-x). */
+static int free_run_status(const char* why) {
+    if (!strcmp(why, "crashed")) {
+        if (exit_mode != EXIT_CRASH)
+            fprintf(stderr, "simboard: the firmware crashed at pc 0x%04x\n", (unsigned)avr->pc);
+        return 1;
+    }
+    if (exit_mode == EXIT_DONE) return strcmp(why, "done") ? 3 : 0;
+    if (exit_mode == EXIT_UNITY) {
+        if (unity_passed < 0) {
+            fprintf(stderr, "simboard: no \"N passed, N failed\" line in the output\n");
+            return 1;
+        }
+        return unity_failed == 0 && unity_passed > 0 ? 0 : 1;
+    }
+    return 0;
+}
+
 static void usage(void) {
     fprintf(stderr,
-            "usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S] [-u control|pty|stdio|none]\n"
-            "                [-l LINK] [-r] [-a CH=MV]... FW.elf\n");
+            "usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S] [-u control|pty|stdio|stdout|none]\n"
+            "                [-l LINK] [-r] [-x crash|done|unity] [-a CH=MV]... FW.elf\n");
 }
 
 int main(int argc, char** argv) {
@@ -614,7 +784,7 @@ int main(int argc, char** argv) {
     double sim_limit = 0;
     unsigned long long adc_init[16];
     int adc_set[16] = {0};
-    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:ra:")) != -1) {
+    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:")) != -1) {
         char* end;
         switch (opt) {
             case 'c': control = 1; break;
@@ -638,10 +808,18 @@ int main(int argc, char** argv) {
                 break;
             case 'u': {
                 int m = -1;
-                for (int i = 0; i < 4; i++)
+                for (int i = 0; i < N_UART_MODES; i++)
                     if (!strcmp(optarg, uart_names[i])) m = i;
-                if (m < 0) { fprintf(stderr, "simboard: -u control|pty|stdio|none\n"); return 2; }
+                if (m < 0) { fprintf(stderr, "simboard: -u control|pty|stdio|stdout|none\n"); return 2; }
                 uart_mode = m;
+                break;
+            }
+            case 'x': {
+                int m = -1;
+                for (int i = 0; i < 3; i++)
+                    if (!strcmp(optarg, exit_names[i])) m = i;
+                if (m < 0) { fprintf(stderr, "simboard: -x crash|done|unity\n"); return 2; }
+                exit_mode = m;
                 break;
             }
             case 'l': snprintf(pty_link, sizeof pty_link, "%s", optarg); break;
@@ -666,8 +844,12 @@ int main(int argc, char** argv) {
         usage();
         return 2;
     }
-    if (control && uart_mode == UART_STDIO) {
-        fprintf(stderr, "simboard: -u stdio needs standard I/O, which -c uses for commands\n");
+    if (control && (uart_mode == UART_STDIO || uart_mode == UART_STDOUT)) {
+        fprintf(stderr, "simboard: -u %s needs standard I/O, which -c uses for commands\n", uart_names[uart_mode]);
+        return 2;
+    }
+    if (control && exit_mode != EXIT_CRASH) {
+        fprintf(stderr, "simboard: -x is for a free run (without -c)\n");
         return 2;
     }
     if (!control && uart_mode == UART_CONTROL) uart_mode = UART_NONE;
@@ -766,7 +948,7 @@ int main(int argc, char** argv) {
         fprintf(stderr, "simboard: %s, stopped (%s) at cycle %llu, %.6f s simulated, %.3f s wall\n",
                 argv[optind], why, (unsigned long long)avr->cycle, (double)avr->cycle / (double)f_cpu,
                 wall_now() - wall_start);
-        if (!strcmp(why, "crashed")) status = 1;
+        status = free_run_status(why);
     }
     if (pty_link[0]) { /* our own link only: still pointing at our pty */
         char to[sizeof pty_name];

@@ -1,8 +1,8 @@
 """The link's wire format (docs/telemetry.md), written once for the host:
 the generator sizes the firmware's buffers from it (schema.link_plan) and
-the ground tools (fswkit.link) frame and decode with it. The firmware's own
-copy is firmware/src/fsw_link.h; tests/link/test_protocol_matches_firmware.py
-holds the two equal."""
+the ground tools frame and decode with it. The firmware's own copy is
+firmware/src/fsw_link.h; tests/link/test_protocol_matches_firmware.py holds
+the two equal."""
 
 from __future__ import annotations
 

@@ -164,7 +164,9 @@ FW_CORE_S     := $(wildcard $(FW_ARDUINO)/cores/arduino/*.S)
 FW_CORE_OBJS  := $(patsubst $(FW_ARDUINO)/cores/arduino/%,$(FW_ADIR)/core/%.o,$(FW_CORE_C) $(FW_CORE_CPP) $(FW_CORE_S))
 FW_ART_OBJS   := $(patsubst $(FW_SRC)/%.cpp,$(FW_ADIR)/rt/%.o,$(FW_RT_SRCS))
 FW_ABINS      := $(patsubst %,$(FW_ADIR)/test_%.elf,$(FW_AVR_SUITES))
-FW_SIMRUN     := $(FW_BUILD)/simrun
+# The suites run on the kit's simulated board (host-tools/fswkit/sim/harness.c),
+# compiled and cached as `fsw sim` builds it; the venv's Python finds it.
+FW_PY         ?= $(if $(PY),$(PY),.venv/bin/python)
 
 $(FW_ADIR)/core/%.c.o: $(FW_ARDUINO)/cores/arduino/%.c $(FW_STAMP_avr)
 	@mkdir -p $(@D)
@@ -200,13 +202,13 @@ $(FW_ADIR)/test_%.elf: $(FW_ADIR)/obj/test_%.o $(FW_ADIR)/obj/test_support.o $(F
     $(patsubst %,$(FW_ADIR)/obj/%.o,$(addprefix test_,$(FW_AVR_SUITES)) test_support unity)
 -include $(wildcard $(FW_ADIR)/core/*.d $(FW_ADIR)/rt/*.d $(FW_ADIR)/obj/*.d)
 
-$(FW_SIMRUN): $(FW_TESTS)/avr/simrun.c
-	@mkdir -p $(@D)
-	$(FW_HOST_CC) -O2 -Wall -Wextra -Werror -o $@ $< -lsimavr
-
-test-firmware-avr: $(FW_ABINS) $(FW_SIMRUN)
-	@fail=0; for t in $(FW_ABINS); do \
-	  echo "== $$t (simavr $(FW_AVR_MCU))"; $(FW_SIMRUN) -m $(FW_AVR_MCU) -t 30 -w 30 $$t || fail=1; done; exit $$fail
+# Each suite runs until it stops itself; its UART output is copied to standard
+# output and the run passes only on a closing `N passed, 0 failed` line, N > 0.
+test-firmware-avr: $(FW_ABINS)
+	@sim=$$($(FW_PY) -c 'from fswkit.sim.board import harness; print(harness())') || exit 1; \
+	fail=0; for t in $(FW_ABINS); do \
+	  echo "== $$t (simavr $(FW_AVR_MCU))"; \
+	  $$sim -u stdout -x unity -m $(FW_AVR_MCU) -t 30 -w 30 $$t || fail=1; done; exit $$fail
 
 # ---- benchmarks (report only; not part of the test run) ------------------------
 FW_BENCH := $(FW_BUILD)/bench

@@ -20,12 +20,12 @@ from fswkit.autocode.emit.machine import emit_machine  # noqa: E402
 from fswkit.autocode.emit.sv import emit_sv  # noqa: E402
 from fswkit.autocode.numeric import F32MODE, F64MODE  # noqa: E402
 from fswkit.autocode.project import load_machine  # noqa: E402
+from fswkit.sim.board import harness  # noqa: E402
 
 OUT = os.path.join(ROOT, "build", "bench")
 RUNTIME = os.path.join(ROOT, "firmware", "src")
 ARDUINO = "/usr/share/arduino/hardware/arduino/avr"
 BENCH = os.path.join(ROOT, "tools", "bench")
-SIMRUN = os.path.join(ROOT, "build", "firmware", "simrun")
 
 
 def sh(cmd, **kw) -> subprocess.CompletedProcess:
@@ -83,11 +83,8 @@ def avr_cycles() -> tuple[int, int]:
     sh(["avr-g++"] + avr_flags("atmega2560", "mega", "ARDUINO_AVR_MEGA2560") + [f"-I{gen}",
         os.path.join(BENCH, "tank_driver.cpp"), os.path.join(gen, "sv.gen.cpp"), os.path.join(gen, "tank.gen.cpp")]
        + libs + ["-fuse-linker-plugin", "-Wl,--gc-sections", "-o", elf])
-    if not os.path.exists(SIMRUN):
-        # firmware.mk names its targets relative to the root
-        sh(["make", "--no-print-directory", "-f", os.path.join(ROOT, "mk", "firmware.mk"),
-            os.path.relpath(SIMRUN, ROOT)], cwd=ROOT)
-    r = subprocess.run([SIMRUN, "-m", "atmega2560", "-t", "10", "-w", "60", elf], capture_output=True, text=True)
+    r = subprocess.run([harness(), "-u", "stdout", "-m", "atmega2560", "-t", "10", "-w", "60", elf],
+                       capture_output=True, text=True)
     m = re.search(r"cycles (\d+) worst (\d+) overhead (\d+) state (\d+)", r.stdout + r.stderr)
     if not m:
         sys.exit(f"bench: no measurement from simavr:\n{r.stdout}{r.stderr}")

@@ -9,7 +9,8 @@ sends everything over UART0 at 2 Mbaud:
     'E' outcome(1) failed_assert(int16) steps(uint64) asserts(uint64)
     'Z'               all cases done (then the firmware sleeps, interrupts off)
 
-tests/differential/avr/diffsim.c runs the ELF and copies those bytes out."""
+The kit's simulated board (host-tools/fswkit/sim/harness.c, free-running
+with `-u stdout -x done`) runs the ELF and copies those bytes out."""
 
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ from fswkit.autocode.emit.script import emit_script_avr, script_writes_locals
 from fswkit.autocode.emit.sv import emit_sv
 from fswkit.autocode.numeric import F32MODE
 
+from fswkit.sim.board import harness as sim_harness
 from harness import cache_dir
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -58,17 +60,16 @@ def _run(cmd: list[str]) -> str:
     return r.stdout
 
 
-def diffsim() -> str:
-    """The simavr harness, built once (cached by its source's hash)."""
-    src = os.path.join(HERE, "avr", "diffsim.c")
-    with open(src, "rb") as f:
-        h = hashlib.sha256(f.read()).hexdigest()[:16]
-    exe = os.path.join(cache_dir(), f"diffsim-{h}")
-    if not os.path.exists(exe):
-        os.makedirs(cache_dir(), exist_ok=True)
-        _run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", exe + ".tmp", src, "-lsimavr"])
-        os.replace(exe + ".tmp", exe)
-    return exe
+def run_uart(elf: str, out: str, *, sim_s: float = 600, wall: float = 120) -> None:
+    """Runs an ELF on the simulated board until the firmware stops itself
+    (sleeps with interrupts off), every byte it sends on UART0 copied
+    unchanged into the file `out`; NativeError if it crashed or a limit
+    (simulated seconds, wall-clock seconds) ended the run first."""
+    with open(out, "wb") as f:
+        r = subprocess.run([sim_harness(), "-u", "stdout", "-x", "done", "-m", MCU, "-t", str(sim_s), "-w", str(wall),
+                            elf], stdout=f, stderr=subprocess.PIPE)
+    if r.returncode != 0:
+        raise native.NativeError(f"simavr run failed (status {r.returncode}): {r.stderr.decode()[-2000:]}")
 
 
 def _cached_object(text: str, name: str, workdir: str, include: list[str], key: bytes) -> str:
@@ -179,9 +180,7 @@ def memory(elf: str) -> tuple[int, int]:
 def run_elf(elf: str, items: list[tuple[int, M.Script]], wall: float = 120) -> dict[int, AvrOutcome]:
     """Runs the ELF under simavr; each case's outcome, decoded."""
     path = elf + ".uart"
-    r = subprocess.run([diffsim(), "-o", path, "-m", MCU, "-t", "600", "-w", str(wall), elf], capture_output=True)
-    if r.returncode != 0:
-        raise native.NativeError(f"simavr run failed (status {r.returncode}): {r.stderr.decode()[-2000:]}")
+    run_uart(elf, path, wall=wall)
     with open(path, "rb") as f:
         data = f.read()
     pos = 0

@@ -199,8 +199,7 @@ def test_avr_float_library(tmp_path):
     subprocess.run([A.AVR_CXX, "-mmcu=" + A.MCU, "-Os", "-std=gnu++11", "-I", str(tmp_path),
                     str(tmp_path / "probe.cpp"), "-o", str(elf)], check=True, capture_output=True)
     out = tmp_path / "probe.bin"
-    subprocess.run([A.diffsim(), "-o", str(out), "-m", A.MCU, "-w", "60", str(elf)], check=True,
-                   capture_output=True)
+    A.run_uart(str(elf), str(out), sim_s=60, wall=60)
     data = out.read_bytes()
     assert len(data) == 17 * len(pairs) + 2 and data.endswith(b"ZZ")
     wrong, subnormal_quotients, off = {}, 0, []

@@ -21,15 +21,12 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tests"))
-
-from conftest import run_fsw  # noqa: E402
 
 from fswkit.autocode.diagnostics import Diagnostics  # noqa: E402
-from fswkit.target.build import elf_size, load  # noqa: E402
 from fswkit.link import wire  # noqa: E402
 from fswkit.link.layout import from_app  # noqa: E402
 from fswkit.link.session import Session  # noqa: E402
+from fswkit.target.build import BuildError, Built, elf_size, firmware, load  # noqa: E402
 
 TANK = ROOT / "examples" / "tank"
 
@@ -101,12 +98,24 @@ Rates rate={rate}
     return folder
 
 
+def build(project: Path, out: Path, board: str | None = None) -> Built | str:
+    """The project's firmware built by the build service, or why not."""
+    diags = Diagnostics()
+    try:
+        app = load(str(project), diags, board)
+        if app is None:
+            return diags.render()
+        built = firmware(app, str(out))
+    except BuildError as e:
+        return str(e)
+    return built if built.fits else built.report
+
+
 def native(project: Path, out: Path) -> Path:
-    r = run_fsw("build", str(project), "--board", "native", "--out", str(out))
-    if r.code != 0:
-        raise SystemExit(f"bench_link: cannot build {project}: {r.err}")
-    name = next(p for p in project.iterdir() if p.suffix == ".app").stem
-    return out / name
+    built = build(project, out, "native")
+    if isinstance(built, str):
+        raise SystemExit(f"bench_link: cannot build {project}: {built}")
+    return Path(built.artifact)
 
 
 def link_bytes(exe: Path, cycles: int, *args: str) -> bytes:
@@ -159,8 +168,7 @@ def lost_simavr(tmp: Path):
     if shutil.which("avr-g++") is None:
         return None
     out = tmp / "tank-uno"
-    r = run_fsw("build", str(TANK), "--out", str(out))
-    if r.code != 0:
+    if isinstance(build(TANK, out), str):
         return None
     s = Session(layout_of(TANK))
     start = time.monotonic()
@@ -223,8 +231,7 @@ def uno_footprint(tmp: Path):
     sizes = {}
     for name, proj in (("with", TANK), ("without", bare)):
         out = tmp / f"uno-{name}"
-        r = run_fsw("build", str(proj), "--out", str(out))
-        if r.code != 0:
+        if isinstance(build(proj, out), str):
             return None
         sizes[name] = elf_size(str(out / "tank.elf"))
     return sizes

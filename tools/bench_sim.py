@@ -13,7 +13,6 @@ from __future__ import annotations
 import collections
 import math
 import os
-import subprocess
 import sys
 import time
 
@@ -32,11 +31,13 @@ WARMUP_S, MEASURE_S = 0.1, 5.0
 
 
 def build(project: str, out: str) -> str:
-    r = subprocess.run([sys.executable, "-m", "fswkit.cli", "build", project, "--board", "uno", "--out", out],
-                       capture_output=True, text=True, cwd=ROOT)
-    if r.returncode != 0:
-        sys.exit(f"bench_sim: building {project} failed:\n{r.stdout[-2000:]}{r.stderr[-4000:]}")
-    return os.path.join(out, os.path.basename(project) + ".elf")
+    """The project's firmware for the Uno, built by the build service; its ELF."""
+    from fswkit.sim.command import build as build_for_sim
+
+    built = build_for_sim(project, "uno", out)  # says why on standard error when it cannot
+    if isinstance(built, int):
+        sys.exit(f"bench_sim: building {project} failed")
+    return built[0]
 
 
 def jitter(elf: str) -> dict:

@@ -18,8 +18,12 @@ import sys
 import tempfile
 import threading
 
-from fswkit.link.log import MAGIC as LOG_MAGIC  # the head of a recording
 
+
+
+# The head of a link recording (`fsw monitor --log`, `fsw sim --plant`):
+# fswkit.link.log writes it; recordings are never overwritten unasked.
+RECORDING_MAGIC = b"FSWLOG1\n"
 
 
 class OutputError(Exception):
@@ -38,12 +42,12 @@ def is_recording(path: str) -> bool:
     """Whether `path` is a link log (`fsw monitor --log`, `fsw sim --plant`)."""
     try:
         with open(path, "rb") as f:
-            return f.read(len(LOG_MAGIC)) == LOG_MAGIC
+            return f.read(len(RECORDING_MAGIC)) == RECORDING_MAGIC
     except OSError:
         return False
 
 
-def _direct(path: str) -> bool:
+def is_direct(path: str) -> bool:
     """Paths written in place: devices, FIFOs, /dev/stdout and the like."""
     if path.startswith(("/dev/", "/proc/")):
         return True
@@ -62,7 +66,7 @@ def check(path: str, inputs=(), *, force: bool = False, what: str = "output") ->
                               "choose another name")
     if os.path.isdir(path):
         raise OutputError(f"cannot write {path}: it is a folder (name a file for the {what})")
-    if _direct(path):
+    if is_direct(path):
         return
     if os.path.lexists(path) and not force and is_recording(path):
         raise OutputError(f"{path}: a link log (a recording) is there: it is never overwritten; "
@@ -137,7 +141,7 @@ def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | 
         out.flush()
         return
     check(path, inputs, force=force, what=what)
-    if _direct(path):
+    if is_direct(path):
         try:
             f = open(path, "wb" if binary else "w", **({} if binary else {"newline": newline}))
         except OSError as e:
@@ -216,7 +220,7 @@ class Replacement:
 
     def __init__(self, target: str):
         self.target = target
-        if _direct(target):
+        if is_direct(target):
             self.path, self._final = target, None
             return
         self._final = os.path.realpath(target) if os.path.islink(target) else target

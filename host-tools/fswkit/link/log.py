@@ -17,10 +17,11 @@ import struct
 import tempfile
 
 from fswkit.autocode.diagnostics import read_input
+from fswkit.outputs import RECORDING_MAGIC, is_direct
 
 from .layout import Layout, LayoutError, from_dict
 
-MAGIC = b"FSWLOG1\n"
+MAGIC = RECORDING_MAGIC
 MAX_LOG = 1 << 30  # bytes of a log the tools read: 1 GiB, a day of a link at 115200 baud
 _REC = struct.Struct("<BQI")
 RX, TX = 0, 1
@@ -39,8 +40,6 @@ class LogWriter:
     full disk) is a LogError saying so."""
 
     def __init__(self, path: str, layout: Layout, *, force: bool = False, **meta):
-        from fswkit.outputs import _direct
-
         self.path = path
         self._fd = None
         self._tmp = None
@@ -50,7 +49,7 @@ class LogWriter:
             raise LogError(f"{path} exists: a log is never overwritten unless asked (--force replaces it); "
                            "choose another name")
         try:
-            if _direct(path):  # a device or a pipe: written in place
+            if is_direct(path):  # a device or a pipe: written in place
                 self._fd = os.open(path, os.O_WRONLY | os.O_APPEND)
             else:
                 target = os.path.realpath(path) if os.path.islink(path) else path

@@ -181,3 +181,13 @@ def test_no_import_cycles_among_the_kits_modules():
     assert "fswkit.cli.main" in g and "fswkit.target.build" in g and "fswkit.autocode.app" in g
     found = cycles(g)
     assert not found, "modules that import each other (a cycle):\n" + "\n".join(describe(c, g) for c in found)
+
+
+def test_the_rooms_never_import_the_command_line():
+    """The command line sits on top: its commands call into the rooms, and no
+    room calls a command (`fsw flash` once built through `fsw build`'s
+    command, with a hand-made argparse.Namespace)."""
+    g = graph()
+    bad = [f"{m} imports {d}" for m in sorted(g) if not m.startswith("fswkit.cli")
+           for d in sorted(g[m]) if d == "fswkit.cli" or d.startswith("fswkit.cli.")]
+    assert not bad, "\n".join(bad)

@@ -1,148 +1,139 @@
-"""Analog and digital channel tables (`.aio`, `.dio`; spec §6): one channel
-per line, checked against the board and the state vector."""
+"""Analog and digital channel tables (`.aio`, `.dio`; spec §6): the checker.
+A table is parsed (appsyntax.parse_table) into rows of tokens; each row is
+checked against the board and the state vector and becomes a `Channel` of
+the model."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from . import model as M
+from .appsyntax import Calibration, ChannelRow, Problem, Table, parse_table
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
-from .lexer import ID, NUM, OP, lex
+from .model import Channel
 from .numeric import REALS
 
-
-@dataclass(frozen=True)
-class Channel:
-    analog: bool
-    direction: str  # "i" or "o"
-    pin: str  # as written: "A0", "4"
-    pin_number: int  # the board's pin number
-    element: M.Element
-    scale: float  # analog inputs: element = volts * scale + offset
-    offset: float
-    path: str
-    line: int
-
-
-def _parse_value(toks, i, src, diags, what, real: str):
-    """A signed number at toks[i:]; returns (value, next index). It must be
-    finite as binary64 and as the board's evaluation type `real` (the
-    firmware computes in it: `scale=1e39` is infinity in binary32)."""
-    neg = False
-    if i < len(toks) and toks[i].kind == OP and toks[i].text == "-":
-        neg, i = True, i + 1
-    if i >= len(toks) or toks[i].kind != NUM:
-        t = toks[i] if i < len(toks) else toks[-1]
-        diags.error(src, IO, t.line, t.col, f"expected a number after `{what}=`")
-        return None, len(toks)
-    v = float(toks[i].text)
-    if not (math.isfinite(v) and math.isfinite(REALS[real].literal(repr(v)))):  # as emit_app converts it
-        most = "binary32: 3.4028235e38" if real == "f32" else "binary64: 1.7976931348623157e308"
-        diags.error(src, IO, toks[i].line, toks[i].col,
-                    f"`{what}` is outside the representable range of the board's numbers ({most} at most)")
-        return None, len(toks)
-    return (-v if neg else v), i + 1
+__all__ = ["Channel", "check_channels", "check_table"]
 
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
                 diags: Diagnostics, used_pins: dict[int, tuple[str, int]] | None = None,
                 used_inputs: dict[str, tuple[str, int]] | None = None) -> tuple[Channel, ...]:
-    """The channels of one table. `used_pins` / `used_inputs` carry what
-    earlier tables of the same application took, so a pin or an input
-    element used twice across tables is reported too."""
+    """The channels of one table, parsed and checked. `used_pins` /
+    `used_inputs` carry what earlier tables of the same application took, so
+    a pin or an input element used twice across tables is reported too."""
+    return check_channels(parse_table(src, analog, diags), sv, board, diags, used_pins, used_inputs)
+
+
+def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnostics,
+                   used_pins: dict[int, tuple[str, int]] | None = None,
+                   used_inputs: dict[str, tuple[str, int]] | None = None) -> tuple[Channel, ...]:
+    """The channels of a parsed table; every refused row is reported."""
     used_pins = {} if used_pins is None else used_pins
     used_inputs = {} if used_inputs is None else used_inputs
-    err = lambda t, msg: diags.error(src, IO, t.line, t.col, msg)  # noqa: E731
-    kind = "analog" if analog else "digital"
+    err = lambda t, msg: diags.error(table.src, IO, t.line, t.col, msg)  # noqa: E731
     out: list[Channel] = []
-    for toks in lex(src, diags, IO):
-        if not toks:
+    for row in table.rows:
+        if isinstance(row, Problem):
+            err(row.tok, row.message)
             continue
-        d = toks[0]
-        if d.kind != ID or d.text not in ("i", "o"):
-            err(d, f"expected a direction `i` or `o`, found `{d.text}`")
+        calibration = _calibration(row, table.analog, board.real, err)
+        if calibration is None:
             continue
-        if len(toks) < 2 or toks[1].kind not in (ID, NUM):
-            t = toks[1] if len(toks) > 1 else d
-            err(t, "expected a pin after the direction")
-            continue
-        pin_tok = toks[1]
-        if len(toks) < 3 or toks[2].kind != ID:
-            t = toks[2] if len(toks) > 2 else pin_tok
-            err(t, "expected an element after the pin")
-            continue
-        el_tok = toks[2]
-        scale, offset = 1.0, 0.0
-        i = 3
-        bad = False
-        seen_opt: set[str] = set()
-        while i < len(toks):
-            t = toks[i]
-            if (t.kind == ID and t.text in ("scale", "offset") and i + 1 < len(toks)
-                    and toks[i + 1].kind == OP and toks[i + 1].text == "="):
-                if not analog or d.text != "i":
-                    err(t, f"`{t.text}=` applies only to analog inputs")
-                    bad = True
-                    break
-                if t.text in seen_opt:
-                    err(t, f"`{t.text}=` given twice")
-                    bad = True
-                    break
-                seen_opt.add(t.text)
-                v, i = _parse_value(toks, i + 2, src, diags, t.text, board.real)
-                if v is None:
-                    bad = True
-                    break
-                if t.text == "scale":
-                    scale = v
-                else:
-                    offset = v
-            else:
-                err(t, f"unexpected `{t.text}`: expected `scale=K` or `offset=B`")
-                bad = True
-                break
-        if bad:
-            continue
-        direction = d.text
-        pin = board.pin(pin_tok.text)
+        pin = _pin(row, table.analog, board, used_pins, err)
         if pin is None:
-            err(pin_tok, f"board `{board.name}` has no pin `{pin_tok.text}`")
             continue
-        if pin in board.reserved:
-            err(pin_tok, f"pin `{pin_tok.text}` is reserved on `{board.name}`: {board.reserved[pin]}")
-            continue
-        if analog and direction == "i" and pin not in board.analog_pins.values():
-            err(pin_tok, f"pin `{pin_tok.text}` of `{board.name}` is not an analog input")
-            continue
-        if analog and direction == "o" and pin not in board.pwm_pins:
-            err(pin_tok, f"pin `{pin_tok.text}` of `{board.name}` cannot drive PWM "
-                         f"(PWM pins: {', '.join(str(p) for p in sorted(board.pwm_pins))})")
-            continue
-        if not analog and pin not in board.digital_pins:
-            err(pin_tok, f"pin `{pin_tok.text}` of `{board.name}` cannot be used as a digital pin")
-            continue
-        if pin in used_pins:
-            where, line = used_pins[pin]
-            err(pin_tok, f"pin `{pin_tok.text}` is already used ({where}:{line})")
-            continue
-        e = sv.find(el_tok.text)
+        e = _element(row, table, sv, used_inputs, err)
         if e is None:
-            err(el_tok, f"unknown element `{el_tok.text}`")
             continue
-        if analog and not e.type.is_float:
-            err(el_tok, f"{kind} channels need an F32 or F64 element; `{e.name}` is {e.type}")
-            continue
-        if not analog and not e.type.is_bool:
-            err(el_tok, f"{kind} channels need a bool element; `{e.name}` is {e.type}")
-            continue
-        if direction == "i":
-            if e.name in used_inputs:
-                where, line = used_inputs[e.name]
-                err(el_tok, f"element `{e.name}` is already written by an input ({where}:{line})")
-                continue
-            used_inputs[e.name] = (src.path, d.line)
-        used_pins[pin] = (src.path, d.line)
-        out.append(Channel(analog, direction, pin_tok.text, pin, e, scale, offset, src.path, d.line))
+        used_pins[pin] = (table.src.path, row.direction.line)
+        out.append(Channel(table.analog, row.direction.text, row.pin.text, pin, e, *calibration,
+                           table.src.path, row.direction.line))
     return tuple(out)
+
+
+def _calibration(row: ChannelRow, analog: bool, real: str, err) -> tuple[float, float] | None:
+    """(scale, offset) of a row; None when one is refused."""
+    values = {"scale": 1.0, "offset": 0.0}
+    seen: set[str] = set()
+    for cal in row.calibrations:
+        key = cal.key.text
+        if not analog or row.direction.text != "i":
+            err(cal.key, f"`{key}=` applies only to analog inputs")
+            return None
+        if key in seen:
+            err(cal.key, f"`{key}=` given twice")
+            return None
+        seen.add(key)
+        v = _value(cal, real, err)
+        if v is None:
+            return None
+        values[key] = v
+    if row.stray is not None:
+        err(row.stray.tok, row.stray.message)
+        return None
+    return values["scale"], values["offset"]
+
+
+def _value(cal: Calibration, real: str, err) -> float | None:
+    """The calibration's number. It must be finite as binary64 and as the
+    board's evaluation type `real` (the firmware computes in it:
+    `scale=1e39` is infinity in binary32)."""
+    if cal.problem is not None:
+        err(cal.problem.tok, cal.problem.message)
+        return None
+    v = float(cal.number.text)
+    if not (math.isfinite(v) and math.isfinite(REALS[real].literal(repr(v)))):  # as the app emitter converts it
+        most = "binary32: 3.4028235e38" if real == "f32" else "binary64: 1.7976931348623157e308"
+        err(cal.number, f"`{cal.key.text}` is outside the representable range of the board's numbers "
+                        f"({most} at most)")
+        return None
+    return -v if cal.negative else v
+
+
+def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err) -> int | None:
+    """The board's number of the row's pin, when the row may use it."""
+    text = row.pin.text
+    pin = board.pin(text)
+    if pin is None:
+        problem = f"board `{board.name}` has no pin `{text}`"
+    elif pin in board.reserved:
+        problem = f"pin `{text}` is reserved on `{board.name}`: {board.reserved[pin]}"
+    elif analog and row.direction.text == "i" and pin not in board.analog_pins.values():
+        problem = f"pin `{text}` of `{board.name}` is not an analog input"
+    elif analog and row.direction.text == "o" and pin not in board.pwm_pins:
+        problem = (f"pin `{text}` of `{board.name}` cannot drive PWM "
+                   f"(PWM pins: {', '.join(str(p) for p in sorted(board.pwm_pins))})")
+    elif not analog and pin not in board.digital_pins:
+        problem = f"pin `{text}` of `{board.name}` cannot be used as a digital pin"
+    elif pin in used_pins:
+        where, line = used_pins[pin]
+        problem = f"pin `{text}` is already used ({where}:{line})"
+    else:
+        return pin
+    err(row.pin, problem)
+    return None
+
+
+def _element(row: ChannelRow, table: Table, sv: M.StateVector, used_inputs: dict, err) -> M.Element | None:
+    """The row's element, when it has the channel's type and, for an input,
+    no other input writes it."""
+    tok = row.element
+    e = sv.find(tok.text)
+    kind = "analog" if table.analog else "digital"
+    if e is None:
+        problem = f"unknown element `{tok.text}`"
+    elif table.analog and not e.type.is_float:
+        problem = f"{kind} channels need an F32 or F64 element; `{e.name}` is {e.type}"
+    elif not table.analog and not e.type.is_bool:
+        problem = f"{kind} channels need a bool element; `{e.name}` is {e.type}"
+    elif row.direction.text == "i" and e.name in used_inputs:
+        where, line = used_inputs[e.name]
+        problem = f"element `{e.name}` is already written by an input ({where}:{line})"
+    else:
+        if row.direction.text == "i":
+            used_inputs[e.name] = (table.src.path, row.direction.line)
+        return e
+    err(tok, problem)
+    return None

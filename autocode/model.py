@@ -1,13 +1,16 @@
 """The typed model: one frozen description of a state vector, a state
-machine or a state script, checked and resolved. The interpreter, the code
+machine, a state script, a channel table or an application, checked and
+resolved. The interpreter, the code
 generator and the telemetry schema read only this; nothing downstream
 re-parses text."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Union
 
+from .board import Board
 from .types import ElemType
 
 
@@ -273,3 +276,67 @@ class Script:
     # Guards of blocks with nothing in them: checked like every guard, never
     # evaluated (a guard is evaluated only before an input or a check).
     idle_guards: tuple[Expr, ...] = ()
+
+
+# ---- channel tables (spec §6) ---------------------------------------------------
+
+@dataclass(frozen=True)
+class Channel:
+    analog: bool
+    direction: str  # "i" or "o"
+    pin: str  # as written: "A0", "4"
+    pin_number: int  # the board's pin number
+    element: Element
+    scale: float  # analog inputs: element = volts * scale + offset
+    offset: float
+    path: str
+    line: int
+
+
+# ---- the application (spec §7) ----------------------------------------------------
+
+TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink")
+TASK_MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
+
+
+@dataclass(frozen=True)
+class Task:
+    name: str
+    kind: str  # one of TASK_KINDS
+    machine: int | None  # index into Application.machines for kind "machine"
+    rate: Fraction  # Hz
+    divider: int  # runs every `divider` executor cycles
+    mode: Element | None  # U8: 0 disabled, 1 safed, 2 enabled
+    start: str  # the mode at boot
+    line: int
+    overruns: Element | None = None  # U16: steps longer than the task's period
+    worst_us: Element | None = None  # U32: the longest step, microseconds
+
+
+@dataclass(frozen=True)
+class Stream:
+    region: Region
+    rate: Fraction
+    divider: int  # executor cycles between samples
+    line: int
+
+
+@dataclass(frozen=True)
+class Application:
+    path: str
+    name: str
+    board: Board
+    rate: int  # executor cycles per second
+    baud: int
+    sv: StateVector
+    machines: tuple[Machine, ...]
+    channels: tuple[Channel, ...]
+    tasks: tuple[Task, ...]
+    time_element: Element
+    time_source: str  # "clock" or "cycle"
+    time_unit: str  # "ms" or "us"
+    telemetry: tuple[Stream, ...]
+    writable: tuple[Element, ...]
+    reset_cause: Element | None = None  # U8: the MCU's reset cause at boot
+    flash_budget: int | None = None  # [budget] flash: bytes of program memory at most
+    ram_budget: int | None = None  # [budget] ram: data + bss + the stack's high-water mark

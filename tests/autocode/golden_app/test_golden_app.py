@@ -1,0 +1,126 @@
+"""Golden files for every diagnostic of the application languages: the
+`.app` config and the `.aio`/`.dio` channel tables it names.
+
+tests/autocode/golden_app/ holds one small application per diagnostic,
+`NAME.app`, beside `NAME.expected`: exactly what `fsw check NAME.app` writes
+to standard error, run from this folder. A case about a channel table names
+its own `NAME.aio` or `NAME.dio`; the other files (rig.sv, rig.sm, rig.aio,
+rig.dio, ...) are the companions the cases share. Each case is the same
+valid application (`valid.app`) with one thing changed, so its diagnostics
+are those of that change.
+
+    FSW_UPDATE_GOLDEN=1 pytest tests/autocode/golden_app/test_golden_app.py
+
+rewrites every .expected file from the current output; review the diff by
+eye before committing: each file is what a user sees.
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT, run_fsw
+
+GOLDEN = Path(__file__).resolve().parent
+UPDATE = os.environ.get("FSW_UPDATE_GOLDEN") == "1"
+
+
+def cases() -> list[Path]:
+    return sorted(GOLDEN.glob("*.app"))
+
+
+@pytest.mark.parametrize("inp", cases(), ids=lambda p: p.name)
+def test_golden_app(inp: Path):
+    expected_path = inp.with_suffix(".expected")
+    r = run_fsw("check", inp.name, cwd=GOLDEN)
+    if UPDATE:
+        expected_path.write_text(r.err)
+    assert expected_path.exists(), f"no {expected_path.name}: run with FSW_UPDATE_GOLDEN=1, then review it"
+    expected = expected_path.read_text()
+    assert r.err == expected
+    assert r.out == ""
+    summary = expected.splitlines()[-1]
+    assert re.fullmatch(r"fsw check: 1 file, \d+ errors?, \d+ warnings?", summary)
+    assert r.code == (0 if ", 0 errors," in summary else 1)
+    assert "Traceback" not in r.err and "internal error" not in r.err
+
+
+def test_the_base_case_is_valid():
+    r = run_fsw("check", "valid.app", cwd=GOLDEN)
+    assert (r.code, r.err) == (0, "fsw check: 1 file, 0 errors, 0 warnings\n")
+
+
+def test_every_expected_file_has_its_input():
+    inputs = {p.with_suffix(".expected") for p in cases()}
+    assert [p.name for p in GOLDEN.glob("*.expected") if p not in inputs] == []
+
+
+# ---- every message the application checker can produce has a golden case ------------
+
+SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py")]
+REPORTERS = {"error", "warning", "err", "at", "Problem"}
+# Messages that no golden case here can hold, and where they are tested instead.
+NOT_GOLDEN = {
+    # two machine files whose names differ only in case: one file on some file systems
+    "machines `": "tests/regression/test_names_reach_cpp_safely.py",
+    "` would generate the same C++ files (`": "tests/regression/test_names_reach_cpp_safely.py",
+    ".gen.h`; file names that differ only in case are one file on some file systems): rename one":
+        "tests/regression/test_names_reach_cpp_safely.py",
+    # a state vector of 256 writable elements
+    "` is writable element ": "tests/regression/test_table_limits_checked_before_generation.py",
+    ": the uplink writes at most ": "tests/regression/test_table_limits_checked_before_generation.py",
+    # a board of another clock than those in boards/
+    "; `baud` is not set, so it is the default: set `baud` in [application]":
+        "tests/regression/test_baud_rate_the_uart_can_make.py",
+}
+
+
+def _literals(node) -> list[str]:
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return [node.value]
+    if isinstance(node, ast.JoinedStr):
+        return [v.value for v in node.values if isinstance(v, ast.Constant)]
+    if isinstance(node, ast.BinOp):
+        return _literals(node.left) + _literals(node.right)
+    return []
+
+
+def message_fragments() -> dict[str, str]:
+    """The literal pieces of every message the sources report: the last
+    argument of a reporter, a `problem = ...` a reporter is given later, and
+    what a `*_problem` function returns."""
+    out = {}
+    for path in SOURCES:
+        tree = ast.parse(path.read_text())
+        found = []
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and node.args:
+                f = node.func
+                name = f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else None
+                if name in REPORTERS:
+                    found.append((node.lineno, node.args[-1]))
+            elif isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "problem"
+                                                      for t in node.targets):
+                found.append((node.lineno, node.value))
+            elif isinstance(node, ast.FunctionDef) and node.name.endswith("_problem"):
+                found += [(r.lineno, r.value) for r in ast.walk(node) if isinstance(r, ast.Return) and r.value]
+        for line, msg in found:
+            for p in _literals(msg):
+                if len(p.strip()) >= 4:
+                    out[p] = f"{path.name}:{line}"
+    return out
+
+
+def test_every_message_has_a_golden_case():
+    fragments = message_fragments()
+    assert len(fragments) > 80  # the scan found the reporters
+    seen = "".join(p.read_text() for p in GOLDEN.glob("*.expected"))
+    missing = [f"{where}: {frag!r}" for frag, where in sorted(fragments.items(), key=lambda kv: kv[1])
+               if frag not in seen and frag not in NOT_GOLDEN]
+    assert missing == []
+    assert [frag for frag in NOT_GOLDEN if frag not in fragments] == []  # each exception still a message

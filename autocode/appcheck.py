@@ -59,7 +59,7 @@ class Parts:
     machine_toks: dict[str, Tok]  # by the machine's file name, without its extension
 
 
-class _Report:
+class Report:
     """Reports about one .app file."""
 
     def __init__(self, src: Source, diags: Diagnostics):
@@ -76,7 +76,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     """The parts of the application in `f`; None when it has no state vector
     to check the rest against. `load_board(name)` gives a board or raises
     BoardError."""
-    r = _Report(f.src, diags)
+    r = Report(f.src, diags)
     settings = _settings(f.application, r)
     name = settings["name"].text if "name" in settings else os.path.splitext(os.path.basename(f.src.path))[0]
     board_tok = settings.get("board") if board_override is None else None
@@ -125,7 +125,7 @@ def complete(parts: Parts, src: Source, diags: Diagnostics, before: int) -> bool
     return True
 
 
-def positive(tok: Tok, r: _Report, what: str) -> Fraction | None:
+def positive(tok: Tok, r: Report, what: str) -> Fraction | None:
     """The exact value of a positive number of at most 10^9; None, reported,
     when `tok` is none."""
     q = exact_literal(tok.text) if tok.kind == NUM else None
@@ -142,7 +142,7 @@ def positive(tok: Tok, r: _Report, what: str) -> Fraction | None:
     return None
 
 
-def options(opts: Options, r: _Report) -> dict[str, tuple[Tok, Tok]]:
+def options(opts: Options, r: Report) -> dict[str, tuple[Tok, Tok]]:
     """The `key=value` options of a row: {key: (key token, value token)}, a
     key given twice reported (its last value kept), then what ended them."""
     out: dict[str, tuple[Tok, Tok]] = {}
@@ -157,7 +157,7 @@ def options(opts: Options, r: _Report) -> dict[str, tuple[Tok, Tok]]:
 
 # ---- [application] --------------------------------------------------------------
 
-def _settings(rows: tuple[Setting, ...], r: _Report) -> dict[str, Tok]:
+def _settings(rows: tuple[Setting, ...], r: Report) -> dict[str, Tok]:
     """{setting: its value token} of the settings that have one value."""
     out: dict[str, Tok] = {}
     for s in rows:
@@ -171,7 +171,7 @@ def _settings(rows: tuple[Setting, ...], r: _Report) -> dict[str, Tok]:
     return out
 
 
-def _board(name: str | None, tok: Tok | None, load_board, r: _Report) -> Board | None:
+def _board(name: str | None, tok: Tok | None, load_board, r: Report) -> Board | None:
     """The named board; a board that is not known is reported at `tok` (at
     1:1 when the name comes from the command line)."""
     if name is None:
@@ -185,7 +185,7 @@ def _board(name: str | None, tok: Tok | None, load_board, r: _Report) -> Board |
         return None
 
 
-def _rate(tok: Tok, r: _Report) -> int:
+def _rate(tok: Tok, r: Report) -> int:
     q = positive(tok, r, "`rate`")
     if q is None:
         return 100
@@ -199,7 +199,7 @@ def _rate(tok: Tok, r: _Report) -> int:
     return 100
 
 
-def _baud(tok: Tok | None, board: Board | None, board_tok: Tok | None, r: _Report) -> int:
+def _baud(tok: Tok | None, board: Board | None, board_tok: Tok | None, r: Report) -> int:
     """The link's baud rate (115200 unless set), which the board's UART must
     make; a default it cannot make is reported at the board's line."""
     if tok is None:
@@ -226,7 +226,7 @@ def _baud(tok: Tok | None, board: Board | None, board_tok: Tok | None, r: _Repor
 
 # ---- [configs] ------------------------------------------------------------------
 
-def _configs(rows: tuple[ConfigFile, ...], r: _Report):
+def _configs(rows: tuple[ConfigFile, ...], r: Report):
     """(the state vector's entry or None, the machines', the I/O tables')."""
     sv_file = None
     machine_files, io_files = [], []
@@ -244,7 +244,7 @@ def _configs(rows: tuple[ConfigFile, ...], r: _Report):
     return sv_file, machine_files, io_files
 
 
-def _machines(files: list[ConfigFile], sv: M.StateVector, board: Board | None, r: _Report):
+def _machines(files: list[ConfigFile], sv: M.StateVector, board: Board | None, r: Report):
     """(the machines, {machine name: its source}) of the `machine` files
     that read, check and have names the generated code can take."""
     machines: list[M.Machine] = []
@@ -283,7 +283,7 @@ def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]
     return None
 
 
-def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board, r: _Report) -> list[M.Channel]:
+def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board, r: Report) -> list[M.Channel]:
     channels: list[M.Channel] = []
     used_pins: dict = {}
     used_inputs: dict = {}
@@ -300,7 +300,7 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board, r: _Repo
 
 # ---- [time] ---------------------------------------------------------------------
 
-def _time(rows: tuple[Setting, ...], r: _Report) -> tuple[str, str]:
+def _time(rows: tuple[Setting, ...], r: Report) -> tuple[str, str]:
     """(source, unit)."""
     chosen = {"source": "clock", "unit": "ms"}
     for s in rows:
@@ -314,7 +314,7 @@ def _time(rows: tuple[Setting, ...], r: _Report) -> tuple[str, str]:
     return chosen["source"], chosen["unit"]
 
 
-def _time_element(machines: list[M.Machine], sv: M.StateVector, r: _Report) -> M.Element | None:
+def _time_element(machines: list[M.Machine], sv: M.StateVector, r: Report) -> M.Element | None:
     """The element every machine's `G` is."""
     g_elems = {m.vars[m.g].name for m in machines}
     if len(g_elems) > 1:
@@ -327,7 +327,7 @@ def _time_element(machines: list[M.Machine], sv: M.StateVector, r: _Report) -> M
 # ---- [tasks] --------------------------------------------------------------------
 
 def _tasks(rows: tuple[TaskRow, ...], sv: M.StateVector, rate: int, machines: list[M.Machine],
-           machine_files: list[ConfigFile], r: _Report):
+           machine_files: list[ConfigFile], r: Report):
     """(the tasks, {task name: its options}); a machine that runs in no task
     is reported at its [configs] line."""
     machine_names = {m.name: i for i, m in enumerate(machines)}
@@ -360,7 +360,7 @@ def _tasks(rows: tuple[TaskRow, ...], sv: M.StateVector, rate: int, machines: li
     return tasks, task_opts
 
 
-def _task_kind(row: TaskRow, tasks: list[Task], link_tasks: dict[str, Task], r: _Report) -> str | None:
+def _task_kind(row: TaskRow, tasks: list[Task], link_tasks: dict[str, Task], r: Report) -> str | None:
     """What the row's task runs, when its name and kind are good."""
     name = row.name
     earlier = next((t for t in tasks if t.name == name.text), None)
@@ -380,7 +380,7 @@ def _task_kind(row: TaskRow, tasks: list[Task], link_tasks: dict[str, Task], r: 
 
 
 def _task_machine(row: TaskRow, machine_names: dict[str, int], machine_lines: dict[int, int],
-                  r: _Report) -> int | None:
+                  r: Report) -> int | None:
     """The index of the machine a `machine` task runs."""
     mt = row.machine
     if mt is None:
@@ -396,7 +396,7 @@ def _task_machine(row: TaskRow, machine_names: dict[str, int], machine_lines: di
 
 
 def _task(row: TaskRow, kind: str, midx: int | None, opts: dict, sv: M.StateVector, rate: int,
-          r: _Report) -> Task | None:
+          r: Report) -> Task | None:
     """The task of a row whose name, kind and machine are good, when its
     settings are."""
     for k, (kt, _) in opts.items():
@@ -418,7 +418,7 @@ def _task(row: TaskRow, kind: str, midx: int | None, opts: dict, sv: M.StateVect
                 stats.get("overruns"), stats.get("worst_us"))
 
 
-def _task_stats(opts: dict, sv: M.StateVector, r: _Report) -> dict[str, M.Element] | None:
+def _task_stats(opts: dict, sv: M.StateVector, r: Report) -> dict[str, M.Element] | None:
     """{`overruns`/`worst_us`: element}; None when one is refused (each is
     reported)."""
     out = {}
@@ -439,7 +439,7 @@ def _task_stats(opts: dict, sv: M.StateVector, r: _Report) -> dict[str, M.Elemen
     return None if bad else out
 
 
-def _task_timing(opts: dict, rate: int, r: _Report) -> tuple[Fraction, int] | None:
+def _task_timing(opts: dict, rate: int, r: Report) -> tuple[Fraction, int] | None:
     """(the task's rate, the executor cycles between its steps)."""
     if "rate" not in opts:
         return Fraction(rate), 1
@@ -454,7 +454,7 @@ def _task_timing(opts: dict, rate: int, r: _Report) -> tuple[Fraction, int] | No
     return q, int(divider)
 
 
-def _task_mode(opts: dict, sv: M.StateVector, r: _Report) -> tuple[M.Element | None, str] | None:
+def _task_mode(opts: dict, sv: M.StateVector, r: Report) -> tuple[M.Element | None, str] | None:
     """(the mode element or None, the mode at boot)."""
     mode_el = None
     if "mode" in opts:
@@ -479,7 +479,7 @@ def _task_mode(opts: dict, sv: M.StateVector, r: _Report) -> tuple[M.Element | N
     return mode_el, st.text
 
 
-def _clock_steps(tasks: list[Task], board: Board | None, time_source: str, time_unit: str, r: _Report) -> None:
+def _clock_steps(tasks: list[Task], board: Board | None, time_source: str, time_unit: str, r: Report) -> None:
     """Every machine's task steps slower than `G` ticks.
 
     With `source clock`, G is the board's millis()/micros(), which advance
@@ -506,7 +506,7 @@ def _clock_steps(tasks: list[Task], board: Board | None, time_source: str, time_
 
 # ---- [telemetry] ----------------------------------------------------------------
 
-def _telemetry(rows: tuple[StreamRow, ...], sv: M.StateVector, tasks: list[Task], r: _Report) -> list[M.Stream]:
+def _telemetry(rows: tuple[StreamRow, ...], sv: M.StateVector, tasks: list[Task], r: Report) -> list[M.Stream]:
     tele = next((t for t in tasks if t.kind == "telemetry"), None)
     streams = []
     for row in rows:
@@ -516,7 +516,7 @@ def _telemetry(rows: tuple[StreamRow, ...], sv: M.StateVector, tasks: list[Task]
     return streams
 
 
-def _stream(row: StreamRow, sv: M.StateVector, tele: Task | None, r: _Report) -> M.Stream | None:
+def _stream(row: StreamRow, sv: M.StateVector, tele: Task | None, r: Report) -> M.Stream | None:
     rt = row.region
     region = next((x for x in sv.regions if x.name == rt.text), None)
     if region is None:
@@ -548,7 +548,7 @@ def _stream(row: StreamRow, sv: M.StateVector, tele: Task | None, r: _Report) ->
 # ---- [uplink], the reset cause, one writer per element -----------------------------
 
 def _uplink(rows: tuple[WritableRow, ...], sv: M.StateVector, tasks: list[Task], machines: list[M.Machine],
-            channels: list[M.Channel], reset_tok: Tok | None, r: _Report) -> list[M.Element]:
+            channels: list[M.Channel], reset_tok: Tok | None, r: Report) -> list[M.Element]:
     """The elements the ground may write: none that the executor, a machine's
     `G`/`S` or an input channel writes."""
     owners = {m.vars[m.g].name: f"`G` of machine `{m.name}`" for m in machines}
@@ -585,7 +585,7 @@ def _uplink(rows: tuple[WritableRow, ...], sv: M.StateVector, tasks: list[Task],
     return writable
 
 
-def _reset_cause(tok: Tok | None, sv: M.StateVector, r: _Report) -> M.Element | None:
+def _reset_cause(tok: Tok | None, sv: M.StateVector, r: Report) -> M.Element | None:
     if tok is None:
         return None
     el = sv.find(tok.text)
@@ -596,7 +596,7 @@ def _reset_cause(tok: Tok | None, sv: M.StateVector, r: _Report) -> M.Element | 
     return el
 
 
-def _one_writer(r: _Report, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs) -> None:
+def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs) -> None:
     """Every element has at most one writer among the input channels, the
     executor (each task's mode, overruns and worst_us; the reset cause) and
     the machines (their assignments and their own `S`); a second writer is
@@ -637,7 +637,7 @@ def _one_writer(r: _Report, channels, tasks, task_opts, reset_tok, reset_el, mac
 
 # ---- [budget] -------------------------------------------------------------------
 
-def _budget(rows: tuple[Setting, ...], board: Board | None, r: _Report) -> dict[str, int]:
+def _budget(rows: tuple[Setting, ...], board: Board | None, r: Report) -> dict[str, int]:
     """{`flash`/`ram`: bytes at most}."""
     budget: dict[str, int] = {}
     for s in rows:
@@ -647,7 +647,7 @@ def _budget(rows: tuple[Setting, ...], board: Board | None, r: _Report) -> dict[
     return budget
 
 
-def _budget_value(s: Setting, budget: dict[str, int], board: Board | None, r: _Report) -> int | None:
+def _budget_value(s: Setting, budget: dict[str, int], board: Board | None, r: Report) -> int | None:
     key = s.key.text
     if key not in ("flash", "ram"):
         r.err(s.key, f"unknown budget `{key}`: expected `flash` or `ram` (bytes)")

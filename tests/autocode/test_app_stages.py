@@ -13,7 +13,7 @@ import pytest
 from conftest import EXAMPLES
 from fswkit.autocode import app as A
 from fswkit.autocode import model as M
-from fswkit.autocode.appcheck import check_app, complete, options, positive
+from fswkit.autocode.appcheck import Report, check_app, complete, options, positive
 from fswkit.autocode.appsyntax import (AppFile, ChannelRow, ConfigFile, Problem, Setting, StreamRow, TaskRow,
                                        WritableRow, parse_app, parse_options, parse_table)
 from fswkit.autocode.board import load_board
@@ -197,17 +197,10 @@ def test_positive_and_options_helpers():
     diags = Diagnostics()
     s = src("[tasks]\na inputs rate=0 rate=2.5 x\n")
     (row,) = parse_app(s, diags).tasks
-
-    class R:
-        def __init__(self):
-            self.src, self.diags = s, diags
-
-        def err(self, tok, msg):
-            diags.error(s, "application config", tok.line, tok.col, msg)
-
-    opts = options(row.options, R())
-    assert positive(opts["rate"][1], R(), "`rate`") == Fraction(5, 2)  # the last value of a key given twice
-    assert positive(row.options.items[0].value, R(), "`rate`") is None
+    r = Report(s, diags)
+    opts = options(row.options, r)
+    assert positive(opts["rate"][1], r, "`rate`") == Fraction(5, 2)  # the last value of a key given twice
+    assert positive(row.options.items[0].value, r, "`rate`") is None
     assert [m for _, _, m in where(diags)] == ["`rate=` given twice", "unexpected `x`: expected `key=value`",
                                                "`rate` must be a positive number, found `0`"]
 

@@ -14,10 +14,11 @@ reason (a reused task name) says only that."""
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 
-from .diagnostics import APP, IO, Diagnostics, Source
-from .lexer import ID, NUM, OP, Tok, lex
+from .diagnostics import APP, IO, Columns, Diagnostics, Source
+from .lexer import ID, NUM, OP, Tok, lex, lex_line
 from .parser import show, split_sections
 
 
@@ -57,7 +58,7 @@ class Setting:
 class ConfigFile:
     """`kind file` in [configs]: `state_vector`, `machine` or `io`."""
     kind: Tok
-    file: Tok | None  # the file name's first token; None when the line has none
+    file: Tok | None  # the file name as written (a PATH token); None when the line has none
     path: str  # the file name as written (to a comment or the end of the line), beside the .app
 
 
@@ -101,7 +102,7 @@ class AppFile:
 def parse_app(src: Source, diags: Diagnostics) -> AppFile:
     """The tree of an .app file; lexical errors, lines before the first
     section and unknown, malformed or duplicate sections are reported."""
-    pre, sections = split_sections(src, lex(src, diags, APP), diags, APP)
+    pre, sections = split_sections(src, _lex_app(src, diags), diags, APP)
     for toks in pre:
         diags.error(src, APP, toks[0].line, toks[0].col, f"unexpected {show(toks[0])} before the first section")
     body: dict[str, list[list[Tok]]] = {}
@@ -129,6 +130,38 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
     )
 
 
+PATH = "path"  # the kind of a [configs] row's file name: its text as written
+_HEADER = re.compile(r"\s*\[\s*([A-Za-z_][A-Za-z0-9_]*)\s*\]")
+_KIND = re.compile(r"\s*[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _lex_app(src: Source, diags: Diagnostics) -> list[list[Tok]]:
+    """The tokens of an .app file, line by line. In [configs] a row is a
+    kind and a file name: the name is not lexed but kept as one PATH token,
+    the text as written to a comment or the end of the line, so `./`, `../`,
+    spaces and any alphabet reach the file system as the user wrote them."""
+    out: list[list[Tok]] = []
+    section = None
+    for i, text in enumerate(src.lines):
+        n = i + 1
+        header = _HEADER.match(text)
+        if header is not None:
+            section = header.group(1)
+        kind = _KIND.match(text) if section == "configs" and header is None else None
+        if kind is None:
+            out.append(lex_line(src, n, text, diags, APP))
+            continue
+        toks = lex_line(src, n, text[:kind.end()], diags, APP)
+        rest = text[kind.end():].split("#", 1)[0]
+        name = rest.strip()
+        if name:
+            pos = kind.end() + (len(rest) - len(rest.lstrip()))
+            col = Columns(text)(pos) if "\t" in text else pos + 1
+            toks.append(Tok(PATH, name, n, col))
+        out.append(toks)
+    return out
+
+
 def _setting(toks: list[Tok]) -> Setting:
     return Setting(toks[0], tuple(toks[1:]))
 
@@ -136,9 +169,7 @@ def _setting(toks: list[Tok]) -> Setting:
 def _config_file(src: Source, folder: str, toks: list[Tok]) -> ConfigFile:
     if len(toks) < 2:
         return ConfigFile(toks[0], None, "")
-    text = src.line(toks[0].line)
-    name = text[col_index(text, toks[1].col):].split("#", 1)[0].strip()
-    return ConfigFile(toks[0], toks[1], os.path.join(folder, name))
+    return ConfigFile(toks[0], toks[1], os.path.join(folder, toks[1].text))
 
 
 def _task_row(toks: list[Tok]) -> TaskRow:

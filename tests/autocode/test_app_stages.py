@@ -72,7 +72,7 @@ def test_parse_gives_rows_with_positions():
 
     sv, machine, io = tree.configs
     assert isinstance(sv, ConfigFile) and sv.path == "rig/tank.sv"
-    assert (machine.file.text, machine.file.line, machine.file.col) == ("my", 8, 14)
+    assert (machine.file.text, machine.file.line, machine.file.col) == ("my tank.sm", 8, 14)  # the file name as written, one token
     assert machine.path == "rig/my tank.sm"  # to the comment, as written
 
     sense, control, act = tree.tasks
@@ -161,7 +161,7 @@ def test_check_resolves_a_tree(tank):
                                                                       ("control", "machine", 1)]
     assert [(x.region.name, x.divider) for x in parts.streams] == [("Sensors", 2), ("Effectors", 10)]
     assert [e.name for e in parts.writable] == ["valveOpen"]
-    assert (parts.sv_tok.text, parts.sv_tok.line, parts.sv_tok.col) == ("tank", 9, 14)  # the file name's first token
+    assert (parts.sv_tok.text, parts.sv_tok.line, parts.sv_tok.col) == ("tank.sv", 9, 14)  # the file name as written
     assert parts.machine_toks["tank"].line == 10
 
 

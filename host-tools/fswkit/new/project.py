@@ -18,6 +18,7 @@ from fswkit.autocode.kit import ROOT as KIT_ROOT
 KEYWORDS = {"if", "else", "and", "or", "not", "true", "false"}
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 LED_PIN = 13  # the on-board LED of the Uno, Nano and Mega
+BAUD = 115200  # the link's rate in the new .app (platformio.ini's monitor_speed follows it)
 
 
 class ScaffoldError(Exception):
@@ -156,7 +157,7 @@ o      {led:<4} valveOpen
 [application]
 board {board.name}
 rate  100
-baud  115200
+baud  {BAUD}
 
 [configs]
 state_vector {name}.sv
@@ -185,7 +186,7 @@ Status     rate=1
 """
 
     out[f"{name}.ss"] = _skeleton(name, out)
-    out["platformio.ini"] = _platformio_ini(name, board, kit_root)
+    out["platformio.ini"] = _platformio_ini(name, board, kit_root, _app_baud(out[f"{name}.app"]))
     out["README.md"] = _readme(name, board)
     out[".gitignore"] = "# Generated code, builds and PlatformIO's work: all made again from the configs.\nbuild/\n"
     return out
@@ -207,7 +208,12 @@ def _skeleton(name: str, texts: dict[str, str]) -> str:
         return skeleton(m)
 
 
-def _platformio_ini(name: str, board: Board, kit_root: str) -> str:
+def _app_baud(app_text: str) -> int:
+    """The `baud` the new .app sets: `pio device monitor` reads the board at it."""
+    return int(re.search(r"^baud\s+(\d+)\s*$", app_text, re.M).group(1))
+
+
+def _platformio_ini(name: str, board: Board, kit_root: str, baud: int) -> str:
     pio = board.raw.get("platformio", {})
     envs = []
     if board.is_avr:
@@ -250,7 +256,8 @@ libdeps_dir = build/pio/libdeps
 extra_scripts = pre:${{fswkit.kit}}/tools/pio_hook.py
 build_src_filter = +<$PIOENV/>
 lib_deps = fswkit=symlink://${{fswkit.kit}}/firmware
-monitor_speed = 115200
+; the link's rate: {name}.app's baud
+monitor_speed = {baud}
 
 """ + "\n".join(envs)
 

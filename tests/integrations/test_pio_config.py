@@ -57,7 +57,7 @@ def test_platformio_ini_parses_with_the_environments_of_the_issue(tmp_path):
     assert pio["test_dir"] == str(ROOT / "tests" / "integrations" / "pio")
     for name in envs:
         env = cfg[f"env:{name}"]
-        assert env["extra_scripts"] == ["pre:tools/pio_hook.py"]
+        assert env["extra_scripts"] == ["pre:integrations/platformio/pio_hook.py"]
         assert env["custom_fsw_project"] == "examples/tank"
         assert env["lib_deps"] == ["fswkit=symlink://firmware"]
         assert env["test_framework"] == "unity"

@@ -1,4 +1,4 @@
-"""tools/pio_hook.py run the way PlatformIO runs it: SCons executes the file
+"""integrations/platformio/pio_hook.py run the way PlatformIO runs it: SCons executes the file
 with `Import`, `COMMAND_LINE_TARGETS` and the build environment in its
 globals (and no `__file__`). The hook regenerates the project's C++ before
 every build and stops a build on a broken config with its located
@@ -15,7 +15,7 @@ import pytest
 
 from conftest import EXAMPLES, ROOT
 
-HOOK = ROOT / "tools" / "pio_hook.py"
+HOOK = ROOT / "integrations" / "platformio" / "pio_hook.py"
 TANK = EXAMPLES / "tank"
 
 
@@ -85,6 +85,7 @@ def run_hook(env, targets=()):
     globs = {"__name__": "SCons.Script", "Import": lambda *names: None, "env": env,
              "COMMAND_LINE_TARGETS": list(targets)}
     exec(code, globs)
+    return globs
 
 
 def uno_env(tmp_path, project, **over):
@@ -205,3 +206,11 @@ def test_debian_avr_gcc_needs_decimal_dig(tmp_path):
     env = uno_env(tmp_path, "examples/tank", platform=FakePlatform("atmelavr", {"toolchain-atmelavr": str(tool)}))
     run_hook(env)
     assert env.appended == [{"CPPDEFINES": [("DECIMAL_DIG", "__DECIMAL_DIG__")]}]
+
+
+def test_hook_finds_the_kits_checkout_without_file(tmp_path):
+    # SCons gives the hook no `__file__`: the checkout (for its .venv/bin/fsw
+    # fallback) comes from the code object's file name, two folders up.
+    globs = run_hook(uno_env(tmp_path, "examples/tank"))
+    assert "__file__" not in globs
+    assert globs["KIT_ROOT"] == str(ROOT)

@@ -64,7 +64,7 @@ def test_scaffold_platformio_ini_parses(fsw, tmp_path):
     env = cfg["env:mega2560"]
     assert env["platform"] == "atmelavr" and env["board"] == "megaatmega2560"
     assert env["custom_fsw_board"] == "mega2560"
-    assert env["extra_scripts"] == [f"pre:{ROOT}/tools/pio_hook.py"]
+    assert env["extra_scripts"] == [f"pre:{ROOT}/integrations/platformio/pio_hook.py"]
     assert env["lib_deps"] == [f"fswkit=symlink://{ROOT}/firmware"]
     assert cfg["env:native"]["platform"] == "native"
     assert cfg["platformio"]["default_envs"] == ["mega2560"]

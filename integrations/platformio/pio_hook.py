@@ -1,4 +1,5 @@
-"""PlatformIO pre-build hook (`extra_scripts = pre:tools/pio_hook.py`).
+"""PlatformIO pre-build hook (`extra_scripts = pre:integrations/platformio/pio_hook.py`;
+integrations/platformio/README.md).
 
 Before every `pio run` of an environment it regenerates the fswkit project's
 C++ with `fsw gen`, into `$PROJECT_SRC_DIR/<environment>/`, so the build
@@ -26,9 +27,10 @@ import shutil
 import subprocess
 import sys
 
-# SCons runs this file without `__file__`; its code object still knows the path.
-KIT_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(
-    globals().get("__file__") or inspect.currentframe().f_code.co_filename)))
+# SCons runs this file without `__file__`; its code object still knows the path
+# (integrations/platformio/pio_hook.py: the kit's checkout is two folders up).
+KIT_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(
+    globals().get("__file__") or inspect.currentframe().f_code.co_filename))))
 
 
 class HookError(Exception):

@@ -163,7 +163,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
                        "crashed": "the firmware crashed", "done": "the firmware stopped itself"}.get(stop, stop)
                 raise CosimError(f"{why} at {t0:.3f} s simulated")
             t1 = k / rate
-            edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges]
+            edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges] if step.edges else ()
             for ev in scenario.advance(t0, t1, edges):
                 run.pin_events.append(ev)
             raw = step.uart

@@ -415,12 +415,13 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
     if (cycle_limit && cycle_limit < stop_at) stop_at = cycle_limit;
     const char* why = NULL;
     while (!why) {
+        avr_t* const a = avr; /* a local: the compiler need not reload it after each instruction */
         for (int i = 0; i < RUN_BATCH; i++) {
-            if (avr->cycle >= stop_at) {
-                why = (has_target && avr->cycle >= target) ? "target" : "sim-limit";
+            if (a->cycle >= stop_at) {
+                why = (has_target && a->cycle >= target) ? "target" : "sim-limit";
                 break;
             }
-            int st = avr_run(avr);
+            int st = avr_run(a);
             if (st == cpu_Done || st == cpu_Crashed) {
                 halted = 1;
                 why = st == cpu_Crashed ? "crashed" : "done";

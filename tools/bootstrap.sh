@@ -12,6 +12,10 @@ PYTHON=${PYTHON:-python3}
 # clang and its runtime (libFuzzer, sanitizers) for the uplink fuzzer.
 APT_PACKAGES=(gcc-avr avr-libc binutils-avr avrdude arduino-core-avr simavr libsimavr-dev
               g++ make graphviz valgrind clang libclang-rt-14-dev)
+# Installed where the distribution has them: arduino-ctags, which arduino-cli
+# runs on an exported sketch's .ino with Debian's Arduino core
+# (integrations/arduino-cli/README.md).
+OPTIONAL_APT_PACKAGES=(arduino-ctags)
 
 as_root() {
     if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
@@ -26,10 +30,34 @@ done
 if ! "$PYTHON" -c 'import ensurepip, venv' >/dev/null 2>&1; then
     missing+=(python3-venv)
 fi
+# An optional package is looked up in apt's lists as they are, and in fresh
+# ones when required packages make apt-get update run anyway.
+has_candidate() { apt-cache policy "$1" 2>/dev/null | grep -q 'Candidate: [^(]'; }
+optional=()
+for p in "${OPTIONAL_APT_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed"; then
+        optional+=("$p")
+    fi
+done
+updated=
 if [ ${#missing[@]} -gt 0 ]; then
-    echo "bootstrap: installing Debian packages: ${missing[*]}"
     export DEBIAN_FRONTEND=noninteractive
     as_root apt-get update -qq
+    updated=1
+fi
+for p in ${optional[@]+"${optional[@]}"}; do
+    if has_candidate "$p"; then
+        missing+=("$p")
+    else
+        echo "bootstrap: $p is not in this distribution's packages: skipped (arduino-cli needs it to compile a sketch)"
+    fi
+done
+if [ ${#missing[@]} -gt 0 ] && [ -z "$updated" ]; then
+    export DEBIAN_FRONTEND=noninteractive
+    as_root apt-get update -qq
+fi
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "bootstrap: installing Debian packages: ${missing[*]}"
     # A parallel apt run can race for the archive lock: retry once.
     as_root apt-get install -y -qq --no-install-recommends "${missing[@]}" \
         || { sleep 5; as_root apt-get install -y -qq --no-install-recommends "${missing[@]}"; }

@@ -44,7 +44,7 @@ def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict
            "// `fsw gen --sketch`. The application is the generated code beside this",
            "// file (app.gen.cpp holds setup() and loop()): change the configs and",
            "// export again rather than editing it. Needs the fswkit library",
-           "// (docs/arduino-cli.md).",
+           "// (integrations/arduino-cli/README.md of fswkit).",
            "#include <fswkit.h>"]
     ino += [f'#include "{h}"' for h in headers]
     files = dict(generated)

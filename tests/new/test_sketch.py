@@ -16,6 +16,7 @@ import subprocess
 import pytest
 
 from conftest import EXAMPLES, ROOT
+from fswkit.new.sketch import BUILD_PROPERTIES
 
 TANK = EXAMPLES / "tank"
 
@@ -32,7 +33,11 @@ def test_sketch_folder_holds_the_generated_code_an_ino_and_the_fqbn(fsw, tmp_pat
     assert "#include <fswkit.h>" in ino and '#include "tank.gen.h"' in ino
     assert "void setup" not in ino  # app.gen.cpp holds setup() and loop()
     assert "void setup() {" in (sketch / "app.gen.cpp").read_text()
-    assert (sketch / "sketch.yaml").read_text().endswith("default_fqbn: arduino:avr:uno\n")
+    yaml = (sketch / "sketch.yaml").read_text()
+    assert yaml.endswith("default_fqbn: arduino:avr:uno\n")
+    # fsw build's flags, named for the command line (the folder cannot carry them)
+    assert "#   --build-property compiler.c.elf.extra_flags=-Wl,--relax\n" in yaml
+    assert "#   --build-property compiler.cpp.extra_flags=-mcall-prologues\n" in yaml
     ref = tmp_path / "ref"
     assert fsw("gen", str(TANK), "--out", str(ref)).code == 0
     for p in ref.iterdir():
@@ -55,17 +60,13 @@ def test_sketch_errors(fsw, tmp_path):
 
 
 DEBIAN_CORE = "/usr/share/arduino/hardware/arduino/avr"
-# What `fsw build` (mk/build.mk) adds to the Arduino core's platform.txt
-# flags, as arduino-cli build properties (integrations/arduino-cli/README.md).
-KIT_PROPERTIES = {"compiler.c.extra_flags": "-mcall-prologues", "compiler.cpp.extra_flags": "-mcall-prologues",
-                  "compiler.c.elf.extra_flags": "-Wl,--relax"}
 
 needs_arduino_cli = pytest.mark.skipif(shutil.which("arduino-cli") is None, reason="arduino-cli not installed")
 
 
 def arduino_cli(sketch, out, tmp_path, kit_flags=False):
     """`arduino-cli compile` of the sketch for the Uno; the process."""
-    props = dict(KIT_PROPERTIES) if kit_flags else {}
+    props = dict(BUILD_PROPERTIES) if kit_flags else {}
     if "FSW_ARDUINO_CLI_FLAGS" in os.environ:
         choose = shlex.split(os.environ["FSW_ARDUINO_CLI_FLAGS"])
     else:
@@ -111,7 +112,8 @@ def test_arduino_cli_compiles_the_exported_sketch(fsw, tmp_path):
 @needs_arduino_cli
 def test_with_the_kits_flags_arduino_cli_builds_fsw_builds_firmware(fsw, tmp_path):
     """The Arduino IDE's flags lack -mcall-prologues and -Wl,--relax: about
-    5 % more flash. With them as build properties, arduino-cli's firmware is
+    5 % more flash. With them as build properties (the ones sketch.yaml
+    names), arduino-cli's firmware is
     `fsw build`'s to within the few bytes LTO places differently because
     arduino-cli archives the core's objects in another order (measured: 12 B
     of 10,436 for the tank on the Uno); RAM is the same."""

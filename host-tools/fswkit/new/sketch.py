@@ -17,6 +17,14 @@ from fswkit.autocode.cnames import comment
 # with `-` or `.`; at most 63 characters.
 SKETCH_NAME = re.compile(r"[0-9A-Za-z_][0-9A-Za-z_.-]{0,62}\Z")
 
+# What `fsw build` (mk/build.mk) adds to the Arduino core's platform.txt
+# flags, as arduino-cli build properties: with them an exported sketch
+# compiles to `fsw build`'s firmware (integrations/arduino-cli/README.md).
+# A sketch folder cannot carry them (sketch.yaml has no place for flags):
+# sketch.yaml names them in a comment.
+BUILD_PROPERTIES = {"compiler.c.extra_flags": "-mcall-prologues", "compiler.cpp.extra_flags": "-mcall-prologues",
+                    "compiler.c.elf.extra_flags": "-Wl,--relax"}
+
 
 class SketchError(Exception):
     pass
@@ -49,8 +57,10 @@ def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict
     ino += [f'#include "{h}"' for h in headers]
     files = dict(generated)
     files[name + ".ino"] = "\n".join(ino) + "\n"
+    props = "".join(f"#   --build-property {k}={v}\n" for k, v in BUILD_PROPERTIES.items())
     files["sketch.yaml"] = (f"# arduino-cli: `arduino-cli compile` in this folder builds for the {app.board.name}.\n"
-                            f"default_fqbn: {fqbn}\n")
+                            "# With fsw build's flags (its firmware; integrations/arduino-cli/README.md of fswkit):\n"
+                            + props + f"default_fqbn: {fqbn}\n")
     return files
 
 

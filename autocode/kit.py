@@ -6,7 +6,9 @@ In a source checkout (and an editable install) they sit at the top of the
 tree, beside `autocode/`. An installed kit (`pip install .`) carries them
 inside the package in the same layout, beside `fswkit/autocode/`
 (pyproject.toml's package-data): fswkit/firmware/src, fswkit/boards,
-fswkit/mk/build.mk. Either way they are found from this file, never from
+fswkit/mk/build.mk, the runtime's Arduino library files and the PlatformIO
+hook (fswkit/integrations/platformio) that a platformio.ini written by
+`fsw new` names. Either way they are found from this file, never from
 the working folder, and nothing is written beside them: builds go to the
 project's folder (or --out), compiled helpers to the user's cache
 (FSW_CACHE_DIR, else $XDG_CACHE_HOME/fswkit or ~/.cache/fswkit)."""

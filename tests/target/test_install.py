@@ -25,7 +25,7 @@ from conftest import EXAMPLES, ROOT
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
 SIMAVR = os.path.exists("/usr/include/simavr/sim_avr.h")
-SOURCES = ("pyproject.toml", "README.md", "host-tools", "autocode", "firmware", "boards", "mk")
+SOURCES = ("pyproject.toml", "README.md", "host-tools", "autocode", "firmware", "boards", "mk", "integrations")
 
 
 def _run(cmd, **kw) -> subprocess.CompletedProcess:
@@ -110,3 +110,20 @@ def test_the_installed_fsw_builds_and_flies_outside_the_tree(installed, tmp_path
         assert r.returncode == 0, r.stdout + r.stderr
         assert "checks passed" in r.stdout and (flight / "summary.txt").is_file()
     assert _files(site_pkg) == before  # builds and caches went elsewhere
+
+
+def test_an_installed_fsw_new_writes_a_platformio_ini_whose_kit_files_exist(installed, tmp_path):
+    """`fsw new` names the kit's PlatformIO hook and the runtime as an
+    Arduino library in platformio.ini: an installed kit carries both."""
+    r = _run([installed / "bin" / "fsw", "new", "rig", "--board", "uno"], env=_env(installed), cwd=tmp_path)
+    assert r.returncode == 0, r.stdout + r.stderr
+    ini = (tmp_path / "rig" / "platformio.ini").read_text()
+    kit = Path(next(line.split("=", 1)[1].strip() for line in ini.splitlines() if line.startswith("kit =")))
+    assert (installed / "lib").resolve() in kit.resolve().parents
+    assert "${fswkit.kit}/integrations/platformio/pio_hook.py" in ini
+    assert "symlink://${fswkit.kit}/firmware" in ini
+    hook = kit / "integrations" / "platformio" / "pio_hook.py"
+    assert hook.is_file(), hook
+    assert 'Import("env")' in hook.read_text()
+    for name in ("library.json", "library.properties", "src/fswkit.h"):
+        assert (kit / "firmware" / name).is_file(), name

@@ -1,5 +1,5 @@
 """The `fsw` command line: its parser, the dispatch to the command modules
-(one per room: front, target, sim, ground, new), and the exit statuses:
+(one per room: front, target, sim, ground, new, tape), and the exit statuses:
 0 success, 1 a failure, 2 a configuration or usage error, 3 an internal
 error of the kit, 128 + N stopped by signal N, 130 by Ctrl-C."""
 
@@ -11,7 +11,7 @@ import re
 import sys
 
 from fswkit import __version__
-from fswkit.cli import front, ground, new, sim, target
+from fswkit.cli import front, ground, new, sim, tape, target
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
 
 # ---- argument types -------------------------------------------------------------------
@@ -214,6 +214,24 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("-o", "--output", required=True, metavar="OUT.png")
     pl.add_argument("--ignore-schema", action="store_true")
     pl.set_defaults(func=ground.cmd_plot)
+
+    tp = sub.add_parser("tape", help="sensor tapes of real flights: import a recorder's log, show a tape "
+                        "(docs/tapes.md)")
+    tsub = tp.add_subparsers(dest="tape_command", metavar="import|show")
+    tsub.required = True
+    ti = tsub.add_parser("import", help="convert an altimeter's CSV log into a sensor tape")
+    ti.add_argument("format", choices=("altos", "cats", "raven", "eggtimer", "rrc3"), metavar="FORMAT",
+                    help="altos | cats | raven | eggtimer | rrc3")
+    ti.add_argument("log", metavar="LOG")
+    ti.add_argument("-o", "--output", required=True, metavar="TAPE.csv", help="the tape to write (- for "
+                    "standard output)")
+    ti.add_argument("--pad-alt", type=float, metavar="M", help="pad elevation in m ASL, for pressure made "
+                    "from a log's altitude (default 0)")
+    ti.add_argument("--force", action="store_true", help="replace TAPE.csv if it exists")
+    ti.set_defaults(func=tape.cmd_import)
+    ts = tsub.add_parser("show", help="a tape's header, span, rates, columns, and its truth events")
+    ts.add_argument("tape", metavar="TAPE.csv")
+    ts.set_defaults(func=tape.cmd_show)
     return p
 
 

@@ -1,0 +1,102 @@
+"""`fsw tape import` (a recorder's log to a sensor tape) and `fsw tape show`
+(a tape's header, span, rates, columns, and its truth file's events):
+fswkit.tape. Bad input is a located message and exit 1, never a traceback."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from fswkit.cli.common import EXIT_FAIL, EXIT_OK
+
+
+def _fail(command: str, e) -> int:
+    for line in str(e).splitlines():
+        sys.stderr.write(f"fsw tape {command}: {line}\n")
+    return EXIT_FAIL
+
+
+def cmd_import(args) -> int:
+    from fswkit.outputs import OutputError, check
+    from fswkit.tape import TapeError, write_tape
+    from fswkit.tape.formats import convert
+    from dataclasses import replace
+
+    try:  # the output is refused before any work (an input, a folder, a missing folder)
+        check(args.output, (args.log,), force=args.force, what="tape")
+        if args.output != "-" and not args.force and os.path.lexists(args.output) \
+                and os.path.isfile(args.output):
+            raise OutputError(f"{args.output}: the file exists: it is not replaced unless asked (--force)")
+        tape = convert(args.format, args.log, args.pad_alt)
+        write_tape(args.output, replace(tape, path=args.output), force=args.force, inputs=(args.log,))
+    except (TapeError, OutputError) as e:
+        return _fail("import", e)
+    if args.output != "-":
+        sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} rows, {tape.start:.2f} to "
+                         f"{tape.end:.2f} s, columns {', '.join(tape.columns_available()) or 'none'}\n")
+    return EXIT_OK
+
+
+def show_text(tape, truth=None, truth_error: str | None = None) -> str:
+    """What `fsw tape show` prints for `tape` (and its Truth, if any)."""
+    import numpy as np
+
+    out = [f"{tape.path}: fswkit sensor tape v1"]
+    for s in tape.sources:
+        out.append(f"  source:  {s}")
+    if tape.flight:
+        out.append(f"  flight:  {tape.flight}")
+    for d in tape.derived:
+        out.append(f"  derived: {d}")
+    for n in tape.notes:
+        out.append(f"  note:    {n}")
+    out.append(f"  rows:    {tape.rows:,}, time {tape.start:.3f} to {tape.end:.3f} s (span {tape.span:.2f} s)")
+    for col in ("pressure_pa", "accel_g"):
+        have = tape.available(col)
+        if not have.any():
+            out.append(f"  {col + ':':12s} not available")
+            continue
+        t = tape.time[have]
+        v = (tape.pressure if col == "pressure_pa" else tape.accel)[have]
+        up, down = tape.rate_hz(col, t1=0.0 if (t < 0).sum() > 1 else None), tape.rate_hz(col)
+        rate = f"{tape.rate_hz(col):.1f} Hz median"
+        if t[0] < 0 and (t < 0).sum() > 1 and abs(up - down) > 0.5:
+            rate += f" ({up:.1f} Hz on the pad)"
+        out.append(f"  {col + ':':12s} {have.sum():,} values, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
+                   f"min {np.min(v):.4g}, max {np.max(v):.4g}")
+    if tape.available("pressure_pa").any():
+        alt = tape.altitude_agl()
+        after = tape.time >= 0
+        if (after & ~np.isnan(alt)).any():
+            i = int(np.nanargmax(np.where(after, alt, np.nan)))
+            out.append(f"  max ISA altitude {alt[i]:.1f} m above the pad ({tape.pad_pressure():.1f} Pa) "
+                       f"at {tape.time[i]:.2f} s (unsmoothed)")
+    if truth_error:
+        out.append(f"  truth:   {truth_error}")
+    elif truth is not None:
+        out.append(f"  truth:   {truth.path}" + (f" ({truth.recorder})" if truth.recorder else ""))
+        for k, v in truth.events():
+            out.append(f"    {k:44s} {v:9.2f} s")
+        for k in ("apogee_m_agl", "raw_max_alt_m_agl", "max_boost_accel_g", "max_accel_g", "pad_pressure_pa"):
+            v = getattr(truth, k)
+            if v is not None:
+                out.append(f"    {k:44s} {v:9.1f}")
+    return "\n".join(out) + "\n"
+
+
+def cmd_show(args) -> int:
+    from fswkit.tape import TapeError, read_tape, read_truth, truth_path
+
+    try:
+        tape = read_tape(args.tape)
+    except TapeError as e:
+        return _fail("show", e)
+    truth = err = None
+    tp = truth_path(args.tape)
+    if os.path.exists(tp):
+        try:
+            truth = read_truth(tp)
+        except TapeError as e:
+            err = str(e).splitlines()[0]
+    sys.stdout.write(show_text(tape, truth, err))
+    return EXIT_FAIL if err else EXIT_OK

@@ -1,0 +1,581 @@
+"""Converters from commercial altimeters' CSV logs to fswkit sensor tapes
+(`fsw tape import FORMAT LOG -o TAPE.csv`). Each format below states its
+columns, units, time base and liftoff convention, and how it was verified;
+docs/tapes.md says the same for users.
+
+Shared rules
+    * The log is read as the kit reads every user file (regular files only,
+      at most MAX_LOG bytes), UTF-8 text; the column line is the first line
+      whose cells (a leading `#` dropped, case and spaces ignored) name the
+      format's required columns. Lines before it are the log's preamble;
+      after it, blank lines and `#` lines are skipped.
+    * A cell that is empty or `NaN` in a sensor column is "not available"
+      (an empty tape cell); a time that is not a finite number, a sensor cell
+      that is not a number, a row too short for the columns used are located
+      errors `LOG:LINE:COL: message`, as is a log without the format's
+      columns (the wrong FORMAT chosen) or a pressure whose unit cannot be
+      told from its magnitude.
+    * Where the log has no pressure, pressure is made from its altitude AGL
+      through the ISA standard atmosphere with the pad at `pad_alt` m ASL
+      (0 when not given, said in the header):
+      p = 101325 * (1 - (pad_alt + h) / 44330.77)^(1 / 0.190263) Pa. Altitudes
+      above the pad come back exactly (H(p) - H(p_pad) = h); only the absolute
+      level depends on `pad_alt`.
+    * Acceleration is axial, in g, +1 at rest on the pad.
+    * Rows keep the log's own times (no resampling), strictly increasing:
+      rows whose time is not after the previous kept row are dropped (the
+      header counts them).
+    * Liftoff: the log's own time origin where the recorder counts from its
+      liftoff detection (AltOS, CATS, Eggtimer); otherwise it is defined here
+      from the data (Raven, RRC3) by one of two rules, said in the header:
+      ACCEL: the first sample above 2 g that stays above 2 g for 0.1 s (the
+      rule of ../shared/flights' truth files); BARO: the last sample within
+      1 m of the pad before the first sample that is 10 m above the pad and
+      stays above it for 0.5 s (the pad being the median pressure altitude of
+      the log's first second).
+
+Formats
+    altos     AltOS (TeleMega, TeleMetrum, EasyMega...) CSV export.
+    cats      CATS flight computer: the filtered-data export
+              (ts, filtered_altitude_AGL, filtered_acceleration) or a Vega
+              barometer log (ts, id, T, P).
+    raven     Featherweight Raven, FIP CSV export (per-channel time columns).
+    eggtimer  Eggtimer flight data download (T, Alt, Veloc, FAlt, ...).
+    rrc3      Missile Works RRC3, mDACS CSV export (time, altitude, pressure, ...).
+Each converter's docstring says what it reads and how it was verified.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from fswkit.autocode.diagnostics import InputError, read_input
+from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure
+
+MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
+G0 = 9.80665  # m/s^2, AltOS's standard gravity
+G_CATS = 9.81  # m/s^2, the GRAVITY constant CATS subtracts
+FT = 0.3048  # m
+
+
+@dataclass
+class Log:
+    """A CSV log: its column names (normalised: lower case, spaces kept
+    single, a leading `#` dropped), the 1-based line of the column line, and
+    its data rows as (line number, cells)."""
+
+    path: str
+    fmt: str
+    names: list[str]
+    raw_names: list[str]
+    column_line: int
+    rows: list[tuple[int, list[str]]]
+
+    def index(self, *aliases: str) -> int | None:
+        """The first column named one of `aliases` (normalised), or None."""
+        for a in aliases:
+            a = _norm(a)
+            if a in self.names:
+                return self.names.index(a)
+        return None
+
+    def err(self) -> _Errors:
+        return _Errors(self.path)
+
+    def numbers(self, col: int, what: str, *, required: bool = False, rows=None) -> np.ndarray:
+        """Column `col` as float64 (NaN for an empty or `NaN` cell); TapeError
+        for a cell that is not a number, a row too short, or (`required`) a
+        missing value."""
+        err = self.err()
+        rows = self.rows if rows is None else rows
+        out = np.empty(len(rows))
+        for i, (ln, cells) in enumerate(rows):
+            if col >= len(cells):
+                err.at(ln, None, f"the row has {len(cells)} cells: no `{self.raw_names[col]}` "
+                                 f"(column {col + 1} of the column line at line {self.column_line})")
+                out[i] = math.nan
+                continue
+            s = cells[col].strip()
+            if s == "" or s.lower() == "nan":
+                if required:
+                    err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`) is empty: "
+                                                    "every row needs it")
+                out[i] = math.nan
+                continue
+            try:
+                v = float(s)
+            except ValueError:
+                v = math.nan
+            if not math.isfinite(v):
+                err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`): `{s[:40]}` is not "
+                                                "a finite number")
+            out[i] = v
+        err.raise_if_any()
+        return out
+
+
+def _norm(name: str) -> str:
+    return " ".join(name.strip().lstrip("#").strip().lower().split())
+
+
+def _col_of(cells: list[str], k: int) -> int:
+    """The 1-based column where cell `k` starts."""
+    return sum(len(c) + 1 for c in cells[:k]) + 1
+
+
+def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str) -> Log:
+    """Reads a CSV log; its column line is the first line for which
+    `wanted(normalised names)` holds. TapeError (located) otherwise."""
+    try:
+        data = read_input(path, MAX_LOG)
+    except FileNotFoundError:
+        raise TapeError([f"{path}: no such file"]) from None
+    except InputError as e:
+        raise TapeError([f"{path}: {e}"]) from None
+    except OSError as e:
+        raise TapeError([f"{path}: cannot read: {e.strerror or e}"]) from None
+    err = _Errors(path)
+    text = _text(data, err)
+    err.raise_if_any()
+    lines = text.split("\n")
+    header = None
+    for n, line in enumerate(lines):
+        line = line.rstrip("\r")
+        if "," not in line:
+            continue
+        names = [_norm(c) for c in line.split(",")]
+        if wanted(names):
+            header = n
+            break
+    if header is None:
+        first = next((l.strip() for l in lines if l.strip()), "")
+        raise TapeError([f"{path}:1:1: not a {FORMATS[fmt].title} log: no line names its columns "
+                         f"({expected}); the first line is `{first[:80]}`"])
+    raw = [c.strip().lstrip("#").strip() for c in lines[header].rstrip("\r").split(",")]
+    rows = []
+    for n in range(header + 1, len(lines)):
+        line = lines[n].rstrip("\r")
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        rows.append((n + 1, line.split(",")))
+    if not rows:
+        raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])
+    return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, rows)
+
+
+# ---- helpers shared by the converters ---------------------------------------------------
+
+def _increasing(t: np.ndarray) -> np.ndarray:
+    """A mask keeping the rows whose time is after the previous kept row's."""
+    keep = np.zeros(t.size, dtype=bool)
+    last = -math.inf
+    for i, v in enumerate(t.tolist()):
+        if v > last:
+            keep[i] = True
+            last = v
+    return keep
+
+
+def _pressure_pa(p: np.ndarray, log: Log, col: int) -> tuple[np.ndarray, str]:
+    """A pressure column in Pa, its unit told from its magnitude: Pa (median
+    10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise."""
+    have = p[~np.isnan(p)]
+    if have.size == 0:
+        raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
+                         f"`{log.raw_names[col]}` holds no value"])
+    med = float(np.median(have))
+    if 10_000 <= med <= 120_000:
+        return p, "Pa"
+    if 100 <= med <= 1_200:
+        return p * 100.0, "hPa (mbar)"
+    raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: cannot tell the unit of "
+                     f"`{log.raw_names[col]}`: its median {med:g} is neither Pa (10,000 to 120,000) nor "
+                     "hPa/mbar (100 to 1,200)"])
+
+
+def _liftoff_accel(t: np.ndarray, a: np.ndarray) -> float | None:
+    """ACCEL rule: the first sample above 2 g that stays above 2 g for 0.1 s."""
+    ok = ~np.isnan(a)
+    t, a = t[ok], a[ok]
+    above = a > 2.0
+    for i in np.flatnonzero(above):
+        j = np.searchsorted(t, t[i] + 0.1, side="right")
+        if above[i:j].all() and t[j - 1] >= t[i] + 0.1 - 1e-9:
+            return float(t[i])
+    return None
+
+
+def _liftoff_baro(t: np.ndarray, h: np.ndarray) -> float | None:
+    """BARO rule on altitude `h` (m, any origin): the last sample within 1 m
+    of the pad before the first sample 10 m above the pad that stays above
+    it for 0.5 s; the pad = median altitude of the first second."""
+    ok = ~np.isnan(h)
+    t, h = t[ok], h[ok]
+    if t.size == 0:
+        return None
+    pad = float(np.median(h[t <= t[0] + 1.0]))
+    up = h - pad > 10.0
+    for i in np.flatnonzero(up):
+        j = np.searchsorted(t, t[i] + 0.5, side="right")
+        if up[i:j].all() and t[j - 1] >= t[i] + 0.5 - 1e-9:
+            near = np.flatnonzero(np.abs(h[:i] - pad) <= 1.0)
+            return float(t[near[-1]]) if near.size else float(t[0])
+    return None
+
+
+def _source(path: str, fmt: str) -> str:
+    return f"{os.path.basename(path)} (imported with `fsw tape import {fmt}`; licence as its owner states)"
+
+
+def _pad_text(pad_alt: float | None) -> str:
+    return f"{pad_alt:g} m ASL (given)" if pad_alt is not None else "0 m ASL assumed (no --pad-alt given)"
+
+
+def _from_altitude(h_agl: np.ndarray, pad_alt: float | None, what: str) -> tuple[np.ndarray, str]:
+    pad = 0.0 if pad_alt is None else pad_alt
+    p = isa_pressure(pad + h_agl)
+    p0 = float(isa_pressure(pad))
+    return p, (f"pressure_pa = from {what} through the ISA standard atmosphere with the pad at "
+               f"{_pad_text(pad_alt)}, P0 = {p0:.1f} Pa: p = 101325*(1-({pad:g}+h)/44330.77)^(1/0.190263); "
+               "absolute level set by the pad altitude")
+
+
+def _dropped(n: int) -> list[str]:
+    return [f"rows dropped: {n} with a time not after the previous row"] if n else []
+
+
+def _check_altitude_range(h: np.ndarray, pad_alt: float | None, log: Log, col: int, unit: str) -> None:
+    top = float(np.nanmax(h)) + (pad_alt or 0.0)
+    if top >= 11_000 or float(np.nanmin(h)) + (pad_alt or 0.0) < -1_000:
+        raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
+                         f"`{log.raw_names[col]}` reaches {top:.0f} m ASL (read as {unit}): beyond the ISA "
+                         "troposphere the tapes use (0 to 11 km); check the unit and --pad-alt"])
+
+
+# ---- AltOS ------------------------------------------------------------------------
+
+def altos(path: str, pad_alt: float | None = None) -> Tape:
+    """AltOS CSV export (AltosUI "Export data", TeleMega, TeleMetrum,
+    EasyMega, EasyMini...).
+
+    Columns used: `time` (s since AltOS's boost detection: 0 = its liftoff,
+    negative on the pad; kept as is), `pressure` (Pa in the exports of
+    current AltOS, hPa/mbar in old versions: told by magnitude),
+    `acceleration` (axial, m/s^2, with the 1 g rest reading removed: 0 on
+    the pad; accel_g = acceleration / 9.80665 + 1). The column line may start
+    with `#`; `altitude` names two columns (barometric, then GPS): the first
+    is used. AltOS writes a row for every GPS or state record carrying the
+    last sensor values: rows that repeat the previous kept row's sensor
+    values (acceleration, pressure, altitude, height, speed) exactly are
+    dropped, like rows whose time is not after the previous one.
+    `--pad-alt` is not used (the log has pressure).
+
+    Verified: the column names and their order against AltosCSV.java
+    (altoslib, `write_general_header` ... `write_basic_header`); units and the
+    time origin against the two AltOS logs of ../shared/flights (Prometheus,
+    TeleMega and TeleMetrum), whose conversion this reproduces row by row."""
+    log = read_log(path, "altos", lambda n: "time" in n and "pressure" in n and
+                   ("version" in n or "state_name" in n or "acceleration" in n),
+                   "time, pressure, acceleration, with version or state_name")
+    it, ip, ia = log.index("time"), log.index("pressure"), log.index("acceleration")
+    t = log.numbers(it, "time", required=True)
+    p_raw = log.numbers(ip, "pressure")
+    a = log.numbers(ia, "acceleration") if ia is not None else np.full(t.size, math.nan)
+    sensor_cols = [c for c in (ia, ip, log.index("altitude"), log.index("height"),
+                               log.index("speed", "accel_speed"), log.index("baro_speed")) if c is not None]
+    sensors = [log.numbers(c, log.raw_names[c]) for c in sensor_cols]
+    keep = np.zeros(t.size, dtype=bool)
+    last_t, last = -math.inf, None
+    late = repeat = 0
+    for i in range(t.size):
+        if not t[i] > last_t:
+            late += 1
+            continue
+        row = tuple(s[i] for s in sensors)
+        if last is not None and all((x == y) or (math.isnan(x) and math.isnan(y)) for x, y in zip(row, last)):
+            repeat += 1
+            continue
+        keep[i] = True
+        last_t, last = t[i], row
+    p, unit = _pressure_pa(p_raw, log, ip)
+    t, p, a = t[keep], p[keep], a[keep]
+    accel = a / G0 + 1.0
+    flight = "recorder AltOS"
+    isr, ifl = log.index("serial"), log.index("flight")
+    cells = log.rows[0][1]
+    if isr is not None and ifl is not None and max(isr, ifl) < len(cells):
+        flight += f" serial {cells[isr].strip()} flight {cells[ifl].strip()}"
+    derived = ["time_s = log column 'time' as is (AltOS: seconds since its boost detection, so 0 = AltOS liftoff)",
+               f"pressure_pa = log column 'pressure' ({unit})" + (" * 100" if unit != "Pa" else " as is"),
+               "accel_g = log column 'acceleration' / 9.80665 + 1 (AltOS reports axial acceleration in m/s^2 "
+               "with the +1 g rest reading removed)" if ia is not None else
+               "accel_g empty: the log has no 'acceleration' column"]
+    if late or repeat:
+        derived.append(f"rows dropped: {late} with a time not after the previous row, {repeat} that repeat the "
+                       "previous row's sensor values exactly (AltOS writes a row for each GPS or state record)")
+    return Tape(path, t, p, accel, (_source(path, "altos"),), flight, tuple(derived))
+
+
+# ---- CATS ------------------------------------------------------------------------
+
+def cats(path: str, pad_alt: float | None = None) -> Tape:
+    """CATS flight computer (CATS Vega) logs, one of two layouts, told by
+    their columns:
+
+    filtered-data export `ts, filtered_altitude_AGL, filtered_acceleration`:
+        `ts` s from CATS's liftoff detection (kept as is);
+        `filtered_altitude_AGL` m above the pad, median-filtered by the
+        recorder (pressure made through ISA with the pad at --pad-alt);
+        `filtered_acceleration` m/s^2 axial, CATS's GRAVITY = 9.81 removed
+        (accel_g = value / 9.81 + 1). Once its state machine reaches DROGUE,
+        CATS writes exactly 0.0 instead of a measurement: a final run of
+        exact zeros after liftoff becomes empty cells.
+    barometer log `ts, id, T, P` (the Vega's baro.csv): `P` in Pa as is (hPa
+        told by magnitude), the rows of the first sensor id only; no
+        acceleration (the IMU log is a separate file whose rocket axis depends
+        on mounting: not read here).
+
+    Verified: layouts and units against the five CATS logs of
+    ../shared/flights (Camoes, Genesis, Lince, Halcyon filtered exports;
+    Hedy baro.csv), whose conversions this reproduces; the zero-after-DROGUE
+    rule as those tapes' headers state it (cats-embedded task_state_est.cpp).
+    No CATS documentation was found with the search tool."""
+    log = read_log(path, "cats", lambda n: "ts" in n and ("filtered_altitude_agl" in n or "p" in n),
+                   "ts with filtered_altitude_AGL, or ts, id, T, P")
+    t = log.numbers(log.index("ts"), "ts", required=True)
+    keep = _increasing(t)
+    late = int((~keep).sum())
+    ih = log.index("filtered_altitude_agl")
+    if ih is not None:
+        h = log.numbers(ih, "filtered_altitude_AGL")
+        _check_altitude_range(h, pad_alt, log, ih, "m AGL")
+        ia = log.index("filtered_acceleration")
+        a = log.numbers(ia, "filtered_acceleration") if ia is not None else np.full(t.size, math.nan)
+        t, h, a = t[keep], h[keep], a[keep]
+        p, how = _from_altitude(h, pad_alt, "'filtered_altitude_AGL' (m, CATS's median-filtered barometric "
+                                            "altitude; not the raw sensor)")
+        accel = a / G_CATS + 1.0
+        derived = ["time_s = log column 'ts' as is (CATS: seconds from its liftoff detection)", how]
+        if ia is None:
+            derived.append("accel_g empty: the log has no 'filtered_acceleration' column")
+        else:
+            derived.append("accel_g = 'filtered_acceleration' / 9.81 + 1 (CATS logs median-filtered axial "
+                           "acceleration in m/s^2 minus its GRAVITY = 9.81)")
+            nz = np.flatnonzero(a != 0.0)
+            start = int(nz[-1]) + 1 if nz.size else 0
+            if start < a.size - 1 and t[start] > 0:
+                accel[start:] = math.nan
+                derived.append(f"accel_g left empty from t = {t[start]:g} s on: from there to the end the log "
+                               "holds exactly 0.0, which CATS writes instead of a measurement once its state "
+                               "machine reaches DROGUE")
+        layout = "filtered-data export"
+    else:
+        ip, iid = log.index("p"), log.index("id")
+        rows = log.rows
+        if iid is not None:
+            first = next((c[iid].strip() for _, c in rows if iid < len(c)), "")
+            sel = np.array([iid < len(c) and c[iid].strip() == first for _, c in rows])
+        else:
+            first, sel = "", np.ones(len(rows), dtype=bool)
+        p_raw = log.numbers(ip, "P")
+        p, unit = _pressure_pa(p_raw, log, ip)
+        m = keep & sel
+        t, p = t[m], p[m]
+        late = int((sel & ~keep).sum())
+        accel = np.full(t.size, math.nan)
+        derived = ["time_s = log column 'ts' as is (CATS: seconds from its liftoff detection)",
+                   f"pressure_pa = log column 'P' ({unit})" + (" * 100" if unit != "Pa" else " as is")
+                   + (f", sensor {first} only" if first else ""),
+                   "accel_g empty: a CATS barometer log holds no acceleration"]
+        layout = "barometer log"
+    derived += _dropped(late)
+    flight = f"recorder CATS flight computer ({layout}); pad elevation {_pad_text(pad_alt)}" \
+        if layout == "filtered-data export" else f"recorder CATS flight computer ({layout})"
+    return Tape(path, t, p, accel, (_source(path, "cats"),), flight, tuple(derived))
+
+
+# ---- Featherweight Raven ---------------------------------------------------------------
+
+def raven(path: str, pad_alt: float | None = None) -> Tape:
+    """Featherweight Raven, CSV export of the Featherweight Interface Program
+    (FIP). Each channel comes as its own time column followed by its value
+    columns (`Time-Axial Accel (Gs), Axial Accel (Gs), bILBA, Time (s),
+    Altitude (Ft-AGL), bILBA`), channels at their own rates and lengths (a
+    channel ends where its time cells end).
+
+    Used: `Axial Accel (Gs)` (g, +1 at rest: as is) and `Altitude (Ft-AGL)`
+    (ft above the pad: pressure through ISA with the pad at --pad-alt). Time:
+    the Raven's seconds from power-up/recording start; liftoff is defined by
+    the ACCEL rule (BARO without an accelerometer channel) and subtracted.
+    Rows follow the accelerometer's clock while it lasts, holding the last
+    altitude sample (sample-and-hold; empty before the first), then the
+    altitude's clock.
+
+    Verified: the layout, units and merge against the NDRT 2020 Raven log of
+    ../shared/flights (RocketPy's ndrt_2020_flight_data.csv), whose
+    conversion this reproduces. The Raven user's manual was found (search
+    corpus pages) but not its export's column list: other FIP channels
+    (pressure, temperature, voltages) are not read."""
+    log = read_log(path, "raven", lambda n: any(c.startswith("time") for c in n)
+                   and ("axial accel (gs)" in n or "altitude (ft-agl)" in n),
+                   "Time..., Axial Accel (Gs) and/or Altitude (Ft-AGL)")
+
+    def channel(col: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+        tcol = max(i for i in range(col) if log.names[i].startswith("time")) if any(
+            log.names[i].startswith("time") for i in range(col)) else None
+        if tcol is None:
+            raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
+                             f"`{log.raw_names[col]}` has no time column before it"])
+        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and c[tcol].strip()]
+        t = log.numbers(tcol, f"{what} time", rows=rows)
+        v = log.numbers(col, what, rows=rows)
+        ok = ~np.isnan(v)
+        t, v = t[ok], v[ok]
+        keep = _increasing(t)
+        return t[keep], v[keep]
+
+    ia, ih = log.index("axial accel (gs)"), log.index("altitude (ft-agl)")
+    ta, a = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0))
+    th, h = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0))
+    if ih is not None:
+        _check_altitude_range(h * FT, pad_alt, log, ih, "ft AGL")
+    t_lift = _liftoff_accel(ta, a) if ta.size else None
+    rule = "ACCEL: first 'Axial Accel (Gs)' sample above 2 g that stays above 2 g for 0.1 s"
+    if t_lift is None and th.size:
+        t_lift = _liftoff_baro(th, h * FT)
+        rule = "BARO: last altitude sample within 1 m of the pad before it is 10 m above for 0.5 s"
+    if t_lift is None:
+        raise TapeError([f"{log.path}: no liftoff found: no accel sample above 2 g for 0.1 s and no "
+                         "altitude 10 m above the pad for 0.5 s"])
+    # rows: the accel clock while it lasts, then the altitude clock
+    t = np.concatenate([ta, th[th > ta[-1]]]) if ta.size else th
+    accel = np.concatenate([a, np.full(t.size - ta.size, math.nan)])
+    if th.size:
+        k = np.searchsorted(th, t, side="right") - 1
+        hh = np.where(k >= 0, h[np.maximum(k, 0)], math.nan)
+        p, how = _from_altitude(hh * FT, pad_alt, "'Altitude (Ft-AGL)' * 0.3048")
+    else:
+        p, how = np.full(t.size, math.nan), "pressure_pa empty: the log has no 'Altitude (Ft-AGL)' channel"
+    derived = [f"liftoff defined here by the {rule}: Raven time {t_lift:.5f} s; time_s = Raven time - {t_lift:.5f}",
+               f"accel_g = 'Axial Accel (Gs)' as is (g, +1 at rest); {ta.size} samples to {ta[-1]:.3f} s Raven "
+               "time, empty after" if ta.size else "accel_g empty: the log has no 'Axial Accel (Gs)' channel",
+               how]
+    if ta.size and th.size:
+        derived.append("merged onto the accel clock while it lasts, holding the last altitude sample "
+                       "(sample-and-hold; empty before the first altitude sample); after the accel data end, "
+                       "rows follow the altitude clock")
+    flight = f"recorder Featherweight Raven (FIP export); pad elevation {_pad_text(pad_alt)}"
+    return Tape(path, t - t_lift, p, accel, (_source(path, "raven"),), flight, tuple(derived))
+
+
+# ---- Eggtimer ---------------------------------------------------------------------
+
+def eggtimer(path: str, pad_alt: float | None = None) -> Tape:
+    """Eggtimer (TRS, Quantum, Proton...) flight data download:
+    `T,Alt,Veloc,FAlt,FVeloc,FVeloc2,LDA,LowV,Apogee,N-O,Drogue,Main`.
+
+    Used: `T` (ms from the Eggtimer's flight start: 0 at liftoff, the row
+    where the recorder's launch detect fired carrying its altitude in `LDA`;
+    time_s = T / 1000, kept as is) and `Alt` (ft above the pad, the raw
+    barometric altitude; `FAlt` is the recorder's filtered one and is not
+    used): pressure through ISA with the pad at --pad-alt. No acceleration
+    (the Eggtimer logs none).
+
+    Verified: column names, units (ms, ft, ft/s) and the time origin against
+    the Eggtimer TRS user's manual's example download (its page 35, found
+    with the search tool); no Eggtimer log was available to convert, so the
+    Quantum's and Proton's layouts are assumed the same where they name
+    these columns (the manual of those was not found)."""
+    log = read_log(path, "eggtimer", lambda n: "t" in n and "alt" in n, "T, Alt (Eggtimer)")
+    it, ih = log.index("t"), log.index("alt")
+    t = log.numbers(it, "T", required=True) / 1000.0
+    h = log.numbers(ih, "Alt") * FT
+    keep = _increasing(t)
+    _check_altitude_range(h, pad_alt, log, ih, "ft AGL")
+    t, h = t[keep], h[keep]
+    p, how = _from_altitude(h, pad_alt, "'Alt' (ft AGL) * 0.3048")
+    derived = ["time_s = log column 'T' / 1000 (Eggtimer: ms from its flight start, 0 = liftoff)", how,
+               "accel_g empty: an Eggtimer logs no acceleration"] + _dropped(int((~keep).sum()))
+    flight = f"recorder Eggtimer; pad elevation {_pad_text(pad_alt)}"
+    return Tape(path, t, p, np.full(t.size, math.nan), (_source(path, "eggtimer"),), flight, tuple(derived))
+
+
+# ---- Missile Works RRC3 --------------------------------------------------------------
+
+def rrc3(path: str, pad_alt: float | None = None) -> Tape:
+    """Missile Works RRC3, CSV export of mDACS:
+    `time,altitude,pressure,velocity,temperature,events,voltages`.
+
+    Used: `time` (s from the start of the recording, 20 Hz), `pressure`
+    (hPa = mbar; Pa told by magnitude) and, only where `pressure` is absent,
+    `altitude` (ft AGL, mDACS's default unit: pressure through ISA with the
+    pad at --pad-alt). Liftoff is defined by the BARO rule on the pressure
+    altitude and subtracted. No acceleration (the RRC3 logs none); the
+    `events` column (the RRC3's Drogue/Main events) is not read.
+
+    Verified: column names, pressure in hPa and altitude in ft against the
+    Juno III RRC3 log in RocketPy (data/rockets/juno3/cots_altimeter.csv:
+    861.7 hPa on the pad; 10,700 ft at the 3,213 m apogee its flight card
+    gives), and the column list against a public reader of mDACS exports
+    (NUSTARS launch-vehicle rrc3py: Time, Altitude, Pressure, Velocity,
+    Temperature, Events, Voltages). No mDACS documentation was found with
+    the search tool: the time origin of `time` (recording start, not
+    liftoff) is what the Juno III log shows (rest at 0 s)."""
+    log = read_log(path, "rrc3", lambda n: "time" in n and ("pressure" in n or "altitude" in n)
+                   and ("velocity" in n or "events" in n), "time, altitude, pressure, velocity, events")
+    it, ip, ih = log.index("time"), log.index("pressure"), log.index("altitude")
+    t = log.numbers(it, "time", required=True)
+    keep = _increasing(t)
+    if ip is not None:
+        p, unit = _pressure_pa(log.numbers(ip, "pressure"), log, ip)
+        t, p = t[keep], p[keep]
+        how = f"pressure_pa = log column 'pressure' ({unit})" + (" * 100" if unit != "Pa" else " as is")
+        h = isa_altitude(p)
+    else:
+        hft = log.numbers(ih, "altitude")
+        _check_altitude_range(hft * FT, pad_alt, log, ih, "ft AGL")
+        t, h = t[keep], hft[keep] * FT
+        p, how = _from_altitude(h, pad_alt, "'altitude' (ft AGL) * 0.3048")
+    t_lift = _liftoff_baro(t, h)
+    if t_lift is None:
+        raise TapeError([f"{log.path}: no liftoff found: the altitude is never 10 m above the pad for 0.5 s"])
+    derived = ["liftoff defined here by the BARO rule: the last sample within 1 m of the pad (median pressure "
+               "altitude of the first second) before the altitude is 10 m above it for 0.5 s: RRC3 time "
+               f"{t_lift:g} s; time_s = RRC3 time - {t_lift:g}", how,
+               "accel_g empty: an RRC3 logs no acceleration"] + _dropped(int((~keep).sum()))
+    flight = "recorder Missile Works RRC3 (mDACS export)"
+    if ip is None:
+        flight += f"; pad elevation {_pad_text(pad_alt)}"
+    return Tape(path, t - t_lift, p, np.full(t.size, math.nan), (_source(path, "rrc3"),), flight, tuple(derived))
+
+
+@dataclass(frozen=True)
+class Format:
+    name: str
+    title: str
+    convert: Callable[[str, float | None], Tape]
+
+
+FORMATS: dict[str, Format] = {
+    "altos": Format("altos", "AltOS CSV export", altos),
+    "cats": Format("cats", "CATS flight computer", cats),
+    "raven": Format("raven", "Featherweight Raven (FIP export)", raven),
+    "eggtimer": Format("eggtimer", "Eggtimer", eggtimer),
+    "rrc3": Format("rrc3", "Missile Works RRC3 (mDACS export)", rrc3),
+}
+
+
+def convert(fmt: str, path: str, pad_alt: float | None = None) -> Tape:
+    """The tape of the log at `path` in format `fmt` (a key of FORMATS);
+    TapeError with located messages when it cannot be read."""
+    if pad_alt is not None and not (-500.0 <= pad_alt <= 9_000.0):
+        raise TapeError([f"--pad-alt {pad_alt:g}: expected a pad elevation from -500 to 9,000 m ASL"])
+    tape = FORMATS[fmt].convert(path, pad_alt)
+    if tape.rows == 0:
+        raise TapeError([f"{path}: no rows left to write"])
+    return tape

@@ -58,10 +58,11 @@ def show_text(tape, truth=None, truth_error: str | None = None) -> str:
             continue
         t = tape.time[have]
         v = (tape.pressure if col == "pressure_pa" else tape.accel)[have]
-        up, down = tape.rate_hz(col, t1=0.0 if (t < 0).sum() > 1 else None), tape.rate_hz(col)
-        rate = f"{tape.rate_hz(col):.1f} Hz median"
-        if t[0] < 0 and (t < 0).sum() > 1 and abs(up - down) > 0.5:
-            rate += f" ({up:.1f} Hz on the pad)"
+        early, late = tape.rate_hz(col, t1=10.0), tape.rate_hz(col, t0=10.0)
+        if early and late and abs(early - late) > 0.05 * max(early, late):
+            rate = f"{early:.1f} Hz median to 10 s, {late:.1f} Hz after"
+        else:
+            rate = f"{tape.rate_hz(col):.1f} Hz median"
         out.append(f"  {col + ':':12s} {have.sum():,} values, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
                    f"min {np.min(v):.4g}, max {np.max(v):.4g}")
     if tape.available("pressure_pa").any():

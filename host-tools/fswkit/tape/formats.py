@@ -32,7 +32,7 @@ Shared rules
       rule of ../shared/flights' truth files); BARO: the last sample within
       1 m of the pad before the first sample that is 10 m above the pad and
       stays above it for 0.5 s (the pad being the median pressure altitude of
-      the log's first second).
+      the log's first second, of its samples before the rise).
 
 Formats
     altos     AltOS (TeleMega, TeleMetrum, EasyMega...) CSV export.
@@ -124,8 +124,9 @@ def _norm(name: str) -> str:
 
 
 def _col_of(cells: list[str], k: int) -> int:
-    """The 1-based column where cell `k` starts."""
-    return sum(len(c) + 1 for c in cells[:k]) + 1
+    """The 1-based column of cell `k`'s first character that is not a space."""
+    cell = cells[k] if k < len(cells) else ""
+    return sum(len(c) + 1 for c in cells[:k]) + 1 + len(cell) - len(cell.lstrip())
 
 
 def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str) -> Log:
@@ -213,19 +214,32 @@ def _liftoff_accel(t: np.ndarray, a: np.ndarray) -> float | None:
 def _liftoff_baro(t: np.ndarray, h: np.ndarray) -> float | None:
     """BARO rule on altitude `h` (m, any origin): the last sample within 1 m
     of the pad before the first sample 10 m above the pad that stays above
-    it for 0.5 s; the pad = median altitude of the first second."""
+    it for 0.5 s; the pad = median altitude of the log's first second, of the
+    samples before the rise (the first sample 10 m above the log's first
+    sample for 0.5 s)."""
     ok = ~np.isnan(h)
     t, h = t[ok], h[ok]
     if t.size == 0:
         return None
-    pad = float(np.median(h[t <= t[0] + 1.0]))
-    up = h - pad > 10.0
-    for i in np.flatnonzero(up):
-        j = np.searchsorted(t, t[i] + 0.5, side="right")
-        if up[i:j].all() and t[j - 1] >= t[i] + 0.5 - 1e-9:
-            near = np.flatnonzero(np.abs(h[:i] - pad) <= 1.0)
-            return float(t[near[-1]]) if near.size else float(t[0])
-    return None
+
+    def rise(base: float) -> int | None:
+        up = h - base > 10.0
+        for i in np.flatnonzero(up):
+            j = np.searchsorted(t, t[i] + 0.5, side="right")
+            if up[i:j].all() and t[j - 1] >= t[i] + 0.5 - 1e-9:
+                return int(i)
+        return None
+
+    i0 = rise(float(h[0]))  # the rise seen from the first sample: the pad is what comes before it
+    if i0 is None:
+        return None
+    pre = (t <= t[0] + 1.0) & (np.arange(t.size) < i0)
+    pad = float(np.median(h[pre])) if pre.any() else float(h[0])
+    i = rise(pad)
+    if i is None:
+        return None
+    near = np.flatnonzero(np.abs(h[:i] - pad) <= 1.0)
+    return float(t[near[-1]]) if near.size else float(t[0])
 
 
 def _source(path: str, fmt: str) -> str:
@@ -545,7 +559,8 @@ def rrc3(path: str, pad_alt: float | None = None) -> Tape:
     if t_lift is None:
         raise TapeError([f"{log.path}: no liftoff found: the altitude is never 10 m above the pad for 0.5 s"])
     derived = ["liftoff defined here by the BARO rule: the last sample within 1 m of the pad (median pressure "
-               "altitude of the first second) before the altitude is 10 m above it for 0.5 s: RRC3 time "
+               "altitude of the log's first second before the rise) before the altitude is 10 m above it for "
+               "0.5 s: RRC3 time "
                f"{t_lift:g} s; time_s = RRC3 time - {t_lift:g}", how,
                "accel_g empty: an RRC3 logs no acceleration"] + _dropped(int((~keep).sum()))
     flight = "recorder Missile Works RRC3 (mDACS export)"

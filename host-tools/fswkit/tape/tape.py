@@ -463,8 +463,7 @@ def read_truth(path: str) -> Truth:
     except ValueError as e:  # an integer of more digits than Python converts
         raise TapeError([f"{path}: {e}"]) from None
     if not isinstance(doc.get("name"), str) or not doc["name"]:
-        err.at(_key_line(text, "name") or 1, 1 if _key_line(text, "name") else None,
-               "a truth file needs `name = \"...\"` (the tape's name)")
+        err.at(_key_line(text, "name") or 1, 1, "a truth file needs `name = \"...\"` (the tape's name)")
     kw: dict[str, Any] = {}
     for k in TRUTH_FLOATS:
         if k in doc:

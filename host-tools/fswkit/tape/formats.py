@@ -451,7 +451,10 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         ok = ~np.isnan(v)
         t, v = t[ok], v[ok]
         keep = _increasing(t)
+        late[0] += int((~keep).sum())
         return t[keep], v[keep]
+
+    late = [0]
 
     ia, ih = log.index("axial accel (gs)"), log.index("altitude (ft-agl)")
     ta, a = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0))
@@ -483,6 +486,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         derived.append("merged onto the accel clock while it lasts, holding the last altitude sample "
                        "(sample-and-hold; empty before the first altitude sample); after the accel data end, "
                        "rows follow the altitude clock")
+    derived += _dropped(late[0])
     flight = f"recorder Featherweight Raven (FIP export); pad elevation {_pad_text(pad_alt)}"
     return Tape(path, t - t_lift, p, accel, (_source(path, "raven"),), flight, tuple(derived))
 

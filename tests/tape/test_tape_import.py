@@ -290,3 +290,10 @@ def test_fsw_tape_import(tmp_path):
     assert r.code == 2
     r = run_fsw("tape", "import", "cats", src, "-o", "-")
     assert r.code == 0 and r.out.startswith("# fswkit sensor tape v1\n")
+    r = run_fsw("tape", "import", "cats", src, "-o", "")
+    assert r.code == 2 and "--output: an empty string names nothing" in r.err
+    r = run_fsw("tape", "show", "")
+    assert r.code == 2 and "an empty string names nothing" in r.err
+    r = run_fsw("tape", "import", "cats", src, "-o", str(tmp_path / "n.csv"), "--pad-alt", "nan")
+    assert r.code == 1 and "--pad-alt nan: expected a pad elevation" in r.err
+    assert not (tmp_path / "n.csv").exists()

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 import sys
 
-from fswkit.cli.common import EXIT_FAIL, EXIT_OK
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK
 
 
 def _fail(command: str, e) -> int:
@@ -22,6 +22,10 @@ def cmd_import(args) -> int:
     from fswkit.tape.formats import convert
     from dataclasses import replace
 
+    for option, value in (("--output", args.output), ("LOG", args.log)):
+        if value == "":  # as main.py refuses an empty option of the other commands
+            sys.stderr.write(f"fsw tape import: {option}: an empty string names nothing: give a path\n")
+            return EXIT_CONFIG
     try:  # the output is refused before any work (an input, a folder, a missing folder)
         check(args.output, (args.log,), force=args.force, what="tape")
         if args.output != "-" and not args.force and os.path.lexists(args.output) \
@@ -88,6 +92,9 @@ def show_text(tape, truth=None, truth_error: str | None = None) -> str:
 def cmd_show(args) -> int:
     from fswkit.tape import TapeError, read_tape, read_truth, truth_path
 
+    if args.tape == "":
+        sys.stderr.write("fsw tape show: TAPE: an empty string names nothing: give a path\n")
+        return EXIT_CONFIG
     try:
         tape = read_tape(args.tape)
     except TapeError as e:

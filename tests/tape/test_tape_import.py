@@ -179,6 +179,19 @@ def test_raven_without_accel_uses_the_baro_rule(tmp_path):
     assert np.isnan(t.accel).all()
 
 
+def test_raven_accel_only(tmp_path):
+    head = "Time-Axial Accel (Gs), Axial Accel (Gs), bILBA, Time (s), Altitude (Ft-AGL), bILBA\n"
+    rows = "".join(f"{i * 0.0025:.4f},{1.0 if i < 40 else 6.0},b0000,,,\n" for i in range(200))
+    t = convert("raven", log(tmp_path, head + rows))
+    assert t.time[40] == pytest.approx(0.0) and np.isnan(t.pressure).all() and t.accel[-1] == 6.0
+
+
+def test_an_altitude_column_without_values_is_refused(tmp_path):
+    assert refused("eggtimer", log(tmp_path, "T,Alt,Veloc\n0,,0\n50,,0\n")) == "L:1:3: `Alt` holds no value"
+    text = "ts,filtered_altitude_AGL,filtered_acceleration\n0,,1\n0.01,,1\n"
+    assert refused("cats", log(tmp_path, text)) == "L:1:4: `filtered_altitude_AGL` holds no value"
+
+
 def test_raven_errors(tmp_path):
     assert "no line names its columns" in refused("raven", log(tmp_path, CATS))
     # resting on the pad: no 2 g for 0.1 s, no climb of 10 m

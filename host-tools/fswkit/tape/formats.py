@@ -264,6 +264,10 @@ def _dropped(n: int) -> list[str]:
 
 
 def _check_altitude_range(h: np.ndarray, pad_alt: float | None, log: Log, col: int, unit: str) -> None:
+    """An altitude column has values, within the ISA troposphere; TapeError otherwise."""
+    if np.isnan(h).all():
+        raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
+                         f"`{log.raw_names[col]}` holds no value"])
     top = float(np.nanmax(h)) + (pad_alt or 0.0)
     if top >= 11_000 or float(np.nanmin(h)) + (pad_alt or 0.0) < -1_000:
         raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
@@ -459,7 +463,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
     ia, ih = log.index("axial accel (gs)"), log.index("altitude (ft-agl)")
     ta, a = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0))
     th, h = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0))
-    if ih is not None:
+    if th.size:
         _check_altitude_range(h * FT, pad_alt, log, ih, "ft AGL")
     t_lift = _liftoff_accel(ta, a) if ta.size else None
     rule = "ACCEL: first 'Axial Accel (Gs)' sample above 2 g that stays above 2 g for 0.1 s"
@@ -477,7 +481,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         hh = np.where(k >= 0, h[np.maximum(k, 0)], math.nan)
         p, how = _from_altitude(hh * FT, pad_alt, "'Altitude (Ft-AGL)' * 0.3048")
     else:
-        p, how = np.full(t.size, math.nan), "pressure_pa empty: the log has no 'Altitude (Ft-AGL)' channel"
+        p, how = np.full(t.size, math.nan), "pressure_pa empty: the log has no 'Altitude (Ft-AGL)' values"
     derived = [f"liftoff defined here by the {rule}: Raven time {t_lift:.5f} s; time_s = Raven time - {t_lift:.5f}",
                f"accel_g = 'Axial Accel (Gs)' as is (g, +1 at rest); {ta.size} samples to {ta[-1]:.3f} s Raven "
                "time, empty after" if ta.size else "accel_g empty: the log has no 'Axial Accel (Gs)' channel",

@@ -101,9 +101,10 @@ class _Errors:
             raise TapeError(self.items, self.hidden)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Tape:
     """One tape: three aligned float64 arrays (NaN = empty cell) and its header.
+    Compared by identity (arrays have no single truth value).
 
     `time` is strictly increasing, in s from liftoff. `sources`, `flight`,
     `derived` and `notes` are the header lines' texts after their key

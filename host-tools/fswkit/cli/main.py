@@ -129,13 +129,20 @@ def parser() -> argparse.ArgumentParser:
     sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
     sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
     sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")
-    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD); with --plant, the folder the "
-                    "flight's log, CSV, plot and summary go to (default PROJECT/build/BOARD/PLANT-flight)")
+    sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD); with --plant or --tape, the folder "
+                    "the flight's log, CSV, plot and summary go to (default PROJECT/build/BOARD/PLANT-flight, "
+                    "PROJECT/build/BOARD/tape-NAME)")
     sm.add_argument("--plant", choices=("rocket", "tank"),
                     help="fly the firmware in closed loop against this plant model (docs/sim.md)")
     sm.add_argument("--params", metavar="FILE.toml", help="with --plant: the plant's parameters "
                     "(default PROJECT/plant.toml)")
-    sm.add_argument("--seed", type=_nonneg_int, metavar="N", help="with --plant: the sensor noise's seed (default 1)")
+    sm.add_argument("--seed", type=_nonneg_int, metavar="N", help="with --plant: the sensor noise's seed; with "
+                    "--tape --perturb: the perturbations' seed (default 1)")
+    sm.add_argument("--tape", metavar="FLIGHT.csv", help="replay a real flight's sensor tape through the firmware, "
+                    "open loop, and check its events against FLIGHT.truth.toml (docs/sim.md, Replaying real flights); "
+                    "--params names the tape config (default PROJECT/tape.toml, else plant.toml's channels and pins)")
+    sm.add_argument("--perturb", type=_nonneg_int, metavar="N", help="with --tape: replay it N times with seeded "
+                    "sensor noise, spikes, dropouts and bias, and report the distribution of the event errors")
     sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro"),
                     help="with --plant rocket: a sensor fault (stuck-baro: the barometer freezes at ignition; "
                     "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit)")

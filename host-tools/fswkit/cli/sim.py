@@ -13,6 +13,11 @@ from fswkit.cli.common import EXIT_CONFIG
 
 
 def cmd_sim(args) -> int:
+    if getattr(args, "tape", None) is not None:
+        return tape_run(args)
+    if getattr(args, "perturb", None) is not None:
+        sys.stderr.write("fsw sim: --perturb needs --tape FLIGHT.csv\n")
+        return EXIT_CONFIG
     if args.plant is not None:
         return plant_run(args)
     if args.params is not None or args.fault is not None or args.seed is not None:
@@ -150,3 +155,99 @@ def plant_run(args) -> int:
     sys.stdout.flush()
     say("wrote " + ", ".join(flight.files[k] for k in ("log", "csv", "png", "summary")))
     return 0 if flight.report.passed else 1
+
+
+def tape_run(args) -> int:
+    """`fsw sim PROJECT --tape FLIGHT.csv [--perturb N --seed S]`: build,
+    replay the tape open loop, write the files, print the events and checks
+    (fswkit.plant.tape_replay)."""
+    from fswkit.link.layout import LayoutError, from_app
+    from fswkit.link.log import LogError
+    from fswkit.outputs import OutputError, Stopped, write_text
+    from fswkit.plant.cosim import CosimError
+    from fswkit.plant.run import INCOMPLETE
+    from fswkit.plant import tape_replay as tr
+    from fswkit.sim.command import build, is_elf, say
+    from fswkit.target.build import BuildError, default_out, load
+    from fswkit.autocode.diagnostics import Diagnostics
+
+    for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
+                       ("--analog", bool(args.analog)), ("--link", args.link is not None),
+                       ("--plant", args.plant is not None), ("--fault", args.fault is not None)):
+        if given:
+            say(f"{opt} does not go with --tape: the tape drives the run")
+            return 2
+    if args.seed is not None and args.perturb is None:
+        say("--seed with --tape needs --perturb N (a plain replay has no randomness)")
+        return 2
+    if is_elf(args.project) or args.project.endswith(".elf"):
+        say(f"{args.project}: --tape needs the project (its folder or .app), not a firmware ELF")
+        return 2
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags, args.board)
+    except BuildError as e:
+        say(str(e))
+        return 2
+    if app is None:
+        sys.stderr.write(diags.render() + "\n")
+        return 2
+    try:
+        layout = from_app(app)
+        cfg = tr.load_config(app, layout, args.params)
+        tape, truth = tr.load_tape(args.tape, cfg)
+    except (LayoutError, tr.ReplayError) as e:
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw sim: {line}\n")
+        return 2
+    name = os.path.splitext(os.path.basename(args.tape))[0]
+    out = args.out or os.path.join(default_out(app), f"tape-{name}")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    built = build(args.project, args.board)
+    if isinstance(built, int):
+        return built
+    elf, board = built
+    if args.perturb is not None:
+        if args.perturb == 0:
+            say("--perturb needs at least one run")
+            return 2
+        seed = 1 if args.seed is None else args.seed
+        say(f"{args.perturb} perturbed replays of {args.tape} ({tape.span:.0f} s of flight each), seed {seed}")
+        t0 = time.monotonic()
+        results = tr.robustness(tape, truth, cfg, elf, board, layout, args.perturb, seed)
+        text, ok = tr.robustness_text(results, tape, args.perturb, seed, time.monotonic() - t0)
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        try:
+            write_text(os.path.join(out, "perturb.csv"), tr.robustness_csv(results), what="the runs' table")
+            write_text(os.path.join(out, "perturb.txt"), text, what="the summary")
+        except OutputError as e:
+            say(str(e))
+            return 1
+        say(f"wrote {os.path.join(out, 'perturb.txt')}, {os.path.join(out, 'perturb.csv')}")
+        return 0 if ok else 1
+    say(f"replaying {args.tape} ({tape.rows:,} rows, {tape.span:.1f} s) open loop on the {board.name}")
+    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
+                  "still the last finished run's")
+    try:
+        o = tr.execute(tape, truth, cfg, app, elf, board, layout, out)
+    except Stopped as e:
+        say(f"stopped by {e}" + incomplete)
+        return 128 + e.signum
+    except KeyboardInterrupt:
+        say("interrupted" + incomplete)
+        raise
+    except (CosimError, LogError) as e:
+        say(str(e) + incomplete)
+        return 1
+    except OSError as e:
+        say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
+        return 1
+    sys.stdout.write(o.report.text())
+    sys.stdout.flush()
+    say("wrote " + ", ".join(o.files[k] for k in ("log", "csv", "png", "summary")))
+    return 0 if o.report.passed else 1

@@ -53,7 +53,8 @@ fuzz: setup fuzz-uplink
 	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py
 	FSW_GEN_CASES=$${FSW_GEN_CASES:-20000} $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/regression/test_accepted_configs_build.py
-	FSW_PROPERTY_SCALE=$${FSW_PROPERTY_SCALE:-5} $(PY) -m pytest -q -p no:cacheprovider tests/autocode/test_properties.py
+	FSW_PROPERTY_SCALE=$${FSW_PROPERTY_SCALE:-5} $(PY) -m pytest -q -p no:cacheprovider \
+	  tests/autocode/lexer tests/autocode/parser tests/autocode/check/test_check_properties.py tests/run/test_interp_properties.py
 
 ## fuzz-uplink: the firmware's uplink parser under libFuzzer with ASan + UBSan
 ## (clang); FUZZ_RUNS inputs (make fuzz: 10,000,000; make test: a short run),

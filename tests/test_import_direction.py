@@ -186,8 +186,9 @@ def test_no_import_cycles_among_the_kits_modules():
 def test_the_rooms_never_import_the_command_line():
     """The command line sits on top: its commands call into the rooms, and no
     room calls a command (`fsw flash` once built through `fsw build`'s
-    command, with a hand-made argparse.Namespace)."""
+    command, with a hand-made argparse.Namespace). fswkit.testing sits above
+    it: its runner and fuzzer run `fsw` commands as a user does."""
     g = graph()
-    bad = [f"{m} imports {d}" for m in sorted(g) if not m.startswith("fswkit.cli")
+    bad = [f"{m} imports {d}" for m in sorted(g) if not m.startswith(("fswkit.cli", "fswkit.testing"))
            for d in sorted(g[m]) if d == "fswkit.cli" or d.startswith("fswkit.cli.")]
     assert not bad, "\n".join(bad)

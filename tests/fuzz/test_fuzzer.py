@@ -1,18 +1,15 @@
-"""The front-end fuzzer (tools/fuzz_frontend.py): a short clean run, and
-proof that it finds what it is for — a planted crash and a planted hang are
-reported, counted and saved. `make fuzz` runs it for a million cases."""
+"""The front-end fuzzer (fswkit.testing.fuzz; tools/fuzz_frontend.py is its
+command line): a short clean run, and proof that it finds what it is for — a
+planted crash and a planted hang are reported, counted and saved. `make fuzz`
+runs it for a million cases."""
 
 from __future__ import annotations
 
 import os
-import sys
 
 import pytest
 
-from conftest import ROOT
-
-sys.path.insert(0, str(ROOT / "tools"))
-import fuzz_frontend as fuzz  # noqa: E402
+from fswkit.testing import fuzz
 
 CASES = int(os.environ.get("FSW_FUZZ_SMOKE", "1000"))
 

@@ -5,7 +5,7 @@ accepts generates pure-ASCII C++ without an error and that C++ compiles for
 the board it names and natively; or the checker refuses it itself, with a
 diagnostic. Never a generator exception, never a compiler error.
 
-Hypothesis draws whole projects: a machine from tests/strategies.py (states,
+Hypothesis draws whole projects: a machine from fswkit.testing.strategies (states,
 statements, locals, windows) plus machines, elements, locals, states,
 regions and tasks named after C++ keywords, the generated code's own
 identifiers (taken from the generated code itself), runtime and C library
@@ -35,7 +35,7 @@ from fswkit.autocode.cnames import CXX_KEYWORDS, TAKEN
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.emit.app import emit_app
 from fswkit.autocode.lexer import KEYWORDS
-from strategies import RESERVED, programs
+from fswkit.testing.strategies import RESERVED, programs
 
 CASES = int(os.environ.get("FSW_GEN_CASES", "160"))
 CHUNK = 120  # projects per seed and compiler run

@@ -38,6 +38,12 @@ def cases() -> list[Path]:
     return out
 
 
+def expected_files() -> list[Path]:
+    """The expected outputs of the three state languages (app/ holds the
+    application language's cases, tests/autocode/golden/app)."""
+    return [p for lang in LANGS for p in sorted((GOLDEN / lang).rglob("*.expected"))]
+
+
 def case_id(p: Path) -> str:
     return p.relative_to(GOLDEN).as_posix()
 
@@ -72,7 +78,7 @@ def test_golden(inp: Path):
 
 def test_every_expected_file_has_its_input():
     inputs = {p.with_suffix(".expected") for p in cases()}
-    orphans = [case_id(p) for p in GOLDEN.rglob("*.expected") if p not in inputs]
+    orphans = [case_id(p) for p in expected_files() if p not in inputs]
     assert orphans == []
 
 
@@ -126,7 +132,7 @@ def message_fragments() -> dict[str, str]:
 def test_every_message_has_a_golden_case():
     fragments = message_fragments()
     assert len(fragments) > 80  # the scan found the reporters
-    seen = "".join(p.read_text() for p in GOLDEN.rglob("*.expected"))
+    seen = "".join(p.read_text() for p in expected_files())
     missing = [f"{where}: {frag!r}" for frag, where in sorted(fragments.items(), key=lambda kv: kv[1])
                if frag not in seen and frag not in NOT_GOLDEN]
     assert missing == []

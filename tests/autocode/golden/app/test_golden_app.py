@@ -1,7 +1,7 @@
 """Golden files for every diagnostic of the application languages: the
 `.app` config and the `.aio`/`.dio` channel tables it names.
 
-tests/autocode/golden_app/ holds one small application per diagnostic,
+tests/autocode/golden/app/ holds one small application per diagnostic,
 `NAME.app`, beside `NAME.expected`: exactly what `fsw check NAME.app` writes
 to standard error, run from this folder. A case about a channel table names
 its own `NAME.aio` or `NAME.dio`; the other files (rig.sv, rig.sm, rig.aio,
@@ -9,7 +9,7 @@ rig.dio, ...) are the companions the cases share. Each case is the same
 valid application (`valid.app`) with one thing changed, so its diagnostics
 are those of that change.
 
-    FSW_UPDATE_GOLDEN=1 pytest tests/autocode/golden_app/test_golden_app.py
+    FSW_UPDATE_GOLDEN=1 pytest tests/autocode/golden/app/test_golden_app.py
 
 rewrites every .expected file from the current output; review the diff by
 eye before committing: each file is what a user sees.

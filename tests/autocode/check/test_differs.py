@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import run_fsw
+from conftest import ROOT, run_fsw
 
 REALS = ("f64", "f32")
 
@@ -370,7 +370,7 @@ def test_refused_where_the_reference_quietly_accepts(tmp_path, what, sm, ss, whe
     assert message.replace("`pick`", "`n`") in DOC  # the reference lists each message, with `n` for the name
 
 
-DOC = (Path(__file__).resolve().parents[2] / "docs" / "languages.md").read_text()
+DOC = (ROOT / "docs" / "languages.md").read_text()
 
 
 def test_an_alias_equal_to_an_earlier_name_is_refused(tmp_path):

@@ -1,11 +1,6 @@
-"""Properties of the front end and the interpreter, over generated programs
-(tests/strategies.py) and generated garbage.
+"""Properties of the interpreter over generated programs
+(fswkit.testing.strategies) and generated expressions:
 
-- round trip: tree -> unparse -> parse gives the tree back, and unparse is
-  a fixed point; every other accepted spelling parses to the same tree;
-- generated valid programs check without errors;
-- no input, however malformed, makes a loader or `fsw check` / `fsw test`
-  raise: only located diagnostics (the fuzzer's invariants, in small);
 - differential: the interpreter's compiled Python and the tree walk of
   `evaluate` agree bit for bit, expression by expression and step by step,
   in binary64 and binary32;
@@ -13,228 +8,30 @@
   conversions are C's, saturated as spec §4.5 says; binary32 literals and
   integers are correctly rounded; rolling windows hold the last N samples.
 
-FSW_PROPERTY_SCALE (default 0.5 in `make test`; `make fuzz` runs 5) multiplies every
-example count;
+FSW_PROPERTY_SCALE scales the example counts (fswkit.testing.properties);
 FSW_PROPERTY_SHRINK=1 shrinks failing programs (slow) before reporting.
 """
 
 from __future__ import annotations
 
 import math
-import os
-import struct
-import sys
-import tempfile
 from dataclasses import replace
 from fractions import Fraction
 
 import numpy as np
-import pytest
-from hypothesis import HealthCheck, Phase, assume, given, settings
+from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from conftest import ROOT, run_fsw
-
-import strategies as T
 from fswkit.autocode import model as M
 from fswkit.autocode import unparse
-from fswkit.autocode.check import check_sm, check_ss, check_sv
-from fswkit.autocode.diagnostics import Diagnostics, Source
 from fswkit.autocode.evaluate import evaluate, local_values
 from fswkit.autocode.numeric import F32MODE, F64MODE, format_value, to_type, truthy
-from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
 from fswkit.autocode.types import TYPES
 from fswkit.run.interp import ERR_TIME, OK, MachineRun, _Emitter, compile_functions
 from fswkit.run.script import run as run_script
 from fswkit.run.windows import make_window
-
-sys.path.insert(0, str(ROOT / "tools"))
-import fuzz_frontend as fuzz  # noqa: E402
-
-SCALE = float(os.environ.get("FSW_PROPERTY_SCALE", "0.5"))
-REAL_MODES = (F64MODE, F32MODE)
-
-
-# Shrinking a whole generated program can take minutes: the program-level
-# tests report the failing program as drawn unless FSW_PROPERTY_SHRINK=1.
-SHRINK = os.environ.get("FSW_PROPERTY_SHRINK") == "1"
-NO_SHRINK = {} if SHRINK else {"phases": [Phase.explicit, Phase.reuse, Phase.generate]}
-
-
-def cases(n: int, **kw):
-    return settings(max_examples=max(1, int(n * SCALE)), deadline=None, database=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
-                                           HealthCheck.large_base_example, HealthCheck.filter_too_much],
-                    **kw)
-
-
-def parse(kind: str, text: str, path: str | None = None):
-    d = Diagnostics()
-    src = Source.from_text(path or f"p.{kind}", text)
-    tree = {"sv": parse_sv, "sm": parse_sm, "ss": parse_ss}[kind](src, d)
-    return tree, src, d
-
-
-def compile_program(p: T.Program):
-    """The checked machine and script of a generated program; asserts that
-    both check without errors."""
-    (svf, svs, d1), (smf, sms, d2), (ssf, sss, d3) = (
-        parse("sv", p.sv_text), parse("sm", p.sm_text), parse("ss", p.ss_text))
-    d = Diagnostics()
-    sv = check_sv(svf, svs, d)
-    m = check_sm(smf, sms, sv, d, warnings=True)
-    script = check_ss(ssf, sss, m, d) if m is not None else None
-    assert not (d1.items or d2.items or d3.items or d.errors), (
-        (d1.render() + d2.render() + d3.render() + d.render()) + "\n" + p.sv_text + p.sm_text + p.ss_text)
-    return m, script
-
-
-def same(a, b) -> bool:
-    """Bit-for-bit equality of two variable values (NaN equals NaN)."""
-    if type(a) is not type(b):
-        return False
-    if isinstance(a, float):
-        return (a != a and b != b) or struct.pack("<d", a) == struct.pack("<d", b)
-    return a == b
-
-
-def assert_same_values(a: list, b: list, m: M.Machine, where: str) -> None:
-    for i, (x, y) in enumerate(zip(a, b)):
-        assert same(x, y), f"{where}: `{m.vars[i].name}` is {x!r} compiled, {y!r} by the tree walk"
-    assert len(a) == len(b)
-
-
-# ---- round trip --------------------------------------------------------------------
-
-@cases(80, **NO_SHRINK)
-@given(T.programs(), st.randoms(use_true_random=False))
-def test_round_trip_and_other_spellings(p, r):
-    for kind, tree, spell in (("sv", p.sv, T.spell_sv), ("sm", p.sm, T.spell_sm), ("ss", p.ss, T.spell_ss)):
-        text = getattr(unparse, f"{kind}_file")(tree)
-        back, _, d = parse(kind, text)
-        assert not d.items, d.render() + "\n" + text
-        assert T.strip(back) == T.strip(tree), text
-        assert getattr(unparse, f"{kind}_file")(back) == text  # a fixed point
-        spelled = spell(tree, r)
-        back, _, d = parse(kind, spelled)
-        assert not d.items, d.render() + "\n" + spelled
-        assert T.strip(back, flags=True) == T.strip(tree, flags=True), spelled
-
-
-@cases(60, **NO_SHRINK)
-@given(T.programs(loose=True))
-def test_round_trip_of_any_calls(p):
-    """Calls of any function with any number of arguments are syntax too."""
-    text = p.sm_text
-    back, _, d = parse("sm", text)
-    assert not d.items, d.render() + "\n" + text
-    assert T.strip(back) == T.strip(p.sm)
-    assert unparse.sm_file(back) == text
-
-
-@cases(60)
-@given(T.programs(loose=True))
-def test_programs_calling_anything_check_to_diagnostics(p):
-    """Calls of any function, any number of arguments, calls in window
-    sizes: the checker reports, never raises."""
-    sources = {f"p.{k}": getattr(p, f"{k}_text") for k in ("sv", "sm", "ss")}
-    (svf, svs, d1), (smf, sms, d2), (ssf, sss, d3) = (parse(k, sources[f"p.{k}"]) for k in ("sv", "sm", "ss"))
-    d = Diagnostics()
-    m = check_sm(smf, sms, check_sv(svf, svs, d), d, warnings=True)
-    if m is not None:
-        check_ss(ssf, sss, m, d)
-    fuzz.check_diagnostics(d, sources)
-
-
-@cases(300)
-@given(T.exprs(T.Ctx(("a", "b", "iffy", "T"), (T._n("3"),)), 5))
-def test_expression_round_trip(e):
-    text = unparse.expr(e)
-    back, _, d = parse("sm", f"[state_vector]\n[local]\nF64 x = {text}\n")
-    assert not d.items, text
-    assert T.strip(back.locals[0].expr) == T.strip(e), text
-
-
-# ---- checking ---------------------------------------------------------------------------
-
-@cases(80, **NO_SHRINK)
-@given(T.programs())
-def test_generated_programs_check_and_run_through_fsw(p):
-    compile_program(p)
-    with tempfile.TemporaryDirectory() as d:
-        for ext, text in (("sv", p.sv_text), ("sm", p.sm_text), ("ss", p.ss_text)):
-            with open(os.path.join(d, f"p.{ext}"), "w") as f:
-                f.write(text)
-        r = run_fsw("check", d)
-        assert r.code == 0, r.err
-        assert ", 0 errors," in r.err
-        r = run_fsw("test", os.path.join(d, "p.ss"), "--real", "f32")
-        if _beyond_binary32(p.sm_text + "\n" + p.ss_text):  # `1e39` is infinity there: an error
-            assert r.code == 2 and "number is outside the representable range of binary32" in r.err, r.err
-            return
-        assert r.code in (0, 1), r.err
-        assert r.out.startswith("state script ran for ")
-
-
-def _beyond_binary32(text: str) -> bool:
-    from fswkit.autocode.lexer import NUM, lex
-
-    toks = lex(Source.from_text("p", text), Diagnostics(), "sm")
-    return any(t.kind == NUM and math.isinf(F32MODE.literal(t.text)) for line in toks for t in line)
-
-
-# ---- malformed input: diagnostics only -------------------------------------------------------
-
-CORPUS = fuzz.corpus(generated=0)
-
-
-def _run(files, changed=frozenset((0, 1, 2))):
-    with tempfile.TemporaryDirectory() as d:
-        fuzz.run_case(tuple(files), d, cli=True, changed=changed)
-
-
-@cases(120)
-@given(st.integers(0, len(CORPUS) - 1), st.randoms(use_true_random=False), st.sets(st.integers(0, 2), min_size=1))
-def test_mutated_inputs_give_only_diagnostics(k, r, which):
-    files = list(CORPUS[k].files)
-    others = [f for p in CORPUS[:8] for f in p.files]
-    for i in which:
-        files[i] = fuzz.mutate(files[i], r, others)
-    _run(files)
-
-
-@cases(100)
-@given(st.binary(max_size=600), st.integers(0, 2), st.integers(0, len(CORPUS) - 1))
-def test_random_bytes_give_only_diagnostics(data, i, k):
-    files = list(CORPUS[k].files)
-    files[i] = data
-    _run(files)
-
-
-@pytest.mark.parametrize("special", range(len(fuzz.SPECIALS)))
-def test_pathological_inputs_give_only_diagnostics(special):
-    """Deep nesting, long lines, huge numbers: in every file."""
-    import random
-
-    tank = next(p for p in CORPUS if p.name.endswith("tank.ss"))
-    for i in range(3):
-        for at in (0, len(tank.files[i]) // 2, len(tank.files[i])):
-            files = list(tank.files)
-            files[i] = files[i][:at] + fuzz.SPECIALS[special](random.Random(special)) + files[i][at:]
-            _run(files)
-
-
-@cases(300)
-@given(st.text(st.sampled_from("ab \t\r\n\x0b\u00e9"), max_size=60), st.lists(st.integers(0, 60), max_size=12))
-def test_incremental_columns_are_visual_columns(text, indices):
-    """The lexer's linear-time columns equal `visual_col` (tabs expanded as
-    `str.expandtabs` does, CR included), at increasing or any indices."""
-    from fswkit.autocode.diagnostics import Columns, visual_col
-
-    cols = Columns(text)
-    for i in sorted(indices) + indices:
-        i = min(i, len(text))
-        assert cols(i) == visual_col(text, i), (text, i)
+from fswkit.testing import strategies as T
+from fswkit.testing.properties import NO_SHRINK, REAL_MODES, assert_same_values, cases, compile_program, same
 
 
 # ---- the tree walk: spec §4.6 and §5 written out plainly ----------------------------------------

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, ROOT
 from fswkit.run import script as script_mod
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.numeric import F64MODE
@@ -21,7 +21,7 @@ from fswkit.run.interp import MachineRun
 from fswkit.new.script import instrument, plan, skeleton, skeleton_runs
 
 TANK = EXAMPLES / "tank"
-MACHINES = Path(__file__).resolve().parent / "machines"
+MACHINES = ROOT / "tests" / "autocode" / "emit" / "machines"
 
 
 def machine(path: Path):

@@ -672,9 +672,13 @@ def _fmt(x, unit="s", sign=False) -> str:
     return f"{x:+.2f} {unit}" if sign else f"{x:.2f} {unit}"
 
 
-def event_table(rp: Replay, cfg: Config, truth) -> list[str]:
-    """The firmware's events beside the truth and the recorder's own."""
+def event_table(rp: Replay, cfg: Config, truth, end: float | None = None) -> list[str]:
+    """The firmware's events beside the truth and the recorder's own; an
+    event after `end` (the tape's last row) is marked: the inputs were
+    held then."""
     ev = firmware_events(rp, cfg)
+    if end is not None:
+        ev = {k: (t, how + (" (after the tape's end)" if t > end else "")) for k, (t, how) in ev.items()}
     rec_name = truth.recorder or "the recorder"
     rows = [("event", "firmware", "how", "truth", "fw − truth", "recorder", "rec − truth", "fw − rec")]
     truths = {"launch": ("liftoff_s", truth.liftoff_s), "burnout": ("burnout_s", truth.burnout_s),
@@ -734,7 +738,7 @@ def summary(rp: Replay, cfg: Config, tape, truth, checks, notes, label: str) -> 
         more = f" and {len(spans) - 5} more runs" if len(spans) > 5 else ""
         fed = "" if cfg.sensors.get(col) is not None else " (not fed)"
         lines.append(f"missing {col}{fed}: {shown}{more}; {how}")
-    lines += event_table(rp, cfg, truth)
+    lines += event_table(rp, cfg, truth, tape.end)
     lines += reports._transition_lines(_Shim(run, rp), cfg.altitude_element, "altitude_m", "m")
     lines += reports._tail_lines(run)
     lines += notes

@@ -191,6 +191,16 @@ def test_fail_path_exit_status_and_log_ending_in_the_air(flights):
     assert "SKIP  landing: the tape ends in the air" in r.out
 
 
+def test_options_that_do_not_go_with_a_tape(tmp_path):
+    tape = _write_tape(tmp_path, "opts")
+    r = run_fsw("sim", str(ROCKET), "--perturb", "3")
+    assert r.code == 2 and "--perturb needs --tape FLIGHT.csv" in r.err
+    r = run_fsw("sim", str(ROCKET), "--tape", str(tape), "--plant", "rocket")
+    assert r.code == 2 and "--plant does not go with --tape" in r.err
+    r = run_fsw("sim", str(ROCKET), "--tape", str(tape), "--seed", "4")
+    assert r.code == 2 and "--seed with --tape needs --perturb N" in r.err
+
+
 def test_bad_inputs_are_located(flights, tmp_path):
     tape = _write_tape(tmp_path, "lonely")
     os.unlink(tmp_path / "lonely.truth.toml")

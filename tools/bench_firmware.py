@@ -13,14 +13,13 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "host-tools"))
 
-from fswkit.autocode.diagnostics import Diagnostics  # noqa: E402
-from fswkit.autocode.emit.machine import emit_machine  # noqa: E402
-from fswkit.autocode.emit.sv import emit_sv  # noqa: E402
-from fswkit.autocode.numeric import F32MODE, F64MODE  # noqa: E402
-from fswkit.autocode.project import load_machine  # noqa: E402
-from fswkit.sim.board import harness  # noqa: E402
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.autocode.emit.machine import emit_machine
+from fswkit.autocode.emit.sv import emit_sv
+from fswkit.autocode.numeric import F32MODE, F64MODE
+from fswkit.autocode.project import load_machine
+from fswkit.sim.board import harness
 
 OUT = os.path.join(ROOT, "build", "bench")
 RUNTIME = os.path.join(ROOT, "firmware", "src")

@@ -19,10 +19,9 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "host-tools"))
 
-from fswkit.plant.cosim import CosimError  # noqa: E402
-from fswkit.plant.run import SetupError, execute, prepare  # noqa: E402
+from fswkit.plant.cosim import CosimError
+from fswkit.plant.run import SetupError, execute, prepare
 
 PROJECT = os.path.join(ROOT, "examples", "rocket")
 OUT = os.path.join(ROOT, "build", "bench", "flights-rocket")  # a build of its own: nobody rebuilds it mid-run

@@ -22,11 +22,11 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 
-from fswkit.autocode.diagnostics import Diagnostics  # noqa: E402
-from fswkit.link import wire  # noqa: E402
-from fswkit.link.layout import from_app  # noqa: E402
-from fswkit.link.session import Session  # noqa: E402
-from fswkit.target.build import BuildError, Built, elf_size, firmware, load  # noqa: E402
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.link import wire
+from fswkit.link.layout import from_app
+from fswkit.link.session import Session
+from fswkit.target.build import BuildError, Built, elf_size, firmware, load
 
 TANK = ROOT / "examples" / "tank"
 

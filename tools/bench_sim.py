@@ -17,9 +17,8 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "host-tools"))
 
-from fswkit.sim.board import SimBoard, SimError  # noqa: E402
+from fswkit.sim.board import SimBoard, SimError
 
 PROJECT = os.path.join(ROOT, "tests", "sim", "toggle")
 OUT = os.path.join(ROOT, "build", "bench", "sim-toggle")

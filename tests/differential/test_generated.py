@@ -6,10 +6,11 @@ generated machines with raw element values no script can produce (NaN
 payloads, binary64 values between binary32 neighbours, arbitrary 64-bit
 integers) and compares everything the machine writes after every step.
 
-Deterministic: the seed is fixed. FSW_DIFF_CASES (default 1000) and
-FSW_DIFF_RAW_CASES (default 300) set how many per mode, FSW_DIFF_SEED the
-seed (for long runs). On a mismatch the failure message holds the configs
-of the case (.sv/.sm/.ss) to reproduce it with `fsw test --native`.
+Deterministic: the seed is fixed. FSW_DIFF_CASES (default 500; `make fuzz`
+runs 20,000) and FSW_DIFF_RAW_CASES (default 300; `make fuzz` 5,000) set
+how many per mode, FSW_DIFF_SEED the seed (for long runs). On a mismatch
+the failure message holds the configs of the case (.sv/.sm/.ss) to
+reproduce it with `fsw test --native`.
 docs/differential.md says what is covered and what was found."""
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import gen_programs as gp
 import harness as H
 from fswkit.autocode.numeric import REALS
 
-CASES = int(os.environ.get("FSW_DIFF_CASES", "1000"))
+CASES = int(os.environ.get("FSW_DIFF_CASES", "500"))
 RAW_CASES = int(os.environ.get("FSW_DIFF_RAW_CASES", "300"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))
 SHOW = 3  # mismatches printed in full

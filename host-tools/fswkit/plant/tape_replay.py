@@ -638,7 +638,12 @@ def evaluate(rp: Replay, cfg: Config, truth, tape) -> tuple[dict, list, list]:
     tol = ck["main_tolerance_m"]
     m = next((e for e in run.pin_events if e.role == "main" and e.level), None)
     name = f"main pin within ±{tol:g} m of {cfg.main_alt_name} = {cfg.main_alt:g} m (truth altitude at the pin)"
-    if m is None:
+    after = rp.truth_h[rp.truth_t > truth.apogee_s]
+    if m is None and (after.size == 0 or after.min() > cfg.main_alt):
+        low = float(after.min()) if after.size else math.nan
+        notes.append(f"SKIP  main: the tape never comes down to {cfg.main_alt_name} = {cfg.main_alt:g} m (its lowest "
+                     f"after apogee: {low:.0f} m), and the main pin never went high: main not checked")
+    elif m is None:
         checks.append(reports.Check(name, False, "the main pin never went high"))
     else:
         h = altitude_at(rp, m.t)
@@ -697,7 +702,7 @@ def event_table(rp: Replay, cfg: Config, truth, end: float | None = None) -> lis
                          f"{cfg.main_alt:g} m ({cfg.main_alt_name})",
                          _fmt(None if h is None else h - cfg.main_alt, "m", True),
                          _fmt(rec_t) + (f" at {rec_h:.0f} m" if rec_h is not None else ""),
-                         _fmt(None if rec_h is None else rec_h - cfg.main_alt, "m", True),
+                         "—",  # the recorder's own configured altitude is not in the truth
                          _fmt(None if fw_t is None or rec_t is None else fw_t - rec_t, "s", True)))
             continue
         rows.append((name, _fmt(fw_t), fw[1] if fw else "never",

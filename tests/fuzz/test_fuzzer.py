@@ -98,3 +98,19 @@ def test_a_worker_stuck_beyond_the_alarm_is_killed_and_replaced(projects, tmp_pa
     assert o.passed + o.failed == 20 and o.failed > 0
     assert any(s.startswith("hang (worker killed)") for s in o.signatures)
     assert any(p.name.startswith("hang-") for p in tmp_path.iterdir())
+
+
+def test_generated_projects_do_not_depend_on_what_was_imported_before():
+    """Hypothesis draws constants from every local module imported so far;
+    the corpus's generated programs are drawn without them, so a case
+    number means the same input in any process."""
+    import subprocess
+    import sys
+
+    draw = ("from fswkit.testing import fuzz; import hashlib; "
+            "print(hashlib.sha256(repr([p.files for p in fuzz.generated_projects(6)]).encode()).hexdigest())")
+    more = "import fswkit.plant.run, fswkit.link.session, fswkit.new.project, fswkit.ground.monitor; "
+    a, b = (subprocess.run([sys.executable, "-c", pre + draw], capture_output=True, text=True, timeout=120)
+            for pre in ("", more))
+    assert a.returncode == b.returncode == 0, a.stderr + b.stderr
+    assert a.stdout == b.stdout

@@ -6,35 +6,10 @@ matching the kit's board definition."""
 from __future__ import annotations
 
 import json
-import os
 import re
-import shutil
-import subprocess
-import sys
 import tomllib
 
-import pytest
-
-from conftest import ROOT
-
-
-def pio_exe() -> str | None:
-    for exe in (os.path.join(os.path.dirname(sys.executable), "pio"), shutil.which("pio")):
-        if exe and os.path.isfile(exe):
-            return exe
-    return None
-
-
-needs_pio = pytest.mark.skipif(pio_exe() is None, reason="PlatformIO not installed (pip install platformio)")
-
-
-def project_config(project_dir, tmp_path) -> dict[str, dict]:
-    env = dict(os.environ, PLATFORMIO_CORE_DIR=str(tmp_path / "pio-core"),
-               PLATFORMIO_SETTING_ENABLE_TELEMETRY="No", PLATFORMIO_SETTING_CHECK_PLATFORMIO_INTERVAL="3650")
-    r = subprocess.run([pio_exe(), "project", "config", "-d", str(project_dir), "--json-output"],
-                       capture_output=True, text=True, env=env, timeout=120)
-    assert r.returncode == 0, r.stderr + r.stdout
-    return {section: dict(options) for section, options in json.loads(r.stdout[r.stdout.index("["):])}
+from conftest import ROOT, needs_pio, project_config
 
 
 def board_toml(name: str) -> dict:

@@ -8,8 +8,7 @@ import shutil
 
 import pytest
 
-from conftest import ROOT
-from test_pio_config import needs_pio, project_config
+from conftest import ROOT, needs_pio, project_config
 
 needs_avr = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
 

@@ -1,23 +1,8 @@
 #!/usr/bin/env python3
 """Mutation fuzzer for the front end (`make fuzz`): the command line over
-fswkit.testing.fuzz, which holds the corpus, mutators and invariants.
-
-Each case takes a project (a `.sv`, a `.sm` and a `.ss`) from the corpus —
-the examples, the state languages' golden cases (tests/autocode/golden)
-in a source tree, and programs drawn from
-fswkit.testing.strategies — mutates one or more of its files (token deletions,
-duplications and swaps, byte flips, truncation, inserted brackets,
-operators, keywords, huge numbers, deep nesting, long lines, tabs, CR, NUL,
-non-UTF-8, random bytes), and runs it through every loader in-process:
-`load_sv`, `load_machine` (with `fsw check`'s warnings), `load_script`, a
-bounded run of a script that compiles (in binary64 or binary32), and every
-100th case `fsw check` / `fsw test` themselves. The invariants (spec §8):
-nothing raises, nothing hangs (a case has 10 s), every diagnostic is
-located inside its file and its caret line renders, a loader returns a
-model exactly when it reported no error, and the commands exit 0, 1 or 2.
-
-Cases are numbered; case i is a pure function of (seed, i), so any case can
-be rebuilt from its number. Failing inputs go to build/fuzz/crashes/.
+fswkit.testing.fuzz, which holds the corpus, mutators and invariants (its
+docstring says what a case is and what must hold). Case i is a pure
+function of (seed, i); failing inputs go to build/fuzz/crashes/.
 
     tools/fuzz_frontend.py --cases 1000000 [--seed 1] [--workers 2]
 """

@@ -54,8 +54,7 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.autocode.diagnostics import InputError, read_input
-from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure
+from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, read_file
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -132,14 +131,7 @@ def _col_of(cells: list[str], k: int) -> int:
 def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str) -> Log:
     """Reads a CSV log; its column line is the first line for which
     `wanted(normalised names)` holds. TapeError (located) otherwise."""
-    try:
-        data = read_input(path, MAX_LOG)
-    except FileNotFoundError:
-        raise TapeError([f"{path}: no such file"]) from None
-    except InputError as e:
-        raise TapeError([f"{path}: {e}"]) from None
-    except OSError as e:
-        raise TapeError([f"{path}: cannot read: {e.strerror or e}"]) from None
+    data = read_file(path, MAX_LOG)
     err = _Errors(path)
     text = _text(data, err)
     err.raise_if_any()

@@ -303,18 +303,23 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
                 tuple(header["derived"]), tuple(header["note"]), tuple(comments))
 
 
-def read_tape(path: str) -> Tape:
-    """Reads and checks the tape at `path`; TapeError (located messages) for a
-    file it cannot read or take."""
+def read_file(path: str, limit: int) -> bytes:
+    """The bytes of a user's file (fswkit.autocode.diagnostics.read_input:
+    size limit, no FIFOs or devices); TapeError when it cannot be read."""
     try:
-        data = read_input(path, MAX_TAPE)
+        return read_input(path, limit)
     except FileNotFoundError:
         raise TapeError([f"{path}: no such file"]) from None
     except InputError as e:
         raise TapeError([f"{path}: {e}"]) from None
     except OSError as e:
         raise TapeError([f"{path}: cannot read: {e.strerror or e}"]) from None
-    return parse_tape(data, path)
+
+
+def read_tape(path: str) -> Tape:
+    """Reads and checks the tape at `path`; TapeError (located messages) for a
+    file it cannot read or take."""
+    return parse_tape(read_file(path, MAX_TAPE), path)
 
 
 # ---- writing ------------------------------------------------------------------------

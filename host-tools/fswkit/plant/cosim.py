@@ -100,6 +100,51 @@ def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, 
         return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta)
 
 
+def stop_words(stop: str, wall_limit: float) -> str:
+    """Why the board stopped before the step's end, in words."""
+    return {"wall-limit": f"the wall-clock limit ({wall_limit:g} s) was reached",
+            "sim-limit": "the simulated-time limit was reached",
+            "crashed": "the firmware crashed", "done": "the firmware stopped itself"}.get(stop, stop)
+
+
+class Telemetry:
+    """The firmware's UART bytes as a run's telemetry: recorded to the link
+    log, decoded by a link Session into the run's samples and the state
+    transitions of `state_element`, timed `offset` seconds before the
+    board's clock (closed-loop flights: 0; tape replays: the tape's time)."""
+
+    def __init__(self, run: Run, layout: Layout, state_element: str | None, log: LogWriter | None,
+                 offset: float = 0.0):
+        self.run, self.layout, self.log, self.offset = run, layout, log, offset
+        self.session = run.session = Session(layout)
+        self.state_element = state_element
+        self.state_names = layout.states.get(state_element, {})
+        self.regions = {s.index: s.region for s in layout.streams}
+        self.per_s = 1000.0 if layout.time_unit == "ms" else 1e6
+        self.last_state = None
+
+    def feed(self, raw: bytes, t: float) -> None:
+        """Takes the bytes the board sent up to simulated time `t` (s)."""
+        if self.log:
+            self.log.record(RX, round(t * 1e9), raw)
+        run = self.run
+        for ev in self.session.feed(raw, t):
+            if ev.kind == "hello" and not ev.info["schema_ok"]:
+                raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
+                                 f"0x{self.layout.schema:08x}: rebuild it")
+            if ev.kind != "sample":
+                continue
+            names = self.regions[ev.stream].names
+            for ts, vals in ev.samples:
+                row = dict(zip(names, vals))
+                tt = ts / self.per_s - self.offset
+                run.samples.append((tt, row))
+                st = row.get(self.state_element)
+                if st is not None and st != self.last_state:
+                    self.last_state = st
+                    run.transitions.append((tt, int(st), self.state_names.get(int(st), str(st))))
+
+
 def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
     rate = scenario.rate
     f_cpu = int(board.f_cpu)
@@ -110,16 +155,10 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
     vref = float(board.adc_vref)
     analog, digital = scenario.inputs(0.0)
     run = Run(columns=scenario.columns)
-    session = Session(layout)
-    run.session = session
-    state_el = scenario.state_element
-    state_names = layout.states.get(state_el, {})
-    regions = {s.index: s.region for s in layout.streams}
-    per_s = 1000.0 if layout.time_unit == "ms" else 1e6
     log = LogWriter(log_path, layout, **(log_meta or {})) if log_path else None
     if log:
         log.commit()  # named from the start: a run killed outright still leaves its log
-    last_state = None
+    telemetry = Telemetry(run, layout, scenario.state_element, log)
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
                      analog=analog)
@@ -157,34 +196,13 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
                                  "watch") from None
             run.round_trips += 1
             if step.run.stop != "target":
-                stop = step.run.stop
-                why = {"wall-limit": f"the wall-clock limit ({wall_limit:g} s) was reached",
-                       "sim-limit": "the simulated-time limit was reached",
-                       "crashed": "the firmware crashed", "done": "the firmware stopped itself"}.get(stop, stop)
-                raise CosimError(f"{why} at {t0:.3f} s simulated")
+                raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {t0:.3f} s simulated")
             t1 = k / rate
             edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges] if step.edges else ()
             for ev in scenario.advance(t0, t1, edges):
                 run.pin_events.append(ev)
-            raw = step.uart
-            if raw:
-                if log:
-                    log.record(RX, round(t1 * 1e9), raw)
-                for ev in session.feed(raw, t1):
-                    if ev.kind == "hello" and not ev.info["schema_ok"]:
-                        raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
-                                         f"0x{layout.schema:08x}: rebuild it")
-                    if ev.kind != "sample":
-                        continue
-                    names = regions[ev.stream].names
-                    for t, vals in ev.samples:
-                        row = dict(zip(names, vals))
-                        ts = t / per_s
-                        run.samples.append((ts, row))
-                        if state_el in row and row[state_el] != last_state:
-                            last_state = row[state_el]
-                            run.transitions.append((ts, int(last_state),
-                                                    state_names.get(int(last_state), str(last_state))))
+            if step.uart:
+                telemetry.feed(step.uart, t1)
             if k % record_every == 0:
                 run.rows.append(scenario.record())
             if scenario.done(t1, run.transitions[-1][2] if run.transitions else None):

@@ -42,13 +42,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fswkit.link.layout import Layout
-from fswkit.link.log import RX, LogWriter
-from fswkit.link.session import Session
+from fswkit.link.log import LogWriter
 from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
 from fswkit.sim.sensors import AnalogSensor, from_channel
 
 from . import report as reports
-from .cosim import CosimError, PinEvent, Run, _one_cpu
+from .cosim import CosimError, PinEvent, Run, Telemetry, _one_cpu, stop_words
 from .params import Field as F
 from .params import ParamsError, Table, locate
 from .params import load as load_params
@@ -469,15 +468,11 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     chunk = f_cpu  # at most a simulated second per batch: telemetry decoded as it comes
     stops = sorted(c for c in changes if 0 < c < end_cycle)
     run = Run(columns=())
-    session = Session(layout)
-    run.session = session
-    state_names = layout.states.get(cfg.state_element, {})
-    regions = {s.index: s.region for s in layout.streams}
-    per_s = 1000.0 if layout.time_unit == "ms" else 1e6
     roles = {p: r for r, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin)) if p is not None}
     log = LogWriter(log_path, layout, **(log_meta or {})) if log_path else None
     if log:
         log.commit()
+    telemetry = Telemetry(run, layout, cfg.state_element, log, offset)
     initial = {pin: series[0] / 1000.0 for pin, series in mv.items()}
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial)
@@ -486,7 +481,6 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
             log.close()
         raise CosimError(str(e)) from None
     wall0 = time.perf_counter()
-    last_state = None
     try:
         for pin in roles:
             b.watch(pin)
@@ -503,34 +497,13 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
             pending = ({}, {})
             run.round_trips += 1
             if step.run.stop != "target":
-                why = {"wall-limit": f"the wall-clock limit ({wall_limit:g} s) was reached",
-                       "sim-limit": "the simulated-time limit was reached", "crashed": "the firmware crashed",
-                       "done": "the firmware stopped itself"}.get(step.run.stop, step.run.stop)
-                raise CosimError(f"{why} at {now / f_cpu - offset:.3f} s tape time")
+                raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {now / f_cpu - offset:.3f} s tape time")
             now = until
             for e in step.edges:
                 te = e.cycle / f_cpu - offset
                 run.pin_events.append(PinEvent(te, e.pin, roles.get(e.pin, str(e.pin)), e.level, {}))
-            raw = step.uart
-            if raw:
-                t1 = now / f_cpu
-                if log:
-                    log.record(RX, round(t1 * 1e9), raw)
-                for ev in session.feed(raw, t1):
-                    if ev.kind == "hello" and not ev.info["schema_ok"]:
-                        raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
-                                         f"0x{layout.schema:08x}: rebuild it")
-                    if ev.kind != "sample":
-                        continue
-                    names = regions[ev.stream].names
-                    for ts, vals in ev.samples:
-                        row = dict(zip(names, vals))
-                        tt = ts / per_s - offset
-                        run.samples.append((tt, row))
-                        st = row.get(cfg.state_element)
-                        if st is not None and st != last_state:
-                            last_state = st
-                            run.transitions.append((tt, int(st), state_names.get(int(st), str(st))))
+            if step.uart:
+                telemetry.feed(step.uart, now / f_cpu)
             if now == target:
                 pending = changes.get(target, ({}, {}))
                 target = next(targets, end_cycle)

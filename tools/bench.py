@@ -25,7 +25,6 @@ instruction counts are the figures to compare over time.
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import resource
 import shutil

@@ -10,7 +10,6 @@ Python decoder, and says so."""
 from __future__ import annotations
 
 import os
-import random
 import shutil
 import subprocess
 import sys

@@ -16,7 +16,6 @@ import shutil
 import signal
 import struct
 import subprocess
-import sys
 import threading
 import time
 
@@ -24,7 +23,7 @@ from fswkit.autocode import model as M
 from fswkit.autocode.emit.script import script_files
 from fswkit.autocode.numeric import Real
 
-from fswkit.autocode.kit import ROOT, RUNTIME
+from fswkit.autocode.kit import RUNTIME
 CXX = os.environ.get("CXX", "g++")
 # binary32 builds mirror an AVR: float R and software binary64 conversion.
 FLAGS = {32: ["-DFSW_REAL_IS_FLOAT=1", "-DFSW_F64_SOFT=1"], 64: ["-DFSW_REAL_IS_FLOAT=0", "-DFSW_F64_SOFT=0"]}

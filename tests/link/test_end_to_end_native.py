@@ -19,7 +19,7 @@ from fswkit.link.client import Ground
 from fswkit.link.log import LogReader
 from fswkit.link.port import open_port
 from fswkit.link.session import Session
-from linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
+from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = needs_cxx()
 RAW = 770  # 770 counts -> 815.4 psi: between 775 and 825, the vent valve opens

@@ -16,7 +16,7 @@ import pytest
 from conftest import run_fsw
 from fswkit.link import wire
 from fswkit.link.session import Session
-from linkfw import TANK, tank_layout
+from support.linkfw import TANK, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,

@@ -14,7 +14,7 @@ import pytest
 
 from fswkit.link import wire
 from fswkit.link.session import Session
-from linkfw import TANK, build_native, needs_cxx, simulated_link, tank_layout
+from support.linkfw import TANK, build_native, needs_cxx, simulated_link, tank_layout
 
 pytestmark = needs_cxx()
 

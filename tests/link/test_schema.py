@@ -9,7 +9,7 @@ from conftest import run_fsw
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.schema import app_schema_hash, link_plan
 from fswkit.target.build import load
-from linkfw import TANK
+from support.linkfw import TANK
 
 
 def variant(tmp_path, name, old, new):

@@ -13,7 +13,7 @@ names and platform macros; state vectors up to past an Uno's RAM; executor,
 task and stream rates up to past their tables' 16-bit ranges; 0 to 260
 tasks; odd application file names. Hypothesis draws the projects in chunks
 of 120, one seed each; the accepted ones are compiled in one -fsyntax-only
-run per board and chunk (tests/regression/cxx.py). FSW_GEN_CASES (default
+run per board and chunk (tests/support/cxx.py). FSW_GEN_CASES (default
 160) sets how many projects; `make fuzz` runs many more."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import pytest
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
-import cxx
+from support import cxx
 from conftest import EXAMPLES
 from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board

@@ -11,7 +11,7 @@ import io
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
+from support.linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
 
 FULL = "/dev/full"
 

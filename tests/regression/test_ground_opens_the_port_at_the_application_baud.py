@@ -12,7 +12,7 @@ import termios
 
 import pytest
 from conftest import run_fsw
-from linkstream import PtyStream, PtyTarget, hello, layout_of, tank_copy
+from support.linkstream import PtyStream, PtyTarget, hello, layout_of, tank_copy
 
 from fswkit.link import wire
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from linkstream import TANK, PtyTarget, layout_of, stream
+from support.linkstream import TANK, PtyTarget, layout_of, stream
 
 from fswkit.link import wire
 from fswkit.link.session import Session, max_frame

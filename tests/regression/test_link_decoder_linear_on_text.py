@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 
 import pytest
-from linkstream import TANK, layout_of, stream
+from support.linkstream import TANK, layout_of, stream
 
 from fswkit.link.session import Session
 

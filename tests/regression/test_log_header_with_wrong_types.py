@@ -10,7 +10,7 @@ import struct
 
 import pytest
 from conftest import run_fsw
-from linkstream import write_log
+from support.linkstream import write_log
 
 from fswkit.link.log import MAGIC
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, layout_of, stream
+from support.linkstream import TANK, layout_of, stream
 
 from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session

@@ -16,7 +16,7 @@ import os
 
 import pytest
 
-import cxx
+from support import cxx
 from conftest import run_fsw
 from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board

@@ -14,7 +14,7 @@ import signal
 
 import pytest
 from conftest import run_fsw
-from linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
+from support.linkstream import TANK, PtyStream, layout_of, tank_copy, write_log
 
 
 def _log(path, first=0, n=400):

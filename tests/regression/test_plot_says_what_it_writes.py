@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 from conftest import run_fsw
-from linkstream import write_log
+from support.linkstream import write_log
 
 
 @pytest.fixture(scope="module")

@@ -14,8 +14,7 @@ import pytest
 
 from conftest import ROOT
 
-sys.path.insert(0, str(ROOT / "tests" / "sim"))
-from simfw import sketch_elf  # noqa: E402
+from support.simfw import sketch_elf  # noqa: E402
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")

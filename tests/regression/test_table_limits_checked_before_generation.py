@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 
 
-import cxx
+from support import cxx
 from fswkit.autocode.app import load_app
 from fswkit.autocode.board import load_board
 from fswkit.autocode.diagnostics import Diagnostics

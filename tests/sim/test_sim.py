@@ -19,7 +19,7 @@ import pytest
 import serial
 
 from conftest import EXAMPLES, ROOT
-from simfw import OUT, dive_uno, halt_uno, probe_uno, spin_uno, tank_mega, tank_uno, toggle_uno  # noqa: F401
+from support.simfw import OUT, dive_uno, halt_uno, probe_uno, spin_uno, tank_mega, tank_uno, toggle_uno  # noqa: F401
 
 from fswkit.sim.board import SimBoard, SimError, harness, pin_map, sim_board
 

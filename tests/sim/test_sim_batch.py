@@ -14,7 +14,7 @@ import subprocess
 import pytest
 
 from conftest import ROOT
-from simfw import c_elf, halt_uno, probe_uno, spin_uno, tank_uno  # noqa: F401,F811
+from support.simfw import c_elf, halt_uno, probe_uno, spin_uno, tank_uno  # noqa: F401,F811
 
 from fswkit.sim.board import Batch, SimBoard, SimError, harness
 

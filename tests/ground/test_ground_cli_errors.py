@@ -9,7 +9,7 @@ from conftest import run_fsw
 from fswkit.link import wire
 from fswkit.link.layout import from_dict
 from fswkit.link.log import LogWriter
-from linkfw import TANK, tank_layout
+from support.linkfw import TANK, tank_layout
 
 
 def clean(r):

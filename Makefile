@@ -84,6 +84,7 @@ bench: setup
 	$(PY) tools/bench_sim.py
 	$(PY) tools/bench_link.py
 	$(PY) tools/bench_flights.py
+	$(PY) tools/bench_tapes.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -17,7 +17,7 @@ exits 0.
 
 The acceptance asks for `--perturb 200` on every tape; at today's replay
 speed (~6× real time, 2,319 s of flight in the eight tapes) that is about
-20 CPU-hours, so the bench runs FSW_TAPE_PERTURB (default 4) perturbed
+21 CPU-hours, so the bench runs FSW_TAPE_PERTURB (default 4) perturbed
 replays of ndrt2020_raven only (FSW_TAPE_PERTURB_TAPE picks another; 0
 skips them). 200 runs per tape wait on replay speed (the sleeping
 executor).
@@ -42,7 +42,11 @@ FIRMWARE = os.path.join(OUT, "firmware")  # a build of its own: nobody rebuilds 
 
 
 def fmt(x, spec: str) -> str:
-    return "—" if x is None else format(x, spec)
+    """x formatted, or a dash as wide as the spec's width when absent."""
+    if x is None:
+        width = "".join(ch for ch in spec.split(".")[0] if ch.isdigit())
+        return format("—", f">{width or 1}")
+    return format(x, spec)
 
 
 def setup():
@@ -168,7 +172,7 @@ def perturbed(folder: str, layout, cfg, elf, board) -> int:
         return 0
     tape, truth = tr.load_tape(path, cfg)
     print(f"\nperturbed replays (fsw sim examples/hpr --tape {name}.csv --perturb {n}); the acceptance's "
-          "--perturb 200 on every tape (~20 CPU-hours at today's speed) waits on replay speed")
+          "--perturb 200 on every tape (~21 CPU-hours at today's speed) waits on replay speed")
     t0 = time.perf_counter()
     results = tr.robustness(tape, truth, cfg, elf, board, layout, n, 1, workers=2)
     text, _ok = tr.robustness_text(results, tape, n, 1, time.perf_counter() - t0)

@@ -38,8 +38,11 @@ docs-img: setup
 ## (R = binary64 and binary32) and on a simulated ATmega328P
 test: setup test-python test-firmware
 
+# pytest on every core (pytest-xdist), a test file's tests on one worker so
+# that a module's costly set-up (a wheel, a firmware build) runs once
+PYTEST_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test-python: setup
-	$(PY) -m pytest tests
+	$(PY) -m pytest -n $(PYTEST_JOBS) --dist loadfile tests
 
 ## fuzz: the front end's mutation fuzzer (1,000,000 cases on both cores,
 ## about an hour; crashing inputs land in build/fuzz/), the uplink parser, the

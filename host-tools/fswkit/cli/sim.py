@@ -94,10 +94,7 @@ def board_run(args) -> int:
 
 def plant_run(args) -> int:
     """`fsw sim PROJECT --plant rocket|tank`: build, fly, write the files, print the checks."""
-    from fswkit.link.log import LogError
-    from fswkit.outputs import Stopped
-    from fswkit.plant.cosim import CosimError
-    from fswkit.plant.run import INCOMPLETE, SetupError, execute, prepare
+    from fswkit.plant.run import SetupError, execute, prepare
     from fswkit.sim.command import build, is_elf, say
     from fswkit.target.build import default_out
 
@@ -135,10 +132,24 @@ def plant_run(args) -> int:
     what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
     say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
         "simulated")
+    return _flown(lambda: execute(sc, elf, board, layout, out), out)
+
+
+def _flown(fly, out: str) -> int:
+    """Runs a flight or a replay that writes its files into `out` as one
+    set, then prints its report; the exit status: 0 when its checks
+    passed, 1 when one failed or the run could not finish, 128 + N when
+    stopped by signal N."""
+    from fswkit.link.log import LogError
+    from fswkit.outputs import Stopped
+    from fswkit.plant.cosim import CosimError
+    from fswkit.plant.run import INCOMPLETE
+    from fswkit.sim.command import say
+
     incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
                   "still the last finished run's")
     try:
-        flight = execute(sc, elf, board, layout, out)
+        done = fly()
     except Stopped as e:
         say(f"stopped by {e}" + incomplete)
         return 128 + e.signum
@@ -151,10 +162,10 @@ def plant_run(args) -> int:
     except OSError as e:
         say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
         return 1
-    sys.stdout.write(flight.report.text())
+    sys.stdout.write(done.report.text())
     sys.stdout.flush()
-    say("wrote " + ", ".join(flight.files[k] for k in ("log", "csv", "png", "summary")))
-    return 0 if flight.report.passed else 1
+    say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "summary")))
+    return 0 if done.report.passed else 1
 
 
 def tape_run(args) -> int:
@@ -162,10 +173,7 @@ def tape_run(args) -> int:
     replay the tape open loop, write the files, print the events and checks
     (fswkit.plant.tape_replay)."""
     from fswkit.link.layout import LayoutError, from_app
-    from fswkit.link.log import LogError
-    from fswkit.outputs import OutputError, Stopped, write_text
-    from fswkit.plant.cosim import CosimError
-    from fswkit.plant.run import INCOMPLETE
+    from fswkit.outputs import OutputError, write_text
     from fswkit.plant import tape_replay as tr
     from fswkit.sim.command import build, is_elf, say
     from fswkit.target.build import BuildError, default_out, load
@@ -231,23 +239,4 @@ def tape_run(args) -> int:
         say(f"wrote {os.path.join(out, 'perturb.txt')}, {os.path.join(out, 'perturb.csv')}")
         return 0 if ok else 1
     say(f"replaying {args.tape} ({tape.rows:,} rows, {tape.span:.1f} s) open loop on the {board.name}")
-    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
-                  "still the last finished run's")
-    try:
-        o = tr.execute(tape, truth, cfg, app, elf, board, layout, out)
-    except Stopped as e:
-        say(f"stopped by {e}" + incomplete)
-        return 128 + e.signum
-    except KeyboardInterrupt:
-        say("interrupted" + incomplete)
-        raise
-    except (CosimError, LogError) as e:
-        say(str(e) + incomplete)
-        return 1
-    except OSError as e:
-        say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
-        return 1
-    sys.stdout.write(o.report.text())
-    sys.stdout.flush()
-    say("wrote " + ", ".join(o.files[k] for k in ("log", "csv", "png", "summary")))
-    return 0 if o.report.passed else 1
+    return _flown(lambda: tr.execute(tape, truth, cfg, app, elf, board, layout, out), out)

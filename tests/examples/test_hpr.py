@@ -1,7 +1,6 @@
-"""The high-power example (examples/hpr): its configs check clean; every
-state script passes in binary64, in the Uno's binary32 and through the
-generated C++, and together they enter every state and take every
-transition; the firmware fits its budget; the navigation's polynomial for
+"""The high-power example (examples/hpr; its configs and scripts are held
+with the other flight examples' in test_flight_examples.py): the firmware
+fits its budget; the navigation's polynomial for
 the ISA altitude, read from nav.sm and run by the interpreter, is within
 its stated error from 35 to 105 kPa; and plant.toml's sensors are hpr.aio's.
 (A closed-loop flight takes about 35 s of wall time: `fsw sim examples/hpr
@@ -23,40 +22,11 @@ from fswkit.autocode.project import load_machine
 from fswkit.run.interp import OK, MachineRun
 
 HPR = EXAMPLES / "hpr"
-SCRIPTS = sorted(p.name for p in HPR.glob("*.ss"))
 
 
 def isa(p: float) -> float:
     """The ISA troposphere's altitude, m, at pressure p, Pa (the tapes' formula)."""
     return 44330.77 * (1 - (p / 101325.0) ** 0.190263)
-
-
-def test_the_example_has_its_scripts():
-    assert {"nav.ss", "mission_flight.ss", "mission_pad.ss", "mission_lockout.ss", "mission_backup.ss",
-            "mission_stuck.ss", "mission_ballistic.ss"} <= set(SCRIPTS)
-
-
-def test_configs_check_clean(fsw):
-    r = fsw("check", "--strict", str(HPR))
-    assert r.code == 0, r.err
-    assert "0 errors, 0 warnings" in r.err
-
-
-@pytest.mark.parametrize("mode", [(), ("--board", "uno"), ("--native", "--board", "uno")],
-                         ids=["f64", "uno", "native-uno"])
-@pytest.mark.parametrize("script", SCRIPTS)
-def test_script_passes(fsw, script, mode):
-    r = fsw("test", str(HPR / script), *mode)
-    assert r.code == 0, r.out + r.err
-    assert "assertion failed" not in r.out and " 0 asserts passed" not in r.out
-
-
-def test_scripts_cover_every_state_and_transition(fsw):
-    r = fsw("test", "--coverage", str(HPR))
-    assert r.code == 0, r.out + r.err
-    assert "coverage of mission.sm: 10/10 states, 15/15 transitions" in r.out
-    assert "coverage of nav.sm: 1/1 states, 0/0 transitions" in r.out
-    assert f"{len(SCRIPTS)} scripts: {len(SCRIPTS)} passed, 0 failed" in r.out
 
 
 @pytest.mark.skipif(shutil.which("avr-g++") is None, reason="needs avr-g++ (make setup)")

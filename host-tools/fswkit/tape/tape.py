@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from fswkit.autocode.diagnostics import InputError, read_input
+from fswkit.autocode.diagnostics import MAX_INPUT, InputError, read_input
 
 MAGIC = "# fswkit sensor tape v1"
 COLUMNS = ("time_s", "pressure_pa", "accel_g")
@@ -449,12 +449,7 @@ def _key_line(text: str, key: str) -> int | None:
 
 def read_truth(path: str) -> Truth:
     """Reads a `.truth.toml`; TapeError with a located message when it cannot."""
-    try:
-        data = read_input(path)
-    except FileNotFoundError:
-        raise TapeError([f"{path}: no such file"]) from None
-    except OSError as e:
-        raise TapeError([f"{path}: cannot read: {e.strerror or e}"]) from None
+    data = read_file(path, MAX_INPUT)
     err = _Errors(path)
     text = _text(data, err) if data else ""
     err.raise_if_any()

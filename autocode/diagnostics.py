@@ -273,6 +273,18 @@ class ConfigError(Exception):
 MAX_INPUT = 1 << 20
 
 
+def toml_error_at(e: Exception, text: str) -> str:
+    """A TOML parser's error (tomllib.TOMLDecodeError) as `LINE:COL: what`,
+    or `LINE: what` when it is at the end of the document, to follow a
+    file's path."""
+    msg = str(e)
+    m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+    if m:
+        return f"{m.group(1)}:{m.group(2)}: {msg[:m.start()].strip()}"
+    m = re.search(r"\(at end of document\)", msg)
+    return f"{text.count(chr(10)) + 1}: {msg[:m.start()].strip() if m else msg}"
+
+
 class InputError(OSError):
     """A user's file that is not read: not a regular file, or too large.
     An OSError, so every reader's `except OSError` reports it."""

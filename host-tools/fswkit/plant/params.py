@@ -15,7 +15,7 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 
-from fswkit.autocode.diagnostics import read_input
+from fswkit.autocode.diagnostics import read_input, toml_error_at
 
 
 class ParamsError(Exception):
@@ -224,13 +224,7 @@ def load(path: str, schema: Schema) -> tuple[dict, dict]:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        msg = str(e)
-        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
-        if m:
-            raise ParamsError([f"{path}:{m.group(1)}:{m.group(2)}: {msg[:m.start()].strip()}"]) from None
-        m = re.search(r"\(at end of document\)", msg)
-        line = text.count("\n") + 1
-        raise ParamsError([f"{path}:{line}: {msg[:m.start()].strip() if m else msg}"]) from None
+        raise ParamsError([f"{path}:{toml_error_at(e, text)}"]) from None
     except ValueError:  # an integer of more digits than Python converts (4,300), not a TOML error
         m = re.search(r"(?<![\w.])[+-]?[0-9][0-9_]{4300,}", text)
         if m is None:

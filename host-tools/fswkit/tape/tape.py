@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from fswkit.autocode.diagnostics import MAX_INPUT, InputError, read_input
+from fswkit.autocode.diagnostics import MAX_INPUT, InputError, read_input, toml_error_at
 
 MAGIC = "# fswkit sensor tape v1"
 COLUMNS = ("time_s", "pressure_pa", "accel_g")
@@ -456,11 +456,7 @@ def read_truth(path: str) -> Truth:
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        msg = str(e)
-        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
-        if m:
-            raise TapeError([f"{path}:{m.group(1)}:{m.group(2)}: {msg[:m.start()].strip()}"]) from None
-        raise TapeError([f"{path}: {msg}"]) from None
+        raise TapeError([f"{path}:{toml_error_at(e, text)}"]) from None
     except ValueError as e:  # an integer of more digits than Python converts
         raise TapeError([f"{path}: {e}"]) from None
     if not isinstance(doc.get("name"), str) or not doc["name"]:

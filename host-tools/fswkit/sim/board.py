@@ -473,6 +473,13 @@ class SimBoard:
         edges = self._edges(toks[7:]) if toks[6] != "n=0" or toks[7] != "overflow=0" else []
         return Batch(run, edges, bytes.fromhex(toks[5][5:]))
 
+    def reset(self) -> None:
+        """Pulses the MCU's reset line (a brown-out): the firmware starts
+        again from its reset vector with its I/O as at power-on, RAM as it
+        was; the cycle count goes on. Inputs driven from outside read their
+        power-on levels until set again."""
+        self.command("reset")
+
     def go(self, until: float | None = None, realtime: bool = True) -> RunResult:
         """Runs free, paced to the wall clock unless realtime=False, until
         simulated second `until` (None: no end), a limit, or Ctrl-C

@@ -719,6 +719,18 @@ static int cmd_stop(int argc, char** argv) {
     return 1;
 }
 
+/* A brown-out: the reset line pulsed. Registers, I/O and the program counter
+   as at power-on, RAM as it was; the cycle count (the co-simulation's clock) goes on. */
+static int cmd_reset(int argc, char** argv) {
+    NO_ARGS;
+    avr_cycle_count_t cycle = avr->cycle;
+    avr_reset(avr);
+    avr->cycle = cycle;
+    halted = 0;
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
 static int cmd_quit(int argc, char** argv) {
     NO_ARGS;
     fprintf(proto, "ok\n");
@@ -733,7 +745,7 @@ static const struct {
     {"info", cmd_info},   {"step", cmd_step},   {"until", cmd_until}, {"go", cmd_go},
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
-    {"peek", cmd_peek},   {"stop", cmd_stop},   {"quit", cmd_quit},
+    {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 

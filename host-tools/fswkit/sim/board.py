@@ -268,6 +268,32 @@ class RamUsage:
     ram: int
 
 
+@dataclass(frozen=True)
+class FunctionProfile:
+    """Calls of one profiled function and the cycles they took (interrupts
+    taken during a call included)."""
+
+    entry: int  # byte address in flash
+    calls: int
+    total: int
+    worst: int
+
+
+@dataclass(frozen=True)
+class Profile:
+    """What `prof` measured since profiling started: cycles the core slept,
+    the frames (a frame runs from the start of the first profiled function to
+    the end of the last profiled call before it starts again: one executor
+    cycle when that function is the first task), and each function's calls."""
+
+    sleep: int
+    frames: int
+    frame_total: int
+    frame_worst: int
+    frame_worst_at: int  # the cycle the worst frame started at
+    functions: tuple[FunctionProfile, ...]
+
+
 # The byte fswkit firmware paints its free RAM with at boot
 # (FSW_STACK_PAINT_BYTE, firmware/src/psl_arduino.cpp).
 STACK_PAINT = 0xC5
@@ -616,6 +642,36 @@ class SimBoard:
                 if addr >= 0x800000:
                     return addr - 0x800000, int(parts[1], 16)
         raise SimError(f"{self.elf}: no variable `{name}`")
+
+    # -- profiling --
+    def profile(self, entries: list[int]) -> None:
+        """Starts counting the cycles spent in the functions at these byte
+        addresses (the first marks a frame: see `Profile`), from zero."""
+        self.command("prof " + " ".join(str(int(e)) for e in entries))
+
+    def profile_read(self) -> Profile:
+        """What `profile` has counted so far."""
+        toks = self.command("prof").split()[1:]
+        f = dict(t.split("=", 1) for t in toks if not t[0].isdigit())
+        fns = []
+        for t in toks:
+            if t[0].isdigit():
+                entry, counts = t.split("=")
+                calls, total, worst = counts.split(":")
+                fns.append(FunctionProfile(int(entry), int(calls), int(total), int(worst)))
+        return Profile(int(f["sleep"]), int(f["frames"]), int(f["frame_total"]), int(f["frame_worst"]),
+                       int(f["frame_worst_at"]), tuple(fns))
+
+    def function(self, name: str) -> int:
+        """The byte address in flash of a function of the firmware, by its
+        (demangled) name without the parameter list and any ` [clone ...]`
+        (`fsw::link_uplink_task`)."""
+        r = subprocess.run(["avr-nm", "-C", self.elf], capture_output=True, text=True)
+        for line in r.stdout.splitlines():
+            parts = line.split(None, 2)
+            if len(parts) == 3 and parts[1] in "tTwW" and parts[2].split("(")[0] == name:
+                return int(parts[0], 16)
+        raise SimError(f"{self.elf}: no function `{name}`")
 
     # -- stack and RAM --
     @functools.cached_property

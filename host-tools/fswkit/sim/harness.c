@@ -165,6 +165,70 @@ static edge_t* edges;
 static size_t n_edges;
 static int edges_overflow;
 
+/* `prof`: cycles spent in chosen functions (the executor's task steps), and
+   in sleep. A call starts when the program counter reaches a function's first
+   instruction and ends when the stack pointer rises above its value there
+   (the return popped the return address): interrupts taken meanwhile count
+   in the call, as they keep the CPU from other work. Calls of profiled
+   functions do not nest (an entry reached during a call is not counted).
+   The first function marks a cycle: a frame runs from its start to the end
+   of the last profiled call before it starts again (the executor's busy
+   time in that cycle, what runs between its tasks included). */
+#define MAX_PROF 32
+typedef struct {
+    avr_flashaddr_t entry; /* byte address */
+    unsigned long long calls, total, worst;
+} prof_fn_t;
+static prof_fn_t prof_fns[MAX_PROF];
+static int prof_n;            /* 0: profiling off */
+static int prof_active = -1;  /* the function in a call, or -1 */
+static uint16_t prof_sp;      /* the stack pointer at its entry */
+static avr_cycle_count_t prof_start, prof_last_end;
+static avr_cycle_count_t prof_frame_start;
+static int prof_frame_open;
+static unsigned long long prof_frames, prof_frame_total, prof_frame_worst, prof_frame_worst_at, prof_sleep;
+
+static void prof_frame_close(void) {
+    if (!prof_frame_open) return;
+    unsigned long long span = prof_last_end > prof_frame_start ? prof_last_end - prof_frame_start : 0;
+    prof_frames++;
+    prof_frame_total += span;
+    if (span > prof_frame_worst) {
+        prof_frame_worst = span;
+        prof_frame_worst_at = prof_frame_start;
+    }
+    prof_frame_open = 0;
+}
+
+/* After each instruction while profiling: `c0` and `slept` are the cycle and
+   whether the core slept before it ran. */
+static void prof_step(avr_t* a, avr_cycle_count_t c0, int slept) {
+    if (slept) prof_sleep += a->cycle - c0;
+    const uint16_t sp = (uint16_t)(a->data[R_SPL] | (a->data[R_SPH] << 8));
+    if (prof_active >= 0) {
+        if (sp <= prof_sp) return;
+        prof_fn_t* f = &prof_fns[prof_active];
+        unsigned long long d = a->cycle - prof_start;
+        f->calls++;
+        f->total += d;
+        if (d > f->worst) f->worst = d;
+        prof_last_end = a->cycle;
+        prof_active = -1;
+    }
+    for (int i = 0; i < prof_n; i++) {
+        if (prof_fns[i].entry != a->pc) continue;
+        if (i == 0) {
+            prof_frame_close();
+            prof_frame_start = a->cycle;
+            prof_frame_open = 1;
+        }
+        prof_active = i;
+        prof_sp = sp;
+        prof_start = a->cycle;
+        break;
+    }
+}
+
 static void logger(avr_t* a, const int level, const char* fmt, va_list ap) {
     if (level > (a ? a->log : LOG_ERROR)) return;
     fputs("simavr: ", stderr);
@@ -421,7 +485,10 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
                 why = (has_target && a->cycle >= target) ? "target" : "sim-limit";
                 break;
             }
+            const avr_cycle_count_t c0 = a->cycle;
+            const int slept = a->state == cpu_Sleeping;
             int st = avr_run(a);
+            if (prof_n) prof_step(a, c0, slept);
             if (st == cpu_Done || st == cpu_Crashed) {
                 halted = 1;
                 why = st == cpu_Crashed ? "crashed" : "done";
@@ -713,6 +780,38 @@ static int cmd_info(int argc, char** argv) {
     return 1;
 }
 
+/* `prof ADDR...` profiles the functions at these byte addresses (the first
+   marks a cycle), starting from zero; `prof` reports: `ok sleep=CYCLES
+   frames=N frame_total=CYCLES frame_worst=CYCLES frame_worst_at=CYCLE` and
+   `ADDR=CALLS:TOTAL:WORST` for each function. */
+static int cmd_prof(int argc, char** argv) {
+    if (argc > 1) {
+        if (argc - 1 > MAX_PROF) return fail("prof: at most %d functions", MAX_PROF);
+        prof_fn_t fns[MAX_PROF];
+        for (int i = 1; i < argc; i++) {
+            unsigned long long v;
+            if (parse_u64(argv[i], &v) || v > avr->flashend) return fail("usage: prof [ADDRESS...] (byte addresses in flash)");
+            memset(&fns[i - 1], 0, sizeof fns[i - 1]);
+            fns[i - 1].entry = (avr_flashaddr_t)v;
+        }
+        memcpy(prof_fns, fns, sizeof fns);
+        prof_n = argc - 1;
+        prof_active = -1;
+        prof_frame_open = 0;
+        prof_frames = prof_frame_total = prof_frame_worst = prof_frame_worst_at = prof_sleep = 0;
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (prof_active < 0) prof_frame_close();
+    fprintf(proto, "ok sleep=%llu frames=%llu frame_total=%llu frame_worst=%llu frame_worst_at=%llu", prof_sleep,
+            prof_frames, prof_frame_total, prof_frame_worst, prof_frame_worst_at);
+    for (int i = 0; i < prof_n; i++)
+        fprintf(proto, " %lu=%llu:%llu:%llu", (unsigned long)prof_fns[i].entry, prof_fns[i].calls, prof_fns[i].total,
+                prof_fns[i].worst);
+    fprintf(proto, "\n");
+    return 1;
+}
+
 static int cmd_stop(int argc, char** argv) {
     NO_ARGS;
     fprintf(proto, "ok\n"); /* ends a `go`; idle, it does nothing */
@@ -745,7 +844,8 @@ static const struct {
     {"info", cmd_info},   {"step", cmd_step},   {"until", cmd_until}, {"go", cmd_go},
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
-    {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"quit", cmd_quit},
+    {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
+    {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 

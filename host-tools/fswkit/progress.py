@@ -57,6 +57,18 @@ def enabled() -> bool:
     return multiprocessing.parent_process() is None
 
 
+def active() -> bool:
+    """Whether a bar opened now would be shown (here or by the process a
+    worker reports to): work that costs something only to measure its
+    total (a dry run of make) is done only then."""
+    d = _display
+    if d is not None and d.pid == os.getpid():
+        return True
+    if _remote_address() is not None:
+        return os.environ.get("FSW_NO_PROGRESS", "") in ("", "0")
+    return enabled()
+
+
 class _Off:
     """A bar that is not shown."""
 
@@ -394,7 +406,8 @@ def _restore_signals(saved):
 def _after_fork_in_child():
     """A child forked while bars are shown is a worker: it gets back the
     streams the display replaced, and never draws."""
-    global _display, _depth
+    global _display, _depth, _lock
+    _lock = threading.Lock()  # another thread may have held it at the fork
     d = _display
     if d is not None:
         _display, _depth = None, 0
@@ -405,42 +418,46 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 _depth = 0  # bars of this process now shown
+_lock = threading.Lock()  # _display and _depth, for bars of several threads (a pool of replays)
 
 
 @contextlib.contextmanager
 def progress(label: str, total: float | int | None = None, unit: str = ""):
     """A progress bar for the block (see the module's documentation)."""
     global _display, _depth, _remote_depth
-    d = _display
-    if d is None or d.pid != os.getpid():
-        remote = _remote(label, total, unit)
-        if remote is not None:
-            _remote_depth += 1
-            try:
-                yield remote
-            finally:
-                _remote_depth -= 1
-                remote.close()
-            return
-        if not enabled():
+    with _lock:
+        d = _display
+        if d is None or d.pid != os.getpid():
+            d = None
+            remote = _remote(label, total, unit)
+            if remote is None and enabled():
+                try:
+                    d = _display = _Display()
+                except Exception:  # noqa: BLE001  (a terminal rich cannot draw on: no bar, never a failure)
+                    _display = None
+        if d is not None:
+            bar = _Bar(d, label, total, unit, _depth)
+            _depth += 1
+    if d is None:
+        if remote is None:
             yield _OFF
             return
+        _remote_depth += 1
         try:
-            d = _display = _Display()
-        except Exception:  # noqa: BLE001  (a terminal rich cannot draw on: no bar, never a failure)
-            _display = None
-            yield _OFF
-            return
-    bar = _Bar(d, label, total, unit, _depth)
-    _depth += 1
+            yield remote
+        finally:
+            _remote_depth -= 1
+            remote.close()
+        return
     try:
         yield bar
     finally:
-        _depth -= 1
-        try:
-            if _display is d:
-                bar.close()
-        finally:
-            if _depth == 0 and _display is d:
+        with _lock:
+            _depth -= 1
+            last = _depth == 0 and _display is d
+            if last:
                 _display = None
-                d.close()
+            elif _display is d:
+                bar.close()
+        if last:
+            d.close()

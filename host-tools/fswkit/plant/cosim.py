@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from fswkit.link.layout import Layout
 from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session
+from fswkit.progress import progress
 from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
@@ -95,9 +96,10 @@ def _one_cpu():
 def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, *,
         wall_limit: float = 900.0, log_meta: dict | None = None) -> Run:
     """Runs the scenario to its end against the firmware; the Run. The
-    board and this thread share one CPU for the run (`_one_cpu`)."""
-    with _one_cpu():
-        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta)
+    board and this thread share one CPU for the run (`_one_cpu`). On a
+    terminal, a bar shows the simulated time of the planned duration."""
+    with _one_cpu(), progress("flight", total=float(scenario.max_s), unit="s") as bar:
+        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar)
 
 
 def stop_words(stop: str, wall_limit: float) -> str:
@@ -145,7 +147,7 @@ class Telemetry:
                     run.transitions.append((tt, int(st), self.state_names.get(int(st), str(st))))
 
 
-def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
+def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar) -> Run:
     rate = scenario.rate
     f_cpu = int(board.f_cpu)
     if f_cpu % rate:
@@ -205,7 +207,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta) -> Run:
                 telemetry.feed(step.uart, t1)
             if k % record_every == 0:
                 run.rows.append(scenario.record())
-            if scenario.done(t1, run.transitions[-1][2] if run.transitions else None):
+            state = run.transitions[-1][2] if run.transitions else None
+            bar.update(t1, state=state or "-")
+            if scenario.done(t1, state):
                 break
         run.steps = k
         run.sim_s = t1

@@ -17,6 +17,7 @@ import re
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass
 
@@ -308,10 +309,47 @@ def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.Com
     (artifact, process). The compiler's whole output goes to `out/build.log`."""
     artifact, args = make_args(app, out, jobs)
     with build_lock(out):
-        proc = subprocess.run(args, capture_output=True, text=True, cwd=out)
+        proc = _run_make(args, out)
         with open(log_path(out), "w") as f:
             f.write(" ".join(args) + "\n" + proc.stdout + proc.stderr)
     return artifact, proc
+
+
+def _is_step(line: str) -> bool:
+    """A command of make's output that is a build step (a compile, an
+    archive, the link, the hex): not the folders it makes, nor make's own words."""
+    line = line.strip()
+    return bool(line) and not line.startswith(("mkdir ", "make:", "make["))
+
+
+def _run_make(args: list[str], out: str) -> subprocess.CompletedProcess:
+    """make in `out`, its output captured (as `subprocess.run` captures it).
+    On a terminal, a bar counts its steps: a dry run (`make -n`) counts
+    those to do, then each command make prints is one done."""
+    from fswkit.progress import active, progress
+
+    if not active():
+        return subprocess.run(args, capture_output=True, text=True, cwd=out)
+    dry = subprocess.run(args + ["-n"], capture_output=True, text=True, cwd=out)
+    total = sum(map(_is_step, dry.stdout.splitlines())) if dry.returncode == 0 else None
+    with progress("build", total=total or None, unit="steps") as bar, \
+            subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=out) as p:
+        try:
+            errors: list[str] = []
+            reader = threading.Thread(target=lambda: errors.append(p.stderr.read()), daemon=True)
+            reader.start()
+            lines, done = [], 0
+            for line in p.stdout:
+                lines.append(line)
+                if _is_step(line):
+                    done += 1
+                    bar.update(min(done, total) if total else done)
+            reader.join()
+            p.wait()
+        except BaseException:
+            p.kill()
+            raise
+    return subprocess.CompletedProcess(args, p.returncode, "".join(lines), "".join(errors))
 
 
 def log_path(out: str) -> str:

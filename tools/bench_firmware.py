@@ -97,7 +97,7 @@ def x86_instructions() -> float:
     gen = os.path.join(OUT, "tank-f64")
     generate(F64MODE, gen)
     exe = os.path.join(OUT, "tank_driver")
-    srcs = [os.path.join(RUNTIME, n) for n in ("fsw_convert.cpp", "fsw_f64.cpp", "fsw_window.cpp")]
+    srcs = [os.path.join(RUNTIME, n) for n in ("fsw_convert.cpp", "fsw_f64.cpp", "fsw_machine.cpp", "fsw_window.cpp")]
     sh(["g++", "-std=gnu++11", "-O2", "-ffp-contract=off", f"-I{RUNTIME}", f"-I{gen}",
         os.path.join(BENCH, "tank_driver.cpp"), os.path.join(gen, "sv.gen.cpp"), os.path.join(gen, "tank.gen.cpp")]
        + srcs + ["-o", exe])

@@ -137,14 +137,21 @@ class ExprEmitter:
                 test = "true" if t else "false"
             else:
                 key, inclusive = t
-                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}ULL"
+                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}{'UL' if bits == 32 else 'ULL'}"
             parts.append(f"!({test})" if neg else f"({test})")
         body = " && ".join(parts)
         if negate:
             body = f"!({body})"
-        return (f"([&]() -> bool {{ const uint8_t* p = {self.ptr(v)}; "
-                f"if (fsw::f{bits}_is_nan(p)) return {'true' if nan_result else 'false'}; "
-                f"const uint{bits}_t k = fsw::f{bits}_key(p); return {body}; }}())")
+        # A NaN reads as +0, and the key of +0 passes the terms exactly when
+        # `0 op c` holds (nan_result): one key read covers both.
+        zero = 1 << (bits - 1)
+        at_zero = all((t if isinstance(t, bool) else (zero >= t[0] if t[1] else zero > t[0])) != neg
+                      for neg, t in terms)
+        assert (at_zero != negate) == nan_result, "threshold terms disagree with R at +0"
+        if len(parts) == 1 and not negate:
+            return parts[0].replace("k ", f"fsw::f{bits}_read_key({self.ptr(v)}) ", 1)
+        return (f"([&]() -> bool {{ const uint{bits}_t k = fsw::f{bits}_read_key({self.ptr(v)}); "
+                f"return {body}; }}())")
 
     # -- integer fast paths, bit-identical to the R semantics ------------------
     def assign(self, var: int, e: M.Expr) -> str:
@@ -284,9 +291,9 @@ class ExprEmitter:
         """`x op c` on the integer itself. Converting an integer to R is
         monotonic and exact near c, so `R(x) op c` equals `x op c`."""
         flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
-        a, c = self.int_operand(left), self.exact_int_const(right)
+        a, c, x = self.int_operand(left), self.exact_int_const(right), left
         if a is None or c is None:
-            a, c = self.int_operand(right), self.exact_int_const(left)
+            a, c, x = self.int_operand(right), self.exact_int_const(left), right
             if a is None or c is None:
                 return None
             op = flip[op]
@@ -300,4 +307,7 @@ class ExprEmitter:
             return "true" if results.pop() else "false"
         if t.kind == "bool":
             return f"(static_cast<int>({text}) {op} {c})"
+        if self.m.vars[x.var].kind == M.TIME_IN_STATE and 0 <= c < 0xFFFFFFFF:
+            # T saturated to 32 bits tests the same against such a c (fsw_machine.h).
+            return f"(fsw::machine_T32({self.prefix}machine) {op} {c}UL)"
         return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"

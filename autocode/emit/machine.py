@@ -70,12 +70,15 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     if stored:
         c.append(f"const uint8_t kLocInit[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
         c.append("")
+    # A state id as entry and step code return it: the narrowest type that
+    # holds them all (an 8-bit MCU passes and tests it in fewer instructions).
+    sid = "uint8_t" if len(m.states) < 0x100 else "uint16_t" if len(m.states) < 0x10000 else "uint32_t"
     for st in m.states:
         for label in ("entry", "step", "exit"):
             stmts = getattr(st, label)
             if not stmts:
                 continue
-            ret = "void" if label == "exit" else "uint32_t"
+            ret = "void" if label == "exit" else sid
             c.append(f"// [{st.name}] .{label}")
             c.append(f"{ret} s{st.id}_{label}() {{")
             _block(stmts, ex, "    ", c, src, m, label != "exit")
@@ -95,13 +98,13 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append(f"        fsw::SvGuard<true> lock; fsw::store<uint32_t>(sv + E_{s.name}, machine.state);")
         c.append("    }")
     else:
-        c.append(f"    if (fsw::machine_begin_step(machine, fsw::load<uint64_t>(sv + E_{g.name})) != fsw::kOk) "
+        c.append(f"    if (fsw::machine_begin(machine, sv + E_{g.name}, sv + E_{s.name}) != fsw::kOk) "
                  "return fsw::kErrTime;")
-        c.append(f"    if (machine.entering != 0) fsw::store<uint32_t>(sv + E_{s.name}, machine.state);")
     for w in m.windows:
         c.append(f"    w{w.index}.push({ex.value(w.arg)});  // {src}:{w.line}")
-    if any(st.entry or st.step for st in m.states):  # else nothing can transition
-        c.append("    uint32_t next = 0;")
+    moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
+    if moves:
+        c.append(f"    {sid} next = 0;")
     c.append("    switch (machine.state) {")
     for st in m.states:
         c.append(f"    case S_{st.name}:")
@@ -109,16 +112,15 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             c.append(f"        if (machine.entering != 0) next = s{st.id}_entry();")
         if st.step:
             c.append(f"        if (next == 0) next = s{st.id}_step();" if st.entry else f"        next = s{st.id}_step();")
-        if st.entry or st.step:
-            c.append("        if (next != 0) {")
-            if st.exit:
-                c.append(f"            s{st.id}_exit();")
-            c.append("            fsw::machine_transition(machine, next);")
-            c.append("        }")
+        if st.exit and (st.entry or st.step):
+            c.append(f"        if (next != 0) s{st.id}_exit();")
         c.append("        break;")
     c.append("    default:")
     c.append("        break;")
     c.append("    }")
+    if moves:
+        # One transition for every state (its .exit, if any, ran above).
+        c.append("    if (next != 0) fsw::machine_transition(machine, next);")
     c.append("    return fsw::kOk;")
     c.append("}")
     c.append("")

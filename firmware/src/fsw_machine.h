@@ -50,8 +50,24 @@ FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
     return kOk;
 }
 
+// What generated step() functions call: machine_begin_step with G read from
+// its element at `g`, and on a state's first step the state id written to
+// the S element at `s` (U32). Out of line: one copy for all the machines.
+FSW_MUST_CHECK FSW_NOINLINE Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s);
+
 // T, the time spent in the current state (valid after machine_begin_step).
 inline uint64_t machine_T(const Machine& m) { return m.t; }
+
+// T saturated to 32 bits: for a constant c < 0xFFFFFFFF, `T op c` is
+// `machine_T32(m) op c` (T >= 2^32 compares as 0xFFFFFFFF does), a 32-bit
+// test where an 8-bit MCU would otherwise compare 8 bytes. Out of line on AVR.
+#if defined(__AVR__)
+FSW_NOINLINE uint32_t machine_T32(const Machine& m);
+#else
+inline uint32_t machine_T32(const Machine& m) {
+    return (m.t >> 32) != 0 ? 0xFFFFFFFFUL : static_cast<uint32_t>(m.t);
+}
+#endif
 
 // `-> target`, called after the current state's .exit ran: the next step
 // is the target's first (a state may transition to itself).

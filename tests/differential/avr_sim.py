@@ -40,7 +40,7 @@ AVR_FLAGS = ["-mmcu=" + MCU, "-DF_CPU=16000000L", "-DARDUINO=10819", "-DARDUINO_
              "-fno-threadsafe-statics", "-ffunction-sections", "-fdata-sections",
              "-Wall", "-Wextra", "-Werror", "-Wno-unused-function"]
 # The runtime files a machine and its runner use (no PSL: no Arduino core).
-RUNTIME_FILES = ("fsw_convert.cpp", "fsw_element.cpp", "fsw_f64.cpp", "fsw_window.cpp")
+RUNTIME_FILES = ("fsw_convert.cpp", "fsw_element.cpp", "fsw_f64.cpp", "fsw_machine.cpp", "fsw_window.cpp")
 
 
 def available() -> str | None:

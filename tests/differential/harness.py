@@ -39,7 +39,7 @@ from gen_programs import Case
 
 JOBS = max(1, min(2, os.cpu_count() or 1))
 # What generated machines and runners call (with the native PSL: the lock).
-RUNTIME_SOURCES = ("fsw_convert.cpp", "fsw_element.cpp", "fsw_f64.cpp", "fsw_sv.cpp", "fsw_window.cpp",
+RUNTIME_SOURCES = ("fsw_convert.cpp", "fsw_element.cpp", "fsw_f64.cpp", "fsw_machine.cpp", "fsw_sv.cpp", "fsw_window.cpp",
                    "psl_native.cpp")
 # Generated scripts stop within a few hundred steps; a native trace longer
 # than this is reported as such, not converted.

@@ -29,7 +29,8 @@ class ParamsError(Exception):
 @dataclass(frozen=True)
 class Field:
     """One key of a table: its kind (`float`, `int`, `str`, `bool`, `pin`,
-    `curve`: a list of [x, y] pairs, `names`: a list of strings), an
+    `curve`: a list of [x, y] pairs, `names`: a list of strings, `range`:
+    [low, high] with both ends within lo..hi), an
     inclusive range for numbers, a default (None: required), and what it is."""
 
     kind: str
@@ -137,6 +138,19 @@ def _value(v, f: Field, name: str) -> tuple[object, str | None]:
         if not isinstance(v, list) or not v or not all(isinstance(x, str) and x for x in v):
             return None, f"{name}: expected a list of names such as [\"Safe\", \"Armed\"]"
         return tuple(v), None
+    if f.kind == "range":  # [low, high]: each within lo..hi, low <= high
+        if (not isinstance(v, list) or len(v) != 2
+                or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)):
+            return None, f"{name}: expected a range [low, high] of two numbers, found {_kind_of(v)} {_show(v)}"
+        pair = []
+        for x in v:
+            x, e = _number(x, Field("float", f.doc, lo=f.lo, hi=f.hi), name)
+            if e:
+                return None, e
+            pair.append(x)
+        if pair[0] > pair[1]:
+            return None, f"{name}: the range's low end {v[0]} is above its high end {v[1]}"
+        return tuple(pair), None
     if f.kind == "curve":
         if not isinstance(v, list) or len(v) < 2:
             return None, f"{name}: expected a list of two or more [seconds, value] points"

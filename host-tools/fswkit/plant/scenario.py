@@ -60,10 +60,13 @@ ROCKET_SCHEMA = {
         "dry_mass_kg": F("float", "mass without propellant, kg", lo=0.01, hi=1000),
         "body_cd_area_m2": F("float", "drag coefficient × reference area of the body, m²", lo=0, hi=10),
     }),
-    "motor": Table("the motor", {
-        "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0, hi=1000),
+    "motor": Table("the motor: a thrust curve written here, or a RASP motor file", {
+        "file": F("str", "a RASP .eng motor file (relative to this file): its first motor's thrust curve, and its "
+                  "propellant mass unless propellant_kg says otherwise", required=False),
+        "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0, hi=1000,
+                           required=False),
         "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated", x_hi=600,
-                          hi=1e6),
+                          hi=1e6, required=False),
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
     }),
@@ -325,6 +328,37 @@ def _time_unit_s(app) -> float:
 
 # ---- the rocket -----------------------------------------------------------------------------
 
+def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
+    """[motor]'s thrust curve and propellant mass: written in the table, or
+    from the RASP file it names (fswkit.plant.motor)."""
+    import os
+
+    from .motor import EngError
+    from .motor import load as load_eng
+
+    fallback = (((0.0, 0.0), (1.0, 100.0), (1.1, 0.0)), mot["propellant_kg"] or 0.0)  # after an error
+    if mot["file"] is not None and mot["thrust_curve"] is not None:
+        bind.err("motor", "file", "a motor file or a thrust_curve, not both")
+        return fallback
+    if mot["file"] is None:
+        if mot["thrust_curve"] is None:
+            bind.err("motor", "", "missing: a thrust_curve, or a RASP motor file (file = \"motors/G80T.eng\")")
+            return fallback
+        if mot["propellant_kg"] is None:
+            bind.err("motor", "", "propellant_kg: missing (a thrust_curve written here needs its propellant mass)")
+            return fallback
+        return mot["thrust_curve"], mot["propellant_kg"]
+    path = os.path.join(os.path.dirname(bind.path), mot["file"])
+    try:
+        eng = load_eng(path)[0]
+    except EngError as e:
+        bind.err("motor", "file", f"the motor file {path} cannot be flown:")
+        bind.errors += e.errors
+        return fallback
+    prop = eng.propellant_kg if mot["propellant_kg"] is None else mot["propellant_kg"]
+    return eng.curve(), prop
+
+
 class RocketScenario:
     kind = "rocket"
     columns = ("time_s", "altitude_m", "velocity_m_s", "accel_m_s2", "specific_force_g", "pressure_pa",
@@ -364,19 +398,21 @@ class RocketScenario:
         veh, mot = p["vehicle"], p["motor"]
         baro_rng, accel_rng, motor_rng = (np.random.Generator(np.random.PCG64(s))
                                           for s in np.random.SeedSequence(seed).spawn(3))
-        nominal = Motor(mot["thrust_curve"])
-        liftoff_weight = (veh["dry_mass_kg"] + mot["propellant_kg"]) * G0
+        curve, propellant = _motor(bind, mot)
+        nominal = Motor(curve)
+        liftoff_weight = (veh["dry_mass_kg"] + propellant) * G0
         if nominal.peak <= liftoff_weight:
-            bind.err("motor", "thrust_curve", f"the peak thrust ({nominal.peak:g} N) never exceeds the "
+            bind.err("motor", "file" if mot["file"] else "thrust_curve", f"the peak thrust ({nominal.peak:g} N) never exceeds the "
                      f"vehicle's weight ({liftoff_weight:.1f} N): it would never leave the pad")
         # this seed's motor: the nominal curve scaled (the clamp only matters for a draw beyond 2.5 sigma
         # with the largest impulse_sd allowed)
         self.motor_factor = max(0.5, 1.0 + mot["impulse_sd"] * float(motor_rng.standard_normal()))
         self.nominal_impulse = nominal.total
-        self.motor = Motor([(t, f * self.motor_factor) for t, f in mot["thrust_curve"]])
+        self.curve, self.propellant_kg = curve, propellant
+        self.motor = Motor([(t, f * self.motor_factor) for t, f in curve])
         if sc["ignition_s"] + self.motor.burn_time >= sc["max_s"]:
             bind.err("scenario", "max_s", "the run must outlast the motor's burn")
-        self.rocket = Rocket(dry_mass=veh["dry_mass_kg"], propellant_mass=mot["propellant_kg"], motor=self.motor,
+        self.rocket = Rocket(dry_mass=veh["dry_mass_kg"], propellant_mass=propellant, motor=self.motor,
                              body_cd_area=veh["body_cd_area_m2"],
                              drogue=Chute(p["drogue"]["cd_area_m2"], p["drogue"]["inflate_s"]),
                              main=Chute(p["main"]["cd_area_m2"], p["main"]["inflate_s"]),

@@ -1,0 +1,209 @@
+"""RASP motor files (`.eng`): the thrust curves rocketeers download
+(thrustcurve.org, the makers' sites) and every flight simulator reads.
+
+    ; comments start with a semicolon, anywhere on a line
+    G80T 29 124 4-7-10 0.0625 0.1252 AT
+       0.02  95.0
+       ...
+       1.50   0.0
+
+The header names the motor, its diameter and length in millimetres, its
+delays (`4-7-10`, `P` for plugged, `0`), its propellant and total masses
+in kilograms and its maker. Then one `time thrust` pair a line, seconds
+from ignition and newtons, times increasing, ending at zero thrust. A file
+may hold several motors, one after another (each header starts one).
+
+`load(path)` reads a file into EngMotor records; a bad file is an EngError
+whose lines are located `file:line:col: message`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+class EngError(Exception):
+    """One or more located errors in a motor file."""
+
+    def __init__(self, errors: list[str]):
+        super().__init__("\n".join(errors))
+        self.errors = errors
+
+
+@dataclass(frozen=True)
+class EngMotor:
+    name: str
+    diameter_mm: float
+    length_mm: float
+    delays: str
+    propellant_kg: float
+    total_kg: float
+    maker: str
+    points: tuple  # ((s, N), ...) as the file gives them
+    path: str
+    line: int  # the header's
+
+    def curve(self) -> tuple:
+        """The points from ignition: (0, 0) first when the file starts later,
+        as simulators read a RASP curve."""
+        return self.points if self.points[0][0] == 0 else ((0.0, 0.0),) + self.points
+
+    @property
+    def total_impulse(self) -> float:
+        c = self.curve()
+        return sum((t1 - t0) * (f0 + f1) / 2 for (t0, f0), (t1, f1) in zip(c, c[1:]))
+
+    @property
+    def burn_time(self) -> float:
+        return self.points[-1][0]
+
+
+def _number(tok: str) -> float | None:
+    try:
+        x = float(tok)
+    except ValueError:
+        return None
+    return x if math.isfinite(x) else None
+
+
+HEADER = "name diameter_mm length_mm delays propellant_kg total_kg maker"
+
+
+def parse(text: str, path: str) -> list[EngMotor]:
+    """The motors of a motor file's text; EngError with every located error."""
+    errors: list[str] = []
+    motors: list[EngMotor] = []
+    cur: dict | None = None
+
+    def err(line: int, col: int, msg: str) -> None:
+        errors.append(f"{path}:{line}:{col}: {msg}")
+
+    def finish() -> None:
+        if cur is None:
+            return
+        pts = cur["points"]
+        if not pts:
+            err(cur["line"], 1, f"motor {cur['name']} has no thrust points (after its header, one `seconds newtons` "
+                "pair a line)")
+        elif not cur["bad"]:
+            if pts[-1][1] != 0:
+                err(cur["last"], cur["last_col"], f"the thrust curve of {cur['name']} must end at zero thrust "
+                    f"(its last point is {pts[-1][1]:g} N at {pts[-1][0]:g} s)")
+            elif len(pts) < 2 and pts[0][0] == 0:
+                err(cur["last"], 1, f"motor {cur['name']} has one point at 0 s: no burn")
+            else:
+                motors.append(EngMotor(cur["name"], cur["dia"], cur["len"], cur["delays"], cur["prop"], cur["total"],
+                                       cur["maker"], tuple(pts), path, cur["line"]))
+
+    for n, raw in enumerate(text.splitlines(), 1):
+        code = raw.split(";", 1)[0]
+        if not code.strip():
+            continue
+        toks, cols = [], []
+        i = 0
+        while i < len(code):
+            if code[i].isspace():
+                i += 1
+                continue
+            j = i
+            while j < len(code) and not code[j].isspace():
+                j += 1
+            toks.append(code[i:j])
+            cols.append(i + 1)
+            i = j
+        first = _number(toks[0])
+        if first is None:  # a header
+            finish()
+            cur = {"name": toks[0], "line": n, "points": [], "bad": False, "last": n, "last_col": 1,
+                   "dia": 0.0, "len": 0.0, "delays": "", "prop": 0.0, "total": 0.0, "maker": ""}
+            if len(toks) < 7:
+                err(n, cols[-1] + len(toks[-1]), f"a motor's header has 7 fields ({HEADER}); this one has "
+                    f"{len(toks)}")
+                cur["bad"] = True
+                continue
+            if len(toks) > 7:
+                err(n, cols[7], f"a motor's header has 7 fields ({HEADER}); this one has {len(toks)} "
+                    "(a maker's name with spaces? write it without)")
+                cur["bad"] = True
+                continue
+            vals = {}
+            for k, idx, lo, what in (("dia", 1, 0.0, "diameter in mm"), ("len", 2, 0.0, "length in mm"),
+                                     ("prop", 4, 0.0, "propellant mass in kg"), ("total", 5, 0.0, "total mass in kg")):
+                x = _number(toks[idx])
+                if x is None or x <= lo:
+                    err(n, cols[idx], f"`{toks[idx]}`: expected the motor's {what}, a positive number")
+                    cur["bad"] = True
+                vals[k] = x
+            if not cur["bad"]:
+                if vals["prop"] > vals["total"]:
+                    err(n, cols[4], f"the propellant ({toks[4]} kg) weighs more than the whole motor "
+                        f"({toks[5]} kg)")
+                    cur["bad"] = True
+                cur.update(vals, delays=toks[3], maker=toks[6])
+            continue
+        if cur is None:
+            err(n, cols[0], f"a thrust point before any motor header (the first line that is not a comment is "
+                f"the header: {HEADER})")
+            cur = {"name": "?", "line": n, "points": [], "bad": True, "last": n, "last_col": 1}
+            continue
+        if len(toks) != 2:
+            err(n, cols[min(2, len(toks) - 1)] if len(toks) > 2 else cols[0] + len(toks[0]),
+                f"a thrust point is two numbers, `seconds newtons`; this line has {len(toks)} field"
+                + ("s" if len(toks) != 1 else ""))
+            cur["bad"] = True
+            continue
+        t, f = first, _number(toks[1])
+        if f is None:
+            err(n, cols[1], f"`{toks[1]}`: expected the thrust in newtons, a number")
+            cur["bad"] = True
+            continue
+        if t < 0:
+            err(n, cols[0], f"{toks[0]} s: a thrust point's time is seconds after ignition, never negative")
+            cur["bad"] = True
+            continue
+        if f < 0:
+            err(n, cols[1], f"{toks[1]} N: thrust is never negative")
+            cur["bad"] = True
+            continue
+        pts = cur["points"]
+        if pts and t <= pts[-1][0]:
+            err(n, cols[0], f"times must increase: {t:g} s after {pts[-1][0]:g} s")
+            cur["bad"] = True
+            continue
+        if pts and pts[-1][1] == 0 and pts[-1][0] > 0:
+            err(n, cols[0], f"a point after the curve ended at zero thrust ({pts[-1][0]:g} s): a motor's curve "
+                "ends at its first zero after ignition")
+            cur["bad"] = True
+            continue
+        pts.append((t, f))
+        cur["last"], cur["last_col"] = n, cols[1]
+    finish()
+    if not errors and not motors:
+        errors.append(f"{path}:1:1: no motor in this file (a RASP .eng file: `;` comments, a header `{HEADER}`, "
+                      "then `seconds newtons` lines ending at zero thrust)")
+    if errors:
+        raise EngError(errors)
+    return motors
+
+
+def load(path: str) -> list[EngMotor]:
+    """The motors of a motor file; EngError for a file that cannot be read
+    or is not a motor file."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        raise EngError([f"{path}: no such motor file"]) from None
+    except IsADirectoryError:
+        raise EngError([f"{path}: a folder, not a motor file"]) from None
+    except OSError as e:
+        raise EngError([f"{path}: {e.strerror or e}"]) from None
+    if b"\0" in raw:
+        line = raw[:raw.index(b"\0")].count(b"\n") + 1
+        raise EngError([f"{path}:{line}:1: a binary file, not a RASP motor file (text)"])
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")  # older files carry a maker's name or a comment in Latin-1
+    return parse(text, path)

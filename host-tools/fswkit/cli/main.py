@@ -143,6 +143,14 @@ def parser() -> argparse.ArgumentParser:
                     "--params names the tape config (default PROJECT/tape.toml, else plant.toml's channels and pins)")
     sm.add_argument("--perturb", type=_nonneg_int, metavar="N", help="with --tape: replay it N times with seeded "
                     "sensor noise, spikes, dropouts and bias, and report the distribution of the event errors")
+    sm.add_argument("--runs", type=_positive_int, metavar="N", help="with --plant rocket: a dispersion study of N "
+                    "flights, each with its own draw of --dispersion (docs/sim.md, Dispersion studies)")
+    sm.add_argument("--jobs", type=_positive_int, metavar="J", help="with --runs: flights at a time (default: the "
+                    "number of cores)")
+    sm.add_argument("--dispersion", metavar="FILE.toml", help="with --runs or --run: how each flight of a study "
+                    "differs from plant.toml's (motor, mass, drag, gusts, sensor errors, brown-outs)")
+    sm.add_argument("--run", type=_nonneg_int, metavar="I", help="with --plant rocket: fly run I of the study with "
+                    "--seed and --dispersion again, alone, writing its files")
     sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro"),
                     help="with --plant rocket: a sensor fault (stuck-baro: the barometer freezes at ignition; "
                     "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit)")

@@ -13,6 +13,12 @@ from fswkit.cli.common import EXIT_CONFIG
 
 
 def cmd_sim(args) -> int:
+    if any(getattr(args, k, None) is not None for k in ("runs", "run", "dispersion")):
+        if getattr(args, "tape", None) is not None or getattr(args, "perturb", None) is not None:
+            sys.stderr.write("fsw sim: --runs, --run and --dispersion fly the rocket plant, not a --tape\n")
+            return EXIT_CONFIG
+        from fswkit.cli.sim_study import study_run
+        return study_run(args)
     if getattr(args, "tape", None) is not None:
         return tape_run(args)
     if getattr(args, "perturb", None) is not None:

@@ -53,6 +53,7 @@ class Run:
     wall_s: float = 0.0
     round_trips: int = 0
     ram: dict = field(default_factory=dict)  # what the board's RAM probes said, if it has them
+    resets: list[float] = field(default_factory=list)  # when the MCU was reset (brown-outs the scenario asked for)
 
 
 _cpu_lock = threading.Lock()
@@ -176,8 +177,16 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar) -> R
             b.watch(pin)
         k = 0
         t1 = 0.0
+        reset_at = getattr(scenario, "reset_at", None)  # a brown-out: the MCU resets at this simulated second
         while True:
             t0 = k / rate
+            if reset_at is not None and t0 >= reset_at:
+                reset_at = None
+                b.reset()
+                run.resets.append(t0)
+                telemetry.offset = -t0  # the firmware's clock starts again from 0
+                last_mv = {name: -1 for name in last_mv}  # every input driven again
+                last_din = {}
             if k:
                 analog, digital = scenario.inputs(t0)
             set_analog, set_digital = {}, {}  # the inputs that changed

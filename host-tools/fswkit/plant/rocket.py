@@ -1,7 +1,8 @@
 """A one-dimensional sport rocket: the vehicle's axis stays vertical.
 
 Forces: the motor's thrust (a table of (seconds from ignition, newtons),
-linearly interpolated), gravity, and drag ½ρv²·CdA against the velocity,
+linearly interpolated), gravity, and drag ½ρv²·CdA against the airspeed (the velocity less
+the air's own vertical motion, `wind`: still air unless a study blows gusts),
 where CdA is the body's plus each parachute's as it inflates (linearly, over
 its inflation time, from the moment its charge fires). The mass burns down
 in proportion to the impulse delivered. The air is the ISA troposphere above
@@ -84,6 +85,7 @@ class Rocket:
         self.touchdown: float | None = None
         self.deployed: dict[str, float] = {}  # chute -> time its charge fired
         self.apogee_h, self.apogee_t = 0.0, None
+        self.wind = None  # t -> the air's vertical velocity, m/s up (gusts: dispersion studies); None: still air
 
     # -- inputs --
     def ignite(self, t: float) -> None:
@@ -134,6 +136,8 @@ class Rocket:
         return self.liftoff is None or self.touchdown is not None
 
     def _accel(self, t: float, h: float, v: float, cda: float) -> float:
+        if self.wind is not None:
+            v -= self.wind(t)  # drag acts on the airspeed
         drag = -0.5 * self._rho(h) * v * abs(v) * cda
         return (self.thrust(t) + drag) / self.mass(t) - self.g
 

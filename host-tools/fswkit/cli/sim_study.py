@@ -1,0 +1,153 @@
+"""`fsw sim PROJECT --plant rocket --runs N [--jobs J] [--dispersion
+FILE.toml] [--seed S] [--out DIR]`: a dispersion study (fswkit.plant.study),
+its table on standard output and in DIR/study.txt, one row per run in
+DIR/study.csv; and `--run I`: run I of a study flown again alone, exactly,
+with its files (log, CSV, plot, summary) as a single flight writes them."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+STUDY_FILES = ("study.txt", "study.csv")
+
+
+def study_run(args) -> int:
+    from fswkit.outputs import OutputError, Stopped, check, stopped_by_signals, write_text
+    from fswkit.plant import dispersion as dispersion_mod
+    from fswkit.progress import progress
+    from fswkit.plant import study
+    from fswkit.plant.params import ParamsError
+    from fswkit.plant.run import SetupError, prepare
+    from fswkit.sim.command import build, is_elf, say
+    from fswkit.target.build import default_out
+
+    what = "--runs" if args.runs is not None else "--run" if args.run is not None else "--dispersion"
+    if args.plant != "rocket":
+        say(f"{what} flies the rocket plant: add --plant rocket" if args.plant is None else
+            f"{what}: dispersion studies fly the rocket plant, not the {args.plant}")
+        return 2
+    if args.runs is None and args.run is None:
+        say("--dispersion needs --runs N (a study) or --run I (one run of a study, again)")
+        return 2
+    if args.runs is not None and args.run is not None:
+        say("--runs N flies a study; --run I flies one of its runs again: one or the other")
+        return 2
+    if args.jobs is not None and args.runs is None:
+        say("--jobs needs --runs N")
+        return 2
+    for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
+                       ("--analog", bool(args.analog)), ("--link", args.link is not None),
+                       ("--fault", args.fault is not None)):
+        if given:
+            say(f"{opt} does not go with {what}: the dispersion file says how each flight differs")
+            return 2
+    if is_elf(args.project) or args.project.endswith(".elf"):
+        say(f"{args.project}: {what} needs the project (its folder or .app), not a firmware ELF")
+        return 2
+    seed = 1 if args.seed is None else args.seed
+    try:
+        app, layout, _sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
+    except SetupError as e:
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
+        return 2
+    params = args.params or os.path.join(os.path.dirname(app.path) or ".", "plant.toml")
+    try:
+        disp = (dispersion_mod.load(args.dispersion) if args.dispersion is not None
+                else dispersion_mod.Dispersion.none())
+    except ParamsError as e:
+        for line in e.errors:
+            sys.stderr.write(f"fsw sim: {line}\n")
+        return 2
+    command = ["fsw", "sim", args.project, "--plant", "rocket"]
+    if args.params:
+        command += ["--params", args.params]
+    if args.board:
+        command += ["--board", args.board]
+    if args.dispersion:
+        command += ["--dispersion", args.dispersion]
+
+    if args.run is not None:
+        return _one_run(args, app, layout, params, disp, seed, default_out)
+
+    out = args.out or os.path.join(default_out(app), "rocket-study")
+    try:
+        os.makedirs(out, exist_ok=True)
+        for name in STUDY_FILES:
+            check(os.path.join(out, name), [params, args.dispersion], what="the study's " + name)
+    except OutputError as e:
+        say(str(e))
+        return 2
+    except OSError as e:
+        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    built = build(args.project, args.board)
+    if isinstance(built, int):
+        return built
+    elf, board = built
+    jobs = args.jobs or study.cores()
+    setup = study.Setup(app, layout, params, elf, board, disp, seed, command)
+    say(f"dispersion study: {args.runs} flights of the real firmware on simulated {board.name}s, {min(jobs, args.runs)} "
+        f"at a time, seed {seed}")
+    done = failed = 0
+    t0 = time.monotonic()
+    with progress("study", total=args.runs, unit="runs") as bar:
+        def on_result(r):
+            nonlocal done, failed
+            done += 1
+            failed += not r.passed
+            bar.update(done, failed=failed)
+
+        with stopped_by_signals():
+            try:
+                results, complete = study.run_study(setup, args.runs, jobs, on_result)
+            except Stopped:  # between two runs' results: the pool is already down
+                results, complete = [], False
+    wall = time.monotonic() - t0
+    text = study.text(setup, results, args.runs, jobs, wall, complete, args.dispersion)
+    sys.stdout.write(text)
+    sys.stdout.flush()
+    try:
+        write_text(os.path.join(out, "study.txt"), text, [params, args.dispersion], what="the study's table")
+        write_text(os.path.join(out, "study.csv"), study.csv_text(results), [params, args.dispersion],
+                   what="the study's runs")
+    except OutputError as e:
+        say(str(e))
+        return 1
+    say(f"wrote {os.path.join(out, 'study.txt')}, {os.path.join(out, 'study.csv')}")
+    if not complete:
+        from fswkit import outputs
+
+        say(f"stopped after {len(results)} of {args.runs} runs")
+        return 128 + (outputs.stopped_by or 2)
+    return 0 if all(r.passed for r in results) else 1
+
+
+def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
+    """`--run I`: run I of the study flown again alone, its files written."""
+    from fswkit.cli.sim import _flown
+    from fswkit.plant import study
+    from fswkit.plant.dispersion import draw
+    from fswkit.plant.run import execute
+    from fswkit.sim.command import build, say
+
+    d = draw(disp, seed, args.run)
+    setup = study.Setup(app, layout, params, "", None, disp, seed)
+    sc = study.scenario_for(setup, d)
+    out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    built = build(args.project, args.board)
+    if isinstance(built, int):
+        return built
+    elf, board = built
+    row = d.row()
+    facts = ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()
+                      if v is not None)
+    say(f"run {args.run} of the study with seed {seed} (sensor noise seed {d.noise_seed}): {facts}")
+    return _flown(lambda: execute(sc, elf, board, layout, out), out)

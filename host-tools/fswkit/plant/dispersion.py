@@ -1,0 +1,288 @@
+"""Dispersion files (`fsw sim PROJECT --plant rocket --runs N --dispersion
+FILE.toml`): how much each flight of a study differs from plant.toml's
+nominal one. TOML checked against a schema as plant.toml is
+(fswkit.plant.params: unknown keys, wrong types and out-of-range values
+located at their line); every key may be left out (no dispersion of that
+kind). docs/sim.md, "Dispersion studies", describes each key.
+
+`draw(disp, seed, index)` is run `index` of a study with seed `seed`: a
+Draw, computed from those two numbers alone (numpy's SeedSequence of
+(seed, index)), so any run can be flown again exactly, alone. `apply(sc,
+draw)` turns a freshly loaded rocket scenario (fswkit.plant.scenario) into
+that run's: motor impulse, dry mass and drag scaled, vertical gusts blown,
+sensor bias, noise, spikes and dropouts added, and a brown-out reset asked
+of the co-simulation (`reset_at`, fswkit.plant.cosim).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .params import Field as F
+from .params import ParamsError, Table
+from .params import load as load_params
+from .rocket import Chute, Motor
+
+
+def _sensor(unit: str, what: str, bias_hi: float, spike_hi: float) -> Table:
+    return Table(f"the {what}'s errors", {
+        "bias_sd": F("float", f"a constant offset for the whole flight, standard deviation in {unit}", default=0.0,
+                     lo=0, hi=bias_hi),
+        "noise_scale": F("range", "its noise (plant.toml's standard deviation) multiplied by a factor drawn "
+                         "uniformly in [low, high]", default=(1.0, 1.0), lo=0, hi=100),
+        "spike_rate_hz": F("float", "spikes per simulated second (a Poisson process)", default=0.0, lo=0, hi=1000),
+        "spike": F("range", f"a spike's size in {unit}, uniform in [low, high], either sign", default=(0.0, 0.0),
+                   lo=0, hi=spike_hi),
+        "spike_s": F("float", "how long a spike lasts, s", default=0.01, above=0, hi=10),
+        "dropout_rate_hz": F("float", "dropouts per simulated second (a Poisson process)", default=0.0, lo=0,
+                             hi=100),
+        "dropout_s": F("range", "a dropout's length in seconds, uniform in [low, high]", default=(0.05, 0.5),
+                       lo=0, hi=60),
+        "dropout_volts": F("float", "what the converter reads during a dropout (an open line), V", default=0.0,
+                           lo=0, hi=5),
+    })
+
+
+SCHEMA = {
+    "": Table("the study", {}),
+    "motor": Table("motor-to-motor spread", {
+        "impulse_sd": F("float", "the thrust scaled by 1 + impulse_sd × a standard normal draw (replaces "
+                        "plant.toml's impulse_sd)", default=0.0, lo=0, hi=0.2),
+    }),
+    "vehicle": Table("the vehicle as built", {
+        "mass_sd": F("float", "dry mass scaled by 1 + mass_sd × a standard normal draw", default=0.0, lo=0, hi=0.3),
+        "drag_sd": F("float", "the body's CdA scaled by 1 + drag_sd × a standard normal draw", default=0.0, lo=0,
+                     hi=0.5),
+        "chute_drag_sd": F("float", "each parachute's CdA scaled by 1 + chute_drag_sd × its own standard normal "
+                           "draw", default=0.0, lo=0, hi=0.5),
+    }),
+    "wind": Table("vertical gusts (the plant has only its vertical axis)", {
+        "gust_rate_hz": F("float", "gusts per simulated second from ignition on (a Poisson process)", default=0.0,
+                          lo=0, hi=100),
+        "gust_sd_m_s": F("float", "a gust's peak vertical air speed, standard deviation in m/s", default=0.0, lo=0,
+                         hi=50),
+        "gust_s": F("range", "a gust's length in seconds, uniform in [low, high] (a half-sine)",
+                    default=(0.5, 2.0), lo=0.01, hi=60),
+    }),
+    "barometer": _sensor("Pa", "barometer", 1e4, 1e5),
+    "accelerometer": _sensor("g", "accelerometer", 10, 100),
+    "brownout": Table("a brown-out: the MCU resets in flight and its firmware starts again", {
+        "probability": F("float", "the share of flights whose MCU resets once", default=0.0, lo=0, hi=1),
+        "window_s": F("range", "when, in seconds after ignition, uniform in [low, high]", default=(0.0, 30.0),
+                      lo=0, hi=3600),
+    }),
+}
+
+KEYS = ("motor", "vehicle", "wind", "barometer", "accelerometer", "brownout")
+
+
+class Dispersion:
+    """A checked dispersion file: `values[table][key]`."""
+
+    def __init__(self, values: dict, path: str | None):
+        self.values, self.path = values, path
+
+    @classmethod
+    def none(cls) -> "Dispersion":
+        """No dispersion at all: every run is plant.toml's flight (its noise seeds apart)."""
+        from .params import check
+
+        values, _ = check({}, SCHEMA, {}, "")
+        return cls(values, None)
+
+
+def load(path: str) -> Dispersion:
+    """A dispersion file, checked; ParamsError with every located error."""
+    if not os.path.exists(path):
+        raise ParamsError([f"{path}: no such file (a dispersion file: see docs/sim.md, Dispersion studies)"])
+    values, _where = load_params(path, SCHEMA)
+    return Dispersion(values, path)
+
+
+@dataclass
+class SensorDraw:
+    bias: float = 0.0
+    noise_scale: float = 1.0
+    spikes: list = field(default_factory=list)  # (start s, end s, size)
+    dropouts: list = field(default_factory=list)  # (start s, end s)
+    dropout_volts: float = 0.0
+
+
+@dataclass
+class Draw:
+    """One run's parameters (everything `apply` needs)."""
+
+    seed: int
+    index: int
+    noise_seed: int  # the scenario's own sensor-noise streams
+    impulse: float | None = None  # factors; impulse None: plant.toml's own motor-to-motor spread
+    mass: float = 1.0
+    drag: float = 1.0
+    drogue_drag: float = 1.0
+    main_drag: float = 1.0
+    gusts: list = field(default_factory=list)  # (start s, length s, peak m/s)
+    baro: SensorDraw = field(default_factory=SensorDraw)
+    accel: SensorDraw = field(default_factory=SensorDraw)
+    brownout_s: float | None = None  # after ignition
+
+    def row(self) -> dict:
+        """The numbers a study's CSV shows for this run."""
+        return {"impulse_factor": self.impulse, "mass_factor": self.mass, "drag_factor": self.drag,
+                "gusts": len(self.gusts), "baro_bias_pa": self.baro.bias, "baro_noise_x": self.baro.noise_scale,
+                "baro_spikes": len(self.baro.spikes), "baro_dropouts": len(self.baro.dropouts),
+                "accel_bias_g": self.accel.bias, "accel_noise_x": self.accel.noise_scale,
+                "accel_spikes": len(self.accel.spikes), "accel_dropouts": len(self.accel.dropouts),
+                "brownout_s": self.brownout_s}
+
+
+def _factor(rng: np.random.Generator, sd: float) -> float:
+    """1 + sd × N(0, 1), kept above 0.2 (a draw beyond 4 sd of the widest spread allowed)."""
+    return max(0.2, 1.0 + sd * float(rng.standard_normal())) if sd else 1.0
+
+
+def _events(rng: np.random.Generator, rate: float, span: float) -> list[float]:
+    """Poisson event times in [0, span)."""
+    if rate <= 0:
+        return []
+    n = int(rng.poisson(rate * span))
+    return sorted(float(x) for x in rng.uniform(0.0, span, n))
+
+
+SPAN_S = 120.0  # events are drawn over this many seconds after ignition (longer than any flight of the example)
+
+
+def _sensor_draw(rng: np.random.Generator, p: dict) -> SensorDraw:
+    d = SensorDraw(dropout_volts=p["dropout_volts"])
+    d.bias = float(rng.normal(0.0, p["bias_sd"])) if p["bias_sd"] else 0.0
+    lo, hi = p["noise_scale"]
+    d.noise_scale = float(rng.uniform(lo, hi)) if hi > lo else lo
+    for t in _events(rng, p["spike_rate_hz"], SPAN_S):
+        size = float(rng.uniform(*p["spike"])) * (1.0 if rng.random() < 0.5 else -1.0)
+        d.spikes.append((t, t + p["spike_s"], size))
+    for t in _events(rng, p["dropout_rate_hz"], SPAN_S):
+        d.dropouts.append((t, t + float(rng.uniform(*p["dropout_s"]))))
+    return d
+
+
+def draw(disp: Dispersion, seed: int, index: int) -> Draw:
+    """Run `index` of the study with seed `seed`: one generator per kind of
+    dispersion, each from SeedSequence((seed, index, kind)), so that a key
+    added to the file leaves the other kinds' draws as they were."""
+    v = disp.values
+    noise_seed = int(np.random.SeedSequence((seed, index)).generate_state(1)[0])
+    rngs = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1))))
+            for i, k in enumerate(KEYS)}
+    d = Draw(seed, index, noise_seed)
+    if v["motor"]["impulse_sd"]:
+        d.impulse = _factor(rngs["motor"], v["motor"]["impulse_sd"])
+    veh = v["vehicle"]
+    r = rngs["vehicle"]
+    d.mass, d.drag = _factor(r, veh["mass_sd"]), _factor(r, veh["drag_sd"])
+    d.drogue_drag, d.main_drag = _factor(r, veh["chute_drag_sd"]), _factor(r, veh["chute_drag_sd"])
+    w = v["wind"]
+    r = rngs["wind"]
+    for t in _events(r, w["gust_rate_hz"], SPAN_S):
+        d.gusts.append((t, float(r.uniform(*w["gust_s"])), float(r.normal(0.0, w["gust_sd_m_s"]))))
+    d.baro = _sensor_draw(rngs["barometer"], v["barometer"])
+    d.accel = _sensor_draw(rngs["accelerometer"], v["accelerometer"])
+    b = v["brownout"]
+    r = rngs["brownout"]
+    if b["probability"] and r.random() < b["probability"]:
+        d.brownout_s = float(r.uniform(*b["window_s"]))
+    return d
+
+
+class _Windows:
+    """Intervals (start, end, value) looked up by time, in order."""
+
+    def __init__(self, spans: list):
+        self.spans = sorted(spans)
+        self.starts = [s[0] for s in self.spans]
+
+    def at(self, t: float):
+        i = bisect.bisect_right(self.starts, t) - 1
+        while i >= 0:  # overlapping spans: the latest that covers t
+            s = self.spans[i]
+            if s[0] <= t < s[1]:
+                return s
+            if self.spans[i][0] < t - 60:  # no span is longer than a minute
+                break
+            i -= 1
+        return None
+
+
+def _gusts(gusts: list, t_ign: float):
+    """The air's vertical velocity at time t: the half-sine gusts summed."""
+    spans = [(t_ign + t, t_ign + t + n, a) for t, n, a in gusts]
+    if not spans:
+        return None
+
+    def wind(t: float) -> float:
+        w = 0.0
+        for a, b, peak in spans:
+            if a <= t < b:
+                w += peak * math.sin(math.pi * (t - a) / (b - a))
+        return w
+
+    return wind
+
+
+def apply(sc, d: Draw) -> None:
+    """Makes a rocket scenario fresh from `scenario.load` (with seed
+    d.noise_seed) fly run `d`."""
+    if sc.kind != "rocket":
+        raise ValueError("dispersions apply to the rocket plant")
+    p = sc.p
+    r = sc.rocket
+    if d.impulse is not None:  # the study's draw replaces plant.toml's motor-to-motor spread
+        sc.motor_factor = d.impulse
+        sc.motor = Motor([(t, f * d.impulse) for t, f in sc.curve])
+        r.motor = sc.motor
+    r.dry_mass *= d.mass
+    r.body_cd_area *= d.drag
+    r.chutes = {"drogue": Chute(r.chutes["drogue"].cd_area * d.drogue_drag, r.chutes["drogue"].inflate_s),
+                "main": Chute(r.chutes["main"].cd_area * d.main_drag, r.chutes["main"].inflate_s)}
+    t_ign = sc.ignition_s if sc.ignition_s is not None else 0.0
+    r.wind = _gusts(d.gusts, t_ign)
+    sc.baro_noise.sigma *= d.baro.noise_scale
+    sc.accel_noise.sigma *= d.accel.noise_scale
+    if d.brownout_s is not None and sc.ignition_s is not None:
+        sc.reset_at = sc.ignition_s + d.brownout_s
+    baro, accel = p["barometer"], p["accelerometer"]
+    errs = []
+    for sd, ch, per_volt in ((d.baro, sc.channels[0], 1.0 / baro["pa_per_volt"]),
+                             (d.accel, sc.channels[1], accel["volts_per_g"])):
+        if sd.bias or sd.spikes or sd.dropouts:
+            errs.append((ch, sd.bias * per_volt, _Windows([(t_ign + a, t_ign + b, s * per_volt)
+                                                           for a, b, s in sd.spikes]),
+                         _Windows([(t_ign + a, t_ign + b, 0.0) for a, b in sd.dropouts]),
+                         sd.dropout_volts, sd is d.baro))
+    if not errs:
+        return
+    inputs = sc.inputs
+    vref = sc.vref
+
+    def dispersed_inputs(t: float):
+        analog, digital = inputs(t)
+        for ch, bias, spikes, dropouts, drop_v, is_baro in errs:
+            v = analog[ch] + bias
+            s = spikes.at(t)
+            if s is not None:
+                v += s[2]
+            if dropouts.at(t) is not None:
+                v = drop_v
+            v = min(max(v, 0.0), vref)
+            analog[ch] = v
+            if is_baro:
+                sc.baro_v = v
+            else:
+                sc.accel_v = v
+        return analog, digital
+
+    sc.inputs = dispersed_inputs
+

@@ -1,9 +1,17 @@
 #!/usr/bin/env python3
 """Benchmarks of the generated firmware (make bench): the tank machine's
 cost per step on an ATmega2560 in simavr (cycles) and on x86-64 (callgrind
-instructions), and the flash and RAM it adds to an Uno sketch. Every number
-is a deterministic count, printed next to the reference implementation's
-figure and our target (shared/targets.md)."""
+instructions), and the flash and RAM it adds to an Uno sketch; then the
+whole rocket example's footprint on the Uno (flash, data + bss, the stack's
+high-water mark measured on the simulated board through the demo flight, and
+RAM with the stack) with a breakdown by component from the ELF's symbols.
+Every number is a deterministic count, printed next to the reference
+implementation's figure or the figure before (shared/targets.md) and our
+target.
+
+    tools/bench_firmware.py            # everything
+    tools/bench_firmware.py rocket     # the rocket's footprint only
+"""
 
 from __future__ import annotations
 
@@ -125,8 +133,143 @@ def avr_footprint() -> tuple[int, int]:
     return f1 - f0, r1 - r0
 
 
+# ---- the rocket example's footprint on the Uno ------------------------------------
+ROCKET = os.path.join(ROOT, "examples", "rocket")
+# shared/targets.md, second wave: "before (2026-11-23)" and the target.
+BEFORE = {"flash": 10_400, "ram": 947, "stack": 220, "static": 727}
+TARGET = {"flash": 8_192, "ram": 640}
+
+# Components, first match wins: (name, test on a demangled symbol name).
+_FLOAT = re.compile(r"^__(\w*sf\w*|fp_\w+|fixuns\w*|fix\w*sf\w*|float\w*|\w*sf3\w*|nan|inf)$")
+_CRT = re.compile(r"^(__\w+|_exit|exit|abort|memcpy\w*|memmove|memset\w*|memcmp\w*|strlen\w*|"
+                  r"_crc_\w+.*|__vector_default|__bad_interrupt)$")
+_ARDUINO = re.compile(r"^(main|init|initVariant|micros|millis|delay\w*|pinMode|digitalWrite|digitalRead|"
+                      r"analogRead|analogWrite|analogReference|turnOffPWM|timer0_\w+|__vector_16|"
+                      r"(digital_pin|port|analog_pin)_to_\w+|yield|setup|loop)$")
+
+
+def component(name: str, machines: tuple[str, ...]) -> str:
+    """The component a symbol of the rocket's ELF belongs to (demangled name;
+    `machines`: the application's machine names)."""
+    ms = "|".join(machines)
+    bare = re.sub(r" \[clone [^\]]*\]", "", name).replace("(anonymous namespace)::", "")
+    bare = re.sub(r"\(.*$", "", bare)  # no argument list
+    bare = re.sub(r"^_ZN12_GLOBAL__N_1\d+(\w+?)E.*$", r"\1", bare)  # LTO-private statics
+    if bare == "main":
+        return "main(): Arduino start-up + inlined set-up"
+    if re.search(rf"fsw_gen::({ms})::|task_({ms})\b|fsw::machine_|fsw::roll_|ext_push|"
+                 r"_read_key|fsw::(read|write)_F32|real_from_|round_to_f32|fsw::(\w+)_from_real", bare):
+        return "generated machines + their runtime"
+    if re.search(r"link|cobs|crc|(^|::)put(_\w+)?$|frame_|send_control|(^|::)apply$|service|pump|"
+                 r"executor_owns|g_rx|g_tx|g_enc|console|uart|__vector_1[89]$", bare, re.I):
+        return "link + UART console"
+    if re.search(r"fsw::io_|task_(sense|act)|kAnalog|kDigital|fsw::(read|write)_elem|fsw::convert|"
+                 r"cal_|adc|g_scan|__vector_21$", bare, re.I):
+        return "I/O (sensing, outputs)"
+    if _ARDUINO.match(bare):
+        return "Arduino core"
+    if re.search(r"fsw::executor|fsw_gen::(\w+::)*(ex|stats|kTasks|kConfig|kPeriodUs)$|fsw::pal::|clock|"
+                 r"watchdog|fsw_capture_mcusr|fsw_paint_stack|fsw_mcusr|g_\w+_ext|inc16|timer|"
+                 r"__vector_(7|11|14)$", bare, re.I):
+        return "executor + clock"
+    if re.search(r"fsw_gen::", bare):
+        return "generated app (state vector, tables)"
+    if _FLOAT.match(bare):
+        return "float library"
+    if _CRT.match(bare):
+        return "C runtime (avr-libc, libgcc)"
+    return "other"
+
+
+def symbol_breakdown(elf: str, machines: tuple[str, ...]) -> dict[str, list[int]]:
+    """{component: [flash bytes, RAM bytes]} from the ELF's sized symbols;
+    flash is code and initialised data's image, RAM is .data + .bss +
+    .noinit. What no sized symbol covers (vector table, padding, section
+    alignment) is `unattributed`."""
+    text = sh(["avr-nm", "-S", "-C", elf]).stdout
+    out: dict[str, list[int]] = {}
+    for line in text.splitlines():
+        m = re.match(r"^([0-9a-f]+) ([0-9a-f]+) (\w) (.*)$", line)
+        if not m:
+            continue
+        addr, size, kind, name = int(m.group(1), 16), int(m.group(2), 16), m.group(3), m.group(4)
+        if kind in "tTwW" and addr < 0x800000:
+            row = out.setdefault(component(name, machines), [0, 0])
+            row[0] += size
+        elif kind in "dD" and addr >= 0x800000:
+            row = out.setdefault(component(name, machines), [0, 0])
+            row[0] += size
+            row[1] += size
+        elif kind in "bB" and addr >= 0x800000:
+            row = out.setdefault(component(name, machines), [0, 0])
+            row[1] += size
+    flash, ram = elf_size(elf)
+    noinit = elf_noinit(elf)
+    out["unattributed (vectors, padding, constants)"] = [flash - sum(r[0] for r in out.values()),
+                                                         ram + noinit - sum(r[1] for r in out.values())]
+    return out
+
+
+def elf_noinit(elf: str) -> int:
+    text = sh(["avr-size", "-A", elf]).stdout
+    m = re.search(r"^\.noinit\s+(\d+)", text, re.M)
+    return int(m.group(1)) if m else 0
+
+
+def rocket_footprint() -> dict:
+    """Builds the rocket as `fsw build` does, flies the demo flight on the
+    simulated Uno (the plant, seed 1) and reads the stack's high-water mark."""
+    from fswkit.plant.run import SetupError, execute, prepare
+    from fswkit.sim.command import build as build_for_sim
+
+    built = build_for_sim(ROCKET, "uno", os.path.join(OUT, "rocket"))
+    if isinstance(built, int):
+        sys.exit("bench: building examples/rocket failed")
+    elf, board = built
+    try:
+        app, layout, sc = prepare(ROCKET, "rocket", seed=1)
+    except SetupError as e:
+        sys.exit(f"bench: {e}")
+    flight = execute(sc, elf, board, layout, None, quiet=True)
+    ram = flight.run.ram.get("ram_usage")
+    if ram is None or isinstance(ram, str):
+        sys.exit(f"bench: the rocket's stack was not measured: {ram}")
+    flash, _ = elf_size(elf)
+    return {"elf": elf, "flash": flash, "static": ram.static, "stack": ram.stack, "ram": ram.total,
+            "passed": flight.report.passed,
+            "parts": symbol_breakdown(elf, tuple(m.name for m in app.machines))}
+
+
+def print_rocket(r: dict) -> None:
+    print()
+    print("rocket example on the Uno (fsw build; stack measured through the demo flight, fsw sim --plant rocket "
+          f"--seed 1: {'all checks pass' if r['passed'] else 'CHECKS FAIL'})")
+    print(f"{'measure':<55} {'before':>10} {'target':>12} {'measured':>10}")
+    rows = [
+        ("flash (.text + .data)", f"{BEFORE['flash']:,} B", f"<= {TARGET['flash']:,} B", f"{r['flash']:,} B",
+         r["flash"] <= TARGET["flash"]),
+        ("static RAM (.data + .bss + .noinit)", f"{BEFORE['static']:,} B", "-", f"{r['static']:,} B", True),
+        ("stack high-water (measured)", f"{BEFORE['stack']:,} B", "-", f"{r['stack']:,} B", True),
+        ("RAM incl. stack", f"{BEFORE['ram']:,} B", f"<= {TARGET['ram']:,} B", f"{r['ram']:,} B",
+         r["ram"] <= TARGET["ram"]),
+    ]
+    for name, before, target, got, ok in rows:
+        print(f"{name:<55} {before:>10} {target:>12} {got:>10}  {'ok' if ok else 'MISSED'}")
+    over_f, over_r = r["flash"] - TARGET["flash"], r["ram"] - TARGET["ram"]
+    if over_f > 0 or over_r > 0:
+        print(f"  still to find: {max(over_f, 0):,} B of flash, {max(over_r, 0):,} B of RAM")
+    print(f"  {'component (from the ELF symbols)':<53} {'flash':>10} {'RAM':>8}")
+    parts = sorted(r["parts"].items(), key=lambda kv: -kv[1][0])
+    for name, (f, ram) in parts:
+        print(f"  {name:<53} {f:>8,} B {ram:>6,} B")
+    print(f"  {'stack high-water':<53} {'':>10} {r['stack']:>6,} B")
+
+
 def main() -> int:
     os.makedirs(OUT, exist_ok=True)
+    if sys.argv[1:] == ["rocket"]:
+        print_rocket(rocket_footprint())
+        return 0
     avg, worst = avr_cycles()
     instr = x86_instructions()
     flash, ram = avr_footprint()
@@ -140,6 +283,7 @@ def main() -> int:
     print(f"{'measure':<55} {'reference':>10} {'target':>12} {'measured':>10}")
     for name, ref, target, got, ok in rows:
         print(f"{name:<55} {ref:>10} {target:>12} {got:>10}  {'ok' if ok else 'MISSED'}")
+    print_rocket(rocket_footprint())
     return 0
 
 

@@ -122,6 +122,7 @@ def sim(*args: str):
     (("--plant", "rocket", "--jobs", "2", "--run", "1"), "--jobs needs --runs N"),
     (("--plant", "rocket", "--runs", "4", "--fault", "stuck-baro"), "--fault does not go with --runs"),
     (("--plant", "rocket", "--runs", "4", "--tape", "x.csv"), "not a --tape"),
+    (("--plant", "rocket", "--runs", "4", "--jobs", "257"), "--jobs 257: at most 256 flights at a time"),
 ])
 def test_option_errors(args, message):
     r = sim(str(ROCKET), *args)

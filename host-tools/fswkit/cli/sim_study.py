@@ -11,6 +11,7 @@ import sys
 import time
 
 STUDY_FILES = ("study.txt", "study.csv")
+MAX_JOBS = 256
 
 
 def study_run(args) -> int:
@@ -36,6 +37,9 @@ def study_run(args) -> int:
         return 2
     if args.jobs is not None and args.runs is None:
         say("--jobs needs --runs N")
+        return 2
+    if args.jobs is not None and args.jobs > MAX_JOBS:
+        say(f"--jobs {args.jobs}: at most {MAX_JOBS} flights at a time (each is a process and a simulated board)")
         return 2
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
                        ("--analog", bool(args.analog)), ("--link", args.link is not None),

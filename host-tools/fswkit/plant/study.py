@@ -30,6 +30,7 @@ import numpy as np
 from . import report as reports
 from .cosim import CosimError, fly
 from .dispersion import Dispersion, Draw, apply, draw
+from .params import ParamsError
 from .scenario import load as load_scenario
 
 
@@ -101,7 +102,7 @@ def fly_run(setup: Setup, index: int) -> RunResult:
         res.checks = [(check_key(c.name), c.name, c.passed, c.detail) for c in rep.checks]
         res.facts = rep.facts
         res.sim_s, res.resets = run.sim_s, list(run.resets)
-    except CosimError as e:
+    except (CosimError, ParamsError) as e:  # ParamsError: plant.toml changed under a running study
         res.error = str(e)
     res.wall_s, res.cpu_s = time.perf_counter() - wall0, _cpu() - cpu0
     return res

@@ -4,10 +4,13 @@
 
 namespace fsw {
 
-static inline WinIdx step_fwd(WinIdx i, WinIdx n) { return static_cast<WinIdx>(i + 1u == n ? 0u : i + 1u); }
-static inline WinIdx step_back(WinIdx i, WinIdx n) { return static_cast<WinIdx>(i == 0 ? n - 1u : i - 1u); }
+template <typename I>
+static inline I step_fwd(I i, I n) { return static_cast<I>(i + 1u == n ? 0u : i + 1u); }
+template <typename I>
+static inline I step_back(I i, I n) { return static_cast<I>(i == 0 ? n - 1u : i - 1u); }
 
-void roll_avg_push(RollAvg& w, Real* ring, WinIdx n, Real x) {
+template <typename I>
+void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
     x = window_sample(x);
     if (w.count == n) {
         w.base = w.base - ring[w.head];  // the oldest sample leaves
@@ -25,17 +28,19 @@ void roll_avg_push(RollAvg& w, Real* ring, WinIdx n, Real x) {
     }
 }
 
-static void ext_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x, bool is_max) {
+template <typename I>
+static void ext_push(RollExtS<I>& w, Real* vals, I* seqs, I n, Real x, bool is_max) {
     x = window_sample(x);
-    const WinIdx seq = w.next;
-    // The front leaves once it is n samples old (at most one per push).
-    if (w.size != 0 && static_cast<WinIdx>(seq - seqs[w.front]) >= n) {
+    const I seq = w.next;
+    // The front leaves once it is n samples old (at most one per push; ages
+    // are below 2^bits of I, as n is, so the wrapping difference is exact).
+    if (w.size != 0 && static_cast<I>(seq - seqs[w.front]) >= n) {
         w.front = step_fwd(w.front, n);
         --w.size;
     }
     // Drop entries the new sample dominates (ties: the newer one stays).
     while (w.size != 0) {
-        const WinIdx back = step_back(w.tail, n);
+        const I back = step_back(w.tail, n);
         const Real b = vals[back];
         if (is_max ? (b > x) : (b < x)) break;
         w.tail = back;
@@ -45,41 +50,46 @@ static void ext_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x, boo
     seqs[w.tail] = seq;
     w.tail = step_fwd(w.tail, n);
     ++w.size;
-    w.next = static_cast<WinIdx>(seq + 1u);
+    w.next = static_cast<I>(seq + 1u);
 }
 
-void roll_max_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x) {
-    ext_push(w, vals, seqs, n, x, true);
+template <typename I>
+void roll_max_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type n, Real x) {
+    ext_push<I>(w, vals, seqs, n, x, true);
 }
 
-void roll_min_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x) {
-    ext_push(w, vals, seqs, n, x, false);
+template <typename I>
+void roll_min_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type n, Real x) {
+    ext_push<I>(w, vals, seqs, n, x, false);
 }
 
 // First index in [lo, hi) whose value is >= x (x > value: keep going right).
-static WinIdx lower_bound(const Real* s, WinIdx lo, WinIdx hi, Real x) {
+template <typename I>
+static I lower_bound(const Real* s, I lo, I hi, Real x) {
     while (lo < hi) {
-        const WinIdx mid = static_cast<WinIdx>(lo + (hi - lo) / 2u);
-        if (s[mid] < x) lo = static_cast<WinIdx>(mid + 1u); else hi = mid;
+        const I mid = static_cast<I>(lo + (hi - lo) / 2u);
+        if (s[mid] < x) lo = static_cast<I>(mid + 1u); else hi = mid;
     }
     return lo;
 }
 
 // First index in [lo, hi) whose value is > x.
-static WinIdx upper_bound(const Real* s, WinIdx lo, WinIdx hi, Real x) {
+template <typename I>
+static I upper_bound(const Real* s, I lo, I hi, Real x) {
     while (lo < hi) {
-        const WinIdx mid = static_cast<WinIdx>(lo + (hi - lo) / 2u);
-        if (s[mid] <= x) lo = static_cast<WinIdx>(mid + 1u); else hi = mid;
+        const I mid = static_cast<I>(lo + (hi - lo) / 2u);
+        if (s[mid] <= x) lo = static_cast<I>(mid + 1u); else hi = mid;
     }
     return lo;
 }
 
-void roll_median_push(RollMedian& w, Real* ring, Real* sorted, WinIdx n, Real x) {
+template <typename I>
+void roll_median_push(RollMedianS<I>& w, Real* ring, Real* sorted, typename same_t<I>::type n, Real x) {
     x = window_sample(x);
     if (w.count < n) {  // filling: insert only
         ring[w.head] = x;
         w.head = step_fwd(w.head, n);
-        const WinIdx j = upper_bound(sorted, 0, w.count, x);
+        const I j = upper_bound<I>(sorted, 0, w.count, x);
         memmove(sorted + j + 1, sorted + j, (w.count - j) * sizeof(Real));
         sorted[j] = x;
         ++w.count;
@@ -90,27 +100,39 @@ void roll_median_push(RollMedian& w, Real* ring, Real* sorted, WinIdx n, Real x)
     w.head = step_fwd(w.head, n);
     // Samples are normalised, so equal values are identical: any copy of
     // `old` may be the one removed.
-    const WinIdx i = lower_bound(sorted, 0, n, old);
+    const I i = lower_bound<I>(sorted, 0, n, old);
     if (x >= old) {
         // Shift the run (old, x) left by one and put x at its end.
-        const WinIdx j = lower_bound(sorted, static_cast<WinIdx>(i + 1u), n, x);
+        const I j = lower_bound<I>(sorted, static_cast<I>(i + 1u), n, x);
         memmove(sorted + i, sorted + i + 1, (j - i - 1u) * sizeof(Real));
         sorted[j - 1u] = x;
     } else {
         // Shift the run (x, old) right by one and put x at its start.
-        const WinIdx j = upper_bound(sorted, 0, i, x);
+        const I j = upper_bound<I>(sorted, 0, i, x);
         memmove(sorted + j + 1, sorted + j, (i - j) * sizeof(Real));
         sorted[j] = x;
     }
 }
 
-Real roll_median_value(const RollMedian& w, const Real* sorted) {
+template <typename I>
+Real roll_median_value(const RollMedianS<I>& w, const Real* sorted) {
     if (w.count == 0) return 0;
-    const WinIdx mid = static_cast<WinIdx>(w.count / 2u);
+    const I mid = static_cast<I>(w.count / 2u);
     if ((w.count & 1u) != 0) return sorted[mid];
     const Real a = sorted[mid - 1u];
     const Real b = sorted[mid];
     return a + (b - a) / 2;
 }
+
+// The two index types in use: bytes for windows of up to 255 samples, WinIdx.
+#define FSW_WINDOW_INSTANCES(I)                                                      \
+    template void roll_avg_push<I>(RollAvgS<I>&, Real*, I, Real);                   \
+    template void roll_max_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
+    template void roll_min_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
+    template void roll_median_push<I>(RollMedianS<I>&, Real*, Real*, I, Real);       \
+    template Real roll_median_value<I>(const RollMedianS<I>&, const Real*);
+FSW_WINDOW_INSTANCES(uint8_t)
+FSW_WINDOW_INSTANCES(WinIdx)
+#undef FSW_WINDOW_INSTANCES
 
 }  // namespace fsw

@@ -8,50 +8,89 @@
 
 namespace fsw {
 
+// std::conditional, without the standard library.
+template <bool B, typename T, typename F>
+struct conditional_t {
+    typedef T type;
+};
+template <typename T, typename F>
+struct conditional_t<false, T, F> {
+    typedef F type;
+};
+
 // A sample as a window stores it: NaN -> +0 (spec), and -0 -> +0 so that
 // equal samples are identical bit patterns (no sign-of-zero ambiguity).
 inline Real window_sample(Real x) { return (x != x || x == 0) ? Real(0) : x; }
 
 // ---- state structs: all-zero is "no samples yet", so they live in .bss ----
+// Templates on the index type I: uint8_t for windows of up to 255 samples
+// (the typed wrappers below pick it: on an 8-bit MCU a byte index is half
+// the RAM and fewer instructions), WinIdx above. The plain names (RollAvg,
+// ...) are the WinIdx ones.
 
 // roll_avg: sum = base + fresh; see docs/runtime.md for the exact order.
-struct RollAvg {
+template <typename I>
+struct RollAvgS {
     Real base;
     Real fresh;
-    WinIdx count;  // samples held, 0..n
-    WinIdx head;   // ring position of the next sample
+    I count;  // samples held, 0..n
+    I head;   // ring position of the next sample
 };
 
 // roll_min / roll_max: a monotonic deque of (value, sequence number).
-struct RollExt {
-    WinIdx next;   // sequence number of the next sample (wraps)
-    WinIdx front;  // deque front (the extreme) position
-    WinIdx tail;   // position after the deque back
-    WinIdx size;   // entries in the deque (0 only before the first sample)
+template <typename I>
+struct RollExtS {
+    I next;   // sequence number of the next sample (wraps)
+    I front;  // deque front (the extreme) position
+    I tail;   // position after the deque back
+    I size;   // entries in the deque (0 only before the first sample)
 };
 
 // roll_median: a ring of raw samples plus the same samples kept sorted.
-struct RollMedian {
-    WinIdx count;
-    WinIdx head;
+template <typename I>
+struct RollMedianS {
+    I count;
+    I head;
 };
 
-// ---- non-template core (one copy in flash whatever the window sizes) -------
-// `n` is the window size N (1..FSW_WINDOW_MAX_N); arrays hold n entries.
+typedef RollAvgS<WinIdx> RollAvg;
+typedef RollExtS<WinIdx> RollExt;
+typedef RollMedianS<WinIdx> RollMedian;
 
-void roll_avg_push(RollAvg& w, Real* ring, WinIdx n, Real x);
-inline Real roll_avg_value(const RollAvg& w) {
+// The index type of a window of N samples.
+template <uint32_t N>
+struct WinIdxFor {
+    typedef typename conditional_t<(N <= 0xFFu), uint8_t, WinIdx>::type type;
+};
+
+// ---- non-template core (one copy in flash per index type in use) ----------
+// `n` is the window size N (1..FSW_WINDOW_MAX_N, 1..255 for uint8_t);
+// arrays hold n entries. Instantiated in fsw_window.cpp for uint8_t and WinIdx.
+template <typename T>
+struct same_t {
+    typedef T type;
+};
+
+template <typename I>
+void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x);
+template <typename I>
+inline Real roll_avg_value(const RollAvgS<I>& w) {
     return w.count == 0 ? Real(0) : (w.base + w.fresh) / static_cast<Real>(w.count);
 }
 
-void roll_max_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x);
-void roll_min_push(RollExt& w, Real* vals, WinIdx* seqs, WinIdx n, Real x);
-inline Real roll_ext_value(const RollExt& w, const Real* vals) {
+template <typename I>
+void roll_max_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type n, Real x);
+template <typename I>
+void roll_min_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type n, Real x);
+template <typename I>
+inline Real roll_ext_value(const RollExtS<I>& w, const Real* vals) {
     return w.size == 0 ? Real(0) : vals[w.front];
 }
 
-void roll_median_push(RollMedian& w, Real* ring, Real* sorted, WinIdx n, Real x);
-Real roll_median_value(const RollMedian& w, const Real* sorted);
+template <typename I>
+void roll_median_push(RollMedianS<I>& w, Real* ring, Real* sorted, typename same_t<I>::type n, Real x);
+template <typename I>
+Real roll_median_value(const RollMedianS<I>& w, const Real* sorted);
 
 // ---- typed wrappers: what generated code declares, one per call site -------
 //     static fsw::RollMedianN<100> w_tank_sm_18;   // zero-initialised
@@ -63,29 +102,32 @@ Real roll_median_value(const RollMedian& w, const Real* sorted);
 template <uint32_t N>
 struct RollAvgN {
     FSW_WINDOW_CHECK_N(N);
-    RollAvg s;
+    typedef typename WinIdxFor<N>::type I;
+    RollAvgS<I> s;
     Real ring[N];
-    void push(Real x) { roll_avg_push(s, ring, static_cast<WinIdx>(N), x); }
+    void push(Real x) { roll_avg_push<I>(s, ring, static_cast<I>(N), x); }
     Real value() const { return roll_avg_value(s); }
 };
 
 template <uint32_t N>
 struct RollMaxN {
     FSW_WINDOW_CHECK_N(N);
-    RollExt s;
+    typedef typename WinIdxFor<N>::type I;
+    RollExtS<I> s;
     Real vals[N];
-    WinIdx seqs[N];
-    void push(Real x) { roll_max_push(s, vals, seqs, static_cast<WinIdx>(N), x); }
+    I seqs[N];
+    void push(Real x) { roll_max_push<I>(s, vals, seqs, static_cast<I>(N), x); }
     Real value() const { return roll_ext_value(s, vals); }
 };
 
 template <uint32_t N>
 struct RollMinN {
     FSW_WINDOW_CHECK_N(N);
-    RollExt s;
+    typedef typename WinIdxFor<N>::type I;
+    RollExtS<I> s;
     Real vals[N];
-    WinIdx seqs[N];
-    void push(Real x) { roll_min_push(s, vals, seqs, static_cast<WinIdx>(N), x); }
+    I seqs[N];
+    void push(Real x) { roll_min_push<I>(s, vals, seqs, static_cast<I>(N), x); }
     Real value() const { return roll_ext_value(s, vals); }
 };
 
@@ -104,10 +146,11 @@ struct RollRangeN {
 template <uint32_t N>
 struct RollMedianN {
     FSW_WINDOW_CHECK_N(N);
-    RollMedian s;
+    typedef typename WinIdxFor<N>::type I;
+    RollMedianS<I> s;
     Real ring[N];
     Real sorted[N];
-    void push(Real x) { roll_median_push(s, ring, sorted, static_cast<WinIdx>(N), x); }
+    void push(Real x) { roll_median_push<I>(s, ring, sorted, static_cast<I>(N), x); }
     Real value() const { return roll_median_value(s, sorted); }
 };
 

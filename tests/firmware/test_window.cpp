@@ -251,6 +251,45 @@ static void test_typed_wrappers_and_range(void) {
     ASSERT_REAL_SAME(Real(14) / 3, a.value());
 }
 
+// Windows of up to 255 samples index with bytes (half the RAM on an 8-bit
+// MCU): the same values, bit for bit, as the WinIdx core on the same
+// samples, well past the byte sequence numbers' wrap at 256 pushes.
+template <uint32_t N>
+static void byte_window_matches_winidx(void) {
+    static_assert(sizeof(typename RollMaxN<N>::I) == 1, "a window of N <= 255 indexes with bytes");
+    static RollAvgN<N> a;
+    static RollMaxN<N> mx;
+    static RollMinN<N> mn;
+    static RollMedianN<N> med;
+    static RollAvg wa; static Real wa_ring[N];
+    static RollExt wx; static Real wx_v[N]; static WinIdx wx_s[N];
+    static RollExt wn; static Real wn_v[N]; static WinIdx wn_s[N];
+    static RollMedian wm; static Real wm_ring[N]; static Real wm_sorted[N];
+    for (uint16_t k = 0; k < 3u * N + 300u; ++k) {
+        const uint32_t r = rng();
+        // Runs of equal values and steady climbs and falls exercise the deques.
+        const Real x = (r & 7u) == 0 ? Real(0) : static_cast<Real>(static_cast<int32_t>(r % 2001u) - 1000) / 8;
+        a.push(x); mx.push(x); mn.push(x); med.push(x);
+        roll_avg_push(wa, wa_ring, static_cast<WinIdx>(N), x);
+        roll_max_push(wx, wx_v, wx_s, static_cast<WinIdx>(N), x);
+        roll_min_push(wn, wn_v, wn_s, static_cast<WinIdx>(N), x);
+        roll_median_push(wm, wm_ring, wm_sorted, static_cast<WinIdx>(N), x);
+        ASSERT_REAL_SAME(roll_avg_value(wa), a.value());
+        ASSERT_REAL_SAME(roll_ext_value(wx, wx_v), mx.value());
+        ASSERT_REAL_SAME(roll_ext_value(wn, wn_v), mn.value());
+        ASSERT_REAL_SAME(roll_median_value(wm, wm_sorted), med.value());
+    }
+}
+
+static void test_byte_indexed_windows_match_the_winidx_core(void) {
+    static_assert(sizeof(RollMaxN<256>::I) == sizeof(WinIdx), "a window of 256 samples indexes with WinIdx");
+    byte_window_matches_winidx<1>();
+    byte_window_matches_winidx<5>();
+#if !defined(__AVR__)  // on the MCU's 2 KB of RAM the two copies of 255 samples do not fit
+    byte_window_matches_winidx<255>();
+#endif
+}
+
 #if !defined(__AVR__)
 // The language's largest window: 100000 samples.
 static void test_largest_window(void) {
@@ -282,6 +321,7 @@ static void run(void) {
     RUN_TEST(test_avg_follows_the_documented_operation_order);
     RUN_TEST(test_avg_does_not_drift);
     RUN_TEST(test_typed_wrappers_and_range);
+    RUN_TEST(test_byte_indexed_windows_match_the_winidx_core);
 #if !defined(__AVR__)
     RUN_TEST(test_largest_window);
 #endif

@@ -8,9 +8,11 @@
 #
 # Flags follow the Arduino core's platform.txt (LTO, -Os, gc-sections), plus
 # -DDECIMAL_DIG=__DECIMAL_DIG__, which Debian's core needs with gcc-avr 5.4,
-# and two that trade a few cycles per call for flash: -mcall-prologues
+# and three that trade a few cycles per call for flash: -mcall-prologues
 # (shared register save/restore) and linker relaxation (short calls and
-# jumps where they reach); together about 4 % of a firmware's flash.
+# jumps where they reach), together about 4 % of a firmware's flash, and
+# -mstrict-X (the X pointer only as the AVR addresses with it: no
+# adjust-and-restore sequences around it; 62 B of the rocket's flash).
 
 # RUNTIME is the runtime's folder: `fsw build` passes it (fswkit.autocode.kit,
 # which knows where the kit's files are, in a checkout or an installed
@@ -35,7 +37,7 @@ CORE_SRCS := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcar
 
 DEFS     := -mmcu=$(MCU) -DF_CPU=$(F_CPU)L -DARDUINO=10819 -D$(BOARD_DEFINE) -DARDUINO_ARCH_AVR
 INCS     := -I$(CORE_DIR) -I$(VAR_DIR)
-SIZE_OPT := -mcall-prologues
+SIZE_OPT := -mcall-prologues -mstrict-X
 OPT      := -Os $(SIZE_OPT) -g -ffunction-sections -fdata-sections -flto -fno-fat-lto-objects
 CFLAGS   := -std=gnu11 $(OPT) $(DEFS) $(INCS)
 CXXFLAGS := -std=gnu++11 $(OPT) -fno-exceptions -fno-rtti -fno-threadsafe-statics \

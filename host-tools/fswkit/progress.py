@@ -406,8 +406,9 @@ def _restore_signals(saved):
 def _after_fork_in_child():
     """A child forked while bars are shown is a worker: it gets back the
     streams the display replaced, and never draws."""
-    global _display, _depth, _lock
+    global _display, _depth, _lock, _threads
     _lock = threading.Lock()  # another thread may have held it at the fork
+    _threads = threading.local()
     d = _display
     if d is not None:
         _display, _depth = None, 0
@@ -419,6 +420,7 @@ if hasattr(os, "register_at_fork"):
 
 _depth = 0  # bars of this process now shown
 _lock = threading.Lock()  # _display and _depth, for bars of several threads (a pool of replays)
+_threads = threading.local()  # .depth: the bars of this thread now shown
 
 
 @contextlib.contextmanager
@@ -436,7 +438,9 @@ def progress(label: str, total: float | int | None = None, unit: str = ""):
                 except Exception:  # noqa: BLE001  (a terminal rich cannot draw on: no bar, never a failure)
                     _display = None
         if d is not None:
-            bar = _Bar(d, label, total, unit, _depth)
+            mine = getattr(_threads, "depth", 0)  # a pool thread's first bar goes under the outer one
+            bar = _Bar(d, label, total, unit, mine or (1 if _depth else 0))
+            _threads.depth = mine + 1
             _depth += 1
     if d is None:
         if remote is None:
@@ -452,6 +456,7 @@ def progress(label: str, total: float | int | None = None, unit: str = ""):
     try:
         yield bar
     finally:
+        _threads.depth -= 1
         with _lock:
             _depth -= 1
             last = _depth == 0 and _display is d

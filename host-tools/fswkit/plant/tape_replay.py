@@ -43,6 +43,7 @@ import numpy as np
 
 from fswkit.link.layout import Layout
 from fswkit.link.log import LogWriter
+from fswkit.progress import progress
 from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
 from fswkit.sim.sensors import AnalogSensor, from_channel
 
@@ -439,12 +440,19 @@ def replay(tape, cfg: Config, elf: str, board, layout: Layout, log_path: str | N
     """The firmware on the simulated board, its inputs driven from the tape
     (or `columns`, a perturbed copy of its columns); the Replay. The
     truth's altitude is taken above `truth.pad_pressure_pa` (else the
-    tape's pad)."""
-    with _one_cpu():
-        return _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth)
+    tape's pad). On a terminal, a bar shows the seconds of the tape replayed."""
+    with _one_cpu(), progress("tape replay", total=_end_s(tape, cfg), unit="s") as bar:
+        return _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar)
 
 
-def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth) -> Replay:
+def _end_s(tape, cfg: Config) -> float:
+    """The simulated second a replay ends at: the tape's length after the
+    pad time, and the run-on."""
+    offset = cfg.pad_s - float(tape.time[0])
+    return float(tape.time[-1]) + offset + cfg.run_on_s
+
+
+def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar) -> Replay:
     f_cpu = int(board.f_cpu)
     t = tape.time
     cols = columns if columns is not None else _columns(tape)
@@ -452,7 +460,7 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     counts = {c: counts_series(cols[c], s, cfg.missing, cfg.silent_volts) for c, s in cfg.sensors.items()
               if s is not None}
     mv = {cfg.sensors[c].pin: [cfg.sensors[c].millivolts(int(k)) for k in counts[c]] for c in counts}
-    end_s = float(t[-1]) + offset + cfg.run_on_s
+    end_s = _end_s(tape, cfg)
     # the input changes, by cycle: (cycle, {pin: volts}, {pin: level})
     changes: dict[int, tuple[dict, dict]] = {}
     cyc = np.rint((t + offset) * f_cpu).astype(np.int64).tolist()
@@ -507,6 +515,7 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
             if now == target:
                 pending = changes.get(target, ({}, {}))
                 target = next(targets, end_cycle)
+            bar.update(now / f_cpu)
         run.steps = len(stops) + 1
         run.sim_s = end_s
         run.wall_s = time.perf_counter() - wall0
@@ -905,8 +914,14 @@ def robustness(tape, truth, cfg: Config, elf: str, board, layout: Layout, n: int
         except (AttributeError, OSError):
             workers = os.cpu_count() or 1
     workers = max(1, min(workers, n))
-    with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+    with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool, \
+            progress("perturbed replays", total=n, unit="runs") as bar:
         futs = [pool.submit(_one_perturbed, i, s, tape, truth, cfg, elf, board, layout) for i, s in enumerate(seqs)]
+        failed = 0
+        for done, f in enumerate(concurrent.futures.as_completed(futs), 1):
+            r = f.result()
+            failed += r.error is not None or not all(c.passed for c in r.checks)
+            bar.update(done, failed=failed)
         return [f.result() for f in futs]
 
 

@@ -53,6 +53,7 @@ class Run:
     wall_s: float = 0.0
     round_trips: int = 0
     ram: dict = field(default_factory=dict)  # what the board's RAM probes said, if it has them
+    profile: object = None  # fswkit.sim.board.Profile of the functions `fly` was asked to profile
     resets: list[float] = field(default_factory=list)  # when the MCU was reset (brown-outs the scenario asked for)
 
 
@@ -95,12 +96,14 @@ def _one_cpu():
 
 
 def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, *,
-        wall_limit: float = 900.0, log_meta: dict | None = None) -> Run:
+        wall_limit: float = 900.0, log_meta: dict | None = None, profile: list[int] | None = None) -> Run:
     """Runs the scenario to its end against the firmware; the Run. The
     board and this thread share one CPU for the run (`_one_cpu`). On a
-    terminal, a bar shows the simulated time of the planned duration."""
+    terminal, a bar shows the simulated time of the planned duration.
+    `profile`: flash byte addresses of functions whose cycles the board
+    counts from reset (SimBoard.profile; tools/bench_busy.py), in run.profile."""
     with _one_cpu(), progress("flight", total=float(scenario.max_s), unit="s") as bar:
-        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar)
+        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile)
 
 
 def stop_words(stop: str, wall_limit: float) -> str:
@@ -148,7 +151,7 @@ class Telemetry:
                     run.transitions.append((tt, int(st), self.state_names.get(int(st), str(st))))
 
 
-def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar) -> Run:
+def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile=None) -> Run:
     rate = scenario.rate
     f_cpu = int(board.f_cpu)
     if f_cpu % rate:
@@ -171,6 +174,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar) -> R
         raise CosimError(str(e)) from None
     wall0 = time.perf_counter()
     try:
+        if profile:
+            b.profile(profile)
         last_mv = {name: _mv(v, vref) for name, v in analog.items()}
         last_din: dict[int, bool] = {}
         for pin in scenario.outputs:
@@ -223,6 +228,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar) -> R
         run.steps = k
         run.sim_s = t1
         run.wall_s = time.perf_counter() - wall0
+        if profile:
+            run.profile = b.profile_read()
         for probe in ("ram_usage", "stack_high_water"):  # the first the board has
             fn = getattr(b, probe, None)
             if callable(fn):

@@ -116,3 +116,18 @@ def test_wilson_interval():
     assert lo == pytest.approx(0.9817, abs=1e-4) and hi == pytest.approx(0.9946, abs=1e-4)
     assert wilson(0, 10)[0] == 0.0 and wilson(10, 10)[1] == pytest.approx(1.0)
     assert wilson(0, 0) == (0.0, 1.0)
+
+
+def test_gusts_sum_the_half_sines_that_cover_a_time():
+    import math
+
+    gusts = [(1.0, 2.0, 3.0), (2.0, 0.5, -1.0), (10.0, 1.0, 2.0)]
+    wind = D._gusts(gusts, 3.0)
+
+    def by_hand(t):
+        return sum(p * math.sin(math.pi * (t - 3 - a) / n) for a, n, p in gusts if 3 + a <= t < 3 + a + n)
+
+    for k in range(2001):
+        t = k / 100
+        assert wind(t) == pytest.approx(by_hand(t), abs=1e-12)
+    assert D._gusts([], 3.0) is None

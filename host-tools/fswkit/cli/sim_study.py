@@ -95,20 +95,18 @@ def study_run(args) -> int:
     setup = study.Setup(app, layout, params, elf, board, disp, seed, command)
     say(f"dispersion study: {args.runs} flights of the real firmware on simulated {board.name}s, {min(jobs, args.runs)} "
         f"at a time, seed {seed}")
-    done = failed = 0
+    finished: list = []
     t0 = time.monotonic()
     with progress("study", total=args.runs, unit="runs") as bar:
         def on_result(r):
-            nonlocal done, failed
-            done += 1
-            failed += not r.passed
-            bar.update(done, failed=failed)
+            finished.append(r)
+            bar.update(len(finished), failed=sum(not x.passed for x in finished))
 
         with stopped_by_signals():
             try:
                 results, complete = study.run_study(setup, args.runs, jobs, on_result)
-            except Stopped:  # between two runs' results: the pool is already down
-                results, complete = [], False
+            except Stopped:  # outside the wait for results (the pool starting or ending): the runs done so far
+                results, complete = sorted(finished, key=lambda r: r.index), False
     wall = time.monotonic() - t0
     text = study.text(setup, results, args.runs, jobs, wall, complete, args.dispersion)
     sys.stdout.write(text)

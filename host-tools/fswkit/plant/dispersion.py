@@ -218,15 +218,20 @@ class _Windows:
 
 def _gusts(gusts: list, t_ign: float):
     """The air's vertical velocity at time t: the half-sine gusts summed."""
-    spans = [(t_ign + t, t_ign + t + n, a) for t, n, a in gusts]
+    spans = sorted((t_ign + t, t_ign + t + n, a) for t, n, a in gusts)
     if not spans:
         return None
+    starts = [a for a, _, _ in spans]
+    longest = max(b - a for a, b, _ in spans)
 
-    def wind(t: float) -> float:
+    def wind(t: float) -> float:  # called four times a plant step: only the gusts that may cover t
         w = 0.0
-        for a, b, peak in spans:
-            if a <= t < b:
+        j = bisect.bisect_right(starts, t) - 1
+        while j >= 0 and starts[j] > t - longest:
+            a, b, peak = spans[j]
+            if t < b:
                 w += peak * math.sin(math.pi * (t - a) / (b - a))
+            j -= 1
         return w
 
     return wind

@@ -120,6 +120,7 @@ def _on_term(signum, _frame):
 def _worker_init(cpus) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     signal.signal(signal.SIGTERM, _on_term)
+    signal.signal(signal.SIGHUP, _on_term)
     try:
         cpu = cpus.get(timeout=5)
         if cpu is not None:

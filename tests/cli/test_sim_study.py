@@ -94,7 +94,7 @@ def test_ctrl_c_ends_a_study_with_the_runs_done(tmp_path: Path):
         for line in p.stderr:
             if "dispersion study:" in line:
                 break
-        time.sleep(8)
+        time.sleep(3)
         os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
         stdout, stderr = p.communicate(timeout=120)
     finally:

@@ -193,7 +193,7 @@ def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
 
 PERCENTILES = (0, 5, 50, 95, 100)
 ERRORS = (("apogee_error_s", "apogee detection − true apogee", "s", "+.3f"),
-          ("apogee_error_m", "detected − true apogee altitude", "m", "+.1f"),
+          ("apogee_error_m", "highest telemetered − true apogee", "m", "+.1f"),
           ("main_error_m", "main's altitude − its configured altitude", "m", "+.1f"))
 
 

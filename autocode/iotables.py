@@ -6,15 +6,39 @@ the model."""
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 from . import model as M
 from .appsyntax import Calibration, ChannelRow, Problem, Table, parse_table
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
 from .model import Channel
-from .numeric import REALS
+from .numeric import REALS, f32_from_fraction
 
-__all__ = ["Channel", "check_channels", "check_table"]
+__all__ = ["Channel", "analog_gain", "analog_value", "check_channels", "check_table"]
+
+
+# ---- what an analog input's element holds (firmware/src/fsw_io.h) -------------
+# The firmware converts a count with one multiply-add, `count * gain +
+# offset`, in the board's arithmetic R: the generator folds the converter
+# (vref / (2^bits - 1)) and the .aio's `scale` into `gain` here, so no
+# division runs on the MCU. Host tools that predict an element's value
+# (tape replays, fswkit.sim.sensors) use analog_value: bit for bit what the
+# native and AVR builds compute.
+
+def analog_gain(scale: float, vref: float, bits: int, real) -> float:
+    """Element units per count in R (`real`: numeric.REALS[...]): the exact
+    R(scale) * R(vref) / (2^bits - 1) rounded once to R."""
+    q = Fraction(real.literal(repr(float(scale)))) * Fraction(real.literal(repr(float(vref)))) / ((1 << bits) - 1)
+    return f32_from_fraction(q) if real.bits == 32 else float(q)
+
+
+def analog_value(count: int, gain: float, offset: float, real) -> float:
+    """count * gain + offset as the firmware computes it in R: the product
+    rounded to R, then the sum rounded to R (never fused)."""
+    if real.bits == 32:
+        return f32_from_fraction(Fraction(f32_from_fraction(Fraction(count) * Fraction(gain))) + Fraction(offset))
+    return float(count) * gain + offset
 
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from ..app import TASK_MODES, Application, Task
 from ..cnames import comment
+from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
 from ..schema import app_schema_hash, link_plan
@@ -69,13 +70,22 @@ def _tables(app: Application, real, out: list[str]) -> dict:
         if kind == "analog":
             out.append(f"const fsw::AnalogChannel {tag}Ch[] FSW_FLASH = {{")
             for c in chans:
-                scale = real_literal(real.literal(repr(c.scale)), real)
+                # inputs: count * gain + offset (iotables.analog_gain folds the
+                # converter into the .aio's scale: no division on the MCU)
+                gain = analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real) if d == "i" else 1.0
                 offset = real_literal(real.literal(repr(c.offset)), real)
-                out.append(f"    {{{scale}, {offset}, E_{c.element.name}, {c.pin_number}, {direction}, "
-                           f"{TYPE_CODE[c.element.type.name]}}},  // {basename(c.path)}:{c.line} pin {c.pin}")
+                out.append(f"    {{{real_literal(gain, real)}, {offset}, E_{c.element.name}, {c.pin_number}, "
+                           f"{direction}, {TYPE_CODE[c.element.type.name]}}},  "
+                           f"// {basename(c.path)}:{c.line} pin {c.pin}"
+                           + (f": {c.scale!r} per volt" if d == "i" else ""))
             out.append("};")
+            raw = "0"
+            if d == "i":
+                # converted in the background, read one run later (fsw_io.h)
+                raw = f"{tag}Raw"
+                out.append(f"volatile uint16_t {raw}[{len(chans)}];  // counts the ADC's interrupt stores")
             out.append(f"const fsw::AnalogTable {tag} FSW_FLASH = {{{tag}Ch, sv, {vref}, {len(chans)}, "
-                       f"{app.board.adc_bits}, kSvLock}};")
+                       f"{app.board.adc_bits}, kSvLock, {raw}}};")
             if all(c.element.type.name == "F32" for c in chans):
                 # no binary64 element: the task that links no F64 conversion
                 # (nor, for inputs, PWM output)
@@ -150,8 +160,6 @@ def _app_cpp(app: Application) -> str:
             for ch in tag:
                 c.append(f"    fsw::io_pin_begin({_pin(app, ch)}, {'fsw::kIoIn' if d == 'i' else 'fsw::kIoOut'});  "
                          f"// {basename(ch.path)}:{ch.line} {ch.element.name}")
-        elif kind == "analog" and d == "i" and tables.get(("task", tag)) == "io_analog_in_task_f32":
-            continue  # nothing to set up: the task refuses any row it cannot serve
         elif kind in ("analog", "digital"):
             c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
     if has_link:

@@ -6,12 +6,6 @@
 
 namespace fsw {
 
-Real analog_value_from_raw(uint16_t raw, Real vref, uint8_t adc_bits, Real scale, Real offset) {
-    const Real full = static_cast<Real>((1UL << adc_bits) - 1UL);
-    const Real volts = static_cast<Real>(raw) * vref / full;
-    return volts * scale + offset;
-}
-
 uint8_t pwm_duty_from_volts(Real volts, Real vref) {
     return U8_from_real(volts / vref * Real(255) + Real(0.5));
 }
@@ -26,7 +20,13 @@ Result io_analog_begin(const AnalogTable* table) {
         AnalogChannel c;
         flash_read(&c, &tab.ch[i], sizeof c);
         if (!analog_type_ok(c.type) || (c.dir != kIoIn && c.dir != kIoOut)) return kErrConfig;
+        if (tab.raw != 0 && c.dir != kIoIn) return kErrConfig;  // a scan converts every row
         if (c.dir == kIoOut) pal::pin_mode(c.pin, pal::kOutput);
+    }
+    if (tab.raw != 0) {
+        while (pal::adc_scan_busy()) {}
+        if (!pal::adc_scan_start(&tab.ch->pin, sizeof(AnalogChannel), tab.n, tab.raw)) return kErrConfig;
+        while (pal::adc_scan_busy()) {}  // once, at boot: the first run reads these
     }
     return kOk;
 }
@@ -46,9 +46,17 @@ Result analog_task(void* ctx) {
         if (!kOutputs && c.dir != kIoIn) return kErrConfig;
         uint8_t* p = tab.sv + c.off;
         if (!kOutputs || c.dir == kIoIn) {
-            // Read (slow: ~100 us on AVR) before taking the lock.
-            const Real v = analog_value_from_raw(pal::analog_read(c.pin), tab.vref, tab.adc_bits,
-                                                 c.scale, c.offset);
+            uint16_t count;
+            if (tab.raw != 0) {
+                // the previous scan's count (it has ended: a scan takes well
+                // under a period; read with interrupts off all the same)
+                const pal::IrqState saved = pal::critical_enter();
+                count = tab.raw[i];
+                pal::critical_exit(saved);
+            } else {
+                count = pal::analog_read(c.pin);  // slow: ~100 us on AVR; before taking the lock
+            }
+            const Real v = analog_value(count, c.gain, c.offset);
             const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
             // Analog elements are F32 or F64 (checked at begin): no general
             // dispatch, which would link every type's conversions.
@@ -61,6 +69,10 @@ Result analog_task(void* ctx) {
             pal::analog_write(c.pin, pwm_duty_from_volts(volts, tab.vref));
         }
     }
+    // the next run's counts, converted in the background meanwhile (a scan
+    // still running, which a period far shorter than it would cause, is
+    // left to finish: the next run reads what it stored)
+    if (tab.raw != 0) (void)pal::adc_scan_start(&tab.ch->pin, sizeof(AnalogChannel), tab.n, tab.raw);
     return kOk;
 }
 

@@ -10,17 +10,28 @@ namespace fsw {
 
 enum IoDir : uint8_t { kIoIn = 0, kIoInPullup = 1, kIoOut = 2 };
 
-// Analog channel: inputs write `volts * scale + offset` into an F32/F64
-// element; outputs drive PWM from an F32/F64 element in volts (0..vref).
+// Analog channel: inputs write `count * gain + offset` into an F32/F64
+// element, where the generator folded the board's converter and the .aio's
+// calibration (`volts * scale + offset`) into one multiply-add:
+// gain = scale * vref / (2^bits - 1), computed on the host
+// (fswkit.autocode.iotables.analog_gain), so no division runs on the MCU.
+// Outputs drive PWM from an F32/F64 element in volts (0..vref).
 struct AnalogChannel {
-    Real scale;       // K (inputs; 1 for none)
-    Real offset;      // B (inputs; 0 for none)
+    Real gain;        // inputs: element units per ADC count
+    Real offset;      // inputs: the element's value at count 0
     ElemOff off;      // element offset in the state vector
     uint8_t pin;      // board pin number (A0 = 14 on an Uno)
     uint8_t dir;      // kIoIn or kIoOut
     uint8_t type;     // kF32 or kF64
 };
 
+// A table of inputs only may sample in the background (`raw` set): each
+// task run converts the counts the previous run's scan left in `raw`, then
+// starts the next scan (pal::adc_scan_start), so the task never waits on
+// the converter; an element then holds the inputs of one run earlier (one
+// executor period of latency at the task's rate). io_analog_begin fills
+// `raw` once, so the first run reads the pins as they were at boot. With
+// `raw` null the task reads each pin as it runs (waiting on each conversion).
 struct AnalogTable {
     const AnalogChannel* ch;  // FSW_FLASH rows
     uint8_t* sv;
@@ -28,6 +39,7 @@ struct AnalogTable {
     uint8_t n;
     uint8_t adc_bits; // ADC resolution: full scale is 2^bits - 1
     bool lock;        // state vector `lock` option
+    volatile uint16_t* raw;  // n counts written in the background, or null
 };
 
 // Digital channel: a bool element mirrored from (kIoIn, kIoInPullup) or
@@ -45,7 +57,8 @@ struct DigitalTable {
     bool lock;
 };
 
-// Checks the table and sets pin modes. `table` points at an FSW_FLASH object.
+// Checks the table and sets pin modes; a table sampled in the background
+// (inputs only) is converted once, waiting. `table` points at an FSW_FLASH object.
 FSW_MUST_CHECK Result io_analog_begin(const AnalogTable* table);
 FSW_MUST_CHECK Result io_digital_begin(const DigitalTable* table);
 
@@ -120,8 +133,12 @@ inline void io_digital_out(Pin pin, const uint8_t* p) { pal::digital_write(pin.n
 #endif
 
 // The conversions the analog task applies (exposed for tests and docs).
-// volts = raw * vref / (2^bits - 1); value = volts * scale + offset.
-Real analog_value_from_raw(uint16_t raw, Real vref, uint8_t adc_bits, Real scale, Real offset);
+// value = count * gain + offset, in R (two roundings: the host mirrors it
+// exactly, fswkit.autocode.iotables.analog_value).
+inline Real analog_value(uint16_t count, Real gain, Real offset) {
+    const Real scaled = static_cast<Real>(count) * gain;  // one rounding, never fused with the add
+    return scaled + offset;
+}
 // duty = trunc(clamp(volts / vref * 255 + 0.5, 0, 255)); NaN -> 0.
 uint8_t pwm_duty_from_volts(Real volts, Real vref);
 

@@ -33,6 +33,15 @@ uint64_t millis64();
 uint16_t analog_read(uint8_t pin);
 // PWM output, duty 0..255.
 void analog_write(uint8_t pin, uint8_t duty);
+// Conversions in the background (non-blocking analog inputs): converts `n`
+// analog pins in turn, entry i's pin being the byte at pins + i * stride
+// (FSW_FLASH), and stores each count into raw[i] as its conversion ends.
+// On an MCU the converter's interrupt stores a count and starts the next
+// conversion, so nobody waits (about 104 us each on an AVR at 16 MHz); the
+// host converts them all at once. Returns false, starting nothing, while a
+// scan is still running; adc_scan_busy() says whether one is.
+bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uint16_t* raw);
+bool adc_scan_busy();
 
 // ---- DigitalIO --------------------------------------------------------------
 enum PinMode : uint8_t { kInput = 0, kInputPullup = 1, kOutput = 2 };

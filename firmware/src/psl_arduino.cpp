@@ -66,6 +66,75 @@ uint64_t millis64() { return clock64_extend(g_millis_ext, millis()); }
 uint16_t analog_read(uint8_t pin) { return static_cast<uint16_t>(analogRead(pin)); }
 void analog_write(uint8_t pin, uint8_t duty) { analogWrite(pin, duty); }
 
+#if defined(__AVR__)
+// The background scan (adc_scan_start): what the ADC interrupt walks.
+namespace {
+struct AdcScan {
+    const uint8_t* pins;     // FSW_FLASH
+    volatile uint16_t* raw;
+    uint8_t stride;
+    uint8_t n;
+    volatile uint8_t next;   // the entry being converted; n when done
+};
+AdcScan g_scan = {0, 0, 0, 0, 0};
+
+// Starts converting a pin as analogRead does (AVcc reference, the pin's
+// channel), with the conversion-complete interrupt on.
+void adc_convert(uint8_t pin) {
+    const uint8_t ch = static_cast<uint8_t>(pin >= A0 ? pin - A0 : pin);
+#if defined(MUX5)
+    ADCSRB = static_cast<uint8_t>((ADCSRB & ~_BV(MUX5)) | (((ch >> 3) & 1u) << MUX5));
+#endif
+    ADMUX = static_cast<uint8_t>(_BV(REFS0) | (ch & 7u));
+    ADCSRA = static_cast<uint8_t>(ADCSRA | _BV(ADIF) | _BV(ADIE) | _BV(ADSC));  // ADIF: writing 1 clears it
+}
+}  // namespace
+
+bool adc_scan_busy() { return g_scan.next < g_scan.n; }
+
+bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uint16_t* raw) {
+    if (adc_scan_busy()) return false;
+    if (n == 0) return true;
+    const IrqState saved = critical_enter();
+    g_scan.pins = pins;
+    g_scan.raw = raw;
+    g_scan.stride = stride;
+    g_scan.n = n;
+    g_scan.next = 0;
+    adc_convert(pgm_read_byte(pins));
+    critical_exit(saved);
+    return true;
+}
+
+}  // namespace pal
+}  // namespace fsw
+
+// A conversion ended: store its count, start the next or stop.
+ISR(ADC_vect) {
+    using fsw::pal::g_scan;
+    const uint8_t lo = ADCL;  // ADCL first: it latches ADCH
+    const uint8_t hi = ADCH;
+    uint8_t i = g_scan.next;
+    g_scan.raw[i] = static_cast<uint16_t>(lo | (hi << 8));
+    g_scan.next = ++i;
+    if (i < g_scan.n) {
+        fsw::pal::adc_convert(pgm_read_byte(g_scan.pins + i * g_scan.stride));
+    } else {
+        ADCSRA = static_cast<uint8_t>(ADCSRA & ~_BV(ADIE));
+    }
+}
+
+namespace fsw {
+namespace pal {
+#else
+// Another MCU: the counts are converted at once, analogRead by analogRead.
+bool adc_scan_busy() { return false; }
+bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uint16_t* raw) {
+    for (uint8_t i = 0; i < n; ++i) raw[i] = static_cast<uint16_t>(analogRead(pins[i * stride]));
+    return true;
+}
+#endif
+
 void pin_mode(uint8_t pin, uint8_t mode) {
     pinMode(pin, mode == kOutput ? OUTPUT : mode == kInputPullup ? INPUT_PULLUP : INPUT);
 }

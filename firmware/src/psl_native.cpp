@@ -150,6 +150,12 @@ uint64_t millis64() { return clock64_extend(g_millis_ext, millis32()); }
 
 uint16_t analog_read(uint8_t pin) { return g_analog[pin]; }
 void analog_write(uint8_t pin, uint8_t duty) { g_pwm[pin] = duty; }
+// The host converts at once: the counts are the pins' when the scan starts.
+bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uint16_t* raw) {
+    for (uint8_t i = 0; i < n; ++i) raw[i] = g_analog[pins[i * stride]];
+    return true;
+}
+bool adc_scan_busy() { return false; }
 
 void pin_mode(uint8_t pin, uint8_t mode) {
     clear_modes();

@@ -16,14 +16,47 @@ void setUp(void) {
 }
 void tearDown(void) {}
 
+// count * gain + offset, the product rounded to R before the sum; the
+// gains below are those the generator computes (iotables.analog_gain) for
+// rocket.aio on an Uno: 6250 and 8 per volt, 5 V over 1023 counts.
 static void test_analog_conversion_formula(void) {
-    ASSERT_REAL_SAME(Real(5), analog_value_from_raw(1023, 5, 10, 1, 0));
-    ASSERT_REAL_SAME(Real(0), analog_value_from_raw(0, 5, 10, 1, 0));
-    ASSERT_REAL_SAME(Real(-3), analog_value_from_raw(0, 5, 10, 2, -3));
-    const Real volts = Real(512) * Real(5) / Real(1023);
-    ASSERT_REAL_SAME(volts * Real(250) + Real(-125), analog_value_from_raw(512, 5, 10, 250, -125));
-    ASSERT_REAL_SAME(Real(3.3), analog_value_from_raw(4095, Real(3.3), 12, 1, 0));
+    ASSERT_REAL_SAME(Real(5), analog_value(1023, Real(5) / Real(1023), 0));
+    ASSERT_REAL_SAME(Real(0), analog_value(0, Real(5) / Real(1023), 0));
+    ASSERT_REAL_SAME(Real(-3), analog_value(0, Real(2), Real(-3)));
+    const Real gain = Real(250);
+    ASSERT_REAL_SAME(Real(512) * gain + Real(-125), analog_value(512, gain, Real(-125)));
+    ASSERT_REAL_SAME(Real(255625), analog_value(1023, gain, Real(-125)));  // 1023 * 250 - 125
+    volatile Real big = Real(65535);  // the widest count
+    ASSERT_REAL_SAME(big * Real(0.5), analog_value(65535, Real(0.5), 0));
 }
+
+#if FSW_REAL_IS_FLOAT
+// Bit patterns of analog_value for rocket.aio's two calibrations, as the
+// host computes them (fswkit.autocode.iotables.analog_value; the host test
+// tests/autocode/check/test_calibration_agreement.py checks this table
+// against it): native and AVR builds agree bit for bit.
+struct CalCase {
+    uint16_t count;
+    uint32_t gain, offset, value;
+};
+static const CalCase kCalCases[] FSW_FLASH = {
+#include "calibration_cases.inc"
+};
+
+static void test_analog_conversion_matches_the_host_bit_for_bit(void) {
+    for (uint16_t i = 0; i < sizeof kCalCases / sizeof kCalCases[0]; ++i) {
+        CalCase c;
+        flash_read(&c, &kCalCases[i], sizeof c);
+        float gain, offset;
+        memcpy(&gain, &c.gain, 4);
+        memcpy(&offset, &c.offset, 4);
+        const float v = analog_value(c.count, gain, offset);
+        uint32_t bits;
+        memcpy(&bits, &v, 4);
+        TEST_ASSERT_EQUAL_HEX32(c.value, bits);
+    }
+}
+#endif
 
 static void test_pwm_duty_from_volts(void) {
     TEST_ASSERT_EQUAL_UINT8(0, pwm_duty_from_volts(0, 5));
@@ -39,10 +72,10 @@ static void test_pwm_duty_from_volts(void) {
 // sv: F32 pressure @0, F64 heater volts @4, bool limit @12, bool valve @13.
 static uint8_t sv[14];
 static const AnalogChannel kAnalog[2] FSW_FLASH = {
-    {Real(250), Real(-125), 0, 14, kIoIn, kF32},
+    {Real(250), Real(-125), 0, 14, kIoIn, kF32},  // 250 per count
     {Real(1), Real(0), 4, 9, kIoOut, kF64},
 };
-static const AnalogTable kAnalogTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 10, false};
+static const AnalogTable kAnalogTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 10, false, 0};
 static const DigitalChannel kDigital[2] FSW_FLASH = {{12, 2, kIoInPullup}, {13, 4, kIoOut}};
 static const DigitalTable kDigitalTable FSW_FLASH = {kDigital, sv, 2, true};
 
@@ -53,7 +86,7 @@ static void test_analog_task_reads_and_writes(void) {
     native::sim_set_analog(14, 1023);
     write_F64(sv + 4, Real(2.5));
     TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogTable)));
-    ASSERT_REAL_SAME(Real(1125), read_F32(sv + 0));  // 5 V * 250 - 125
+    ASSERT_REAL_SAME(Real(255625), read_F32(sv + 0));  // 1023 * 250 - 125
     TEST_ASSERT_EQUAL_UINT8(128, native::sim_pwm(9));
     native::sim_set_analog(14, 0);
     TEST_ASSERT_EQUAL(kOk, io_analog_task(const_cast<AnalogTable*>(&kAnalogTable)));
@@ -66,7 +99,7 @@ static const AnalogChannel kAnalogF32[2] FSW_FLASH = {
     {Real(250), Real(-125), 0, 14, kIoIn, kF32},
     {Real(8), Real(-20), 4, 15, kIoIn, kF32},
 };
-static const AnalogTable kAnalogF32Table FSW_FLASH = {kAnalogF32, sv, Real(5), 2, 10, false};
+static const AnalogTable kAnalogF32Table FSW_FLASH = {kAnalogF32, sv, Real(5), 2, 10, false, 0};
 
 static void test_analog_f32_task_matches_the_general_task(void) {
     TEST_ASSERT_EQUAL(kOk, io_analog_begin(&kAnalogF32Table));
@@ -81,7 +114,7 @@ static void test_analog_f32_task_matches_the_general_task(void) {
         ASSERT_REAL_SAME(a, read_F32(sv + 0));
         ASSERT_REAL_SAME(b, read_F32(sv + 4));
         uint8_t expect[4];
-        write_F32(expect, analog_value_from_raw(raw, 5, 10, 250, -125));  // rounded to binary32
+        write_F32(expect, analog_value(raw, 250, -125));  // rounded to binary32
         ASSERT_REAL_SAME(read_F32(expect), a);
     }
     uint8_t before[sizeof sv];
@@ -103,7 +136,7 @@ static void test_analog_in_task_matches_the_general_task(void) {
     ASSERT_REAL_SAME(a, read_F32(sv + 0));
     ASSERT_REAL_SAME(b, read_F32(sv + 4));
     static const AnalogChannel kOut[1] FSW_FLASH = {{Real(1), Real(0), 0, 9, kIoOut, kF32}};
-    static const AnalogTable kOutTable FSW_FLASH = {kOut, sv, Real(5), 1, 10, false};
+    static const AnalogTable kOutTable FSW_FLASH = {kOut, sv, Real(5), 1, 10, false, 0};
     native::sim_set_analog(9, 0);
     TEST_ASSERT_EQUAL(kErrConfig, io_analog_in_task_f32(const_cast<AnalogTable*>(&kOutTable)));
     TEST_ASSERT_EQUAL_UINT8(0, native::sim_pwm(9));  // nothing driven
@@ -125,15 +158,56 @@ static void test_digital_task_mirrors_pins(void) {
     TEST_ASSERT_FALSE(native::sim_digital(4));
 }
 
+// A table sampled in the background: begin converts once (the first run
+// reads the pins as they were at boot); each run converts the counts of
+// the previous run's scan and starts the next: one run of latency.
+static volatile uint16_t scan_raw[2];
+static const AnalogTable kScanTable FSW_FLASH = {kAnalogF32, sv, Real(5), 2, 10, false, scan_raw};
+
+static void test_background_scan_reads_one_run_late(void) {
+    native::sim_set_analog(14, 100);
+    native::sim_set_analog(15, 200);
+    TEST_ASSERT_EQUAL(kOk, io_analog_begin(&kScanTable));
+    TEST_ASSERT_EQUAL_UINT16(100, scan_raw[0]);
+    TEST_ASSERT_EQUAL_UINT16(200, scan_raw[1]);
+    native::sim_set_analog(14, 300);
+    native::sim_set_analog(15, 400);
+    TEST_ASSERT_EQUAL(kOk, io_analog_in_task_f32(const_cast<AnalogTable*>(&kScanTable)));
+    ASSERT_REAL_SAME(analog_value(100, 250, -125), read_F32(sv + 0));  // boot's counts
+    ASSERT_REAL_SAME(analog_value(200, 8, -20), read_F32(sv + 4));
+    TEST_ASSERT_EQUAL_UINT16(300, scan_raw[0]);  // the next run's, converted meanwhile
+    TEST_ASSERT_EQUAL(kOk, io_analog_task_f32(const_cast<AnalogTable*>(&kScanTable)));
+    ASSERT_REAL_SAME(analog_value(300, 250, -125), read_F32(sv + 0));
+    ASSERT_REAL_SAME(analog_value(400, 8, -20), read_F32(sv + 4));
+    TEST_ASSERT_FALSE(pal::adc_scan_busy());
+}
+
+// The scan walks the rows' pins in flash with the table's stride.
+static void test_scan_walks_the_pins_of_the_rows(void) {
+    uint16_t raw[2] = {0, 0};
+    native::sim_set_analog(14, 11);
+    native::sim_set_analog(15, 22);
+    TEST_ASSERT_TRUE(pal::adc_scan_start(&kAnalogF32[0].pin, sizeof(AnalogChannel), 2, raw));
+    TEST_ASSERT_EQUAL_UINT16(11, raw[0]);
+    TEST_ASSERT_EQUAL_UINT16(22, raw[1]);
+    TEST_ASSERT_TRUE(pal::adc_scan_start(&kAnalogF32[1].pin, sizeof(AnalogChannel), 1, raw));
+    TEST_ASSERT_EQUAL_UINT16(22, raw[0]);
+}
+
+// A scan converts every row: a table with an output row cannot sample in
+// the background.
+static const AnalogTable kScanMixedTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 10, false, scan_raw};
+
 static const AnalogChannel kBadType[1] FSW_FLASH = {{1, 0, 0, 14, kIoIn, kU8}};
-static const AnalogTable kBadTypeTable FSW_FLASH = {kBadType, sv, Real(5), 1, 10, false};
-static const AnalogTable kBadBitsTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 0, false};
+static const AnalogTable kBadTypeTable FSW_FLASH = {kBadType, sv, Real(5), 1, 10, false, 0};
+static const AnalogTable kBadBitsTable FSW_FLASH = {kAnalog, sv, Real(5), 2, 0, false, 0};
 static const DigitalChannel kBadDir[1] FSW_FLASH = {{12, 2, 9}};
 static const DigitalTable kBadDirTable FSW_FLASH = {kBadDir, sv, 1, false};
 
 static void test_begin_refuses_bad_tables(void) {
     TEST_ASSERT_EQUAL(kErrConfig, io_analog_begin(&kBadTypeTable));
     TEST_ASSERT_EQUAL(kErrConfig, io_analog_begin(&kBadBitsTable));
+    TEST_ASSERT_EQUAL(kErrConfig, io_analog_begin(&kScanMixedTable));
     TEST_ASSERT_EQUAL(kErrConfig, io_digital_begin(&kBadDirTable));
 }
 #endif
@@ -186,12 +260,17 @@ static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_analog_conversion_formula);
     RUN_TEST(test_pwm_duty_from_volts);
+#if FSW_REAL_IS_FLOAT
+    RUN_TEST(test_analog_conversion_matches_the_host_bit_for_bit);
+#endif
     RUN_TEST(test_resolved_pins_drive_and_read);
 #if FSW_PLATFORM_NATIVE
     RUN_TEST(test_analog_task_reads_and_writes);
     RUN_TEST(test_analog_f32_task_matches_the_general_task);
     RUN_TEST(test_analog_in_task_matches_the_general_task);
     RUN_TEST(test_digital_task_mirrors_pins);
+    RUN_TEST(test_background_scan_reads_one_run_late);
+    RUN_TEST(test_scan_walks_the_pins_of_the_rows);
     RUN_TEST(test_begin_refuses_bad_tables);
 #endif
     (void)UNITY_END();

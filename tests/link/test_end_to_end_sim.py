@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 
 from conftest import run_fsw
+from fswkit.autocode.iotables import analog_gain
+from fswkit.autocode.numeric import F32MODE
 from fswkit.link import wire
 from fswkit.link.session import Session
 from support.linkfw import TANK, tank_layout
@@ -25,11 +27,12 @@ VOLTS = 3.76  # 769 counts: 814.7 psi, between 775 and 825: the controller holds
 
 
 def psi_f32(raw: int) -> float:
-    """tank.aio's calibration as the Uno computes it: binary32, in the
-    runtime's order, stored into the F64 element exactly."""
+    """tank.aio's calibration as the Uno computes it: binary32, one
+    multiply-add per count (the generator's gain, fsw_io.h), stored into the
+    F64 element exactly."""
     f = np.float32
-    volts = f(raw) * f(5.0) / f(1023.0)
-    return float(volts * f(250.0) + f(-125.0))
+    gain = f(analog_gain(250.0, 5.0, 10, F32MODE))
+    return float(f(f(raw) * gain) + f(-125.0))
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,9 @@ of the project's `.aio` calibration (`element = volts * scale + offset`, so
 sensor's output saturates), converted as a real AVR ADC converts,
 `counts = floor(V * 2^bits / Vref)` at most `2^bits - 1`, with the board's
 `[adc] bits` and `vref`. The firmware then reads
-`counts * Vref / (2^bits - 1) * scale + offset` (`reading`).
+`counts * gain + offset`, gain = scale * Vref / (2^bits - 1) folded on the
+host (`reading`: with the board's arithmetic `real`, bit for bit the
+firmware's, fswkit.autocode.iotables.analog_value).
 
 The simulated board takes an input in whole millivolts and converts it as
 `floor(mV * (2^bits - 1) / Vref_mV)` (simavr); `millivolts(counts)` is the
@@ -17,6 +19,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from fswkit.autocode.iotables import analog_gain, analog_value
+from fswkit.autocode.numeric import REALS
 
 
 @dataclass(frozen=True)
@@ -30,6 +35,7 @@ class AnalogSensor:
     offset: float
     vref: float  # volts
     bits: int
+    real: str | None = None  # the board's arithmetic ("f32", "f64"); None: the ideal, in binary64
 
     def __post_init__(self):
         if not self.scale or not math.isfinite(self.scale):
@@ -55,9 +61,14 @@ class AnalogSensor:
         return self.counts(self.volts(value))
 
     def reading(self, counts: int) -> float:
-        """What the firmware's element holds for a count (its calibration,
-        in double precision: the board's own arithmetic may round it)."""
-        return counts * self.vref / self.full * self.scale + self.offset
+        """What the firmware's element holds for a count: with `real`, its
+        multiply-add in the board's arithmetic, bit for bit
+        (iotables.analog_value); without, the calibration in binary64."""
+        if self.real is None:
+            return counts * self.vref / self.full * self.scale + self.offset
+        r = REALS[self.real]
+        gain = analog_gain(self.scale, self.vref, self.bits, r)
+        return analog_value(counts, gain, r.literal(repr(self.offset)), r)
 
     def millivolts(self, counts: int) -> int:
         """The whole millivolts that the simulated converter turns into
@@ -79,4 +90,4 @@ class AnalogSensor:
 def from_channel(channel, board) -> AnalogSensor:
     """The sensor of a project's analog input channel (autocode's Channel)."""
     return AnalogSensor(channel.pin, channel.element.name, float(channel.scale), float(channel.offset),
-                        float(board.adc_vref), int(board.adc_bits))
+                        float(board.adc_vref), int(board.adc_bits), board.real)

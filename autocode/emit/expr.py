@@ -49,7 +49,7 @@ class ExprEmitter:
     def read(self, i: int) -> str:
         v = self.m.vars[i]
         if v.kind == M.TIME_IN_STATE:
-            return f"fsw::real_from_U64({self.prefix}machine.t)"
+            return f"fsw::machine_T_real({self.prefix}machine)"
         if i in self.consts:
             return real_literal(self.consts[i], self.real)
         text = f"fsw::read_{v.type.name}({self.ptr(v)})"
@@ -161,7 +161,23 @@ class ExprEmitter:
         if const is not None:
             return const
         fast = self.int_add(var, e)
+        if fast is None:
+            fast = self.time_store(var, e)
         return fast if fast is not None else self.write(var, self.value(e))
+
+    def time_store(self, var: int, e: M.Expr):
+        """`x = T` for an integer x of at most 32 bits: R(T) converted to x's
+        type is T saturated at x's maximum, rounded to R's precision first
+        (fsw::machine_T_int, integer code only)."""
+        target = self.m.vars[var]
+        t = target.type
+        if type(e) is not M.Ref or self.m.vars[e.var].kind != M.TIME_IN_STATE:
+            return None
+        if t.kind != "int" or t.size > 4 or (self.sv_lock and target.kind == M.ELEMENT):
+            return None
+        ctype = self._ctype(t)
+        return (f"fsw::store<{ctype}>({self.ptr(target)}, static_cast<{ctype}>("
+                f"fsw::machine_T_int({self.prefix}machine, {t.hi}UL)));")
 
     def constant_store(self, var: int, e: M.Expr):
         """`x = <literals only>`: the converted value is known now; store it."""

@@ -18,6 +18,45 @@ uint32_t machine_T32(const Machine& m) {
     const uint8_t* t = reinterpret_cast<const uint8_t*>(&m.t);
     return load<uint32_t>(t + 4) != 0 ? 0xFFFFFFFFUL : load<uint32_t>(t);
 }
+
+Real machine_T_real(const Machine& m) {
+    const uint8_t* t = reinterpret_cast<const uint8_t*>(&m.t);
+    uint32_t lo = load<uint32_t>(t), hi = load<uint32_t>(t + 4);
+    if (hi == 0) return static_cast<Real>(lo);  // correctly rounded by the float library
+    // Shift right until the value fits 32 bits, OR-ing what falls off into
+    // bit 0 (below the guard bit: the rounding is unchanged), convert, and
+    // scale by 2^k exactly.
+    uint8_t k = 0, sticky = 0;
+    do {
+        sticky = static_cast<uint8_t>(sticky | (lo & 1u));
+        lo = (lo >> 1) | (hi << 31);
+        hi >>= 1;
+        ++k;
+    } while (hi != 0);
+    // Times 2^k: k added to the exponent field (bits 23..30; the value is a
+    // normal number from 2^31 to 2^64, so the field neither wraps nor spills).
+    Real r = static_cast<Real>(lo | sticky);
+    uint32_t bits;
+    memcpy(&bits, &r, sizeof bits);
+    bits += static_cast<uint32_t>(static_cast<uint16_t>(k << 7)) << 16;  // k << 23, as byte moves
+    memcpy(&r, &bits, sizeof r);
+    return r;
+}
 #endif
+
+uint32_t round_f32_saturated(uint32_t v, uint32_t hi) {
+    if (v >= 0x1000000UL) {
+        // 24 significant bits: drop s low bits, round to nearest, ties to even.
+        uint8_t s = 1;
+        while ((v >> s) >= 0x1000000UL) ++s;
+        const uint32_t unit = 1UL << s, rem = v & (unit - 1u), half = unit >> 1;
+        v -= rem;
+        if (rem > half || (rem == half && (v & unit) != 0)) {
+            v += unit;
+            if (v == 0) return hi;  // rounded up to 2^32, above any hi
+        }
+    }
+    return v > hi ? hi : v;
+}
 
 }  // namespace fsw

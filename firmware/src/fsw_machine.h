@@ -4,6 +4,7 @@
 #ifndef FSW_MACHINE_H
 #define FSW_MACHINE_H
 
+#include "fsw_convert.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -74,6 +75,28 @@ inline uint32_t machine_T32(const Machine& m) {
 inline void machine_transition(Machine& m, uint32_t target) {
     m.state = target;
     m.pending = 1;
+}
+
+// R(T), what T reads as in an expression: real_from_U64(T), on AVR without
+// the 64-bit conversion routine (a 32-bit conversion, exact scaling).
+#if defined(__AVR__)
+FSW_NOINLINE FSW_NOCLONE Real machine_T_real(const Machine& m);
+#else
+inline Real machine_T_real(const Machine& m) { return real_from_U64(m.t); }
+#endif
+
+// `x = T` for an integer x whose largest value is hi (< 2^32): R(T)
+// converted to x's type, which for T >= 0 is R(T) saturated at hi: T itself
+// where R holds it, else T rounded to R's precision (binary32: 24 bits,
+// ties to even). No float code.
+uint32_t round_f32_saturated(uint32_t v, uint32_t hi);
+inline uint32_t machine_T_int(const Machine& m, uint32_t hi) {
+    const uint32_t v = machine_T32(m);
+#if FSW_REAL_IS_FLOAT
+    return round_f32_saturated(v, hi);
+#else
+    return v > hi ? hi : v;  // binary64 holds every T32 exactly; T >= 2^32 saturates
+#endif
 }
 
 }  // namespace fsw

@@ -73,6 +73,39 @@ static void test_init_macro_equals_reset(void) {
     TEST_ASSERT_EQUAL_UINT64(a.entry_g, b.entry_g);
 }
 
+// What generated code reads T as: R(T) (machine_T_real, on AVR without the
+// 64-bit conversion), `x = T` into integers (machine_T_int) and T against a
+// constant (machine_T32) agree with the R semantics, bit for bit.
+static void check_T(uint64_t t) {
+    Machine m = FSW_MACHINE_INIT(1);
+    m.t = t;
+    const Real r = real_from_U64(t);
+    ASSERT_REAL_SAME(r, machine_T_real(m));
+    TEST_ASSERT_EQUAL_UINT32(U32_from_real(r), machine_T_int(m, 0xFFFFFFFFUL));
+    TEST_ASSERT_EQUAL_UINT32(static_cast<uint32_t>(I32_from_real(r)), machine_T_int(m, 0x7FFFFFFFUL));
+    TEST_ASSERT_EQUAL_UINT32(U16_from_real(r), machine_T_int(m, 0xFFFFUL));
+    TEST_ASSERT_EQUAL_UINT32(static_cast<uint32_t>(I8_from_real(r)), machine_T_int(m, 0x7FUL));
+    TEST_ASSERT_EQUAL_UINT32(t >= 0xFFFFFFFFULL ? 0xFFFFFFFFUL : static_cast<uint32_t>(t), machine_T32(m));
+}
+
+static void test_T_reads_as_R_and_converts_like_R(void) {
+    const uint64_t edges[] = {0, 1, 127, 128, 255, 256, 65535, 65536, 0xFFFFFFULL, 0x1000000ULL, 0x1000001ULL,
+                              0x1000002ULL, 0x1000003ULL, 0x2000006ULL, 0x7FFFFFBFULL, 0x7FFFFFC0ULL, 0x7FFFFFFFULL,
+                              0x80000000ULL, 0xFFFFFF7FULL, 0xFFFFFF80ULL, 0xFFFFFF81ULL, 0xFFFFFFFEULL, 0xFFFFFFFFULL,
+                              0x100000000ULL, 0x100000001ULL, 0x100000080ULL, 0x100000100ULL, 0x100000180ULL,
+                              0x1000000FFULL, (1ULL << 40) + (1ULL << 16), (1ULL << 40) + (1ULL << 16) + 1,
+                              (1ULL << 63) - 1, 1ULL << 63, ~0ULL};
+    for (size_t i = 0; i < sizeof edges / sizeof edges[0]; ++i) check_T(edges[i]);
+    uint64_t x = 0x9E3779B97F4A7C15ULL;
+    for (int i = 0; i < 400; ++i) {  // every magnitude, and the bits around the rounding point
+        x ^= x << 13; x ^= x >> 7; x ^= x << 17;
+        const uint64_t t = x >> (i % 64);
+        check_T(t);
+        check_T(t | 0x80ULL);
+        check_T(t & ~0xFFULL);
+    }
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_first_step_enters_the_initial_state_with_T_zero);
@@ -80,6 +113,7 @@ static void run(void) {
     RUN_TEST(test_transition_makes_the_next_step_the_targets_first);
     RUN_TEST(test_T_is_exact_beyond_what_R_can_hold);
     RUN_TEST(test_init_macro_equals_reset);
+    RUN_TEST(test_T_reads_as_R_and_converts_like_R);
     (void)UNITY_END();
 }
 

@@ -106,6 +106,45 @@ static void test_T_reads_as_R_and_converts_like_R(void) {
     }
 }
 
+// machine_begin (what generated step() calls: G from its element, S written
+// on a state's first step; on AVR byte loops) does what machine_begin_step
+// does, G equal, backwards, carrying across bytes and 2^32 included.
+static void test_machine_begin_matches_machine_begin_step(void) {
+    Machine a = FSW_MACHINE_INIT(2), b = FSW_MACHINE_INIT(2);
+    uint8_t g[8], s[4] = {0, 0, 0, 0};
+    uint64_t x = 0x0123456789ABCDEFULL, G = 0xFFFFFFF0ULL;
+    for (int i = 0; i < 600; ++i) {
+        x ^= x << 13; x ^= x >> 7; x ^= x << 17;
+        switch (x % 6) {
+            case 0: break;                                 // equal: refused
+            case 1: G -= (x >> 8) % 300; break;            // backwards: refused
+            case 2: G += 1; break;
+            case 3: G += 0x100 - (G & 0xFF); break;        // carries into the next byte
+            case 4: G += (x >> 16) % 100000; break;
+            default: G += 1ULL << ((x >> 8) % 40); break;  // big jumps, past 2^32
+        }
+        if ((x >> 20) % 7 == 0) {
+            machine_transition(a, 1 + (x >> 24) % 3);
+            machine_transition(b, a.state);
+        }
+        memcpy(g, &G, 8);
+        const Result ra = machine_begin(a, g, s);
+        const Result rb = machine_begin_step(b, G);
+        TEST_ASSERT_EQUAL(rb, ra);
+        TEST_ASSERT_EQUAL_UINT64(b.last_g, a.last_g);
+        TEST_ASSERT_EQUAL_UINT64(b.entry_g, a.entry_g);
+        TEST_ASSERT_EQUAL_UINT64(b.t, a.t);
+        TEST_ASSERT_EQUAL_UINT8(b.entering, a.entering);
+        TEST_ASSERT_EQUAL_UINT8(b.pending, a.pending);
+        TEST_ASSERT_EQUAL_UINT8(b.started, a.started);
+        if (rb == kOk && b.entering != 0) {
+            uint32_t written;
+            memcpy(&written, s, 4);
+            TEST_ASSERT_EQUAL_UINT32(b.state, written);
+        }
+    }
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_first_step_enters_the_initial_state_with_T_zero);
@@ -114,6 +153,7 @@ static void run(void) {
     RUN_TEST(test_T_is_exact_beyond_what_R_can_hold);
     RUN_TEST(test_init_macro_equals_reset);
     RUN_TEST(test_T_reads_as_R_and_converts_like_R);
+    RUN_TEST(test_machine_begin_matches_machine_begin_step);
     (void)UNITY_END();
 }
 

@@ -4,6 +4,8 @@ that are bit-identical to it (the differential tests hold them to that)."""
 
 from __future__ import annotations
 
+import math
+
 import struct
 
 from .. import model as M
@@ -73,10 +75,34 @@ class ExprEmitter:
         if t is M.Neg:
             return f"(-{self.value(e.operand)})"
         if t is M.Arith:
+            inv = self.exact_reciprocal(e.right) if e.op == "/" else None
+            if inv is not None:  # x / 2^k is x * 2^-k, bit for bit: no division on the MCU
+                return f"({self.value(e.left)} * {real_literal(inv, self.real)})"
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
         if t is M.Roll:
             return f"{self.windows}{e.window}.value()"
         return f"fsw::real_from_truth({self.cond(e)})"
+
+    def exact_reciprocal(self, e: M.Expr) -> float | None:
+        """1/c when `e` is a constant c = ±2^k whose reciprocal R holds as a
+        normal number: dividing by c and multiplying by 1/c then round the
+        same exact quotient, so they give the same bits (NaN, infinities and
+        signed zeros included). None otherwise."""
+        if type(e) is M.Neg:
+            inv = self.exact_reciprocal(e.operand)
+            return None if inv is None else -inv
+        if type(e) is M.Const:
+            c = self.real.literal(e.text)
+        elif type(e) is M.Ref and e.var in self.consts:  # a local the machine never writes
+            c = self.consts[e.var]
+        else:
+            return None
+        if c == 0 or c != c or math.isinf(c) or abs(math.frexp(c)[0]) != 0.5:
+            return None
+        inv = 1.0 / c
+        tiny = 2.0 ** (-126 if self.real.bits == 32 else -1022)
+        big = 2.0 ** (127 if self.real.bits == 32 else 1023)
+        return inv if tiny <= abs(inv) <= big else None
 
     def cond(self, e: M.Expr) -> str:
         t = type(e)

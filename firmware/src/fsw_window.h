@@ -106,7 +106,12 @@ struct RollAvgN {
     RollAvgS<I> s;
     Real ring[N];
     void push(Real x) { roll_avg_push<I>(s, ring, static_cast<I>(N), x); }
-    Real value() const { return roll_avg_value(s); }
+    // A full window of a power-of-two N multiplies by 1/N, a constant R
+    // holds exactly: the same bits as the division, with no division routine.
+    Real value() const {
+        if ((N & (N - 1)) == 0 && s.count == N) return (s.base + s.fresh) * (Real(1) / Real(N));
+        return roll_avg_value(s);
+    }
 };
 
 template <uint32_t N>

@@ -100,8 +100,21 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     else:
         c.append(f"    if (fsw::machine_begin(machine, sv + E_{g.name}, sv + E_{s.name}) != fsw::kOk) "
                  "return fsw::kErrTime;")
+    # Windows over the same argument take one read of it (an element read is
+    # a call on AVR), pushed where the first of them was. An argument reads
+    # only windows of lower index (inner calls get theirs first), and equal
+    # arguments read the same ones, so every window still sees its argument
+    # after the windows it reads were pushed.
+    args: dict[str, list] = {}
     for w in m.windows:
-        c.append(f"    w{w.index}.push({ex.value(w.arg)});  // {src}:{w.line}")
+        args.setdefault(ex.value(w.arg), []).append(w)
+    for k, (arg, ws) in enumerate(args.items()):
+        if len(ws) == 1:
+            c.append(f"    w{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
+            continue
+        c.append(f"    const fsw::Real x{k} = {arg};")
+        for w in ws:
+            c.append(f"    w{w.index}.push(x{k});  // {src}:{w.line}")
     moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
     if moves:
         c.append(f"    {sid} next = 0;")

@@ -88,6 +88,7 @@ bench: setup
 	$(PY) tools/bench_link.py
 	$(PY) tools/bench_flights.py
 	$(PY) tools/bench_tapes.py
+	$(PY) tools/bench_busy.py
 	$(PY) tools/bench_study.py
 	$(MAKE) --no-print-directory bench-firmware
 

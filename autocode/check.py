@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
+from . import memo
 from . import model as M
 from . import syntax as S
 from .diagnostics import SM, SS, SV, Diagnostic, Diagnostics, Source, visual_col
@@ -32,6 +33,10 @@ def unknown_type(name: str) -> str:
 
 
 def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
+    return memo.run(("check_sv", id(f), src.path, src.text), (f,), diags, lambda d: _check_sv(f, src, d))
+
+
+def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     lang = SV
     lock = False
     for o in f.options:
@@ -180,6 +185,8 @@ def format_number(v) -> str:
 def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     """The value of a window size expression: literals and locals' initial
     values only (spec §4.4); None after reporting why not."""
+    if type(n) is S.Num:  # the common case: a literal, which nothing can make wrong here
+        return F64MODE.literal(n.text)
     # Counted on `error_count`: `errors` builds a list, and one per window
     # made many windows with errors quadratic.
     reported = res.diags.error_count
@@ -209,6 +216,19 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
 def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
              warnings: bool = False) -> M.Machine | None:
     """The typed machine, or None when it has errors (all reported)."""
+    checked = memo.run(("check_sm", id(f), id(sv), src.path, src.text), (f, sv), diags,
+                       lambda d: _check_sm(f, src, sv, d))
+    if checked is None:
+        return None
+    m, consts, used = checked
+    if warnings:
+        machine_warnings(m, f, src, diags, consts, used)
+    return m
+
+
+def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
+    """(the typed machine, its locals' values, the variables used), or None
+    when it has errors (all reported)."""
     lang = SM
     before = diags.error_count
     err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
@@ -348,9 +368,7 @@ def check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics,
         return None
     name = src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
     m = M.Machine(src.path, name, sv, tuple(vars_), tuple(states), tuple(windows), g, s, t_idx)
-    if warnings:
-        machine_warnings(m, f, src, diags, consts, res.used)
-    return m
+    return m, consts, frozenset(res.used)
 
 
 def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_) -> M.Expr:
@@ -616,17 +634,21 @@ def machine_warnings(m: M.Machine, f: S.SmFile, src: Source, diags: Diagnostics,
 def assignments(m: M.Machine):
     """Every assignment of the machine, nested ones included, state by
     state and block by block in source order."""
+    out: list[M.Assign] = []
+
     def walk(stmts):
         for st in stmts:
             if isinstance(st, M.Assign):
-                yield st
+                out.append(st)
             elif isinstance(st, M.If):
-                yield from walk(st.then)
-                yield from walk(st.orelse)
+                walk(st.then)
+                walk(st.orelse)
 
     for st in m.states:
-        for block in (st.entry, st.step, st.exit):
-            yield from walk(block)
+        walk(st.entry)
+        walk(st.step)
+        walk(st.exit)
+    return out
 
 
 def assigned_vars(m: M.Machine) -> set[int]:

@@ -23,15 +23,17 @@ class Tok(NamedTuple):
     col: int  # 1-based, tabs expanded
 
 
-_TOKEN = re.compile(r"""
-    (?P<ws>[ \t\f\v\r]+)
-  | (?P<comment>\#.*)
+# One token, with the blanks before it (a line's blanks are no token).
+_BLANKS = r"[ \t\f\v\r]*"
+_TOKEN = re.compile(_BLANKS + r"""(?:
+    (?P<comment>\#.*)
   | (?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)
   | (?P<id>[A-Za-z_][A-Za-z0-9_]*)
   | (?P<annot>@[A-Za-z_][A-Za-z0-9_]*)
   | (?P<label>\.[A-Za-z_][A-Za-z0-9_]*)
   | (?P<op>->|<=|>=|==|!=|[-+*/<>=!(){}:,\[\]])
-""", re.X)
+)""", re.X)
+_SKIP_BLANKS = re.compile(_BLANKS)
 _NUMBER_TAIL = re.compile(r"[A-Za-z0-9_.]+")
 
 
@@ -51,7 +53,10 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
     bad_end = -1  # a run of unexpected characters is reported once, at its start
     while pos < end:
         m = match(text, pos)
-        if m is None:
+        if m is None:  # blanks to the end, or a character no token starts with
+            pos = _SKIP_BLANKS.match(text, pos).end()
+            if pos == end:
+                break
             if pos != bad_end:
                 col = cols(pos) if cols else pos + 1
                 diags.lexical_error(src, lang, n, col, f"unexpected {describe(text[pos])}")
@@ -59,10 +64,11 @@ def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> l
             bad_end = pos
             continue
         kind = m.lastgroup
-        s = m.group()
-        col = cols(pos) if cols else pos + 1
+        s = m[kind]
         pos = m.end()
-        if kind == "ws" or kind == "comment":
+        start = pos - len(s)
+        col = cols(start) if cols else start + 1
+        if kind == "comment":
             continue
         if kind == "num":
             tail = _NUMBER_TAIL.match(text, pos)

@@ -124,6 +124,9 @@ class _F64(Real):
         return float(text)
 
 
+_F32_LITERALS: dict[str, float] = {}  # a literal's text -> its binary32 value (exact rounding costs)
+
+
 class _F32(Real):
     name, bits = "f32", 32
 
@@ -134,6 +137,12 @@ class _F32(Real):
         return f32_from_int(i)
 
     def literal(self, text: str) -> float:
+        value = _F32_LITERALS.get(text)
+        if value is None:
+            value = _F32_LITERALS[text] = self._literal(text)
+        return value
+
+    def _literal(self, text: str) -> float:
         if text in BOOL_LITERALS:
             return BOOL_LITERALS[text]
         d = float(text)

@@ -10,10 +10,13 @@ import math
 
 from .diagnostics import SM, SS, SV, Diagnostics, Source
 from .lexer import ANNOT, EOF, ID, KW, LABEL, NL, NUM, OP, Tok, lex
+from . import memo
 from . import syntax as S
 
 MAX_NESTING = 64  # parentheses, unary operators, nested guards and braces
 MAX_DEPTH = 200  # depth of one expression tree
+_REL = 4
+_LEVELS = {"or": 1, "and": 2, "==": 3, "!=": 3, **{op: _REL for op in S.RELATIONAL}, "+": 5, "-": 5, "*": 6, "/": 6}
 FUNCTIONS = ("roll_avg", "roll_median", "roll_min", "roll_max", "roll_range")
 
 
@@ -151,76 +154,51 @@ class Parser:
 
     # -- expressions
     def expression(self) -> S.Expr:
+        start = self.i
         e = self.or_expr()
-        if tree_depth(e) > MAX_DEPTH:
+        # every level of a tree has a token of its own: fewer tokens, no deeper tree
+        if self.i - start > MAX_DEPTH and tree_depth(e) > MAX_DEPTH:
             raise ParseError(Tok(OP, "", e.line, e.col),
                              f"expression is nested too deeply (more than {MAX_DEPTH} levels of operators)")
         return e
 
+    # The binary operators by precedence climbing: one call a level of the
+    # tree rather than one a level of the grammar. Levels, loosest first:
+    # or, and, == !=, the relational chain, + -, * /; all left-associative,
+    # a run of relational operators one node (S.Chain). The current token is
+    # read as self.toks[self.i]: the stream ends with EOF, which `next`
+    # never passes. Only operators and keywords have these texts.
     def or_expr(self) -> S.Expr:
-        left = self.and_expr()
-        while self.at_kw("or"):
-            op = self.next()
-            left = S.Binary(left.line, left.col, "or", left, self.and_expr(), op.col)
-        return left
+        return self.binary(1)
 
-    def and_expr(self) -> S.Expr:
-        left = self.eq_expr()
-        while self.at_kw("and"):
-            op = self.next()
-            left = S.Binary(left.line, left.col, "and", left, self.eq_expr(), op.col)
-        return left
-
-    def eq_expr(self) -> S.Expr:
-        left = self.rel_expr()
+    def binary(self, min_level: int) -> S.Expr:
+        left = self.unary()
+        toks = self.toks
+        levels = _LEVELS
         while True:
-            t = self.peek()
-            if t.kind == OP and t.text in ("==", "!="):
-                self.next()
-                left = S.Binary(left.line, left.col, t.text, left, self.rel_expr(), t.col)
-            else:
+            t = toks[self.i]
+            level = levels.get(t.text)
+            if level is None or level < min_level:
                 return left
-
-    def rel_expr(self) -> S.Expr:
-        first = self.add_expr()
-        operands, ops, cols = [first], [], []
-        while True:
-            t = self.peek()
-            if t.kind == OP and t.text in S.RELATIONAL:
-                self.next()
+            self.i += 1
+            if level != _REL:
+                left = S.Binary(left.line, left.col, t.text, left, self.binary(level + 1), t.col)
+                continue
+            operands, ops, cols = [left, self.binary(_REL + 1)], [t.text], [t.col]
+            t = toks[self.i]
+            while levels.get(t.text) == _REL:
+                self.i += 1
                 ops.append(t.text)
                 cols.append(t.col)
-                operands.append(self.add_expr())
+                operands.append(self.binary(_REL + 1))
+                t = toks[self.i]
+            if len(ops) == 1:
+                left = S.Binary(left.line, left.col, ops[0], left, operands[1], cols[0])
             else:
-                break
-        if not ops:
-            return first
-        if len(ops) == 1:
-            return S.Binary(first.line, first.col, ops[0], first, operands[1], cols[0])
-        return S.Chain(first.line, first.col, tuple(operands), tuple(ops))
-
-    def add_expr(self) -> S.Expr:
-        left = self.mul_expr()
-        while True:
-            t = self.peek()
-            if t.kind == OP and t.text in ("+", "-"):
-                self.next()
-                left = S.Binary(left.line, left.col, t.text, left, self.mul_expr(), t.col)
-            else:
-                return left
-
-    def mul_expr(self) -> S.Expr:
-        left = self.unary()
-        while True:
-            t = self.peek()
-            if t.kind == OP and t.text in ("*", "/"):
-                self.next()
-                left = S.Binary(left.line, left.col, t.text, left, self.unary(), t.col)
-            else:
-                return left
+                left = S.Chain(left.line, left.col, tuple(operands), tuple(ops))
 
     def unary(self) -> S.Expr:
-        t = self.peek()
+        t = self.toks[self.i]
         if (t.kind == OP and t.text in ("-", "!")) or (t.kind == KW and t.text == "not"):
             self.next()
             self.enter(t)
@@ -230,9 +208,9 @@ class Parser:
         return self.primary()
 
     def primary(self) -> S.Expr:
-        t = self.peek()
+        t = self.toks[self.i]
         if t.kind == NUM:
-            self.next()
+            self.i += 1
             if float(t.text) == math.inf:  # every literal must be a finite binary64 (401 digits is not)
                 raise ParseError(t, "number is outside the representable range")
             return S.Num(t.line, t.col, t.text)
@@ -530,6 +508,10 @@ def _line_parser(toks: list[Tok], src, diags, lang) -> Parser:
 
 
 def parse_sv(src: Source, diags: Diagnostics) -> S.SvFile:
+    return memo.run(("parse_sv", src.path, src.text), (), diags, lambda d: _parse_sv(src, d))
+
+
+def _parse_sv(src: Source, diags: Diagnostics) -> S.SvFile:
     lang = SV
     lines = lex(src, diags, lang)
     pre, sections = split_sections(src, lines, diags, lang)
@@ -576,6 +558,10 @@ def _elem_decl(toks: list[Tok], src, diags, lang) -> S.ElemDecl | None:
 
 
 def parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
+    return memo.run(("parse_sm", src.path, src.text), (), diags, lambda d: _parse_sm(src, d))
+
+
+def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
     lang = SM
     lines = lex(src, diags, lang)
     pre, sections = split_sections(src, lines, diags, lang)

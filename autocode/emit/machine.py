@@ -33,6 +33,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         offsets[v.index] = size
         size += v.type.size
     init_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in stored)
+    assert m.states[0].id == 1, "a zero fsw::Machine starts in state 1"
     guard = f"{ns.upper()}_{name.upper()}_H"
     h = [banner([m.path, m.sv.path], m.sv), f"#ifndef {guard}", f"#define {guard}", "",
          '#include "fswkit.h"', "", f"namespace {ns} {{", f"namespace {name} {{", "",
@@ -59,7 +60,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     c = [banner([m.path, m.sv.path], m.sv), f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
          version_check(f"{name}.gen.cpp"), real_check(src, real),
          f"namespace {ns} {{", f"namespace {name} {{", "",
-         f"fsw::Machine machine = FSW_MACHINE_INIT({m.states[0].id});"]
+         "fsw::Machine machine;  // zero: before the first step in the first state (fsw::machine_begin)"]
     if stored:
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
     c += ["", "namespace {", ""]

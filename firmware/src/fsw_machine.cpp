@@ -21,6 +21,10 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
     }
     m.started = 1;
     memcpy(last, g, 8);
+    if (m.state == 0) {  // a zero Machine: before the first step in state 1
+        m.state = 1;
+        m.pending = 1;
+    }
     m.entering = m.pending;
     uint8_t* entry = reinterpret_cast<uint8_t*>(&m.entry_g);
     if (m.pending != 0) {
@@ -39,6 +43,7 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
 }
 #else
 Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
+    if (m.state == 0 && m.started == 0) machine_reset(m, 1);  // a zero Machine (fsw_machine.h)
     if (machine_begin_step(m, load<uint64_t>(g)) != kOk) return kErrTime;
     if (m.entering != 0) store<uint32_t>(s, m.state);
     return kOk;

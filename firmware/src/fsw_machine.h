@@ -54,6 +54,9 @@ FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
 // What generated step() functions call: machine_begin_step with G read from
 // its element at `g`, and on a state's first step the state id written to
 // the S element at `s` (U32). Out of line: one copy for all the machines.
+// A Machine of all zeros (static storage, no initialiser: .bss, no copy of
+// it in flash) is FSW_MACHINE_INIT(1) to machine_begin, the first state of
+// every generated machine.
 FSW_MUST_CHECK FSW_NOINLINE FSW_NOCLONE Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s);
 
 // T, the time spent in the current state (valid after machine_begin_step).

@@ -145,6 +145,29 @@ static void test_machine_begin_matches_machine_begin_step(void) {
     }
 }
 
+// Generated machines are zero-initialised (.bss): machine_begin takes a zero
+// Machine for FSW_MACHINE_INIT(1).
+static void test_a_zero_machine_begins_in_state_1(void) {
+    Machine z;
+    memset(&z, 0, sizeof z);
+    Machine a = FSW_MACHINE_INIT(1);
+    uint8_t s[4] = {0xAA, 0xAA, 0xAA, 0xAA};
+    const uint64_t gs[] = {7, 7, 9, 30};
+    for (size_t i = 0; i < sizeof gs / sizeof gs[0]; ++i) {
+        uint8_t g[8];
+        memcpy(g, &gs[i], 8);
+        TEST_ASSERT_EQUAL(machine_begin_step(a, gs[i]), machine_begin(z, g, s));
+        TEST_ASSERT_EQUAL_UINT32(a.state, z.state);
+        TEST_ASSERT_EQUAL_UINT8(a.entering, z.entering);
+        TEST_ASSERT_EQUAL_UINT8(a.pending, z.pending);
+        TEST_ASSERT_EQUAL_UINT64(a.t, z.t);
+        TEST_ASSERT_EQUAL_UINT64(a.entry_g, z.entry_g);
+    }
+    uint32_t written;
+    memcpy(&written, s, 4);
+    TEST_ASSERT_EQUAL_UINT32(1, written);  // S written on the first step
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_first_step_enters_the_initial_state_with_T_zero);
@@ -154,6 +177,7 @@ static void run(void) {
     RUN_TEST(test_init_macro_equals_reset);
     RUN_TEST(test_T_reads_as_R_and_converts_like_R);
     RUN_TEST(test_machine_begin_matches_machine_begin_step);
+    RUN_TEST(test_a_zero_machine_begins_in_state_1);
     (void)UNITY_END();
 }
 

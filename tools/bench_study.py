@@ -15,7 +15,7 @@ line under it gives the same rate from the CPU time the runs used (the
 flights' own processes and their simulated boards), which does not depend on
 what else runs: cores × 3,600 / CPU seconds per flight.
 
-    tools/bench_study.py [--runs 1000] [--jobs CORES] [--seed 1]
+    tools/bench_study.py [--runs 1000] [--jobs CORES] [--seed 1]     (FSW_STUDY_RUNS=N make bench: N runs)
 """
 
 from __future__ import annotations
@@ -40,7 +40,8 @@ BEFORE_PER_HOUR = 455  # shared/targets.md, measured 2026-11-23 (~455 with two f
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--runs", type=int, default=1000, help="flights in the study (default 1000)")
+    ap.add_argument("--runs", type=int, default=int(os.environ.get("FSW_STUDY_RUNS", "1000")),
+                    help="flights in the study (default 1000, or FSW_STUDY_RUNS)")
     ap.add_argument("--jobs", type=int, default=study.cores(), help="flights at a time (default: the cores)")
     ap.add_argument("--seed", type=int, default=1, help="the study's seed (default 1)")
     args = ap.parse_args()

@@ -18,6 +18,7 @@ bool armSwitch          # the arming key
 bool abortCmd           # set by the ground to abort before launch
 U8   phase              # set by the mission for nav: 0 pad, 1 boost, 2 coast, 3 under a canopy
 bool baroStuck          # the pressure has not moved by half a count for STUCK_TIME
+U8   agree              # samples in a row the barometer agreed with the filter (within its gate), at most 255
 
 [Nav]                   # not streamed (a third stream would collide with the others at 115200 baud)
 U32  navState

@@ -16,6 +16,7 @@ G == 0 {
     velocity  = 0
     baroAlt   = 0
     baroStuck = false
+    agree     = 255                        # the barometer agrees with the filter throughout
     armSwitch = false
     abortCmd  = false
 }

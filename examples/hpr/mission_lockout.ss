@@ -4,8 +4,10 @@
 # through); just after burnout the speed is negative again, within
 # COAST_LOCK; then, past it, the accelerometer reads thrust (THRUST_G) with
 # a negative speed; then the speed is negative for one sample short of
-# CONFIRM (noise). Only the real crossing, held CONFIRM samples, calls
-# apogee, 0.1 s after it.
+# CONFIRM (noise); then negative for 0.2 s while the barometer has agreed
+# with the filter one sample short of QUIET (a pressure transient, as when
+# another computer's charge fires). Only the real crossing, held CONFIRM
+# samples, calls apogee, 0.1 s after it.
 
 [options]
 delta_t    10
@@ -19,6 +21,7 @@ G == 0 {
     velocity  = 0
     baroAlt   = 0
     baroStuck = false
+    agree     = 255
     armSwitch = true
     abortCmd  = false
 }
@@ -49,7 +52,15 @@ T >= 2000 and T < 2500 {
     velocity = 100
 }
 T >= 2500 and T < 2590: velocity = -1     # 9 samples: one short of CONFIRM
-T >= 2590 and T < 3000: velocity = 50
+T >= 2590 and T < 2700: velocity = 50
+T >= 2700 and T < 2900 {                  # 20 samples falling, but the barometer has agreed ...
+    velocity = -5
+    agree = QUIET - 1                     # ... one sample short of QUIET (a charge's transient)
+}
+T >= 2900 and T < 3000 {
+    velocity = 50
+    agree = 255
+}
 T >= 3000: velocity = 3 - 9.80665 * (T - 3000) / 1000   # crosses zero at T = 3306
 true: @assert phase == 2
 

@@ -4,7 +4,8 @@
 # pressure settles and freezes at launch; a 2 s boost at 10 g (the
 # accelerometer drives the estimate); a 150 ms transonic dip of 3,000 Pa
 # (about 290 m) in boost and a one-sample charge spike at apogee move
-# nothing (outside the filter's GATE); the vertical speed crosses zero
+# nothing (outside the filter's GATE) but reset `agree`, the samples in a
+# row the barometer agreed with the filter; the vertical speed crosses zero
 # within 0.3 s of the profile's apogee (20 s after burnout, G = 23000);
 # under a canopy at 30 m/s the filter settles on the descent rate; a
 # pressure frozen for STUCK_TIME is flagged stuck, and released when it
@@ -32,6 +33,8 @@ G > 1000 and G <= 3000: pressure = pressure * (1 - 0.0341632 * 98.0665 * (G - 10
 G == 2000: pressure = pressure - 3000                                # the transonic dip ...
 G == 2150: pressure = pressure + 3000                                # ... for 150 ms
 G >= 2000 and G <= 2160: @assert roll_range(altitude, 2) < 3         # no jump
+G == 2100: @assert agree == 0                                        # the barometer disagrees ...
+G == 2700: @assert agree >= 50                                       # ... then agrees again
 G == 2990: @assert velocity > 190 and velocity < 200 and altitude > 190 and altitude < 205
 G == 3000 {
     phase = 2                                                        # burnout: coast at -1 g
@@ -45,6 +48,9 @@ G == 23300: @assert velocity < 0 and velocity > -5
 G == 23500: pressure = pressure + 1500                               # a charge's spike: 145 m down ...
 G == 23510: pressure = pressure - 1500                               # ... for one sample
 G >= 23400 and G <= 23600: @assert roll_range(altitude, 2) < 1
+G == 23500: @assert agree == 0                                       # the spike is a disagreement ...
+G == 23600: @assert agree >= 9 and agree <= 11                       # ... and agreement counts again after it
+G == 40000: @assert agree == 255                                     # at most 255
 G == 24000: phase = 3                                                # under the drogue
 # 30 m/s down from 2152.5 m
 G > 24000 and G <= 60000: pressure = pressure * (1 + 0.0341632 * 30 * 0.01 / (288.15 - 0.0065 * (1400 + 2152.5 - 30 * (G - 24000) / 1000)))

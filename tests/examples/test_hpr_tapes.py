@@ -54,3 +54,4 @@ def test_ndrt2020_raven_replays_through_hpr_with_every_check_passing(tmp_path):
     assert cfg.main_alt == 300.0
     assert abs(n["main_err_m"]) <= 15.0, text  # truth altitude at the main pin − 300 m
     assert "landing_err_s" in n, text  # the tape lands: landing is checked
+

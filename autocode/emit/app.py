@@ -51,6 +51,32 @@ def _pin(app: Application, c) -> str:
     return f"FSW_PIN({c.pin_number}, {port}, {bit})"
 
 
+class _Scan:
+    """Analog inputs served one call each from a background scan of `tag`Pins
+    into `tag`Raw (fsw_io.h, "analog inputs, one call each")."""
+
+    def __init__(self, tag: str, chans):
+        self.tag, self.chans = tag, chans
+
+
+def _analog_inputs(app: Application, real, scan: _Scan) -> list[str]:
+    """The inputs task's lines for its analog inputs: each element takes its
+    count * gain + offset (iotables.analog_gain folds the converter into the
+    .aio's scale: no division on the MCU), then the next scan starts."""
+    out = []
+    for k, c in enumerate(scan.chans):
+        gain = real_literal(analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real), real)
+        offset = real_literal(real.literal(repr(c.offset)), real)
+        write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
+                 f"fsw::analog_value(fsw::io_analog_count({scan.tag}Raw, {k}), {gain}, {offset}));")
+        if app.sv.lock:
+            write = "{ fsw::SvGuard<true> lock; " + write + " }"
+        out.append(f"    {write}  // {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt")
+    out.append(f"    fsw::io_analog_scan({scan.tag}Pins, {len(scan.chans)}, {scan.tag}Raw);  "
+               "// the next run's counts, converted in the background")
+    return out
+
+
 def _tables(app: Application, real, out: list[str]) -> dict:
     """Channel tables grouped by direction; returns {group: table name}, or
     for digital channels served one call each {group: [channels]}."""
@@ -67,29 +93,29 @@ def _tables(app: Application, real, out: list[str]) -> dict:
             continue
         tag = f"k{kind.capitalize()}{'In' if d == 'i' else 'Out'}"
         direction = "fsw::kIoIn" if d == "i" else "fsw::kIoOut"
+        if kind == "analog" and d == "i":
+            # one call per channel on counts an ADC scan of this pin list
+            # converted in the background, read one run later (fsw_io.h)
+            out.append(f"const uint8_t {tag}Pins[{len(chans)}] FSW_FLASH = {{"
+                       + ", ".join(str(c.pin_number) for c in chans) + "};  // "
+                       + ", ".join(f"{basename(c.path)}:{c.line} {c.pin}" for c in chans))
+            out.append(f"volatile uint16_t {tag}Raw[{len(chans)}];  // counts the ADC's interrupt stores")
+            out.append("")
+            names[(kind, d)] = _Scan(tag, chans)
+            continue
         if kind == "analog":
             out.append(f"const fsw::AnalogChannel {tag}Ch[] FSW_FLASH = {{")
             for c in chans:
-                # inputs: count * gain + offset (iotables.analog_gain folds the
-                # converter into the .aio's scale: no division on the MCU)
-                gain = analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real) if d == "i" else 1.0
                 offset = real_literal(real.literal(repr(c.offset)), real)
-                out.append(f"    {{{real_literal(gain, real)}, {offset}, E_{c.element.name}, {c.pin_number}, "
+                out.append(f"    {{{real_literal(1.0, real)}, {offset}, E_{c.element.name}, {c.pin_number}, "
                            f"{direction}, {TYPE_CODE[c.element.type.name]}}},  "
-                           f"// {basename(c.path)}:{c.line} pin {c.pin}"
-                           + (f": {c.scale!r} per volt" if d == "i" else ""))
+                           f"// {basename(c.path)}:{c.line} pin {c.pin}")
             out.append("};")
-            raw = "0"
-            if d == "i":
-                # converted in the background, read one run later (fsw_io.h)
-                raw = f"{tag}Raw"
-                out.append(f"volatile uint16_t {raw}[{len(chans)}];  // counts the ADC's interrupt stores")
             out.append(f"const fsw::AnalogTable {tag} FSW_FLASH = {{{tag}Ch, sv, {vref}, {len(chans)}, "
-                       f"{app.board.adc_bits}, kSvLock, {raw}}};")
+                       f"{app.board.adc_bits}, kSvLock, 0}};")
             if all(c.element.type.name == "F32" for c in chans):
                 # no binary64 element: the task that links no F64 conversion
-                # (nor, for inputs, PWM output)
-                names[("task", tag)] = "io_analog_in_task_f32" if d == "i" else "io_analog_task_f32"
+                names[("task", tag)] = "io_analog_task_f32"
         elif _direct_digital(app, chans):
             names[(kind, d)] = chans
             continue
@@ -160,6 +186,8 @@ def _app_cpp(app: Application) -> str:
             for ch in tag:
                 c.append(f"    fsw::io_pin_begin({_pin(app, ch)}, {'fsw::kIoIn' if d == 'i' else 'fsw::kIoOut'});  "
                          f"// {basename(ch.path)}:{ch.line} {ch.element.name}")
+        elif isinstance(tag, _Scan):  # the first scan, waited for: the first run reads it
+            c.append(f"    fsw::io_analog_scan_begin({tag.tag}Pins, {len(tag.chans)}, {tag.tag}Raw);")
         elif kind in ("analog", "digital"):
             c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
     if has_link:
@@ -208,7 +236,7 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
     if t.kind in ("inputs", "outputs"):
         d = "i" if t.kind == "inputs" else "o"
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
-        if len(calls) == 1 and not isinstance(calls[0][1], list):
+        if len(calls) == 1 and not isinstance(calls[0][1], (list, _Scan)):
             kind, tag = calls[0]
             fn = tables.get(("task", tag), f"io_{kind}_task")
             return f"fsw::{fn}", f"const_cast<void*>(static_cast<const void*>(&{tag}))"
@@ -232,6 +260,11 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         if not calls:
             out.append("    return fsw::kOk;  // no channels in this direction")
         for k, (kind, tag) in enumerate(calls):
+            if isinstance(tag, _Scan):
+                out += _analog_inputs(app, real_of(app), tag)
+                if k == len(calls) - 1:
+                    out.append("    return fsw::kOk;")
+                continue
             if isinstance(tag, list):
                 for ch in tag:
                     fn = "io_digital_in" if d == "i" else "io_digital_out"

@@ -12,6 +12,15 @@ uint8_t pwm_duty_from_volts(Real volts, Real vref) {
 
 static bool analog_type_ok(uint8_t t) { return t == kF32 || t == kF64; }
 
+// The scan of a table sampled in the background, once, waited for: the
+// task's first run reads these counts.
+static Result first_scan(const AnalogTable& tab) {
+    while (pal::adc_scan_busy()) {}
+    if (!pal::adc_scan_start(&tab.ch->pin, sizeof(AnalogChannel), tab.n, tab.raw)) return kErrConfig;
+    while (pal::adc_scan_busy()) {}
+    return kOk;
+}
+
 Result io_analog_begin(const AnalogTable* table) {
     AnalogTable tab;
     flash_read(&tab, table, sizeof tab);
@@ -23,12 +32,13 @@ Result io_analog_begin(const AnalogTable* table) {
         if (tab.raw != 0 && c.dir != kIoIn) return kErrConfig;  // a scan converts every row
         if (c.dir == kIoOut) pal::pin_mode(c.pin, pal::kOutput);
     }
-    if (tab.raw != 0) {
-        while (pal::adc_scan_busy()) {}
-        if (!pal::adc_scan_start(&tab.ch->pin, sizeof(AnalogChannel), tab.n, tab.raw)) return kErrConfig;
-        while (pal::adc_scan_busy()) {}  // once, at boot: the first run reads these
-    }
-    return kOk;
+    return tab.raw != 0 ? first_scan(tab) : kOk;
+}
+
+void io_analog_scan_begin(const uint8_t* pins, uint8_t n, volatile uint16_t* raw) {
+    while (pal::adc_scan_busy()) {}
+    (void)pal::adc_scan_start(pins, 1, n, raw);  // nothing runs: it starts
+    while (pal::adc_scan_busy()) {}
 }
 
 namespace {

@@ -60,6 +60,7 @@ struct DigitalTable {
 // Checks the table and sets pin modes; a table sampled in the background
 // (inputs only) is converted once, waiting. `table` points at an FSW_FLASH object.
 FSW_MUST_CHECK Result io_analog_begin(const AnalogTable* table);
+
 FSW_MUST_CHECK Result io_digital_begin(const DigitalTable* table);
 
 // Executor task steps; ctx is the FSW_FLASH table. One pass over the table.
@@ -131,6 +132,32 @@ inline void io_pin_begin(Pin pin, uint8_t dir) {
 inline void io_digital_in(Pin pin, uint8_t* p) { *p = pal::digital_read(pin.n) ? 1 : 0; }
 inline void io_digital_out(Pin pin, const uint8_t* p) { pal::digital_write(pin.n, *p != 0); }
 #endif
+
+// ---- analog inputs, one call each (generated I/O tasks) -----------------------
+// Generated inputs tasks convert each analog input with one inline call on
+// constants the generator computed (no table read at run time), from the
+// counts of a background scan of a flash list of pins:
+//     fsw::write_F32(sv + E_p, fsw::analog_value(fsw::io_analog_count(kAnalogInRaw, 0), 30.54741f, 76875.0f));
+//     fsw::io_analog_scan(kAnalogInPins, 2, kAnalogInRaw);  // the next run's counts
+// so an element holds the pins as they were one run earlier (the scan of
+// the previous run), as with a table sampled in the background.
+
+// Entry i of the scan's counts, read whole (interrupts off: the ADC's
+// interrupt writes them; the scan has ended long before, all the same).
+inline uint16_t io_analog_count(const volatile uint16_t* raw, uint8_t i) {
+    const pal::IrqState saved = pal::critical_enter();
+    const uint16_t v = raw[i];
+    pal::critical_exit(saved);
+    return v;
+}
+// Starts converting the n pins at `pins` (FSW_FLASH bytes) into raw, in the
+// background (a scan still running is left to finish).
+inline void io_analog_scan(const uint8_t* pins, uint8_t n, volatile uint16_t* raw) {
+    (void)pal::adc_scan_start(pins, 1, n, raw);
+}
+// At boot: the first scan, waited for, so the task's first run reads the
+// pins as they were then.
+void io_analog_scan_begin(const uint8_t* pins, uint8_t n, volatile uint16_t* raw);
 
 // The conversions the analog task applies (exposed for tests and docs).
 // value = count * gain + offset, in R (two roundings: the host mirrors it

@@ -70,17 +70,16 @@ void analog_write(uint8_t pin, uint8_t duty) { analogWrite(pin, duty); }
 // The background scan (adc_scan_start): what the ADC interrupt walks.
 namespace {
 struct AdcScan {
-    const uint8_t* pins;     // FSW_FLASH
-    volatile uint16_t* raw;
+    const uint8_t* pin;      // FSW_FLASH: the pin being converted
+    volatile uint16_t* raw;  // where its count goes
     uint8_t stride;
-    uint8_t n;
-    volatile uint8_t next;   // the entry being converted; n when done
+    volatile uint8_t left;   // conversions not yet stored; 0 when done
 };
-AdcScan g_scan = {0, 0, 0, 0, 0};
+AdcScan g_scan = {0, 0, 0, 0};
 
 // Starts converting a pin as analogRead does (AVcc reference, the pin's
 // channel), with the conversion-complete interrupt on.
-void adc_convert(uint8_t pin) {
+inline __attribute__((always_inline)) void adc_convert(uint8_t pin) {
     const uint8_t ch = static_cast<uint8_t>(pin >= A0 ? pin - A0 : pin);
 #if defined(MUX5)
     ADCSRB = static_cast<uint8_t>((ADCSRB & ~_BV(MUX5)) | (((ch >> 3) & 1u) << MUX5));
@@ -90,17 +89,16 @@ void adc_convert(uint8_t pin) {
 }
 }  // namespace
 
-bool adc_scan_busy() { return g_scan.next < g_scan.n; }
+bool adc_scan_busy() { return g_scan.left != 0; }
 
 bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uint16_t* raw) {
     if (adc_scan_busy()) return false;
     if (n == 0) return true;
     const IrqState saved = critical_enter();
-    g_scan.pins = pins;
+    g_scan.pin = pins;
     g_scan.raw = raw;
     g_scan.stride = stride;
-    g_scan.n = n;
-    g_scan.next = 0;
+    g_scan.left = n;
     adc_convert(pgm_read_byte(pins));
     critical_exit(saved);
     return true;
@@ -114,11 +112,14 @@ ISR(ADC_vect) {
     using fsw::pal::g_scan;
     const uint8_t lo = ADCL;  // ADCL first: it latches ADCH
     const uint8_t hi = ADCH;
-    uint8_t i = g_scan.next;
-    g_scan.raw[i] = static_cast<uint16_t>(lo | (hi << 8));
-    g_scan.next = ++i;
-    if (i < g_scan.n) {
-        fsw::pal::adc_convert(pgm_read_byte(g_scan.pins + i * g_scan.stride));
+    volatile uint16_t* raw = g_scan.raw;
+    *raw = static_cast<uint16_t>(lo | (hi << 8));
+    const uint8_t left = static_cast<uint8_t>(g_scan.left - 1);
+    g_scan.left = left;
+    if (left != 0) {
+        g_scan.raw = raw + 1;
+        g_scan.pin += g_scan.stride;
+        fsw::pal::adc_convert(pgm_read_byte(g_scan.pin));
     } else {
         ADCSRA = static_cast<uint8_t>(ADCSRA & ~_BV(ADIE));
     }

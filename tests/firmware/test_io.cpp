@@ -179,6 +179,7 @@ static void test_background_scan_reads_one_run_late(void) {
     TEST_ASSERT_EQUAL(kOk, io_analog_task_f32(const_cast<AnalogTable*>(&kScanTable)));
     ASSERT_REAL_SAME(analog_value(300, 250, -125), read_F32(sv + 0));
     ASSERT_REAL_SAME(analog_value(400, 8, -20), read_F32(sv + 4));
+
     TEST_ASSERT_FALSE(pal::adc_scan_busy());
 }
 
@@ -192,6 +193,24 @@ static void test_scan_walks_the_pins_of_the_rows(void) {
     TEST_ASSERT_EQUAL_UINT16(22, raw[1]);
     TEST_ASSERT_TRUE(pal::adc_scan_start(&kAnalogF32[1].pin, sizeof(AnalogChannel), 1, raw));
     TEST_ASSERT_EQUAL_UINT16(22, raw[0]);
+}
+
+// Generated inputs tasks: one call per channel on the counts of a scan of a
+// flash list of pins, and the next scan started: one run of latency.
+static const uint8_t kScanPins[2] FSW_FLASH = {15, 14};
+
+static void test_one_call_inputs_read_the_previous_scan(void) {
+    static volatile uint16_t raw[2];
+    native::sim_set_analog(14, 7);
+    native::sim_set_analog(15, 9);
+    io_analog_scan_begin(kScanPins, 2, raw);
+    TEST_ASSERT_EQUAL_UINT16(9, io_analog_count(raw, 0));
+    TEST_ASSERT_EQUAL_UINT16(7, io_analog_count(raw, 1));
+    native::sim_set_analog(15, 1023);
+    write_F32(sv, analog_value(io_analog_count(raw, 0), 8, -20));  // as a generated task does
+    io_analog_scan(kScanPins, 2, raw);
+    ASSERT_REAL_SAME(Real(9) * Real(8) + Real(-20), read_F32(sv));  // the boot scan's count
+    TEST_ASSERT_EQUAL_UINT16(1023, io_analog_count(raw, 0));         // the next run's
 }
 
 // A scan converts every row: a table with an output row cannot sample in
@@ -271,6 +290,7 @@ static void run(void) {
     RUN_TEST(test_digital_task_mirrors_pins);
     RUN_TEST(test_background_scan_reads_one_run_late);
     RUN_TEST(test_scan_walks_the_pins_of_the_rows);
+    RUN_TEST(test_one_call_inputs_read_the_previous_scan);
     RUN_TEST(test_begin_refuses_bad_tables);
 #endif
     (void)UNITY_END();

@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 
-from support.simfw import tank_uno  # noqa: F401
+from support.simfw import tank_uno  # noqa: F401  (a fixture)
 
 from fswkit.sim.board import SimBoard, SimError
 

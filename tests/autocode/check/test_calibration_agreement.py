@@ -66,11 +66,14 @@ def test_generated_tables_carry_the_hosts_gain(fsw, tmp_path):
     r = fsw("gen", str(EXAMPLES / "rocket"), "--out", str(tmp_path))
     assert r.code == 0, r.err
     text = (tmp_path / "app.gen.cpp").read_text()
-    rows = re.findall(r"\{([-0-9.e]+)f, \(?([-0-9.e]+)f\)?, E_(\w+), \d+, fsw::kIoIn", text)
-    assert [(e, f32(float(g)), float(o)) for g, o, e in rows] == [
+    rows = re.findall(r"write_F32\(sv \+ E_(\w+), fsw::analog_value\(fsw::io_analog_count\(kAnalogInRaw, \d\), "
+                      r"([-0-9.e]+)f, \(?([-0-9.e]+)f\)?\)\);", text)
+    assert [(e, f32(float(g)), float(o)) for e, g, o in rows] == [
         ("pressure", analog_gain(6250.0, 5.0, 10, F32MODE), 76875.0),
         ("accel", analog_gain(8.0, 5.0, 10, F32MODE), -20.0)]
-    assert "volatile uint16_t kAnalogInRaw[2];" in text and "io_analog_begin(&kAnalogIn)" in text
+    assert "volatile uint16_t kAnalogInRaw[2];" in text
+    assert "fsw::io_analog_scan_begin(kAnalogInPins, 2, kAnalogInRaw);" in text
+    assert "fsw::io_analog_scan(kAnalogInPins, 2, kAnalogInRaw);" in text
 
 
 def test_the_simulated_sensor_reads_what_the_firmware_computes():

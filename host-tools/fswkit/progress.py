@@ -80,21 +80,28 @@ _OFF = _Off()
 
 
 class _Bar:
-    """A bar of this process's display."""
+    """A bar of this process's display. An update between two pushes is
+    kept (`value`) and pushed by the display's next refresh: the bar never
+    stays behind the work."""
 
     def __init__(self, display, label, total, unit, depth):
         self._display, self._next = display, 0.0
+        self.seq = self.pushed = 0
+        self.value = None  # (seq, done, fields) of the last update
         self.task = display.add(label, total, unit, depth)
+        display.bars.append(self)
 
     def update(self, done, **fields) -> None:
+        self.seq += 1
+        self.value = value = (self.seq, done, fields)
         now = time.monotonic()
         if now < self._next:
             return
         self._next = now + INTERVAL
-        self._display.update(self.task, done, fields)
+        self._display.push(self, value)
 
     def close(self) -> None:
-        self._display.remove(self.task)
+        self._display.remove(self)
 
 
 class _Remote:
@@ -242,6 +249,7 @@ class _Display:
 
         self.pid = os.getpid()
         self.lock = threading.RLock()
+        self.bars: list[_Bar] = []
         same_terminal = False
         try:  # standard output on the same terminal: its lines printed above the bars
             same_terminal = sys.stdout.isatty() and os.path.samestat(
@@ -249,7 +257,14 @@ class _Display:
         except (AttributeError, ValueError, OSError):
             pass
         self._streams = (sys.stdout, sys.stderr)
-        self.progress = Progress(*_columns(), console=Console(file=sys.stderr), transient=True,
+        display = self
+
+        class Flushing(Progress):
+            def get_renderables(self):
+                display.flush()
+                yield from super().get_renderables()
+
+        self.progress = Flushing(*_columns(), console=Console(file=sys.stderr), transient=True,
                                  redirect_stdout=same_terminal, redirect_stderr=True)
         self.remote_tasks: dict[tuple[int, int], int] = {}
         self.channel = None
@@ -285,9 +300,29 @@ class _Display:
         with self.lock:
             self.progress.update(task, completed=done, extra=extra)
 
-    def remove(self, task):
+    def push(self, bar, value):
         with self.lock:
-            self.progress.remove_task(task)
+            if value[0] > bar.pushed:
+                bar.pushed = value[0]
+                self.update(bar.task, value[1], value[2])
+
+    def flush(self):
+        """Pushes the updates the bars kept (from rich's refresh: never waits
+        for the lock, which a thread adding a bar holds while it refreshes)."""
+        if not self.lock.acquire(blocking=False):
+            return
+        try:
+            for bar in self.bars:
+                value = bar.value
+                if value is not None and value[0] > bar.pushed:
+                    self.push(bar, value)
+        finally:
+            self.lock.release()
+
+    def remove(self, bar):
+        with self.lock:
+            self.bars.remove(bar)
+            self.progress.remove_task(bar.task)
 
     # bars of workers
     def _receive(self):

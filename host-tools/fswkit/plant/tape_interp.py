@@ -1,0 +1,134 @@
+"""A sensor tape through a project's machines in the reference interpreter
+(binary32) instead of the simulated board: the same open-loop replay as
+fswkit.plant.tape_replay, its events checked by the same `evaluate`, in a
+fraction of a second per flight instead of minutes. Tests fly every
+real-flight tape with it; tools/bench_tapes.py runs `--perturb`'s
+hundreds of perturbed replays per tape with it, beside a few on the board.
+
+What it shares with the board's replay: the inputs (each tape column
+through the inverse of the `.aio` calibration and the converter,
+`counts_series`, an empty cell holding the last count), read back through
+the calibration in binary32 as the firmware's analog task computes it
+(fsw_io.cpp, analog_value_from_raw), held between rows; the timeline
+(the tape's first row at `pad_s`, the arming switch at `arm_s`, `run_on_s`
+after the last row); the machines stepped every 1000 / rate ms in the
+order the application lists them, sharing the state vector's elements.
+What it leaves out: the executor's clock (G is the step's time here,
+millis() on the board), the UART and the telemetry (an event is seen at
+its step, not in the next frame), the other tasks. On the eight shared
+tapes its events agree with the board's within a step or two
+(docs/sim.md, "Replaying real flights")."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fswkit.autocode.numeric import F32MODE, f32
+from fswkit.run.interp import MachineRun
+
+from .cosim import PinEvent, Run
+from .tape_replay import Replay, _columns, _pad, counts_series, missing_spans, smoothed_altitude
+
+
+class InterpError(Exception):
+    """The project cannot be replayed in the interpreter (say why)."""
+
+
+def _element_of(app, pin: int | None, analog: bool = False) -> str | None:
+    if pin is None:
+        return None
+    ch = next((c for c in app.channels if c.pin_number == pin and c.analog == analog), None)
+    return ch.element.name if ch is not None else None
+
+
+def _mission(app, cfg):
+    names = set(cfg.states.values())
+    m = next((m for m in app.machines if names <= {s.name for s in m.states}), None)
+    if m is None:
+        raise InterpError("no machine of the project has the states " + ", ".join(sorted(names)))
+    return m
+
+
+def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay:
+    """The Replay of `tape` (or `columns`, a perturbed copy of its columns)
+    through the project's machines, as tape_replay.replay gives the board's:
+    `run.transitions` of the mission machine and `run.pin_events` of the
+    pyro pins, at tape seconds."""
+    if not app.rate or 1000 % int(app.rate):
+        raise InterpError(f"an executor rate of {app.rate} Hz is not a whole number of milliseconds a step")
+    step_ms = 1000 // int(app.rate)
+    t = tape.time
+    cols = columns if columns is not None else _columns(tape)
+    offset = cfg.pad_s - float(t[0])
+    values = {}
+    for col, s in cfg.sensors.items():
+        if s is None:
+            continue
+        counts = counts_series(cols[col], s, cfg.missing, cfg.silent_volts)
+        full, vref, scale, off = f32(float(s.full)), f32(s.vref), f32(s.scale), f32(s.offset)
+        values[s.element] = [f32(f32(f32(f32(float(k)) * vref) / full) * scale + off) for k in counts.tolist()]
+    arm = _element_of(app, cfg.arm_pin)
+    pins = [(role, _element_of(app, p), p) for role, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin))
+            if p is not None]
+    mission = _mission(app, cfg)
+    runs = [MachineRun(m, F32MODE, 0) for m in app.machines]
+    shared = [[(v.name, v.index) for v in m.vars if v.kind == "element"] for m in app.machines]
+    sv = {e.name: (0.0 if e.type.kind == "float" else 0) for e in app.sv.elements}
+    k_mission = app.machines.index(mission)
+    states = mission.states
+    at_row = t + offset
+    end_s = float(t[-1]) + offset + cfg.run_on_s
+    steps = int(end_s * 1000) // step_ms
+    run = Run(columns=())
+    row, prev = -1, None
+    high = {role: False for role, _, _ in pins}
+    for k in range(1, steps + 1):
+        g = k * step_ms
+        now = g / 1000.0
+        while row + 1 < len(t) and at_row[row + 1] <= now:
+            row += 1
+        for name, series in values.items():
+            sv[name] = series[max(row, 0)]
+        if arm is not None:
+            sv[arm] = now >= cfg.arm_s
+        sv["time"] = g
+        for mr, elements in zip(runs, shared):
+            v = mr.v
+            for name, i in elements:
+                v[i] = sv[name]
+            mr.step()
+            for name, i in elements:
+                sv[name] = v[i]
+        tt = now - offset
+        st = runs[k_mission].state
+        if st != prev:
+            run.transitions.append((tt, states[st].id, states[st].name))
+            prev = st
+        for role, element, pin in pins:
+            level = bool(sv[element])
+            if level != high[role]:
+                run.pin_events.append(PinEvent(tt, pin, role, level, {}))
+                high[role] = level
+    run.steps = steps
+    run.sim_s = end_s
+    th = smoothed_altitude(tape, _pad(tape, truth))
+    counts = {c: counts_series(cols[c], s, cfg.missing, cfg.silent_volts) for c, s in cfg.sensors.items()
+              if s is not None}
+    return Replay(run, offset, counts, {c: missing_spans(t, v) for c, v in _columns(tape).items()}, *th)
+
+
+def perturbed(app, cfg, tape, truth, n: int, seed: int) -> list:
+    """N perturbed replays in the interpreter, run i from the i-th child of
+    SeedSequence(seed) as `fsw sim --perturb` draws them (the same
+    perturbations as the board's runs of that seed): [(numbers, checks)]
+    from tape_replay.evaluate."""
+    from .tape_replay import evaluate, perturb
+
+    out = []
+    for seq in np.random.SeedSequence(seed).spawn(n):
+        rng = np.random.Generator(np.random.PCG64(seq))
+        cols = perturb(_columns(tape), tape.time, rng)
+        rp = replay(app, cfg, tape, truth=truth, columns=cols)
+        nums, checks, _notes = evaluate(rp, cfg, truth, tape)
+        out.append((nums, checks))
+    return out

@@ -16,7 +16,7 @@
 # that costs nothing measurable: -fno-move-loop-invariants (values hoisted out
 # of loops hold registers an 8-bit MCU then saves and reloads; 70 B of the
 # rocket's flash, its busy time per cycle unchanged). (-fno-gcse would save
-# 300 B more, but the rocket built with it fails its demo flight: not used.)
+# 230 B more, but costs 26 B of measured stack and slows nav: not used.)
 
 # RUNTIME is the runtime's folder: `fsw build` passes it (fswkit.autocode.kit,
 # which knows where the kit's files are, in a checkout or an installed

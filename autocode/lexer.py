@@ -43,9 +43,47 @@ def describe(ch: str) -> str:
     return f"character `{ch}`" if ch.isprintable() else f"character U+{ord(ch):04X}"
 
 
+_new_tok = tuple.__new__
+_NUMBER_TAIL_START = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_.")
+
+
+def _lex_clean(n: int, text: str) -> list[Tok] | None:
+    """The tokens of a line that holds nothing wrong and no tab (the common
+    case, one regex search a token); None for any other line, which
+    `lex_line` reads character by character with its reports."""
+    toks: list[Tok] = []
+    append = toks.append
+    pos = 0
+    for m in _TOKEN.finditer(text):
+        if m.start() != pos:  # something no token starts with was skipped
+            return None
+        kind = m.lastgroup
+        s = m[kind]
+        pos = m.end()
+        if kind == "comment":
+            continue
+        if kind == "num":
+            if text[pos:pos + 1] in _NUMBER_TAIL_START and pos < len(text):
+                return None
+        elif kind == "id":
+            if s in KEYWORDS:
+                kind = KW
+        elif kind == "annot":
+            if s not in ANNOTATIONS:
+                return None
+        append(_new_tok(Tok, (kind, s, n, pos - len(s) + 1)))
+    if pos != len(text) and text[pos:].strip(" \t\f\v\r"):
+        return None
+    return toks
+
+
 def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> list[Tok]:
     """Tokens of line `n` (without its newline). Lexical errors are reported
     and the offending characters skipped."""
+    if "\t" not in text:
+        toks = _lex_clean(n, text)
+        if toks is not None:
+            return toks
     toks: list[Tok] = []
     pos, end = 0, len(text)
     match = _TOKEN.match

@@ -124,6 +124,16 @@ Real roll_median_value(const RollMedianS<I>& w, const Real* sorted) {
     return a + (b - a) / 2;
 }
 
+#if defined(__AVR__)
+template <typename I>
+Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv) {
+    if (inv != 0 && w.count == n) return (w.base + w.fresh) * inv;
+    return roll_avg_value(w);
+}
+template Real roll_avg_mean<uint8_t>(const RollAvgS<uint8_t>&, uint8_t, Real);
+template Real roll_avg_mean<WinIdx>(const RollAvgS<WinIdx>&, WinIdx, Real);
+#endif
+
 // The two index types in use: bytes for windows of up to 255 samples, WinIdx.
 #define FSW_WINDOW_INSTANCES(I)                                                      \
     template void roll_avg_push<I>(RollAvgS<I>&, Real*, I, Real);                   \

@@ -78,6 +78,21 @@ inline Real roll_avg_value(const RollAvgS<I>& w) {
     return w.count == 0 ? Real(0) : (w.base + w.fresh) / static_cast<Real>(w.count);
 }
 
+// The value of a window of n samples: roll_avg_value, but times `inv` (1/n,
+// exact) instead of divided by n once the window is full when inv is not 0
+// (n a power of two: the same quotient, no division on the MCU). Out of line
+// on AVR, where the float calls inline cost flash at every use.
+#if defined(__AVR__)
+template <typename I>
+FSW_NOINLINE Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv);
+#else
+template <typename I>
+inline Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv) {
+    if (inv != 0 && w.count == n) return (w.base + w.fresh) * inv;
+    return roll_avg_value(w);
+}
+#endif
+
 template <typename I>
 void roll_max_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type n, Real x);
 template <typename I>
@@ -108,10 +123,7 @@ struct RollAvgN {
     void push(Real x) { roll_avg_push<I>(s, ring, static_cast<I>(N), x); }
     // A full window of a power-of-two N multiplies by 1/N, a constant R
     // holds exactly: the same bits as the division, with no division routine.
-    Real value() const {
-        if ((N & (N - 1)) == 0 && s.count == N) return (s.base + s.fresh) * (Real(1) / Real(N));
-        return roll_avg_value(s);
-    }
+    Real value() const { return roll_avg_mean<I>(s, static_cast<I>(N), (N & (N - 1)) == 0 ? Real(1) / Real(N) : 0); }
 };
 
 template <uint32_t N>

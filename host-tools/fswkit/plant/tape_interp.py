@@ -8,8 +8,11 @@ hundreds of perturbed replays per tape with it, beside a few on the board.
 What it shares with the board's replay: the inputs (each tape column
 through the inverse of the `.aio` calibration and the converter,
 `counts_series`, an empty cell holding the last count), read back through
-the calibration in binary32 as the firmware's analog task computes it
-(fsw_io.cpp, analog_value_from_raw), held between rows; the timeline
+the calibration in binary32 as the firmware computes it (count * gain +
+offset, iotables.analog_value), held between rows, and one step late as
+the firmware's inputs are (its ADC scan converts them in the background
+for the next run of the inputs task: step k reads the pins as they were at
+step k - 1, the first step at boot); the timeline
 (the tape's first row at `pad_s`, the arming switch at `arm_s`, `run_on_s`
 after the last row); the machines stepped every 1000 / rate ms in the
 order the application lists them, sharing the state vector's elements.
@@ -23,7 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fswkit.autocode.numeric import F32MODE, f32
+from fswkit.autocode.iotables import analog_gain, analog_value
+from fswkit.autocode.numeric import F32MODE
 from fswkit.run.interp import MachineRun
 
 from .cosim import PinEvent, Run
@@ -65,8 +69,8 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
         if s is None:
             continue
         counts = counts_series(cols[col], s, cfg.missing, cfg.silent_volts)
-        full, vref, scale, off = f32(float(s.full)), f32(s.vref), f32(s.scale), f32(s.offset)
-        values[s.element] = [f32(f32(f32(f32(float(k)) * vref) / full) * scale + off) for k in counts.tolist()]
+        gain, off = analog_gain(s.scale, s.vref, s.bits, F32MODE), F32MODE.literal(repr(float(s.offset)))
+        values[s.element] = [analog_value(k, gain, off, F32MODE) for k in counts.tolist()]
     arm = _element_of(app, cfg.arm_pin)
     pins = [(role, _element_of(app, p), p) for role, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin))
             if p is not None]
@@ -85,7 +89,8 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     for k in range(1, steps + 1):
         g = k * step_ms
         now = g / 1000.0
-        while row + 1 < len(t) and at_row[row + 1] <= now:
+        sampled = (k - 1) * step_ms / 1000.0  # the previous step's scan (the first step's: at boot)
+        while row + 1 < len(t) and at_row[row + 1] <= sampled:
             row += 1
         for name, series in values.items():
             sv[name] = series[max(row, 0)]

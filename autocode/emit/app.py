@@ -158,6 +158,11 @@ def _app_cpp(app: Application) -> str:
     if has_link:
         c += _link(app)
     steps = {}
+    if _shared_time_store(app):
+        # G written by one function for every machine task (8 stores a call
+        # on AVR); capitalised, so no machine's or task's name can be it.
+        c.append(f"FSW_NOINLINE void store_G_now(uint8_t* g) {{ fsw::store<uint64_t>(g, {_now(app)}); }}")
+        c.append("")
     for t in app.tasks:
         steps[t.name] = _direct_step(t, tables)
         if steps[t.name] is None:
@@ -243,6 +248,12 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
     return None
 
 
+def _shared_time_store(app: Application) -> bool:
+    """Whether machine tasks write G through one out-of-line function: two
+    or more of them, no lock."""
+    return not app.sv.lock and sum(t.kind == "machine" for t in app.tasks) >= 2
+
+
 def _task_fn(app: Application, t: Task, tables) -> list[str]:
     out = [f"// Task `{t.name}` ({t.kind}), every {t.divider} cycle(s).",
            f"fsw::Result task_{t.name}(void*) {{"]
@@ -251,6 +262,8 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         g = m.vars[m.g].name
         if app.sv.lock:
             out.append(f"    {{ fsw::SvGuard<true> lock; fsw::store<uint64_t>(sv + E_{g}, {_now(app)}); }}")
+        elif _shared_time_store(app):
+            out.append(f"    store_G_now(sv + E_{g});")
         else:
             out.append(f"    fsw::store<uint64_t>(sv + E_{g}, {_now(app)});")
         out.append(f"    return {c_ident(m.name)}::step();")

@@ -172,7 +172,8 @@ def native_steps_per_second(long_exe: str, short_exe: str, runs: int) -> tuple[f
 
 
 def fsw_command(*args: str) -> list[str]:
-    return [sys.executable, "-c", "import sys; from fswkit.cli import main; sys.exit(main(sys.argv[1:]))", *args]
+    """`fsw ARGS` as a user runs it (the `fsw` script calls main() as this does)."""
+    return [sys.executable, "-m", "fswkit.cli", *args]
 
 
 def child_cpu() -> float:

@@ -88,7 +88,6 @@ uint64_t f64_bits_from_f32(float v) {
 
 #if defined(__AVR__)
 uint32_t f32_read_key(const uint8_t* p) { return f32_is_nan(p) ? 0x80000000UL : f32_key(p); }
-uint64_t f64_read_key(const uint8_t* p) { return f64_is_nan(p) ? 0x8000000000000000ULL : f64_key(p); }
 #endif
 
 }  // namespace fsw

@@ -49,14 +49,15 @@ inline bool f32_is_nan(const uint8_t* p) {
 // The key of the value an element reads as (a NaN reads as +0: the key of
 // +0), for threshold tests in generated code: `R(x) op c` for a literal c is
 // a test of this key against constants, NaN included. Out of line (one copy
-// however many tests a machine has) on AVR, inline elsewhere.
+// however many tests a machine has) on AVR, inline elsewhere. The 64-bit
+// one stays inline on AVR too: its result is compared in the caller byte
+// by byte, and a call would add as many cycles as a step's tests take.
 #if defined(__AVR__)
 FSW_NOINLINE uint32_t f32_read_key(const uint8_t* p);
-FSW_NOINLINE uint64_t f64_read_key(const uint8_t* p);
 #else
 inline uint32_t f32_read_key(const uint8_t* p) { return f32_is_nan(p) ? 0x80000000UL : f32_key(p); }
-inline uint64_t f64_read_key(const uint8_t* p) { return f64_is_nan(p) ? 0x8000000000000000ULL : f64_key(p); }
 #endif
+inline uint64_t f64_read_key(const uint8_t* p) { return f64_is_nan(p) ? 0x8000000000000000ULL : f64_key(p); }
 
 }  // namespace fsw
 

@@ -5,6 +5,7 @@
 #define FSW_MACHINE_H
 
 #include "fsw_convert.h"
+#include "fsw_element.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -57,7 +58,16 @@ FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
 // A Machine of all zeros (static storage, no initialiser: .bss, no copy of
 // it in flash) is FSW_MACHINE_INIT(1) to machine_begin, the first state of
 // every generated machine.
+#if defined(__AVR__)
 FSW_MUST_CHECK FSW_NOINLINE FSW_NOCLONE Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s);
+#else
+FSW_MUST_CHECK inline Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
+    if (m.state == 0 && m.started == 0) machine_reset(m, 1);  // a zero Machine
+    if (machine_begin_step(m, load<uint64_t>(g)) != kOk) return kErrTime;
+    if (m.entering != 0) store<uint32_t>(s, m.state);
+    return kOk;
+}
+#endif
 
 // T, the time spent in the current state (valid after machine_begin_step).
 inline uint64_t machine_T(const Machine& m) { return m.t; }

@@ -90,6 +90,32 @@
 #  error "fswkit: FSW_WATCHDOG_MS must be one of 15 30 60 120 250 500 1000 2000"
 #endif
 
+// The executor sleeps between cycles (AVR): Timer1 in CTC mode paces the
+// cycles and keeps the clock (micros/millis: the Arduino core's Timer0
+// overflow interrupt is turned off, so its millis()/delay() stop), the CPU
+// idles until a compare interrupt FSW_WAKE_EARLY_US before the cycle is due,
+// then waits out the rest with interrupts off and starts the cycle on the
+// timer's count. 0: the executor polls micros() as on other platforms.
+#ifndef FSW_SLEEP
+#  if defined(__AVR__)
+#    define FSW_SLEEP 1
+#  else
+#    define FSW_SLEEP 0
+#  endif
+#endif
+#if FSW_SLEEP && !defined(__AVR__)
+#  error "fswkit: FSW_SLEEP is implemented for AVR boards only: set FSW_SLEEP=0"
+#endif
+// How long before a cycle is due the sleeping executor wakes: longer than
+// any interrupt handler that may be running then (a UART or ADC handler
+// takes a few microseconds), so the cycle still starts on the timer's count.
+#ifndef FSW_WAKE_EARLY_US
+#  define FSW_WAKE_EARLY_US 24
+#endif
+#if FSW_WAKE_EARLY_US < 4 || FSW_WAKE_EARLY_US > 1000
+#  error "fswkit: FSW_WAKE_EARLY_US must be 4..1000"
+#endif
+
 // Per-task step timing (worst case, overruns): costs two clock reads per task.
 #ifndef FSW_TASK_TIMING
 #  define FSW_TASK_TIMING 1

@@ -50,10 +50,16 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
         *mode_byte(c, t, i) = t.init_mode;  // one byte: atomic on every target
     }
     pal::begin();
+#if FSW_SLEEP
+    pal::cycle_timer_begin(c.period_us);
+#endif
     ex.next_due_us = pal::micros32();
     ex.cycles = 0;
     ex.cycles_high = 0;
     ex.late = 0;
+    ex.late_overrun = 0;
+    ex.late_other = 0;
+    ex.skipped = 0;
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
@@ -98,6 +104,27 @@ void executor_run_cycle(Executor& ex) {
     if (++ex.cycles == 0) ++ex.cycles_high;
 }
 
+#if FSW_SLEEP
+namespace {
+inline void count(uint16_t& n, uint8_t by) {
+    n = static_cast<uint16_t>(n > 0xFFFFu - by ? 0xFFFFu : n + by);
+}
+}  // namespace
+
+bool executor_poll(Executor& ex) {
+    uint8_t skipped;
+    const uint8_t why = pal::cycle_wait(skipped);
+    if (why == pal::kCycleNotDue) return false;
+    if (why != pal::kCycleOnTime) {
+        count(ex.late, 1);
+        count(why == pal::kCycleLateOverrun ? ex.late_overrun : ex.late_other, 1);
+    }
+    count(ex.skipped, skipped);
+    executor_run_cycle(ex);
+    pal::cycle_end();
+    return true;
+}
+#else
 bool executor_poll(Executor& ex) {
     // On 32 bits, wrap-safe: the due time is never more than a period ahead,
     // so the signed difference tells "not yet" from "late by so much" for
@@ -116,6 +143,7 @@ bool executor_poll(Executor& ex) {
     executor_run_cycle(ex);
     return true;
 }
+#endif
 
 uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
     const ExecConfig c = executor_config(ex);

@@ -63,6 +63,13 @@ struct Executor {
     uint16_t late;           // cycles that started a full period or more late
     uint8_t reset_cause;     // captured at executor_begin
     uint32_t cycles_high;    // cycles run, high 32 bits: wraps of `cycles`
+    // Why cycles started late (FSW_SLEEP; `late` counts them all): the
+    // previous cycle's tasks ran past the start, or something else held
+    // the CPU then (interrupts, the link's service between cycles). Cycle
+    // starts that passed unserved are skipped and counted. All saturate.
+    uint16_t late_overrun;
+    uint16_t late_other;
+    uint16_t skipped;
 };
 
 // Cycles run, all 64 bits: `[time] source cycle` keeps counting past the
@@ -83,11 +90,16 @@ inline uint64_t executor_cycles(const Executor& ex) {
 FSW_MUST_CHECK Result executor_begin(Executor& ex, const ExecConfig* cfg);
 // Runs one cycle now: kicks the watchdog, then each due task in order.
 void executor_run_cycle(Executor& ex);
-// Runs a cycle if one is due (call from loop()); true when one ran. A cycle
-// that starts a full period late counts in `late`, and the schedule
-// restarts from now (missed cycles are skipped, not run in a burst). Time
-// is micros32(), compared wrap-safe: the due time is never more than a
-// period ahead, so a poll may come up to 2^31 us (35.8 minutes) late.
+// Runs a cycle if one is due (call from loop()); true when one ran.
+// With FSW_SLEEP (AVR) it first sleeps until the cycle is due or another
+// interrupt wakes the CPU (false then: loop() serves the link and calls
+// again); cycles start on a hardware timer's count, a late one (started
+// after its time) counts in `late` and in why, and a start that passed
+// unserved is skipped. Otherwise it polls micros32(): a cycle that starts
+// a full period late counts in `late`, and the schedule restarts from now
+// (missed cycles are skipped, not run in a burst); compared wrap-safe, the
+// due time never more than a period ahead, so a poll may come up to 2^31 us
+// (35.8 minutes) late.
 bool executor_poll(Executor& ex);
 
 // The configuration the executor runs (a copy of its FSW_FLASH object).

@@ -28,6 +28,27 @@ uint32_t millis32();
 uint64_t micros64();
 uint64_t millis64();
 
+// ---- Cycle timer (FSW_SLEEP: the sleeping executor) ----------------------------
+#if FSW_SLEEP
+// What cycle_wait() found.
+enum CycleWait : uint8_t {
+    kCycleOnTime = 0,       // a cycle starts now, on the timer's count
+    kCycleLateOverrun = 1,  // a cycle starts late: the previous cycle's tasks ran past its start
+    kCycleLateOther = 2,    // a cycle starts late: something else held the CPU at its start
+                            // (interrupts, the link's service between cycles)
+    kCycleNotDue = 0xFF     // no cycle yet: another interrupt woke the CPU
+};
+// Starts the timer that paces cycles of `period_us` (1..1000000, a divisor
+// of 1000000) and keeps the clock from then on; the first cycle is due at once.
+void cycle_timer_begin(uint32_t period_us);
+// Sleeps until the next cycle is due or another interrupt wakes the CPU.
+// A cycle that is due returns with interrupts on, marked as running until
+// cycle_end(); `skipped` counts the cycles whose start passed unserved.
+uint8_t cycle_wait(uint8_t& skipped);
+// The cycle cycle_wait() started has ended.
+void cycle_end();
+#endif
+
 // ---- AnalogIO ---------------------------------------------------------------
 // Raw ADC reading of an analog pin (board pin number, e.g. A0 = 14 on an Uno).
 uint16_t analog_read(uint8_t pin);

@@ -10,6 +10,7 @@
 #include "fsw_pal.h"
 
 #if defined(__AVR__)
+#include <avr/sleep.h>
 #include <avr/wdt.h>
 
 // MCUSR must be read and cleared before anything else runs, or a watchdog
@@ -58,10 +59,181 @@ Clock64 g_millis_ext;
 
 void begin() {}
 
+#if FSW_SLEEP
+// ---- The cycle timer: Timer1 (16-bit) in CTC mode, clk/8 ---------------------
+// A cycle of P us is n equal sub-periods of S = P / n us (n the smallest
+// power of two with S <= kMaxSubUs); OCR1A = S x ticks/us - 1 ends each, its
+// compare interrupt (or cycle_wait(), when it waits for it) counts them and
+// keeps the clock. OCR1B wakes the CPU FSW_WAKE_EARLY_US before a sub-period
+// ends; in the last one cycle_wait() then spins, interrupts off, until the
+// count wraps, so a cycle starts within one spin (8 CPU cycles) of its time,
+// whatever handler ran when the CPU woke.
+#if F_CPU == 16000000L
+#define FSW_T1_TICKS_PER_US 2u  // clk/8: 0.5 us a tick
+#elif F_CPU == 8000000L
+#define FSW_T1_TICKS_PER_US 1u
+#else
+#error "fswkit: the sleeping executor's timer needs F_CPU of 8 or 16 MHz: set FSW_SLEEP=0"
+#endif
+#if !defined(TIMSK1) || !defined(OCIE1B) || !defined(WGM12)
+#error "fswkit: the sleeping executor needs a 16-bit Timer1 with two compare units: set FSW_SLEEP=0"
+#endif
+
+namespace {
+const uint16_t kMaxSubUs = 32000u;  // x 2 ticks fits OCR1A; sums below fit 16 bits
+
+struct CycleTimer {
+    uint32_t base_us;   // the clock at the start of the running sub-period
+    uint32_t ms;        // milliseconds at that start, and the microseconds past them
+    uint16_t ms_frac;   //   (< 1000)
+    uint16_t sub_us;    // a sub-period, us; as whole ms + us:
+    uint16_t sub_ms;
+    uint16_t sub_frac;
+    uint16_t early;     // OCR1B: the count where the CPU wakes to spin
+    uint8_t sub;        // sub-periods ended in this cycle
+    uint8_t last;       // n - 1
+    uint8_t spin;       // period too short to sleep in: spin from mid-period
+    volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
+    volatile uint8_t why;       // why the first of them was missed (CycleWait)
+    volatile uint8_t running;   // a cycle's tasks are running
+};
+CycleTimer g_ct;
+
+// A sub-period ended (compare interrupt, or cycle_wait() that waited for it,
+// interrupts off): the clock moves on; true when a cycle is due.
+__attribute__((noinline)) bool sub_period_ended() {
+    g_ct.base_us += g_ct.sub_us;
+    g_ct.ms += g_ct.sub_ms;
+    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + g_ct.sub_frac);
+    if (f >= 1000u) {
+        f = static_cast<uint16_t>(f - 1000u);
+        ++g_ct.ms;
+    }
+    g_ct.ms_frac = f;
+    if (g_ct.sub != g_ct.last) {
+        ++g_ct.sub;
+        return false;
+    }
+    g_ct.sub = 0;
+    return true;
+}
+
+// The timer's count now, in us past the sub-period's start, and whether a
+// sub-period ended that the interrupt has not counted yet (interrupts off).
+inline uint16_t elapsed_us(bool& wrapped) {
+    const uint16_t t = TCNT1;
+    wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < g_ct.early;
+    return static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
+}
+}  // namespace
+
+void cycle_timer_begin(uint32_t period_us) {
+    // P = 2^a 5^b (a divisor of 1000000): halving it at most five times
+    // gives whole sub-periods of at most kMaxSubUs (1000000 / 32 = 31250).
+    uint8_t n = 1;
+    while (period_us > kMaxSubUs) {
+        period_us >>= 1;
+        n = static_cast<uint8_t>(n << 1);
+    }
+    const uint16_t sub_us = static_cast<uint16_t>(period_us);
+    const uint16_t top = static_cast<uint16_t>(sub_us * FSW_T1_TICKS_PER_US - 1u);
+    const uint16_t early_ticks = FSW_WAKE_EARLY_US * FSW_T1_TICKS_PER_US;
+    const IrqState saved = critical_enter();
+    g_ct.base_us = 0;  // the clock counts from here
+    g_ct.ms = 0;
+    g_ct.ms_frac = 0;
+    g_ct.sub_us = sub_us;
+    g_ct.sub_ms = static_cast<uint16_t>(sub_us / 1000u);
+    g_ct.sub_frac = static_cast<uint16_t>(sub_us % 1000u);
+    g_ct.spin = top < 4u * early_ticks;
+    g_ct.early = g_ct.spin ? static_cast<uint16_t>(top / 2u + 1u) : static_cast<uint16_t>(top - early_ticks);
+    g_ct.sub = 0;
+    g_ct.last = static_cast<uint8_t>(n - 1u);
+    g_ct.due = 1;  // the first cycle: at once, on time
+    g_ct.why = kCycleOnTime;
+    g_ct.running = 0;
+    TIMSK0 = static_cast<uint8_t>(TIMSK0 & ~_BV(TOIE0));  // the core's millis() stops here
+    TCCR1A = 0;
+    TCCR1B = 0;
+    TCNT1 = 0;
+    OCR1A = top;
+    OCR1B = g_ct.early;
+    TIFR1 = static_cast<uint8_t>(_BV(OCF1A) | _BV(OCF1B));  // writing 1 clears a flag
+    TIMSK1 = static_cast<uint8_t>(_BV(OCIE1A) | (g_ct.spin ? 0 : _BV(OCIE1B)));
+    TCCR1B = static_cast<uint8_t>(_BV(WGM12) | _BV(CS11));  // CTC on OCR1A, clk/8: counting
+    critical_exit(saved);
+}
+
+uint8_t cycle_wait(uint8_t& skipped) {
+    for (uint8_t pass = 0;; ++pass) {
+        cli();
+        if (g_ct.due != 0) {  // a start passed (late), or the first cycle
+            skipped = static_cast<uint8_t>(g_ct.due - 1u);
+            const uint8_t why = g_ct.why;
+            g_ct.due = 0;
+            g_ct.why = kCycleOnTime;
+            g_ct.running = 1;
+            sei();
+            return why;
+        }
+        if (g_ct.sub == g_ct.last && TCNT1 >= g_ct.early) {
+            // The last stretch, interrupts off: until the count wraps to 0.
+            while (TCNT1 >= g_ct.early) {
+            }
+            TIFR1 = _BV(OCF1A);  // this sub-period's end is counted here
+            (void)sub_period_ended();
+            skipped = 0;
+            g_ct.running = 1;
+            sei();
+            return kCycleOnTime;
+        }
+        if (pass != 0 || g_ct.spin) {
+            sei();
+            return kCycleNotDue;
+        }
+        // Sleep; sei's next instruction runs before any interrupt, so a
+        // wake-up cannot be lost between the test above and the sleep.
+        SMCR = _BV(SE);  // idle mode (SM2..0 = 0): timers, UART and ADC run on
+        sei();
+        sleep_cpu();
+        SMCR = 0;
+    }
+}
+
+void cycle_end() { g_ct.running = 0; }
+
+uint32_t micros32() {
+    const IrqState saved = critical_enter();
+    bool wrapped;
+    const uint16_t us = elapsed_us(wrapped);
+    uint32_t t = g_ct.base_us + us;
+    if (wrapped) t += g_ct.sub_us;
+    critical_exit(saved);
+    return t;
+}
+
+uint32_t millis32() {
+    const IrqState saved = critical_enter();
+    bool wrapped;
+    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + elapsed_us(wrapped));  // < 1000 + 32000
+    uint32_t ms = g_ct.ms;
+    if (wrapped) {
+        ms += g_ct.sub_ms;
+        f = static_cast<uint16_t>(f + g_ct.sub_frac);
+    }
+    critical_exit(saved);
+    while (f >= 1000u) {  // at most 33 times
+        f = static_cast<uint16_t>(f - 1000u);
+        ++ms;
+    }
+    return ms;
+}
+#else
 uint32_t micros32() { return micros(); }
 uint32_t millis32() { return millis(); }
-uint64_t micros64() { return clock64_extend(g_micros_ext, micros()); }
-uint64_t millis64() { return clock64_extend(g_millis_ext, millis()); }
+#endif
+uint64_t micros64() { return clock64_extend(g_micros_ext, micros32()); }
+uint64_t millis64() { return clock64_extend(g_millis_ext, millis32()); }
 
 uint16_t analog_read(uint8_t pin) { return static_cast<uint16_t>(analogRead(pin)); }
 void analog_write(uint8_t pin, uint8_t duty) { analogWrite(pin, duty); }
@@ -177,5 +349,20 @@ uint8_t reset_cause() { return 0; }
 
 }  // namespace pal
 }  // namespace fsw
+
+#if FSW_SLEEP
+// A sub-period of the cycle timer ended while nothing waited for it: the
+// clock moves on, and a cycle start that passed is marked due, with why it
+// was missed (the running cycle overran, or something else held the CPU).
+ISR(TIMER1_COMPA_vect) {
+    using fsw::pal::g_ct;
+    if (fsw::pal::sub_period_ended()) {
+        if (g_ct.due == 0) g_ct.why = g_ct.running ? fsw::pal::kCycleLateOverrun : fsw::pal::kCycleLateOther;
+        if (g_ct.due != 0xFFu) ++g_ct.due;
+    }
+}
+// The CPU wakes to wait out the last stretch before a cycle (cycle_wait()).
+EMPTY_INTERRUPT(TIMER1_COMPB_vect);
+#endif
 
 #endif  // FSW_PLATFORM_ARDUINO

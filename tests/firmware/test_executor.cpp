@@ -33,8 +33,11 @@ static void spend(uint16_t us) {
 #endif
 }
 
+static uint32_t task0_at_us;  // when task 0 (first in every cycle) last started
+
 static Result step_fn(void* ctx) {
     const uint8_t i = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(ctx));
+    if (i == 0) task0_at_us = pal::micros32();
     note(static_cast<char>('A' + i));
     ++calls[i];
     spend(busy_us[i]);
@@ -181,13 +184,46 @@ static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
 #else
     TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kConfig));
     TEST_ASSERT_TRUE((WDTCSR & _BV(WDE)) != 0);  // watchdog armed
-    const uint32_t start = micros();
+    const uint32_t start = pal::micros32();
     uint16_t ran = 0;
-    while (micros() - start < 10500UL) {
+    while (pal::micros32() - start < 10500UL) {
         if (executor_poll(ex)) ++ran;
     }
     TEST_ASSERT_TRUE(ran >= 10 && ran <= 12);
     TEST_ASSERT_EQUAL_UINT16(0, ex.late);
+#if FSW_SLEEP
+    // Cycles start on the timer's count: one period apart to within a spin.
+    uint32_t starts[4];
+    for (uint8_t i = 0; i < 4;) {
+        if (executor_poll(ex)) starts[i++] = task0_at_us;
+    }
+    for (uint8_t i = 1; i < 4; ++i) {
+        const uint32_t d = starts[i] - starts[i - 1];
+        TEST_ASSERT_TRUE(d >= 999 && d <= 1001);
+    }
+    // A step that runs past the next start: that cycle is late, because of
+    // an overrun; a start that passed unserved is skipped, not run in a burst.
+    busy_us[0] = 2300;
+    while (!executor_poll(ex)) {
+    }
+    busy_us[0] = 0;
+    while (!executor_poll(ex)) {
+    }
+    TEST_ASSERT_EQUAL_UINT16(1, ex.late);
+    TEST_ASSERT_EQUAL_UINT16(1, ex.late_overrun);
+    TEST_ASSERT_EQUAL_UINT16(0, ex.late_other);
+    TEST_ASSERT_EQUAL_UINT16(1, ex.skipped);
+    // Held between cycles (interrupts off past a start): late for another reason.
+    while (!executor_poll(ex)) {
+    }
+    noInterrupts();
+    delayMicroseconds(1100);
+    interrupts();
+    while (!executor_poll(ex)) {
+    }
+    TEST_ASSERT_EQUAL_UINT16(2, ex.late);
+    TEST_ASSERT_EQUAL_UINT16(1, ex.late_other);
+#endif
 #endif
 }
 

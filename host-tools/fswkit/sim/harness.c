@@ -106,6 +106,13 @@ static double wall_now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* simavr's default makes the host sleep in wall-clock time while the core
+   sleeps; the board runs as fast as it can and run() paces it when asked. */
+static void no_wall_sleep(avr_t* a, avr_cycle_count_t how_long) {
+    (void)a;
+    (void)how_long;
+}
+
 static void sleep_s(double s) {
     if (s <= 0) return;
     struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
@@ -999,6 +1006,7 @@ int main(int argc, char** argv) {
     }
     avr_init(avr);
     avr->log = LOG_ERROR;
+    avr->sleep = no_wall_sleep; /* a sleeping core skips to its next event; pacing is run()'s */
     if (fw.flashbase + fw.flashsize > avr->flashend + 1u) {
         fprintf(stderr, "simboard: %s holds %u B of code, more than the %s's %u B of flash\n", argv[optind],
                 (unsigned)(fw.flashbase + fw.flashsize), mcu_name, (unsigned)(avr->flashend + 1u));

@@ -28,6 +28,10 @@ class Board:
     reserved: dict[int, str]  # pin -> why it is reserved
     adc_bits: int
     adc_vref: float
+    # the timer the executor keeps (`executor.timer`), and the PWM pins it
+    # takes from analog outputs (`executor.timer_pins`)
+    timer: str = ""
+    timer_pins: frozenset[int] = frozenset()
     # pin -> (port letter, bit) on an AVR board's MCU (`arduino.ports`); empty
     # when the board file does not say (channels then go through pin numbers)
     ports: dict[int, tuple[str, int]] = field(default_factory=dict, compare=False)
@@ -117,6 +121,8 @@ def board_from_dict(name: str, d: dict) -> Board:
         reserved={pin(r["pin"], "pins.reserved.pin"): str(r["reason"]) for r in pins.get("reserved", [])},
         adc_bits=_int(d["adc"]["bits"], "adc.bits", 1, 16),
         adc_vref=_volts(d["adc"]["vref"], "adc.vref"),
+        timer=str(d.get("executor", {}).get("timer", "")),
+        timer_pins=frozenset(pin(p, "executor.timer_pins") for p in d.get("executor", {}).get("timer_pins", [])),
         ports=_ports(d.get("arduino", {}).get("ports", [])),
         raw=d,
     )

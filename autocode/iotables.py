@@ -126,9 +126,12 @@ def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err) -> i
         problem = f"pin `{text}` is reserved on `{board.name}`: {board.reserved[pin]}"
     elif analog and row.direction.text == "i" and pin not in board.analog_pins.values():
         problem = f"pin `{text}` of `{board.name}` is not an analog input"
+    elif analog and row.direction.text == "o" and pin in board.timer_pins:
+        problem = (f"pin `{text}` of `{board.name}` cannot drive PWM: its timer ({board.timer}) paces the "
+                   f"executor (PWM pins: {', '.join(str(p) for p in sorted(board.pwm_pins - board.timer_pins))})")
     elif analog and row.direction.text == "o" and pin not in board.pwm_pins:
         problem = (f"pin `{text}` of `{board.name}` cannot drive PWM "
-                   f"(PWM pins: {', '.join(str(p) for p in sorted(board.pwm_pins))})")
+                   f"(PWM pins: {', '.join(str(p) for p in sorted(board.pwm_pins - board.timer_pins))})")
     elif not analog and pin not in board.digital_pins:
         problem = f"pin `{text}` of `{board.name}` cannot be used as a digital pin"
     elif pin in used_pins:

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Benchmark of the simulated board (make bench): the executor's period
-jitter at 1 kHz on a simulated Uno, against shared/targets.md (<= 8 us).
+jitter at 1 kHz on a simulated Uno, against shared/targets.md (<= 8 us; with
+the executor sleeping between cycles, <= 2 us; 7.94 us before, 2026-11-23).
 
 The project tests/sim/toggle flips pin 13 on every executor cycle; the
 simulated board timestamps the pin's edges in CPU cycles (deterministic in
@@ -26,6 +27,7 @@ TANK_OUT = os.path.join(ROOT, "build", "bench", "sim-tank")
 PIN = 13
 PERIOD_US = 1000.0
 TARGET_US = 8.0
+SLEEP_TARGET_US = 2.0  # targets.md, second wave: with the executor sleeping between cycles
 WARMUP_S, MEASURE_S = 0.1, 5.0
 
 
@@ -90,6 +92,8 @@ def main() -> int:
     rows = [
         ("period, mean", "1,000 us", f"{j['mean']:,.3f} us", None),
         ("period jitter, max |period - 1 ms|", f"<= {TARGET_US:g} us", f"{j['peak']:.2f} us", j["peak"] <= TARGET_US),
+        ("  the sleeping executor's (before: 7.94 us)", f"<= {SLEEP_TARGET_US:g} us", f"{j['peak']:.2f} us",
+         j["peak"] <= SLEEP_TARGET_US),
         ("period jitter, peak to peak", "-", f"{j['pp']:.2f} us", None),
         ("period jitter, RMS", "-", f"{j['rms']:.2f} us", None),
         (f"periods within {TARGET_US:g} us of 1 ms", "-", f"{100 * j['within']:.1f} %", None),

@@ -49,3 +49,21 @@ def test_profile_restarts_from_zero_and_refuses_bad_addresses(tank_uno):
             b.profile([1 << 20])
         with pytest.raises(SimError, match="no function `no_such_function`"):
             b.function("no_such_function")
+
+
+def test_the_executor_sleeps_between_cycles(tank_uno):
+    """Between cycles the core sleeps (idle, until the executor's timer wakes
+    it): of 0.1 s at 100 Hz, the tank's tasks keep it busy a few percent, so
+    well over three quarters of the cycles are asleep, and the cycles spent
+    in the tasks are not counted as sleep."""
+    with SimBoard(tank_uno, "uno", analog={"A0": 3.9}, sim_limit=5) as b:
+        up = b.function("fsw::link_uplink_task")
+        down = b.function("fsw::link_telemetry_task")
+        b.run_for(0.005)
+        b.profile([up, down])
+        c0 = b.cycle
+        b.run_for(0.1)
+        total = b.cycle - c0
+        p = b.profile_read()
+    assert p.sleep > 0.75 * total
+    assert p.sleep + p.frame_total <= total

@@ -483,19 +483,27 @@ def _clock_steps(tasks: list[Task], board: Board | None, time_source: str, time_
     """Every machine's task steps slower than `G` ticks.
 
     With `source clock`, G is the board's millis()/micros(), which advance
-    in ticks of the timer that keeps them: on an AVR Arduino core millis()
-    moves on every 16,384 CPU cycles (1.024 ms at 16 MHz, by 2 at 8 MHz),
-    so a machine stepping faster than that sometimes sees G stand still,
-    and a machine whose time does not increase is safed."""
+    in ticks of the timer that keeps them. On a board whose executor keeps
+    its own timer (`executor.timer`: cycles start on its count, and the
+    clock is its 0.5 us ticks) G moves on by the cycle's exact period. On
+    any other AVR board the Arduino core's millis() moves on every 16,384
+    CPU cycles (1.024 ms at 16 MHz, by 2 at 8 MHz), so a machine stepping
+    faster than that sometimes sees G stand still, and a machine whose time
+    does not increase is safed."""
     per_second = 1000 if time_unit == "ms" else 1000000
     tick_us = (Fraction(16384 * 1000000, board.f_cpu) if board is not None and board.f_cpu and
-               time_source == "clock" and time_unit == "ms" else None)
+               not board.timer and time_source == "clock" and time_unit == "ms" else None)
     for t in tasks:
         if t.kind != "machine":
             continue
         if t.rate > per_second:
             r.at(t.line, 1, f"task `{t.name}` runs at {hz(t.rate)} Hz but `G` counts in {time_unit}: "
                             "`G` would not increase between its steps (use `unit us`)")
+        elif time_source == "clock" and t.rate == per_second:
+            r.at(t.line, 1, f"task `{t.name}` steps every 1 {time_unit} and `G` is the clock in {time_unit}: a "
+                            f"cycle that starts late would step in the same {time_unit} as the one before, and "
+                            "a machine whose time does not increase is safed (use `unit us`, `source cycle`, "
+                            "or a slower rate)")
         elif tick_us is not None and Fraction(1000000) / t.rate < tick_us:
             r.at(t.line, 1,
                  f"task `{t.name}` steps every {float(Fraction(1000000) / t.rate):g} us, but with `source clock` "

@@ -1,4 +1,4 @@
-# millis too coarse
+# millis too coarse: a machine stepping every millisecond on the millisecond clock
 [application]
 board uno
 rate 1000

@@ -16,8 +16,8 @@ on both sensors, docs/sim.md) of EVERY tape: FSW_TAPE_PERTURB (default
 interpreter (fswkit.plant.tape_interp: the same inputs and checks, about
 700× real time: 200 runs of the eight tapes are ~11 CPU-minutes), and
 FSW_TAPE_PERTURB_BOARD (default 1) runs a tape on the simulated board
-(~6× real time: one run of the eight is ~6.5 CPU-minutes; 200 would be
-~21 CPU-hours). For each: the runs with a pyro pin during boost (target
+(~25× real time with the sleeping executor: one run of the eight is
+~1.5 CPU-minutes; 200 would be ~5 CPU-hours). For each: the runs with a pyro pin during boost (target
 0), the share of runs meeting each check, the apogee error's spread.
 
 A failed check is a measured result, printed; the tool exits non-zero only
@@ -253,7 +253,7 @@ def perturbed(folder: str, paths: list, layout, cfg, elf, board, jobs: int) -> i
         print(f"{n * len(paths)} interpreted replays in {time.perf_counter() - t0:.0f} s wall with {jobs} at a time")
     if nb > 0:
         print(f"\nperturbed replays on the simulated Uno (fsw sim --tape T --perturb {nb} --seed {seed}), "
-              f"{nb} a tape; 200 a tape would take ~{200 * 390 / 3600:.0f} CPU-hours at today's replay speed")
+              f"{nb} a tape; 200 a tape would take ~{200 * 90 / 3600:.0f} CPU-hours at today's replay speed")
         print(head)
         print("-" * len(head))
         for name, p in zip(names, paths):

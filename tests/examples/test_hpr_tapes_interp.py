@@ -6,7 +6,7 @@ no pyro pin before burnout, the drogue pin within -0.5/+1.0 s of the
 barometric apogee, the main pin within ±15 m of MAIN_ALT where the tape
 comes down to it, the landing within -1/+10 s of the tape's where it
 lands, none in the air where it does not. The board's replays
-(test_hpr_tapes.py, one tape; tools/bench_tapes.py, all eight) agree with
+(test_hpr_tapes.py and tools/bench_tapes.py) agree with
 these within a step or two. Skips only when the tapes' folder is absent
 (a user's clone)."""
 

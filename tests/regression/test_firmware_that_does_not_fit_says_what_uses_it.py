@@ -79,7 +79,7 @@ def test_machine_code_too_big_for_the_flash_is_reported_by_machine(fsw, tmp_path
     (tmp_path / "big.app").write_text(APP)
     (tmp_path / "big.sv").write_text("[Flight]\nU64 time\nU32 state\nF64 x\nF64 y\n")
     sm = ["[state_vector]", "U64 time @alias G", "U32 state @alias S", "F64 x", "F64 y", ""]
-    n = 100
+    n = 200  # well past the Uno's 32 KB whatever the generator saves
     for i in range(1, n + 1):
         sm += [f"[S{i}]", ".step", f"    x = x * {1 + i / 1000} + y / {i}.5 - {i}",
                f"    y = (y + x * {i}) / (x - {i}.25)", f"    x > {i * 10} and y < {i}: -> S{i % n + 1}", ""]

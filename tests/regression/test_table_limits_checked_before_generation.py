@@ -106,7 +106,7 @@ def test_locals_of_65535_bytes_accepted_65536_refused(tmp_path):
 def test_task_divider_of_64000_accepted_65536_refused(tmp_path):
     # Rates divide 1,000,000, so a divider is 2^a 5^b: 64,000 is the largest
     # under 65,536, the first that does not fit a uint16_t.
-    _pair(tmp_path, lambda d, ok: _app(d, rate=1000, tasks=f"slow outputs rate={1000 / (64000 if ok else 65536)}\n"),
+    _pair(tmp_path, lambda d, ok: _app(d, rate=1000, unit="us", tasks=f"slow outputs rate={1000 / (64000 if ok else 65536)}\n"),
           "a.app:11:1", "runs every 65,536 executor cycles: at most every 65,535")
 
 

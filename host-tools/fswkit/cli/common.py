@@ -4,6 +4,7 @@ output file."""
 
 from __future__ import annotations
 
+import os
 import sys
 
 from fswkit.autocode.diagnostics import Diagnostics
@@ -60,3 +61,36 @@ def write_output(text: str, out: str | None, command: str, inputs=()) -> int:
         sys.stderr.write(f"fsw {command}: {e}\n")
         return EXIT_FAIL
     return EXIT_OK
+
+
+def flown(fly, out: str) -> int:
+    """Runs a flight or a replay that writes its files into `out` as one
+    set, then prints its report; the exit status: 0 when its checks
+    passed, 1 when one failed or the run could not finish, 128 + N when
+    stopped by signal N."""
+    from fswkit.link.log import LogError
+    from fswkit.outputs import Stopped
+    from fswkit.plant.cosim import CosimError
+    from fswkit.plant.run import INCOMPLETE
+    from fswkit.sim.command import say
+
+    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
+                  "still the last finished run's")
+    try:
+        done = fly()
+    except Stopped as e:
+        say(f"stopped by {e}" + incomplete)
+        return 128 + e.signum
+    except KeyboardInterrupt:
+        say("interrupted" + incomplete)
+        raise
+    except (CosimError, LogError) as e:  # LogError: the log could not be written (a full disk)
+        say(str(e) + incomplete)
+        return 1
+    except OSError as e:
+        say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
+        return 1
+    sys.stdout.write(done.report.text())
+    sys.stdout.flush()
+    say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "summary")))
+    return 0 if done.report.passed else 1

@@ -9,7 +9,7 @@ import os
 import sys
 import time
 
-from fswkit.cli.common import EXIT_CONFIG
+from fswkit.cli.common import EXIT_CONFIG, flown
 
 
 def cmd_sim(args) -> int:
@@ -138,40 +138,7 @@ def plant_run(args) -> int:
     what = f"seed {sc.seed}" + (f", fault {sc.fault}" if sc.fault else "")
     say(f"{args.plant} plant at {sc.rate} Hz in lock-step with the {board.name}, {what}; up to {sc.max_s:g} s "
         "simulated")
-    return _flown(lambda: execute(sc, elf, board, layout, out), out)
-
-
-def _flown(fly, out: str) -> int:
-    """Runs a flight or a replay that writes its files into `out` as one
-    set, then prints its report; the exit status: 0 when its checks
-    passed, 1 when one failed or the run could not finish, 128 + N when
-    stopped by signal N."""
-    from fswkit.link.log import LogError
-    from fswkit.outputs import Stopped
-    from fswkit.plant.cosim import CosimError
-    from fswkit.plant.run import INCOMPLETE
-    from fswkit.sim.command import say
-
-    incomplete = (f"; its partial files are in {os.path.join(out, INCOMPLETE)}, and the files in {out} are "
-                  "still the last finished run's")
-    try:
-        done = fly()
-    except Stopped as e:
-        say(f"stopped by {e}" + incomplete)
-        return 128 + e.signum
-    except KeyboardInterrupt:
-        say("interrupted" + incomplete)
-        raise
-    except (CosimError, LogError) as e:  # LogError: the log could not be written (a full disk)
-        say(str(e) + incomplete)
-        return 1
-    except OSError as e:
-        say(f"cannot write {e.filename or out}: {e.strerror or e}" + incomplete)
-        return 1
-    sys.stdout.write(done.report.text())
-    sys.stdout.flush()
-    say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "summary")))
-    return 0 if done.report.passed else 1
+    return flown(lambda: execute(sc, elf, board, layout, out), out)
 
 
 def tape_run(args) -> int:
@@ -245,4 +212,4 @@ def tape_run(args) -> int:
         say(f"wrote {os.path.join(out, 'perturb.txt')}, {os.path.join(out, 'perturb.csv')}")
         return 0 if ok else 1
     say(f"replaying {args.tape} ({tape.rows:,} rows, {tape.span:.1f} s) open loop on the {board.name}")
-    return _flown(lambda: tr.execute(tape, truth, cfg, app, elf, board, layout, out), out)
+    return flown(lambda: tr.execute(tape, truth, cfg, app, elf, board, layout, out), out)

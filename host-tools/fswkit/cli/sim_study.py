@@ -129,7 +129,7 @@ def study_run(args) -> int:
 
 def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
     """`--run I`: run I of the study flown again alone, its files written."""
-    from fswkit.cli.sim import _flown
+    from fswkit.cli.common import flown
     from fswkit.plant import study
     from fswkit.plant.dispersion import draw
     from fswkit.plant.run import execute
@@ -152,4 +152,4 @@ def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
     facts = ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()
                       if v is not None)
     say(f"run {args.run} of the study with seed {seed} (sensor noise seed {d.noise_seed}): {facts}")
-    return _flown(lambda: execute(sc, elf, board, layout, out), out)
+    return flown(lambda: execute(sc, elf, board, layout, out), out)

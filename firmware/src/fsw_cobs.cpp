@@ -3,6 +3,10 @@
 
 #include "fsw_crc.h"
 
+#if defined(__AVR__)
+#include <util/crc16.h>
+#endif
+
 namespace fsw {
 
 void cobs_begin(CobsEncoder& e, uint8_t* out) {
@@ -28,24 +32,45 @@ FSW_NOINLINE FSW_NOCLONE static void put_raw(CobsEncoder& e, uint8_t b) {
     }
 }
 
-void cobs_put(CobsEncoder& e, uint8_t b) {
-    e.crc = crc16_update(e.crc, b);
-    put_raw(e, b);
-}
-
+// The encoder's loop: its state in registers, the CRC inline, the output
+// through pointers; about 35 AVR cycles a byte (make bench measures it).
 void cobs_put_bytes(CobsEncoder& e, const uint8_t* p, uint16_t n) {
-    for (uint16_t i = 0; i < n; ++i) cobs_put(e, p[i]);
+    uint8_t* w = e.out + e.len;
+    uint8_t* code_p = e.out + e.code_at;
+    uint8_t code = e.code;
+    uint16_t crc = e.crc;
+    for (; n != 0; --n) {
+        const uint8_t b = *p++;
+#if defined(__AVR__)
+        crc = _crc_xmodem_update(crc, b);
+#else
+        crc = crc16_update(crc, b);
+#endif
+        if (b == 0) {
+            *code_p = code;
+            code_p = w++;
+            code = 1;
+        } else {
+            *w++ = b;
+            if (++code == 0xFFu) {  // a full block: 254 data bytes, no zero implied
+                *code_p = 0xFFu;
+                code_p = w++;
+                code = 1;
+            }
+        }
+    }
+    e.len = static_cast<uint16_t>(w - e.out);
+    e.code_at = static_cast<uint16_t>(code_p - e.out);
+    e.code = code;
+    e.crc = crc;
 }
 
-void cobs_put_u16(CobsEncoder& e, uint16_t v) {
-    cobs_put(e, static_cast<uint8_t>(v));
-    cobs_put(e, static_cast<uint8_t>(v >> 8));
-}
+void cobs_put(CobsEncoder& e, uint8_t b) { cobs_put_bytes(e, &b, 1); }
 
-void cobs_put_u32(CobsEncoder& e, uint32_t v) {
-    cobs_put_u16(e, static_cast<uint16_t>(v));
-    cobs_put_u16(e, static_cast<uint16_t>(v >> 16));
-}
+// Little-endian targets (fsw_config.h): a value's bytes are its wire order.
+void cobs_put_u16(CobsEncoder& e, uint16_t v) { cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&v), 2); }
+
+void cobs_put_u32(CobsEncoder& e, uint32_t v) { cobs_put_bytes(e, reinterpret_cast<const uint8_t*>(&v), 4); }
 
 uint16_t cobs_end(CobsEncoder& e) {
     const uint16_t crc = e.crc;

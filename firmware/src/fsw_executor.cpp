@@ -137,6 +137,8 @@ bool executor_poll(Executor& ex) {
     flash_read(&period, &ex.cfg->period_us, sizeof period);
     if (late_by >= period) {
         if (ex.late != 0xFFFFu) ++ex.late;
+        const uint32_t missed = late_by / period;  // cycle starts that passed unserved
+        ex.skipped = static_cast<uint16_t>(ex.skipped > 0xFFFFu - missed ? 0xFFFFu : ex.skipped + missed);
         ex.next_due_us += late_by;  // restart the schedule from now
     }
     ex.next_due_us += period;

@@ -109,13 +109,14 @@ void send_batch(Link& l, const LinkConfig& c, const LinkStream& s, LinkStreamSta
 
 void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, uint32_t now32) {
     LinkStreamState& st = c.stream_state[i];
-    const uint16_t late = c.ex->late;
+    const uint16_t skipped = c.ex->skipped;
     // Samples of a frame are evenly spaced: a batch the executor broke by
-    // skipping cycles goes out as it is.
-    if (st.count != 0 && late != st.late0) send_batch(l, c, s, st, i, false);
+    // skipping cycles goes out as it is (a cycle that only started late
+    // still takes its sample).
+    if (st.count != 0 && skipped != st.skipped0) send_batch(l, c, s, st, i, false);
     if (st.count == 0) {
         st.t0 = now32;
-        st.late0 = late;
+        st.skipped0 = skipped;
     }
     if (static_cast<uint8_t>(st.count + 1u) < s.batch) {
         sv_move(c, s.store + st.count * s.size, c.sv + s.off, s.size);
@@ -154,10 +155,14 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         const ExecConfig ec = executor_config(ex);
         for (uint8_t i = 0; i < ec.n_tasks; ++i) {
             const TaskStats& s = ec.stats[i];
-            put(executor_task_mode(ex, i));
-            put(s.faults);  // saturates at 255
-            put_u16(s.overruns);
-            put_u16(static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us));
+            ElemOff mode_off;  // the task's mode: its element, or its record
+            flash_read(&mode_off, &ec.tasks[i].mode_off, sizeof mode_off);
+            const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
+            const uint8_t row[6] = {mode_off != kNoElement ? ec.sv[mode_off] : s.mode,
+                                    s.faults,  // saturates at 255
+                                    static_cast<uint8_t>(s.overruns), static_cast<uint8_t>(s.overruns >> 8),
+                                    static_cast<uint8_t>(worst), static_cast<uint8_t>(worst >> 8)};
+            put_bytes(row, sizeof row);
         }
     } else {
         const uint16_t off = l.snapshot_at;
@@ -171,23 +176,31 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
 }
 
 // Sends waiting control frames while the transmit buffer is free:
-// acknowledgements first, then hello, health, snapshot chunks.
+// acknowledgements first, then hello, health, snapshot chunks. After a
+// hello or a health frame (the two long ones) the next waits for a whole
+// executor cycle to pass, so no step, and no cycle with the gap after it,
+// composes both.
 void service(Link& l, const LinkConfig& c) {
     while (tx_free(l)) {
         const uint8_t p = l.pending;
+        const uint8_t cycle = static_cast<uint8_t>(c.ex->cycles);
+        const bool big_ok = static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;
         uint8_t type;
         if (p & kPendAck) {
             type = kFrameAck;
-        } else if (p & kPendHello) {
+        } else if (big_ok && (p & kPendHello)) {
             type = kFrameHello;
-        } else if (p & kPendHealth) {
+        } else if (big_ok && (p & kPendHealth)) {
             type = kFrameHealth;
         } else if (l.snapshot_at != kNoSnapshot) {
             type = kFrameSnapshot;
         } else {
             return;
         }
-        l.pending = static_cast<uint8_t>(p & (p - 1u));  // the lowest bit: the one sent (none for a snapshot)
+        if (type == kFrameHello || type == kFrameHealth) l.big_cycle = cycle;
+        // the bit of the frame sent: the lowest of those it may send (none for a snapshot)
+        const uint8_t may = big_ok ? p : static_cast<uint8_t>(p & kPendAck);
+        l.pending = static_cast<uint8_t>(p & ~(may & (0u - may)));
         send_control(l, c, type);
     }
 }
@@ -297,6 +310,7 @@ void link_begin(Link& l, const LinkConfig* cfg) {
     l.snapshot_at = kNoSnapshot;
     l.health_countdown = c.health_every;
     l.hello_countdown = c.hello_every;
+    l.big_cycle = 0xFEu;  // the boot hello may go in the first cycle
     l.pending = kPendHello;
 }
 

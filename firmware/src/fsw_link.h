@@ -60,7 +60,7 @@ struct LinkStream {
 struct LinkStreamState {
     uint32_t t0;         // time of the first sample of the open batch
     uint16_t countdown;  // telemetry runs until the next sample
-    uint16_t late0;      // executor `late` count when the batch opened
+    uint16_t skipped0;   // executor `skipped` count when the batch opened
     uint8_t count;       // samples in the open batch
 };
 
@@ -122,6 +122,7 @@ struct Link {
     uint8_t ack_status;
     uint8_t pending;        // control frames waiting for the transmit buffer
     uint8_t hello_countdown;
+    uint8_t big_cycle;      // low byte of the executor cycle count at the last hello or health frame
     uint8_t rx_len;
     bool rx_over;
     uint8_t rx[FSW_LINK_RX_CAP];

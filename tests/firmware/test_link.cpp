@@ -343,6 +343,29 @@ static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(voi
     TEST_ASSERT_EQUAL_INT16(0x0909, load<int16_t>(sv + 10));
 }
 
+// Every third health frame brings a hello (hello_every 3): the two long
+// frames never go out in the same cycle or the gap after it, so no step
+// composes both.
+static void test_hello_and_health_never_share_a_cycle(void) {
+    uint8_t hellos = 0, healths = 0, both = 0;
+    for (uint8_t k = 0; k < 100; ++k) {
+        run(1);
+        collect();
+        uint8_t he = 0, hl = 0;
+        for (uint8_t i = 0; i < n_frames; ++i) {
+            if (frames[i].len < 0) continue;
+            if (frames[i].body[0] == kFrameHello) ++he;
+            if (frames[i].body[0] == kFrameHealth) ++hl;
+        }
+        if (he != 0 && hl != 0) ++both;
+        hellos = static_cast<uint8_t>(hellos + he);
+        healths = static_cast<uint8_t>(healths + hl);
+    }
+    TEST_ASSERT_EQUAL_UINT8(0, both);
+    TEST_ASSERT_EQUAL_UINT8(10, healths);
+    TEST_ASSERT_EQUAL_UINT8(1 + 3, hellos);  // at boot, then with every third health frame
+}
+
 static void test_ping_hello_snapshot(void) {
     run(1);
     collect();
@@ -413,6 +436,7 @@ static void run_all(void) {
     RUN_TEST(test_mode_commands);
     RUN_TEST(test_set_of_a_mode_element_is_locked);
     RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
+    RUN_TEST(test_hello_and_health_never_share_a_cycle);
     RUN_TEST(test_ping_hello_snapshot);
     RUN_TEST(test_bad_tables_do_not_pass_the_compile_time_checks);
 }

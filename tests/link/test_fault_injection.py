@@ -35,11 +35,15 @@ def frame_spans(data: bytes) -> list[tuple[int, int]]:
 
 def test_clean_link_loses_nothing(clean):
     s = Session(tank_layout())
-    s.feed(clean)
+    events = s.feed(clean)
     assert s.stats.lost == 0 and s.deframer.stats.invalid == 0 and s.deframer.stats.crc_errors == 0
     assert s.stats.frames == len(frame_spans(clean)) > 20000
     assert s.health["dropped"] == 0  # the target never found its transmit buffer full
-    assert s.health["frames"] == s.last_seq
+    healths = [e for e in events if e.kind == "health"]
+    assert len(healths) > 100
+    # each health frame counts the frames sent before it: its own sequence number
+    assert all(e.info["frames"] == e.seq for e in healths)
+    assert healths[-1].seq <= s.last_seq
 
 
 def corrupt(data: bytes, rnd: random.Random, ber: float, drop: float) -> tuple[bytes, np.ndarray]:

@@ -94,3 +94,16 @@ def flown(fly, out: str) -> int:
     sys.stdout.flush()
     say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "summary")))
     return 0 if done.report.passed else 1
+
+
+def folder_and_firmware(project: str, board: str | None, out: str):
+    """Creates the output folder `out` and builds the project's firmware for
+    the simulated board: (elf, board), or the exit status after saying why."""
+    from fswkit.sim.command import build, say
+
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        return 2
+    return build(project, board)

@@ -9,7 +9,7 @@ import os
 import sys
 import time
 
-from fswkit.cli.common import EXIT_CONFIG, flown
+from fswkit.cli.common import EXIT_CONFIG, flown, folder_and_firmware
 
 
 def cmd_sim(args) -> int:
@@ -148,7 +148,7 @@ def tape_run(args) -> int:
     from fswkit.link.layout import LayoutError, from_app
     from fswkit.outputs import OutputError, write_text
     from fswkit.plant import tape_replay as tr
-    from fswkit.sim.command import build, is_elf, say
+    from fswkit.sim.command import is_elf, say
     from fswkit.target.build import BuildError, default_out, load
     from fswkit.autocode.diagnostics import Diagnostics
 
@@ -183,12 +183,7 @@ def tape_run(args) -> int:
         return 2
     name = os.path.splitext(os.path.basename(args.tape))[0]
     out = args.out or os.path.join(default_out(app), f"tape-{name}")
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as e:
-        say(f"cannot create the output folder {out}: {e.strerror or e}")
-        return 2
-    built = build(args.project, args.board)
+    built = folder_and_firmware(args.project, args.board, out)
     if isinstance(built, int):
         return built
     elf, board = built

@@ -129,22 +129,17 @@ def study_run(args) -> int:
 
 def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
     """`--run I`: run I of the study flown again alone, its files written."""
-    from fswkit.cli.common import flown
+    from fswkit.cli.common import flown, folder_and_firmware
     from fswkit.plant import study
     from fswkit.plant.dispersion import draw
     from fswkit.plant.run import execute
-    from fswkit.sim.command import build, say
+    from fswkit.sim.command import say
 
     d = draw(disp, seed, args.run)
     setup = study.Setup(app, layout, params, "", None, disp, seed)
     sc = study.scenario_for(setup, d)
     out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as e:
-        say(f"cannot create the output folder {out}: {e.strerror or e}")
-        return 2
-    built = build(args.project, args.board)
+    built = folder_and_firmware(args.project, args.board, out)
     if isinstance(built, int):
         return built
     elf, board = built

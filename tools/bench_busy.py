@@ -211,7 +211,9 @@ def main() -> int:
             over = {n: v[0] for n, v in h["by_task"].items() if v[0]}
             if over:
                 print("  overruns by task: " + ", ".join(f"{n} {k}" for n, k in over.items()))
-            if h["overruns"] or h["faults"] or h["late"] or h["safed"]:
+            # late starts are counted, not failed: with the executor sleeping,
+            # a cycle after a long step starts late by design (docs/runtime.md)
+            if h["overruns"] or h["faults"] or h["safed"]:
                 status = 1
         if not rep.passed:
             status = 1

@@ -6,6 +6,7 @@
 #define FSW_LINK_H
 
 #include "fsw_executor.h"
+#include "fsw_param.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -93,6 +94,7 @@ struct LinkConfig {
     uint8_t hello_every;              // health frames between hellos (0: only on request)
     uint8_t uplink_task;              // index of the uplink task (0xFF: none)
     bool lock;                        // state vector `lock` option
+    ParamStore* params;               // the parameter store (null: no parameters; docs/parameters.md)
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health

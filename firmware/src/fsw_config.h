@@ -225,6 +225,11 @@
 #ifndef FSW_LINK_RX_PER_RUN
 #  define FSW_LINK_RX_PER_RUN 64
 #endif
+// Bytes of the parameter store's stage queue (PARAM_STAGE arguments waiting
+// for the EEPROM; docs/parameters.md). A STAGE that does not fit is BUSY.
+#ifndef FSW_PARAM_QUEUE
+#  define FSW_PARAM_QUEUE 24
+#endif
 
 // Elements and regions are little-endian in memory (spec 2); typed access
 // copies bytes straight into locals, so the host must be little-endian too.

@@ -63,10 +63,7 @@ constexpr uint16_t param_eeprom_end(uint16_t base, uint16_t size) {
     return static_cast<uint16_t>(base + 2u * (kParamHeader + size));
 }
 
-// Bytes of the stage queue (PARAM_STAGE arguments waiting for the EEPROM).
-#ifndef FSW_PARAM_QUEUE
-#  define FSW_PARAM_QUEUE 24
-#endif
+// FSW_PARAM_QUEUE (bytes of the stage queue): fsw_config.h.
 
 // The store's run-time record (RAM).
 struct ParamStore {

@@ -1,67 +1,20 @@
-"""Real flights through examples/hpr: every tape of ../shared/flights/
-replayed whole and open loop on the simulated Uno as `fsw sim examples/hpr
---tape` does (2,239 s of flight, about 90 s of CPU with the sleeping
-executor): every check passes on every tape, no pyro pin in boost, the
-drogue pin within -0.5/+1.0 s of the barometric apogee, the main pin
-within ±15 m of MAIN_ALT = 300 m where the tape comes down to it.
-`make bench` (tools/bench_tapes.py) prints the table.
-Skips only when the tapes' folder is absent (a user's clone) or the AVR
-tools are missing."""
+"""Real flights through examples/hpr, the CATS tapes but the longest (and any tape of a recorder not named): see tests/support/hpr_tapes.py."""
 
 from __future__ import annotations
 
-import os
-import shutil
-
 import pytest
 
-from conftest import EXAMPLES, ROOT
+from support.hpr_tapes import MARKS, build_hpr, replay_and_check, tapes
 
-FLIGHTS = ROOT.parent / "shared" / "flights"
-TAPES = sorted(p.stem for p in FLIGHTS.glob("*.csv")) if FLIGHTS.is_dir() else []
-HPR = EXAMPLES / "hpr"
-
-pytestmark = [
-    pytest.mark.skipif(not FLIGHTS.is_dir(), reason=f"{FLIGHTS} is absent (the shared flight tapes live beside "
-                       "the kit, not in a clone): no real flight to replay"),
-    pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
-                       reason="gcc-avr and libsimavr-dev are needed (make setup)"),
-]
+pytestmark = MARKS
 
 
 @pytest.fixture(scope="module")
 def hpr_firmware(tmp_path_factory):
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.link.layout import from_app
-    from fswkit.plant import tape_replay as tr
-    from fswkit.sim.command import build
-    from fswkit.target.build import load
-
-    diags = Diagnostics()
-    app = load(str(HPR), diags)
-    assert app is not None, diags.render()
-    layout = from_app(app)
-    cfg = tr.load_config(app, layout, None)
-    built = build(str(HPR), out=str(tmp_path_factory.mktemp("hpr") / "firmware"))
-    assert not isinstance(built, int), "examples/hpr's firmware did not build"
-    elf, board = built
-    return app, layout, cfg, elf, board
+    return build_hpr(tmp_path_factory)
 
 
-@pytest.mark.parametrize("name", TAPES)
+@pytest.mark.parametrize("name", tapes("cats"))
 def test_every_tape_replays_through_hpr_with_every_check_passing(name, hpr_firmware):
-    from fswkit.plant import tape_replay as tr
+    replay_and_check(name, hpr_firmware)
 
-    app, layout, cfg, elf, board = hpr_firmware
-    tape, truth = tr.load_tape(str(FLIGHTS / f"{name}.csv"), cfg)
-    o = tr.execute(tape, truth, cfg, app, elf, board, layout, None)
-    text = o.report.text()
-    assert o.report.checks and all(c.passed for c in o.report.checks), text
-    n = o.numbers
-    assert n["boost_pyro"] == 0, text
-    assert -0.5 <= n["apogee_err_s"] <= 1.0, text  # drogue pin − barometric apogee
-    assert cfg.main_alt == 300.0
-    assert ("main_err_m" in n) == (name != "halcyon_cats"), text  # halcyon's log ends 441 m up
-    if "main_err_m" in n:
-        assert abs(n["main_err_m"]) <= 15.0, text  # truth altitude at the main pin − 300 m
-    assert ("landing_err_s" in n) == (truth.landing_s is not None), text

@@ -1,0 +1,19 @@
+"""Real flights through examples/hpr, the AltOS and Raven tapes: see tests/support/hpr_tapes.py."""
+
+from __future__ import annotations
+
+import pytest
+
+from support.hpr_tapes import MARKS, build_hpr, replay_and_check, tapes
+
+pytestmark = MARKS
+
+
+@pytest.fixture(scope="module")
+def hpr_firmware(tmp_path_factory):
+    return build_hpr(tmp_path_factory)
+
+
+@pytest.mark.parametrize("name", tapes("altos_raven"))
+def test_every_tape_replays_through_hpr_with_every_check_passing(name, hpr_firmware):
+    replay_and_check(name, hpr_firmware)

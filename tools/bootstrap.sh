@@ -11,7 +11,8 @@ PYTHON=${PYTHON:-python3}
 # avrdude for flashing, graphviz to render `fsw graph`, valgrind for `make bench`,
 # clang and its runtime (libFuzzer, sanitizers) for the uplink fuzzer.
 APT_PACKAGES=(gcc-avr avr-libc binutils-avr avrdude arduino-core-avr simavr libsimavr-dev
-              g++ make graphviz valgrind clang libclang-rt-14-dev)
+              g++ make graphviz valgrind clang libclang-rt-14-dev
+              chromium chromium-driver)
 # Installed where the distribution has them: arduino-ctags, which arduino-cli
 # runs on an exported sketch's .ino with Debian's Arduino core
 # (integrations/arduino-cli/README.md).
@@ -29,6 +30,9 @@ for p in "${APT_PACKAGES[@]}"; do
 done
 if ! "$PYTHON" -c 'import ensurepip, venv' >/dev/null 2>&1; then
     missing+=(python3-venv)
+fi
+if ! command -v npm >/dev/null 2>&1; then  # a Node.js of another origin brings its own npm
+    missing+=(nodejs npm)
 fi
 # An optional package is looked up in apt's lists as they are, and in fresh
 # ones when required packages make apt-get update run anyway.
@@ -73,3 +77,14 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install -q --upgrade pip
 "$VENV/bin/python" -m pip install -q -e ".[test]"
+
+# The web ground station draws its plots with uPlot, from the npm registry,
+# into build/web (fswkit.web.app finds it there; FSW_UPLOT_DIR elsewhere).
+UPLOT=uplot@1.6.32
+if [ ! -f build/web/node_modules/uplot/package.json ] || \
+   ! grep -q '"version": "1.6.32"' build/web/node_modules/uplot/package.json; then
+    echo "bootstrap: installing $UPLOT from the npm registry into build/web"
+    mkdir -p build/web
+    npm install --no-save --no-audit --no-fund --loglevel=error --prefix build/web "$UPLOT" >/dev/null \
+        || { sleep 5; npm install --no-save --no-audit --no-fund --loglevel=error --prefix build/web "$UPLOT" >/dev/null; }
+fi

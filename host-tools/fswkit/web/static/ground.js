@@ -1,0 +1,304 @@
+// The web ground station's page: one WebSocket carries every decoded frame
+// (arrays of messages), the link's figures twice a second and the command
+// history; commands go by POST /api/command after a confirmation.
+"use strict";
+
+const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2"];
+const STATE_COLORS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#9c755f",
+                      "#bab0ac", "#ff9da7"];
+const MAX_POINTS = 200000;
+
+let layout = null;
+let perSecond = 1000;
+const values = {};           // element -> last value
+const series = { t: [] };    // time (s) and one array per element sampled
+let chart = null;
+let picked = [];
+let paused = false;
+let dirty = false;
+const states = {};           // S element -> {current, since, segments: [[t0, t1, id]], list: []}
+let lastTime = null;
+
+function $(id) { return document.getElementById(id); }
+function el(tag, attrs, text) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  return e;
+}
+
+function fmt(v) {
+  if (v === null || v === undefined) return "—";
+  if (typeof v === "boolean") return v ? "true" : "false";
+  if (typeof v === "number" && !Number.isInteger(v)) return v.toPrecision(6).replace(/\.?0+$/, "");
+  return String(v);
+}
+
+function stateName(elem, id) {
+  const names = layout.elements.find(e => e.name === elem).states || {};
+  return names[String(id)] || String(id);
+}
+
+async function start() {
+  layout = await (await fetch("/api/layout")).json();
+  perSecond = layout.time_unit === "us" ? 1e6 : 1e3;
+  $("title").textContent = `${layout.title} — ${layout.name} (schema ${layout.schema})`;
+  document.title = `${layout.name}: fsw ground`;
+  buildValueTable();
+  buildPicker();
+  buildCommands();
+  for (const s of layout.state_elements) states[s] = { current: null, since: null, segments: [], list: [] };
+  buildTimeline();
+  connect();
+  setInterval(draw, 200);
+}
+
+function buildValueTable() {
+  const body = $("value-table").tBodies[0];
+  for (const e of layout.elements) {
+    const tr = el("tr");
+    tr.append(el("td", {}, e.name), el("td", { id: `value-${e.name}` }, "—"));
+    body.append(tr);
+  }
+}
+
+function numeric(e) { return e.kind !== "bool" && !e.states; }
+
+function buildPicker() {
+  const box = $("picker");
+  const candidates = layout.elements.filter(e => numeric(e) && e.name !== layout.elements[0].name);
+  candidates.forEach((e, i) => {
+    const cb = el("input", { type: "checkbox", id: `pick-${e.name}` });
+    cb.checked = i < 2;
+    cb.addEventListener("change", () => { picked = candidates.filter(c => $(`pick-${c.name}`).checked)
+      .map(c => c.name); makeChart(); });
+    const lab = el("label");
+    lab.append(cb, " " + e.name);
+    box.append(lab);
+  });
+  picked = candidates.slice(0, 2).map(e => e.name);
+  $("pause").addEventListener("click", () => {
+    paused = !paused;
+    $("pause").textContent = paused ? "Resume" : "Pause";
+    dirty = true;
+  });
+  $("window").addEventListener("change", () => { dirty = true; });
+  makeChart();
+}
+
+function makeChart() {
+  if (chart) chart.destroy();
+  const opts = {
+    width: Math.max(300, $("chart").clientWidth || 700), height: 280,
+    scales: { x: { time: false } },
+    axes: [{ label: "time (s)" }, {}],
+    series: [{ label: "t (s)" }].concat(picked.map((n, i) => ({ label: n, stroke: COLORS[i % COLORS.length],
+                                                                 width: 1.5 }))),
+    cursor: { drag: { x: true, y: false } },
+  };
+  chart = new uPlot(opts, [[]].concat(picked.map(() => [])), $("chart"));
+  dirty = true;
+}
+
+function draw() {
+  if (!chart || paused || !dirty) return;
+  dirty = false;
+  const t = series.t;
+  const win = Number($("window").value);
+  let from = 0;
+  if (win > 0 && t.length) {
+    const lo = t[t.length - 1] - win;
+    while (from < t.length && t[from] < lo) from++;
+  }
+  const data = [t.slice(from)].concat(picked.map(n => (series[n] || []).slice(from)));
+  chart.setData(data);
+}
+
+function addSamples(msg) {
+  const idx = {};
+  msg.names.forEach((n, i) => { idx[n] = i + 1; });
+  for (const row of msg.rows) {
+    const ts = row[0] / perSecond;
+    lastTime = ts;
+    msg.names.forEach((n, i) => { values[n] = row[i + 1]; });
+    // one time column for all: an element not in this region repeats its last value
+    series.t.push(ts);
+    for (const e of layout.elements) {
+      if (!numeric(e)) continue;
+      (series[e.name] = series[e.name] || []).push(values[e.name] === undefined ? null : values[e.name]);
+    }
+    for (const s of layout.state_elements) if (idx[s] !== undefined) noteState(s, row[idx[s]], ts);
+  }
+  if (series.t.length > MAX_POINTS) {
+    const cut = series.t.length - MAX_POINTS;
+    for (const k of Object.keys(series)) series[k].splice(0, cut);
+  }
+  for (const n of msg.names) { const c = $(`value-${n}`); if (c) c.textContent = fmt(values[n]); }
+  dirty = true;
+}
+
+function noteState(elem, id, ts) {
+  const s = states[elem];
+  if (s.current === id) return;
+  if (s.current !== null) {
+    s.segments.push([s.since, ts, s.current]);
+    s.list.push(`${ts.toFixed(2)} s  ${stateName(elem, s.current)} → ${stateName(elem, id)}`);
+  } else {
+    s.list.push(`${ts.toFixed(2)} s  ${stateName(elem, id)}`);
+  }
+  s.current = id;
+  s.since = ts;
+  drawTimeline(elem);
+}
+
+function buildTimeline() {
+  for (const s of layout.state_elements) {
+    const box = el("div", { class: "machine" });
+    box.append(el("strong", {}, s), el("div", { class: "band", id: `band-${s}` }),
+               el("ol", { class: "transitions", id: `transitions-${s}` }));
+    $("timeline").append(box);
+  }
+}
+
+function drawTimeline(elem) {
+  const s = states[elem];
+  const band = $(`band-${elem}`);
+  const segs = s.segments.concat(s.current !== null ? [[s.since, lastTime, s.current]] : []);
+  if (!segs.length) return;
+  const t0 = segs[0][0], t1 = Math.max(segs[segs.length - 1][1], t0 + 1e-6);
+  band.replaceChildren(...segs.map(([a, b, id]) => {
+    const d = el("div", { class: "seg", title: `${stateName(elem, id)} ${a.toFixed(2)}–${b.toFixed(2)} s` },
+                 stateName(elem, id));
+    d.style.left = `${(100 * (a - t0)) / (t1 - t0)}%`;
+    d.style.width = `${Math.max(0.2, (100 * (b - a)) / (t1 - t0))}%`;
+    d.style.background = STATE_COLORS[(id - 1) % STATE_COLORS.length];
+    return d;
+  }));
+  const list = $(`transitions-${elem}`);
+  list.replaceChildren(...s.list.map(x => el("li", {}, x)));
+  list.scrollTop = list.scrollHeight;
+}
+
+function showLink(msg) {
+  const pill = $("link-status");
+  if (msg.age === null) {
+    pill.className = "pill waiting";
+    pill.textContent = msg.note || "waiting for the target";
+  } else if (msg.stale) {
+    pill.className = "pill stale";
+    pill.textContent = `stale: last frame ${msg.age.toFixed(1)} s ago${msg.note ? " (" + msg.note + ")" : ""}`;
+  } else {
+    pill.className = "pill live";
+    pill.textContent = "live";
+  }
+  $("link-figures").textContent = `${msg.frames} frames`;
+  if (lastTime !== null) for (const s of layout.state_elements) drawTimeline(s);
+}
+
+function showHealth(info) {
+  const rows = [["reset cause", info.reset_words], ["cycles", info.cycles], ["late starts", info.late],
+                ["frames sent", info.frames], ["frames dropped (busy)", info.dropped],
+                ["commands applied", info.rx_ok], ["CRC errors", info.rx_crc], ["malformed", info.rx_malformed],
+                ["refused", info.rx_refused], ["replayed", info.rx_replayed]];
+  $("link-table").tBodies[0].replaceChildren(...rows.map(([k, v]) => {
+    const tr = el("tr"); tr.append(el("th", {}, k), el("td", {}, fmt(v))); return tr; }));
+  $("task-table").tBodies[0].replaceChildren(...info.tasks.map(t => {
+    const tr = el("tr", { id: `task-${t.name}` });
+    for (const v of [t.name, t.kind, t.mode_name, t.faults, t.overruns, t.worst_us]) tr.append(el("td", {}, fmt(v)));
+    return tr;
+  }));
+}
+
+function addHistory(entry) {
+  const li = el("li", { class: entry.ok ? "ok" : "refused" },
+                `${entry.text} — ${entry.ok ? "applied" : "refused: " + entry.words} (${entry.who})`);
+  $("history").prepend(li);
+}
+
+// ---- commands ---------------------------------------------------------------
+
+function checkValue(e, text) {
+  const v = text.trim();
+  if (e.kind === "bool") return ["true", "false", "1", "0"].includes(v.toLowerCase()) ? null
+    : "true, false, 1 or 0";
+  if (e.kind === "float") return v !== "" && !Number.isNaN(Number(v)) ? null : "a number";
+  if (!/^[-+]?(0x[0-9a-f]+|\d+)$/i.test(v)) return "a whole number";
+  const n = BigInt(v.replace(/^\+/, ""));
+  if (n < BigInt(e.lo) || n > BigInt(e.hi)) return `a whole number in ${e.lo}..${e.hi}`;
+  return null;
+}
+
+function ask(text) {
+  return new Promise(resolve => {
+    const d = $("confirm");
+    $("confirm-text").textContent = text;
+    d.addEventListener("close", () => resolve(d.returnValue === "yes"), { once: true });
+    d.showModal();
+  });
+}
+
+async function send(kind, target, value, errBox) {
+  errBox.textContent = "";
+  if (!(await ask(`Send to the target: ${kind} ${target} ${kind === "set" ? "= " : ""}${value}?`))) return;
+  const r = await fetch("/api/command", { method: "POST", headers: { "Content-Type": "application/json" },
+                                          body: JSON.stringify({ kind, target, value }) });
+  const answer = await r.json();
+  if (!r.ok) errBox.textContent = answer.words;
+}
+
+function buildCommands() {
+  const panel = $("command-panel");
+  if (!layout.has_uplink) { panel.textContent = "This application has no uplink task."; return; }
+  for (const e of layout.elements.filter(x => x.writable)) {
+    const row = el("div", { class: "cmd" });
+    const input = el("input", { id: `cmd-${e.name}`, placeholder: e.type, size: 10 });
+    const btn = el("button", { id: `send-${e.name}`, type: "button" }, "Set");
+    const err = el("span", { class: "err", id: `err-${e.name}` });
+    btn.addEventListener("click", () => {
+      const bad = checkValue(e, input.value);
+      if (bad) { err.textContent = `${e.name} is ${e.type}: give ${bad}`; return; }
+      send("set", e.name, input.value.trim(), err);
+    });
+    row.append(el("label", { for: `cmd-${e.name}` }, `${e.name} (${e.type})`), input, btn, err);
+    panel.append(row);
+  }
+  for (const t of layout.tasks) {
+    const row = el("div", { class: "cmd" });
+    const sel = el("select", { id: `mode-${t.name}` });
+    for (const m of ["enabled", "safed", "disabled"]) sel.append(el("option", { value: m }, m));
+    const btn = el("button", { id: `send-mode-${t.name}`, type: "button" }, "Mode");
+    const err = el("span", { class: "err" });
+    btn.addEventListener("click", () => send("mode", t.name, sel.value, err));
+    row.append(el("label", {}, `task ${t.name}`), sel, btn, err);
+    panel.append(row);
+  }
+}
+
+// ---- the feed ---------------------------------------------------------------
+
+function handle(msg) {
+  switch (msg.t) {
+    case "samples": addSamples(msg); break;
+    case "health": showHealth(msg.info); break;
+    case "hello": break;
+    case "link": showLink(msg); break;
+    case "command": addHistory(msg); break;
+    case "history": msg.commands.forEach(addHistory); break;
+  }
+}
+
+function connect() {
+  const ws = new WebSocket(`ws://${location.host}/ws`);
+  ws.onmessage = ev => {
+    const data = JSON.parse(ev.data);
+    (Array.isArray(data) ? data : [data]).forEach(handle);
+  };
+  ws.onclose = () => {
+    const pill = $("link-status");
+    pill.className = "pill stale";
+    pill.textContent = "the station is gone: reconnecting";
+    setTimeout(connect, 1000);
+  };
+}
+
+window.addEventListener("load", start);

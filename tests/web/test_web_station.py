@@ -1,0 +1,140 @@
+"""The web ground station in a real headless browser (Debian's Chromium
+driven by Selenium through chromedriver): the tank firmware built for
+`native` runs with its console on a pseudo-terminal, the station owns that
+port, and the page loads, shows values as they change, sends a command
+through the confirmation step and shows its acknowledgement, refuses a
+value of the wrong type before sending it, and shows the link stale when
+the target stops."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import threading
+import time
+
+import pytest
+
+from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
+
+CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
+pytestmark = [
+    needs_cxx(),
+    pytest.mark.skipif(not (os.path.exists(CHROMIUM) and os.path.exists(DRIVER)),
+                       reason="Debian's chromium and chromium-driver are needed (make setup)"),
+]
+RAW = 770  # 815.86 psi: the vent valve opens
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def exe(tmp_path_factory):
+    return build_native(TANK, tmp_path_factory.mktemp("tank"))
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+              "--disable-background-networking", "--disable-component-update", "--disable-sync",
+              "--disable-dev-shm-usage", "--window-size=1400,1000"):
+        opts.add_argument(a)
+    drv = webdriver.Chrome(service=Service(DRIVER), options=opts)
+    yield drv
+    drv.quit()
+
+
+class Station:
+    """The web station on a port, serving in a thread."""
+
+    def __init__(self, port: str):
+        import uvicorn
+
+        from fswkit.link.port import open_port
+        from fswkit.web.app import create_app
+        from fswkit.web.source import LiveSource
+
+        self.serial = open_port(port, 115200)
+        self.source = LiveSource(tank_layout(), self.serial)
+        self.http = free_port()
+        self.url = f"http://127.0.0.1:{self.http}/"
+        self.server = uvicorn.Server(uvicorn.Config(create_app(self.source), host="127.0.0.1", port=self.http,
+                                                    log_level="warning", ws="websockets-sansio"))
+        self.thread = threading.Thread(target=self.server.run, daemon=True)
+        self.thread.start()
+        deadline = time.monotonic() + 10
+        while not self.server.started:
+            assert time.monotonic() < deadline, "the station did not start"
+            time.sleep(0.02)
+
+    def close(self):
+        self.server.should_exit = True
+        self.thread.join(5)
+        self.serial.close()
+
+
+def wait_for(fn, what: str, timeout: float = 10.0):
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            v = fn()
+        except Exception:  # the page is still building what fn looks for
+            v = None
+        if v:
+            return v
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.1)
+
+
+def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_stale(exe, browser, tmp_path):
+    from selenium.webdriver.common.by import By
+
+    with PtyTarget(exe, f"a14={RAW}") as target:
+        station = Station(target.port)
+        try:
+            browser.get(station.url)
+            text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+            wait_for(lambda: text("link-status") == "live", "the link to show live")
+            assert "tank" in browser.title
+            # a value arrives and updates: the time element grows
+            t1 = wait_for(lambda: float(text("value-time")), "the time to show")
+            t2 = wait_for(lambda: float(text("value-time")) > t1 and float(text("value-time")), "the time to change")
+            assert t2 > t1
+            assert float(text("value-tankPressure")) == float(f"{volts_psi(RAW):.6g}")
+            # the plot has drawn the samples (uPlot's canvas) and the state timeline its state
+            assert browser.find_element(By.CSS_SELECTOR, "#chart canvas")
+            wait_for(lambda: "TankVentControl" in text("timeline"), "the state timeline")
+            # a value of the wrong type is refused in the page, before anything is sent
+            box = browser.find_element(By.ID, "cmd-valveOpen")
+            box.send_keys("maybe")
+            browser.find_element(By.ID, "send-valveOpen").click()
+            assert "valveOpen is bool" in text("err-valveOpen")
+            assert not browser.find_element(By.ID, "confirm").get_attribute("open")
+            # a command: confirmed, sent, acknowledged, in the history
+            box.clear()
+            box.send_keys("false")
+            browser.find_element(By.ID, "send-valveOpen").click()
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+            assert "set valveOpen = false" in text("confirm-text")
+            browser.find_element(By.ID, "confirm-yes").click()
+            item = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#history li"), "the history")[0]
+            assert "set valveOpen = false" in item.text and "applied" in item.text, item.text
+            assert "ok" in item.get_attribute("class")
+            browser.save_screenshot(str(tmp_path / "live.png"))
+            # the target stops: the page says the link is stale
+            target.stop()
+            wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator", timeout=10)
+            assert "last frame" in text("link-status")
+        finally:
+            station.close()

@@ -9,7 +9,6 @@ the target stops."""
 from __future__ import annotations
 
 import os
-import shutil
 import socket
 import threading
 import time

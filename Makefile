@@ -18,7 +18,13 @@ $(STAMP): pyproject.toml tools/bootstrap.sh
 	VENV=$(VENV) tools/bootstrap.sh
 	touch $@
 
-setup: $(STAMP)
+# uPlot for the web ground station (tools/bootstrap.sh installs it from the
+# npm registry into build/web): set up again after a `make clean`
+UPLOT   := build/web/node_modules/uplot/package.json
+$(UPLOT): | $(STAMP)
+	VENV=$(VENV) tools/bootstrap.sh
+
+setup: $(STAMP) $(UPLOT)
 
 ## demo: the example rocket's firmware built for an Uno from its configs,
 ## flown in closed loop on the simulated board (a 1-D rocket model at 1 kHz),

@@ -96,6 +96,7 @@ bench: setup
 	$(PY) tools/bench_tapes.py
 	$(PY) tools/bench_busy.py
 	$(PY) tools/bench_study.py
+	$(PY) tools/bench_web.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

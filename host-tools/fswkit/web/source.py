@@ -39,7 +39,7 @@ def _message(ev: Event, layout: Layout) -> dict | None:
     """One decoded event as the browser gets it."""
     if ev.kind == "sample":
         region = layout.streams[ev.stream].region
-        return {"t": "samples", "names": list(region.names),
+        return {"t": "samples", "host": ev.host_time, "names": list(region.names),
                 "rows": [[time] + [_json(v) for v in values] for time, values in ev.samples]}
     if ev.kind in ("hello", "health", "ack"):
         info = {k: _json(v) for k, v in ev.info.items() if not isinstance(v, (list, tuple, dict))}

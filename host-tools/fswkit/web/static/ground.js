@@ -17,6 +17,9 @@ let picked = [];
 let paused = false;
 let dirty = false;
 const states = {};           // S element -> {current, since, segments: [[t0, t1, id]], list: []}
+// frame-to-page latency: seconds from the frame's bytes reaching the station
+// to its message reaching this page (the same host's clock), last 10,000
+window.fswLatency = [];
 let lastTime = null;
 
 function $(id) { return document.getElementById(id); }
@@ -115,6 +118,10 @@ function draw() {
 }
 
 function addSamples(msg) {
+  if (msg.host) {
+    window.fswLatency.push(Date.now() / 1000 - msg.host);
+    if (window.fswLatency.length > 10000) window.fswLatency.shift();
+  }
   const idx = {};
   msg.names.forEach((n, i) => { idx[n] = i + 1; });
   for (const row of msg.rows) {

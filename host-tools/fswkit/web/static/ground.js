@@ -65,21 +65,24 @@ function buildValueTable() {
   }
 }
 
-function numeric(e) { return e.kind !== "bool" && !e.states; }
+// every element but the time is plotted: bools (0/1) and states (their ids) as steps
+function plotted(e) { return e.name !== layout.elements[0].name; }
+function stepped(e) { return e.kind === "bool" || !!e.states; }
 
 function buildPicker() {
   const box = $("picker");
-  const candidates = layout.elements.filter(e => numeric(e) && e.name !== layout.elements[0].name);
-  candidates.forEach((e, i) => {
+  const candidates = layout.elements.filter(plotted);
+  const first = candidates.filter(e => !stepped(e)).slice(0, 2).map(e => e.name);
+  candidates.forEach(e => {
     const cb = el("input", { type: "checkbox", id: `pick-${e.name}` });
-    cb.checked = i < 2;
+    cb.checked = first.includes(e.name);
     cb.addEventListener("change", () => { picked = candidates.filter(c => $(`pick-${c.name}`).checked)
       .map(c => c.name); makeChart(); });
     const lab = el("label");
     lab.append(cb, " " + e.name);
     box.append(lab);
   });
-  picked = candidates.slice(0, 2).map(e => e.name);
+  picked = first;
   $("pause").addEventListener("click", () => {
     paused = !paused;
     $("pause").textContent = paused ? "Resume" : "Pause";
@@ -95,8 +98,12 @@ function makeChart() {
     width: Math.max(300, $("chart").clientWidth || 700), height: 280,
     scales: { x: { time: false } },
     axes: [{ label: "time (s)" }, {}],
-    series: [{ label: "t (s)" }].concat(picked.map((n, i) => ({ label: n, stroke: COLORS[i % COLORS.length],
-                                                                 width: 1.5 }))),
+    series: [{ label: "t (s)" }].concat(picked.map((n, i) => {
+      const e = layout.elements.find(x => x.name === n);
+      const s = { label: n, stroke: COLORS[i % COLORS.length], width: 1.5 };
+      if (stepped(e)) s.paths = uPlot.paths.stepped({ align: 1 });
+      return s;
+    })),
     cursor: { drag: { x: true, y: false } },
   };
   chart = new uPlot(opts, [[]].concat(picked.map(() => [])), $("chart"));
@@ -131,8 +138,9 @@ function addSamples(msg) {
     // one time column for all: an element not in this region repeats its last value
     series.t.push(ts);
     for (const e of layout.elements) {
-      if (!numeric(e)) continue;
-      (series[e.name] = series[e.name] || []).push(values[e.name] === undefined ? null : values[e.name]);
+      if (!plotted(e)) continue;
+      const v = values[e.name];
+      (series[e.name] = series[e.name] || []).push(v === undefined ? null : typeof v === "boolean" ? +v : v);
     }
     for (const s of layout.state_elements) if (idx[s] !== undefined) noteState(s, row[idx[s]], ts);
   }
@@ -228,7 +236,14 @@ function checkValue(e, text) {
   const v = text.trim();
   if (e.kind === "bool") return ["true", "false", "1", "0"].includes(v.toLowerCase()) ? null
     : "true, false, 1 or 0";
-  if (e.kind === "float") return v !== "" && !Number.isNaN(Number(v)) ? null : "a number";
+  if (e.kind === "float") {
+    const limit = e.type === "F32" ? 3.4028235e38 : Number.MAX_VALUE;
+    if (/^[-+]?inf(inity)?$/i.test(v)) return null;
+    const x = Number(v);
+    if (v === "" || Number.isNaN(x)) return "a number";
+    if (Math.abs(x) > limit) return `a number within ±${limit}, or inf`;
+    return null;
+  }
   if (!/^[-+]?(0x[0-9a-f]+|\d+)$/i.test(v)) return "a whole number";
   const n = BigInt(v.replace(/^\+/, ""));
   if (n < BigInt(e.lo) || n > BigInt(e.hi)) return `a whole number in ${e.lo}..${e.hi}`;

@@ -35,10 +35,12 @@ demo: setup
 	$(FSW) sim examples/rocket --plant rocket --seed $(DEMO_SEED) --out $(BUILD)/demo
 
 ## docs-img: the demo flight's plot shown in README.md (a test checks that
-## docs/img/rocket-flight.png is this tree's seed-1 flight)
+## docs/img/rocket-flight.png is this tree's seed-1 flight) and the web
+## station's page as the browser test sees it (docs/ground.md)
 docs-img: setup
 	$(FSW) sim examples/rocket --plant rocket --seed 1 --out $(BUILD)/docs-img
 	mkdir -p docs/img && cp $(BUILD)/docs-img/flight.png docs/img/rocket-flight.png
+	FSW_SCREENSHOTS=docs/img $(PY) -m pytest -q -p no:cacheprovider tests/web/test_web_station.py
 
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P

@@ -130,7 +130,9 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             item = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#history li"), "the history")[0]
             assert "set valveOpen = false" in item.text and "applied" in item.text, item.text
             assert "ok" in item.get_attribute("class")
-            browser.save_screenshot(str(tmp_path / "live.png"))
+            # docs/ground.md shows this page: `make docs-img` runs this test with FSW_SCREENSHOTS=docs/img
+            shots = os.environ.get("FSW_SCREENSHOTS") or str(tmp_path)
+            assert browser.save_screenshot(os.path.join(shots, "ground-web.png"))
             # the target stops: the page says the link is stale
             target.stop()
             wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator", timeout=10)

@@ -148,7 +148,11 @@ function addSamples(msg) {
     const cut = series.t.length - MAX_POINTS;
     for (const k of Object.keys(series)) series[k].splice(0, cut);
   }
-  for (const n of msg.names) { const c = $(`value-${n}`); if (c) c.textContent = fmt(values[n]); }
+  for (const n of msg.names) {
+    const c = $(`value-${n}`);
+    if (c) c.textContent = layout.state_elements.includes(n) ? `${values[n]} (${stateName(n, values[n])})`
+                                                             : fmt(values[n]);
+  }
   dirty = true;
 }
 

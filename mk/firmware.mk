@@ -23,7 +23,7 @@ FW_AVR_CXX    ?= avr-g++
 FW_AVR_CC     ?= avr-gcc
 
 # Suites: one file per scenario, tests/firmware/test_<name>.cpp.
-FW_SUITES     := convert f64 window machine tank executor clock sv io link
+FW_SUITES     := convert f64 window machine tank executor clock sv io link param
 FW_AVR_SUITES := convert f64 window machine tank executor clock sv io
 
 FW_RT_SRCS    := $(wildcard $(FW_SRC)/*.cpp)

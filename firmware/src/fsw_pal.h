@@ -99,6 +99,19 @@ IrqState critical_enter();
 void critical_exit(IrqState saved);
 #endif
 
+// ---- EEPROM -----------------------------------------------------------------
+// Bytes of EEPROM (an ATmega328P's 1,024; the host's model has as many).
+uint16_t eeprom_size();
+// A byte; waits for a write in progress to end (at most one byte's write
+// time: 3.4 ms on an AVR), so it is for boot and for a writer that is idle.
+uint8_t eeprom_read(uint16_t addr);
+// Whether a byte write may start now (the previous one has ended).
+bool eeprom_ready();
+// Starts writing one byte (only when eeprom_ready()); returns at once. On
+// an AVR the write ends 3.4 ms later, and the EEPROM-ready interrupt wakes
+// a sleeping CPU then, so a background writer goes on at the EEPROM's pace.
+void eeprom_write(uint16_t addr, uint8_t value);
+
 // ---- Watchdog ---------------------------------------------------------------
 // Arms the watchdog (FSW_WATCHDOG_MS) when FSW_WATCHDOG is on.
 void watchdog_begin();

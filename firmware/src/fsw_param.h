@@ -71,11 +71,11 @@ struct ParamStore {
     uint16_t seq;               // the current bank's sequence number (0 with the defaults)
     uint8_t source;             // ParamSource | kParamDirty | kParamWriting
     uint8_t loading;            // a load is open (PARAM_BEGIN .. PARAM_COMMIT)
-    // the background writer: EEPROM bytes still to write
-    uint16_t w_addr;            // next EEPROM address
-    uint16_t w_left;            // bytes left in the current job step
-    uint8_t w_job;              // what is being written (fsw_param.cpp)
-    uint16_t w_crc;             // CRC of what was written so far
+    // the background writer (fsw_param.cpp): what it writes, where it is
+    uint16_t w_crc;             // the new bank's CRC (header phase)
+    uint8_t w_job;              // the writer's phase (0: idle)
+    uint8_t w_id;               // parameter (values phase) or header byte
+    uint8_t w_b;                // byte within it
     uint8_t q_len;              // bytes in the stage queue
     uint8_t queue[FSW_PARAM_QUEUE];
 };

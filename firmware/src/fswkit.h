@@ -16,5 +16,6 @@
 #include "fsw_executor.h"
 #include "fsw_io.h"
 #include "fsw_link.h"
+#include "fsw_param.h"
 
 #endif  // FSWKIT_H

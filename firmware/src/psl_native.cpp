@@ -42,6 +42,23 @@ uint16_t g_uart_buffer;
 uint64_t g_uart_busy_until_bits;  // simulated time (in bit times) the last queued byte ends
 uint32_t g_uart_overruns;
 uint32_t g_written;
+// The EEPROM model: 1,024 bytes, erased (0xFF) at start, kept across
+// sim_reset() (as a board keeps it across resets), written through to a
+// file when one is named, and frozen after a given number of writes (a
+// power cut: the writes before it stay, none after it lands).
+const uint16_t kEepromSize = 1024;
+uint8_t g_eeprom[kEepromSize];
+bool g_eeprom_init;
+uint32_t g_eeprom_writes;
+uint32_t g_eeprom_freeze = 0xFFFFFFFFu;
+FILE* g_eeprom_file;
+
+void eeprom_init() {
+    if (!g_eeprom_init) {
+        memset(g_eeprom, 0xFF, sizeof g_eeprom);
+        g_eeprom_init = true;
+    }
+}
 
 // Re-entrant spin lock: the owner is the address of a thread-local byte.
 __thread char t_token;
@@ -137,11 +154,60 @@ void sim_reset() {
     g_written = 0;
 }
 
+void sim_eeprom_erase() {
+    g_eeprom_init = false;
+    eeprom_init();
+    g_eeprom_writes = 0;
+    g_eeprom_freeze = 0xFFFFFFFFu;
+}
+uint8_t* sim_eeprom() {
+    eeprom_init();
+    return g_eeprom;
+}
+uint32_t sim_eeprom_writes() { return g_eeprom_writes; }
+void sim_eeprom_freeze_after(uint32_t writes) { g_eeprom_freeze = g_eeprom_writes + writes; }
+bool sim_eeprom_file(const char* path) {
+    eeprom_init();
+    if (g_eeprom_file) fclose(g_eeprom_file);
+    g_eeprom_file = fopen(path, "r+b");
+    if (g_eeprom_file) {
+        const size_t n = fread(g_eeprom, 1, sizeof g_eeprom, g_eeprom_file);
+        if (n < sizeof g_eeprom) memset(g_eeprom + n, 0xFF, sizeof g_eeprom - n);
+    } else {
+        g_eeprom_file = fopen(path, "w+b");
+    }
+    if (!g_eeprom_file) return false;
+    if (fseek(g_eeprom_file, 0, SEEK_SET) != 0 || fwrite(g_eeprom, 1, sizeof g_eeprom, g_eeprom_file) != sizeof g_eeprom ||
+        fflush(g_eeprom_file) != 0) {
+        fclose(g_eeprom_file);
+        g_eeprom_file = 0;
+        return false;
+    }
+    return true;
+}
+
 }  // namespace native
 
 namespace pal {
 
 void begin() { clear_modes(); }
+
+uint16_t eeprom_size() { return kEepromSize; }
+uint8_t eeprom_read(uint16_t addr) {
+    eeprom_init();
+    return addr < kEepromSize ? g_eeprom[addr] : 0xFF;
+}
+bool eeprom_ready() { return true; }
+void eeprom_write(uint16_t addr, uint8_t value) {
+    eeprom_init();
+    if (addr >= kEepromSize || g_eeprom_writes >= g_eeprom_freeze) return;
+    ++g_eeprom_writes;
+    g_eeprom[addr] = value;
+    if (g_eeprom_file && fseek(g_eeprom_file, addr, SEEK_SET) == 0) {
+        fputc(value, g_eeprom_file);
+        fflush(g_eeprom_file);
+    }
+}
 
 uint32_t micros32() { return static_cast<uint32_t>(now_us()); }
 uint32_t millis32() { return static_cast<uint32_t>(now_us() / 1000u); }

@@ -1,0 +1,401 @@
+// Parameters (docs/parameters.md): two EEPROM banks, boot from the newest
+// valid one, changes from the ground, and a writer that puts one byte into
+// the EEPROM whenever it is ready, so that nothing waits for it.
+#include "fsw_param.h"
+
+#include "fsw_crc.h"
+#include "fsw_pal.h"
+
+#if defined(__AVR__)
+#include <avr/interrupt.h>
+#include <avr/io.h>
+// An EEPROM write ended: the handler only turns itself off; waking the CPU
+// was the point (pal::eeprom_write asked for it), so the loop's param_poll
+// writes the next byte.
+ISR(EE_READY_vect) { EECR = static_cast<uint8_t>(EECR & ~_BV(EERIE)); }
+#endif
+
+namespace fsw {
+
+namespace {
+
+// The writer's phases.
+enum Job : uint8_t {
+    kIdle = 0,
+    kClearThenStage = 1,  // a load begins: clear the staging bank's magic
+    kStage = 2,           // a load is open: staged values go to the bank as they come
+    kClear = 3,           // a save begins: clear the target bank's magic
+    kValues = 4,          // the value block (a load's staged values are there already)
+    kHeader = 5,          // sequence number, table hash, CRC
+    kMagic = 6,           // last: the bank is whole
+};
+
+ParamConfig config(const ParamStore& s) {
+    ParamConfig c;
+    flash_read(&c, s.cfg, sizeof c);
+    return c;
+}
+
+ParamDef def(const ParamConfig& c, uint8_t id) {
+    ParamDef d;
+    flash_read(&d, &c.defs[id], sizeof d);
+    return d;
+}
+
+uint16_t bank_size(const ParamConfig& c) { return static_cast<uint16_t>(kParamHeader + c.size); }
+uint16_t bank_base(const ParamConfig& c, uint8_t bank) {
+    return static_cast<uint16_t>(c.eeprom_base + (bank ? bank_size(c) : 0u));
+}
+// The bank a save or load writes: the one that is not current.
+uint8_t target_bank(const ParamStore& s) { return (s.source & 3u) == kParamBankA ? 1u : 0u; }
+
+// A value as a key: `n` bytes, most significant first, whose order as
+// unsigned bytes (memcmp) is the value's order. Signed integers have their
+// sign bit flipped; floats are sign-magnitude, so a negative one is
+// inverted whole and a positive one has its sign bit set; -0 is 0. A NaN's
+// key lies beyond an infinity's, so outside every finite range.
+void order_key(uint8_t type, const uint8_t* v, uint8_t n, uint8_t* key) {
+    bool zero = true;
+    for (uint8_t i = 0; i < n; ++i) {
+        key[i] = v[n - 1u - i];
+        if (i != 0 && key[i] != 0) zero = false;
+    }
+    if (type == kF32 || type == kF64) {
+        if (zero && (key[0] & 0x7Fu) == 0) key[0] = 0;  // -0 is 0
+        if (key[0] & 0x80u) {
+            for (uint8_t i = 0; i < n; ++i) key[i] = static_cast<uint8_t>(~key[i]);
+            return;
+        }
+    } else if (type > kI64) {
+        return;  // unsigned
+    }
+    key[0] = static_cast<uint8_t>(key[0] ^ 0x80u);
+}
+
+// Whether `v` is a value parameter `d` may take (ranges are finite).
+bool in_range(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {
+    if (d.type == kBool) return v[0] <= 1u;
+    uint8_t lim[16] = {0}, k[8], lo[8], hi[8];
+    const uint8_t n = elem_size(d.type);
+    flash_read(lim, c.pool + d.range, 2u * n);
+    order_key(d.type, v, n, k);
+    order_key(d.type, lim, n, lo);
+    order_key(d.type, lim + n, n, hi);
+    return memcmp(lo, k, n) <= 0 && memcmp(k, hi, n) <= 0;
+}
+
+// Whether the declaring machine is in a state that allows a change.
+bool state_allows(const ParamConfig& c, const ParamDef& d) {
+    ParamWhen w;
+    flash_read(&w, &c.whens[d.when], sizeof w);
+    uint32_t st;
+    memcpy(&st, c.sv + w.state_off, sizeof st);
+    if (st == 0 || (st - 1u) / 8u >= w.n) return false;
+    uint8_t byte;
+    flash_read(&byte, c.pool + w.mask + (st - 1u) / 8u, 1);
+    return (byte >> ((st - 1u) % 8u)) & 1u;
+}
+
+void set_bytes(const ParamConfig& c, uint16_t off, const uint8_t* v, uint8_t n) {
+    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    memcpy(c.val + off, v, n);
+    if (c.lock) pal::critical_exit(saved);
+}
+
+// Walks `args`, (id, value)...: kParamOk when every entry is a known id
+// with a whole value in range; else the status and the id it stopped at.
+uint8_t check_entries(const ParamConfig& c, const uint8_t* a, uint8_t len, uint8_t& bad) {
+    uint8_t i = 0;
+    if (len == 0) return kParamBadLength;
+    while (i < len) {
+        const uint8_t id = a[i];
+        bad = id;
+        if (id >= c.n) return kParamNoParam;
+        const ParamDef d = def(c, id);
+        const uint8_t n = elem_size(d.type);
+        if (static_cast<uint16_t>(i) + 1u + n > len) return kParamBadLength;
+        if (!in_range(c, d, a + i + 1)) return kParamOutOfRange;
+        i = static_cast<uint8_t>(i + 1u + n);
+    }
+    bad = 0xFF;
+    return kParamOk;
+}
+
+// CRC of a bank's contents: sequence number, table hash, value block (`v`,
+// or the EEPROM at `ee` when v is null).
+uint16_t bank_crc(const ParamConfig& c, uint16_t seq, const uint8_t* v, uint16_t ee) {
+    uint16_t crc = kCrcInit;
+    crc = crc16_update(crc, static_cast<uint8_t>(seq));
+    crc = crc16_update(crc, static_cast<uint8_t>(seq >> 8));
+    for (uint8_t i = 0; i < 4; ++i) crc = crc16_update(crc, static_cast<uint8_t>(c.hash >> (8u * i)));
+    for (uint16_t i = 0; i < c.size; ++i) crc = crc16_update(crc, v ? v[i] : pal::eeprom_read(static_cast<uint16_t>(ee + i)));
+    return crc;
+}
+
+uint16_t ee_u16(uint16_t addr) {
+    return static_cast<uint16_t>(pal::eeprom_read(addr) | (pal::eeprom_read(static_cast<uint16_t>(addr + 1u)) << 8));
+}
+
+// Whether bank `b` is whole, of this table, with a good CRC and values in
+// range; its sequence number in `seq`.
+bool bank_valid(const ParamConfig& c, uint8_t b, uint16_t& seq) {
+    const uint16_t base = bank_base(c, b);
+    if (pal::eeprom_read(base) != kParamMagic) return false;
+    seq = ee_u16(static_cast<uint16_t>(base + 1u));
+    uint32_t hash = 0;
+    for (uint8_t i = 4; i-- > 0;) hash = (hash << 8) | pal::eeprom_read(static_cast<uint16_t>(base + 3u + i));
+    if (hash != c.hash) return false;
+    const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
+                                                  pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
+    const uint16_t values = static_cast<uint16_t>(base + kParamHeader);
+    if (bank_crc(c, seq, 0, values) != stored) return false;
+    for (uint8_t id = 0; id < c.n; ++id) {
+        const ParamDef d = def(c, id);
+        uint8_t v[8];
+        for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+        if (!in_range(c, d, v)) return false;
+    }
+    return true;
+}
+
+// The live values differ from the current bank (or the defaults).
+void refresh_dirty(ParamStore& s, const ParamConfig& c) {
+    bool dirty;
+    if ((s.source & 3u) == kParamDefaults) {
+        dirty = false;
+        for (uint16_t i = 0; i < c.size && !dirty; ++i) {
+            uint8_t b;
+            flash_read(&b, c.defaults + i, 1);
+            dirty = b != c.val[i];
+        }
+    } else {
+        const uint16_t base = bank_base(c, static_cast<uint8_t>((s.source & 3u) - kParamBankA));
+        const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
+                                                      pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
+        dirty = bank_crc(c, s.seq, c.val, 0) != stored;
+    }
+    s.source = static_cast<uint8_t>((s.source & ~kParamDirty) | (dirty ? kParamDirty : 0u));
+}
+
+bool staged(const ParamConfig& c, uint8_t id) { return (c.staged[id >> 3] >> (id & 7u)) & 1u; }
+
+// The byte of the header (bank offsets 1..8) being written, new sequence
+// number first.
+uint8_t header_byte(const ParamStore& s, const ParamConfig& c, uint8_t i) {
+    const uint16_t seq = static_cast<uint16_t>(s.seq + 1u);
+    if (i < 2) return static_cast<uint8_t>(seq >> (8u * i));
+    if (i < 6) return static_cast<uint8_t>(c.hash >> (8u * (i - 2u)));
+    return i == 6 ? static_cast<uint8_t>(s.w_crc >> 8) : static_cast<uint8_t>(s.w_crc);
+}
+
+bool busy(const ParamStore& s) { return (s.source & kParamWriting) != 0; }
+
+}  // namespace
+
+void param_begin(ParamStore& s, const ParamConfig* cfg) {
+    memset(&s, 0, sizeof s);
+    s.cfg = cfg;
+    const ParamConfig c = config(s);
+    memset(c.staged, 0, (c.n + 7u) / 8u);
+    uint16_t seq_a = 0, seq_b = 0;
+    const bool a = pal::eeprom_size() >= param_eeprom_end(c.eeprom_base, c.size) && bank_valid(c, 0, seq_a);
+    const bool b = pal::eeprom_size() >= param_eeprom_end(c.eeprom_base, c.size) && bank_valid(c, 1, seq_b);
+    if (a || b) {
+        const uint8_t bank = a && b ? (static_cast<int16_t>(seq_b - seq_a) > 0 ? 1u : 0u) : b ? 1u : 0u;
+        const uint16_t values = static_cast<uint16_t>(bank_base(c, bank) + kParamHeader);
+        for (uint16_t i = 0; i < c.size; ++i) c.val[i] = pal::eeprom_read(static_cast<uint16_t>(values + i));
+        s.seq = bank ? seq_b : seq_a;
+        s.source = bank ? kParamBankB : kParamBankA;
+    } else {
+        flash_read(c.val, c.defaults, c.size);
+        s.source = kParamDefaults;
+    }
+}
+
+uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
+    const ParamConfig c = config(s);
+    bad = 0xFF;
+    if (busy(s)) return kParamBusy;
+    const uint8_t st = check_entries(c, a, len, bad);
+    if (st != kParamOk) return st;
+    for (uint8_t i = 0; i < len;) {  // a change only in an allowed state
+        const ParamDef d = def(c, a[i]);
+        const uint8_t n = elem_size(d.type);
+        if (memcmp(c.val + d.off, a + i + 1, n) != 0 && !state_allows(c, d)) {
+            bad = a[i];
+            return kParamWrongState;
+        }
+        i = static_cast<uint8_t>(i + 1u + n);
+    }
+    for (uint8_t i = 0; i < len;) {
+        const ParamDef d = def(c, a[i]);
+        const uint8_t n = elem_size(d.type);
+        set_bytes(c, d.off, a + i + 1, n);
+        i = static_cast<uint8_t>(i + 1u + n);
+    }
+    refresh_dirty(s, c);
+    return kParamOk;
+}
+
+uint8_t param_save(ParamStore& s) {
+    if (busy(s)) return kParamBusy;
+    s.source |= kParamWriting;
+    s.w_job = kClear;
+    return kParamOk;
+}
+
+uint8_t param_load_begin(ParamStore& s) {
+    if (busy(s) && !s.loading) return kParamBusy;  // a save under way; an open load starts again
+    const ParamConfig c = config(s);
+    memset(c.staged, 0, (c.n + 7u) / 8u);
+    s.q_len = 0;
+    s.loading = 1;
+    s.source |= kParamWriting;
+    s.w_job = kClearThenStage;
+    return kParamOk;
+}
+
+uint8_t param_stage(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
+    bad = 0xFF;
+    if (!s.loading || s.w_job > kStage) return kParamNoLoad;
+    const ParamConfig c = config(s);
+    const uint8_t st = check_entries(c, a, len, bad);
+    if (st != kParamOk) return st;
+    if (static_cast<uint16_t>(s.q_len) + len > sizeof s.queue) return kParamBusy;
+    memcpy(s.queue + s.q_len, a, len);
+    s.q_len = static_cast<uint8_t>(s.q_len + len);
+    for (uint8_t i = 0; i < len;) {
+        const uint8_t id = a[i];
+        c.staged[id >> 3] = static_cast<uint8_t>(c.staged[id >> 3] | (1u << (id & 7u)));
+        i = static_cast<uint8_t>(i + 1u + elem_size(def(c, id).type));
+    }
+    return kParamOk;
+}
+
+uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
+    bad = 0xFF;
+    if (!s.loading || s.w_job > kStage) return kParamNoLoad;
+    if (s.q_len != 0 || s.w_job != kStage || !pal::eeprom_ready()) return kParamBusy;
+    const ParamConfig c = config(s);
+    const uint16_t values = static_cast<uint16_t>(bank_base(c, target_bank(s)) + kParamHeader);
+    // the block the load makes: staged values from the bank, the others live
+    uint16_t sum = kCrcInit;
+    for (uint8_t id = 0; id < c.n; ++id) {
+        const ParamDef d = def(c, id);
+        const uint8_t n = elem_size(d.type);
+        for (uint8_t k = 0; k < n; ++k) {
+            const uint16_t off = static_cast<uint16_t>(d.off + k);
+            sum = crc16_update(sum, staged(c, id) ? pal::eeprom_read(static_cast<uint16_t>(values + off)) : c.val[off]);
+        }
+    }
+    if (sum != crc) return kParamMismatch;
+    uint8_t v[8];
+    for (uint8_t id = 0; id < c.n; ++id) {
+        if (!staged(c, id)) continue;
+        const ParamDef d = def(c, id);
+        const uint8_t n = elem_size(d.type);
+        for (uint8_t k = 0; k < n; ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+        if (memcmp(v, c.val + d.off, n) != 0 && !state_allows(c, d)) {
+            bad = id;
+            return kParamWrongState;
+        }
+    }
+    for (uint8_t id = 0; id < c.n; ++id) {  // in one step: the loaded set is live
+        if (!staged(c, id)) continue;
+        const ParamDef d = def(c, id);
+        const uint8_t n = elem_size(d.type);
+        for (uint8_t k = 0; k < n; ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+        set_bytes(c, d.off, v, n);
+    }
+    s.w_job = kValues;
+    s.w_id = 0;
+    s.w_b = 0;
+    return kParamOk;
+}
+
+uint8_t param_get(const ParamStore& s, uint8_t first, uint8_t& count, uint8_t* out, uint8_t max) {
+    const ParamConfig c = config(s);
+    uint8_t used = 0;
+    count = 0;
+    for (uint16_t id = first; id < c.n; ++id) {
+        const ParamDef d = def(c, static_cast<uint8_t>(id));
+        const uint8_t n = elem_size(d.type);
+        if (static_cast<uint16_t>(used) + n > max) break;
+        const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+        memcpy(out + used, c.val + d.off, n);
+        if (c.lock) pal::critical_exit(saved);
+        used = static_cast<uint8_t>(used + n);
+        ++count;
+    }
+    return used;
+}
+
+uint16_t param_crc(const ParamStore& s) {
+    const ParamConfig c = config(s);
+    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    const uint16_t crc = crc16(c.val, c.size);
+    if (c.lock) pal::critical_exit(saved);
+    return crc;
+}
+
+void param_poll(ParamStore& s) {
+    if (s.w_job == kIdle || s.cfg == 0 || !pal::eeprom_ready()) return;
+    const ParamConfig c = config(s);
+    const uint16_t base = bank_base(c, target_bank(s));
+    switch (s.w_job) {
+    case kClearThenStage:
+    case kClear:
+        pal::eeprom_write(base, 0x00);
+        s.w_job = s.w_job == kClear ? kValues : kStage;
+        s.w_id = 0;
+        s.w_b = 0;
+        return;
+    case kStage: {
+        if (s.q_len == 0) return;
+        const ParamDef d = def(c, s.queue[0]);
+        const uint8_t n = elem_size(d.type);
+        pal::eeprom_write(static_cast<uint16_t>(base + kParamHeader + d.off + s.w_b), s.queue[1 + s.w_b]);
+        if (++s.w_b == n) {
+            s.w_b = 0;
+            s.q_len = static_cast<uint8_t>(s.q_len - 1u - n);
+            memmove(s.queue, s.queue + 1 + n, s.q_len);
+        }
+        return;
+    }
+    case kValues:
+        while (s.w_id < c.n) {
+            const ParamDef d = def(c, s.w_id);
+            if (s.loading && staged(c, s.w_id)) {  // already in the bank
+                ++s.w_id;
+                continue;
+            }
+            pal::eeprom_write(static_cast<uint16_t>(base + kParamHeader + d.off + s.w_b), c.val[d.off + s.w_b]);
+            if (++s.w_b == elem_size(d.type)) {
+                s.w_b = 0;
+                ++s.w_id;
+            }
+            return;
+        }
+        s.w_crc = bank_crc(c, static_cast<uint16_t>(s.seq + 1u), c.val, 0);
+        s.w_job = kHeader;
+        s.w_id = 0;
+        return;
+    case kHeader:
+        pal::eeprom_write(static_cast<uint16_t>(base + 1u + s.w_id), header_byte(s, c, s.w_id));
+        if (++s.w_id == 8) s.w_job = kMagic;
+        return;
+    case kMagic:
+        pal::eeprom_write(base, kParamMagic);
+        s.seq = static_cast<uint16_t>(s.seq + 1u);
+        s.source = static_cast<uint8_t>(target_bank(s) ? kParamBankB : kParamBankA);  // writing and dirty off
+        s.loading = 0;
+        s.w_job = kIdle;
+        memset(c.staged, 0, (c.n + 7u) / 8u);
+        refresh_dirty(s, c);
+        return;
+    default:
+        s.w_job = kIdle;
+    }
+}
+
+}  // namespace fsw

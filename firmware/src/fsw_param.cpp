@@ -96,9 +96,14 @@ bool state_allows(const ParamConfig& c, const ParamDef& d) {
     return (byte >> ((st - 1u) % 8u)) & 1u;
 }
 
-void set_bytes(const ParamConfig& c, uint16_t off, const uint8_t* v, uint8_t n) {
+void set_bytes(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {
     const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
-    memcpy(c.val + off, v, n);
+    memcpy(d.ptr, v, elem_size(d.type));
+    if (c.lock) pal::critical_exit(saved);
+}
+void get_bytes(const ParamConfig& c, const ParamDef& d, uint8_t* v) {
+    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    memcpy(v, d.ptr, elem_size(d.type));
     if (c.lock) pal::critical_exit(saved);
 }
 
@@ -121,14 +126,26 @@ uint8_t check_entries(const ParamConfig& c, const uint8_t* a, uint8_t len, uint8
     return kParamOk;
 }
 
-// CRC of a bank's contents: sequence number, table hash, value block (`v`,
-// or the EEPROM at `ee` when v is null).
-uint16_t bank_crc(const ParamConfig& c, uint16_t seq, const uint8_t* v, uint16_t ee) {
+// CRC of the live value block, continuing `crc`.
+uint16_t live_crc(const ParamConfig& c, uint16_t crc) {
+    for (uint8_t id = 0; id < c.n; ++id) {
+        const ParamDef d = def(c, id);
+        uint8_t v[8];
+        get_bytes(c, d, v);
+        crc = crc16(v, elem_size(d.type), crc);
+    }
+    return crc;
+}
+
+// CRC of a bank's contents: sequence number, table hash, value block (the
+// live values, or the EEPROM's at `ee` when `ee` is not 0xFFFF).
+uint16_t bank_crc(const ParamConfig& c, uint16_t seq, uint16_t ee) {
     uint16_t crc = kCrcInit;
     crc = crc16_update(crc, static_cast<uint8_t>(seq));
     crc = crc16_update(crc, static_cast<uint8_t>(seq >> 8));
     for (uint8_t i = 0; i < 4; ++i) crc = crc16_update(crc, static_cast<uint8_t>(c.hash >> (8u * i)));
-    for (uint16_t i = 0; i < c.size; ++i) crc = crc16_update(crc, v ? v[i] : pal::eeprom_read(static_cast<uint16_t>(ee + i)));
+    if (ee == 0xFFFFu) return live_crc(c, crc);
+    for (uint16_t i = 0; i < c.size; ++i) crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(ee + i)));
     return crc;
 }
 
@@ -148,7 +165,7 @@ bool bank_valid(const ParamConfig& c, uint8_t b, uint16_t& seq) {
     const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
                                                   pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
     const uint16_t values = static_cast<uint16_t>(base + kParamHeader);
-    if (bank_crc(c, seq, 0, values) != stored) return false;
+    if (bank_crc(c, seq, values) != stored) return false;
     for (uint8_t id = 0; id < c.n; ++id) {
         const ParamDef d = def(c, id);
         uint8_t v[8];
@@ -163,16 +180,18 @@ void refresh_dirty(ParamStore& s, const ParamConfig& c) {
     bool dirty;
     if ((s.source & 3u) == kParamDefaults) {
         dirty = false;
-        for (uint16_t i = 0; i < c.size && !dirty; ++i) {
-            uint8_t b;
-            flash_read(&b, c.defaults + i, 1);
-            dirty = b != c.val[i];
+        for (uint8_t id = 0; id < c.n && !dirty; ++id) {
+            const ParamDef d = def(c, id);
+            uint8_t v[8], w[8];
+            get_bytes(c, d, v);
+            flash_read(w, c.defaults + d.off, elem_size(d.type));
+            dirty = memcmp(v, w, elem_size(d.type)) != 0;
         }
     } else {
         const uint16_t base = bank_base(c, static_cast<uint8_t>((s.source & 3u) - kParamBankA));
         const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
                                                       pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
-        dirty = bank_crc(c, s.seq, c.val, 0) != stored;
+        dirty = bank_crc(c, s.seq, 0xFFFFu) != stored;
     }
     s.source = static_cast<uint8_t>((s.source & ~kParamDirty) | (dirty ? kParamDirty : 0u));
 }
@@ -203,11 +222,21 @@ void param_begin(ParamStore& s, const ParamConfig* cfg) {
     if (a || b) {
         const uint8_t bank = a && b ? (static_cast<int16_t>(seq_b - seq_a) > 0 ? 1u : 0u) : b ? 1u : 0u;
         const uint16_t values = static_cast<uint16_t>(bank_base(c, bank) + kParamHeader);
-        for (uint16_t i = 0; i < c.size; ++i) c.val[i] = pal::eeprom_read(static_cast<uint16_t>(values + i));
+        for (uint8_t id = 0; id < c.n; ++id) {
+            const ParamDef d = def(c, id);
+            uint8_t v[8];
+            for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+            set_bytes(c, d, v);
+        }
         s.seq = bank ? seq_b : seq_a;
         s.source = bank ? kParamBankB : kParamBankA;
     } else {
-        flash_read(c.val, c.defaults, c.size);
+        for (uint8_t id = 0; id < c.n; ++id) {
+            const ParamDef d = def(c, id);
+            uint8_t v[8];
+            flash_read(v, c.defaults + d.off, elem_size(d.type));
+            set_bytes(c, d, v);
+        }
         s.source = kParamDefaults;
     }
 }
@@ -221,7 +250,9 @@ uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
     for (uint8_t i = 0; i < len;) {  // a change only in an allowed state
         const ParamDef d = def(c, a[i]);
         const uint8_t n = elem_size(d.type);
-        if (memcmp(c.val + d.off, a + i + 1, n) != 0 && !state_allows(c, d)) {
+        uint8_t v[8];
+        get_bytes(c, d, v);
+        if (memcmp(v, a + i + 1, n) != 0 && !state_allows(c, d)) {
             bad = a[i];
             return kParamWrongState;
         }
@@ -230,7 +261,7 @@ uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
     for (uint8_t i = 0; i < len;) {
         const ParamDef d = def(c, a[i]);
         const uint8_t n = elem_size(d.type);
-        set_bytes(c, d.off, a + i + 1, n);
+        set_bytes(c, d, a + i + 1);
         i = static_cast<uint8_t>(i + 1u + n);
     }
     refresh_dirty(s, c);
@@ -280,32 +311,30 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
     const uint16_t values = static_cast<uint16_t>(bank_base(c, target_bank(s)) + kParamHeader);
     // the block the load makes: staged values from the bank, the others live
     uint16_t sum = kCrcInit;
+    uint8_t v[8], w[8];
     for (uint8_t id = 0; id < c.n; ++id) {
         const ParamDef d = def(c, id);
         const uint8_t n = elem_size(d.type);
-        for (uint8_t k = 0; k < n; ++k) {
-            const uint16_t off = static_cast<uint16_t>(d.off + k);
-            sum = crc16_update(sum, staged(c, id) ? pal::eeprom_read(static_cast<uint16_t>(values + off)) : c.val[off]);
+        get_bytes(c, d, v);
+        if (staged(c, id)) {
+            for (uint8_t k = 0; k < n; ++k) w[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+            if (memcmp(v, w, n) != 0 && !state_allows(c, d)) {
+                if (bad == 0xFF) bad = id;  // the first refused, reported once the CRC holds
+            }
+            memcpy(v, w, n);
         }
+        sum = crc16(v, n, sum);
     }
-    if (sum != crc) return kParamMismatch;
-    uint8_t v[8];
-    for (uint8_t id = 0; id < c.n; ++id) {
-        if (!staged(c, id)) continue;
-        const ParamDef d = def(c, id);
-        const uint8_t n = elem_size(d.type);
-        for (uint8_t k = 0; k < n; ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
-        if (memcmp(v, c.val + d.off, n) != 0 && !state_allows(c, d)) {
-            bad = id;
-            return kParamWrongState;
-        }
+    if (sum != crc) {
+        bad = 0xFF;
+        return kParamMismatch;
     }
+    if (bad != 0xFF) return kParamWrongState;
     for (uint8_t id = 0; id < c.n; ++id) {  // in one step: the loaded set is live
         if (!staged(c, id)) continue;
         const ParamDef d = def(c, id);
-        const uint8_t n = elem_size(d.type);
-        for (uint8_t k = 0; k < n; ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
-        set_bytes(c, d.off, v, n);
+        for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
+        set_bytes(c, d, v);
     }
     s.w_job = kValues;
     s.w_id = 0;
@@ -321,22 +350,14 @@ uint8_t param_get(const ParamStore& s, uint8_t first, uint8_t& count, uint8_t* o
         const ParamDef d = def(c, static_cast<uint8_t>(id));
         const uint8_t n = elem_size(d.type);
         if (static_cast<uint16_t>(used) + n > max) break;
-        const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
-        memcpy(out + used, c.val + d.off, n);
-        if (c.lock) pal::critical_exit(saved);
+        get_bytes(c, d, out + used);
         used = static_cast<uint8_t>(used + n);
         ++count;
     }
     return used;
 }
 
-uint16_t param_crc(const ParamStore& s) {
-    const ParamConfig c = config(s);
-    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
-    const uint16_t crc = crc16(c.val, c.size);
-    if (c.lock) pal::critical_exit(saved);
-    return crc;
-}
+uint16_t param_crc(const ParamStore& s) { return live_crc(config(s), kCrcInit); }
 
 void param_poll(ParamStore& s) {
     if (s.w_job == kIdle || s.cfg == 0 || !pal::eeprom_ready()) return;
@@ -369,14 +390,16 @@ void param_poll(ParamStore& s) {
                 ++s.w_id;
                 continue;
             }
-            pal::eeprom_write(static_cast<uint16_t>(base + kParamHeader + d.off + s.w_b), c.val[d.off + s.w_b]);
+            uint8_t v[8];
+            get_bytes(c, d, v);
+            pal::eeprom_write(static_cast<uint16_t>(base + kParamHeader + d.off + s.w_b), v[s.w_b]);
             if (++s.w_b == elem_size(d.type)) {
                 s.w_b = 0;
                 ++s.w_id;
             }
             return;
         }
-        s.w_crc = bank_crc(c, static_cast<uint16_t>(s.seq + 1u), c.val, 0);
+        s.w_crc = bank_crc(c, static_cast<uint16_t>(s.seq + 1u), 0xFFFFu);
         s.w_job = kHeader;
         s.w_id = 0;
         return;

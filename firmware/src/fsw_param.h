@@ -24,8 +24,12 @@ enum ParamSource : uint8_t {
 static const uint8_t kParamDirty = 0x40;    // source bit 6: live values differ from the current bank
 static const uint8_t kParamWriting = 0x80;  // source bit 7: a bank is being written
 
-// One parameter (FSW_FLASH, in id order).
+// One parameter (FSW_FLASH, in id order). Its value lives in RAM where the
+// declaring machine reads it (`ptr`, its generated `prm` block); the value
+// block of the banks, the CRC and the defaults are the parameters' values
+// laid end to end in id order (`off`).
 struct ParamDef {
+    uint8_t* ptr;    // the live value (RAM)
     uint16_t off;    // offset of its value in the value block
     uint16_t range;  // offset in the pool of its MIN then MAX (elem_size(type) bytes each,
                      // little-endian values of the type; unused for bool)
@@ -48,7 +52,6 @@ struct ParamConfig {
     const ParamWhen* whens;
     const uint8_t* pool;        // ranges and state bitsets (FSW_FLASH)
     const uint8_t* defaults;    // the default value block, size bytes (FSW_FLASH)
-    uint8_t* val;               // the live value block (RAM), size bytes
     uint8_t* staged;            // RAM bitset, (n + 7) / 8 bytes: ids staged in the open load
     const uint8_t* sv;          // the state vector (for `S`)
     uint32_t hash;              // the table hash stored in every bank
@@ -107,7 +110,7 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad);
 // Copies up to `max` bytes of the values of ids first.. into `out`: the
 // number of whole values copied is returned in `count`, the bytes as result.
 uint8_t param_get(const ParamStore& s, uint8_t first, uint8_t& count, uint8_t* out, uint8_t max);
-// CRC-16 of the live value block.
+// CRC-16 of the live value block (the live values in id order).
 uint16_t param_crc(const ParamStore& s);
 
 // The background writer: writes the next EEPROM byte if the EEPROM is

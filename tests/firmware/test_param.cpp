@@ -21,7 +21,8 @@ static uint8_t val[11];
 static uint8_t staged_bits[1];
 static ParamStore g_store;
 
-static const ParamDef kDefs[4] FSW_FLASH = {{0, 0, kF32, 0}, {4, 8, kU32, 1}, {8, 0, kBool, 1}, {9, 16, kI16, 0}};
+static const ParamDef kDefs[4] FSW_FLASH = {
+    {val + 0, 0, 0, kF32, 0}, {val + 4, 4, 8, kU32, 1}, {val + 8, 8, 0, kBool, 1}, {val + 9, 9, 16, kI16, 0}};
 static const ParamWhen kWhens[2] FSW_FLASH = {{0, 20, 1}, {0, 21, 1}};
 static const uint8_t kPool[22] FSW_FLASH = {
     0x00, 0x00, 0x48, 0x42, 0x00, 0x80, 0x3b, 0x45,  // 50.0f, 3000.0f
@@ -32,9 +33,9 @@ static const uint8_t kDefaults[11] FSW_FLASH = {0x00, 0x00, 0x16, 0x43,  // 150.
                                                 0x10, 0x27, 0x00, 0x00,  // 10000
                                                 0x01,                    // true
                                                 0xfb, 0xff};             // -5
-static const ParamConfig kConfig FSW_FLASH = {kDefs, kWhens, kPool, kDefaults, val, staged_bits, sv,
+static const ParamConfig kConfig FSW_FLASH = {kDefs, kWhens, kPool, kDefaults, staged_bits, sv,
                                               0x12345678UL, 11, 0, 4, false};
-static const ParamConfig kOtherTable FSW_FLASH = {kDefs, kWhens, kPool, kDefaults, val, staged_bits, sv,
+static const ParamConfig kOtherTable FSW_FLASH = {kDefs, kWhens, kPool, kDefaults, staged_bits, sv,
                                                   0x12345679UL, 11, 0, 4, false};
 static const uint16_t kBank = kParamHeader + 11;
 

@@ -94,6 +94,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
         return None
     sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
     machines, machine_srcs = _machines(machine_files, sv, board, r)
+    _parameters(machines, machine_files, board, r)
     channels = _channels(io_files, sv, board, r) if board is not None else []
 
     time_source, time_unit = _time(f.time, r)
@@ -265,6 +266,33 @@ def _machines(files: list[ConfigFile], sv: M.StateVector, board: Board | None, r
         srcs[m.name] = msrc
         machines.append(m)
     return machines, srcs
+
+
+def _parameters(machines: list[M.Machine], files: list[ConfigFile], board: Board | None, r: Report) -> None:
+    """The machines' parameters as one table (docs/parameters.md): names
+    unique across the application (the ground addresses them by name), at
+    most 255, and two banks that fit the board's EEPROM."""
+    from .params import HEADER, MAX_PARAMS
+
+    by_file = {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in files}
+    seen: dict[str, str] = {}
+    count = size = 0
+    for m in machines:
+        for v in m.vars:
+            if v.param is None:
+                continue
+            if v.name in seen:
+                r.err(by_file.get(m.name, files[0].file if files else None),
+                      f"parameter `{v.name}` of machine `{m.name}` has the name of a parameter of machine "
+                      f"`{seen[v.name]}`: the ground addresses parameters by name, rename one")
+            seen.setdefault(v.name, m.name)
+            count += 1
+            size += v.type.size
+    if count > MAX_PARAMS:
+        r.at(1, 1, f"the application has {count} parameters: at most {MAX_PARAMS}")
+    if count and board is not None and 2 * (HEADER + size) > board.eeprom:
+        r.at(1, 1, f"the parameters' two EEPROM banks take {2 * (HEADER + size):,} B (2 x ({HEADER} + {size})) "
+                   f"but the {board.name} has {board.eeprom:,} B of EEPROM")
 
 
 def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]) -> str | None:

@@ -307,7 +307,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
             err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
             continue
         init_resolver = Resolver(src, diags, lang, names, vars_, [], None)  # no copy: quadratic in locals
-        init = _resolve_init(init_resolver, d, local_decls, vars_)
+        init = _resolve_init(init_resolver, d, local_decls, vars_,
+                             param_names=frozenset(p.name for p in f.params))
         init_used |= init_resolver.used
         idx = len(vars_)
         if local_bytes <= MAX_LOCALS_SIZE < local_bytes + t.size:
@@ -315,6 +316,44 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
                                     "local offsets are 16-bit")
         local_bytes += t.size
         vars_.append(M.Var(idx, M.LOCAL, d.name, None, t, d.read_only, d.line, init))
+        names[d.name] = idx
+        name_lines[d.name] = d.line
+    # parameters: read-only locals whose value the ground may change
+    param_decls: dict[str, S.ParamDecl] = {d.name: d for d in reversed(f.params)}
+    param_exprs: dict[int, tuple[S.ParamDecl, M.Expr | None, M.Expr | None]] = {}
+    for d in f.params:
+        t = TYPES.get(d.type)
+        if t is None:
+            err(d.line, d.type_col, unknown_type(d.type))
+            t = TYPES["F64"]
+        if d.name == "T":
+            err(d.line, d.name_col, "`T` is the built-in time in state and cannot name a parameter")
+            continue
+        if d.name in names:
+            err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
+            continue
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)
+        init = _resolve_init(init_resolver, d, {**local_decls, **param_decls}, vars_, "default value")
+        bounds = []
+        for what, e in (("@min", d.min), ("@max", d.max)):
+            if e is None:
+                bounds.append(None)
+                continue
+            b = S.LocalDecl(e.line, 0, d.type, 0, d.name + what, e, True)
+            bounds.append(_resolve_init(init_resolver, b, {**local_decls, **param_decls}, vars_, f"`{what}` value",
+                                        owner=d.name))
+        init_used |= init_resolver.used
+        if t.is_bool and (d.min is not None or d.max is not None):
+            at = dict(d.annot_cols)
+            col = at.get("@min", at.get("@max", d.name_col))
+            err(d.line, col, f"`{d.name}` is bool: a bool parameter has no range (`@min`/`@max`)")
+        elif not t.is_bool and (d.min is None or d.max is None):
+            missing = " and ".join(a for a, e in (("`@min`", d.min), ("`@max`", d.max)) if e is None)
+            err(d.line, d.name_col, f"parameter `{d.name}` needs {missing}: the ground may set it only within "
+                                    "a range")
+        idx = len(vars_)
+        param_exprs[idx] = (d, bounds[0], bounds[1])
+        vars_.append(M.Var(idx, M.LOCAL, d.name, None, t, True, d.line, init, M.Param(None, None, d.unit, ())))
         names[d.name] = idx
         name_lines[d.name] = d.line
     t_idx = len(vars_)
@@ -364,6 +403,9 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         states.append(M.State(idx, idx + 1, st.header.name, st.header.line,
                               blocks["entry"], blocks["step"], blocks["exit"]))
 
+    for idx, (d, lo_e, hi_e) in param_exprs.items():
+        vars_[idx] = _param_var(vars_[idx], d, lo_e, hi_e, consts, state_index, err)
+
     if diags.error_count != before or g is None or s is None:
         return None
     name = src.path.replace("\\", "/").rsplit("/", 1)[-1].rsplit(".", 1)[0]
@@ -371,30 +413,99 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     return m, consts, frozenset(res.used)
 
 
-def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_) -> M.Expr:
-    """A local's initial value: literals and earlier locals only."""
+def _param_var(v: M.Var, d: S.ParamDecl, lo_e, hi_e, consts, state_index, err) -> M.Var:
+    """A parameter's Var with its range (values of its type) and the ids of
+    the states that allow a change; errors for a range outside the type, a
+    default outside the range, an unknown state."""
+    from .numeric import to_type
+
+    t = v.type
+    bounds = []
+    for what, e in (("@min", lo_e), ("@max", hi_e)):
+        if e is None:
+            bounds.append(None)
+            continue
+        col = dict(d.annot_cols).get(what, d.name_col)
+        try:
+            x = evaluate(e, F64MODE, lambda i: _const(consts, i))
+        except NotConstant:
+            bounds.append(None)
+            continue
+        if x != x or x in (math.inf, -math.inf):
+            err(d.line, col, f"`{what}` of `{d.name}` must be a finite number, not {x}")
+            bounds.append(None)
+            continue
+        if t.is_int and (x != int(x) or not t.lo <= x <= t.hi):
+            err(d.line, col, f"`{what}` of `{d.name}` must be a whole number in {t.lo}..{t.hi} ({t}), not {x:g}")
+            bounds.append(None)
+            continue
+        if t.is_float and t.size == 4 and abs(x) > 3.4028234663852886e38:
+            err(d.line, col, f"`{what}` of `{d.name}` is beyond binary32 (F32): {x:g}")
+            bounds.append(None)
+            continue
+        bounds.append(to_type(t, x))
+    lo, hi = bounds
+    if lo is not None and hi is not None:
+        if lo > hi:
+            err(d.line, dict(d.annot_cols)["@max"], f"`@max` of `{d.name}` ({hi:g}) is below its `@min` ({lo:g})")
+        elif v.index in consts and not lo <= consts[v.index] <= hi:
+            err(d.line, d.name_col, f"the default of `{d.name}` ({consts[v.index]:g}) is outside its range "
+                                    f"{lo:g}..{hi:g}")
+    when: list[int] = []
+    for st, col in d.when:
+        if st not in state_index:
+            known = ", ".join(state_index) or "none"
+            err(d.line, col, f"`@when {st}`: no state `{st}` in this machine (its states: {known})")
+        elif state_index[st] + 1 in when:
+            err(d.line, col, f"state `{st}` is named twice after `@when`")
+        else:
+            when.append(state_index[st] + 1)
+    if not d.when and state_index:
+        when = [1]  # without @when: the initial state only
+    return M.Var(v.index, v.kind, v.name, v.alias, t, True, v.line, v.init, M.Param(lo, hi, d.unit, tuple(when)))
+
+
+def _const(consts, i):
+    if i not in consts:
+        raise NotConstant(None)
+    return float(consts[i])
+
+
+def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_, what: str = "initial value",
+                  owner: str | None = None, param_names: frozenset = frozenset()) -> M.Expr:
+    """A local's initial value (a parameter's default or bound): literals and
+    earlier locals only (and earlier parameters, for a parameter)."""
     ok = True
+    param = isinstance(d, S.ParamDecl) or owner is not None
+    who = owner or d.name
 
     def visit(e):
         nonlocal ok
         if isinstance(e, S.Name):
-            if e.name == d.name:
-                res.error(e.line, e.col, f"local `{d.name}` cannot be used in its own initial value")
+            if not param and (e.name in param_names or
+                              (e.name in res.names and vars_[res.names[e.name]].param is not None)):
+                res.error(e.line, e.col, f"initial value of `{d.name}` uses parameter `{e.name}`: a local's "
+                                         "initial value cannot depend on a value the ground may change")
+                ok = False
+            elif e.name == who:
+                res.error(e.line, e.col, f"parameter `{who}` cannot be used in its own {what}" if param else
+                          f"local `{d.name}` cannot be used in its own initial value")
                 ok = False
             elif e.name in res.names and vars_[res.names[e.name]].kind != M.LOCAL:
-                res.error(e.line, e.col, f"initial value of `{d.name}` uses element `{e.name}`: "
+                res.error(e.line, e.col, f"{what} of `{who}` uses element `{e.name}`: "
                                          "only literals and earlier locals are allowed")
                 ok = False
             elif e.name == "T":
-                res.error(e.line, e.col, f"initial value of `{d.name}` uses `T`: "
+                res.error(e.line, e.col, f"{what} of `{who}` uses `T`: "
                                          "only literals and earlier locals are allowed")
                 ok = False
             elif e.name not in res.names and e.name in local_decls:
-                res.error(e.line, e.col, f"initial value of `{d.name}` uses `{e.name}`, declared later "
+                res.error(e.line, e.col, f"{what} of `{who}` uses `{e.name}`, declared later "
                                          f"(line {local_decls[e.name].line}): only earlier locals are allowed")
                 ok = False
         elif isinstance(e, S.Call):
-            res.error(e.line, e.col, f"`{e.func}` cannot be used in an initial value")
+            res.error(e.line, e.col, f"`{e.func}` cannot be used in an {what}" if what[0] in "aeiou" else
+                      f"`{e.func}` cannot be used in a {what}")
             ok = False
             return
         for c in _children(e):
@@ -434,8 +545,8 @@ def _stmts(stmts, res: Resolver, state_index, in_exit: bool, err) -> tuple[M.Stm
                 err(st.line, st.col, "`T` is read-only: it is the time spent in the current state")
                 continue
             if v.read_only:
-                kind = "local" if v.kind == M.LOCAL else "element"
-                why = ""
+                kind = "parameter" if v.param else "local" if v.kind == M.LOCAL else "element"
+                why = ": the ground changes it (`fsw param set`), the machine only reads it" if v.param else ""
                 for role, what in (("G", "the global time, written by the application"),
                                    ("S", "the current state's ID, written by the machine itself")):
                     if v.kind == M.ELEMENT and role in (v.name, v.alias):
@@ -624,8 +735,8 @@ def machine_warnings(m: M.Machine, f: S.SmFile, src: Source, diags: Diagnostics,
         if v.index in used or v.index in (m.g, m.s) or v.kind == M.TIME_IN_STATE:
             continue
         if v.kind == M.LOCAL:
-            d = next(d for d in f.locals if d.name == v.name)
-            warn(d.line, d.name_col, f"local `{v.name}` is never used")
+            d = next(d for d in (*f.locals, *f.params) if d.name == v.name)
+            warn(d.line, d.name_col, f"{'parameter' if v.param else 'local'} `{v.name}` is never used")
         else:
             d = next(d for d in f.elements if d.name == v.name)
             warn(d.line, d.name_col, f"element `{v.name}` is listed but never used")

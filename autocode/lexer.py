@@ -10,7 +10,7 @@ from typing import NamedTuple
 from .diagnostics import Columns, Diagnostics, Source
 
 KEYWORDS = frozenset({"if", "else", "and", "or", "not", "true", "false"})
-ANNOTATIONS = frozenset({"@read_only", "@alias", "@assert", "@stop"})
+ANNOTATIONS = frozenset({"@read_only", "@alias", "@assert", "@stop", "@min", "@max", "@unit", "@when"})
 
 # Token kinds.
 NUM, ID, KW, OP, ANNOT, LABEL, NL, EOF = "num", "id", "kw", "op", "annot", "label", "nl", "eof"

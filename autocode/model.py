@@ -64,6 +64,7 @@ class Var:
     read_only: bool  # for the machine; G, S and T always are
     line: int
     init: "Expr | None" = None  # locals: the initial value
+    param: "Param | None" = None  # a parameter (a read-only local the ground may change)
 
     @property
     def display(self) -> str:
@@ -72,6 +73,17 @@ class Var:
         if self.alias is not None and self.alias.encode() < self.name.encode():
             return self.alias
         return self.name
+
+
+@dataclass(frozen=True)
+class Param:
+    """What makes a local a parameter (docs/parameters.md): its range (values
+    of its type, None for a bool), its unit text, and the states in which a
+    change is allowed (state ids, 1-based)."""
+    min: object
+    max: object
+    unit: str
+    when: tuple[int, ...]
 
 
 # ---- expressions: every operand converted to R ---------------------------------

@@ -571,9 +571,22 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
     elements: list[S.SmElem] = []
     locals_: list[S.LocalDecl] = []
     states: list[S.StateDecl] = []
-    sv_header = local_header = None
+    params: list[S.ParamDecl] = []
+    sv_header = local_header = param_header = None
     for header, body in sections:
         name = header.name
+        if name == "parameters":
+            if param_header is not None:
+                diags.error(src, lang, header.line, header.col + 1,
+                            f"duplicate `[parameters]` section (previously on line {param_header.line})")
+            elif states:
+                diags.error(src, lang, header.line, header.col + 1, "`[parameters]` must come before the first state")
+            param_header = param_header or header
+            for toks in body:
+                d = _param_decl(toks, src, diags, lang)
+                if d is not None:
+                    params.append(d)
+            continue
         if name == "state_vector" or name == "local":
             prev = sv_header if name == "state_vector" else local_header
             if prev is not None:
@@ -602,7 +615,8 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
         if name == "<malformed>":
             continue
         states.append(S.StateDecl(header, _state_blocks(body, src, diags, lang)))
-    return S.SmFile(src.path, tuple(elements), tuple(locals_), tuple(states), sv_header, local_header)
+    return S.SmFile(src.path, tuple(elements), tuple(locals_), tuple(states), sv_header, local_header,
+                    tuple(params), param_header)
 
 
 def _sm_elem(toks: list[Tok], src, diags, lang) -> S.SmElem | None:
@@ -669,6 +683,90 @@ def _local_decl(toks: list[Tok], src, diags, lang) -> S.LocalDecl | None:
         p.report(e)
         return None
     return S.LocalDecl(d.line, d.type_col, d.type, d.name_col, d.name, expr, read_only)
+
+
+PARAM_ANNOTS = ("@min", "@max", "@unit", "@when")
+
+
+def _param_decl(toks: list[Tok], src, diags, lang) -> S.ParamDecl | None:
+    """`TYPE name = default [@min E] [@max E] [@unit TEXT] [@when STATE...]`."""
+    d = _elem_decl(toks[:2], src, diags, lang)
+    if d is None:
+        return None
+    if len(toks) < 3 or not (toks[2].kind == OP and toks[2].text == "="):
+        found = show(toks[2]) if len(toks) > 2 else "end of line"
+        col = toks[2].col if len(toks) > 2 else toks[1].col + len(toks[1].text)
+        diags.error(src, lang, d.line, col, f"expected `= default value` after `{d.name}`, found {found}")
+        return None
+    # split at the annotations: the default, then each annotation's tokens
+    parts: list[tuple[Tok | None, list[Tok]]] = [(None, [])]
+    for t in toks[3:]:
+        if t.kind == ANNOT:
+            parts.append((t, []))
+        else:
+            parts[-1][1].append(t)
+
+    def expr_of(what: str, at: Tok, ts: list[Tok]) -> S.Expr | None:
+        if not ts:
+            diags.error(src, lang, at.line, at.col + len(at.text), f"expected {what}")
+            return None
+        p = _line_parser(ts, src, diags, lang)
+        try:
+            e = p.expression()
+            if not p.at_end():
+                t = p.peek()
+                raise ParseError(t, f"unexpected {show(t)} after {what}")
+        except ParseError as e_:
+            p.report(e_)
+            return None
+        return e
+
+    default = expr_of("a default value", toks[2], parts[0][1])
+    if default is None:
+        return None
+    lo = hi = None
+    unit = ""
+    when: list[tuple[str, int]] = []
+    when_col = 0
+    seen: dict[str, int] = {}
+    ok = True
+    for at, ts in parts[1:]:
+        if at.text not in PARAM_ANNOTS:
+            diags.error(src, lang, at.line, at.col,
+                        f"unexpected `{at.text}`: a parameter takes `@min`, `@max`, `@unit` and `@when`")
+            ok = False
+            continue
+        if at.text in seen:
+            diags.error(src, lang, at.line, at.col, f"`{at.text}` given twice for `{d.name}`")
+            ok = False
+            continue
+        seen[at.text] = at.col
+        if at.text == "@min":
+            lo = expr_of("a minimum after `@min`", at, ts)
+            ok = ok and lo is not None
+        elif at.text == "@max":
+            hi = expr_of("a maximum after `@max`", at, ts)
+            ok = ok and hi is not None
+        elif at.text == "@unit":
+            if not ts:
+                diags.error(src, lang, at.line, at.col + len(at.text), "expected a unit after `@unit`")
+                ok = False
+            unit = "".join(t.text for t in ts)
+        else:
+            when_col = at.col
+            if not ts:
+                diags.error(src, lang, at.line, at.col + len(at.text), "expected state names after `@when`")
+                ok = False
+            for t in ts:
+                if t.kind != ID:
+                    diags.error(src, lang, t.line, t.col, f"expected a state name after `@when`, found {show(t)}")
+                    ok = False
+                    break
+                when.append((t.text, t.col))
+    if not ok:
+        return None
+    return S.ParamDecl(d.line, d.type_col, d.type, d.name_col, d.name, default, lo, hi, unit, tuple(when), when_col,
+                       tuple(seen.items()))
 
 
 LABELS = ("entry", "step", "exit")

@@ -190,6 +190,24 @@ class LocalDecl:
 
 
 @dataclass(frozen=True)
+class ParamDecl:
+    """A `[parameters]` line: `TYPE name = default`, then `@min`, `@max`,
+    `@unit`, `@when` in any order (docs/parameters.md)."""
+    line: int
+    type_col: int
+    type: str
+    name_col: int
+    name: str
+    expr: Expr
+    min: Expr | None
+    max: Expr | None
+    unit: str
+    when: tuple[tuple[str, int], ...]  # (state name, column)
+    when_col: int  # column of `@when` (0: none)
+    annot_cols: tuple[tuple[str, int], ...] = ()  # (annotation, column) as written
+
+
+@dataclass(frozen=True)
 class Block:
     line: int
     col: int
@@ -211,6 +229,8 @@ class SmFile:
     states: tuple[StateDecl, ...]
     sv_header: Header | None = None
     local_header: Header | None = None
+    params: tuple[ParamDecl, ...] = ()
+    param_header: Header | None = None
 
 
 @dataclass(frozen=True)

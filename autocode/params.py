@@ -1,0 +1,183 @@
+"""The application's parameters (docs/parameters.md): every machine's
+`[parameters]` in one table, ids in [configs] order then file order, with
+their place in the value block, the table hash the EEPROM banks carry, and
+the values a ground or a parameter file may give them.
+
+Both ends use this module: the generator for the firmware's tables and
+defaults, the ground (`fsw param`), `fsw sim --params` and the tests."""
+
+from __future__ import annotations
+
+import hashlib
+import struct
+from dataclasses import dataclass
+
+from .evaluate import local_values
+from .numeric import REALS
+from .types import ElemType
+
+HEADER = 9  # a bank's header: magic, seq u16, table hash u32, CRC u16
+MAGIC = 0x50
+MAX_PARAMS = 255
+
+
+@dataclass(frozen=True)
+class AppParam:
+    id: int
+    name: str
+    machine: str
+    type: ElemType
+    default: object  # a value of the type (int, or float), in the board's evaluation type
+    min: object | None  # None for a bool
+    max: object | None
+    unit: str
+    when: tuple[str, ...]  # the states that allow a change
+    when_ids: tuple[int, ...]
+    off: int  # offset in the value block
+    state_element: str  # the declaring machine's `S` element
+    var: int  # index in the machine's vars
+    line: int
+    path: str
+
+    @property
+    def fmt(self) -> str:
+        return "<" + self.type.fmt
+
+    def pack(self, value) -> bytes:
+        return struct.pack(self.fmt, value)
+
+    def unpack(self, data: bytes):
+        v = struct.unpack(self.fmt, data)[0]
+        return bool(v) if self.type.is_bool else v
+
+    def range_text(self) -> str:
+        if self.type.is_bool:
+            return "true or false"
+        return f"{_num(self.min)}..{_num(self.max)}"
+
+
+def _num(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def app_parameters(app) -> tuple[AppParam, ...]:
+    """The table: every machine's parameters, in [configs] order."""
+    cached = getattr(app, "_fsw_params", None)
+    if cached is not None:
+        return cached
+    real = REALS[app.board.real]
+    out: list[AppParam] = []
+    off = 0
+    for m in app.machines:
+        params = [v for v in m.vars if v.param is not None]
+        if not params:
+            continue
+        values = local_values(m, real)
+        names = {st.id: st.name for st in m.states}
+        for v in params:
+            out.append(AppParam(len(out), v.name, m.name, v.type, values[v.index], v.param.min, v.param.max,
+                                v.param.unit, tuple(names[i] for i in v.param.when), v.param.when,
+                                off, m.vars[m.s].name, v.index, v.line, m.path))
+            off += v.type.size
+    table = tuple(out)
+    try:
+        object.__setattr__(app, "_fsw_params", table)
+    except (AttributeError, TypeError):
+        pass
+    return table
+
+
+def block_size(params) -> int:
+    return sum(p.type.size for p in params)
+
+
+def table_text(params) -> str:
+    """The canonical text the table hash is taken over: what a bank's bytes
+    mean (ids, names, types, offsets) and what makes a value valid (ranges,
+    states). Defaults and units are not in it: a bank saved before a default
+    changed still holds valid values."""
+    lines = ["parameters 1"]
+    for p in params:
+        rng = "-" if p.type.is_bool else f"{p.pack(p.min).hex()} {p.pack(p.max).hex()}"
+        lines.append(f"{p.id} {p.name} {p.type.name} {p.off} {rng} {p.machine} "
+                     f"{','.join(str(i) for i in p.when_ids)}")
+    return "\n".join(lines) + "\n"
+
+
+def param_hash(params) -> int:
+    """The table hash (u32): the first 4 bytes, little-endian, of SHA-256
+    over table_text."""
+    return int.from_bytes(hashlib.sha256(table_text(params).encode()).digest()[:4], "little")
+
+
+def default_block(params) -> bytes:
+    return b"".join(p.pack(p.default) for p in params)
+
+
+def check_value(p: AppParam, value) -> tuple[object, str | None]:
+    """A value a user gave for `p` (a Python bool, int, float, or text as
+    typed) as a value of its type, or (None, why it cannot be)."""
+    t = p.type
+    if isinstance(value, str):
+        text = value.strip()
+        low = text.lower()
+        if t.is_bool:
+            if low in ("true", "1"):
+                return True, None
+            if low in ("false", "0"):
+                return False, None
+            return None, f"`{p.name}` is bool: give true or false, not `{value}`"
+        try:
+            value = int(text, 0) if t.is_int else float(text)
+        except ValueError:
+            kind = "a whole number" if t.is_int else "a number"
+            return None, f"`{p.name}` is {t.name}: `{value}` is not {kind}"
+    if t.is_bool:
+        if isinstance(value, bool):
+            return value, None
+        return None, f"`{p.name}` is bool: give true or false, not {value!r}"
+    if isinstance(value, bool):
+        return None, f"`{p.name}` is {t.name}: give a number, not {str(value).lower()}"
+    if t.is_int:
+        if isinstance(value, float):
+            if value != value or value != int(value):
+                return None, f"`{p.name}` is {t.name}: give a whole number, not {value:g}"
+            value = int(value)
+        if not isinstance(value, int):
+            return None, f"`{p.name}` is {t.name}: give a whole number, not {value!r}"
+    else:
+        if not isinstance(value, (int, float)):
+            return None, f"`{p.name}` is {t.name}: give a number, not {value!r}"
+        value = float(value)
+        if value != value:
+            return None, f"`{p.name}`: NaN is not a value a parameter may take"
+        if t.size == 4:
+            try:
+                value = struct.unpack("<f", struct.pack("<f", value))[0]
+            except OverflowError:
+                return None, f"`{p.name}` is F32: {value:g} is beyond its range"
+    if not p.min <= value <= p.max:
+        return None, f"`{p.name}` = {_num(value)} is outside its range {p.range_text()}" + \
+            (f" {p.unit}" if p.unit else "")
+    return value, None
+
+
+def value_block(params, values: dict[str, object]) -> bytes:
+    """The value block with `values` (checked values, by name) over the
+    defaults."""
+    return b"".join(p.pack(values.get(p.name, p.default)) for p in params)
+
+
+def crc16(data: bytes, crc: int = 0xFFFF) -> int:
+    import binascii
+
+    return binascii.crc_hqx(data, crc)
+
+
+def bank_image(params, values: dict[str, object], seq: int = 1) -> bytes:
+    """A bank's bytes as the firmware writes them (docs/parameters.md)."""
+    block = value_block(params, values)
+    h = param_hash(params)
+    body = struct.pack("<HI", seq & 0xFFFF, h)
+    crc = crc16(body + block)
+    return bytes([MAGIC]) + body + struct.pack(">H", crc) + block

@@ -277,22 +277,24 @@ def _parameters(machines: list[M.Machine], files: list[ConfigFile], board: Board
     by_file = {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in files}
     seen: dict[str, str] = {}
     count = size = 0
+    last = None  # the `machine` line of the last machine with parameters
     for m in machines:
+        tok = by_file.get(m.name)
         for v in m.vars:
             if v.param is None:
                 continue
+            last = tok
             if v.name in seen:
-                r.err(by_file.get(m.name, files[0].file if files else None),
-                      f"parameter `{v.name}` of machine `{m.name}` has the name of a parameter of machine "
-                      f"`{seen[v.name]}`: the ground addresses parameters by name, rename one")
+                r.err(tok, f"parameter `{v.name}` of machine `{m.name}` has the name of a parameter of machine "
+                           f"`{seen[v.name]}`: the ground addresses parameters by name, rename one")
             seen.setdefault(v.name, m.name)
             count += 1
             size += v.type.size
     if count > MAX_PARAMS:
-        r.at(1, 1, f"the application has {count} parameters: at most {MAX_PARAMS}")
+        r.err(last, f"the application has {count} parameters: at most {MAX_PARAMS}")
     if count and board is not None and 2 * (HEADER + size) > board.eeprom:
-        r.at(1, 1, f"the parameters' two EEPROM banks take {2 * (HEADER + size):,} B (2 x ({HEADER} + {size})) "
-                   f"but the {board.name} has {board.eeprom:,} B of EEPROM")
+        r.err(last, f"the parameters' two EEPROM banks take {2 * (HEADER + size):,} B (2 x ({HEADER} + {size})) "
+                    f"but the {board.name} has {board.eeprom:,} B of EEPROM")
 
 
 def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]) -> str | None:

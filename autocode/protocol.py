@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import struct
 
-PROTOCOL = 1  # the hello frame's protocol number; the firmware's kLinkProtocol
+PROTOCOL = 2  # the hello frame's protocol number; the firmware's kLinkProtocol
 HEADER = 6  # type, sequence number, time (low 32 bits)
 CRC = 2  # CRC-16/CCITT-FALSE, high byte first
 CRC_INIT = 0xFFFF
@@ -17,7 +17,13 @@ CRC_INIT = 0xFFFF
 HELLO, HEALTH, ACK, SNAPSHOT, SAMPLE = 0x01, 0x02, 0x03, 0x04, 0x80
 # uplink opcodes
 OP_PING, OP_HELLO, OP_SNAPSHOT, OP_SET, OP_MODE = 0x01, 0x02, 0x03, 0x04, 0x05
-OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode"}
+# parameters (docs/parameters.md)
+OP_PARAM_GET, OP_PARAM_SET, OP_PARAM_SAVE, OP_PARAM_BEGIN = 0x06, 0x07, 0x08, 0x09
+OP_PARAM_STAGE, OP_PARAM_COMMIT, OP_PARAM_INFO = 0x0A, 0x0B, 0x0C
+OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode",
+            OP_PARAM_GET: "param_get", OP_PARAM_SET: "param_set", OP_PARAM_SAVE: "param_save",
+            OP_PARAM_BEGIN: "param_begin", OP_PARAM_STAGE: "param_stage", OP_PARAM_COMMIT: "param_commit",
+            OP_PARAM_INFO: "param_info"}
 # acknowledgement status: 0 applied, anything else refused
 STATUS = {
     0: ("OK", "applied"),
@@ -29,14 +35,26 @@ STATUS = {
     6: ("BAD_MODE", "mode must be 0 disabled, 1 safed or 2 enabled"),
     7: ("LOCKED", "the executor keeps it: the uplink task's own mode, a task's mode, overruns or worst_us "
                   "element, the reset cause (modes change only by `mode`)"),
+    8: ("NO_PARAM", "no such parameter"),
+    9: ("OUT_OF_RANGE", "a value outside the parameter's range"),
+    10: ("WRONG_STATE", "the declaring machine is not in a state that allows a change"),
+    11: ("BUSY", "a parameter bank is being written, or the stage queue is full: try again"),
+    12: ("NO_LOAD", "no parameter load is open (PARAM_BEGIN first)"),
+    13: ("MISMATCH", "the staged set's CRC is not the one committed"),
 }
 
 # payloads, little-endian
-HELLO_PAYLOAD = struct.Struct("<BIIIBBBBH")  # protocol, schema, time_hi, frames, version x3, reset cause, last_seq
-HEALTH_PAYLOAD = struct.Struct("<IIIIHBHHHHHHH")  # time_hi, frames, dropped, cycles, late, reset cause, rx counters, last_seq;
+# protocol, schema, time_hi, frames, version x3, reset cause, last_seq, parameter store state
+HELLO_PAYLOAD = struct.Struct("<BIIIBBBBHB")
+# time_hi, frames, dropped, cycles, late, reset cause, rx counters, last_seq, parameter store state;
+HEALTH_PAYLOAD = struct.Struct("<IIIIHBHHHHHHHB")
 # then one HEALTH_TASK per task
 HEALTH_TASK = struct.Struct("<BBHH")    # mode, faults, overruns, worst_us
-ACK_PAYLOAD = struct.Struct("<HBBH")    # command seq, opcode, status, last_seq
+ACK_PAYLOAD = struct.Struct("<HBBH")    # command seq, opcode, status, last_seq; then a parameter command's data
+PARAM_INFO = struct.Struct("<BHHBI")    # source, seq, live CRC, count, table hash
+# the parameter store's state byte: bits 0..1 the source, bit 6 unsaved changes, bit 7 a bank being written
+PARAM_SOURCES = {0: "no parameters", 1: "defaults", 2: "bank A", 3: "bank B"}
+PARAM_DIRTY, PARAM_WRITING = 0x40, 0x80
 SNAPSHOT_OFFSET = 2  # a snapshot frame's payload: offset (u16), then state vector bytes
 
 

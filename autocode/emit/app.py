@@ -9,6 +9,7 @@ from ..cnames import comment
 from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
+from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan
 from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
@@ -155,6 +156,9 @@ def _app_cpp(app: Application) -> str:
     c.append(f"fsw::TaskStats stats[{max(n, 1)}];")
     c.append("")
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
+    params = app_parameters(app)
+    if params:
+        c += _params(app, params)
     if has_link:
         c += _link(app)
     steps = {}
@@ -185,6 +189,8 @@ def _app_cpp(app: Application) -> str:
     c.append("")
     c.append("// Starts the executor and the I/O channels; false on a bad table.")
     c.append("bool begin() {")
+    if params:
+        c.append("    fsw::param_begin(params, &kParamConfig);  // the newest valid EEPROM bank, else the defaults")
     c.append("    if (fsw::executor_begin(ex, &kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
         if kind in ("analog", "digital") and isinstance(tag, list):
@@ -201,11 +207,15 @@ def _app_cpp(app: Application) -> str:
     c.append("    return true;")
     c.append("}")
     c.append("")
-    if has_link:
-        c.append("// Runs a cycle when one is due; between cycles, feeds the serial link.")
+    if has_link or params:
+        c.append("// Runs a cycle when one is due; between cycles, feeds the serial link"
+                 + (" and writes\n// the next parameter byte to the EEPROM when it is ready." if params else "."))
         c.append("void poll() {")
         c.append("    (void)fsw::executor_poll(ex);")
-        c.append("    fsw::link_poll(link);")
+        if has_link:
+            c.append("    fsw::link_poll(link);")
+        if params:
+            c.append("    fsw::param_poll(params);")
         c.append("}")
     else:
         c.append("// Runs a cycle when one is due.")
@@ -355,10 +365,59 @@ def _link(app: Application) -> list[str]:
     c.append(f"    sv, {'kLinkStreams' if plan.streams else '0'}, {'link_streams' if plan.streams else '0'}, "
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
-             f"{plan.hello_every}, {up}, kSvLock}};")
+             f"{plan.hello_every}, {up}, kSvLock{', &params' if app_parameters(app) else ''}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")
+    c.append("")
+    return c
+
+
+def _params(app: Application, params) -> list[str]:
+    """The parameter table (docs/parameters.md): where each value lives (its
+    machine's `prm` block), its place in the value block, its range and
+    states, the defaults, and the store."""
+    from ..params import default_block, param_hash
+
+    name = basename(app.path)
+    pool = bytearray()
+    defs, whens, when_rows = [], [], {}
+    for p in params:
+        rng = 0
+        if not p.type.is_bool:
+            rng = len(pool)
+            pool += p.pack(p.min) + p.pack(p.max)
+        key = (p.machine, p.when_ids)
+        if key not in when_rows:
+            n = (max(p.when_ids) + 7) // 8 if p.when_ids else 0
+            mask = bytearray(n)
+            for sid in p.when_ids:
+                mask[(sid - 1) // 8] |= 1 << ((sid - 1) % 8)
+            when_rows[key] = len(whens)
+            whens.append((p.state_element, len(pool), n, p.machine, p.when))
+            pool += mask
+        defs.append((p, rng, when_rows[key]))
+    size = sum(p.type.size for p in params)
+    c = ["// ---- parameters (docs/parameters.md) ----",
+         f"const fsw::ParamDef kParamDefs[{len(params)}] FSW_FLASH = {{"]
+    for p, rng, w in defs:
+        m = c_ident(p.machine)
+        c.append(f"    {{{m}::prm + {m}::P_{p.name}, {p.off}, {rng}, {ELEM_CODE[p.type.name]}, {w}}},  "
+                 f"// {basename(p.path)}:{p.line} {p.name} ({p.type.name}, {p.range_text()}{' ' + p.unit if p.unit else ''})")
+    c.append("};")
+    c.append(f"const fsw::ParamWhen kParamWhens[{len(whens)}] FSW_FLASH = {{")
+    for st, off, n, m, when in whens:
+        c.append(f"    {{E_{st}, {off}, {n}}},  // {m}: {' '.join(when)}")
+    c.append("};")
+    c.append(f"const uint8_t kParamPool[{max(len(pool), 1)}] FSW_FLASH = {{{', '.join(str(b) for b in pool) or '0'}}};"
+             "  // ranges, then state sets")
+    c.append(f"const uint8_t kParamDefaults[{size}] FSW_FLASH = {{{', '.join(str(b) for b in default_block(params))}}};")
+    c.append(f"uint8_t param_staged[{(len(params) + 7) // 8}];")
+    c.append(f"const fsw::ParamConfig kParamConfig FSW_FLASH = {{kParamDefs, kParamWhens, kParamPool, kParamDefaults, "
+             f"param_staged, sv, 0x{param_hash(params):08x}UL, {size}, 0, {len(params)}, kSvLock}};")
+    c.append("fsw::ParamStore params;")
+    c.append(f"// {name}: {len(params)} parameter(s), {size} B of values; the EEPROM from "
+             f"{2 * (9 + size)} on is free (kParamEepromEnd)")
     c.append("")
     return c
 

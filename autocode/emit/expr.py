@@ -39,13 +39,15 @@ class ExprEmitter:
         # (A state script may write any local, so scripts keep them all.)
         written = assigned_vars(m)
         for v in m.vars:
-            if v.kind == M.LOCAL and not scriptable and (v.read_only or v.index not in written):
+            if v.kind == M.LOCAL and not scriptable and v.param is None and (v.read_only or v.index not in written):
                 self.consts[v.index] = real.read(v.type, values[v.index])
         self.sv_lock = m.sv.lock
 
     def ptr(self, v: M.Var) -> str:
         if v.kind == M.ELEMENT:
             return f"{self.ns}::sv + {self.ns}::E_{v.name}" if self.prefix else f"sv + E_{v.name}"
+        if v.param is not None and not self.scriptable:  # the parameter block the ground writes
+            return f"{self.prefix}prm + {self.prefix}{enumerator('P_', v.name)}"
         return f"{self.prefix}loc + {self.prefix}{enumerator('L_', v.name)}"
 
     def read(self, i: int) -> str:

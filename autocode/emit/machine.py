@@ -26,13 +26,20 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     src = basename(m.path)
     ex = ExprEmitter(m, real, scriptable)
     values = local_values(m, real)
-    stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts]
+    params = [] if scriptable else [v for v in m.vars if v.param is not None]
+    stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
     offsets: dict[int, int] = {}
     size = 0
     for v in stored:
         offsets[v.index] = size
         size += v.type.size
     init_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in stored)
+    poff: dict[int, int] = {}
+    psize = 0
+    for v in params:
+        poff[v.index] = psize
+        psize += v.type.size
+    param_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in params)
     assert m.states[0].id == 1, "a zero fsw::Machine starts in state 1"
     guard = f"{ns.upper()}_{name.upper()}_H"
     h = [banner([m.path, m.sv.path], m.sv), f"#ifndef {guard}", f"#define {guard}", "",
@@ -50,6 +57,15 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         h.append("};")
         h.append(f"static const uint16_t kLocSize = {size};")
         h.append("extern uint8_t loc[kLocSize];")
+    if params:
+        h.append("// Parameters (docs/parameters.md): the ground changes them, the parameter")
+        h.append("// store keeps them in EEPROM; the machine only reads them. Defaults until boot.")
+        h.append("enum : uint16_t {")
+        for v in params:
+            h.append(f"    {enumerator('P_', v.name)} = {poff[v.index]},  // {v.type.name}")
+        h.append("};")
+        h.append(f"static const uint16_t kPrmSize = {psize};")
+        h.append("extern uint8_t prm[kPrmSize];")
     h.append("")
     h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
     h.append("FSW_MUST_CHECK fsw::Result step();")
@@ -63,6 +79,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
          "fsw::Machine machine;  // zero: before the first step in the first state (fsw::machine_begin)"]
     if stored:
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
+    if params:
+        c.append(f"uint8_t prm[kPrmSize] = {{{', '.join(str(b) for b in param_bytes)}}};")
     c += ["", "namespace {", ""]
     for w in m.windows:
         c.append(f"{window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")

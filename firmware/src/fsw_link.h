@@ -11,7 +11,7 @@
 
 namespace fsw {
 
-static const uint8_t kLinkProtocol = 1;
+static const uint8_t kLinkProtocol = 2;
 
 // Downlink frame types (target -> ground). A sample frame's type is
 // kFrameSample | stream index (streams 0..127).
@@ -30,6 +30,14 @@ enum LinkOp : uint8_t {
     kOpSnapshot = 0x03,  // no arguments: the whole state vector follows
     kOpSet = 0x04,       // element index (u16), value (the element's bytes)
     kOpMode = 0x05,      // task index (u8), mode (u8: 0 disabled, 1 safed, 2 enabled)
+    // parameters (docs/parameters.md); without a parameter store: UNKNOWN_OP
+    kOpParamGet = 0x06,     // first id (u8), count (u8): the ack carries first, count, values
+    kOpParamSet = 0x07,     // (id u8, value)...: all or none, live (not saved)
+    kOpParamSave = 0x08,    // no arguments: write the live values to the other bank
+    kOpParamBegin = 0x09,   // no arguments: open a load (staged into the other bank)
+    kOpParamStage = 0x0A,   // (id u8, value)...
+    kOpParamCommit = 0x0B,  // CRC-16 (u16) of the value block the load makes
+    kOpParamInfo = 0x0C,    // no arguments: the ack carries the store's state
 };
 
 // Acknowledgement status: 0 applied, anything else refused (a NACK).
@@ -43,6 +51,13 @@ enum LinkStatus : uint8_t {
     kAckBadMode = 6,      // mode not 0, 1 or 2
     kAckLocked = 7,       // the executor's: the uplink task's mode, or a SET of a task's mode,
                           // overruns or worst_us element or of the reset cause
+    // the parameter store's (ParamStatus, fsw_param.h)
+    kAckNoParam = 8,      // no such parameter
+    kAckOutOfRange = 9,   // a value outside its range
+    kAckWrongState = 10,  // the declaring machine is not in a state that allows a change
+    kAckBusy = 11,        // a bank is being written, or the stage queue is full
+    kAckNoLoad = 12,      // STAGE or COMMIT without BEGIN
+    kAckMismatch = 13,    // the staged set's CRC is not the committed one
 };
 
 static const uint8_t kLinkHeader = 6;  // type, sequence number, time (low 32 bits)
@@ -122,6 +137,8 @@ struct Link {
     uint16_t ack_seq;
     uint8_t ack_op;
     uint8_t ack_status;
+    uint8_t ack_x;          // parameter commands: the first id asked for (GET), the id refused
+    uint8_t ack_y;          // GET: how many values were asked for
     uint8_t pending;        // control frames waiting for the transmit buffer
     uint8_t hello_countdown;
     uint8_t big_cycle;      // low byte of the executor cycle count at the last hello or health frame
@@ -167,10 +184,10 @@ constexpr bool link_writable_ok(uint16_t off, uint8_t type, uint16_t sv_size) {
 
 // The rest: at most 128 streams, snapshot chunks of at least one byte, and a
 // transmit buffer that holds a hello (the longest control frame but
-// health), a health frame for `n_tasks` tasks and a snapshot chunk.
+// health; a PARAM_INFO ack is shorter), a health frame for `n_tasks` tasks and a snapshot chunk.
 constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks) {
-    return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 19u) <= tx_cap &&
-           link_encoded_max(kLinkHeader + 33u + 6u * n_tasks) <= tx_cap &&
+    return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 20u) <= tx_cap &&
+           link_encoded_max(kLinkHeader + 34u + 6u * n_tasks) <= tx_cap &&
            link_encoded_max(kLinkHeader + 2u + snapshot_chunk) <= tx_cap;
 }
 

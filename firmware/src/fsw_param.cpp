@@ -342,20 +342,15 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
     return kParamOk;
 }
 
-uint8_t param_get(const ParamStore& s, uint8_t first, uint8_t& count, uint8_t* out, uint8_t max) {
+uint8_t param_value(const ParamStore& s, uint8_t id, uint8_t* out) {
     const ParamConfig c = config(s);
-    uint8_t used = 0;
-    count = 0;
-    for (uint16_t id = first; id < c.n; ++id) {
-        const ParamDef d = def(c, static_cast<uint8_t>(id));
-        const uint8_t n = elem_size(d.type);
-        if (static_cast<uint16_t>(used) + n > max) break;
-        get_bytes(c, d, out + used);
-        used = static_cast<uint8_t>(used + n);
-        ++count;
-    }
-    return used;
+    if (id >= c.n) return 0;
+    const ParamDef d = def(c, id);
+    get_bytes(c, d, out);
+    return elem_size(d.type);
 }
+
+uint8_t param_count(const ParamStore& s) { return config(s).n; }
 
 uint16_t param_crc(const ParamStore& s) { return live_crc(config(s), kCrcInit); }
 

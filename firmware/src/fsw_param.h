@@ -107,9 +107,11 @@ uint8_t param_load_begin(ParamStore& s);
 uint8_t param_stage(ParamStore& s, const uint8_t* args, uint8_t len, uint8_t& bad);
 uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad);
 
-// Copies up to `max` bytes of the values of ids first.. into `out`: the
-// number of whole values copied is returned in `count`, the bytes as result.
-uint8_t param_get(const ParamStore& s, uint8_t first, uint8_t& count, uint8_t* out, uint8_t max);
+// The live value of parameter `id` into `out` (8 bytes of room): its size,
+// 0 when there is no such parameter.
+uint8_t param_value(const ParamStore& s, uint8_t id, uint8_t* out);
+// Parameters in the table.
+uint8_t param_count(const ParamStore& s);
 // CRC-16 of the live value block (the live values in id order).
 uint16_t param_crc(const ParamStore& s);
 

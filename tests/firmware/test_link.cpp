@@ -36,7 +36,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             20, 96, 10, 20, 2, 3, 3, 0, false};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -152,7 +152,8 @@ static void test_boot_hello_carries_the_schema(void) {
     collect();
     const Frame* h = find(kFrameHello);
     TEST_ASSERT_NOT_NULL(h);
-    TEST_ASSERT_EQUAL_INT16(6 + 19, h->len);
+    TEST_ASSERT_EQUAL_INT16(6 + 20, h->len);
+    TEST_ASSERT_EQUAL_UINT8(kParamNone, h->body[6 + 19]);  // no parameter store
     TEST_ASSERT_EQUAL_UINT8(0, h->body[1]);  // the first frame
     TEST_ASSERT_EQUAL_UINT8(kLinkProtocol, h->body[6]);
     uint32_t schema;
@@ -183,9 +184,10 @@ static void test_health_reports_tasks_and_counters(void) {
     collect();
     const Frame* h = find(kFrameHealth);
     TEST_ASSERT_NOT_NULL(h);
-    TEST_ASSERT_EQUAL_INT16(6 + 33 + 6 * 2, h->len);
+    TEST_ASSERT_EQUAL_INT16(6 + 34 + 6 * 2, h->len);
     TEST_ASSERT_EQUAL_UINT32(9, load<uint32_t>(h->body + 6 + 12));  // executor cycles so far
-    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, h->body[6 + 33]);         // task 0 mode
+    TEST_ASSERT_EQUAL_UINT8(kParamNone, h->body[6 + 33]);           // no parameter store
+    TEST_ASSERT_EQUAL_UINT8(kModeEnabled, h->body[6 + 34]);         // task 0 mode
 }
 
 static void test_full_uart_drops_and_counts_never_blocks(void) {
@@ -291,7 +293,7 @@ static void test_mode_commands(void) {
 // changes only by MODE.
 static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
 static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 2, 3, 0, false};
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0};
 
 static void test_set_of_a_mode_element_is_locked(void) {
     link_begin(link, &kConfigMode);
@@ -412,10 +414,10 @@ static void test_bad_tables_do_not_pass_the_compile_time_checks(void) {
     TEST_ASSERT_TRUE(link_writable_ok(12, kF64, 20));
     TEST_ASSERT_FALSE(link_writable_ok(13, kF64, 20));
     TEST_ASSERT_FALSE(link_writable_ok(0, 11, 20));
-    // control frames: a health frame of 2 tasks is 6 + 33 + 12 + 2 bytes, 55 encoded
-    TEST_ASSERT_TRUE(link_config_ok(55, 20, 2, 2));
-    TEST_ASSERT_FALSE(link_config_ok(54, 20, 2, 2));
-    TEST_ASSERT_FALSE(link_config_ok(55, 45, 2, 2));  // a snapshot chunk of 45 needs 57
+    // control frames: a health frame of 2 tasks is 6 + 34 + 12 + 2 bytes, 56 encoded
+    TEST_ASSERT_TRUE(link_config_ok(56, 20, 2, 2));
+    TEST_ASSERT_FALSE(link_config_ok(55, 20, 2, 2));
+    TEST_ASSERT_FALSE(link_config_ok(56, 46, 2, 2));  // a snapshot chunk of 46 needs 58
     TEST_ASSERT_FALSE(link_config_ok(96, 0, 2, 2));   // chunks of no byte
     TEST_ASSERT_FALSE(link_config_ok(96, 20, 129, 2));
     TEST_ASSERT_EQUAL_UINT32(cobs_max_encoded(90), link_encoded_max(88));

@@ -6,6 +6,7 @@ from __future__ import annotations
 import shutil
 
 from conftest import run_fsw
+from fswkit.autocode.protocol import HELLO_PAYLOAD
 from fswkit.link import wire
 from fswkit.link.layout import from_dict
 from fswkit.link.log import LogWriter
@@ -81,8 +82,7 @@ def test_truncated_log_and_unknown_plot_element(tmp_path):
     lay = tank_layout()
     path = tmp_path / "cut.fswlog"
     w = LogWriter(str(path), lay)
-    hello = (bytes((1,)) + lay.schema.to_bytes(4, "little") + bytes(4) + bytes(4) + bytes((0, 1, 0, 0))
-             + bytes(2))
+    hello = HELLO_PAYLOAD.pack(wire.PROTOCOL, lay.schema, 0, 0, 0, 1, 0, 0, 0, 0)
     w.record(0, 1, wire.downlink(wire.HELLO, 0, 0, hello))
     sensors = (7).to_bytes(8, "little") + (1).to_bytes(4, "little") + bytes(8)
     w.record(0, 2, wire.downlink(0x80, 1, 10, sensors))
@@ -113,8 +113,7 @@ def test_live_view_renders_every_element_and_the_link():
 
     lay = tank_layout()
     s = Session(lay)
-    hello = (bytes((1,)) + lay.schema.to_bytes(4, "little") + bytes(4) + bytes(4) + bytes((0, 1, 0, 0))
-             + bytes(2))
+    hello = HELLO_PAYLOAD.pack(wire.PROTOCOL, lay.schema, 0, 0, 0, 1, 0, 0, 0, 0)
     import struct
     sensors = struct.pack("<QId", 20, 2, 815.5)
     s.feed(wire.downlink(wire.HELLO, 0, 0, hello) + wire.downlink(0x80, 1, 20, sensors), 1.0)

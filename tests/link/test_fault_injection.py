@@ -108,6 +108,8 @@ def check_faults(clean: bytes, layout, rnd: random.Random) -> int:
     first, last = survived[0], survived[-1]
     assert s.stats.frames == len(survived)
     assert s.stats.lost == (last - first + 1) - len(survived)
-    assert s.deframer.stats.invalid == 0
+    # a corrupted frame that passes the CRC-16 by chance (1 in 65,536 of the
+    # ~4,000 corrupted here) is refused by its type and length, never decoded
+    assert s.deframer.stats.invalid <= 2
     assert s.last_seq == last
     return len(spans) - len(survived)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from conftest import EXAMPLES
 
+from fswkit.autocode.protocol import HEALTH_PAYLOAD, HELLO_PAYLOAD
 from fswkit.link import wire
 
 TANK = EXAMPLES / "tank"
@@ -36,12 +37,12 @@ def layout_of(project: Path):
 
 
 def hello(layout, full: int, t: int) -> bytes:
-    payload = struct.pack("<BIIIBBBBH", wire.PROTOCOL, layout.schema, t >> 32, full, 1, 0, 0, 0, 0)
+    payload = HELLO_PAYLOAD.pack(wire.PROTOCOL, layout.schema, t >> 32, full, 1, 0, 0, 0, 0, 0)
     return wire.downlink(wire.HELLO, full, t, payload)
 
 
 def health(layout, full: int, t: int) -> bytes:
-    head = struct.pack("<IIIIHBHHHHHHH", t >> 32, full, 0, full, 0, 0, 0, 0, 0, 0, 0, 0, 0)
+    head = HEALTH_PAYLOAD.pack(t >> 32, full, 0, full, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0)
     tasks = b"".join(struct.pack("<BBHH", 2, 0, 0, 10) for _ in layout.tasks)
     payload = head + tasks
     assert len(payload) == layout.health_payload

@@ -156,8 +156,8 @@ class Session:
             return n == _HELLO.size
         if ftype == wire.HEALTH:
             return n == lay.health_payload
-        if ftype == wire.ACK:
-            return n == _ACK.size
+        if ftype == wire.ACK:  # a parameter command's data may follow
+            return n >= _ACK.size
         if ftype == wire.SNAPSHOT:
             return n >= 2 and _U16.unpack_from(body, wire.HEADER)[0] + n - 2 <= lay.sv_size
         return False
@@ -229,10 +229,10 @@ class Session:
         if ftype == wire.HEALTH:
             return self._health(seq, time, host_time, payload)
         if ftype == wire.ACK:
-            cseq, op, status, last = _ACK.unpack(payload)
+            cseq, op, status, last = _ACK.unpack_from(payload)
             name, why = wire.STATUS.get(status, (f"STATUS_{status}", "unknown status"))
             info = {"cmd_seq": cseq, "op": op, "op_name": wire.OP_NAMES.get(op, f"op_{op}"), "status": status,
-                    "status_name": name, "reason": why, "last_seq": last}
+                    "status_name": name, "reason": why, "last_seq": last, "data": bytes(payload[_ACK.size:])}
             self.acks.append(info)
             return Event("ack", seq, time, host_time, info=info)
         return self._snapshot(seq, time, host_time, payload)
@@ -246,9 +246,9 @@ class Session:
         self.latency = d - self.delay_min
 
     def _hello(self, seq, time, host_time, payload) -> Event:
-        proto, schema, _hi, frames, major, minor, patch, cause, last = _HELLO.unpack(payload)
+        proto, schema, _hi, frames, major, minor, patch, cause, last, params = _HELLO.unpack(payload)
         info = {"protocol": proto, "schema": schema, "frames": frames, "runtime": f"{major}.{minor}.{patch}",
-                "reset_cause": cause, "last_seq": last, "expected_schema": self.layout.schema}
+                "reset_cause": cause, "last_seq": last, "params": params, "expected_schema": self.layout.schema}
         self.hello = info
         self.target_schema = schema
         ok = schema == self.layout.schema and proto == wire.PROTOCOL
@@ -275,7 +275,7 @@ class Session:
     def _health(self, seq, time, host_time, payload) -> Event:
         f = _HEALTH.unpack_from(payload)
         keys = ("time_hi", "frames", "dropped", "cycles", "late", "reset_cause", "rx_ok", "rx_crc",
-                "rx_malformed", "rx_oversized", "rx_replayed", "rx_refused", "last_seq")
+                "rx_malformed", "rx_oversized", "rx_replayed", "rx_refused", "last_seq", "params")
         info = dict(zip(keys, f))
         tasks = []
         for i, (name, kind) in enumerate(self.layout.tasks):

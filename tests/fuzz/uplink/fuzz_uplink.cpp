@@ -5,7 +5,9 @@
 //   2. task modes change only by an applied MODE, and the uplink task stays enabled;
 //   3. the console is never written past its free space (the executor never blocks);
 //   4. every frame the target sends decodes and verifies;
-//   5. no out-of-bounds access, no undefined behaviour (the sanitizers).
+//   5. no out-of-bounds access, no undefined behaviour (the sanitizers);
+//   6. parameters (docs/parameters.md) hold values in their ranges only, and
+//      change only by an applied parameter command.
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -39,8 +41,22 @@ const LinkStream kStreams[2] = {{0, 8, 1, 2, store0}, {8, 13, 3, 1, 0}};
 // The two mode elements are listed too, as no generated table lists them:
 // the target must refuse their SET (LOCKED) whatever the table says.
 const LinkWritable kWritable[5] = {{2, 8, kU8}, {3, 9, kU8}, {4, 10, kBool}, {5, 11, kI16}, {6, 13, kF64}};
+// Parameters: F32 gainP [-10, 10] and U8 level [0, 5] in state 1, bool beep
+// in states 1 and 2; the declaring machine's state is pstate (state 1).
+uint8_t prm[6];
+uint8_t pstate[4] = {1, 0, 0, 0};
+uint8_t pstaged[1];
+ParamStore params;
+const ParamDef kParamDefs[3] = {{prm, 0, 0, kF32, 0}, {prm + 4, 4, 8, kU8, 0}, {prm + 5, 5, 0, kBool, 1}};
+const ParamWhen kParamWhens[2] = {{0, 10, 1}, {0, 11, 1}};
+const uint8_t kParamPool[12] = {0x00, 0x00, 0x20, 0xc1, 0x00, 0x00, 0x20, 0x41, 0, 5, 0x01, 0x03};
+const uint8_t kParamDefaults[6] = {0, 0, 0x80, 0x3f, 2, 1};  // 1.0f, 2, true
+const ParamConfig kParamConfig = {kParamDefs, kParamWhens, kParamPool, kParamDefaults, pstaged, pstate,
+                                  0x5A5A0001UL, 6, 0, 3, false};
+
 const LinkConfig kConfig = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0x12345678UL, 21, 96, 5,
-                            21, 2, 5, 2, 0, false};
+                            21, 2, 5, 2, 0, false, &params};
+
 
 static_assert(link_stream_ok(0, 8, 1, 2, true, 21, 96) && link_stream_ok(8, 13, 3, 1, false, 21, 96) &&
                   link_writable_ok(13, kF64, 21) && link_config_ok(96, 21, 2, 3),
@@ -52,6 +68,15 @@ uint16_t out_len;
 void fail(const char* what) {
     fprintf(stderr, "invariant broken: %s\n", what);
     abort();
+}
+
+// invariant 6: every parameter within its range
+void check_params(const uint8_t* before_prm, bool applied) {
+    float g;
+    memcpy(&g, prm, 4);
+    if (!(g >= -10.0f && g <= 10.0f)) fail("a parameter out of its range");
+    if (prm[4] > 5 || prm[5] > 1) fail("a parameter out of its range");
+    if (!applied && memcmp(before_prm, prm, sizeof prm) != 0) fail("a parameter changed without an applied command");
 }
 
 // Every frame the target sent decodes and verifies (invariant 4).
@@ -86,9 +111,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     static const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false};
     if (executor_begin(ex, &cfg) != kOk) fail("begin");
     pal::console_begin(115200UL);
+    native::sim_eeprom_erase();
+    param_begin(params, &kParamConfig);
     link_begin(link, &kConfig);
     uint8_t before[sizeof sv];
     memcpy(before, sv, sizeof sv);
+    uint8_t before_prm[sizeof prm];
+    memcpy(before_prm, prm, sizeof prm);
 
     size_t at = 0;
     for (int cycle = 0; cycle < 4000 && (at < size || cycle < 2); ++cycle) {
@@ -101,6 +130,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             clock_ms += 5;
             native::sim_advance_us(5000);
             link_poll(link);
+            param_poll(params);
         }
         // invariants 1 and 2: compare against the last state
         const bool applied = link.n.rx_ok != ok_before;
@@ -113,6 +143,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             if (mode1 && sv[i] > kModeEnabled) fail("mode out of range");
         }
         if (sv[8] != kModeEnabled) fail("the uplink task left enabled mode");
+        check_params(before_prm, applied);
+        memcpy(before_prm, prm, sizeof prm);
         memcpy(before, sv, sizeof sv);
         if (native::console_overruns() != 0) fail("wrote past the console's free space");
         check_output();

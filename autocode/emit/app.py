@@ -424,6 +424,9 @@ def _params(app: Application, params) -> list[str]:
 
 def _native_main(app: Application) -> list[str]:
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
+    params = bool(app_parameters(app))
+    between = (['fsw::link_poll(fsw_gen::link);'] if has_link else []) + \
+        (['fsw::param_poll(fsw_gen::params);'] if params else [])
     c = ['#include <stdio.h>',
          '#include <stdlib.h>',
          '#include <string.h>',
@@ -440,6 +443,7 @@ def _native_main(app: Application) -> list[str]:
          '//   PINS: aPIN=RAW sets an ADC reading, dPIN=0|1 a digital input level.',
          '//   --first-cycle N        starts the cycle count at N (with `[time] source cycle`,',
          '//                          G too): a long run\'s 2^32 wrap without the wait',
+         '//   --eeprom FILE          the EEPROM model is loaded from FILE and written through to it',
          'int main(int argc, char** argv) {',
          '    unsigned long cycles = 0, baud = 0;',
          '    unsigned long long first_cycle = 0;',
@@ -453,6 +457,11 @@ def _native_main(app: Application) -> list[str]:
          '            baud = strtoul(argv[++i], 0, 10);',
          '        } else if (strcmp(argv[i], "--first-cycle") == 0 && i + 1 < argc) {',
          '            first_cycle = strtoull(argv[++i], 0, 10);',
+         '        } else if (strcmp(argv[i], "--eeprom") == 0 && i + 1 < argc) {',
+         '            if (!fsw::native::sim_eeprom_file(argv[++i])) {',
+         '                fprintf(stderr, "cannot open the EEPROM file %s\\n", argv[i]);',
+         '                return 2;',
+         '            }',
          '        } else if (sscanf(argv[i], "a%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 65536) {',
          '            fsw::native::sim_set_analog(static_cast<uint8_t>(pin), static_cast<uint16_t>(value));',
          '        } else if (sscanf(argv[i], "d%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 2) {',
@@ -461,7 +470,7 @@ def _native_main(app: Application) -> list[str]:
          '            cycles = strtoul(argv[i], 0, 10);',
          '            simulated = true;',
          '        } else {',
-         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [--first-cycle N] [aPIN=RAW] [dPIN=0|1]\\n",',
+         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [--first-cycle N] [--eeprom FILE] [aPIN=RAW] [dPIN=0|1]\\n",',
          '                    argv[0]);',
          '            return 2;',
          '        }',
@@ -488,8 +497,7 @@ def _native_main(app: Application) -> list[str]:
          '                clock_gettime(CLOCK_MONOTONIC, &t);',
          '                const int64_t ahead = static_cast<int64_t>(k * fsw_gen::kPeriodUs) -',
          '                    ((t.tv_sec - t0.tv_sec) * 1000000LL + (t.tv_nsec - t0.tv_nsec) / 1000);']
-    if has_link:
-        c += ['                fsw::link_poll(fsw_gen::link);']
+    c += ['                ' + x for x in between]
     c += ['                if (ahead <= 0) break;',
           '                usleep(static_cast<useconds_t>(ahead > 1000 ? 1000 : ahead));',
           '            }',
@@ -497,11 +505,11 @@ def _native_main(app: Application) -> list[str]:
           '    }',
           '    for (unsigned long i = 0; i < cycles; ++i) {',
          '        fsw_gen::run_cycle();']
-    if has_link:
+    if between:
         c += ['        for (uint32_t t = 0; t < fsw_gen::kPeriodUs; t += 50) {  // loop() between cycles',
-              '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs - t < 50 ? fsw_gen::kPeriodUs - t : 50);',
-              '            fsw::link_poll(fsw_gen::link);',
-              '        }']
+              '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs - t < 50 ? fsw_gen::kPeriodUs - t : 50);']
+        c += ['            ' + x for x in between]
+        c += ['        }']
     else:
         c += ['        fsw::native::sim_advance_us(fsw_gen::kPeriodUs);']
     c += ['    }',

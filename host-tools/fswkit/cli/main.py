@@ -222,6 +222,21 @@ def parser() -> argparse.ArgumentParser:
     cm._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     cm.set_defaults(func=_command("ground", "cmd_cmd"))
 
+    pa = sub.add_parser("param", help="a target's parameters over the link: list, get, set, save, load, diff "
+                                      "(docs/parameters.md)")
+    pa.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
+    pa.add_argument("action", choices=("list", "get", "set", "save", "load", "diff"), metavar="ACTION",
+                    help="list [-o FILE.toml] | get NAME... | set NAME=VALUE... | save | load FILE.toml | "
+                         "diff [FILE.toml]")
+    pa.add_argument("args", nargs="*", metavar="ARG")
+    pa.add_argument("--port", required=True, help="serial device or pyserial URL")
+    pa.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    pa.add_argument("-o", "--output", metavar="FILE.toml", help="list: also write the values as a parameter file")
+    pa.add_argument("--force", action="store_true", help="list -o: replace an existing file")
+    pa.add_argument("--ignore-schema", action="store_true", help="talk to the target even when the schema differs")
+    pa._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
+    pa.set_defaults(func=_command("param", "cmd_param"))
+
     lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")
     lc.add_argument("log", metavar="LOG")
     lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")

@@ -1,0 +1,196 @@
+"""`fsw param PROJECT list|get|set|save|load|diff`: a target's parameters
+over the link (docs/parameters.md, fswkit.param)."""
+
+from __future__ import annotations
+
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+
+
+def _say(msg: str) -> None:
+    sys.stderr.write(f"fsw param: {msg}\n")
+
+
+def _show(p, v) -> str:
+    if p.type.is_bool:
+        return "true" if v else "false"
+    if p.type.is_float:
+        return f"{v:.9g}"
+    return str(v)
+
+
+def cmd_param(args) -> int:
+    from fswkit.autocode.params import app_parameters, check_value
+    from fswkit.autocode.schema import link_plan
+    from fswkit.link.layout import from_app
+    from fswkit.param.files import ParamFileError, params_text, read_params
+    from fswkit.target.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags)
+    except BuildError as e:
+        _say(str(e))
+        return EXIT_CONFIG
+    print_diags(diags)
+    if app is None:
+        return EXIT_CONFIG
+    params = app_parameters(app)
+    if not params:
+        _say(f"{args.project}: the application declares no parameters (a machine's [parameters] section, "
+             "docs/languages.md)")
+        return EXIT_CONFIG
+    by_name = {p.name: p for p in params}
+    # everything the user typed is checked before the port is opened
+    wanted: dict[str, object] = {}
+    file_values = None
+    if args.action in ("get",):
+        if not args.args:
+            _say("usage: fsw param PROJECT get NAME...")
+            return EXIT_CONFIG
+        for n in args.args:
+            if n not in by_name:
+                _say(f"unknown parameter `{n}` (the project's parameters: {', '.join(by_name)})")
+                return EXIT_CONFIG
+    elif args.action == "set":
+        if not args.args:
+            _say("usage: fsw param PROJECT set NAME=VALUE...")
+            return EXIT_CONFIG
+        for a in args.args:
+            name, eq, text = a.partition("=")
+            if not eq:
+                _say(f"`{a}`: expected NAME=VALUE")
+                return EXIT_CONFIG
+            p = by_name.get(name.strip())
+            if p is None:
+                _say(f"unknown parameter `{name.strip()}` (the project's parameters: {', '.join(by_name)})")
+                return EXIT_CONFIG
+            v, why = check_value(p, text)
+            if why is not None:
+                _say(why)
+                return EXIT_CONFIG
+            wanted[p.name] = v
+    elif args.action in ("load", "diff"):
+        if args.action == "load" and len(args.args) != 1:
+            _say("usage: fsw param PROJECT load FILE.toml")
+            return EXIT_CONFIG
+        if len(args.args) > 1:
+            _say("usage: fsw param PROJECT diff [FILE.toml]")
+            return EXIT_CONFIG
+        if args.args:
+            try:
+                file_values = read_params(args.args[0], params)
+            except ParamFileError as e:
+                sys.stderr.write(f"{e}\n")
+                return EXIT_CONFIG
+    elif args.args:
+        _say(f"`{args.action}` takes no arguments")
+        return EXIT_CONFIG
+    if args.output is not None and args.action != "list":
+        _say("-o/--output goes with `list`")
+        return EXIT_CONFIG
+    if args.output is not None:
+        import os
+
+        from fswkit.outputs import OutputError, check
+
+        if os.path.lexists(args.output) and not args.force:
+            _say(f"{args.output} exists: a parameter file is never overwritten without --force")
+            return EXIT_FAIL
+        try:
+            check(args.output, [app.path], force=args.force, what="parameter file")
+        except OutputError as e:
+            _say(str(e))
+            return EXIT_FAIL
+    return _talk(args, app, params, by_name, wanted, file_values, from_app(app), link_plan(app).tx_cap,
+                 params_text)
+
+
+def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
+    from fswkit.ground.monitor import schema_message, summary
+    from fswkit.link.client import Ground, LinkTimeout
+    from fswkit.link.port import PortError, open_port, port_errors
+    from fswkit.link.session import Session
+    from fswkit.param.client import ParamClient, ParamError, PortTransport
+
+    session = Session(layout, ignore_schema=args.ignore_schema)
+    baud = args.baud or app.baud
+    try:
+        port = open_port(args.port, baud)
+    except PortError as e:
+        _say(str(e))
+        return EXIT_FAIL
+    try:
+        ground = Ground(port, session)
+        try:
+            ground.handshake(timeout=3.0)
+        except LinkTimeout as e:
+            _say(f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session))
+            return EXIT_FAIL
+        if not session.hello["schema_ok"] and not args.ignore_schema:
+            _say(schema_message(session, args.project))
+            return EXIT_FAIL
+        client = ParamClient(PortTransport(ground), params, tx_cap)
+        return _action(args, client, params, by_name, wanted, file_values, params_text)
+    except ParamError as e:
+        _say(str(e))
+        return EXIT_FAIL
+    except port_errors() as e:
+        _say(f"{args.port}: the port went away ({e})")
+        return EXIT_FAIL
+    finally:
+        try:
+            port.close()
+        except Exception:  # noqa: BLE001 - closing a port that went away
+            pass
+
+
+def _action(args, client, params, by_name, wanted, file_values, params_text) -> int:
+    a = args.action
+    if a == "set":
+        client.set(wanted)
+        print("fsw param: set " + ", ".join(f"{k} = {_show(by_name[k], v)}" for k, v in wanted.items())
+              + " (live, not saved: `fsw param save` keeps them across power cycles)")
+        return EXIT_OK
+    if a == "save":
+        inf = client.save()
+        print(f"fsw param: saved in {inf['source_name']} (sequence {inf['seq']})")
+        return EXIT_OK
+    if a == "load":
+        inf = client.load(file_values)
+        print(f"fsw param: loaded {len(file_values)} value(s) from {args.args[0]}, verified (CRC 0x{inf['crc']:04x}),"
+              f" saved in {inf['source_name']} (sequence {inf['seq']})")
+        return EXIT_OK
+    inf = client.info()
+    values = client.get_all()
+    if a == "get":
+        for n in args.args:
+            print(f"{n} = {_show(by_name[n], values[n])}")
+        return EXIT_OK
+    if a == "diff":
+        ref = file_values if file_values is not None else {p.name: p.default for p in params}
+        what = args.args[0] if args.args else "the defaults"
+        differ = [p for p in params if p.name in ref and p.pack(values[p.name]) != p.pack(ref[p.name])]
+        for p in differ:
+            print(f"{p.name}: target {_show(p, values[p.name])}, {what} {_show(p, ref[p.name])}")
+        print(f"fsw param: {len(differ)} of {len(ref)} differ from {what}")
+        return 1 if differ else EXIT_OK
+    # list
+    state = (f"{inf['source_name']}" + (f", sequence {inf['seq']}" if inf['source'] >= 2 else "")
+             + (", unsaved changes" if inf["dirty"] else "") + (", writing" if inf["writing"] else ""))
+    print(f"parameters of {args.project}: {len(params)} ({state}; live CRC 0x{inf['crc']:04x})")
+    w = max(len(p.name) for p in params)
+    for p in params:
+        v = values[p.name]
+        mark = " " if p.pack(v) == p.pack(p.default) else "*"
+        unit = f" {p.unit}" if p.unit else ""
+        print(f"{mark} {p.name:<{w}}  {_show(p, v):>12}{unit:<6}  default {_show(p, p.default)}, "
+              f"{p.range_text()}, in {' '.join(p.when)}")
+    if args.output is not None:
+        from fswkit.outputs import write_text
+
+        write_text(args.output, params_text(params, values, f"parameters read from the target of {args.project}"))
+        print(f"fsw param: wrote {args.output}")
+    return EXIT_OK

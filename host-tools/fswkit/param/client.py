@@ -1,0 +1,337 @@
+"""The ground's parameter client (docs/parameters.md): lists, sets, saves
+and loads a target's parameters over the link.
+
+Commands are pipelined: several are in flight at once (as many bytes as
+the target's UART receive buffer holds), each acknowledged on its own;
+one whose acknowledgement does not come in time is sent again with a new
+sequence number, so a lossy radio slows a transfer down but never stalls
+it. A load is staged, committed with the CRC of the whole value block it
+makes, and verified by reading the live CRC back.
+
+The client talks through a transport: a serial port (PortTransport, wall
+clock) or the simulated board's UART (SimTransport, simulated clock, with
+frames dropped at random in each direction for tests and benches)."""
+
+from __future__ import annotations
+
+import random
+import struct
+import time
+from collections import deque
+from dataclasses import dataclass
+
+from fswkit.autocode.params import AppParam, crc16
+from fswkit.autocode.protocol import (OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO, OP_PARAM_SAVE,
+                                      OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES, PARAM_WRITING)
+from fswkit.link import wire
+from fswkit.link.session import Session
+
+RX_CAP = 24  # the target's uplink frame buffer (FSW_LINK_RX_CAP): encoded bytes, delimiter excluded
+RX_WINDOW = 56  # uplink bytes in flight at most: the target's UART receive buffer holds 64
+REPLAY, BUSY, NO_LOAD = 1, 11, 12
+
+
+class ParamError(Exception):
+    """A refusal or a failure, said in words."""
+
+
+@dataclass
+class Stats:
+    sent: int = 0
+    resent: int = 0
+    acks: int = 0
+    busy: int = 0
+
+
+# ---- transports -------------------------------------------------------------------------
+
+class PortTransport:
+    """A serial port through the link client (wall clock)."""
+
+    def __init__(self, ground):
+        self.ground = ground
+        self.session = ground.session
+
+    def now(self) -> float:
+        return time.monotonic()
+
+    def send(self, data: bytes) -> None:
+        self.ground.send(data)
+
+    def events(self, wait: float):
+        return self.ground.read(wait)
+
+
+class Lossy:
+    """Drops whole frames (the bytes up to a delimiter) with probability
+    `p`, as a radio loses packets; the delimiter stays, so the next frame
+    is intact."""
+
+    def __init__(self, p: float, rnd: random.Random):
+        self.p, self.rnd = p, rnd
+        self.partial = bytearray()
+        self.frames = self.dropped = 0
+
+    def __call__(self, data: bytes) -> bytes:
+        out = bytearray()
+        self.partial += data
+        while True:
+            i = self.partial.find(0)
+            if i < 0:
+                break
+            frame = bytes(self.partial[:i + 1])
+            del self.partial[:i + 1]
+            if i == 0:  # a bare delimiter
+                out += frame
+                continue
+            self.frames += 1
+            if self.rnd.random() < self.p:
+                self.dropped += 1
+                out += b"\0"
+            else:
+                out += frame
+        return bytes(out)
+
+
+class SimTransport:
+    """The simulated board's UART (its `control` mode): time is the board's
+    simulated time; frames may be dropped in each direction."""
+
+    def __init__(self, board, session: Session, up: Lossy | None = None, down: Lossy | None = None):
+        self.board, self.session = board, session
+        self.up, self.down = up, down
+        self.uplink_bytes = 0
+
+    def now(self) -> float:
+        return self.board.time()
+
+    def send(self, data: bytes) -> None:
+        if self.up is not None:
+            data = self.up(data)
+        self.uplink_bytes += len(data)
+        if data:
+            self.board.uart_write(data)
+
+    def events(self, wait: float):
+        self.board.run_for(max(wait, 0.001))
+        data = self.board.uart_read()
+        if self.down is not None:
+            data = self.down(data)
+        return self.session.feed(data, self.board.time()) if data else []
+
+
+# ---- the client -------------------------------------------------------------------------
+
+def _encoded(args: bytes) -> int:
+    return wire.encoded_size(3 + len(args))
+
+
+class ParamClient:
+    def __init__(self, transport, params: tuple[AppParam, ...], tx_cap: int, timeout: float = 0.5,
+                 deadline: float = 30.0):
+        self.t = transport
+        self.params = params
+        self.tx_cap = tx_cap
+        self.timeout = timeout
+        self.deadline = deadline
+        self.stats = Stats()
+        s = transport.session
+        known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
+        self._seq = (max(known) + 1) & 0xFFFF if known else 1
+        self.on_event = None  # every decoded event is passed here (a monitor may show them)
+
+    def _next_seq(self) -> int:
+        if self._seq == 0:
+            self._seq = 1
+        seq = self._seq
+        self._seq = (seq + 1) & 0xFFFF
+        return seq
+
+    def run(self, cmds: list[tuple[int, bytes]], busy_retry: bool = True) -> list[dict]:
+        """Each command sent (several in flight), until each has its
+        acknowledgement; the acks in the commands' order. A REPLAY answer
+        resynchronises the sequence numbers; BUSY is tried again a little
+        later (when busy_retry); a command unanswered within `timeout` goes
+        again with a new number."""
+        t = self.t
+        results: list[dict | None] = [None] * len(cmds)
+        queue = deque(range(len(cmds)))
+        inflight: dict[int, tuple[int, float, int]] = {}  # seq -> (command, sent at, bytes)
+        not_before = 0.0
+        start = t.now()
+        while any(r is None for r in results):
+            now = t.now()
+            if now - start > self.deadline:
+                raise ParamError(f"no answer from the target after {self.deadline:g} s "
+                                 f"({self.stats.resent} commands sent again)")
+            busy_bytes = sum(b for _, _, b in inflight.values())
+            while queue and now >= not_before:
+                i = queue[0]
+                op, args = cmds[i]
+                size = _encoded(args) + 1
+                if inflight and busy_bytes + size > RX_WINDOW:
+                    break
+                queue.popleft()
+                seq = self._next_seq()
+                t.send(wire.uplink(op, seq, args))
+                self.stats.sent += 1
+                inflight[seq] = (i, now, size)
+                busy_bytes += size
+            for ev in t.events(0.01):
+                if self.on_event is not None:
+                    self.on_event(ev)
+                if ev.kind != "ack" or ev.info["cmd_seq"] not in inflight:
+                    continue
+                i, _, _ = inflight.pop(ev.info["cmd_seq"])
+                self.stats.acks += 1
+                st = ev.info["status"]
+                if st == REPLAY:
+                    self._seq = (ev.info["last_seq"] + 1) & 0xFFFF
+                    queue.appendleft(i)
+                elif st == BUSY and busy_retry:
+                    self.stats.busy += 1
+                    queue.appendleft(i)
+                    not_before = t.now() + 0.02
+                else:
+                    results[i] = ev.info
+            now = t.now()
+            for seq, (i, sent, _) in list(inflight.items()):
+                if now - sent > self.timeout:
+                    del inflight[seq]
+                    queue.appendleft(i)
+                    self.stats.resent += 1
+        return results  # type: ignore[return-value]
+
+    # ---- the operations --------------------------------------------------------------
+
+    def info(self) -> dict:
+        ack = self.run([(OP_PARAM_INFO, b"")])[0]
+        if ack["status"] != 0:
+            raise ParamError(f"the target refused PARAM_INFO: {ack['status_name']}: {ack['reason']}")
+        if len(ack["data"]) < PARAM_INFO.size:
+            raise ParamError("the target's firmware has no parameters (PARAM_INFO carried no state)")
+        source, seq, crc, count, h = PARAM_INFO.unpack_from(ack["data"])
+        return {"source": source & 3, "source_name": PARAM_SOURCES[source & 3], "dirty": bool(source & 0x40),
+                "writing": bool(source & PARAM_WRITING), "seq": seq, "crc": crc, "count": count, "hash": h}
+
+    def get_all(self) -> dict[str, object]:
+        """Every parameter's live value, by name."""
+        room = self.tx_cap - 24 - self.tx_cap // 254
+        chunks = []
+        i = 0
+        while i < len(self.params):
+            first, used = i, 0
+            while i < len(self.params) and used + self.params[i].type.size <= room and i - first < 255:
+                used += self.params[i].type.size
+                i += 1
+            if i == first:
+                raise ParamError("the target's transmit buffer holds no parameter value")
+            chunks.append((first, i - first))
+        values: dict[str, object] = {}
+        todo = chunks
+        while todo:
+            acks = self.run([(OP_PARAM_GET, bytes(c)) for c in todo])
+            nxt = []
+            for (first, count), ack in zip(todo, acks):
+                if ack["status"] != 0:
+                    raise ParamError(f"the target refused PARAM_GET {first}: {ack['status_name']}: {ack['reason']}")
+                data = ack["data"]
+                if len(data) < 2 or data[0] != first:
+                    raise ParamError("the target's PARAM_GET answer does not match the request")
+                n, at = data[1], 2
+                for p in self.params[first:first + n]:
+                    values[p.name] = p.unpack(data[at:at + p.type.size])
+                    at += p.type.size
+                if n < count:
+                    nxt.append((first + n, count - n))
+            todo = nxt
+        return values
+
+    def _entries(self, values: dict[str, object]) -> list[bytes]:
+        by_name = {p.name: p for p in self.params}
+        return [bytes((by_name[k].id,)) + by_name[k].pack(v) for k, v in values.items()]
+
+    def _refusal(self, ack: dict, what: str) -> ParamError:
+        why = f"{ack['status_name']}: {ack['reason']}"
+        data = ack.get("data", b"")
+        if data and data[0] < len(self.params):
+            p = self.params[data[0]]
+            if ack["status"] == 10:
+                why = (f"`{p.name}` may change only while machine `{p.machine}` is in "
+                       f"{' or '.join(p.when)} (WRONG_STATE)")
+            elif ack["status"] == 9:
+                why = f"`{p.name}` must be within {p.range_text()} (OUT_OF_RANGE)"
+            else:
+                why = f"`{p.name}`: {why}"
+        return ParamError(f"{what} refused: {why}")
+
+    def set(self, values: dict[str, object]) -> None:
+        """Live values, all or none (not saved)."""
+        args = b"".join(self._entries(values))
+        if _encoded(args) > RX_CAP:
+            raise ParamError(f"{len(values)} values do not fit one command ({_encoded(args)} bytes encoded, the "
+                             f"target takes {RX_CAP}): set fewer at a time, or use `fsw param load FILE.toml`")
+        ack = self.run([(OP_PARAM_SET, args)])[0]
+        if ack["status"] != 0:
+            raise self._refusal(ack, "set")
+
+    def _wait_written(self, budget: float) -> dict:
+        start = self.t.now()
+        while True:
+            inf = self.info()
+            if not inf["writing"]:
+                return inf
+            if self.t.now() - start > budget:
+                raise ParamError(f"the target was still writing its parameter bank after {budget:g} s")
+            self.t.events(0.05)
+
+    def _write_budget(self) -> float:
+        return 5.0 + 2 * (9 + sum(p.type.size for p in self.params)) * 0.0034
+
+    def save(self) -> dict:
+        """The live values into the other EEPROM bank; its state once written."""
+        before = self.info()
+        ack = self.run([(OP_PARAM_SAVE, b"")])[0]
+        if ack["status"] != 0:
+            raise self._refusal(ack, "save")
+        after = self._wait_written(self._write_budget())
+        if after["seq"] == before["seq"] or after["source"] not in (2, 3):
+            raise ParamError("the save did not complete: the target still reports "
+                             f"{after['source_name']} (sequence {after['seq']})")
+        return after
+
+    def load(self, values: dict[str, object], current: dict[str, object] | None = None) -> dict:
+        """A whole set, all or nothing: staged, committed with the CRC of the
+        block it makes, then verified by the live CRC read back."""
+        if current is None:
+            current = self.get_all()
+        block = b"".join(p.pack(values.get(p.name, current[p.name])) for p in self.params)
+        crc = crc16(block)
+        before = self.info()
+        ack = self.run([(OP_PARAM_BEGIN, b"")])[0]
+        if ack["status"] != 0:
+            raise self._refusal(ack, "load")
+        # entries into frames that fit the target's receive buffer
+        frames, cur = [], b""
+        for e in self._entries(values):
+            if cur and _encoded(cur + e) > RX_CAP:
+                frames.append(cur)
+                cur = b""
+            cur += e
+        if cur:
+            frames.append(cur)
+        for ack in self.run([(OP_PARAM_STAGE, f) for f in frames]):
+            if ack["status"] != 0:
+                raise self._refusal(ack, "load")
+        ack = self.run([(OP_PARAM_COMMIT, struct.pack("<H", crc))])[0]
+        if ack["status"] == NO_LOAD:  # an earlier copy of the commit was applied, its ack lost
+            pass
+        elif ack["status"] != 0:
+            raise self._refusal(ack, "load")
+        after = self._wait_written(self._write_budget())
+        if after["crc"] != crc:
+            raise ParamError(f"the load did not verify: the target's live CRC is 0x{after['crc']:04x}, "
+                             f"the file's 0x{crc:04x}")
+        if after["seq"] == before["seq"]:
+            raise ParamError("the load did not reach the EEPROM: the bank's sequence number did not change")
+        return after

@@ -1,0 +1,93 @@
+"""Parameter files: plain TOML that teams keep next to their project, one
+top-level key per parameter (`MAIN_ALT = 200`). Read with tomllib (the
+standard library's TOML parser); every problem is located at its line and
+column. Written with the range, unit and default of each parameter as
+comments."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+
+from fswkit.autocode.params import AppParam, check_value
+
+
+class ParamFileError(Exception):
+    """A located problem in a parameter file (`path:line:col: message`)."""
+
+
+def _where(text: str, key: str) -> tuple[int, int, int]:
+    """Line, the key's column and the value's column of `key = ...` at the
+    top level ((1, 1, 1) when not found)."""
+    pat = re.compile(rf'^([ \t]*)(?:"{re.escape(key)}"|{re.escape(key)})[ \t]*=[ \t]*', re.M)
+    m = pat.search(text)
+    if m is None:
+        return 1, 1, 1
+    line = text.count("\n", 0, m.start()) + 1
+    bol = text.rfind("\n", 0, m.start()) + 1
+    return line, m.start() + len(m.group(1)) - bol + 1, m.end() - bol + 1
+
+
+def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
+    """{name: checked value} of a parameter file; ParamFileError (located)
+    for a file that is not TOML, a table, an unknown name, a value of the
+    wrong type or out of range."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise ParamFileError(f"{path}: cannot read: {e.strerror or e}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ParamFileError(f"{path}: not UTF-8 text (byte {e.start})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        msg = str(e)
+        m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
+        at = f"{m.group(1)}:{m.group(2)}" if m else "1:1"
+        what = re.sub(r" \(at .*\)$", "", msg)
+        raise ParamFileError(f"{path}:{at}: not valid TOML: {what}") from None
+    by_name = {p.name: p for p in params}
+    out: dict[str, object] = {}
+    problems = []
+    for key, value in doc.items():
+        line, col, vcol = _where(text, key)
+        if isinstance(value, dict):
+            problems.append(f"{path}:{line}:{col}: `{key}` is a table: a parameter file holds one "
+                            "`NAME = value` per parameter, no tables")
+            continue
+        p = by_name.get(key)
+        if p is None:
+            known = ", ".join(by_name) or "none"
+            problems.append(f"{path}:{line}:{col}: unknown parameter `{key}` (the project's parameters: {known})")
+            continue
+        v, why = check_value(p, value)
+        if why is not None:
+            problems.append(f"{path}:{line}:{vcol}: {why}")
+            continue
+        out[key] = v
+    if problems:
+        raise ParamFileError("\n".join(problems))
+    return out
+
+
+def _toml_value(p: AppParam, v) -> str:
+    if p.type.is_bool:
+        return "true" if v else "false"
+    if p.type.is_float:
+        return repr(float(v))  # ranges are finite: no inf or nan here
+    return str(int(v))
+
+
+def params_text(params: tuple[AppParam, ...], values: dict[str, object], title: str) -> str:
+    """A parameter file with every parameter's value, commented."""
+    lines = [f"# {title}", "# fswkit parameter file (docs/parameters.md): NAME = value", ""]
+    for p in params:
+        v = values.get(p.name, p.default)
+        unit = f" {p.unit}" if p.unit else ""
+        lines.append(f"# {p.machine}: {p.type.name}, {p.range_text()}{unit}, default {_toml_value(p, p.default)}, "
+                     f"changes in {' '.join(p.when)}")
+        lines.append(f"{p.name} = {_toml_value(p, v)}")
+    return "\n".join(lines) + "\n"

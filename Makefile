@@ -99,6 +99,7 @@ bench: setup
 	$(PY) tools/bench_busy.py
 	$(PY) tools/bench_study.py
 	$(PY) tools/bench_web.py
+	$(PY) tools/bench_params.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -181,3 +181,33 @@ def bank_image(params, values: dict[str, object], seq: int = 1) -> bytes:
     body = struct.pack("<HI", seq & 0xFFFF, h)
     crc = crc16(body + block)
     return bytes([MAGIC]) + body + struct.pack(">H", crc) + block
+
+
+def valid_banks(params, eeprom: bytes, base: int = 0) -> list[tuple[int, int, bytes]]:
+    """The banks the firmware would take at boot, as (bank, sequence number,
+    value block), newest first: magic, table hash, CRC and every value in
+    its range (fsw_param.cpp's rule, restated for tests and tools)."""
+    size = block_size(params)
+    h = param_hash(params)
+    out = []
+    for b in (0, 1):
+        at = base + b * (HEADER + size)
+        bank = eeprom[at:at + HEADER + size]
+        if len(bank) < HEADER + size or bank[0] != MAGIC:
+            continue
+        seq, th = struct.unpack_from("<HI", bank, 1)
+        if th != h or struct.unpack_from(">H", bank, 7)[0] != crc16(bank[1:7] + bank[HEADER:]):
+            continue
+        block = bank[HEADER:]
+        ok = True
+        for p in params:
+            v = p.unpack(block[p.off:p.off + p.type.size])
+            if p.type.is_bool:
+                ok = ok and block[p.off] <= 1
+            elif not (v == v and p.min <= v <= p.max):
+                ok = False
+        if ok:
+            out.append((b, seq, block))
+    if len(out) == 2 and ((out[1][1] - out[0][1]) & 0xFFFF) not in range(1, 0x8000):
+        return out
+    return list(reversed(out)) if len(out) == 2 else out

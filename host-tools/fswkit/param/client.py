@@ -27,7 +27,11 @@ from fswkit.link import wire
 from fswkit.link.session import Session
 
 RX_CAP = 24  # the target's uplink frame buffer (FSW_LINK_RX_CAP): encoded bytes, delimiter excluded
-RX_WINDOW = 56  # uplink bytes in flight at most: the target's UART receive buffer holds 64
+# uplink bytes in flight at most: the target's UART receive buffer holds 64,
+# and it takes a command off it about every 20 ms (faster than 9,600 baud
+# brings one), so a window a little over the buffer keeps the pipe full
+# without ever overflowing it
+RX_WINDOW = 90
 REPLAY, BUSY, NO_LOAD = 1, 11, 12
 
 
@@ -103,7 +107,7 @@ class SimTransport:
         self.uplink_bytes = 0
 
     def now(self) -> float:
-        return self.board.time()
+        return self.board.time
 
     def send(self, data: bytes) -> None:
         if self.up is not None:
@@ -117,7 +121,7 @@ class SimTransport:
         data = self.board.uart_read()
         if self.down is not None:
             data = self.down(data)
-        return self.session.feed(data, self.board.time()) if data else []
+        return self.session.feed(data, self.board.time) if data else []
 
 
 # ---- the client -------------------------------------------------------------------------
@@ -128,12 +132,14 @@ def _encoded(args: bytes) -> int:
 
 class ParamClient:
     def __init__(self, transport, params: tuple[AppParam, ...], tx_cap: int, timeout: float = 0.5,
-                 deadline: float = 30.0):
+                 deadline: float = 30.0, baud: int = 115200):
         self.t = transport
         self.params = params
         self.tx_cap = tx_cap
-        self.timeout = timeout
+        self.byte_s = 10.0 / baud  # a byte's time on the wire
+        self.timeout = timeout  # the longest wait for an acknowledgement
         self.deadline = deadline
+        self.rtt: float | None = None  # smoothed round trip of acknowledged commands
         self.stats = Stats()
         s = transport.session
         known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
@@ -151,14 +157,25 @@ class ParamClient:
         """Each command sent (several in flight), until each has its
         acknowledgement; the acks in the commands' order. A REPLAY answer
         resynchronises the sequence numbers; BUSY is tried again a little
-        later (when busy_retry); a command unanswered within `timeout` goes
-        again with a new number."""
+        later (when busy_retry); a command unanswered in time goes again with
+        a new number, and an acknowledgement of any of its copies counts."""
         t = self.t
         results: list[dict | None] = [None] * len(cmds)
         queue = deque(range(len(cmds)))
-        inflight: dict[int, tuple[int, float, int]] = {}  # seq -> (command, sent at, bytes)
+        inflight: dict[int, tuple[int, float, int]] = {}  # seq -> (command, sent at, bytes): its latest copy
+        copies: dict[int, int] = {}  # every sequence number sent -> its command
         not_before = 0.0
         start = t.now()
+        resent: set[int] = set()  # commands sent more than once: their round trips are ambiguous
+
+        def service(i: int) -> float:
+            """How long command i keeps the link busy: its frame up, its ack
+            down (a GET's carries values), a cycle of the target's, and room
+            for the telemetry that shares the downlink."""
+            op, args = cmds[i]
+            down = (self.tx_cap if op == OP_PARAM_GET else 24) + 2
+            return 1.5 * (_encoded(args) + 1 + down) * self.byte_s + 0.02
+
         while any(r is None for r in results):
             now = t.now()
             if now - start > self.deadline:
@@ -167,6 +184,9 @@ class ParamClient:
             busy_bytes = sum(b for _, _, b in inflight.values())
             while queue and now >= not_before:
                 i = queue[0]
+                if results[i] is not None:  # answered meanwhile (an earlier copy's ack)
+                    queue.popleft()
+                    continue
                 op, args = cmds[i]
                 size = _encoded(args) + 1
                 if inflight and busy_bytes + size > RX_WINDOW:
@@ -176,31 +196,54 @@ class ParamClient:
                 t.send(wire.uplink(op, seq, args))
                 self.stats.sent += 1
                 inflight[seq] = (i, now, size)
+                copies[seq] = i
                 busy_bytes += size
             for ev in t.events(0.01):
                 if self.on_event is not None:
                     self.on_event(ev)
-                if ev.kind != "ack" or ev.info["cmd_seq"] not in inflight:
+                if ev.kind != "ack" or ev.info["cmd_seq"] not in copies:
                     continue
-                i, _, _ = inflight.pop(ev.info["cmd_seq"])
+                seq = ev.info["cmd_seq"]
+                i = copies.pop(seq)
+                sent = inflight.pop(seq, None)
+                if results[i] is not None:
+                    continue  # another copy was answered already
                 self.stats.acks += 1
+                if sent is not None and i not in resent:  # Karn: only unambiguous samples
+                    rtt = t.now() - sent[1]
+                    self.rtt = rtt if self.rtt is None else 0.8 * self.rtt + 0.2 * rtt
                 st = ev.info["status"]
                 if st == REPLAY:
                     self._seq = (ev.info["last_seq"] + 1) & 0xFFFF
+                    self._drop_copies(inflight, copies, i)
                     queue.appendleft(i)
                 elif st == BUSY and busy_retry:
                     self.stats.busy += 1
+                    self._drop_copies(inflight, copies, i)
                     queue.appendleft(i)
                     not_before = t.now() + 0.02
                 else:
                     results[i] = ev.info
+                    self._drop_copies(inflight, copies, i)
+            # a command waits behind those sent before it: its ack is due after
+            # theirs, plus a margin (a quarter of the round trips measured)
             now = t.now()
-            for seq, (i, sent, _) in list(inflight.items()):
-                if now - sent > self.timeout:
-                    del inflight[seq]
+            margin = 0.06 if self.rtt is None else min(self.timeout, 0.04 + 0.25 * self.rtt)
+            ahead = 0.0
+            for seq, (i, sent, _) in sorted(inflight.items(), key=lambda kv: kv[1][1]):
+                ahead += service(i)
+                if now - sent > ahead + margin:
+                    del inflight[seq]  # its ack still counts if it comes (copies)
                     queue.appendleft(i)
+                    resent.add(i)
                     self.stats.resent += 1
         return results  # type: ignore[return-value]
+
+    @staticmethod
+    def _drop_copies(inflight, copies, i) -> None:
+        for seq in [s for s, c in copies.items() if c == i]:
+            del copies[seq]
+            inflight.pop(seq, None)
 
     # ---- the operations --------------------------------------------------------------
 
@@ -307,7 +350,6 @@ class ParamClient:
             current = self.get_all()
         block = b"".join(p.pack(values.get(p.name, current[p.name])) for p in self.params)
         crc = crc16(block)
-        before = self.info()
         ack = self.run([(OP_PARAM_BEGIN, b"")])[0]
         if ack["status"] != 0:
             raise self._refusal(ack, "load")
@@ -332,6 +374,7 @@ class ParamClient:
         if after["crc"] != crc:
             raise ParamError(f"the load did not verify: the target's live CRC is 0x{after['crc']:04x}, "
                              f"the file's 0x{crc:04x}")
-        if after["seq"] == before["seq"]:
-            raise ParamError("the load did not reach the EEPROM: the bank's sequence number did not change")
+        if after["dirty"] or after["source"] not in (2, 3):
+            raise ParamError("the load did not reach the EEPROM: the target reports "
+                             f"{after['source_name']}{' with unsaved changes' if after['dirty'] else ''}")
         return after

@@ -631,6 +631,31 @@ class SimBoard:
         """`count` bytes of the MCU's data space (registers, I/O, RAM)."""
         return bytes.fromhex(self.command(f"peek {int(address)} {int(count)}")[3:])
 
+    # -- EEPROM (kept across resets) --
+    def eeprom_read(self, address: int, count: int) -> bytes:
+        """`count` bytes of the EEPROM from `address`."""
+        out = b""
+        for a in range(address, address + count, 1024):
+            n = min(1024, address + count - a)
+            out += bytes.fromhex(self.command(f"eeprom read {int(a)} {int(n)}")[3:])
+        return out
+
+    def eeprom_write(self, address: int, data: bytes) -> None:
+        """Writes EEPROM bytes as a programmer would (no write time, no count)."""
+        for i in range(0, len(data), 1024):
+            self.command(f"eeprom write {int(address + i)} {data[i:i + 1024].hex()}")
+
+    def eeprom_cut(self, writes: int) -> None:
+        """A power cut right after the firmware's `writes`-th EEPROM byte
+        write from now: the MCU resets there, the EEPROM keeps what was
+        written."""
+        self.command(f"eeprom cut {int(writes)}")
+
+    def eeprom_count(self) -> tuple[int, int]:
+        """(EEPROM byte writes the firmware started, power cuts made)."""
+        f = dict(t.split("=") for t in self.command("eeprom count").split()[1:])
+        return int(f["writes"]), int(f["cuts"])
+
     def symbol(self, name: str) -> tuple[int, int]:
         """(data address, size) of a variable of the firmware, by its
         (demangled) name, from the ELF's symbol table."""

@@ -34,6 +34,7 @@
    file serves the pty from the simulation loop instead. */
 #define _GNU_SOURCE
 #include <simavr/avr_adc.h>
+#include <simavr/avr_eeprom.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
@@ -469,6 +470,33 @@ static const char* state_name(int st) {
     }
 }
 
+/* The EEPROM: simavr's EEPROM module keeps the bytes (across resets); the
+   harness counts the byte writes the firmware starts (EECR with EEPE set)
+   and, when asked, pulses reset right after the Nth of them: a power cut at
+   that byte (`eeprom cut N`). */
+#define EECR_ADDR 0x3F /* data-space address of EECR on the ATmega328P and ATmega2560 */
+static unsigned long long ee_writes, ee_resets, ee_cut_at;
+static int ee_cut_armed;
+static volatile int ee_cut_now;
+
+static void on_eecr_write(struct avr_t* a, avr_io_addr_t addr, uint8_t v, void* param) {
+    (void)a, (void)addr, (void)param;
+    if (!(v & 0x02)) return; /* EEPE: a write starts */
+    ee_writes++;
+    if (ee_cut_armed && ee_writes >= ee_cut_at) {
+        ee_cut_armed = 0;
+        ee_cut_now = 1;
+    }
+}
+
+static void ee_power_cut(avr_t* a) {
+    ee_cut_now = 0;
+    avr_cycle_count_t cycle = a->cycle;
+    avr_reset(a);
+    a->cycle = cycle;
+    ee_resets++;
+}
+
 /* Runs until cycle `target` (when has_target), a limit, the firmware
    stopping, SIGINT, or (watch_input) a command arriving on the control
    channel. Returns why it stopped. */
@@ -495,6 +523,7 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
             const avr_cycle_count_t c0 = a->cycle;
             const int slept = a->state == cpu_Sleeping;
             int st = avr_run(a);
+            if (__builtin_expect(ee_cut_now, 0)) ee_power_cut(a);
             if (prof_n) prof_step(a, c0, slept);
             if (st == cpu_Done || st == cpu_Crashed) {
                 halted = 1;
@@ -777,6 +806,58 @@ static int cmd_peek(int argc, char** argv) {
     return 1;
 }
 
+/* `eeprom read ADDR COUNT` (hex), `eeprom write ADDR HEX`, `eeprom cut N`
+   (reset right after the Nth byte write from now), `eeprom count` (writes
+   started, cuts made). */
+static int cmd_eeprom(int argc, char** argv) {
+    static const char usage[] = "usage: eeprom read ADDR COUNT | eeprom write ADDR HEX | eeprom cut N | eeprom count";
+    unsigned long long a = 0, b = 0;
+    avr_eeprom_desc_t d;
+    if (argc == 2 && !strcmp(argv[1], "count")) {
+        fprintf(proto, "ok writes=%llu cuts=%llu armed=%d\n", ee_writes, ee_resets, ee_cut_armed);
+        return 1;
+    }
+    if (argc == 3 && !strcmp(argv[1], "cut")) {
+        if (parse_u64(argv[2], &a) || a == 0) return fail("eeprom cut N: N >= 1 writes from now");
+        ee_cut_at = ee_writes + a;
+        ee_cut_armed = 1;
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (argc == 4 && (!strcmp(argv[1], "read") || !strcmp(argv[1], "write"))) {
+        /* simavr's EEPROM module lends its bytes (GET with no buffer; its
+           return value says nothing on some versions: the pointer does) */
+        d.ee = NULL;
+        d.offset = 0;
+        d.size = avr->e2end + 1;
+        avr_ioctl(avr, AVR_IOCTL_EEPROM_GET, &d);
+        if (!d.ee) return fail("eeprom: this MCU has none");
+        const unsigned long long size = (unsigned long long)avr->e2end + 1;
+        if (!strcmp(argv[1], "read")) {
+            if (parse_u64(argv[2], &a) || parse_u64(argv[3], &b) || b > MAX_PEEK || a + b > size)
+                return fail("eeprom read ADDR COUNT: within 0-0x%x, at most %d bytes", (unsigned)avr->e2end, MAX_PEEK);
+            fprintf(proto, "ok ");
+            hex_out(d.ee + a, (size_t)b);
+            fprintf(proto, "\n");
+            return 1;
+        }
+        bytes_t data = {0};
+        if (parse_u64(argv[2], &a) || hex_in(argv[3], &data)) {
+            free(data.buf);
+            return fail("eeprom write ADDR HEX: an address and an even number of hex digits");
+        }
+        if (a + data.len > size) {
+            free(data.buf);
+            return fail("eeprom write: beyond the EEPROM's %llu bytes", size);
+        }
+        if (data.len) memcpy(d.ee + a, data.buf, data.len);
+        free(data.buf);
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    return fail("%s", usage);
+}
+
 static int cmd_info(int argc, char** argv) {
     NO_ARGS;
     fprintf(proto, "ok proto=%d mcu=%s f_cpu=%u cycle=%llu time=%.9f state=%s uart=%s", PROTO_VERSION, mcu_name,
@@ -852,7 +933,7 @@ static const struct {
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
     {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
-    {"quit", cmd_quit},
+    {"eeprom", cmd_eeprom}, {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 
@@ -1015,6 +1096,7 @@ int main(int argc, char** argv) {
     snprintf(fw.mmcu, sizeof fw.mmcu, "%s", mcu_name);
     fw.frequency = f_cpu;
     avr_load_firmware(avr, &fw);
+    avr_register_io_write(avr, EECR_ADDR, on_eecr_write, NULL); /* after the EEPROM module's own */
     avr->frequency = f_cpu;
     avr->vcc = avr->avcc = avr->aref = 5000; /* millivolts: the Arduino boards' 5 V supply and reference */
     for (int ch = 0; ch < 16; ch++)

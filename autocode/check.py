@@ -887,9 +887,65 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         err(last, 1, "the state script has no `@stop`: it would never end")
     if diags.error_count != before:
         return None
+    values = _script_params(f, m, err)
+    if diags.error_count != before:
+        return None
+    if values:  # the run sees the script's parameter values, as a loaded file would give them
+        from .params import machine_with_values
+        m = machine_with_values(m, values)
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
                     tuple(sections), tuple(windows), tuple(idle_guards))
+
+
+def _script_params(f: S.SsFile, m: M.Machine, err) -> dict:
+    """A script's `[parameters]` values, checked (a parameter of the
+    machine, a constant of its type, in its range)."""
+    from .params import check_value, var_param
+
+    out: dict = {}
+    seen: dict[str, int] = {}
+    for sp in f.params:
+        v = m.var(sp.name)
+        if v is None or v.param is None:
+            names = ", ".join(x.name for x in m.vars if x.param is not None) or "none"
+            err(sp.line, sp.col, f"`{sp.name}` is not a parameter of machine `{m.name}` (its parameters: {names})")
+            continue
+        if sp.name in seen:
+            err(sp.line, sp.col, f"parameter `{sp.name}` given twice (previously on line {seen[sp.name]})")
+            continue
+        seen[sp.name] = sp.line
+        try:
+            x = evaluate(_const_of(sp.expr), F64MODE, _no_var)
+        except NotConstant:
+            err(sp.line, sp.expr_col, f"the value of `{sp.name}` must be a number or true/false")
+            continue
+        if v.type.is_bool and x not in (0.0, 1.0):
+            err(sp.line, sp.expr_col, f"`{sp.name}` is bool: give true or false")
+            continue
+        value = (x != 0) if v.type.is_bool else (int(x) if v.type.is_int and x == int(x) else x)
+        value, why = check_value(var_param(m, v), value)
+        if why is not None:
+            err(sp.line, sp.expr_col, why)
+            continue
+        out[sp.name] = value
+    return out
+
+
+def _no_var(i):
+    raise NotConstant(None)
+
+
+def _const_of(e: S.Expr) -> M.Expr:
+    """A literal, a negated literal or true/false as a model expression;
+    NotConstant for anything else."""
+    if isinstance(e, S.Num):
+        return M.Const(e.text, e.line, e.col)
+    if isinstance(e, S.Bool):
+        return M.Const("true" if e.value else "false", e.line, e.col)
+    if isinstance(e, S.Unary) and e.op == "-" and isinstance(e.operand, S.Num):
+        return M.Neg(M.Const(e.operand.text, e.line, e.col), e.line, e.col)
+    raise NotConstant(None)
 
 
 def failure_diagnostics(script: M.Script, source_line) -> dict:

@@ -211,3 +211,45 @@ def valid_banks(params, eeprom: bytes, base: int = 0) -> list[tuple[int, int, by
     if len(out) == 2 and ((out[1][1] - out[0][1]) & 0xFFFF) not in range(1, 0x8000):
         return out
     return list(reversed(out)) if len(out) == 2 else out
+
+
+def _const_expr(v, line: int, col: int):
+    from . import model as Mo
+
+    if isinstance(v, bool):
+        return Mo.Const("true" if v else "false", line, col)
+    text = repr(float(v)) if isinstance(v, float) else str(int(v))
+    if text.startswith("-"):
+        return Mo.Neg(Mo.Const(text[1:], line, col), line, col)
+    return Mo.Const(text, line, col)
+
+
+def machine_with_values(m, values: dict[str, object]):
+    """The machine with these parameters' defaults replaced by `values` (by
+    name; checked values): what the host runs (a state script with
+    overrides, a plant or tape run with a parameter file) sees them as the
+    firmware would after loading them."""
+    import dataclasses
+
+    if not any(v.param is not None and v.name in values for v in m.vars):
+        return m
+    new_vars = tuple(dataclasses.replace(v, init=_const_expr(values[v.name], v.line, 1))
+                     if v.param is not None and v.name in values else v for v in m.vars)
+    return dataclasses.replace(m, vars=new_vars)
+
+
+def app_with_values(app, values: dict[str, object]):
+    """The application with its parameters' defaults replaced by `values`."""
+    import dataclasses
+
+    if not values:
+        return app
+    return dataclasses.replace(app, machines=tuple(machine_with_values(m, values) for m in app.machines))
+
+
+def var_param(m, v) -> AppParam:
+    """One machine's parameter as a table row (id -1: outside an
+    application), for checking a value given for it."""
+    names = {st.id: st.name for st in m.states}
+    return AppParam(-1, v.name, m.name, v.type, None, v.param.min, v.param.max, v.param.unit,
+                    tuple(names[i] for i in v.param.when), v.param.when, 0, m.vars[m.s].name, v.index, v.line, m.path)

@@ -821,12 +821,41 @@ def parse_ss(src: Source, diags: Diagnostics) -> S.SsFile:
         diags.error(src, lang, t.line, t.col, f"unexpected {show(t)} before the first section")
     options: list[S.Option] = []
     out: list[S.ScriptSection] = []
+    params: list[S.ScriptParam] = []
     for header, body in sections:
         if header.name == "options":
             options.extend(_options(body))
+        elif header.name == "parameters":
+            for toks in body:
+                sp = _script_param(toks, src, diags, lang)
+                if sp is not None:
+                    params.append(sp)
         elif header.name == "<malformed>":
             continue
         else:
             p = Parser(stream(body), src, diags, lang)
             out.append(S.ScriptSection(header, p.ss_statements()))
-    return S.SsFile(src.path, tuple(options), tuple(out))
+    return S.SsFile(src.path, tuple(options), tuple(out), tuple(params))
+
+
+def _script_param(toks: list[Tok], src, diags, lang) -> S.ScriptParam | None:
+    """`NAME = value` in a script's `[parameters]` section."""
+    t = toks[0]
+    if t.kind != ID:
+        diags.error(src, lang, t.line, t.col, f"expected a parameter name, found {show(t)}")
+        return None
+    if len(toks) < 3 or not (toks[1].kind == OP and toks[1].text == "="):
+        found = show(toks[1]) if len(toks) > 1 else "end of line"
+        col = toks[1].col if len(toks) > 1 else t.col + len(t.text)
+        diags.error(src, lang, t.line, col, f"expected `= value` after `{t.text}`, found {found}")
+        return None
+    p = _line_parser(toks[2:], src, diags, lang)
+    try:
+        e = p.expression()
+        if not p.at_end():
+            x = p.peek()
+            raise ParseError(x, f"unexpected {show(x)} after the value")
+    except ParseError as err:
+        p.report(err)
+        return None
+    return S.ScriptParam(t.line, t.col, t.text, e, toks[2].col)

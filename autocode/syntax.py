@@ -240,7 +240,18 @@ class ScriptSection:
 
 
 @dataclass(frozen=True)
+class ScriptParam:
+    """A script's `[parameters]` line: `NAME = value`."""
+    line: int
+    col: int
+    name: str
+    expr: Expr
+    expr_col: int
+
+
+@dataclass(frozen=True)
 class SsFile:
     path: str
     options: tuple[Option, ...]
     sections: tuple[ScriptSection, ...]
+    params: tuple[ScriptParam, ...] = ()

@@ -365,7 +365,8 @@ def _link(app: Application) -> list[str]:
     c.append(f"    sv, {'kLinkStreams' if plan.streams else '0'}, {'link_streams' if plan.streams else '0'}, "
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
-             f"{plan.hello_every}, {up}, kSvLock{', &params' if app_parameters(app) else ''}}};")
+             f"{plan.hello_every}, {up}, kSvLock"
+             f"{', &params, fsw::link_param_apply, fsw::link_param_ack' if app_parameters(app) else ''}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")

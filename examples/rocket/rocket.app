@@ -34,5 +34,5 @@ Outputs  rate=10
 abortCmd
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 12288            # measured high-water mark to the RAM
-ram   1024
+flash 18432            # measured high-water mark to the RAM
+ram   1152

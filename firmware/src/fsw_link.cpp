@@ -126,41 +126,6 @@ void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, u
     send_batch(l, c, s, st, i, true);
 }
 
-// What a parameter command's ack carries after its 6 bytes: GET's values
-// (first id, count, values: as many as the transmit buffer holds), INFO's
-// store state, the id a refusal stopped at.
-FSW_NOINLINE void put_param_data(Link& l, const LinkConfig& c) {
-    const ParamStore& ps = *c.params;
-    const uint8_t op = l.ack_op;
-    if (l.ack_status == kAckOk && op == kOpParamGet) {
-        // room for values: the frame (header, ack, first, count, CRC) and its
-        // COBS overhead within the transmit buffer
-        uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
-        uint8_t n = 0;
-        uint8_t v[8];
-        while (n < l.ack_y && param_value(ps, static_cast<uint8_t>(l.ack_x + n), v) != 0) {
-            const uint8_t size = param_value(ps, static_cast<uint8_t>(l.ack_x + n), v);
-            if (size > room) break;
-            room = static_cast<uint16_t>(room - size);
-            ++n;
-        }
-        put(l.ack_x);
-        put(n);
-        for (uint8_t i = 0; i < n; ++i) put_bytes(v, param_value(ps, static_cast<uint8_t>(l.ack_x + i), v));
-    } else if (l.ack_status == kAckOk && op == kOpParamInfo) {
-        put(ps.source);
-        put_u16(ps.seq);
-        put_u16(param_crc(ps));
-        put(param_count(ps));
-        ParamConfig pc;
-        flash_read(&pc, ps.cfg, sizeof pc);
-        put_u32(pc.hash);
-    } else if (l.ack_status != kAckOk && l.ack_x != 0xFF &&
-               (op == kOpParamSet || op == kOpParamStage || op == kOpParamCommit)) {
-        put(l.ack_x);
-    }
-}
-
 // One control frame: `type` is kFrameAck, kFrameHello, kFrameHealth or
 // kFrameSnapshot.
 FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
@@ -172,7 +137,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
         put_u16(l.n.last_seq);
-        if (c.params != 0) put_param_data(l, c);
+        if (c.params != 0 && c.param_ack != 0) c.param_ack(l, *c.params);
     } else if (type == kFrameHello) {
         put(kLinkProtocol);
         put_u32(c.schema);
@@ -279,35 +244,11 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
     return kAckNotWritable;
 }
 
-// A parameter command (kOpParamGet..kOpParamInfo) on the store.
-FSW_NOINLINE uint8_t apply_param(Link& l, ParamStore& ps, uint8_t op, const uint8_t* a, uint8_t alen) {
-    uint8_t bad = 0xFF;
-    uint8_t st;
-    if (op == kOpParamSet || op == kOpParamStage) {
-        st = op == kOpParamSet ? param_set(ps, a, alen, bad) : param_stage(ps, a, alen, bad);
-    } else if (op == kOpParamGet) {
-        if (alen != 2) return kAckBadLength;
-        l.ack_x = a[0];
-        l.ack_y = a[1];
-        return a[0] < param_count(ps) ? static_cast<uint8_t>(kAckOk) : static_cast<uint8_t>(kParamNoParam);
-    } else if (op == kOpParamCommit) {
-        if (alen != 2) return kAckBadLength;
-        st = param_commit(ps, load<uint16_t>(a), bad);
-    } else {
-        if (alen != 0) return kAckBadLength;
-        st = op == kOpParamSave    ? param_save(ps)
-             : op == kOpParamBegin ? param_load_begin(ps)
-                                   : static_cast<uint8_t>(kAckOk);
-    }
-    l.ack_x = bad;
-    return st;
-}
-
 FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
     if (op == kOpSet) return apply_set(c, a, alen);
     if (op >= kOpParamGet && op <= kOpParamInfo) {
-        if (c.params == 0) return kAckUnknownOp;
-        return apply_param(l, *c.params, op, a, alen);
+        if (c.params == 0 || c.param_apply == 0) return kAckUnknownOp;
+        return c.param_apply(l, *c.params, op, a, alen);
     }
     if (op == kOpMode) {
         if (alen != 2) return kAckBadLength;
@@ -443,6 +384,66 @@ void link_poll(Link& l) {
     LinkConfig c;
     read_config(l, c);
     service(l, c);
+}
+
+// What a parameter command's ack carries after its 6 bytes: GET's values
+// (first id, count, values: as many as the transmit buffer holds), INFO's
+// store state, the id a refusal stopped at.
+void link_param_ack(Link& l, const ParamStore& ps) {
+    LinkConfig c;
+    read_config(l, c);
+    const uint8_t op = l.ack_op;
+    if (l.ack_status == kAckOk && op == kOpParamGet) {
+        // room for values: the frame (header, ack, first, count, CRC) and its
+        // COBS overhead within the transmit buffer
+        uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
+        uint8_t n = 0;
+        uint8_t v[8];
+        while (n < l.ack_y && param_value(ps, static_cast<uint8_t>(l.ack_x + n), v) != 0) {
+            const uint8_t size = param_value(ps, static_cast<uint8_t>(l.ack_x + n), v);
+            if (size > room) break;
+            room = static_cast<uint16_t>(room - size);
+            ++n;
+        }
+        put(l.ack_x);
+        put(n);
+        for (uint8_t i = 0; i < n; ++i) put_bytes(v, param_value(ps, static_cast<uint8_t>(l.ack_x + i), v));
+    } else if (l.ack_status == kAckOk && op == kOpParamInfo) {
+        put(ps.source);
+        put_u16(ps.seq);
+        put_u16(param_crc(ps));
+        put(param_count(ps));
+        ParamConfig pc;
+        flash_read(&pc, ps.cfg, sizeof pc);
+        put_u32(pc.hash);
+    } else if (l.ack_status != kAckOk && l.ack_x != 0xFF &&
+               (op == kOpParamSet || op == kOpParamStage || op == kOpParamCommit)) {
+        put(l.ack_x);
+    }
+}
+
+// A parameter command (kOpParamGet..kOpParamInfo) on the store.
+uint8_t link_param_apply(Link& l, ParamStore& ps, uint8_t op, const uint8_t* a, uint8_t alen) {
+    uint8_t bad = 0xFF;
+    uint8_t st;
+    if (op == kOpParamSet || op == kOpParamStage) {
+        st = op == kOpParamSet ? param_set(ps, a, alen, bad) : param_stage(ps, a, alen, bad);
+    } else if (op == kOpParamGet) {
+        if (alen != 2) return kAckBadLength;
+        l.ack_x = a[0];
+        l.ack_y = a[1];
+        return a[0] < param_count(ps) ? static_cast<uint8_t>(kAckOk) : static_cast<uint8_t>(kParamNoParam);
+    } else if (op == kOpParamCommit) {
+        if (alen != 2) return kAckBadLength;
+        st = param_commit(ps, load<uint16_t>(a), bad);
+    } else {
+        if (alen != 0) return kAckBadLength;
+        st = op == kOpParamSave    ? param_save(ps)
+             : op == kOpParamBegin ? param_load_begin(ps)
+                                   : static_cast<uint8_t>(kAckOk);
+    }
+    l.ack_x = bad;
+    return st;
 }
 
 }  // namespace fsw

@@ -89,6 +89,13 @@ struct LinkWritable {
 
 typedef uint64_t (*LinkClockFn)();
 
+struct Link;
+// The parameter commands (docs/parameters.md), reached through the
+// configuration so that a link without parameters links none of their code:
+// generated code passes link_param_apply and link_param_ack (below).
+typedef uint8_t (*LinkParamApplyFn)(Link& link, ParamStore& store, uint8_t op, const uint8_t* args, uint8_t len);
+typedef void (*LinkParamAckFn)(Link& link, const ParamStore& store);
+
 // The link's configuration: constant data generated from the application
 // config (FSW_FLASH), pointing at the RAM it works in.
 struct LinkConfig {
@@ -110,6 +117,8 @@ struct LinkConfig {
     uint8_t uplink_task;              // index of the uplink task (0xFF: none)
     bool lock;                        // state vector `lock` option
     ParamStore* params;               // the parameter store (null: no parameters; docs/parameters.md)
+    LinkParamApplyFn param_apply;     // link_param_apply, with a store
+    LinkParamAckFn param_ack;         // link_param_ack, with a store
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -159,6 +168,11 @@ Result link_uplink_task(void* link);
 // From loop(), between cycles: sends waiting control frames and feeds the
 // transmit buffer to the console as it drains.
 void link_poll(Link& link);
+// A parameter command (kOpParamGet..kOpParamInfo) on the store, and what its
+// acknowledgement carries after its 6 bytes (GET's values, INFO's state,
+// the id a refusal stopped at).
+uint8_t link_param_apply(Link& link, ParamStore& store, uint8_t op, const uint8_t* args, uint8_t len);
+void link_param_ack(Link& link, const ParamStore& store);
 
 // ---- compile-time checks of the tables -------------------------------------
 // The generator emits a static_assert of each for its tables; a hand-written

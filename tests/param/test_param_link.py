@@ -161,3 +161,43 @@ def test_a_bad_file_is_refused_with_its_place_before_the_port_opens(text, where,
     assert r.code == 2, r.err
     assert f"{f}:{where}:" in r.err and what in r.err, r.err
     assert "Traceback" not in r.err
+
+
+def test_a_script_runs_with_its_parameters_and_param_overrides_them():
+    """vent.ss sets OPEN_AT = 600 and HOLD_MS = 100: the valve opens at
+    610 psi after 100 ms in Armed. --param OPEN_AT=650 keeps it shut (the
+    script's assertion fails), in the interpreter and natively alike."""
+    script = str(RIG / "vent.ss")
+    r = run_fsw("test", script)
+    assert r.code == 0, r.out + r.err
+    for native in ((), ("--native",)):
+        r = run_fsw("test", script, "--param", "OPEN_AT=650", *native)
+        assert r.code == 1 and "valve = false" in r.out, r.out + r.err
+    r = run_fsw("test", script, "--param", "OPEN_AT=650", "--param", "TRIM=45")  # 610 + 45 > 650
+    assert r.code == 0, r.out + r.err
+    r = run_fsw("test", script, "--param", "OPEN_AT=5000")
+    assert r.code == 2 and "outside its range 100..900 psi" in r.err
+    r = run_fsw("test", script, "--param", "SPEED=3")
+    assert r.code == 2 and "not a parameter of machine `tuned`" in r.err
+
+
+def test_fsw_sim_flies_one_image_with_another_parameter_file(tmp_path):
+    """--fw-params programs the file's values into the simulated board's
+    EEPROM before boot: the rocket's main fires at the file's MAIN_ALT, and
+    the flight's checks judge it against that altitude."""
+    import shutil
+
+    if shutil.which("avr-g++") is None:
+        pytest.skip("gcc-avr is needed (make setup)")
+    from conftest import EXAMPLES
+
+    f = tmp_path / "field.toml"
+    f.write_text("MAIN_ALT = 250\n")
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--seed", "1", "--fw-params", str(f),
+                "--out", str(tmp_path / "flight"))
+    assert r.code == 0, r.out + r.err
+    assert "main fired within ±15 m of MAIN_ALT = 250 m" in r.out, r.out
+    f.write_text("MAIN_ALT = 5\n")
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--fw-params", str(f),
+                "--out", str(tmp_path / "flight2"))
+    assert r.code == 2 and f"{f}:1:12: `MAIN_ALT` = 5 is outside its range 30..3000 m" in r.err, r.err

@@ -128,6 +128,35 @@ def cmd_test(args) -> int:
     return EXIT_FAIL if EXIT_FAIL in codes or incomplete else EXIT_OK
 
 
+def _with_params(script, given: list[str]):
+    """The script run with `--param NAME=VALUE` values (checked against the
+    machine's parameters), or None after a message."""
+    import dataclasses
+
+    from fswkit.autocode.params import check_value, machine_with_values, var_param
+
+    m = script.machine
+    values = {}
+    for g in given:
+        name, eq, text = g.partition("=")
+        name = name.strip()
+        v = m.var(name) if eq else None
+        if not eq:
+            sys.stderr.write(f"fsw test: --param {g}: expected NAME=VALUE\n")
+            return None
+        if v is None or v.param is None:
+            names = ", ".join(x.name for x in m.vars if x.param is not None) or "none"
+            sys.stderr.write(f"fsw test: --param {g}: `{name}` is not a parameter of machine `{m.name}` "
+                             f"(its parameters: {names})\n")
+            return None
+        value, why = check_value(var_param(m, v), text)
+        if why is not None:
+            sys.stderr.write(f"fsw test: --param {g}: {why}\n")
+            return None
+        values[name] = value
+    return dataclasses.replace(script, machine=machine_with_values(m, values))
+
+
 def _test_one(path: str, args, real):
     """Runs one script; (exit code, (machine, result) for coverage or None)."""
     from fswkit.autocode.project import load_script, source_of
@@ -139,6 +168,10 @@ def _test_one(path: str, args, real):
         print_diags(diags)
         return EXIT_CONFIG, None
     print_diags(diags)  # warnings only
+    if args.param:
+        script = _with_params(script, args.param)
+        if script is None:
+            return EXIT_CONFIG, None
     sources: dict[str, object] = {}
 
     def line_of(p: str, n: int) -> str:

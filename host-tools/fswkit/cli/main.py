@@ -112,6 +112,9 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
     t.add_argument("--coverage", action="store_true",
                    help="report the states and transitions the scripts never reached, and fail if any")
+    t.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="run with this parameter value (docs/parameters.md); overrides the script's [parameters]; "
+                        "repeatable")
     t.set_defaults(func=_command("front", "cmd_test"))
 
     g = sub.add_parser("graph", help="a machine as Graphviz DOT or Mermaid")
@@ -149,6 +152,9 @@ def parser() -> argparse.ArgumentParser:
                     help="fly the firmware in closed loop against this plant model (docs/sim.md)")
     sm.add_argument("--params", metavar="FILE.toml", help="with --plant: the plant's parameters "
                     "(default PROJECT/plant.toml)")
+    sm.add_argument("--fw-params", metavar="FILE.toml", help="the firmware's parameters (docs/parameters.md): the "
+                    "file's values are programmed into the board's EEPROM before boot, so one image flies another "
+                    "rocket (--params names the plant's or the tape's config)")
     sm.add_argument("--seed", type=_nonneg_int, metavar="N", help="with --plant: the sensor noise's seed; with "
                     "--tape --perturb: the perturbations' seed (default 1)")
     sm.add_argument("--tape", metavar="FLIGHT.csv", help="replay a real flight's sensor tape through the firmware, "

@@ -14,6 +14,10 @@ from fswkit.cli.common import EXIT_CONFIG, flown, folder_and_firmware
 
 def cmd_sim(args) -> int:
     if any(getattr(args, k, None) is not None for k in ("runs", "run", "dispersion")):
+        if getattr(args, "fw_params", None) is not None:
+            sys.stderr.write("fsw sim: --fw-params flies one firmware's parameters; a study draws its own "
+                             "flights (not with --runs, --run or --dispersion)\n")
+            return EXIT_CONFIG
         if getattr(args, "tape", None) is not None or getattr(args, "perturb", None) is not None:
             sys.stderr.write("fsw sim: --runs, --run and --dispersion fly the rocket plant, not a --tape\n")
             return EXIT_CONFIG
@@ -30,6 +34,24 @@ def cmd_sim(args) -> int:
         sys.stderr.write("fsw sim: --params, --seed and --fault need --plant rocket|tank\n")
         return EXIT_CONFIG
     return board_run(args)
+
+
+def _fw_image(args):
+    """The EEPROM image of `--fw-params` for the project, or 2 after a message."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.plant.run import SetupError, firmware_params
+    from fswkit.target.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags, args.board)
+        if app is None:
+            sys.stderr.write(diags.render() + "\n")
+            return 2
+        return firmware_params(app, args.fw_params)[1]
+    except (BuildError, SetupError) as e:
+        sys.stderr.write(f"fsw sim: {e}\n")
+        return 2
 
 
 def board_run(args) -> int:
@@ -59,12 +81,20 @@ def board_run(args) -> int:
         if isinstance(built, int):
             return built
         elf, board = built
+    image = None
+    if args.fw_params is not None:
+        if is_elf(args.project) or args.project.endswith(".elf"):
+            say("--fw-params needs the project (its parameters' table), not a firmware ELF")
+            return 2
+        image = _fw_image(args)
+        if isinstance(image, int):
+            return image
     analog = analog_args(args.analog or [], board)
     if isinstance(analog, str):
         say(analog)
         return 2
     try:
-        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link)
+        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link, eeprom=image)
     except SimError as e:
         say(str(e))
         return 1
@@ -120,7 +150,7 @@ def plant_run(args) -> int:
     try:
         seed = 1 if args.seed is None else args.seed
         app, layout, sc = prepare(args.project, args.plant, params=args.params, seed=seed, fault=args.fault,
-                                  board=args.board)
+                                  board=args.board, fw_params=args.fw_params)
     except SetupError as e:
         for line in str(e).splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
@@ -173,9 +203,19 @@ def tape_run(args) -> int:
     if app is None:
         sys.stderr.write(diags.render() + "\n")
         return 2
+    image = None
+    if args.fw_params is not None:
+        from fswkit.plant.run import SetupError, firmware_params
+
+        try:
+            app, image = firmware_params(app, args.fw_params)
+        except SetupError as e:
+            sys.stderr.write(f"fsw sim: {e}\n")
+            return 2
     try:
         layout = from_app(app)
         cfg = tr.load_config(app, layout, args.params)
+        cfg.eeprom = image
         tape, truth = tr.load_tape(args.tape, cfg)
     except (LayoutError, tr.ReplayError) as e:
         for line in str(e).splitlines():

@@ -167,6 +167,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
     telemetry = Telemetry(run, layout, scenario.state_element, log)
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
+                     eeprom=getattr(scenario, "eeprom", None),
                      analog=analog)
     except SimError as e:
         if log:

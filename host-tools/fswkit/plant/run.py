@@ -47,9 +47,11 @@ def _say(text: str) -> None:
 
 
 def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 1, fault: str | None = None,
-            board: str | None = None):
+            board: str | None = None, fw_params: str | None = None):
     """(app, layout, scenario) for a project folder and its parameters
-    file; SetupError with located messages for bad input."""
+    file; SetupError with located messages for bad input. `fw_params`: a
+    file of the firmware's parameters (docs/parameters.md), programmed into
+    the board's EEPROM before boot; the checks see its values."""
     from fswkit.target.build import BuildError, load
     from fswkit.link.layout import LayoutError, from_app
 
@@ -64,6 +66,9 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
         raise SetupError(str(e)) from None
     if app is None:
         raise SetupError(diags.render())
+    image = None
+    if fw_params is not None:
+        app, image = firmware_params(app, fw_params)
     try:
         layout = from_app(app)
     except LayoutError as e:
@@ -74,7 +79,25 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
         sc = load_scenario(plant, params, app, layout, seed, fault)
     except ParamsError as e:
         raise SetupError("\n".join(e.errors)) from None
+    sc.eeprom = image
     return app, layout, sc
+
+
+def firmware_params(app, path: str):
+    """(the application as it runs with the parameter file at `path`, the
+    EEPROM image that makes the firmware boot with it: its bank A);
+    SetupError for a project without parameters or a bad file."""
+    from fswkit.autocode.params import app_parameters, app_with_values, bank_image
+    from fswkit.param.files import ParamFileError, read_params
+
+    params = app_parameters(app)
+    if not params:
+        raise SetupError(f"--fw-params {path}: the application declares no parameters")
+    try:
+        values = read_params(path, params)
+    except ParamFileError as e:
+        raise SetupError(str(e)) from None
+    return app_with_values(app, values), bank_image(params, values, seq=1)
 
 
 def budget_checks(app, elf: str, run: Run) -> list[reports.Check]:

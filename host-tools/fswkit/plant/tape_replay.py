@@ -156,6 +156,7 @@ class Config:
     main_alt_name: str
     checks: dict
     notes: list = field(default_factory=list)
+    eeprom: bytes | None = None  # the EEPROM programmed before boot (fsw sim --fw-params)
 
 
 class _Origins(_Binder):
@@ -483,7 +484,8 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     telemetry = Telemetry(run, layout, cfg.state_element, log, offset)
     initial = {pin: series[0] / 1000.0 for pin, series in mv.items()}
     try:
-        b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial)
+        b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial,
+                     eeprom=cfg.eeprom)
     except SimError as e:
         if log:
             log.close()

@@ -341,7 +341,8 @@ class SimBoard:
 
     def __init__(self, elf: str, board: str | Board = "uno", *, uart: str = "control",
                  sim_limit: float | None = None, wall_limit: float | None = None,
-                 analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None):
+                 analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None,
+                 eeprom: bytes | None = None):
         self.board = sim_board(board)
         self.mcu = self.board.raw["sim"]["simavr_mcu"]
         self.f_cpu = int(f_cpu or self.board.f_cpu)
@@ -383,6 +384,8 @@ class SimBoard:
             raise
         self.port: str | None = f.get("port")
         self.cycle = 0
+        if eeprom:  # programmed before the firmware's first instruction (fsw sim --fw-params)
+            self.eeprom_write(0, eeprom)
 
     # -- plumbing --
     def _stderr(self) -> str:

@@ -1,0 +1,9 @@
+[options]
+delta_t 10
+
+[parameters]
+OPEN_AT = 300
+OPEN_AT = 400
+
+[all_states]
+G == 100: @stop

@@ -18,14 +18,14 @@ def test_a_budgeted_project_loads_for_the_native_board():
     app = load_app(str(EXAMPLES / "rocket" / "rocket.app"), diags, board_override="native")
     assert diags.error_count == 0, diags
     assert app is not None and app.board.name == "native"
-    assert (app.flash_budget, app.ram_budget) == (12288, 1024)
+    assert (app.flash_budget, app.ram_budget) == (18432, 1152)
 
 
 def test_a_budget_over_an_avr_board_is_still_refused(tmp_path):
     project = tmp_path / "rocket"
     shutil.copytree(EXAMPLES / "rocket", project, ignore=shutil.ignore_patterns("build"))
     app_file = project / "rocket.app"
-    app_file.write_text(app_file.read_text().replace("flash 12288", "flash 40000"))
+    app_file.write_text(app_file.read_text().replace("flash 18432", "flash 40000"))
     diags = Diagnostics()
     assert load_app(str(app_file), diags) is None
     assert [(d.line, d.message) for d in diags.errors] == [

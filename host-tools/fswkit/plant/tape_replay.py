@@ -12,9 +12,10 @@ does (fswkit.sim.sensors). Between rows the value is held. An empty cell
 holds the last value (`missing = "hold"`) or makes the sensor output
 `silent_volts` (`missing = "silent"`).
 
-The board is driven with `SimBoard.batch` from one input change to the
-next (no plant, no lock-step): one round trip per tape row at most, so a
-replay runs as fast as simavr runs the firmware.
+The board is given every input change at once (`SimBoard.schedule`: it
+applies each at its cycle itself; no plant, no lock-step) and runs a
+simulated second per `SimBoard.batch`, so a replay runs as fast as simavr
+runs the firmware.
 
 Which column feeds which input, the arming switch, the pyro pins, the
 mission machine's states and the main's configured altitude come from
@@ -474,7 +475,7 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     if cfg.arm_pin is not None:
         changes.setdefault(int(round(cfg.arm_s * f_cpu)), ({}, {}))[1][cfg.arm_pin] = True
     end_cycle = int(round(end_s * f_cpu))
-    chunk = f_cpu  # at most a simulated second per batch: telemetry decoded as it comes
+    chunk = f_cpu  # a simulated second per batch: telemetry decoded as it comes
     stops = sorted(c for c in changes if 0 < c < end_cycle)
     run = Run(columns=())
     roles = {p: r for r, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin)) if p is not None}
@@ -494,17 +495,18 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     try:
         for pin in roles:
             b.watch(pin)
-        pending: tuple[dict, dict] = changes.get(0, ({}, {}))
-        targets = iter(stops + [end_cycle])
-        target = next(targets)
+        # every input change goes to the board at once: it applies each at its
+        # cycle itself, and the replay runs a simulated second per round trip
+        b.schedule([(c, *changes[c]) for c in stops])
+        first = changes.get(0, ({}, {}))
         now = 0
         while now < end_cycle:
-            until = min(target, now + chunk)
+            until = min(end_cycle, now + chunk)
             try:
-                step = b.batch(until, pending[0], pending[1])
+                step = b.batch(until, first[0], first[1])
             except EdgeOverflow:
                 raise CosimError("the board recorded more pin edges than it keeps") from None
-            pending = ({}, {})
+            first = ({}, {})
             run.round_trips += 1
             if step.run.stop != "target":
                 raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {now / f_cpu - offset:.3f} s tape time")
@@ -514,9 +516,6 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
                 run.pin_events.append(PinEvent(te, e.pin, roles.get(e.pin, str(e.pin)), e.level, {}))
             if step.uart:
                 telemetry.feed(step.uart, now / f_cpu)
-            if now == target:
-                pending = changes.get(target, ({}, {}))
-                target = next(targets, end_cycle)
             bar.update(now / f_cpu)
         run.steps = len(stops) + 1
         run.sim_s = end_s

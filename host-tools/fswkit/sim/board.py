@@ -634,6 +634,24 @@ class SimBoard:
         """`count` bytes of the MCU's data space (registers, I/O, RAM)."""
         return bytes.fromhex(self.command(f"peek {int(address)} {int(count)}")[3:])
 
+    def schedule(self, changes) -> int:
+        """Input changes applied by the board itself as simulated time
+        reaches them: `changes` is [(cycle, {pin: volts}, {pin: level})] in
+        cycle order. An open-loop replay then runs in long steps, without a
+        round trip per change. Returns the number of changes scheduled."""
+        fd, path = tempfile.mkstemp(prefix="fsw-sched-", suffix=".txt")
+        try:
+            with os.fdopen(fd, "w") as f:
+                for cycle, analog, digital in changes:
+                    for p, v in analog.items():
+                        f.write(f"{int(cycle)} {self.adc_channel(p)}={self._millivolts(v)}\n")
+                    for pin, level in digital.items():
+                        port, bit = self._port_bit(pin)
+                        f.write(f"{int(cycle)} {port}{bit}={1 if level else 0}\n")
+            return int(self.command(f"sched {path}").split("n=")[1])
+        finally:
+            os.unlink(path)
+
     # -- EEPROM (kept across resets) --
     def eeprom_read(self, address: int, count: int) -> bytes:
         """`count` bytes of the EEPROM from `address`."""

@@ -806,6 +806,92 @@ static int cmd_peek(int argc, char** argv) {
     return 1;
 }
 
+/* `sched FILE`: input changes at given cycles, applied by the harness as
+   simulated time reaches each (a cycle timer: a sleeping core wakes for
+   it), so that an open-loop replay needs no round trip per change. FILE
+   holds lines `CYCLE CH=MV` (ADC channel, millivolts) or `CYCLE PB=0|1`
+   (port, bit, level), in cycle order; `sched` alone drops what is left. */
+typedef struct {
+    unsigned long long cycle;
+    uint32_t value;
+    char port; /* 0: ADC channel `bit` */
+    uint8_t bit;
+} sched_t;
+static sched_t* sched_v;
+static size_t sched_n, sched_at;
+
+static avr_cycle_count_t on_sched(struct avr_t* a, avr_cycle_count_t when, void* param) {
+    (void)when, (void)param;
+    while (sched_at < sched_n && sched_v[sched_at].cycle <= a->cycle) {
+        const sched_t* e = &sched_v[sched_at++];
+        if (e->port)
+            avr_raise_irq(avr_io_getirq(a, AVR_IOCTL_IOPORT_GETIRQ(e->port), e->bit), e->value);
+        else
+            avr_raise_irq(avr_io_getirq(a, AVR_IOCTL_ADC_GETIRQ, e->bit), e->value);
+    }
+    return sched_at < sched_n ? (avr_cycle_count_t)sched_v[sched_at].cycle : 0;
+}
+
+static int cmd_sched(int argc, char** argv) {
+    avr_cycle_timer_cancel(avr, on_sched, NULL);
+    free(sched_v);
+    sched_v = NULL;
+    sched_n = sched_at = 0;
+    if (argc == 1) {
+        fprintf(proto, "ok n=0\n");
+        return 1;
+    }
+    if (argc != 2) return fail("usage: sched [FILE] (lines `CYCLE CH=MV` or `CYCLE PB=0|1`, in cycle order)");
+    FILE* f = fopen(argv[1], "r");
+    if (!f) return fail("sched: cannot read %s: %s", argv[1], strerror(errno));
+    size_t cap = 0;
+    char line[128];
+    unsigned long long last = 0;
+    int lineno = 0;
+    while (fgets(line, sizeof line, f)) {
+        lineno++;
+        unsigned long long cycle, v, value;
+        char tok[32], *eq;
+        if (sscanf(line, "%llu %31s", &cycle, tok) != 2 || !(eq = strchr(tok, '=')) || cycle < last) {
+            fclose(f);
+            return fail("sched: %s:%d: expected `CYCLE CH=MV` or `CYCLE PB=0|1`, in cycle order", argv[1], lineno);
+        }
+        *eq = 0;
+        sched_t e = {cycle, 0, 0, 0};
+        int bad;
+        if (tok[0] >= '0' && tok[0] <= '9') {
+            bad = parse_u64(tok, &v) || v >= ADC_IRQ_TEMP || parse_u64(eq + 1, &value) || value > 1000000;
+            e.bit = (uint8_t)v;
+        } else {
+            bad = parse_port_bit((char[]){tok[0], 0}, tok + 1, &e.port, &e.bit) || parse_u64(eq + 1, &value) ||
+                  value > 1;
+        }
+        if (bad) {
+            fclose(f);
+            return fail("sched: %s:%d: bad input `%s`", argv[1], lineno, tok);
+        }
+        e.value = (uint32_t)value;
+        if (sched_n == cap) {
+            cap = cap ? 2 * cap : 1024;
+            sched_t* grown = realloc(sched_v, cap * sizeof *sched_v);
+            if (!grown) {
+                fclose(f);
+                return fail("sched: out of memory");
+            }
+            sched_v = grown;
+        }
+        sched_v[sched_n++] = e;
+        last = cycle;
+    }
+    fclose(f);
+    if (sched_n) {
+        unsigned long long first = sched_v[0].cycle;
+        avr_cycle_timer_register(avr, first > avr->cycle ? first - avr->cycle : 1, on_sched, NULL);
+    }
+    fprintf(proto, "ok n=%zu\n", sched_n);
+    return 1;
+}
+
 /* `eeprom read ADDR COUNT` (hex), `eeprom write ADDR HEX`, `eeprom cut N`
    (reset right after the Nth byte write from now), `eeprom count` (writes
    started, cuts made). */
@@ -933,7 +1019,7 @@ static const struct {
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
     {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
-    {"eeprom", cmd_eeprom}, {"quit", cmd_quit},
+    {"eeprom", cmd_eeprom}, {"sched", cmd_sched}, {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 

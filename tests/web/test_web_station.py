@@ -139,3 +139,27 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             assert "last frame" in text("link-status")
         finally:
             station.close()
+
+
+def test_fsw_web_serves_the_station_for_a_project(exe):
+    """`fsw web PROJECT --port P --http-port 0` prints the URL it serves;
+    the layout and the page come from it; Ctrl-C (SIGINT) ends it."""
+    import json
+    import signal
+    import subprocess
+    import sys
+    import urllib.request
+
+    with PtyTarget(exe, f"a14={RAW}") as target:
+        p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "web", str(TANK), "--port", target.port,
+                              "--http-port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            url = p.stdout.readline().strip()
+            assert url.startswith("http://127.0.0.1:"), p.stderr.read() if p.poll() is not None else url
+            lay = json.loads(urllib.request.urlopen(url + "api/layout", timeout=5).read())
+            assert lay["name"] == "tank" and [e["name"] for e in lay["elements"] if e["writable"]] == ["valveOpen"]
+            page = urllib.request.urlopen(url, timeout=5).read().decode()
+            assert '<script src="/uplot/uPlot.iife.min.js">' in page
+        finally:
+            p.send_signal(signal.SIGINT)
+            assert p.wait(10) == 0, p.stderr.read()

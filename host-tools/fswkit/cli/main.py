@@ -228,6 +228,16 @@ def parser() -> argparse.ArgumentParser:
     cm._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     cm.set_defaults(func=_command("ground", "cmd_cmd"))
 
+    wb = sub.add_parser("web", help="the web ground station on a target's serial port (docs/ground.md)")
+    wb.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
+    wb.add_argument("--port", help="serial device or pyserial URL (default: the only serial port found)")
+    wb.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    wb.add_argument("--http-port", type=int, default=8000, metavar="N",
+                    help="the web server's TCP port on localhost (default 8000; 0: any free one)")
+    wb.add_argument("--host", default="127.0.0.1", help="the address to serve on (default 127.0.0.1: this machine only)")
+    wb.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
+    wb.set_defaults(func=_command("web", "cmd_web"))
+
     pa = sub.add_parser("param", help="a target's parameters over the link: list, get, set, save, load, diff "
                                       "(docs/parameters.md)")
     pa.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")

@@ -110,7 +110,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         finally:
             await source.stop()
 
-    return Starlette(routes=[
+    app = Starlette(routes=[
         Route("/", index),
         Route("/api/layout", layout),
         Route("/api/command", command, methods=["POST"]),
@@ -118,6 +118,8 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         Mount("/static", StaticFiles(directory=STATIC)),
         Mount("/uplot", StaticFiles(directory=assets)),
     ], lifespan=lifespan)
+    app.state.source = source
+    return app
 
 
 def serve(app: Starlette, host: str = "127.0.0.1", port: int = 8000, on_ready=None) -> None:

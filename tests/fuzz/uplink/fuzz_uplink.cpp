@@ -97,9 +97,39 @@ void check_output() {
     out_len = static_cast<uint16_t>(out_len - start);
 }
 
+// Framed mode (data[0] bit 1): the rest of the input is (length, body)...,
+// each body sent as a whole uplink frame with its CRC and COBS, so that the
+// fuzzer explores the command parsers behind the CRC (opcodes, arguments,
+// sequence numbers) instead of the CRC itself.
+uint8_t wire_buf[32768];
+
+size_t frame_input(const uint8_t* data, size_t size) {
+    size_t out = 0, i = 1;
+    static uint8_t body[64];
+    while (i < size && out + 2 * sizeof body < sizeof wire_buf) {
+        const size_t n = data[i++] % 40u;
+        const size_t take = n < size - i ? n : size - i;
+        memcpy(body, data + i, take);
+        i += take;
+        const uint16_t crc = crc16(body, static_cast<uint16_t>(take));
+        body[take] = static_cast<uint8_t>(crc >> 8);
+        body[take + 1] = static_cast<uint8_t>(crc);
+        CobsEncoder e;
+        cobs_begin(e, wire_buf + out);
+        cobs_put_bytes(e, body, static_cast<uint16_t>(take + 2));
+        out += cobs_end(e);
+        if (wire_buf[out - 1] != 0) wire_buf[out++] = 0;
+    }
+    return out;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    if (size > 0 && (data[0] & 2)) {  // framed: CRC and COBS done here
+        size = frame_input(data, size);
+        data = wire_buf;
+    }
     native::sim_reset();
     memset(sv, 0, sizeof sv);
     for (uint8_t i = 0; i < sizeof sv; ++i) sv[i] = static_cast<uint8_t>(0xA0 + i);

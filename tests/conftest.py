@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -19,6 +20,14 @@ EXAMPLES = ROOT / "examples"
 SHARED = ROOT.parent / "shared"
 
 __all__ = ["ROOT", "EXAMPLES", "SHARED", "Ran", "run_fsw", "fsw", "pio_exe", "needs_pio", "project_config"]
+
+# Tests that press Ctrl-C (SIGINT) on a command need it to reach the command.
+# A suite started in the background by a non-interactive shell (`make test &`,
+# some CI runners) inherits SIGINT ignored, and an ignored signal stays
+# ignored across exec: the commands would never see it. Python's own handler
+# here is reset to the default in every child instead.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture

@@ -295,16 +295,24 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     local_decls: dict[str, S.LocalDecl] = {d.name: d for d in reversed(f.locals)}
     init_used: set[int] = set()
     local_bytes = 0
-    for d in f.locals:
+    def declared(d, kind: str):
+        """The type of a new local or parameter `d`, or None when its name
+        cannot be taken (reported)."""
         t = TYPES.get(d.type)
         if t is None:
             err(d.line, d.type_col, unknown_type(d.type))
             t = TYPES["F64"]  # carry on, so that its uses are not reported again
         if d.name == "T":
-            err(d.line, d.name_col, "`T` is the built-in time in state and cannot name a local")
-            continue
+            err(d.line, d.name_col, f"`T` is the built-in time in state and cannot name a {kind}")
+            return None
         if d.name in names:
             err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
+            return None
+        return t
+
+    for d in f.locals:
+        t = declared(d, "local")
+        if t is None:
             continue
         init_resolver = Resolver(src, diags, lang, names, vars_, [], None)  # no copy: quadratic in locals
         init = _resolve_init(init_resolver, d, local_decls, vars_,
@@ -322,15 +330,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     param_decls: dict[str, S.ParamDecl] = {d.name: d for d in reversed(f.params)}
     param_exprs: dict[int, tuple[S.ParamDecl, M.Expr | None, M.Expr | None]] = {}
     for d in f.params:
-        t = TYPES.get(d.type)
+        t = declared(d, "parameter")
         if t is None:
-            err(d.line, d.type_col, unknown_type(d.type))
-            t = TYPES["F64"]
-        if d.name == "T":
-            err(d.line, d.name_col, "`T` is the built-in time in state and cannot name a parameter")
-            continue
-        if d.name in names:
-            err(d.line, d.name_col, f"reuse of name `{d.name}` (previously used on line {name_lines[d.name]})")
             continue
         init_resolver = Resolver(src, diags, lang, names, vars_, [], None)
         init = _resolve_init(init_resolver, d, {**local_decls, **param_decls}, vars_, "default value")

@@ -652,14 +652,23 @@ def _sm_elem(toks: list[Tok], src, diags, lang) -> S.SmElem | None:
     return S.SmElem(d.line, d.type_col, d.type, d.name_col, d.name, read_only, alias, alias_col)
 
 
-def _local_decl(toks: list[Tok], src, diags, lang) -> S.LocalDecl | None:
+def _assigned_decl(toks: list[Tok], src, diags, lang, what: str) -> S.ElemDecl | None:
+    """`TYPE name =` at the head of a local's or a parameter's line; None
+    after reporting a malformed one."""
     d = _elem_decl(toks[:2], src, diags, lang)
     if d is None:
         return None
     if len(toks) < 3 or not (toks[2].kind == OP and toks[2].text == "="):
         found = show(toks[2]) if len(toks) > 2 else "end of line"
         col = toks[2].col if len(toks) > 2 else toks[1].col + len(toks[1].text)
-        diags.error(src, lang, d.line, col, f"expected `= initial value` after `{d.name}`, found {found}")
+        diags.error(src, lang, d.line, col, f"expected `= {what}` after `{d.name}`, found {found}")
+        return None
+    return d
+
+
+def _local_decl(toks: list[Tok], src, diags, lang) -> S.LocalDecl | None:
+    d = _assigned_decl(toks, src, diags, lang, "initial value")
+    if d is None:
         return None
     rest = toks[3:]
     read_only = False
@@ -690,13 +699,8 @@ PARAM_ANNOTS = ("@min", "@max", "@unit", "@when")
 
 def _param_decl(toks: list[Tok], src, diags, lang) -> S.ParamDecl | None:
     """`TYPE name = default [@min E] [@max E] [@unit TEXT] [@when STATE...]`."""
-    d = _elem_decl(toks[:2], src, diags, lang)
+    d = _assigned_decl(toks, src, diags, lang, "default value")
     if d is None:
-        return None
-    if len(toks) < 3 or not (toks[2].kind == OP and toks[2].text == "="):
-        found = show(toks[2]) if len(toks) > 2 else "end of line"
-        col = toks[2].col if len(toks) > 2 else toks[1].col + len(toks[1].text)
-        diags.error(src, lang, d.line, col, f"expected `= default value` after `{d.name}`, found {found}")
         return None
     # split at the annotations: the default, then each annotation's tokens
     parts: list[tuple[Tok | None, list[Tok]]] = [(None, [])]

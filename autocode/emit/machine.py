@@ -16,6 +16,17 @@ from .common import banner, basename, c_ident, parens, real_check, value_bytes, 
 from .expr import ExprEmitter
 
 
+def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
+    """Variables laid end to end, little-endian like elements: (offset by
+    var index, bytes in all, their initial bytes)."""
+    offsets: dict[int, int] = {}
+    size = 0
+    for v in vs:
+        offsets[v.index] = size
+        size += v.type.size
+    return offsets, size, b"".join(value_bytes(v.type, values[v.index]) for v in vs)
+
+
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
                  ns: str = "fsw_gen") -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
@@ -28,18 +39,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     values = local_values(m, real)
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
     stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
-    offsets: dict[int, int] = {}
-    size = 0
-    for v in stored:
-        offsets[v.index] = size
-        size += v.type.size
-    init_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in stored)
-    poff: dict[int, int] = {}
-    psize = 0
-    for v in params:
-        poff[v.index] = psize
-        psize += v.type.size
-    param_bytes = b"".join(value_bytes(v.type, values[v.index]) for v in params)
+    offsets, size, init_bytes = _packed(stored, values)
+    poff, psize, param_bytes = _packed(params, values)
     assert m.states[0].id == 1, "a zero fsw::Machine starts in state 1"
     guard = f"{ns.upper()}_{name.upper()}_H"
     h = [banner([m.path, m.sv.path], m.sv), f"#ifndef {guard}", f"#define {guard}", "",

@@ -201,3 +201,21 @@ def test_fsw_sim_flies_one_image_with_another_parameter_file(tmp_path):
     r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--fw-params", str(f),
                 "--out", str(tmp_path / "flight2"))
     assert r.code == 2 and f"{f}:1:12: `MAIN_ALT` = 5 is outside its range 30..3000 m" in r.err, r.err
+
+
+def test_fsw_sim_params_takes_a_parameter_file_too(tmp_path):
+    """`--params FILE` with only top-level NAME = value lines is the
+    firmware's parameters; a file with tables stays the plant's config."""
+    import shutil
+
+    if shutil.which("avr-g++") is None:
+        pytest.skip("gcc-avr is needed (make setup)")
+    from conftest import EXAMPLES
+
+    f = tmp_path / "field.toml"
+    f.write_text("MAIN_ALT = 5\n")
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(f),
+                "--out", str(tmp_path / "flight"))
+    assert r.code == 2 and "`MAIN_ALT` = 5 is outside its range 30..3000 m" in r.err, r.err
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(f), "--fw-params", str(f))
+    assert r.code == 2 and "give one" in r.err

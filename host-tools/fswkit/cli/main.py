@@ -151,7 +151,8 @@ def parser() -> argparse.ArgumentParser:
     sm.add_argument("--plant", choices=("rocket", "tank"),
                     help="fly the firmware in closed loop against this plant model (docs/sim.md)")
     sm.add_argument("--params", metavar="FILE.toml", help="with --plant: the plant's parameters "
-                    "(default PROJECT/plant.toml)")
+                    "(default PROJECT/plant.toml); a file of top-level NAME = value lines only is the firmware's "
+                    "parameters instead (as --fw-params)")
     sm.add_argument("--fw-params", metavar="FILE.toml", help="the firmware's parameters (docs/parameters.md): the "
                     "file's values are programmed into the board's EEPROM before boot, so one image flies another "
                     "rocket (--params names the plant's or the tape's config)")

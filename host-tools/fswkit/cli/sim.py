@@ -12,7 +12,26 @@ import time
 from fswkit.cli.common import EXIT_CONFIG, flown, folder_and_firmware
 
 
+def _firmware_param_file(path: str) -> bool:
+    """Whether `--params FILE` names a file of the firmware's parameters
+    (top-level `NAME = value` lines only) rather than a plant's or a tape's
+    configuration (which are tables)."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+        return False  # the plant's or the tape's reader says what is wrong with it
+    return bool(doc) and not any(isinstance(v, dict) for v in doc.values())
+
+
 def cmd_sim(args) -> int:
+    if getattr(args, "params", None) is not None and _firmware_param_file(args.params):
+        if getattr(args, "fw_params", None) is not None:
+            sys.stderr.write("fsw sim: --params and --fw-params both name the firmware's parameters: give one\n")
+            return EXIT_CONFIG
+        args.fw_params, args.params = args.params, None
     if any(getattr(args, k, None) is not None for k in ("runs", "run", "dispersion")):
         if getattr(args, "fw_params", None) is not None:
             sys.stderr.write("fsw sim: --fw-params flies one firmware's parameters; a study draws its own "

@@ -163,3 +163,62 @@ def test_fsw_web_serves_the_station_for_a_project(exe):
         finally:
             p.send_signal(signal.SIGINT)
             assert p.wait(10) == 0, p.stderr.read()
+
+
+def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
+    """The tests/param/tuned rig (native, on a pty): the station reads its
+    parameters through the port it owns; a value set in the page, after
+    the confirmation, is live on the target and in the shared history; a
+    value out of range is refused with its range."""
+    from selenium.webdriver.common.by import By
+
+    import uvicorn
+
+    from conftest import ROOT, run_fsw
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.params import app_parameters
+    from fswkit.autocode.schema import link_plan
+    from fswkit.link.layout import from_app
+    from fswkit.link.port import open_port
+    from fswkit.target.build import load
+    from fswkit.web.app import create_app
+    from fswkit.web.source import LiveSource
+
+    rig = ROOT / "tests" / "param" / "tuned"
+    r = run_fsw("build", str(rig), "--board", "native", "--out", str(tmp_path / "b"))
+    assert r.code == 0, r.err
+    app = load(str(rig), Diagnostics())
+    with PtyTarget(tmp_path / "b" / "tuned", "--eeprom", str(tmp_path / "e.bin")) as target:
+        serial = open_port(target.port, 115200)
+        source = LiveSource(from_app(app), serial, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
+        http = free_port()
+        server = uvicorn.Server(uvicorn.Config(create_app(source), host="127.0.0.1", port=http, log_level="warning",
+                                               ws="websockets-sansio"))
+        thread = threading.Thread(target=server.run, daemon=True)
+        thread.start()
+        try:
+            while not server.started:
+                time.sleep(0.02)
+            browser.get(f"http://127.0.0.1:{http}/")
+            text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+            wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+            assert text("param-state") == "defaults"
+            box = browser.find_element(By.ID, "pset-OPEN_AT")
+            box.send_keys("650.5")
+            browser.find_element(By.ID, "psend-OPEN_AT").click()
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+            browser.find_element(By.ID, "confirm-yes").click()
+            wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the new value")
+            assert "unsaved changes" in text("param-state")
+            item = browser.find_elements(By.CSS_SELECTOR, "#history li")[0]
+            assert "param set OPEN_AT = 650.5" in item.text and "applied" in item.text
+            box = browser.find_element(By.ID, "pset-HOLD_MS")
+            box.send_keys("5")
+            browser.find_element(By.ID, "psend-HOLD_MS").click()
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+            browser.find_element(By.ID, "confirm-yes").click()
+            wait_for(lambda: "outside its range 10..60000 ms" in text("param-err"), "the refusal")
+        finally:
+            server.should_exit = True
+            thread.join(5)
+            serial.close()

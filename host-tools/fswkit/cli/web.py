@@ -8,6 +8,17 @@ import sys
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, port_or_only
 
 
+def _parameters(project: str):
+    """(the application's parameter table, its link's transmit buffer size)."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.params import app_parameters
+    from fswkit.autocode.schema import link_plan
+    from fswkit.target.build import load
+
+    app = load(project, Diagnostics())
+    return (app_parameters(app), link_plan(app).tx_cap) if app is not None else ((), 0)
+
+
 def cmd_web(args) -> int:
     from fswkit.cli.ground import _link_baud, _link_layout
     from fswkit.link.port import PortError, open_port
@@ -32,7 +43,9 @@ def cmd_web(args) -> int:
     except PortError as e:
         sys.stderr.write(f"fsw web: {e}\n")
         return EXIT_FAIL
-    app = create_app(LiveSource(layout, port, ignore_schema=args.ignore_schema), title=f"fsw web {args.project}")
+    params, tx_cap = _parameters(args.project)
+    app = create_app(LiveSource(layout, port, ignore_schema=args.ignore_schema, params=params, tx_cap=tx_cap,
+                                baud=baud), title=f"fsw web {args.project}")
 
     def ready(url: str) -> None:
         sys.stdout.write(f"{url}\n")

@@ -51,6 +51,7 @@ def layout_json(source: Source) -> dict:
                          "lo": t.lo if t.is_int else None, "hi": t.hi if t.is_int else None,
                          "writable": e.name in lay.writable, "states": lay.states.get(e.name)})
     return {"name": lay.name, "schema": f"0x{lay.schema:08x}", "time_unit": lay.time_unit, "rate": lay.rate,
+            "has_params": bool(getattr(source, "params", ())),
             "elements": elements, "tasks": [{"name": n, "kind": k} for n, k in lay.tasks],
             "state_elements": list(lay.states), "has_uplink": lay.has_uplink}
 
@@ -75,6 +76,24 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         try:
             entry = await source.command(who, body["kind"], body["target"], body["value"])
         except CommandError as e:
+            return JSONResponse({"ok": False, "words": str(e)}, status_code=422)
+        return JSONResponse(entry)
+
+    async def params(request: Request) -> Response:
+        if request.method == "GET":
+            if not hasattr(source, "params_now"):
+                return JSONResponse({"ok": False, "words": "this source has no target"})
+            return JSONResponse(await source.params_now())
+        try:
+            body = await request.json()
+        except ValueError:
+            return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
+        if not isinstance(body, dict) or not isinstance(body.get("values"), dict):
+            return JSONResponse({"ok": False, "words": "expected {values: {NAME: VALUE}}"}, status_code=400)
+        who = f"web {request.client.host if request.client else '?'}"
+        try:
+            entry = await source.params_set(who, body["values"])
+        except (CommandError, AttributeError) as e:
             return JSONResponse({"ok": False, "words": str(e)}, status_code=422)
         return JSONResponse(entry)
 
@@ -114,6 +133,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         Route("/", index),
         Route("/api/layout", layout),
         Route("/api/command", command, methods=["POST"]),
+        Route("/api/params", params, methods=["GET", "POST"]),
         WebSocketRoute("/ws", feed),
         Mount("/static", StaticFiles(directory=STATIC)),
         Mount("/uplot", StaticFiles(directory=assets)),

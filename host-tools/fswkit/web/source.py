@@ -54,6 +54,8 @@ def _message(ev: Event, layout: Layout) -> dict | None:
 
 
 def _json(v):
+    if isinstance(v, (bytes, bytearray)):
+        return v.hex()  # an ack's data
     if isinstance(v, float) and v != v:
         return None  # JSON has no NaN
     if isinstance(v, float) and v in (float("inf"), float("-inf")):
@@ -136,13 +138,18 @@ class Source:
 
 class LiveSource(Source):
     """A port owned through the link client: a thread reads it; commands go
-    one at a time through a lock, each waiting for its acknowledgement."""
+    one at a time through a lock, each waiting for its acknowledgement.
+    With the application's parameter table (`params`, `tx_cap`, `baud`),
+    the firmware's parameters are listed and set through the same port
+    (fswkit.param.client)."""
 
-    def __init__(self, layout: Layout, port, log=None, ignore_schema: bool = False):
+    def __init__(self, layout: Layout, port, log=None, ignore_schema: bool = False, *, params=(),
+                 tx_cap: int = 0, baud: int = 115200):
         super().__init__(layout)
         from fswkit.link.client import Ground
 
         self.ground = Ground(port, Session(layout, ignore_schema), log)
+        self.params, self.tx_cap, self.baud = tuple(params), tx_cap, baud
         self._lock = threading.Lock()  # one command on the wire at a time, and the port's reads
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -195,6 +202,68 @@ class LiveSource(Source):
                 return self.ground.command(op, args, tries=3, timeout=0.5, on_event=lambda ev: self._events([ev]))
             except LinkTimeout as e:
                 return {"status": None, "words": str(e)}
+
+    def _param_client(self):
+        from fswkit.param.client import ParamClient, PortTransport
+
+        c = ParamClient(PortTransport(self.ground), self.params, self.tx_cap, baud=self.baud, deadline=10.0)
+        c.on_event = lambda ev: self._events([ev])
+        return c
+
+    def _params_now(self) -> dict:
+        from fswkit.param.client import ParamError
+
+        with self._lock:
+            try:
+                c = self._param_client()
+                info = c.info()
+                values = c.get_all()
+            except ParamError as e:
+                return {"ok": False, "words": str(e)}
+        rows = [{"name": p.name, "machine": p.machine, "type": p.type.name, "unit": p.unit,
+                 "value": _json(values[p.name]), "default": _json(p.default), "min": _json(p.min),
+                 "max": _json(p.max), "when": list(p.when), "range": p.range_text()} for p in self.params]
+        return {"ok": True, "info": info, "params": rows}
+
+    async def params_now(self) -> dict:
+        """The target's parameters and its store's state (PARAM_INFO)."""
+        if not self.params:
+            return {"ok": False, "words": "the application declares no parameters"}
+        return await asyncio.get_running_loop().run_in_executor(None, self._params_now)
+
+    def _params_set(self, values: dict) -> str | None:
+        from fswkit.param.client import ParamError
+
+        with self._lock:
+            try:
+                self._param_client().set(values)
+            except ParamError as e:
+                return str(e)
+        return None
+
+    async def params_set(self, who: str, given: dict) -> dict:
+        """Live values, all or none, after the same checks as `fsw param set`."""
+        from fswkit.autocode.params import check_value
+
+        by_name = {p.name: p for p in self.params}
+        values = {}
+        for name, text in given.items():
+            p = by_name.get(name)
+            if p is None:
+                raise CommandError(f"unknown parameter `{name}`")
+            v, why = check_value(p, str(text))
+            if why is not None:
+                raise CommandError(why)
+            values[name] = v
+        if not values:
+            raise CommandError("no value given")
+        why = await asyncio.get_running_loop().run_in_executor(None, self._params_set, values)
+        text = "param set " + ", ".join(f"{k} = {given[k]}" for k in values)
+        entry = {"t": "command", "who": who, "text": text, "status": 0 if why is None else None,
+                 "ok": why is None, "words": why or "applied", "host_time": time.time()}
+        self.history.append(entry)
+        self.publish(entry)
+        return entry
 
     async def command(self, who: str, kind: str, target: str, value: str) -> dict:
         op, args, text = self.encode(kind, target, value)

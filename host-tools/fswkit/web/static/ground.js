@@ -52,6 +52,8 @@ async function start() {
   buildCommands();
   for (const s of layout.state_elements) states[s] = { current: null, since: null, segments: [], list: [] };
   buildTimeline();
+  if (layout.has_params) { $("parameters").hidden = false; $("param-refresh").addEventListener("click", readParams);
+                           readParams(); }
   connect();
   setInterval(draw, 200);
 }
@@ -298,6 +300,40 @@ function buildCommands() {
     row.append(el("label", {}, `task ${t.name}`), sel, btn, err);
     panel.append(row);
   }
+}
+
+// ---- parameters (docs/parameters.md) -------------------------------------------
+
+const SOURCES = ["no parameters", "defaults", "bank A", "bank B"];
+
+async function readParams() {
+  $("param-err").textContent = "";
+  const r = await (await fetch("/api/params")).json();
+  if (!r.ok) { $("param-err").textContent = r.words; return; }
+  const i = r.info;
+  $("param-state").textContent = `${SOURCES[i.source]}${i.source >= 2 ? ", sequence " + i.seq : ""}` +
+    `${i.dirty ? ", unsaved changes" : ""}${i.writing ? ", writing" : ""}`;
+  $("param-table").tBodies[0].replaceChildren(...r.params.map(p => {
+    const tr = el("tr", { id: `param-${p.name}` });
+    const input = el("input", { id: `pset-${p.name}`, size: 8, placeholder: p.type });
+    const btn = el("button", { type: "button", id: `psend-${p.name}` }, "Set");
+    btn.addEventListener("click", () => setParam(p, input.value.trim()));
+    const cells = [p.name, `${fmt(p.value)}${p.unit ? " " + p.unit : ""}`, p.range, p.when.join(" ")];
+    cells.forEach((c, k) => tr.append(el("td", k === 1 ? { id: `pval-${p.name}` } : {}, c)));
+    const a = el("td"); a.append(input); const b = el("td"); b.append(btn);
+    tr.append(a, b);
+    return tr;
+  }));
+}
+
+async function setParam(p, text) {
+  $("param-err").textContent = "";
+  if (!(await ask(`Set parameter ${p.name} = ${text} on the target (live, until saved)?`))) return;
+  const r = await fetch("/api/params", { method: "POST", headers: { "Content-Type": "application/json" },
+                                         body: JSON.stringify({ values: { [p.name]: text } }) });
+  const answer = await r.json();
+  await readParams();
+  if (!r.ok || !answer.ok) $("param-err").textContent = answer.words;
 }
 
 // ---- the feed ---------------------------------------------------------------

@@ -13,6 +13,7 @@ from fswkit import outputs
 from fswkit.link import wire
 from fswkit.link.layout import Layout
 from fswkit.link.session import Event, Session, describe
+from fswkit.web.source import reset_words
 
 
 class GroundError(Exception):
@@ -75,7 +76,7 @@ def render(session: Session, now: float, title: str):
     if h is not None:
         link.add_row("target dropped", str(h["dropped"]))
         link.add_row("executor late cycles", str(h["late"]))
-        link.add_row("reset cause", f"0x{h['reset_cause']:02x}")
+        link.add_row("reset cause", f"{reset_words(h['reset_cause'])} (0x{h['reset_cause']:02x})")
         link.add_row("uplink ok/refused", f"{h['rx_ok']}/{h['rx_refused']}")
         link.add_row("uplink crc/malformed/replayed",
                      f"{h['rx_crc']}/{h['rx_malformed']}/{h['rx_replayed']}")

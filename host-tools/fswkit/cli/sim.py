@@ -21,7 +21,7 @@ def _firmware_param_file(path: str) -> bool:
     try:
         with open(path, "rb") as f:
             doc = tomllib.load(f)
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+    except (OSError, ValueError):  # TOMLDecodeError, a bad encoding, an integer too long for int()
         return False  # the plant's or the tape's reader says what is wrong with it
     return bool(doc) and not any(isinstance(v, dict) for v in doc.values())
 

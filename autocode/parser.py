@@ -507,6 +507,21 @@ def _line_parser(toks: list[Tok], src, diags, lang) -> Parser:
     return Parser(stream([toks]), src, diags, lang)
 
 
+def _whole_expression(toks: list[Tok], src, diags, lang, what: str) -> S.Expr | None:
+    """The expression `toks` hold, with nothing after it (`unexpected X
+    after WHAT`); None after reporting."""
+    p = _line_parser(toks, src, diags, lang)
+    try:
+        e = p.expression()
+        if not p.at_end():
+            t = p.peek()
+            raise ParseError(t, f"unexpected {show(t)} after {what}")
+    except ParseError as err:
+        p.report(err)
+        return None
+    return e
+
+
 def parse_sv(src: Source, diags: Diagnostics) -> S.SvFile:
     return memo.run(("parse_sv", src.path, src.text), (), diags, lambda d: _parse_sv(src, d))
 
@@ -682,14 +697,8 @@ def _local_decl(toks: list[Tok], src, diags, lang) -> S.LocalDecl | None:
         t = toks[2]
         diags.error(src, lang, t.line, t.col + 1, "expected an expression")
         return None
-    p = _line_parser(rest, src, diags, lang)
-    try:
-        expr = p.expression()
-        if not p.at_end():
-            t = p.peek()
-            raise ParseError(t, f"unexpected {show(t)} after the initial value")
-    except ParseError as e:
-        p.report(e)
+    expr = _whole_expression(rest, src, diags, lang, "the initial value")
+    if expr is None:
         return None
     return S.LocalDecl(d.line, d.type_col, d.type, d.name_col, d.name, expr, read_only)
 
@@ -714,16 +723,7 @@ def _param_decl(toks: list[Tok], src, diags, lang) -> S.ParamDecl | None:
         if not ts:
             diags.error(src, lang, at.line, at.col + len(at.text), f"expected {what}")
             return None
-        p = _line_parser(ts, src, diags, lang)
-        try:
-            e = p.expression()
-            if not p.at_end():
-                t = p.peek()
-                raise ParseError(t, f"unexpected {show(t)} after {what}")
-        except ParseError as e_:
-            p.report(e_)
-            return None
-        return e
+        return _whole_expression(ts, src, diags, lang, what)
 
     default = expr_of("a default value", toks[2], parts[0][1])
     if default is None:
@@ -853,13 +853,7 @@ def _script_param(toks: list[Tok], src, diags, lang) -> S.ScriptParam | None:
         col = toks[1].col if len(toks) > 1 else t.col + len(t.text)
         diags.error(src, lang, t.line, col, f"expected `= value` after `{t.text}`, found {found}")
         return None
-    p = _line_parser(toks[2:], src, diags, lang)
-    try:
-        e = p.expression()
-        if not p.at_end():
-            x = p.peek()
-            raise ParseError(x, f"unexpected {show(x)} after the value")
-    except ParseError as err:
-        p.report(err)
+    e = _whole_expression(toks[2:], src, diags, lang, "the value")
+    if e is None:
         return None
     return S.ScriptParam(t.line, t.col, t.text, e, toks[2].col)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from .evaluate import local_values
 from .numeric import REALS
+from .protocol import crc16
 from .types import ElemType
 
 HEADER = 9  # a bank's header: magic, seq u16, table hash u32, CRC u16
@@ -166,12 +167,6 @@ def value_block(params, values: dict[str, object]) -> bytes:
     """The value block with `values` (checked values, by name) over the
     defaults."""
     return b"".join(p.pack(values.get(p.name, p.default)) for p in params)
-
-
-def crc16(data: bytes, crc: int = 0xFFFF) -> int:
-    import binascii
-
-    return binascii.crc_hqx(data, crc)
 
 
 def bank_image(params, values: dict[str, object], seq: int = 1) -> bytes:

@@ -7,6 +7,7 @@ the two equal."""
 from __future__ import annotations
 
 import struct
+from binascii import crc_hqx
 
 PROTOCOL = 2  # the hello frame's protocol number; the firmware's kLinkProtocol
 HEADER = 6  # type, sequence number, time (low 32 bits)
@@ -56,6 +57,12 @@ PARAM_INFO = struct.Struct("<BHHBI")    # source, seq, live CRC, count, table ha
 PARAM_SOURCES = {0: "no parameters", 1: "defaults", 2: "bank A", 3: "bank B"}
 PARAM_DIRTY, PARAM_WRITING = 0x40, 0x80
 SNAPSHOT_OFFSET = 2  # a snapshot frame's payload: offset (u16), then state vector bytes
+
+
+def crc16(data: bytes, crc: int = CRC_INIT) -> int:
+    """CRC-16/CCITT-FALSE of `data`, continuing `crc`: the link's frames and
+    the parameter banks (the firmware's fsw_crc.h)."""
+    return crc_hqx(data, crc)
 
 
 def encoded_max(n: int) -> int:

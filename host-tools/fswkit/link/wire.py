@@ -13,7 +13,7 @@ from dataclasses import dataclass
 # The numbers of the protocol are written once, in autocode (the generator
 # sizes the firmware's buffers from them); the ground tools read them here.
 from fswkit.autocode.protocol import (ACK, CRC, CRC_INIT, HEADER, HEALTH, HELLO, OP_HELLO, OP_MODE, OP_NAMES,
-                                      OP_PING, OP_SET, OP_SNAPSHOT, PROTOCOL, SAMPLE, SNAPSHOT, STATUS,
+                                      OP_PING, OP_SET, OP_SNAPSHOT, PROTOCOL, SAMPLE, SNAPSHOT, STATUS, crc16,
                                       encoded_max)
 
 __all__ = ["ACK", "CRC", "CRC_INIT", "HEADER", "HEALTH", "HELLO", "OP_HELLO", "OP_MODE", "OP_NAMES", "OP_PING",
@@ -22,10 +22,6 @@ __all__ = ["ACK", "CRC", "CRC_INIT", "HEADER", "HEALTH", "HELLO", "OP_HELLO", "O
            "frame", "uplink"]
 
 _U32 = struct.Struct("<I")
-
-
-def crc16(data: bytes) -> int:
-    return crc_hqx(data, CRC_INIT)
 
 
 def cobs_encode(data: bytes) -> bytes:

@@ -20,7 +20,8 @@ import time
 from collections import deque
 from dataclasses import dataclass
 
-from fswkit.autocode.params import AppParam, crc16
+from fswkit.autocode.params import AppParam
+from fswkit.autocode.protocol import crc16
 from fswkit.autocode.protocol import (OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO, OP_PARAM_SAVE,
                                       OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES, PARAM_WRITING)
 from fswkit.link import wire

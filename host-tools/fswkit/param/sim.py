@@ -8,7 +8,7 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass
 
-from fswkit.autocode.params import crc16
+from fswkit.autocode.protocol import crc16
 
 
 @dataclass

@@ -399,11 +399,10 @@ void link_param_ack(Link& l, const ParamStore& ps) {
         uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
         uint8_t n = 0;
         uint8_t v[8];
-        while (n < l.ack_y && param_value(ps, static_cast<uint8_t>(l.ack_x + n), v) != 0) {
+        for (; n < l.ack_y; ++n) {  // how many whole values fit
             const uint8_t size = param_value(ps, static_cast<uint8_t>(l.ack_x + n), v);
-            if (size > room) break;
+            if (size == 0 || size > room) break;
             room = static_cast<uint16_t>(room - size);
-            ++n;
         }
         put(l.ack_x);
         put(n);

@@ -149,6 +149,12 @@ uint16_t bank_crc(const ParamConfig& c, uint16_t seq, uint16_t ee) {
     return crc;
 }
 
+// A bank's stored CRC (high byte first, at offset 7).
+uint16_t stored_crc(uint16_t base) {
+    return static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
+                                 pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
+}
+
 uint16_t ee_u16(uint16_t addr) {
     return static_cast<uint16_t>(pal::eeprom_read(addr) | (pal::eeprom_read(static_cast<uint16_t>(addr + 1u)) << 8));
 }
@@ -162,8 +168,7 @@ bool bank_valid(const ParamConfig& c, uint8_t b, uint16_t& seq) {
     uint32_t hash = 0;
     for (uint8_t i = 4; i-- > 0;) hash = (hash << 8) | pal::eeprom_read(static_cast<uint16_t>(base + 3u + i));
     if (hash != c.hash) return false;
-    const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
-                                                  pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
+    const uint16_t stored = stored_crc(base);
     const uint16_t values = static_cast<uint16_t>(base + kParamHeader);
     if (bank_crc(c, seq, values) != stored) return false;
     for (uint8_t id = 0; id < c.n; ++id) {
@@ -189,9 +194,7 @@ void refresh_dirty(ParamStore& s, const ParamConfig& c) {
         }
     } else {
         const uint16_t base = bank_base(c, static_cast<uint8_t>((s.source & 3u) - kParamBankA));
-        const uint16_t stored = static_cast<uint16_t>((pal::eeprom_read(static_cast<uint16_t>(base + 7u)) << 8) |
-                                                      pal::eeprom_read(static_cast<uint16_t>(base + 8u)));
-        dirty = bank_crc(c, s.seq, 0xFFFFu) != stored;
+        dirty = bank_crc(c, s.seq, 0xFFFFu) != stored_crc(base);
     }
     s.source = static_cast<uint8_t>((s.source & ~kParamDirty) | (dirty ? kParamDirty : 0u));
 }

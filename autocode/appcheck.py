@@ -7,7 +7,7 @@ into the model's `Application`.
 The sections are checked in the order each needs the others: [application]
 (the board, the rate), [configs] (the files it names, read and checked),
 [time], [tasks], [telemetry], [uplink] (with the reset cause and the one
-writer of each element), [budget]."""
+writer of each element), [budget], [log] (logcheck.py)."""
 
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import check_table
 from .lexer import ID, NUM, Tok
+from .logcheck import check_log
 from .limits import U8_COUNT, hz
 from .model import TASK_KINDS, TASK_MODES, Task
 from .numeric import REALS, exact_literal
@@ -57,6 +58,7 @@ class Parts:
     budget: dict[str, int]
     sv_tok: Tok
     machine_toks: dict[str, Tok]  # by the machine's file name, without its extension
+    log: M.Log | None = None
 
 
 class Report:
@@ -110,9 +112,10 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     reset_cause = _reset_cause(settings.get("reset_cause"), sv, r)
     _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs)
     budget = _budget(f.budget, board, r)
+    log = check_log(f.log, sv, tasks, machines, board, r)
     return Parts(name, board, rate, baud, sv, machines, channels, time_source, time_unit, time_element, tasks,
                  streams, writable, reset_cause, budget, sv_file.file,
-                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files})
+                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log)
 
 
 def complete(parts: Parts, src: Source, diags: Diagnostics, before: int) -> bool:
@@ -381,7 +384,7 @@ def _tasks(rows: tuple[TaskRow, ...], sv: M.StateVector, rate: int, machines: li
             continue
         task_opts[task.name] = opts
         tasks.append(task)
-        if kind in ("telemetry", "uplink"):
+        if kind in ("telemetry", "uplink", "recorder"):
             link_tasks[kind] = task
     for name, idx in machine_names.items():
         if idx not in machine_lines:
@@ -402,8 +405,9 @@ def _task_kind(row: TaskRow, tasks: list[Task], link_tasks: dict[str, Task], r: 
         r.err(row.kind or name, f"expected what the task runs: one of {', '.join(TASK_KINDS)}")
     elif row.kind.text in link_tasks:
         first = link_tasks[row.kind.text]
-        r.err(row.kind, f"a second `{row.kind.text}` task: task `{first.name}` on line {first.line} already drives "
-                        f"the serial link (at most one `{row.kind.text}` task)")
+        what = "keeps the flight record" if row.kind.text == "recorder" else "drives the serial link"
+        r.err(row.kind, f"a second `{row.kind.text}` task: task `{first.name}` on line {first.line} already {what} "
+                        f"(at most one `{row.kind.text}` task)")
     else:
         return row.kind.text
     return None

@@ -31,7 +31,7 @@ class Problem:
 
 # ---- the application config (.app) ----------------------------------------------
 
-SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget")
+SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log")
 
 
 @dataclass(frozen=True)
@@ -97,6 +97,7 @@ class AppFile:
     telemetry: tuple[StreamRow, ...] = ()
     uplink: tuple[WritableRow, ...] = ()
     budget: tuple[Setting, ...] = ()
+    log: tuple[Setting, ...] = ()
 
 
 def parse_app(src: Source, diags: Diagnostics) -> AppFile:
@@ -127,6 +128,7 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
         telemetry=rows("telemetry", lambda toks: StreamRow(toks[0], parse_options(toks, 1))),
         uplink=rows("uplink", lambda toks: WritableRow(toks[0], toks[1] if len(toks) > 1 else None)),
         budget=rows("budget", _setting),
+        log=rows("log", _setting),
     )
 
 

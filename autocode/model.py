@@ -307,7 +307,7 @@ class Channel:
 
 # ---- the application (spec §7) ----------------------------------------------------
 
-TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink")
+TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink", "recorder")
 TASK_MODES = {"disabled": 0, "safed": 1, "enabled": 2}  # values of a task's U8 mode element
 
 
@@ -334,6 +334,31 @@ class Stream:
 
 
 @dataclass(frozen=True)
+class LogField:
+    """An element the flight recorder keeps (docs/recorder.md, "Encodings")."""
+    element: Element
+    enc: str  # raw, hold, delta, quant
+    step: Fraction | None  # delta, quant: the value of one count
+    width: int  # bytes of its absolute value in a sample
+    line: int
+
+
+@dataclass(frozen=True)
+class Log:
+    """The `[log]` section: what the flight recorder keeps, when, and where."""
+    store: str  # "eeprom"
+    record: int  # bytes per record
+    newest: bool  # full: overwrite the oldest records (else stop)
+    machine: int  # index into Application.machines: whose states the rates name
+    trigger: int  # the state id whose entry starts a flight
+    before: Fraction  # seconds kept before the trigger
+    rates: tuple[Fraction, ...]  # Hz by state id (index 0 unused)
+    erase: tuple[int, ...]  # state ids in which an erase is allowed
+    fields: tuple[LogField, ...]  # in record order: held, delta, quant, raw
+    line: int  # the [log] section's first row
+
+
+@dataclass(frozen=True)
 class Application:
     path: str
     name: str
@@ -352,3 +377,4 @@ class Application:
     reset_cause: Element | None = None  # U8: the MCU's reset cause at boot
     flash_budget: int | None = None  # [budget] flash: bytes of program memory at most
     ram_budget: int | None = None  # [budget] ram: data + bss + the stack's high-water mark
+    log: Log | None = None  # [log]: the flight recorder

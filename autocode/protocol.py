@@ -21,10 +21,13 @@ OP_PING, OP_HELLO, OP_SNAPSHOT, OP_SET, OP_MODE = 0x01, 0x02, 0x03, 0x04, 0x05
 # parameters (docs/parameters.md)
 OP_PARAM_GET, OP_PARAM_SET, OP_PARAM_SAVE, OP_PARAM_BEGIN = 0x06, 0x07, 0x08, 0x09
 OP_PARAM_STAGE, OP_PARAM_COMMIT, OP_PARAM_INFO = 0x0A, 0x0B, 0x0C
+# the flight recorder (docs/recorder.md)
+OP_LOG_INFO, OP_LOG_READ, OP_LOG_ERASE = 0x0D, 0x0E, 0x0F
 OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode",
             OP_PARAM_GET: "param_get", OP_PARAM_SET: "param_set", OP_PARAM_SAVE: "param_save",
             OP_PARAM_BEGIN: "param_begin", OP_PARAM_STAGE: "param_stage", OP_PARAM_COMMIT: "param_commit",
-            OP_PARAM_INFO: "param_info"}
+            OP_PARAM_INFO: "param_info", OP_LOG_INFO: "log_info", OP_LOG_READ: "log_read",
+            OP_LOG_ERASE: "log_erase"}
 # acknowledgement status: 0 applied, anything else refused
 STATUS = {
     0: ("OK", "applied"),

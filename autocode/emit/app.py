@@ -159,6 +159,8 @@ def _app_cpp(app: Application) -> str:
     params = app_parameters(app)
     if params:
         c += _params(app, params)
+    if app.log is not None:
+        c += _recorder(app)
     if has_link:
         c += _link(app)
     steps = {}
@@ -191,6 +193,8 @@ def _app_cpp(app: Application) -> str:
     c.append("bool begin() {")
     if params:
         c.append("    fsw::param_begin(params, &kParamConfig);  // the newest valid EEPROM bank, else the defaults")
+    if app.log is not None:
+        c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")
     c.append("    if (fsw::executor_begin(ex, &kConfig) != fsw::kOk) return false;")
     for (kind, d), tag in tables.items():
         if kind in ("analog", "digital") and isinstance(tag, list):
@@ -207,15 +211,18 @@ def _app_cpp(app: Application) -> str:
     c.append("    return true;")
     c.append("}")
     c.append("")
-    if has_link or params:
+    if has_link or params or app.log is not None:
         c.append("// Runs a cycle when one is due; between cycles, feeds the serial link"
-                 + (" and writes\n// the next parameter byte to the EEPROM when it is ready." if params else "."))
+                 + (" and writes\n// the next parameter or record byte to the EEPROM when it is ready."
+                    if params or app.log is not None else "."))
         c.append("void poll() {")
         c.append("    (void)fsw::executor_poll(ex);")
         if has_link:
             c.append("    fsw::link_poll(link);")
         if params:
             c.append("    fsw::param_poll(params);")
+        if app.log is not None:
+            c.append("    fsw::log_poll(rec);")
         c.append("}")
     else:
         c.append("// Runs a cycle when one is due.")
@@ -248,6 +255,8 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
         return "fsw::link_telemetry_task", "&link"
     if t.kind == "uplink":
         return "fsw::link_uplink_task", "&link"
+    if t.kind == "recorder":
+        return "fsw::log_task", "&rec"
     if t.kind in ("inputs", "outputs"):
         d = "i" if t.kind == "inputs" else "o"
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
@@ -307,6 +316,8 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         out.append("    return fsw::link_telemetry_task(&link);")
     elif t.kind == "uplink":
         out.append("    return fsw::link_uplink_task(&link);")
+    elif t.kind == "recorder":
+        out.append("    return fsw::log_task(&rec);")
     else:
         raise GenError(f"{basename(app.path)}:{t.line}: task `{t.name}`: unknown task kind `{t.kind}`")
     out.append("}")
@@ -366,10 +377,59 @@ def _link(app: Application) -> list[str]:
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
              f"{plan.hello_every}, {up}, kSvLock"
-             f"{', &params, fsw::link_param_apply, fsw::link_param_ack' if app_parameters(app) else ''}}};")
+             f"{_link_stores(app)}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")
+    c.append("")
+    return c
+
+
+def _link_stores(app: Application) -> str:
+    """The LinkConfig's last fields: the parameter store and the recorder."""
+    has_params = bool(app_parameters(app))
+    out = ""
+    if has_params or app.log is not None:
+        out += ", &params, fsw::link_param_apply, fsw::link_param_ack" if has_params else ", 0, 0, 0"
+    if app.log is not None:
+        out += ", &rec, fsw::link_log_apply, fsw::link_log_ack"
+    return out
+
+
+def _recorder(app: Application) -> list[str]:
+    """The flight recorder's tables (docs/recorder.md): the fields and their
+    encodings, the sample divider and erase permission of each state, RAM
+    for the ring, the fifo and the previous sample."""
+    from ..recorder import plan as log_plan
+    from ..schema import app_schema_hash
+
+    p = log_plan(app)
+    name = basename(app.path)
+    enc = {"raw": "fsw::kLogRaw", "hold": "fsw::kLogHold", "delta": "fsw::kLogDelta", "quant": "fsw::kLogQuant"}
+    c = ["// ---- the flight recorder (docs/recorder.md) ----",
+         f"const fsw::LogField kLogFields[{len(p.fields)}] FSW_FLASH = {{"]
+    for f, lf in zip(p.fields, app.log.fields):
+        scale = f"{float(1 / f.step)!r}f" if f.step is not None else "0.0f"
+        c.append(f"    {{E_{f.name}, {ELEM_CODE[f.type.name]}, {enc[f.enc]}, {f.width}, {scale}}},  "
+                 f"// {name}:{lf.line} {f.name} {f.enc}{'=' + str(f.step) if f.step is not None else ''}")
+    c.append("};")
+    c.append(f"const uint8_t kLogDividers[{len(p.dividers)}] FSW_FLASH = {{{', '.join(map(str, p.dividers))}}};"
+             "  // by state id: task runs between samples (0: none)")
+    c.append(f"const uint8_t kLogEraseOk[{len(p.erase_ok)}] FSW_FLASH = {{{', '.join(map(str, p.erase_ok))}}};")
+    c.append(f"uint8_t log_ring[{p.ring_cap * p.sample_size}];  // {p.ring_cap} samples of {p.sample_size} B")
+    c.append(f"uint8_t log_fifo[{p.fifo_cap}];")
+    c.append(f"uint8_t log_last[{p.sample_size - 2}];")
+    time_us = "true" if app.time_unit == "us" else "false"
+    c.append(f"const fsw::LogConfig kLogConfig FSW_FLASH = {{kLogFields, kLogDividers, kLogEraseOk, log_ring, "
+             f"log_fifo, log_last, sv, 0x{app_schema_hash(app):08x}UL, 0x{p.hash:08x}UL, {p.before_ms}UL, "
+             f"E_{p.state_element}, E_{p.time_element}, {p.base}UL, {p.slots}, {int(p.period_ms)}, {p.record}, "
+             f"{len(p.fields)}, {len(p.dividers)}, {p.trigger}, {p.sample_size}, {p.ring_cap}, {p.fifo_cap}, "
+             f"{p.n_hold}, {'true' if p.escape else 'false'}, {'true' if p.newest else 'false'}, {time_us}}};")
+    c.append(f"static_assert(fsw::log_config_ok({p.record}, {p.opening}, {p.worst}, {p.ring_cap}, {p.fifo_cap}, "
+             f"{p.slots}), \"{name}: the recorder's tables\");")
+    c.append("fsw::Recorder rec;")
+    c.append(f"// {name}: {p.slots} records of {p.record} B from EEPROM byte {p.base}; "
+             f"RAM {p.ram} B (docs/recorder.md)")
     c.append("")
     return c
 
@@ -427,7 +487,8 @@ def _native_main(app: Application) -> list[str]:
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
     params = bool(app_parameters(app))
     between = (['fsw::link_poll(fsw_gen::link);'] if has_link else []) + \
-        (['fsw::param_poll(fsw_gen::params);'] if params else [])
+        (['fsw::param_poll(fsw_gen::params);'] if params else []) + \
+        (['fsw::log_poll(fsw_gen::rec);'] if app.log is not None else [])
     c = ['#include <stdio.h>',
          '#include <stdlib.h>',
          '#include <string.h>',

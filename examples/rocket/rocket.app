@@ -23,6 +23,7 @@ uplink   uplink            rate=100
 sense    inputs            rate=100
 nav      machine nav       rate=100
 mission  machine mission   rate=100
+log      recorder          rate=100
 act      outputs           rate=100
 downlink telemetry         rate=100
 
@@ -33,6 +34,19 @@ Outputs  rate=10
 [uplink]
 abortCmd
 
+[log]                  # the flight recorder (docs/recorder.md): `fsw dump` reads it back
+store   eeprom         # what the parameters leave of the Uno's 1 KB
+record  64             # bytes per record
+full    stop           # a full log keeps the first flights; `fsw dump --erase` makes room
+machine mission
+trigger Boost          # launch starts a flight ...
+before  0.5            # ... with the half second before it
+rate    10             # Hz
+rate    0 Safe Landed Abort
+erase   Safe Landed
+element altitude delta=0.1
+element state
+
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 18432            # measured high-water mark to the RAM
+flash 22528            # measured high-water mark to the RAM
 ram   1152

@@ -138,6 +138,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
         put_u16(l.n.last_seq);
         if (c.params != 0 && c.param_ack != 0) c.param_ack(l, *c.params);
+        if (c.log != 0 && c.log_ack != 0) c.log_ack(l, *c.log);
     } else if (type == kFrameHello) {
         put(kLinkProtocol);
         put_u32(c.schema);
@@ -249,6 +250,10 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
     if (op >= kOpParamGet && op <= kOpParamInfo) {
         if (c.params == 0 || c.param_apply == 0) return kAckUnknownOp;
         return c.param_apply(l, *c.params, op, a, alen);
+    }
+    if (op >= kOpLogInfo && op <= kOpLogErase) {
+        if (c.log == 0 || c.log_apply == 0) return kAckUnknownOp;
+        return c.log_apply(l, *c.log, op, a, alen);
     }
     if (op == kOpMode) {
         if (alen != 2) return kAckBadLength;
@@ -443,6 +448,58 @@ uint8_t link_param_apply(Link& l, ParamStore& ps, uint8_t op, const uint8_t* a, 
     }
     l.ack_x = bad;
     return st;
+}
+
+// What a recorder command's ack carries after its 6 bytes: INFO's state,
+// READ's record, offset, count and bytes (as many as the transmit buffer holds).
+void link_log_ack(Link& l, const Recorder& r) {
+    LinkConfig c;
+    read_config(l, c);
+    if (l.ack_status != kAckOk) return;
+    LogConfig lc;
+    flash_read(&lc, r.cfg, sizeof lc);
+    if (l.ack_op == kOpLogInfo) {
+        put(r.mode);
+        put(r.flight);
+        put_u16(r.head);
+        put_u16(r.seq);
+        put_u16(lc.slots);
+        put(lc.record);
+        put_u16(r.dropped);
+        put_u32(lc.hash);
+    } else if (l.ack_op == kOpLogRead) {
+        const uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
+        const uint8_t n = r.rd_n < room ? r.rd_n : static_cast<uint8_t>(room);
+        put_u16(r.rd_slot);
+        put(r.rd_off);
+        put(n);
+        uint8_t b[16];
+        for (uint8_t done = 0; done < n;) {
+            const uint8_t k = static_cast<uint8_t>(n - done > sizeof b ? sizeof b : n - done);
+            log_read(r, r.rd_slot, static_cast<uint8_t>(r.rd_off + done), k, b);
+            put_bytes(b, k);
+            done = static_cast<uint8_t>(done + k);
+        }
+    }
+}
+
+// A recorder command (kOpLogInfo..kOpLogErase).
+uint8_t link_log_apply(Link& l, Recorder& r, uint8_t op, const uint8_t* a, uint8_t alen) {
+    (void)l;
+    if (op == kOpLogRead) {
+        if (alen != 4) return kAckBadLength;
+        LogConfig lc;
+        flash_read(&lc, r.cfg, sizeof lc);
+        const uint16_t slot = load<uint16_t>(a);
+        if (slot >= lc.slots || static_cast<uint16_t>(a[2]) + a[3] > lc.record) return kAckOutOfRange;
+        r.rd_slot = slot;
+        r.rd_off = a[2];
+        r.rd_n = a[3];
+        return kAckOk;
+    }
+    if (alen != 0) return kAckBadLength;
+    if (op == kOpLogErase) return log_erase(r) ? static_cast<uint8_t>(kAckOk) : static_cast<uint8_t>(kAckWrongState);
+    return kAckOk;
 }
 
 }  // namespace fsw

@@ -6,6 +6,7 @@
 #define FSW_LINK_H
 
 #include "fsw_executor.h"
+#include "fsw_log.h"
 #include "fsw_param.h"
 #include "fsw_types.h"
 
@@ -38,6 +39,10 @@ enum LinkOp : uint8_t {
     kOpParamStage = 0x0A,   // (id u8, value)...
     kOpParamCommit = 0x0B,  // CRC-16 (u16) of the value block the load makes
     kOpParamInfo = 0x0C,    // no arguments: the ack carries the store's state
+    // the flight recorder (docs/recorder.md); without one: UNKNOWN_OP
+    kOpLogInfo = 0x0D,   // no arguments: the ack carries the recorder's state
+    kOpLogRead = 0x0E,   // record (u16), offset (u8), count (u8): the ack carries the bytes
+    kOpLogErase = 0x0F,  // no arguments: erase every record (only in the states `[log] erase` names)
 };
 
 // Acknowledgement status: 0 applied, anything else refused (a NACK).
@@ -95,6 +100,9 @@ struct Link;
 // generated code passes link_param_apply and link_param_ack (below).
 typedef uint8_t (*LinkParamApplyFn)(Link& link, ParamStore& store, uint8_t op, const uint8_t* args, uint8_t len);
 typedef void (*LinkParamAckFn)(Link& link, const ParamStore& store);
+// The recorder's commands, likewise: generated code passes link_log_apply and link_log_ack.
+typedef uint8_t (*LinkLogApplyFn)(Link& link, Recorder& rec, uint8_t op, const uint8_t* args, uint8_t len);
+typedef void (*LinkLogAckFn)(Link& link, const Recorder& rec);
 
 // The link's configuration: constant data generated from the application
 // config (FSW_FLASH), pointing at the RAM it works in.
@@ -119,6 +127,9 @@ struct LinkConfig {
     ParamStore* params;               // the parameter store (null: no parameters; docs/parameters.md)
     LinkParamApplyFn param_apply;     // link_param_apply, with a store
     LinkParamAckFn param_ack;         // link_param_ack, with a store
+    Recorder* log;                    // the flight recorder (null: none; docs/recorder.md)
+    LinkLogApplyFn log_apply;         // link_log_apply, with a recorder
+    LinkLogAckFn log_ack;             // link_log_ack, with a recorder
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -173,6 +184,9 @@ void link_poll(Link& link);
 // the id a refusal stopped at).
 uint8_t link_param_apply(Link& link, ParamStore& store, uint8_t op, const uint8_t* args, uint8_t len);
 void link_param_ack(Link& link, const ParamStore& store);
+// A recorder command (kOpLogInfo..kOpLogErase), and what its ack carries.
+uint8_t link_log_apply(Link& link, Recorder& rec, uint8_t op, const uint8_t* args, uint8_t len);
+void link_log_ack(Link& link, const Recorder& rec);
 
 // ---- compile-time checks of the tables -------------------------------------
 // The generator emits a static_assert of each for its tables; a hand-written

@@ -17,5 +17,6 @@
 #include "fsw_io.h"
 #include "fsw_link.h"
 #include "fsw_param.h"
+#include "fsw_log.h"
 
 #endif  // FSWKIT_H

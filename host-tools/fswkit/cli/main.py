@@ -254,6 +254,21 @@ def parser() -> argparse.ArgumentParser:
     pa._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     pa.set_defaults(func=_command("param", "cmd_param"))
 
+    du = sub.add_parser("dump", help="a target's flight record over the link, each flight as a link log "
+                                     "(docs/recorder.md)")
+    du.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
+    du.add_argument("--port", required=True, help="serial device or pyserial URL")
+    du.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    du.add_argument("-o", "--output", required=True, metavar="DIR", help="the folder for flight-N.log files")
+    du.add_argument("--flight", type=int, metavar="N", help="this flight (default: the newest)")
+    du.add_argument("--all", action="store_true", help="every flight in the record")
+    du.add_argument("--force", action="store_true", help="replace existing flight-N.log files")
+    du.add_argument("--erase", action="store_true", help="after the dump, erase the record (asks first; only in the "
+                    "states `[log] erase` names)")
+    du.add_argument("--yes", action="store_true", help="--erase without asking")
+    du.add_argument("--ignore-schema", action="store_true", help="talk to the target even when the schema differs")
+    du.set_defaults(func=_command("dump", "cmd_dump"))
+
     lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")
     lc.add_argument("log", metavar="LOG")
     lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")

@@ -55,6 +55,7 @@ class Run:
     ram: dict = field(default_factory=dict)  # what the board's RAM probes said, if it has them
     profile: object = None  # fswkit.sim.board.Profile of the functions `fly` was asked to profile
     resets: list[float] = field(default_factory=list)  # when the MCU was reset (brown-outs the scenario asked for)
+    eeprom: bytes | None = None  # the board's EEPROM after the flight (the flight recorder's store)
 
 
 _cpu_lock = threading.Lock()
@@ -231,6 +232,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         run.wall_s = time.perf_counter() - wall0
         if profile:
             run.profile = b.profile_read()
+        if getattr(board, "eeprom", 0):
+            run.eeprom = b.eeprom_read(0, board.eeprom)
         for probe in ("ram_usage", "stack_high_water"):  # the first the board has
             fn = getattr(b, probe, None)
             if callable(fn):

@@ -1,0 +1,256 @@
+"""The `[log]` section of the application config (docs/recorder.md): what
+the flight recorder keeps, at which rate in which states, and where.
+
+    [log]
+    store   eeprom                # where records go
+    record  64                    # bytes per record, 32..255
+    full    stop                  # stop | newest: what happens when the store is full
+    machine mission               # the machine whose states the lines below name
+    trigger Boost                 # entering this state starts a flight
+    before  0.5                   # seconds kept in RAM before the trigger, committed with it
+    rate    10                    # Hz in the states no other `rate` line names
+    rate    0 Landed Abort        # Hz in these states; 0 records nothing (and ends a flight)
+    erase   Safe                  # the states in which the ground may erase the log
+    element altitude delta=0.1    # an element and its encoding: raw, hold, delta=STEP, quant=STEP
+    element state                 # (a machine's state number: held, one byte)
+
+Every problem is reported where it is written."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from . import model as M
+from .appsyntax import Setting
+from .lexer import ID, NUM, OP, Tok
+from .limits import hz
+from .numeric import exact_literal
+
+KEYS = ("store", "record", "full", "machine", "trigger", "before", "rate", "erase", "element")
+ONCE = ("store", "record", "full", "machine", "trigger", "before", "erase")
+ENCODINGS = ("raw", "hold", "delta", "quant")
+MAX_BEFORE = 60
+
+
+def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine],
+              board, r) -> M.Log | None:
+    """The checked `[log]` section, None when it is absent or has errors
+    (reported through `r`, appcheck's Report)."""
+    rec_task = next((t for t in tasks if t.kind == "recorder"), None)
+    if not rows:
+        if rec_task is not None:
+            r.at(rec_task.line, 1, f"task `{rec_task.name}` is a `recorder` but the application has no [log] section")
+        return None
+    first = rows[0].key
+    before_errors = r.diags.error_count
+    once: dict[str, Setting] = {}
+    rates: list[Setting] = []
+    elements: list[Setting] = []
+    for s in rows:
+        k = s.key.text
+        if k not in KEYS:
+            r.err(s.key, f"unknown [log] setting `{k}`: expected one of {', '.join(KEYS)}")
+        elif k in ONCE:
+            if k in once:
+                r.err(s.key, f"`{k}` given twice (first on line {once[k].key.line})")
+            else:
+                once[k] = s
+        elif k == "rate":
+            rates.append(s)
+        else:
+            elements.append(s)
+    if rec_task is None:
+        r.err(first, "[log] needs a `recorder` task in [tasks] (e.g. `log recorder rate=100`)")
+    for k in ("store", "machine", "trigger"):
+        if k not in once:
+            r.err(first, f"[log] needs `{k}`")
+    if not elements:
+        r.err(first, "[log] needs at least one `element`")
+
+    store = _one_word(once.get("store"), ("eeprom",), "eeprom", r)
+    if store == "eeprom" and board is not None and board.eeprom == 0:
+        r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
+    record = _record(once.get("record"), r)
+    full = _one_word(once.get("full"), ("stop", "newest"), "stop", r)
+    machine = _machine(once.get("machine"), machines, r)
+    m = machines[machine] if machine is not None else None
+    trigger = _states(once.get("trigger"), m, r, one=True)
+    before = _before(once.get("before"), r)
+    erase = _states(once.get("erase"), m, r) if "erase" in once else ((m.states[0].id,) if m else ())
+    state_rates = _rates(rates, m, rec_task, r)
+    if trigger and state_rates is not None and state_rates[trigger[0]] == 0:
+        r.err(once["trigger"].values[0], f"the trigger state `{once['trigger'].values[0].text}` records nothing "
+                                         "(rate 0): a flight would end as it starts")
+    fields = _fields(elements, sv, machines, r)
+    if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
+        return None
+    order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
+    fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
+    return M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line)
+
+
+def _one_word(s: Setting | None, words: tuple[str, ...], default: str, r) -> str | None:
+    if s is None:
+        return default
+    if len(s.values) != 1 or s.values[0].text not in words:
+        at = s.values[0] if s.values else s.key
+        r.err(at, f"`{s.key.text}` takes one of: {', '.join(words)}")
+        return None
+    return s.values[0].text
+
+
+def _record(s: Setting | None, r) -> int:
+    if s is None:
+        return 64
+    t = s.values[0] if s.values else s.key
+    if len(s.values) != 1 or t.kind != NUM or not t.text.isdigit() or not 32 <= int(t.text) <= 255:
+        r.err(t, "`record` takes the bytes of a record: a whole number from 32 to 255")
+        return 64
+    return int(t.text)
+
+
+def _machine(s: Setting | None, machines: list[M.Machine], r) -> int | None:
+    if s is None:
+        return None
+    names = [m.name for m in machines]
+    if len(s.values) != 1 or s.values[0].text not in names:
+        r.err(s.values[0] if s.values else s.key,
+              f"`machine` takes the name of a machine from [configs] ({', '.join(names) or 'none'})")
+        return None
+    return names.index(s.values[0].text)
+
+
+def _states(s: Setting | None, m: M.Machine | None, r, one: bool = False) -> tuple[int, ...]:
+    if s is None or m is None:
+        return ()
+    if not s.values or (one and len(s.values) != 1):
+        r.err(s.values[1] if len(s.values) > 1 else s.key,
+              f"`{s.key.text}` takes {'one state' if one else 'states'} of machine `{m.name}`")
+        return ()
+    by_name = {st.name: st.id for st in m.states}
+    out = []
+    for t in s.values:
+        if t.text not in by_name:
+            r.err(t, f"machine `{m.name}` has no state `{t.text}` (states: {', '.join(by_name)})")
+        else:
+            out.append(by_name[t.text])
+    return tuple(out)
+
+
+def _before(s: Setting | None, r) -> Fraction:
+    if s is None:
+        return Fraction(0)
+    t = s.values[0] if s.values else s.key
+    q = exact_literal(t.text) if t.kind == NUM and len(s.values) == 1 else None
+    if q is None or not 0 <= q <= MAX_BEFORE:
+        r.err(t, f"`before` takes the seconds kept before the trigger: a number from 0 to {MAX_BEFORE}")
+        return Fraction(0)
+    return q
+
+
+def _rates(rows: list[Setting], m: M.Machine | None, task: M.Task | None, r) -> tuple[Fraction, ...] | None:
+    """Hz by state id (index 0 unused); None on an error."""
+    if m is None:
+        return None
+    default: Fraction | None = None
+    default_line = 0
+    named: dict[int, tuple[Fraction, int]] = {}
+    ok = True
+    by_name = {st.name: st.id for st in m.states}
+    for s in rows:
+        if not s.values:
+            r.err(s.key, "`rate` takes Hz, then the states it applies to (none: every other state)")
+            ok = False
+            continue
+        t = s.values[0]
+        q = exact_literal(t.text) if t.kind == NUM else None
+        if q is None or q < 0:
+            r.err(t, f"`rate` takes Hz (0 or a positive number), found `{t.text}`")
+            ok = False
+            continue
+        if q != 0 and task is not None and (task.rate / q).denominator != 1:
+            r.err(t, f"log rate {t.text} Hz must divide the recorder task's rate {hz(task.rate)} Hz")
+            ok = False
+            continue
+        if q != 0 and task is not None and task.rate / q > 255:
+            r.err(t, f"log rate {t.text} Hz is below 1/255 of the recorder task's rate {hz(task.rate)} Hz")
+            ok = False
+            continue
+        if len(s.values) == 1:
+            if default is not None:
+                r.err(s.key, f"a second `rate` for every other state (the first is on line {default_line})")
+                ok = False
+            default, default_line = q, s.key.line
+            continue
+        for st in s.values[1:]:
+            if st.text not in by_name:
+                r.err(st, f"machine `{m.name}` has no state `{st.text}` (states: {', '.join(by_name)})")
+                ok = False
+            elif by_name[st.text] in named:
+                r.err(st, f"state `{st.text}` already has a rate on line {named[by_name[st.text]][1]}")
+                ok = False
+            else:
+                named[by_name[st.text]] = (q, st.line)
+    if not ok:
+        return None
+    base = default if default is not None else Fraction(0)
+    return (Fraction(0),) + tuple(named.get(st.id, (base, 0))[0] for st in m.states)
+
+
+def _fields(rows: list[Setting], sv: M.StateVector, machines: list[M.Machine], r) -> list[M.LogField] | None:
+    by_name = {e.name: e for e in sv.elements}
+    states = {m.vars[m.s].name: len(m.states) for m in machines}  # state elements: their machine's state count
+    out: list[M.LogField] = []
+    seen: dict[str, int] = {}
+    ok = True
+    for s in rows:
+        if not s.values or s.values[0].kind != ID:
+            r.err(s.values[0] if s.values else s.key, "`element` takes an element of the state vector, then its "
+                                                      "encoding: raw, hold, delta=STEP or quant=STEP")
+            ok = False
+            continue
+        et = s.values[0]
+        e = by_name.get(et.text)
+        if e is None:
+            r.err(et, f"unknown element `{et.text}`")
+            ok = False
+            continue
+        if et.text in seen:
+            r.err(et, f"element `{et.text}` is logged twice (first on line {seen[et.text]})")
+            ok = False
+            continue
+        seen[et.text] = et.line
+        f = _encoding(s, e, states.get(e.name), r)
+        if f is None:
+            ok = False
+        else:
+            out.append(f)
+    if len(out) > 32:
+        r.err(rows[32].key, "at most 32 elements are logged")
+        ok = False
+    return out if ok else None
+
+
+def _encoding(s: Setting, e: M.Element, n_states: int | None, r) -> M.LogField | None:
+    rest = s.values[1:]
+    narrow = 1 if n_states is not None and n_states < 256 else e.type.size  # a state number fits a byte
+    if not rest:
+        return M.LogField(e, "hold" if n_states is not None else "raw", None, narrow, s.key.line)
+    w = rest[0]
+    if w.kind == ID and w.text in ("raw", "hold") and len(rest) == 1:
+        if e.type.size > 8:
+            r.err(w, f"element `{e.name}` cannot be logged")
+            return None
+        return M.LogField(e, w.text, None, narrow, s.key.line)
+    if w.kind == ID and w.text in ("delta", "quant") and len(rest) == 3 and rest[1].kind == OP \
+            and rest[1].text == "=" and rest[2].kind == NUM:
+        if e.type.name != "F32":
+            r.err(w, f"`{w.text}=STEP` encodes F32 elements; `{e.name}` is {e.type.name} (log it `raw`)")
+            return None
+        q = exact_literal(rest[2].text)
+        if q is None or q <= 0 or q > 10**6:
+            r.err(rest[2], f"`{w.text}=` takes the value of one count: a positive number, found `{rest[2].text}`")
+            return None
+        return M.LogField(e, w.text, q, 4 if w.text == "delta" else 2, s.key.line)
+    r.err(w, f"unknown encoding `{' '.join(t.text for t in rest)}`: expected raw, hold, delta=STEP or quant=STEP")
+    return None

@@ -1,0 +1,433 @@
+// The flight recorder (docs/recorder.md). Three parts that never wait:
+//   - the task samples the chosen elements into a RAM ring (before the
+//     trigger the ring keeps the newest `before` seconds; after it, it is the
+//     queue in front of the encoder);
+//   - the encoder turns queued samples into the bytes of the open record
+//     (held values in its header, deltas, escapes) and pushes them into a
+//     small fifo, closing the record when a sample does not fit it;
+//   - the writer (log_poll) puts one fifo byte into the EEPROM whenever it is
+//     ready: a record's first byte is cleared first and written last, so a
+//     power cut leaves every record whole or invalid.
+#include "fsw_log.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "fsw_crc.h"
+#include "fsw_pal.h"
+
+namespace fsw {
+
+namespace {
+
+// The writer's phases (Recorder::w_phase).
+enum Phase : uint8_t {
+    kWIdle = 0,
+    kWClear = 1,  // the record's first byte becomes 0: no longer a valid record
+    kWBody = 2,   // fifo bytes, in order, from byte 1
+    kWTail = 3,   // the record is sealed: period, used, CRC at its end
+    kWMagic = 4,  // last: its kind, and the record is whole
+    kWErase = 5,  // every record's first byte becomes 0
+};
+
+// Recorder::flags
+static const uint8_t kSealed = 0x01;     // the open record takes no more bytes
+static const uint8_t kStartDue = 0x02;   // the flight's start record is still to be written
+static const uint8_t kEnding = 0x04;     // the state records nothing: close the flight once drained
+
+LogConfig config(const Recorder& r) {
+    LogConfig c;
+    flash_read(&c, r.cfg, sizeof c);
+    return c;
+}
+
+LogField field(const LogConfig& c, uint8_t i) {
+    LogField f;
+    flash_read(&f, &c.fields[i], sizeof f);
+    return f;
+}
+
+uint8_t table_u8(const uint8_t* table, uint8_t i) {
+    uint8_t v;
+    flash_read(&v, table + i, 1);
+    return v;
+}
+
+uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_cast<uint32_t>(slot) * c.record; }
+
+uint8_t store_read(uint32_t addr) { return pal::eeprom_read(static_cast<uint16_t>(addr)); }
+
+// Whether slot `s` holds a whole record; its sequence number and flight.
+bool slot_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) {
+    const uint32_t a = slot_addr(c, s);
+    const uint8_t magic = store_read(a);
+    if (magic != kLogStart && magic != kLogData) return false;
+    const uint8_t used = store_read(a + c.record - 3u);
+    if (used < kLogHeader || used > c.record - kLogTail) return false;
+    uint16_t crc = kCrcInit;
+    for (uint8_t i = 0; i < used; ++i) crc = crc16_update(crc, store_read(a + i));
+    for (uint8_t i = c.record - kLogTail; i < c.record - 2u; ++i) crc = crc16_update(crc, store_read(a + i));
+    const uint16_t stored = static_cast<uint16_t>(store_read(a + c.record - 2u) | (store_read(a + c.record - 1u) << 8));
+    if (crc != stored) return false;
+    seq = static_cast<uint16_t>(store_read(a + 1u) | (store_read(a + 2u) << 8));
+    flight = store_read(a + 3u);
+    return true;
+}
+
+uint32_t now_ms(const LogConfig& c) {
+    uint64_t t;
+    memcpy(&t, c.sv + c.time_off, sizeof t);
+    if (c.time_us) t /= 1000u;
+    return static_cast<uint32_t>(t);
+}
+
+uint8_t state_of(const LogConfig& c) {
+    uint32_t s;
+    memcpy(&s, c.sv + c.state_off, sizeof s);
+    return s < c.n_states ? static_cast<uint8_t>(s) : 0u;
+}
+
+int32_t quantise(float v, float scale, int32_t lim) {
+    const float q = v * scale;
+    if (!(q > -static_cast<float>(lim))) return -lim;  // NaN too
+    if (q > static_cast<float>(lim)) return lim;
+    return static_cast<int32_t>(lroundf(q));
+}
+
+// One sample of every field, absolute, into `out` (sample_size - 2 bytes).
+void take(const LogConfig& c, uint8_t* out) {
+    for (uint8_t i = 0; i < c.n_fields; ++i) {
+        const LogField f = field(c, i);
+        const uint8_t* p = c.sv + f.off;
+        if (f.enc == kLogDelta || f.enc == kLogQuant) {
+            float v;
+            memcpy(&v, p, sizeof v);
+            const int32_t q = quantise(v, f.scale, f.enc == kLogDelta ? 0x7FFFFFFFL : 0x7FFFL);
+            memcpy(out, &q, f.width);  // little-endian: the low bytes
+        } else {
+            memcpy(out, p, f.width);
+        }
+        out += f.width;
+    }
+}
+
+uint8_t* ring_at(const LogConfig& c, const Recorder& r, uint8_t k) {
+    uint8_t i = static_cast<uint8_t>(r.r_first + k);
+    if (i >= c.ring_cap) i = static_cast<uint8_t>(i - c.ring_cap);
+    return c.ring + static_cast<uint16_t>(i) * c.sample_size;
+}
+
+void ring_pop(const LogConfig& c, Recorder& r) {
+    r.r_first = static_cast<uint8_t>(r.r_first + 1u == c.ring_cap ? 0u : r.r_first + 1u);
+    --r.r_len;
+}
+
+// A ring sample's full time from its low 16 bits: samples are younger than 65 s.
+uint32_t sample_time(const uint8_t* s, uint32_t now) {
+    uint16_t t16;
+    memcpy(&t16, s, 2);
+    return now - static_cast<uint16_t>(static_cast<uint16_t>(now) - t16);
+}
+
+void push(const LogConfig& c, Recorder& r, uint8_t b) {
+    uint8_t i = static_cast<uint8_t>(r.f_head + r.f_len);
+    if (i >= c.fifo_cap) i = static_cast<uint8_t>(i - c.fifo_cap);
+    c.fifo[i] = b;
+    ++r.f_len;
+    ++r.used;
+    r.crc = crc16_update(r.crc, b);
+}
+
+void push_n(const LogConfig& c, Recorder& r, const void* p, uint8_t n) {
+    const uint8_t* b = static_cast<const uint8_t*>(p);
+    for (uint8_t i = 0; i < n; ++i) push(c, r, b[i]);
+}
+
+// Opens a record of `kind` in the head slot: false when the store is full.
+bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0) {
+    if (r.head >= c.slots) {
+        if (!c.newest) {
+            r.mode = kLogFull;
+            return false;
+        }
+        r.head = 0;
+    }
+    r.kind = kind;
+    r.used = 1;  // the kind: written last, counted in the CRC first
+    r.crc = crc16_update(kCrcInit, kind);
+    r.period = 0;
+    r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
+    r.w_slot = r.head;
+    r.w_phase = kWClear;
+    push_n(c, r, &r.seq, 2);
+    push(c, r, r.flight);
+    push_n(c, r, &t0, 4);
+    return true;
+}
+
+void seal(Recorder& r) { r.flags |= kSealed; }
+
+// The flight's start record: trigger time, schema and log hashes.
+void write_start(const LogConfig& c, Recorder& r) {
+    if (!open_record(c, r, kLogStart, r.t_trigger)) return;
+    push_n(c, r, &c.schema, 4);
+    push_n(c, r, &c.hash, 4);
+    seal(r);
+    r.flags = static_cast<uint8_t>(r.flags & ~kStartDue);
+}
+
+// Bytes the sample `s` takes appended to the open record (escapes
+// included), 0 when it cannot be appended: another period, a difference out
+// of range, a held change without escapes, or no room.
+uint8_t append_size(const LogConfig& c, const Recorder& r, const uint8_t* s, uint32_t t) {
+    if (r.period == 0 ? t == r.t_next || t - r.t_next > 0xFFFFu : t != r.t_next + r.period) return 0;
+    uint8_t n = 0;
+    const uint8_t* v = s + 2;
+    const uint8_t* l = c.last;
+    for (uint8_t i = 0; i < c.n_fields; ++i) {
+        const LogField f = field(c, i);
+        if (f.enc == kLogHold) {
+            if (memcmp(v, l, f.width) != 0) {
+                if (!c.escape) return 0;
+                n = static_cast<uint8_t>(n + 2u + f.width);
+            }
+        } else if (f.enc == kLogDelta) {
+            int32_t q, p;
+            memcpy(&q, v, 4);
+            memcpy(&p, l, 4);
+            const int32_t d = q - p;
+            if (d < -127 || d > 127) return 0;
+            ++n;
+        } else {
+            n = static_cast<uint8_t>(n + f.width);
+        }
+        v += f.width;
+        l += f.width;
+    }
+    return r.used + n + kLogTail <= c.record ? n : 0;
+}
+
+void append(const LogConfig& c, Recorder& r, const uint8_t* s) {
+    const uint8_t* v = s + 2;
+    uint8_t* l = c.last;
+    for (uint8_t i = 0; i < c.n_hold; ++i) {  // escapes first: [0x80, field, value]
+        const LogField f = field(c, i);
+        if (memcmp(v, l, f.width) != 0) {
+            push(c, r, kLogEscape);
+            push(c, r, i);
+            push_n(c, r, v, f.width);
+        }
+        v += f.width;
+        l += f.width;
+    }
+    for (uint8_t i = c.n_hold; i < c.n_fields; ++i) {
+        const LogField f = field(c, i);
+        if (f.enc == kLogDelta) {
+            int32_t q, p;
+            memcpy(&q, v, 4);
+            memcpy(&p, l, 4);
+            push(c, r, static_cast<uint8_t>(static_cast<int8_t>(q - p)));
+        } else {
+            push_n(c, r, v, f.width);
+        }
+        v += f.width;
+        l += f.width;
+    }
+    memcpy(c.last, s + 2, c.sample_size - 2u);
+}
+
+// Moves queued samples into records while the fifo has room.
+void encode(const LogConfig& c, Recorder& r, uint32_t now) {
+    for (;;) {
+        if (r.w_phase >= kWTail || (r.flags & kSealed)) return;  // the sealed record is being finished
+        if (r.w_phase == kWIdle) {  // nothing open
+            if (r.mode != kLogRecording) return;
+            if (r.flags & kStartDue) {
+                write_start(c, r);
+                return;
+            }
+            if (r.r_len == 0) {
+                if (r.flags & kEnding) r.mode = kLogIdle;  // the flight is over
+                return;
+            }
+            const uint8_t* s = ring_at(c, r, 0);
+            const uint32_t t = sample_time(s, now);
+            if (!open_record(c, r, kLogData, t)) return;
+            const uint8_t* v = s + 2;
+            for (uint8_t i = 0; i < c.n_fields; ++i) {  // held values, then the first sample
+                const LogField f = field(c, i);
+                push_n(c, r, v, f.width);
+                v += f.width;
+            }
+            memcpy(c.last, s + 2, c.sample_size - 2u);
+            r.t_next = t;
+            ring_pop(c, r);
+            continue;
+        }
+        if (r.r_len == 0) {
+            if (r.flags & kEnding) seal(r);
+            return;
+        }
+        const uint8_t* s = ring_at(c, r, 0);
+        const uint32_t t = sample_time(s, now);
+        const uint8_t n = append_size(c, r, s, t);
+        if (n == 0) {
+            seal(r);
+            return;
+        }
+        if (r.f_len + n > c.fifo_cap) return;  // the writer catches up first
+        if (r.period == 0) r.period = static_cast<uint16_t>(t - r.t_next);
+        r.t_next = t;
+        append(c, r, s);
+        ring_pop(c, r);
+    }
+}
+
+// Before the trigger: drops the oldest samples while the one after it is
+// still at least `before` old, so what is kept covers `before` whole.
+void trim(const LogConfig& c, Recorder& r, uint32_t now) {
+    while (r.r_len >= 2 && now - sample_time(ring_at(c, r, 1), now) >= c.before_ms) ring_pop(c, r);
+}
+
+}  // namespace
+
+void log_begin(Recorder& r, const LogConfig* cfg) {
+    memset(&r, 0, sizeof r);
+    r.cfg = cfg;
+    const LogConfig c = config(r);
+    bool any = false;
+    uint16_t best = 0, best_seq = 0;
+    uint8_t best_flight = 0;
+    for (uint16_t s = 0; s < c.slots; ++s) {
+        uint16_t seq;
+        uint8_t flight;
+        if (!slot_valid(c, s, seq, flight)) continue;
+        if (!any || static_cast<int16_t>(seq - best_seq) > 0) {
+            any = true;
+            best = s;
+            best_seq = seq;
+            best_flight = flight;
+        }
+    }
+    if (any) {
+        r.head = static_cast<uint16_t>(best + 1u);
+        r.seq = static_cast<uint16_t>(best_seq + 1u);
+        r.flight = best_flight;
+        if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+    }
+    r.state = state_of(c);
+}
+
+Result log_task(void* ctx) {
+    Recorder& r = *static_cast<Recorder*>(ctx);
+    const LogConfig c = config(r);
+    const uint8_t prev = r.state;
+    const uint8_t st = state_of(c);
+    r.state = st;
+    const uint32_t now = now_ms(c);
+    const uint8_t div = table_u8(c.divider, st);
+    if (r.mode == kLogIdle && st == c.trigger && prev != c.trigger) {
+        r.mode = kLogRecording;
+        r.flight = static_cast<uint8_t>(r.flight == 0xFF ? 1u : r.flight + 1u);
+        r.t_trigger = now;
+        r.flags = kStartDue;
+        trim(c, r, now);
+    }
+    if (r.mode == kLogRecording) {
+        if (div == 0) r.flags |= kEnding;
+        else r.flags = static_cast<uint8_t>(r.flags & ~kEnding);
+    }
+    if (div != 0 && r.runs % div == 0 && (r.mode == kLogIdle || r.mode == kLogRecording)) {
+        if (r.r_len == c.ring_cap) {
+            if (r.mode == kLogIdle) {
+                ring_pop(c, r);  // before the trigger: the oldest goes
+            } else if (r.dropped != 0xFFFFu) {
+                ++r.dropped;
+            }
+        }
+        if (r.r_len < c.ring_cap) {
+            uint8_t* s = ring_at(c, r, r.r_len);
+            const uint16_t t16 = static_cast<uint16_t>(now);
+            memcpy(s, &t16, 2);
+            take(c, s + 2);
+            ++r.r_len;
+        }
+    }
+    ++r.runs;
+    if (r.mode == kLogIdle) trim(c, r, now);  // keep only what the trigger would commit
+    encode(c, r, now);
+    return kOk;
+}
+
+void log_poll(Recorder& r) {
+    if (r.w_phase == kWIdle || !pal::eeprom_ready()) return;
+    const LogConfig c = config(r);
+    const uint32_t a = slot_addr(c, r.w_slot);
+    switch (r.w_phase) {
+    case kWClear:
+        pal::eeprom_write(static_cast<uint16_t>(a), 0x00);
+        r.w_phase = kWBody;
+        r.w_pos = 1;
+        return;
+    case kWBody:
+        if (r.f_len != 0) {
+            pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), c.fifo[r.f_head]);
+            r.f_head = static_cast<uint8_t>(r.f_head + 1u == c.fifo_cap ? 0u : r.f_head + 1u);
+            --r.f_len;
+            ++r.w_pos;
+        } else if (r.flags & kSealed) {
+            const uint8_t tail[3] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used};
+            for (uint8_t i = 0; i < 3; ++i) r.crc = crc16_update(r.crc, tail[i]);
+            r.w_phase = kWTail;
+            r.w_pos = static_cast<uint8_t>(c.record - kLogTail);
+        }
+        return;
+    case kWTail: {
+        const uint8_t k = static_cast<uint8_t>(r.w_pos - (c.record - kLogTail));
+        const uint8_t tail[5] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used,
+                                 static_cast<uint8_t>(r.crc), static_cast<uint8_t>(r.crc >> 8)};
+        pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), tail[k]);
+        if (++r.w_pos == c.record) r.w_phase = kWMagic;
+        return;
+    }
+    case kWMagic:
+        pal::eeprom_write(static_cast<uint16_t>(a), r.kind);
+        r.w_phase = kWIdle;
+        r.used = 0;
+        r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
+        ++r.head;
+        ++r.seq;
+        if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+        return;
+    case kWErase:
+        pal::eeprom_write(static_cast<uint16_t>(a), 0x00);
+        if (++r.w_slot == c.slots) {
+            r.w_phase = kWIdle;
+            r.head = 0;
+            r.mode = kLogIdle;
+        }
+        return;
+    default:
+        r.w_phase = kWIdle;
+    }
+}
+
+bool log_erase(Recorder& r) {
+    const LogConfig c = config(r);
+    if (r.mode == kLogRecording || r.mode == kLogErasing || r.w_phase != kWIdle) return false;
+    if (table_u8(c.erase_ok, state_of(c)) == 0) return false;
+    r.mode = kLogErasing;
+    r.r_len = 0;
+    r.f_len = 0;
+    r.w_slot = 0;
+    r.w_phase = kWErase;
+    return true;
+}
+
+void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
+    const LogConfig c = config(r);
+    const uint32_t a = slot_addr(c, slot) + off;
+    for (uint8_t i = 0; i < n; ++i) out[i] = store_read(a + i);
+}
+
+}  // namespace fsw

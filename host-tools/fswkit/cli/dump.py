@@ -1,0 +1,136 @@
+"""`fsw dump PROJECT --port P [--flight N | --all] -o DIR [--erase]`: a
+target's flight record over the link, each flight written as a link log
+(docs/recorder.md)."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+
+
+def _say(msg: str) -> None:
+    sys.stderr.write(f"fsw dump: {msg}\n")
+
+
+def cmd_dump(args) -> int:
+    from fswkit.autocode.recorder import plan
+    from fswkit.target.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags)
+    except BuildError as e:
+        _say(str(e))
+        return EXIT_CONFIG
+    print_diags(diags)
+    if app is None:
+        return EXIT_CONFIG
+    p = plan(app)
+    if p is None:
+        _say(f"{args.project}: the application has no flight recorder (a [log] section, docs/recorder.md)")
+        return EXIT_CONFIG
+    if args.flight is not None and args.all:
+        _say("--flight N and --all: choose one")
+        return EXIT_CONFIG
+    if os.path.exists(args.output) and not os.path.isdir(args.output):
+        _say(f"{args.output} is not a folder")
+        return EXIT_CONFIG
+    return _talk(args, app, p)
+
+
+def _talk(args, app, p) -> int:
+    from fswkit.autocode.recorder import RecordError, decode
+    from fswkit.autocode.schema import link_plan
+    from fswkit.autocode.protocol import OP_LOG_ERASE
+    from fswkit.ground.monitor import schema_message, summary
+    from fswkit.link.client import Ground, LinkTimeout
+    from fswkit.link.layout import from_app
+    from fswkit.link.log import LogError
+    from fswkit.link.port import PortError, open_port
+    from fswkit.link.session import Session
+    from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
+
+    session = Session(from_app(app), ignore_schema=args.ignore_schema)
+    baud = args.baud or app.baud
+    try:
+        port = open_port(args.port, baud)
+    except PortError as e:
+        _say(str(e))
+        return EXIT_FAIL
+    try:
+        ground = Ground(port, session)
+        try:
+            ground.handshake(timeout=3.0)
+        except LinkTimeout as e:
+            _say(f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session))
+            return EXIT_FAIL
+        if not session.hello["schema_ok"] and not args.ignore_schema:
+            _say(schema_message(session, args.project))
+            return EXIT_FAIL
+
+        def command(op, a):
+            return ground.command(op, a, tries=5, timeout=0.5)
+
+        try:
+            inf = query_info(command)
+            if (inf["hash"], inf["slots"], inf["record"]) != (p.hash, p.slots, p.record):
+                _say(f"the target's recorder (log hash {inf['hash']:08x}, {inf['slots']} records of "
+                     f"{inf['record']} B) is not this project's ({p.hash:08x}, {p.slots} of {p.record} B): "
+                     "dump with the project the firmware was built from")
+                return EXIT_FAIL
+            print(f"recorder: {inf['mode_name']}, flight {inf['flight']}, {inf['slots']} records of "
+                  f"{inf['record']} B, next {inf['head']}; {inf['dropped']} samples dropped")
+            image = read_image(command, p, link_plan(app).tx_cap)
+        except (DumpError, LinkTimeout) as e:
+            _say(str(e))
+            return EXIT_FAIL
+        try:
+            flights, empty = decode(p, image)
+        except RecordError as e:
+            _say(f"{e}: the records were not written by this project's firmware")
+            return EXIT_FAIL
+        print(f"{len(flights)} flight(s) in {p.slots - empty} record(s); {empty} record(s) empty or torn")
+        chosen = flights
+        if args.flight is not None:
+            chosen = [f for f in flights if f.number == args.flight]
+            if not chosen:
+                _say(f"no flight {args.flight} in the record (flights: "
+                     f"{', '.join(str(f.number) for f in flights) or 'none'})")
+                return EXIT_FAIL
+        elif not args.all and flights:
+            chosen = flights[-1:]  # the newest
+        os.makedirs(args.output, exist_ok=True)
+        for f in chosen:
+            path = os.path.join(args.output, f"flight-{f.number}.log")
+            try:
+                n = write_flight(path, app, p, f, force=args.force)
+            except LogError as e:
+                _say(str(e))
+                return EXIT_FAIL
+            s = f.samples
+            span = f"{s[0][0] / 1000:.2f}–{s[-1][0] / 1000:.2f} s" if s else "no samples"
+            trig = f", trigger at {f.start.t0 / 1000:.2f} s" if f.start else ", its start record overwritten"
+            print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
+        if args.erase:
+            if not args.yes:
+                if not sys.stdin.isatty():
+                    _say("--erase asks for a confirmation: add --yes when no one is at the terminal")
+                    return EXIT_FAIL
+                answer = input(f"erase every record on the target ({len(flights)} flight(s), dumped above)? "
+                               "type `erase`: ")
+                if answer.strip() != "erase":
+                    print("not erased")
+                    return EXIT_OK
+            ack = command(OP_LOG_ERASE, b"")
+            if ack["status"] != 0:
+                allowed = [n for i, n in enumerate(p.states) if p.erase_ok[i + 1]]
+                _say(f"the target refused to erase: {ack['reason']} (erasing is allowed in "
+                     f"{', '.join(allowed)}, and never while a flight is recorded)")
+                return EXIT_FAIL
+            print("erasing the record on the target")
+        return EXIT_OK
+    finally:
+        port.close()

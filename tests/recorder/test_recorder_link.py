@@ -1,0 +1,110 @@
+"""`fsw dump` against the firmware: the tests/recorder/logged rig built for
+`native` runs with its console on a pseudo-terminal and its EEPROM in a
+file. Its pin 2 starts one-second "flights"; the ground dumps them as link
+logs that `fsw log2csv` reads, each sample checking itself (the level is the
+time / 4, the count goes up by one per step). The record survives restarts;
+erasing asks first and is refused while the machine is in a state that
+does not allow it."""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import run_fsw
+from support.linkfw import PtyTarget, needs_cxx
+
+pytestmark = needs_cxx()
+RIG = Path(__file__).resolve().parent / "logged"
+
+
+@pytest.fixture(scope="module")
+def exe(tmp_path_factory):
+    out = tmp_path_factory.mktemp("logged")
+    r = run_fsw("build", str(RIG), "--board", "native", "--out", str(out))
+    assert r.code == 0, r.err
+    return out / "logged"
+
+
+def dump(port, out, *args):
+    return run_fsw("dump", str(RIG), "--port", port, "-o", str(out), *args)
+
+
+def rows(log: Path) -> list[dict]:
+    r = run_fsw("log2csv", str(log))
+    assert r.code == 0, r.err
+    return list(csv.DictReader(io.StringIO(r.out)))
+
+
+def check_flight(samples: list[dict]) -> None:
+    """Every sample of a flight checks itself; samples are 20 ms apart."""
+    assert samples
+    times = [int(float(s["time_ms"])) if "time_ms" in s else None for s in samples]
+    prev = None
+    for s in samples:
+        t = int(round(float(s[next(k for k in s if k.startswith("time"))])))
+        assert float(s["level"]) == pytest.approx(t / 4, abs=0.125)
+        count = int(s["count"])
+        if prev is not None and int(s["state"]) == 2:
+            assert t - prev[0] == 20
+            if prev[2] == 2:
+                assert count == prev[1] + 2  # the machine counts every 10 ms step, the log takes every second
+        prev = (t, count, int(s["state"]))
+    assert times is not None
+
+
+def test_a_flight_is_dumped_as_a_log_and_survives_a_restart(exe, tmp_path):
+    eeprom = tmp_path / "eeprom.bin"
+    out = tmp_path / "dump"
+    with PtyTarget(exe, "--eeprom", str(eeprom), "d2=1") as t:
+        time.sleep(1.6)  # Idle -> Run (the flight, 1 s) -> Done
+        r = dump(t.port, out)
+        assert r.code == 0, r.err
+        assert "1 flight(s)" in r.out and "flight 1:" in r.out
+    samples = rows(out / "flight-1.log")
+    states = [int(s["state"]) for s in samples]
+    assert states[0] == 1 and 2 in states  # the seconds before the trigger (Idle), then Run
+    assert sum(st == 2 for st in states) >= 49  # 50 Hz for one second
+    check_flight(samples)
+    # a restart: the next flight is appended, numbered 2, and flight 1 is unchanged
+    with PtyTarget(exe, "--eeprom", str(eeprom), "d2=1") as t:
+        time.sleep(1.6)
+        r = dump(t.port, out, "--all")
+        assert r.code == 2 or r.code == 1, r.out  # flight-1.log exists: never overwritten without --force
+        assert "exists" in r.err
+        r = dump(t.port, out, "--all", "--force")
+        assert r.code == 0, r.err
+        assert "2 flight(s)" in r.out
+    assert rows(out / "flight-1.log") == samples
+    check_flight(rows(out / "flight-2.log"))
+
+
+def test_erase_asks_first_and_only_in_the_allowed_states(exe, tmp_path):
+    eeprom = tmp_path / "eeprom.bin"
+    out = tmp_path / "dump"
+    with PtyTarget(exe, "--eeprom", str(eeprom), "d2=1") as t:
+        time.sleep(1.6)
+        r = dump(t.port, out, "--erase")  # no terminal, no --yes: refused, nothing erased
+        assert r.code != 0 and "--yes" in r.err
+        r = dump(t.port, out, "--erase", "--yes", "--force")
+        assert r.code == 0 and "erasing" in r.out, r.err
+        time.sleep(0.3)
+        r = dump(t.port, tmp_path / "again")
+        assert r.code == 0 and "0 flight(s)" in r.out, r.out + r.err
+
+
+def test_erase_is_refused_while_a_flight_is_recorded(exe, tmp_path):
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin"), "d2=1") as t:
+        time.sleep(0.3)  # in Run: recording
+        r = dump(t.port, tmp_path / "d", "--erase", "--yes")
+        assert r.code != 0 and "refused to erase" in r.err and "Idle, Done" in r.err, r.out + r.err
+
+
+def test_a_project_without_a_recorder_is_told_so(tmp_path):
+    r = run_fsw("dump", str(Path(__file__).resolve().parents[1] / "param" / "tuned"), "--port", "/dev/null",
+                "-o", str(tmp_path))
+    assert r.code == 2 and "no flight recorder" in r.err

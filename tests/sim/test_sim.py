@@ -402,3 +402,20 @@ def test_protocol_errors_are_messages(spin_uno):
         with pytest.raises(SimError, match="usage: step"):
             b.exchange(["step x", "step 100", "info"])
         assert b.info()["mcu"] == "atmega328p"  # still answering, in step
+
+
+def test_an_input_driven_again_after_a_reset_reaches_the_pin(toggle_uno):
+    """A reset clears the PIN registers; driving an input to the level it
+    had before must reach the pin again (simavr drops a raise of an IRQ's
+    current value: a brown-out flight's arming key read low after the reset)."""
+    with SimBoard(toggle_uno, "uno", sim_limit=5) as b:
+        b.run_for(0.01)
+        b.set_digital(2, True)
+        b.run_for(0.01)
+        assert b.ports()["D"][2] & 0x04
+        b.reset()
+        b.run_for(0.01)
+        assert not b.ports()["D"][2] & 0x04  # power-on level
+        b.set_digital(2, True)
+        b.run_for(0.01)
+        assert b.ports()["D"][2] & 0x04

@@ -336,13 +336,19 @@ class SimBoard:
     seconds of simulated time / of wall-clock time since start after which
     every run stops (None: no limit). analog: initial volts per analog pin,
     set before the first instruction runs. link: with a pty, also make this
-    path a symbolic link to it.
+    path a symbolic link to it. spi_flash: an SPI NOR flash chip (a
+    W25Q64JV's commands and timing) on the MCU's SPI with its chip select on
+    this port pin, and optionally its size in bytes ("B2", "B2:1048576"; 8
+    MiB by default). flash_file / eeprom_file: files that keep the flash's /
+    the EEPROM's bytes between runs (read at start if present, written when
+    the board closes).
     """
 
     def __init__(self, elf: str, board: str | Board = "uno", *, uart: str = "control",
                  sim_limit: float | None = None, wall_limit: float | None = None,
                  analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None,
-                 eeprom: bytes | None = None):
+                 eeprom: bytes | None = None, spi_flash: str | None = None, flash_file: str | None = None,
+                 eeprom_file: str | None = None):
         self.board = sim_board(board)
         self.mcu = self.board.raw["sim"]["simavr_mcu"]
         self.f_cpu = int(f_cpu or self.board.f_cpu)
@@ -364,6 +370,14 @@ class SimBoard:
             args += ["-l", link]
         for pin, volts in (analog or {}).items():
             args += ["-a", f"{self.adc_channel(pin)}={self._millivolts(volts)}"]
+        if flash_file is not None and spi_flash is None:
+            raise ValueError("flash_file keeps the SPI flash's bytes: it needs spi_flash")
+        if spi_flash is not None:
+            args += ["-s", str(spi_flash)]
+        if flash_file is not None:
+            args += ["-S", os.fspath(flash_file)]
+        if eeprom_file is not None:
+            args += ["-E", os.fspath(eeprom_file)]
         self._err = tempfile.TemporaryFile()
         try:
             self._proc = subprocess.Popen(args + [elf], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -676,6 +690,44 @@ class SimBoard:
         """(EEPROM byte writes the firmware started, power cuts made)."""
         f = dict(t.split("=") for t in self.command("eeprom count").split()[1:])
         return int(f["writes"]), int(f["cuts"])
+
+    # -- SPI NOR flash (spi_flash=...) --
+    def flash_read(self, address: int, count: int) -> bytes:
+        """`count` bytes of the SPI flash's array from `address`."""
+        out = b""
+        for a in range(address, address + count, PEEK_MAX):
+            n = min(PEEK_MAX, address + count - a)
+            out += bytes.fromhex(self.command(f"flash read {int(a)} {int(n)}")[3:])
+        return out
+
+    def flash_write(self, address: int, data: bytes) -> None:
+        """Stores bytes in the flash's array as they are (no write enable,
+        no 1->0 rule, no time): a test's fixture."""
+        for i in range(0, len(data), 1024):
+            self.command(f"flash write {int(address + i)} {data[i:i + 1024].hex()}")
+
+    def flash_erase(self) -> None:
+        """Sets the whole flash to 0xFF at once (as from the factory)."""
+        self.command("flash erase")
+
+    def flash_info(self) -> dict:
+        """The chip: size (bytes), jedec (the 3 ID bytes), cs ("B2"), busy
+        and wel (its status bits), programs and erases started, cuts made,
+        armed (a `flash_cut` is pending)."""
+        f = _fields(self.command("flash info"))
+        out: dict = {k: int(v) for k, v in f.items() if k not in ("jedec", "cs")}
+        for k in ("busy", "wel", "armed"):
+            out[k] = bool(out[k])
+        out["jedec"] = bytes.fromhex(f["jedec"])
+        out["cs"] = f["cs"]
+        return out
+
+    def flash_cut(self, operations: int) -> None:
+        """A power cut right after the `operations`-th page program or erase
+        from now starts: the MCU resets there and that operation is left
+        half done (a prefix of its bytes programmed or erased, the same for
+        the same operation count); the chip's BUSY and WEL are cleared."""
+        self.command(f"flash cut {int(operations)}")
 
     def symbol(self, name: str) -> tuple[int, int]:
         """(data address, size) of a variable of the firmware, by its

@@ -20,7 +20,12 @@
 
    usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S]
                    [-u control|pty|stdio|stdout|none] [-l LINK] [-r]
-                   [-x crash|done|unity] [-a CH=MV]... FW.elf
+                   [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]
+                   [-s CSPIN[:SIZE] [-S FLASH_FILE]] FW.elf
+
+   -s puts an SPI NOR flash chip (a W25Q64JV's commands and timing) on the
+   AVR's SPI, its chip select on pin CSPIN (B2: the Uno's D10); -S and -E
+   keep that flash's and the AVR EEPROM's bytes in files between runs.
 
    The board stops itself at the simulated-time limit (-t, seconds; 0 = none)
    and the wall-clock limit (-w, seconds since start; 0 = none), and when its
@@ -36,12 +41,14 @@
 #include <simavr/avr_adc.h>
 #include <simavr/avr_eeprom.h>
 #include <simavr/avr_ioport.h>
+#include <simavr/avr_spi.h>
 #include <simavr/avr_uart.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_cycle_timers.h>
 #include <simavr/sim_elf.h>
 #include <simavr/sim_io.h>
 #include <simavr/sim_irq.h>
+#include <simavr/sim_time.h>
 
 #include <errno.h>
 #include <fcntl.h>
@@ -473,11 +480,15 @@ static const char* state_name(int st) {
 /* The EEPROM: simavr's EEPROM module keeps the bytes (across resets); the
    harness counts the byte writes the firmware starts (EECR with EEPE set)
    and, when asked, pulses reset right after the Nth of them: a power cut at
-   that byte (`eeprom cut N`). */
+   that byte (`eeprom cut N`). With -E FILE its bytes live in FILE between
+   runs. */
 #define EECR_ADDR 0x3F /* data-space address of EECR on the ATmega328P and ATmega2560 */
 static unsigned long long ee_writes, ee_resets, ee_cut_at;
 static int ee_cut_armed;
-static volatile int ee_cut_now;
+static const char* ee_file; /* -E: NULL for none */
+/* A power cut is due right after the instruction that set it (`eeprom cut`,
+   `flash cut`): one flag, so that the run loop tests one word per instruction. */
+static volatile int cut_now;
 
 static void on_eecr_write(struct avr_t* a, avr_io_addr_t addr, uint8_t v, void* param) {
     (void)a, (void)addr, (void)param;
@@ -485,16 +496,314 @@ static void on_eecr_write(struct avr_t* a, avr_io_addr_t addr, uint8_t v, void* 
     ee_writes++;
     if (ee_cut_armed && ee_writes >= ee_cut_at) {
         ee_cut_armed = 0;
-        ee_cut_now = 1;
+        ee_resets++;
+        cut_now = 1;
     }
 }
 
-static void ee_power_cut(avr_t* a) {
-    ee_cut_now = 0;
+/* ---- the SPI NOR flash ---------------------------------------------------------------- */
+
+/* -s CSPIN[:SIZE]: a Winbond W25Q-class serial NOR flash (modelled on the
+   W25Q64JV datasheet) on the AVR's hardware SPI, chip select active low on
+   an AVR pin. simavr's SPI module raises SPI_IRQ_OUTPUT with each byte the
+   master shifts out, as the transfer ends (simavr 1.6: 100 us after SPDR is
+   written, whatever the clock divider), and takes the byte shifted in on
+   SPI_IRQ_INPUT; the chip answers there and then, before SPIF is seen, so
+   SPDR reads it as the byte of that transfer. Each answer depends on the
+   bytes before it only, as on the wire (full duplex: the chip cannot answer
+   the byte it is being sent).
+
+   As on the part: program and erase start when CS rises after a whole
+   command, need the write-enable latch (WEL, set by 06h) and clear it when
+   done; while one runs (BUSY) every command but the status reads is
+   ignored; a page program ANDs its bytes into the array (it can only clear
+   bits) and wraps within its 256-byte page. BUSY lasts the datasheet's
+   typical time in simulated time (a cycle timer; also checked whenever the
+   chip is touched, since simavr's reset drops cycle timers). What the chip
+   does at the end (the new bytes, the erased range) is applied then, so
+   that a power cut (`flash cut N`, or any power cut) can leave it half done. */
+#define FL_PAGE 256u
+#define FL_MFR 0xEFu       /* Winbond */
+#define FL_MEMTYPE 0x40u   /* W25Q..JV-IQ (SPI) */
+#define FL_CHIP_ERASE_US_PER_MIB 2500000u /* tCE: typ 20 s for the 8 MiB W25Q64JV (5 s W25Q16JV, 40 s W25Q128JV) */
+enum { FL_OP_NONE, FL_OP_PROGRAM, FL_OP_ERASE };
+
+static struct {
+    uint8_t* mem; /* NULL: no flash on this board */
+    uint32_t size;
+    uint8_t cap;  /* log2(size): the JEDEC ID's capacity byte; the device ID is cap - 1 */
+    char cs_port;
+    uint8_t cs_bit;
+    const char* file; /* -S: NULL for none */
+    avr_irq_t* miso;  /* SPI_IRQ_INPUT */
+    /* the transaction while CS is low */
+    uint8_t cs_level; /* as the chip sees it: high (deselected) until the AVR drives it low */
+    uint8_t op;
+    uint32_t n;       /* bytes since CS fell */
+    uint32_t addr;
+    int ignored;      /* sent to a busy or powered-down chip */
+    uint8_t buf[FL_PAGE], buf_set[FL_PAGE]; /* a page program's bytes, by column */
+    uint8_t col;
+    /* the chip */
+    int wel, busy, powered_down;
+    avr_cycle_count_t busy_until;
+    int op_kind;      /* the program or erase in progress while busy */
+    uint32_t op_addr, op_len;
+    uint8_t op_data[FL_PAGE], op_set[FL_PAGE];
+    unsigned long long programs, erases, ops, cuts, cut_at;
+    int cut_armed;
+} fl;
+
+static uint8_t fl_status1(void) { return (uint8_t)((fl.busy ? 0x01 : 0) | (fl.wel ? 0x02 : 0)); }
+
+/* Applies the operation in progress: whole, or (power cut) only a prefix
+   of its bytes, of a length drawn from the operation's ordinal so that a
+   cut test replays exactly. */
+static void fl_apply(int partial) {
+    uint32_t done = fl.op_len; /* erase: bytes from the start; program: columns holding data, in page order */
+    if (partial) {
+        uint32_t total = fl.op_len;
+        if (fl.op_kind == FL_OP_PROGRAM) {
+            total = 0;
+            for (uint32_t i = 0; i < FL_PAGE; i++) total += fl.op_set[i];
+        }
+        uint64_t z = fl.ops * 0x9E3779B97F4A7C15ull; /* splitmix64 of the ordinal */
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        /* at least one byte done and one not, when there are two: half done */
+        done = total >= 2 ? 1 + (uint32_t)(z % (total - 1)) : 0;
+    }
+    if (fl.op_kind == FL_OP_ERASE) {
+        memset(fl.mem + fl.op_addr, 0xFF, done);
+    } else if (fl.op_kind == FL_OP_PROGRAM) {
+        for (uint32_t i = 0; i < FL_PAGE && done; i++) {
+            if (!fl.op_set[i]) continue;
+            fl.mem[fl.op_addr + i] &= fl.op_data[i]; /* NOR: programming only clears bits */
+            done--;
+        }
+    }
+    fl.op_kind = FL_OP_NONE;
+}
+
+static avr_cycle_count_t on_fl_done(struct avr_t* a, avr_cycle_count_t when, void* param);
+
+static void fl_finish(void) {
+    fl_apply(0);
+    fl.busy = 0;
+    fl.wel = 0;
+    avr_cycle_timer_cancel(avr, on_fl_done, NULL);
+}
+
+static avr_cycle_count_t on_fl_done(struct avr_t* a, avr_cycle_count_t when, void* param) {
+    (void)a, (void)when, (void)param;
+    if (fl.busy) fl_finish();
+    return 0;
+}
+
+/* An operation whose time is up is done, whether or not its timer fired. */
+static void fl_tick(void) {
+    if (fl.busy && avr->cycle >= fl.busy_until) fl_finish();
+}
+
+static void fl_start(int kind, uint32_t addr, uint32_t len, uint32_t usec) {
+    fl.op_kind = kind;
+    fl.op_addr = addr;
+    fl.op_len = len;
+    fl.busy = 1; /* WEL stays set until the operation ends */
+    fl.busy_until = avr->cycle + avr_usec_to_cycles(avr, usec);
+    avr_cycle_timer_register_usec(avr, usec, on_fl_done, NULL);
+    fl.ops++;
+    if (kind == FL_OP_PROGRAM)
+        fl.programs++;
+    else
+        fl.erases++;
+    if (fl.cut_armed && fl.ops >= fl.cut_at) {
+        fl.cut_armed = 0;
+        fl.cuts++;
+        cut_now = 1; /* after this instruction: the operation has started, nothing of it is done */
+    }
+}
+
+static void fl_erase_cmd(uint32_t len, uint32_t usec) {
+    if (fl.n == 4 && fl.wel) fl_start(FL_OP_ERASE, fl.addr & (fl.size - 1) & ~(len - 1), len, usec);
+}
+
+/* CS rose: commands that act then (all that change the chip) do so, only
+   after a whole command as the datasheet asks (a write enable of exactly 8
+   bits, an erase of exactly 32). */
+static void fl_deselect(void) {
+    fl.cs_level = 1;
+    if (fl.n == 0 || fl.ignored) {
+        fl.n = 0;
+        return;
+    }
+    switch (fl.op) {
+        case 0x06: if (fl.n == 1) fl.wel = 1; break;
+        case 0x04: if (fl.n == 1) fl.wel = 0; break;
+        case 0xB9: if (fl.n == 1) fl.powered_down = 1; break;
+        case 0xAB: fl.powered_down = 0; break;
+        case 0x02:
+            if (fl.n >= 5 && fl.wel) {
+                memcpy(fl.op_data, fl.buf, FL_PAGE);
+                memcpy(fl.op_set, fl.buf_set, FL_PAGE);
+                fl_start(FL_OP_PROGRAM, fl.addr & (fl.size - 1) & ~(FL_PAGE - 1), FL_PAGE, 400); /* tPP typ 0.4 ms */
+            }
+            break;
+        case 0x20: fl_erase_cmd(4096, 45000); break;     /* tSE typ 45 ms */
+        case 0x52: fl_erase_cmd(32768, 120000); break;   /* tBE1 typ 120 ms */
+        case 0xD8: fl_erase_cmd(65536, 150000); break;   /* tBE2 typ 150 ms */
+        case 0xC7:
+        case 0x60:
+            if (fl.n == 1 && fl.wel)
+                fl_start(FL_OP_ERASE, 0, fl.size,
+                         (uint32_t)((unsigned long long)FL_CHIP_ERASE_US_PER_MIB * fl.size / (1u << 20)));
+            break;
+        default: break;
+    }
+    fl.n = 0;
+}
+
+/* One byte from the master while CS is low; returns the byte shifted out. */
+static uint8_t fl_byte(uint8_t in) {
+    const uint32_t i = fl.n++;
+    if (i == 0) {
+        fl.op = in;
+        fl.addr = 0;
+        /* the status reads work at any time; the rest waits for BUSY to
+           clear, and a powered-down chip wakes on ABh only */
+        fl.ignored = (fl.busy && in != 0x05 && in != 0x35 && in != 0x15) || (fl.powered_down && in != 0xAB);
+        if (in == 0x02) {
+            memset(fl.buf, 0xFF, FL_PAGE);
+            memset(fl.buf_set, 0, FL_PAGE);
+        }
+        return 0xFF;
+    }
+    if (fl.ignored) return 0xFF; /* MISO stays high-impedance: the pull-up */
+    const int addr_byte = i <= 3;
+    if (addr_byte) fl.addr = (fl.addr << 8) | in;
+    switch (fl.op) {
+        case 0x05: return fl_status1();
+        case 0x35: /* status 2 and 3: no quad enable, no protection, defaults */
+        case 0x15: return 0x00;
+        case 0x9F: {
+            const uint8_t id[3] = {FL_MFR, FL_MEMTYPE, fl.cap};
+            return id[(i - 1) % 3];
+        }
+        case 0x90: /* address 0: manufacturer first; 1: device first; then alternating */
+            if (addr_byte) return 0xFF;
+            return ((i - 4) + (fl.addr & 1)) % 2 ? (uint8_t)(fl.cap - 1) : FL_MFR;
+        case 0xAB: return addr_byte ? 0xFF : (uint8_t)(fl.cap - 1); /* three dummy bytes, then the device ID */
+        case 0x0B:
+            if (i == 4) return 0xFF; /* the dummy byte */
+            /* fall through */
+        case 0x03: {
+            if (addr_byte) return 0xFF;
+            fl.addr &= fl.size - 1; /* the address wraps at the end of the array */
+            const uint8_t v = fl.mem[fl.addr];
+            fl.addr = (fl.addr + 1) & (fl.size - 1);
+            return v;
+        }
+        case 0x02:
+            if (i == 3) fl.col = (uint8_t)fl.addr;
+            if (addr_byte) return 0xFF;
+            fl.buf[fl.col] = in; /* past the page's end it wraps to the start, overwriting */
+            fl.buf_set[fl.col] = 1;
+            fl.col++;
+            return 0xFF;
+        default: return 0xFF;
+    }
+}
+
+static void on_fl_mosi(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq, (void)param;
+    fl_tick();
+    /* deselected, the chip leaves MISO alone and the pull-up reads 0xFF;
+       it answers anyway, because simavr 1.6 completes a master's transfer
+       (SPIF) only when a byte comes in */
+    avr_raise_irq(fl.miso, fl.cs_level ? 0xFF : fl_byte((uint8_t)value));
+}
+
+static void on_fl_cs(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq, (void)param;
+    const uint8_t level = value ? 1 : 0;
+    if (level == fl.cs_level) return;
+    fl_tick();
+    if (level) {
+        fl_deselect();
+    } else {
+        fl.cs_level = 0;
+        fl.n = 0;
+    }
+}
+
+/* The board loses power: the chip's operation in progress stays half done,
+   its latches and the transaction on the wire are lost; the AVR resets. */
+static void power_cut(avr_t* a) {
+    cut_now = 0;
+    if (fl.mem) {
+        fl_tick();
+        if (fl.busy) fl_apply(1);
+        fl.busy = fl.wel = fl.powered_down = 0;
+        avr_cycle_timer_cancel(a, on_fl_done, NULL);
+    }
     avr_cycle_count_t cycle = a->cycle;
     avr_reset(a);
     a->cycle = cycle;
-    ee_resets++;
+    fl.cs_level = 1; /* CS floats: the pull-up */
+    fl.n = 0;
+}
+
+/* ---- files that keep a memory between runs (-S, -E) ------------------------------------ */
+
+/* Reads FILE into buf if it exists: 0 when read or absent, -1 (said on
+   standard error) when unreadable or of another size. */
+static int image_load(const char* path, uint8_t* buf, size_t size, const char* what) {
+    FILE* f = fopen(path, "rb");
+    if (!f) {
+        if (errno == ENOENT) return 0; /* the first run: starts blank, saved at exit */
+        fprintf(stderr, "simboard: cannot read %s (%s): %s\n", path, what, strerror(errno));
+        return -1;
+    }
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || (unsigned long long)st.st_size != (unsigned long long)size) {
+        fprintf(stderr, "simboard: %s holds %lld bytes, the %s has %zu: a file of another chip or board\n", path,
+                (long long)st.st_size, what, size);
+        fclose(f);
+        return -1;
+    }
+    size_t got = fread(buf, 1, size, f);
+    fclose(f);
+    if (got != size) {
+        fprintf(stderr, "simboard: cannot read %s (%s): short read\n", path, what);
+        return -1;
+    }
+    return 0;
+}
+
+/* Writes buf to FILE through a temporary file renamed over it, so that a
+   harness stopped meanwhile leaves the old contents whole. */
+static int image_save(const char* path, const uint8_t* buf, size_t size, const char* what) {
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    FILE* f = fopen(tmp, "wb");
+    int ok = f && fwrite(buf, 1, size, f) == size;
+    if (f && fclose(f) != 0) ok = 0;
+    if (ok && rename(tmp, path) != 0) ok = 0;
+    if (!ok) {
+        fprintf(stderr, "simboard: cannot save the %s in %s: %s\n", what, path, strerror(errno));
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+/* simavr's EEPROM module lends its bytes (GET with no buffer; its return
+   value says nothing on some versions: the pointer does). */
+static uint8_t* eeprom_bytes(void) {
+    avr_eeprom_desc_t d = {NULL, 0, avr->e2end + 1u};
+    avr_ioctl(avr, AVR_IOCTL_EEPROM_GET, &d);
+    return d.ee;
 }
 
 /* Runs until cycle `target` (when has_target), a limit, the firmware
@@ -523,7 +832,7 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
             const avr_cycle_count_t c0 = a->cycle;
             const int slept = a->state == cpu_Sleeping;
             int st = avr_run(a);
-            if (__builtin_expect(ee_cut_now, 0)) ee_power_cut(a);
+            if (__builtin_expect(cut_now, 0)) power_cut(a);
             if (prof_n) prof_step(a, c0, slept);
             if (st == cpu_Done || st == cpu_Crashed) {
                 halted = 1;
@@ -719,7 +1028,12 @@ static int cmd_din(int argc, char** argv) {
     unsigned long long a;
     if (argc != 4 || parse_port_bit(argv[1], argv[2], &port, &bit) || parse_u64(argv[3], &a) || a > 1)
         return fail("usage: din PORT BIT 0|1 (a port this MCU has)");
-    avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit), (uint32_t)a);
+    avr_irq_t* irq = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit);
+    /* simavr drops a raise of the value an IRQ already holds, but a reset
+       clears the PIN register without telling the IRQ: forget the old value,
+       so that the level reaches the pin however it was driven before. */
+    irq->value = !a;
+    avr_raise_irq(irq, (uint32_t)a);
     fprintf(proto, "ok\n");
     return 1;
 }
@@ -944,6 +1258,62 @@ static int cmd_eeprom(int argc, char** argv) {
     return fail("%s", usage);
 }
 
+/* `flash read ADDR COUNT` (hex), `flash write ADDR HEX` (stores the bytes as
+   they are, bypassing the chip's rules: a test's fixture), `flash erase`
+   (all 0xFF), `flash info`, `flash cut N` (a power cut right after the Nth
+   program or erase from now starts, leaving it half done). */
+static int cmd_flash(int argc, char** argv) {
+    static const char usage[] =
+        "usage: flash read ADDR COUNT | flash write ADDR HEX | flash erase | flash info | flash cut N";
+    unsigned long long a = 0, b = 0;
+    if (!fl.mem) return fail("flash: no SPI flash on this board (start the harness with -s CSPIN[:SIZE])");
+    fl_tick(); /* an operation whose time is up shows done */
+    if (argc == 2 && !strcmp(argv[1], "info")) {
+        fprintf(proto,
+                "ok size=%lu jedec=%02x%02x%02x cs=%c%u busy=%d wel=%d programs=%llu erases=%llu cuts=%llu armed=%d\n",
+                (unsigned long)fl.size, FL_MFR, FL_MEMTYPE, fl.cap, fl.cs_port, fl.cs_bit, fl.busy, fl.wel,
+                fl.programs, fl.erases, fl.cuts, fl.cut_armed);
+        return 1;
+    }
+    if (argc == 2 && !strcmp(argv[1], "erase")) {
+        memset(fl.mem, 0xFF, fl.size);
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (argc == 3 && !strcmp(argv[1], "cut")) {
+        if (parse_u64(argv[2], &a) || a == 0) return fail("flash cut N: N >= 1 programs or erases from now");
+        fl.cut_at = fl.ops + a;
+        fl.cut_armed = 1;
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (argc == 4 && !strcmp(argv[1], "read")) {
+        if (parse_u64(argv[2], &a) || parse_u64(argv[3], &b) || b > MAX_PEEK || a + b > fl.size)
+            return fail("flash read ADDR COUNT: within 0-0x%lx, at most %d bytes", (unsigned long)fl.size - 1,
+                        MAX_PEEK);
+        fprintf(proto, "ok ");
+        hex_out(fl.mem + a, (size_t)b);
+        fprintf(proto, "\n");
+        return 1;
+    }
+    if (argc == 4 && !strcmp(argv[1], "write")) {
+        bytes_t data = {0};
+        if (parse_u64(argv[2], &a) || hex_in(argv[3], &data)) {
+            free(data.buf);
+            return fail("flash write ADDR HEX: an address and an even number of hex digits");
+        }
+        if (a + data.len > fl.size) {
+            free(data.buf);
+            return fail("flash write: beyond the flash's %lu bytes", (unsigned long)fl.size);
+        }
+        if (data.len) memcpy(fl.mem + a, data.buf, data.len);
+        free(data.buf);
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    return fail("%s", usage);
+}
+
 static int cmd_info(int argc, char** argv) {
     NO_ARGS;
     fprintf(proto, "ok proto=%d mcu=%s f_cpu=%u cycle=%llu time=%.9f state=%s uart=%s", PROTO_VERSION, mcu_name,
@@ -1000,6 +1370,10 @@ static int cmd_reset(int argc, char** argv) {
     avr_reset(avr);
     avr->cycle = cycle;
     halted = 0;
+    if (fl.mem && !fl.cs_level) { /* the AVR lets go of CS: the pull-up raises it, the chip sees it rise */
+        fl_tick();
+        fl_deselect();
+    }
     fprintf(proto, "ok\n");
     return 1;
 }
@@ -1019,7 +1393,7 @@ static const struct {
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
     {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
-    {"eeprom", cmd_eeprom}, {"sched", cmd_sched}, {"quit", cmd_quit},
+    {"eeprom", cmd_eeprom}, {"flash", cmd_flash}, {"sched", cmd_sched}, {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 
@@ -1063,7 +1437,8 @@ static int free_run_status(const char* why) {
 static void usage(void) {
     fprintf(stderr,
             "usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S] [-u control|pty|stdio|stdout|none]\n"
-            "                [-l LINK] [-r] [-x crash|done|unity] [-a CH=MV]... FW.elf\n");
+            "                [-l LINK] [-r] [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]\n"
+            "                [-s CSPIN[:SIZE] [-S FLASH_FILE]] FW.elf\n");
 }
 
 int main(int argc, char** argv) {
@@ -1071,7 +1446,8 @@ int main(int argc, char** argv) {
     double sim_limit = 0;
     unsigned long long adc_init[16];
     int adc_set[16] = {0};
-    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:")) != -1) {
+    const char* flash_spec = NULL;
+    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:s:S:E:")) != -1) {
         char* end;
         switch (opt) {
             case 'c': control = 1; break;
@@ -1124,6 +1500,9 @@ int main(int argc, char** argv) {
                 adc_set[ch] = 1;
                 break;
             }
+            case 's': flash_spec = optarg; break;
+            case 'S': fl.file = optarg; break;
+            case 'E': ee_file = optarg; break;
             default: usage(); return 2;
         }
     }
@@ -1140,6 +1519,30 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (!control && uart_mode == UART_CONTROL) uart_mode = UART_NONE;
+    if (fl.file && !flash_spec) {
+        fprintf(stderr, "simboard: -S FILE keeps the SPI flash's bytes: it needs the flash (-s CSPIN[:SIZE])\n");
+        return 2;
+    }
+    unsigned long long flash_size = 8u << 20; /* the W25Q64JV's 64 Mbit */
+    if (flash_spec) {
+        char pin[3] = {0};
+        const char* colon = strchr(flash_spec, ':');
+        const size_t pin_len = colon ? (size_t)(colon - flash_spec) : strlen(flash_spec);
+        if (pin_len == 2) memcpy(pin, flash_spec, 2);
+        if (pin_len != 2 || pin[0] < 'A' || pin[0] > 'L' || pin[1] < '0' || pin[1] > '7') {
+            fprintf(stderr, "simboard: -s CSPIN[:SIZE]: CSPIN is a port and bit such as B2\n");
+            return 2;
+        }
+        /* powers of two from 64 KiB to 16 MiB: the W25Q family's sizes
+           that 24-bit addresses reach, the JEDEC capacity byte their log2 */
+        if (colon && (parse_u64(colon + 1, &flash_size) || flash_size < (1u << 16) || flash_size > (1u << 24) ||
+                      (flash_size & (flash_size - 1)))) {
+            fprintf(stderr, "simboard: -s CSPIN[:SIZE]: SIZE is a power of two from 65536 to 16777216 bytes\n");
+            return 2;
+        }
+        fl.cs_port = pin[0];
+        fl.cs_bit = (uint8_t)(pin[1] - '0');
+    }
 
     /* Responses go to the original standard output; anything a library
        prints on standard output lands on standard error instead. */
@@ -1187,6 +1590,53 @@ int main(int argc, char** argv) {
     avr->vcc = avr->avcc = avr->aref = 5000; /* millivolts: the Arduino boards' 5 V supply and reference */
     for (int ch = 0; ch < 16; ch++)
         if (adc_set[ch]) avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ch), (uint32_t)adc_init[ch]);
+
+    /* -E: the file's bytes replace what the ELF's .eeprom section put there */
+    if (ee_file) {
+        const size_t size = (size_t)avr->e2end + 1;
+        uint8_t* ee = eeprom_bytes();
+        uint8_t* buf = malloc(size);
+        if (!ee || !buf) {
+            fprintf(stderr, "simboard: -E: the %s has no EEPROM\n", mcu_name);
+            return 2;
+        }
+        memcpy(buf, ee, size);
+        if (image_load(ee_file, buf, size, "EEPROM") != 0) return 2;
+        avr_eeprom_desc_t d = {buf, 0, (uint32_t)size};
+        avr_ioctl(avr, AVR_IOCTL_EEPROM_SET, &d);
+        free(buf);
+    }
+
+    if (flash_spec) {
+        avr_ioport_state_t st;
+        if (port_state(fl.cs_port, &st) != 0) {
+            fprintf(stderr, "simboard: -s: the %s has no port %c\n", mcu_name, fl.cs_port);
+            return 2;
+        }
+        /* the SPI's name in its ioctl is 0 on simavr 1.6's megas, '0' on others */
+        avr_irq_t* mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_OUTPUT);
+        fl.miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_INPUT);
+        if (!mosi || !fl.miso) {
+            mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_OUTPUT);
+            fl.miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_INPUT);
+        }
+        if (!mosi || !fl.miso) {
+            fprintf(stderr, "simboard: -s: simavr's %s has no SPI\n", mcu_name);
+            return 2;
+        }
+        fl.size = (uint32_t)flash_size;
+        fl.cap = (uint8_t)__builtin_ctzll(flash_size);
+        fl.mem = malloc(fl.size);
+        if (!fl.mem) {
+            fprintf(stderr, "simboard: out of memory\n");
+            return 3;
+        }
+        memset(fl.mem, 0xFF, fl.size); /* from the factory: erased */
+        if (fl.file && image_load(fl.file, fl.mem, fl.size, "SPI flash") != 0) return 2;
+        fl.cs_level = 1;
+        avr_irq_register_notify(mosi, on_fl_mosi, NULL);
+        avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(fl.cs_port), fl.cs_bit), on_fl_cs, NULL);
+    }
 
     /* UART0: raw bytes, not simavr's line printer. */
     uint32_t flags = 0;
@@ -1238,6 +1688,17 @@ int main(int argc, char** argv) {
                 argv[optind], why, (unsigned long long)avr->cycle, (double)avr->cycle / (double)f_cpu,
                 wall_now() - wall_start);
         status = free_run_status(why);
+    }
+    /* The board is switched off: a flash operation still running stays
+       half done, as a power cut leaves it; the memories go to their files. */
+    if (fl.mem) {
+        fl_tick();
+        if (fl.busy) fl_apply(1);
+        if (fl.file && image_save(fl.file, fl.mem, fl.size, "SPI flash") != 0 && status == 0) status = 1;
+    }
+    if (ee_file) {
+        uint8_t* ee = eeprom_bytes();
+        if (ee && image_save(ee_file, ee, (size_t)avr->e2end + 1, "EEPROM") != 0 && status == 0) status = 1;
     }
     if (pty_link[0]) { /* our own link only: still pointing at our pty */
         char to[sizeof pty_name];

@@ -81,6 +81,17 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if trigger and state_rates is not None and state_rates[trigger[0]] == 0:
         r.err(once["trigger"].values[0], f"the trigger state `{once['trigger'].values[0].text}` records nothing "
                                          "(rate 0): a flight would end as it starts")
+    if state_rates is not None and rec_task is not None:
+        import math
+        m_all = 1
+        for q in state_rates:
+            if q:
+                d = int(rec_task.rate / q)
+                m_all = m_all * d // math.gcd(m_all, d)
+        if m_all > 65535:
+            r.err(rates[0].key, f"the log rates' sample dividers have a common multiple of {m_all:,}: at most 65,535 "
+                                "(use rates whose dividers of the task's rate share factors)")
+            state_rates = None
     fields = _fields(elements, sv, machines, r)
     if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
         return None

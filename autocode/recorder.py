@@ -71,6 +71,7 @@ class Plan:
     trigger: int
     before_ms: int
     period_ms: Fraction  # one recorder task run
+    runs_mod: int  # the run counter's wrap: a multiple of every divider
     ring_cap: int
     fifo_cap: int
     sample_size: int
@@ -94,7 +95,7 @@ class Plan:
         return self.slots * self.record
 
 
-RECORDER_SIZE = 39  # sizeof(fsw::Recorder) on an AVR (tests/recorder checks it against the ELF)
+RECORDER_SIZE = 34  # sizeof(fsw::Recorder) on an AVR (tests/recorder checks it against the ELF)
 
 
 def log_text(log, sv) -> str:
@@ -148,12 +149,21 @@ def plan(app) -> Plan | None:
     sample_size = 2 + sum(f.width for f in fields)
     opening = max(HEADER + 8, HEADER + sum(f.width for f in fields))
     worst = sum((2 + f.width) if escape else 0 for f in fields[:n_hold]) + sum(f.encoded() for f in fields[n_hold:])
-    fifo_cap = max(opening, worst)
+    fifo_cap = max(opening - 1, worst)  # the kind byte is not queued: it is written last
     return Plan(fields, log.record, base, slots, log.newest, dividers,
                 tuple(1 if sid in log.erase else 0 for sid in range(len(log.rates))), log.trigger,
-                int(log.before * 1000), Fraction(1000) / task.rate, max(ring_cap, 2), fifo_cap, sample_size,
+                int(log.before * 1000), Fraction(1000) / task.rate, _runs_mod(dividers), max(ring_cap, 2), fifo_cap, sample_size,
                 opening, worst, n_hold, escape, log_hash(log, app.sv), m.vars[m.s].name, app.time_element.name,
                 m.name, tuple(st.name for st in m.states))
+
+
+def _runs_mod(dividers) -> int:
+    m = 1
+    for d in dividers:
+        if d:
+            m = m * d // math.gcd(m, d)
+    k = 65535 // m  # the largest multiple that fits 16 bits: fewer wraps
+    return m * max(k, 1)
 
 
 # ---- decoding -------------------------------------------------------------------------

@@ -422,7 +422,8 @@ def _recorder(app: Application) -> list[str]:
     time_us = "true" if app.time_unit == "us" else "false"
     c.append(f"const fsw::LogConfig kLogConfig FSW_FLASH = {{kLogFields, kLogDividers, kLogEraseOk, log_ring, "
              f"log_fifo, log_last, sv, 0x{app_schema_hash(app):08x}UL, 0x{p.hash:08x}UL, {p.before_ms}UL, "
-             f"E_{p.state_element}, E_{p.time_element}, {p.base}UL, {p.slots}, {int(p.period_ms)}, {p.record}, "
+             f"E_{p.state_element}, E_{p.time_element}, {p.base}UL, {p.slots}, {int(p.period_ms)}, {p.runs_mod}, "
+             f"{p.record}, "
              f"{len(p.fields)}, {len(p.dividers)}, {p.trigger}, {p.sample_size}, {p.ring_cap}, {p.fifo_cap}, "
              f"{p.n_hold}, {'true' if p.escape else 'false'}, {'true' if p.newest else 'false'}, {time_us}}};")
     c.append(f"static_assert(fsw::log_config_ok({p.record}, {p.opening}, {p.worst}, {p.ring_cap}, {p.fifo_cap}, "

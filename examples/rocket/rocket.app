@@ -49,4 +49,4 @@ element state
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
 flash 22528            # measured high-water mark to the RAM
-ram   1152
+ram   1280

@@ -469,14 +469,15 @@ void link_log_ack(Link& l, const Recorder& r) {
         put_u32(lc.hash);
     } else if (l.ack_op == kOpLogRead) {
         const uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
-        const uint8_t n = r.rd_n < room ? r.rd_n : static_cast<uint8_t>(room);
+        const uint8_t off = l.ack_x;
+        const uint8_t n = l.ack_y < room ? l.ack_y : static_cast<uint8_t>(room);
         put_u16(r.rd_slot);
-        put(r.rd_off);
+        put(off);
         put(n);
         uint8_t b[16];
         for (uint8_t done = 0; done < n;) {
-            const uint8_t k = static_cast<uint8_t>(n - done > sizeof b ? sizeof b : n - done);
-            log_read(r, r.rd_slot, static_cast<uint8_t>(r.rd_off + done), k, b);
+            const uint8_t k = static_cast<uint8_t>(n - done > static_cast<int>(sizeof b) ? sizeof b : n - done);
+            log_read(r, r.rd_slot, static_cast<uint8_t>(off + done), k, b);
             put_bytes(b, k);
             done = static_cast<uint8_t>(done + k);
         }
@@ -485,7 +486,6 @@ void link_log_ack(Link& l, const Recorder& r) {
 
 // A recorder command (kOpLogInfo..kOpLogErase).
 uint8_t link_log_apply(Link& l, Recorder& r, uint8_t op, const uint8_t* a, uint8_t alen) {
-    (void)l;
     if (op == kOpLogRead) {
         if (alen != 4) return kAckBadLength;
         LogConfig lc;
@@ -493,8 +493,8 @@ uint8_t link_log_apply(Link& l, Recorder& r, uint8_t op, const uint8_t* a, uint8
         const uint16_t slot = load<uint16_t>(a);
         if (slot >= lc.slots || static_cast<uint16_t>(a[2]) + a[3] > lc.record) return kAckOutOfRange;
         r.rd_slot = slot;
-        r.rd_off = a[2];
-        r.rd_n = a[3];
+        l.ack_x = a[2];
+        l.ack_y = a[3];
         return kAckOk;
     }
     if (alen != 0) return kAckBadLength;

@@ -168,8 +168,8 @@ bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0) {
 void seal(Recorder& r) { r.flags |= kSealed; }
 
 // The flight's start record: trigger time, schema and log hashes.
-void write_start(const LogConfig& c, Recorder& r) {
-    if (!open_record(c, r, kLogStart, r.t_trigger)) return;
+void write_start(const LogConfig& c, Recorder& r, uint32_t now) {
+    if (!open_record(c, r, kLogStart, now)) return;
     push_n(c, r, &c.schema, 4);
     push_n(c, r, &c.hash, 4);
     seal(r);
@@ -243,7 +243,7 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
         if (r.w_phase == kWIdle) {  // nothing open
             if (r.mode != kLogRecording) return;
             if (r.flags & kStartDue) {
-                write_start(c, r);
+                write_start(c, r, now);
                 return;
             }
             if (r.r_len == 0) {
@@ -329,7 +329,6 @@ Result log_task(void* ctx) {
     if (r.mode == kLogIdle && st == c.trigger && prev != c.trigger) {
         r.mode = kLogRecording;
         r.flight = static_cast<uint8_t>(r.flight == 0xFF ? 1u : r.flight + 1u);
-        r.t_trigger = now;
         r.flags = kStartDue;
         trim(c, r, now);
     }
@@ -353,7 +352,7 @@ Result log_task(void* ctx) {
             ++r.r_len;
         }
     }
-    ++r.runs;
+    if (++r.runs == c.runs_mod) r.runs = 0;
     if (r.mode == kLogIdle) trim(c, r, now);  // keep only what the trigger would commit
     encode(c, r, now);
     return kOk;

@@ -53,6 +53,7 @@ struct LogConfig {
     uint32_t base;              // store address of slot 0
     uint16_t slots;             // records the store holds
     uint16_t period_ms;         // one task run, ms
+    uint16_t runs_mod;          // a multiple of every divider: the run counter wraps there
     uint8_t record;             // bytes per record, 32..255
     uint8_t n_fields;
     uint8_t n_states;           // rows of divider / erase_ok
@@ -79,12 +80,11 @@ enum LogMode : uint8_t {
 struct Recorder {
     const LogConfig* cfg;   // FSW_FLASH
     uint32_t t_next;        // the open record: time its next sample must have
-    uint32_t t_trigger;     // the current flight's trigger time
     uint16_t head;          // slot of the record being built (or the next one)
     uint16_t seq;           // its sequence number
     uint16_t dropped;       // samples lost: the ring was full (saturates)
     uint16_t crc;           // CRC of the open record's bytes so far
-    uint32_t runs;          // task runs since boot: a sample every `divider` of them
+    uint16_t runs;          // task runs since boot, modulo runs_mod: a sample every `divider` of them
     uint16_t w_slot;        // the writer: slot and byte it writes next
     uint16_t period;        // the open record's sample period, ms (0: one sample so far)
     uint8_t w_pos;
@@ -93,16 +93,14 @@ struct Recorder {
     uint8_t flags;          // fsw_log.cpp
     uint8_t flight;         // number of the current (or last) flight
     uint8_t mode;           // LogMode
-    uint8_t countdown;      // task runs to the next sample
     uint8_t r_first;        // ring: oldest sample
     uint8_t r_len;          // ring: samples in it
     uint8_t f_head;         // fifo: oldest byte
     uint8_t f_len;          // fifo: bytes in it
     uint8_t used;           // bytes of the open record so far (0: none open)
     uint8_t state;          // the machine's state at the last run
-    uint8_t rd_n;           // LOG_READ being acknowledged: bytes
-    uint16_t rd_slot;       //   its slot
-    uint8_t rd_off;         //   and offset
+    uint16_t rd_slot;       // the record a LOG_READ being acknowledged reads (the link keeps
+                            // its offset and count)
 };
 
 // Boot: finds the newest valid record (blocking reads of each record's
@@ -124,10 +122,12 @@ void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t*
 // Records of at least the header, one sample and the tail; a sample that
 // fits the fifo; a ring of at least two samples.
 // `opening`: a data record's header and first sample (and a start record's
-// 16 bytes); `worst_sample`: the most bytes a later sample takes.
+// 16 bytes; all but the kind go through the fifo); `worst_sample`: the most
+// bytes a later sample takes.
 constexpr bool log_config_ok(uint16_t record, uint8_t opening, uint8_t worst_sample, uint8_t ring_cap,
                              uint8_t fifo_cap, uint16_t slots) {
-    return record >= 32 && record <= 255 && opening + worst_sample + kLogTail <= record && opening <= fifo_cap &&
+    return record >= 32 && record <= 255 && static_cast<uint16_t>(opening + worst_sample + kLogTail) <= record &&
+           opening <= static_cast<uint16_t>(fifo_cap + 1u) &&
            worst_sample <= fifo_cap && ring_cap >= 2 && slots >= 2;
 }
 

@@ -92,7 +92,7 @@ def flown(fly, out: str) -> int:
         return 1
     sys.stdout.write(done.report.text())
     sys.stdout.flush()
-    say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "summary")))
+    say("wrote " + ", ".join(done.files[k] for k in ("log", "csv", "png", "record", "summary") if k in done.files))
     return 0 if done.report.passed else 1
 
 

@@ -26,7 +26,9 @@ from .params import ParamsError
 from .scenario import FAULTS, PLANTS
 from .scenario import load as load_scenario
 
-FILES = {"log": "telemetry.log", "csv": "flight.csv", "png": "flight.png", "summary": "summary.txt"}
+FILES = {"log": "telemetry.log", "csv": "flight.csv", "png": "flight.png", "record": "record.log",
+         "summary": "summary.txt"}
+OPTIONAL = ("record",)  # written only by some runs (the flight recorder's dump)
 
 
 class SetupError(Exception):
@@ -163,6 +165,9 @@ def _execute(sc, elf, board, layout, folder: str | None) -> Flight:
     meta = {"source": f"fsw sim --plant {sc.kind}", "clock": "simulated", "seed": sc.seed, "fault": sc.fault}
     run = fly(sc, elf, board, layout, files.get("log"), log_meta=meta)
     rep = reports.rocket(run, sc) if sc.kind == "rocket" else reports.tank(run, sc)
+    flight_record = None
+    if sc.app.log is not None:
+        flight_record = _recorder(sc, run, rep)
     rep.checks += budget_checks(sc.app, elf, run)
     if folder is not None:
         reports.write_csv(run, layout, sc.state_element, files["csv"])
@@ -171,9 +176,43 @@ def _execute(sc, elf, board, layout, folder: str | None) -> Flight:
         with open(files["csv"], "rb") as f:
             digest = hashlib.sha256(f.read()).hexdigest()
         reports.plot(run, sc, files["png"], title, digest)
+        if flight_record is not None:
+            from fswkit.recorder.dump import write_flight
+
+            write_flight(files["record"], sc.app, *flight_record)
         with open(files["summary"], "w") as f:
             f.write(rep.text())
     return Flight(run, rep, sc, files)
+
+
+def _recorder(sc, run: Run, rep) -> tuple | None:
+    """The flight recorder's part of the report (docs/recorder.md): the
+    record read from the board's EEPROM after the flight, against the
+    telemetry and the truth; (plan, flight) to write as record.log."""
+    from fswkit.recorder.check import newest_flight, recorder_report
+
+    log = sc.app.log
+    m = sc.app.machines[log.machine]
+    names = {st.id: st.name for st in m.states}
+    trig = names[log.trigger]
+    launch = next((t for t, _, n in run.transitions if n == trig), None)
+    end = None
+    if launch is not None:
+        stop = {names[i] for i, r in enumerate(log.rates) if i and r == 0}
+        end = next((t for t, _, n in run.transitions if t > launch and n in stop), None)
+    truth = None
+    if sc.kind == "rocket":
+        i, j = run.columns.index("time_s"), run.columns.index("altitude_m")
+        truth = ([r[i] for r in run.rows], [r[j] for r in run.rows])
+    lines, checks = recorder_report(sc.app, run, reports.Check, launch_s=launch, landed_s=end, truth=truth,
+                                    alt_element=getattr(sc, "altitude_element", None))
+    rep.lines += lines
+    rep.checks += checks
+    try:
+        p, flight, _, _ = newest_flight(sc.app, run.eeprom)
+    except ValueError:
+        return None
+    return (p, flight) if flight is not None else None
 
 
 def _install(stage: str, out: str) -> dict:
@@ -183,7 +222,12 @@ def _install(stage: str, out: str) -> dict:
     files = {k: os.path.join(out, v) for k, v in FILES.items()}
     with contextlib.suppress(FileNotFoundError):
         os.unlink(files["summary"])
-    for k in ("log", "csv", "png", "summary"):
+    for k in ("log", "csv", "png", "record", "summary"):
+        if k in OPTIONAL and not os.path.exists(os.path.join(stage, FILES[k])):
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(files[k])  # the previous run's: it does not belong to this set
+            files.pop(k)
+            continue
         os.replace(os.path.join(stage, FILES[k]), files[k])
     shutil.rmtree(stage, ignore_errors=True)
     return files

@@ -520,6 +520,8 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
         run.steps = len(stops) + 1
         run.sim_s = end_s
         run.wall_s = time.perf_counter() - wall0
+        if getattr(board, "eeprom", 0):
+            run.eeprom = b.eeprom_read(0, board.eeprom)  # the flight recorder's store
         try:
             run.ram["ram_usage"] = b.ram_usage()
         except (SimError, TypeError, ValueError) as e:
@@ -850,8 +852,12 @@ def _execute(tape, truth, cfg, app, elf, board, layout, folder) -> Outcome:
             "tape": tape.path, "tape_offset_s": cfg.pad_s - tape.start}
     rp = replay(tape, cfg, elf, board, layout, files.get("log"), truth=truth, log_meta=meta)
     nums, checks, notes = evaluate(rp, cfg, truth, tape)
+    record_lines, flight_record = [], None
+    if app.log is not None:
+        record_lines, flight_record = _recorder(app, rp, checks)
     checks += budget_checks(app, elf, rp.run)
     rep = summary(rp, cfg, tape, truth, checks, notes, f"{layout.name}: tape replay")
+    rep.lines += record_lines
     nums["speed"] = rp.run.sim_s / rp.run.wall_s if rp.run.wall_s else float("inf")
     if folder is not None:
         with open(files["csv"], "w", newline="") as f:
@@ -877,9 +883,39 @@ def _execute(tape, truth, cfg, app, elf, board, layout, folder) -> Outcome:
         title = (f"{layout.name}: tape {os.path.basename(tape.path)}"
                  + (" — all checks pass" if rep.passed else " — CHECKS FAIL"))
         plot(rp, cfg, tape, files["png"], title, digest)
+        if flight_record is not None:
+            from fswkit.recorder.dump import write_flight
+
+            write_flight(files["record"], app, *flight_record)
         with open(files["summary"], "w") as f:
             f.write(rep.text())
     return Outcome(rp, rep, nums, files)
+
+
+def _recorder(app, rp, checks) -> tuple[list[str], tuple | None]:
+    """The flight recorder after a replay (docs/recorder.md): the record
+    against the telemetry and the tape's truth; (lines, (plan, flight))."""
+    from fswkit.recorder.check import newest_flight, recorder_report
+
+    log = app.log
+    names = {st.id: st.name for st in app.machines[log.machine].states}
+    run = rp.run
+    launch = next((t for t, _, n in run.transitions if n == names[log.trigger]), None)
+    end = None
+    if launch is not None:
+        stop = {names[i] for i, r in enumerate(log.rates) if i and r == 0}
+        end = next((t for t, _, n in run.transitions if t > launch and n in stop), None)
+    fw = (lambda t: None if t is None else t + rp.offset)  # noqa: E731  (tape seconds -> the firmware's)
+    truth = (rp.truth_t + rp.offset, rp.truth_h) if rp.truth_t.size else None
+    alt = next((f.element.name for f in log.fields if f.element.name == "altitude"), None)
+    lines, more = recorder_report(app, run, reports.Check, launch_s=fw(launch), landed_s=fw(end), truth=truth,
+                                  alt_element=alt)
+    checks += more
+    try:
+        p, flight, _, _ = newest_flight(app, run.eeprom)
+    except ValueError:
+        return lines, None
+    return lines, ((p, flight) if flight is not None else None)
 
 
 # ---- robustness runs -------------------------------------------------------------------

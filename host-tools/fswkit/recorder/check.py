@@ -1,0 +1,92 @@
+"""What a simulated flight's recorder kept (docs/recorder.md): the record is
+read from the board's store after the flight, decoded as `fsw dump`
+decodes it, and compared with the telemetry of the same run (value for
+value where both have a sample) and with the plant's truth."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fswkit.autocode.recorder import Flight, RecordError, decode, plan
+
+
+def newest_flight(app, image: bytes | None):
+    """(plan, the newest flight, every flight, empty records) of a store
+    image of the whole EEPROM; the flight is None when there is none."""
+    p = plan(app)
+    if p is None or image is None:
+        return p, None, [], 0
+    flights, empty = decode(p, image[p.base:p.base + p.size])
+    return p, (flights[-1] if flights else None), flights, empty
+
+
+def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: float | None,
+                    truth=None, alt_element: str | None = None):
+    """(summary lines, checks) for a flight's record. `launch_s`, `landed_s`:
+    when the firmware entered its trigger state and the state that ends a
+    flight, in the firmware's seconds; `truth`: (times in the firmware's
+    seconds, true altitudes) to compare the recorded `alt_element` with."""
+    try:
+        p, flight, flights, empty = newest_flight(app, run.eeprom)
+    except RecordError as e:
+        return [f"flight recorder: {e}"], [check_cls("the flight record decodes", False, str(e))]
+    lines = [f"flight recorder: {len(flights)} flight(s) in {p.slots - empty} of {p.slots} records of "
+             f"{p.record} B (EEPROM {p.base}–{p.base + p.size - 1})"]
+    if flight is None:
+        return lines, [check_cls("the recorder kept the flight", False, "no flight in the record")]
+    s = flight.samples
+    used = len(flight.records) + (flight.start is not None)
+    span = (s[-1][0] - s[0][0]) / 1000 if s else 0.0
+    per_record = len(s) / max(1, len(flight.records))
+    capacity = (p.slots - 1) * per_record * span / max(1, len(s) - 1) if len(s) > 1 else 0.0
+    lines.append(f"  flight {flight.number}: {len(s)} samples in {used} records ({used * p.record} B), "
+                 f"{s[0][0] / 1000:.3f}–{s[-1][0] / 1000:.3f} s; {per_record:.1f} samples and "
+                 f"{p.record / per_record:.2f} B a sample; the store holds about {capacity:.0f} s of such flight")
+    checks = []
+    rate = float(max(app.log.rates))
+    period_ms = 1000 / float(rate)
+    gaps = [b[0] - a[0] for a, b in zip(s, s[1:])]
+    worst = max(gaps) if gaps else 0
+    before = (launch_s * 1000 - s[0][0]) / 1000 if launch_s is not None else float("nan")
+    end_ok = landed_s is None or s[-1][0] >= landed_s * 1000 - period_ms
+    ok = launch_s is not None and before >= float(app.log.before) - 1e-9 and worst <= period_ms + 1e-9 and end_ok
+    checks.append(check_cls(
+        f"the record covers {float(app.log.before):g} s before launch to landing at {rate:g} Hz",
+        ok, f"from {before:.2f} s before launch to {s[-1][0] / 1000:.2f} s"
+            + (f" (landing {landed_s:.2f} s)" if landed_s is not None else "") + f", largest gap {worst} ms"))
+    # value for value against the telemetry of the same run
+    tele = {}
+    for _, row in run.samples:
+        if "time" in row:
+            tele[int(row["time"]) & 0xFFFFFFFF] = row
+    steps = {f.name: (float(f.step) / 2 + 1e-6 if f.step is not None else 0.0) for f in p.fields}
+    both = bad = 0
+    first_bad = ""
+    for t, v in s:
+        row = tele.get(t)
+        if row is None:
+            continue
+        both += 1
+        for name, x in v.items():
+            if name not in row:
+                continue
+            y = row[name]
+            if not (abs(float(x) - float(y)) <= steps[name]):
+                bad += 1
+                if not first_bad:
+                    first_bad = f"; first at {t} ms: {name} recorded {x}, telemetered {y}"
+    checks.append(check_cls("the record matches the telemetry value for value where both have a sample "
+                            "(within half a step where the encoding quantises)",
+                            both > 0 and bad == 0, f"{both} common samples, {bad} differ{first_bad}"))
+    if truth is not None and len(truth[0]) and alt_element in {f.name for f in p.fields}:
+        tt = np.array([t / 1000 for t, _ in s])
+        rec = np.array([v[alt_element] for _, v in s], dtype=float)
+        true_t, true_h = np.asarray(truth[0], dtype=float), np.asarray(truth[1], dtype=float)
+        err = rec - np.interp(tt, true_t, true_h)
+        peak_rec, peak_true = float(rec.max()), float(np.nanmax(true_h))
+        lines.append(f"  {alt_element} against the truth: RMS {float(np.sqrt(np.mean(err ** 2))):.2f} m, "
+                     f"largest {float(np.abs(err).max()):.2f} m; apogee recorded {peak_rec:.1f} m, true "
+                     f"{peak_true:.1f} m")
+        checks.append(check_cls("the recorded apogee is within 5 % of the true one", abs(peak_rec - peak_true)
+                                <= 0.05 * abs(peak_true), f"{peak_rec:.1f} m against {peak_true:.1f} m"))
+    return lines, checks

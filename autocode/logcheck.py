@@ -176,7 +176,8 @@ def _rates(rows: list[Setting], m: M.Machine | None, task: M.Task | None, r) -> 
         t = s.values[0]
         q = exact_literal(t.text) if t.kind == NUM else None
         if q is None or q < 0:
-            r.err(t, f"`rate` takes Hz (0 or a positive number), found `{t.text}`")
+            shown = t.text + (s.values[1].text if t.text == "-" and len(s.values) > 1 else "")
+            r.err(t, f"`rate` takes Hz (0 or a positive number), found `{shown}`")
             ok = False
             continue
         if q != 0 and task is not None and (task.rate / q).denominator != 1:

@@ -6,14 +6,6 @@
 #include "fsw_crc.h"
 #include "fsw_pal.h"
 
-#if defined(__AVR__)
-#include <avr/interrupt.h>
-#include <avr/io.h>
-// An EEPROM write ended: the handler only turns itself off; waking the CPU
-// was the point (pal::eeprom_write asked for it), so the loop's param_poll
-// writes the next byte.
-ISR(EE_READY_vect) { EECR = static_cast<uint8_t>(EECR & ~_BV(EERIE)); }
-#endif
 
 namespace fsw {
 

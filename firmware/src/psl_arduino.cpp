@@ -350,9 +350,12 @@ uint8_t reset_cause() { return 0; }
 #if defined(__AVR__)
 // The EEPROM through its registers (datasheet 8.4): a write is started and
 // left to the hardware; EERIE asks for the ready interrupt, whose handler
-// (fsw_param.cpp, linked only with parameters) only turns itself off, so
-// that a sleeping CPU wakes when a byte is done and the generated loop
-// gives the parameter writer its next byte.
+// (below) only turns itself off, so that a sleeping CPU wakes when a byte
+// is done and the generated loop gives the writer (parameters, the flight
+// recorder) its next byte. The handler is here, beside the write that
+// enables it, so that every firmware that writes the EEPROM has it: an
+// interrupt without a handler resets an AVR.
+ISR(EE_READY_vect) { EECR = static_cast<uint8_t>(EECR & ~_BV(EERIE)); }
 uint16_t eeprom_size() { return static_cast<uint16_t>(E2END + 1u); }
 uint8_t eeprom_read(uint16_t addr) {
     while (EECR & _BV(EEPE)) {

@@ -112,7 +112,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     reset_cause = _reset_cause(settings.get("reset_cause"), sv, r)
     _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs)
     budget = _budget(f.budget, board, r)
-    log = check_log(f.log, sv, tasks, machines, board, r)
+    log = check_log(f.log, sv, tasks, machines, board, r, channels=channels)
     return Parts(name, board, rate, baud, sv, machines, channels, time_source, time_unit, time_element, tasks,
                  streams, writable, reset_cause, budget, sv_file.file,
                  {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log)

@@ -2,7 +2,10 @@
 the flight recorder keeps, at which rate in which states, and where.
 
     [log]
-    store   eeprom                # where records go
+    store   eeprom                # where records go: eeprom, or spi_nor PIN [SIZE]
+                                  # (an SPI NOR flash chip, chip select on board pin PIN,
+                                  # SIZE bytes, or a number and K or M: 64 K..16 M,
+                                  # default 8 M)
     record  64                    # bytes per record, 32..255
     full    stop                  # stop | newest: what happens when the store is full
     machine mission               # the machine whose states the lines below name
@@ -19,6 +22,7 @@ Every problem is reported where it is written."""
 from __future__ import annotations
 
 from fractions import Fraction
+from os.path import basename
 
 from . import model as M
 from .appsyntax import Setting
@@ -30,12 +34,24 @@ KEYS = ("store", "record", "full", "machine", "trigger", "before", "rate", "eras
 ONCE = ("store", "record", "full", "machine", "trigger", "before", "erase")
 ENCODINGS = ("raw", "hold", "delta", "quant")
 MAX_BEFORE = 60
+STORES = ("eeprom", "spi_nor")
+NOR_SECTOR = 4096  # bytes a sector erase clears: records never straddle one
+NOR_SIZES = (64 << 10, 16 << 20)  # a power of two between these
+NOR_DEFAULT = 8 << 20  # the W25Q64JV
+UNITS = {"K": 1 << 10, "KiB": 1 << 10, "M": 1 << 20, "MiB": 1 << 20}
+MAX_SLOTS = 65535  # record indexes are u16
+# The SPI bus's pins by MCU, as port and bit (the board's `arduino.ports` maps
+# them to its pin numbers): (MOSI, MISO, SCK).
+SPI_BUS = {"atmega328p": (("B", 3), ("B", 4), ("B", 5)), "atmega2560": (("B", 2), ("B", 3), ("B", 1))}
+SPI_BUS_UNO_PINS = {11: "MOSI", 12: "MISO", 13: "SCK"}  # boards without a port map (native: the Uno's pins)
+
 
 
 def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine],
-              board, r) -> M.Log | None:
+              board, r, channels: list[M.Channel] | None = None) -> M.Log | None:
     """The checked `[log]` section, None when it is absent or has errors
-    (reported through `r`, appcheck's Report)."""
+    (reported through `r`, appcheck's Report). `channels`: the I/O channels,
+    whose pins an SPI flash's chip select must not take."""
     rec_task = next((t for t in tasks if t.kind == "recorder"), None)
     if not rows:
         if rec_task is not None:
@@ -67,11 +83,20 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if not elements:
         r.err(first, "[log] needs at least one `element`")
 
-    store = _one_word(once.get("store"), ("eeprom",), "eeprom", r)
+    store, cs_pin, flash_size = _store(once.get("store"), board, channels, r)
     if store == "eeprom" and board is not None and board.eeprom == 0:
         r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
     record = _record(once.get("record"), r)
+    if store == "spi_nor" and "record" in once and (record & (record - 1) or record > 128):
+        r.err(once["record"].values[0], f"`record` on spi_nor is a power of two from 32 to 128 "
+                                        f"(records never straddle a {NOR_SECTOR}-byte sector or a 256-byte page): "
+                                        f"found {record}")
     full = _one_word(once.get("full"), ("stop", "newest"), "stop", r)
+    if store == "spi_nor" and full == "newest":
+        r.err(once["full"].values[0], "`full newest` is not available on spi_nor: a flash sector is erased whole, so "
+                                      "overwriting the oldest records would drop a whole sector of them at a time, "
+                                      "and boot finds the end of the log by a binary search that needs the records "
+                                      "written from the chip's start; use `full stop` and `fsw dump --erase`")
     machine = _machine(once.get("machine"), machines, r)
     m = machines[machine] if machine is not None else None
     trigger = _states(once.get("trigger"), m, r, one=True)
@@ -81,23 +106,86 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if trigger and state_rates is not None and state_rates[trigger[0]] == 0:
         r.err(once["trigger"].values[0], f"the trigger state `{once['trigger'].values[0].text}` records nothing "
                                          "(rate 0): a flight would end as it starts")
-    if state_rates is not None and rec_task is not None:
-        import math
-        m_all = 1
-        for q in state_rates:
-            if q:
-                d = int(rec_task.rate / q)
-                m_all = m_all * d // math.gcd(m_all, d)
-        if m_all > 65535:
-            r.err(rates[0].key, f"the log rates' sample dividers have a common multiple of {m_all:,}: at most 65,535 "
-                                "(use rates whose dividers of the task's rate share factors)")
-            state_rates = None
     fields = _fields(elements, sv, machines, r)
     if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
         return None
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
-    return M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line)
+    return M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
+                 cs_pin, flash_size)
+
+
+def _store(s: Setting | None, board, channels: list[M.Channel] | None, r) -> tuple[str | None, int | None, int]:
+    """(store, chip-select pin, flash bytes) of `store eeprom` / `store spi_nor PIN [SIZE]`."""
+    if s is None:
+        return "eeprom", None, 0
+    if not s.values or s.values[0].text not in STORES or (s.values[0].text == "eeprom" and len(s.values) != 1):
+        at = s.values[1] if len(s.values) > 1 and s.values[0].text == "eeprom" else (s.values[0] if s.values else s.key)
+        r.err(at, "`store` takes one of: eeprom, spi_nor PIN [SIZE]")
+        return None, None, 0
+    if s.values[0].text == "eeprom":
+        return "eeprom", None, 0
+    rest = s.values[1:]
+    if not rest or len(rest) > 3 or (len(rest) == 3 and rest[2].text not in UNITS):
+        r.err(rest[-1] if len(rest) > 2 else s.values[0],
+              "`store spi_nor` takes the chip select's pin, then the chip's size (default 8 MiB): bytes, or a "
+              "number and K or M, e.g. `spi_nor 10 1 M`")
+        return None, None, 0
+    ok = True
+    pin = _cs_pin(rest[0], board, channels, r)
+    if pin is None:
+        ok = False
+    size = NOR_DEFAULT
+    if len(rest) >= 2:
+        size = _size(rest[1], rest[2] if len(rest) == 3 else None, r)
+        if size is None:
+            ok = False
+    return ("spi_nor", pin, size) if ok else (None, None, 0)
+
+
+def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r) -> int | None:
+    if board is None:
+        return None
+    if t.kind != NUM or not t.text.isdigit() or len(t.text) > 3 or int(t.text) not in board.digital_pins:
+        pins = sorted(board.digital_pins)
+        r.err(t, f"the {board.name} has no digital pin `{t.text}` for the flash's chip select "
+                 f"(digital pins: {pins[0]}..{pins[-1]})" if pins else f"the {board.name} has no digital pins")
+        return None
+    pin = int(t.text)
+    if pin in board.reserved:
+        r.err(t, f"pin {pin} is reserved on the {board.name}: {board.reserved[pin]}")
+        return None
+    bus = _spi_bus(board)
+    if pin in bus:
+        r.err(t, f"pin {pin} is the SPI bus's {bus[pin]} on the {board.name}: the chip select must be another pin")
+        return None
+    for c in channels or ():
+        if c.pin_number == pin:
+            r.err(t, f"pin {pin} is already the channel of `{c.element.name}` ({basename(c.path)}:{c.line})")
+            return None
+    return pin
+
+
+def _spi_bus(board) -> dict[int, str]:
+    """The board's SPI bus pins: pin -> MOSI / MISO / SCK."""
+    bus = SPI_BUS.get(board.mcu)
+    if bus is None or not board.ports:
+        return dict(SPI_BUS_UNO_PINS)
+    by_port = {pb: pin for pin, pb in board.ports.items()}
+    return {by_port[pb]: name for pb, name in zip(bus, ("MOSI", "MISO", "SCK")) if pb in by_port}
+
+
+def _size(t: Tok, unit: Tok | None, r) -> int | None:
+    """Bytes from `1048576`, `1024 K`, `1 M` (a power of two, 64K..16M). The
+    lexer takes `1M` for a malformed number: the unit is a word of its own."""
+    mult = UNITS[unit.text] if unit is not None else 1
+    n = int(t.text) * mult if t.kind == NUM and t.text.isdigit() and t.text.isascii() and len(t.text) <= 9 else None
+    if n is None or n & (n - 1) or not NOR_SIZES[0] <= n <= NOR_SIZES[1]:
+        shown = t.text + (" " + unit.text if unit is not None else "")
+        r.err(t, f"the flash's size is a power of two from 64 K to 16 M (bytes, or a number and K or M), "
+                 f"found `{shown}`")
+        return None
+    return n
 
 
 def _one_word(s: Setting | None, words: tuple[str, ...], default: str, r) -> str | None:
@@ -250,9 +338,6 @@ def _encoding(s: Setting, e: M.Element, n_states: int | None, r) -> M.LogField |
         return M.LogField(e, "hold" if n_states is not None else "raw", None, narrow, s.key.line)
     w = rest[0]
     if w.kind == ID and w.text in ("raw", "hold") and len(rest) == 1:
-        if e.type.size > 8:
-            r.err(w, f"element `{e.name}` cannot be logged")
-            return None
         return M.LogField(e, w.text, None, narrow, s.key.line)
     if w.kind == ID and w.text in ("delta", "quant") and len(rest) == 3 and rest[1].kind == OP \
             and rest[1].text == "=" and rest[2].kind == NUM:

@@ -356,6 +356,8 @@ class Log:
     erase: tuple[int, ...]  # state ids in which an erase is allowed
     fields: tuple[LogField, ...]  # in record order: held, delta, quant, raw
     line: int  # the [log] section's first row
+    cs_pin: int | None = None  # store spi_nor: the chip select's board pin
+    flash_size: int = 0  # store spi_nor: bytes of the chip
 
 
 @dataclass(frozen=True)

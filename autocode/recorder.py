@@ -3,7 +3,8 @@ generator sizes the firmware's tables and RAM from it, and the ground
 (`fsw dump`, `fsw sim`) and the tests decode records with it.
 
 A record is `record` bytes in one of `slots` slots of the store, from
-`base` (after the parameter banks):
+`base` (after the parameter banks; 0 on an SPI NOR flash, whose slots are
+the chip's size / record, at most 65,535):
 
     0        kind: 0xF0 a flight's start, 0xF1 samples (written last)
     1..2     sequence number, u16 (one more for each record written)
@@ -34,6 +35,8 @@ START, DATA = 0xF0, 0xF1
 HEADER = 8
 TAIL = 5
 ESCAPE = 0x80
+MAX_SLOTS = 65535  # slot numbers are u16
+NOR_SECTOR = 4096  # an SPI NOR flash's erase sector
 EEPROM_WRITE_S = 0.0034  # one AVR EEPROM byte (datasheet: 3.3 ms typical, 3.4 ms with the margin avr-libc uses)
 
 
@@ -84,6 +87,9 @@ class Plan:
     time_element: str
     machine: str
     states: tuple[str, ...]  # names by state id - 1
+    store: str = "eeprom"  # or "spi_nor" (docs/recorder.md, "On an SPI NOR flash chip")
+    cs_pin: int | None = None  # spi_nor: the chip select's board pin
+    flash_size: int = 0  # spi_nor: bytes of the chip
 
     @property
     def ram(self) -> int:
@@ -137,27 +143,43 @@ def plan(app) -> Plan | None:
     task = next(t for t in app.tasks if t.kind == "recorder")
     m = app.machines[log.machine]
     params = app_parameters(app)
-    base = 2 * (PHEADER + sum(p.type.size for p in params)) if params else 0
-    slots = (app.board.eeprom - base) // log.record
+    store = log.store
+    if store == "spi_nor":  # the whole chip, from 0 (slot numbers are u16)
+        base = 0
+        slots = min(log.flash_size // log.record, MAX_SLOTS)
+    else:
+        base = 2 * (PHEADER + sum(p.type.size for p in params)) if params else 0
+        slots = (app.board.eeprom - base) // log.record
     fields = tuple(Field(f.element.name, f.element.type, f.enc, f.step, f.width) for f in log.fields)
     n_hold = sum(f.enc == "hold" for f in fields)
     escape = n_hold < len(fields) and fields[n_hold].enc == "delta"
     dividers = tuple(0 if r == 0 else int(task.rate / r) for r in log.rates)
     max_rate = max(log.rates)
     pre_rate = max((log.rates[s] for s in _predecessors(m, log.trigger)), default=max_rate)
-    ring_cap = math.floor(log.before * pre_rate) + 1 + math.ceil(0.025 * max_rate) + 1
+    # the `before` seconds and one older sample, then room for what comes while the writer is busy: on the
+    # EEPROM a record's tail and kind (6 writes, 20 ms); on a flash a start record and a sector erase (45 ms),
+    # a pass of the loop each (one a cycle)
+    busy_s = 0.025 if log.store == "eeprom" else 0.1
+    ring_cap = math.floor(log.before * pre_rate) + 1 + math.ceil(busy_s * max_rate) + 1
     sample_size = 2 + sum(f.width for f in fields)
     opening = max(HEADER + 8, HEADER + sum(f.width for f in fields))
     worst = sum((2 + f.width) if escape else 0 for f in fields[:n_hold]) + sum(f.encoded() for f in fields[n_hold:])
     fifo_cap = max(opening - 1, worst)  # the kind byte is not queued: it is written last
+    if log.store == "spi_nor":  # a program a cycle carries what the fifo holds: room for a record's opening and more
+        fifo_cap = min(255, max(opening - 1, worst) + worst * 2)
     return Plan(fields, log.record, base, slots, log.newest, dividers,
                 tuple(1 if sid in log.erase else 0 for sid in range(len(log.rates))), log.trigger,
-                int(log.before * 1000), Fraction(1000) / task.rate, _runs_mod(dividers), max(ring_cap, 2), fifo_cap, sample_size,
+                int(log.before * 1000), Fraction(1000) / task.rate, _runs_mod(dividers), max(ring_cap, 2), fifo_cap,
+                sample_size,
                 opening, worst, n_hold, escape, log_hash(log, app.sv), m.vars[m.s].name, app.time_element.name,
-                m.name, tuple(st.name for st in m.states))
+                m.name, tuple(st.name for st in m.states), store, log.cs_pin,
+                log.flash_size)
 
 
 def _runs_mod(dividers) -> int:
+    """A multiple of every divider within 16 bits. Rates are exact decimals of
+    a task rate that divides 1,000,000, so dividers have no prime factors but
+    2 and 5, and their least common multiple is at most 128 x 125."""
     m = 1
     for d in dividers:
         if d:

@@ -64,8 +64,8 @@ def variant_1khz(folder: str = os.path.join(OUT, "rocket-1khz")) -> tuple[str, s
     app_path = os.path.join(folder, "rocket.app")
     with open(app_path) as f:
         text = f.read()
-    text = re.sub(r"(?m)^rate(\s+)\d+", r"rate\g<1>1000", text)
-    text = re.sub(r"(?m)^(\w+\s+(?:uplink|inputs|machine \w+|outputs|telemetry)\s+)rate=\d+", r"\1rate=1000", text)
+    text = re.sub(r"(?m)^rate(\s+)\d+", r"rate\g<1>1000", text, count=1)  # [application]'s, not [log]'s
+    text = re.sub(r"(?m)^(\w+\s+(?:uplink|inputs|machine \w+|outputs|telemetry|recorder)\s+)rate=\d+", r"\1rate=1000", text)
     for source in ("clock", "cycle"):
         with open(app_path, "w") as f:
             f.write(re.sub(r"(?m)^source\s+\w+", f"source {source}", text))

@@ -49,6 +49,43 @@ def without_log(tmp: Path) -> Path:
     return dst
 
 
+SPI_LOG = """[log]                  # the rocket's recorder on an SPI NOR flash: every flight element at 100 Hz
+store   spi_nor 10 1 M     # chip select on D10, a W25Q80 (1 MiB)
+record  128
+full    stop
+machine mission
+trigger Boost
+before  0.5
+rate    100            # Hz: the machines' rate, from launch to landing
+rate    10 Armed       # the half second before launch, in RAM until then
+rate    0 Safe Landed Abort
+erase   Safe Landed
+element altitude delta=0.1
+element accel quant=0.01
+element pressure quant=4
+element drogue
+element main
+element state
+
+"""
+
+
+def variant_spi(dst: Path) -> Path:
+    """examples/rocket with its recorder on an SPI NOR flash, written into
+    `dst` from the example's own configs: [log] above, the LED moved off
+    the SPI bus's SCK (pin 13) to pin 7, the budget raised for the
+    recorder's ring at 100 Hz."""
+    shutil.copytree(ROCKET, dst, ignore=shutil.ignore_patterns("build"))
+    app = (dst / "rocket.app").read_text()
+    app = re.sub(r"\[log\][^\[]*", SPI_LOG, app)
+    app = re.sub(r"(?m)^flash \d+", "flash 24576", app)
+    app = re.sub(r"(?m)^ram   \d+", "ram   1400", app)
+    (dst / "rocket.app").write_text(app)
+    dio = (dst / "rocket.dio").read_text()
+    (dst / "rocket.dio").write_text(re.sub(r"(?m)^o(\s+)13(\s+)led", r"o\g<1>7 \g<2>led", dio))
+    return dst
+
+
 def fly(project: Path, elf: str):
     from fswkit.plant.cosim import fly as cosim_fly
     from fswkit.plant.run import prepare
@@ -72,7 +109,7 @@ def main() -> int:
         app0, built0 = build(nolog, tmp / "nolog")
         app, run = fly(ROCKET, built.artifact)
         _, run0 = fly(nolog, built0.artifact)
-        p, flight, flights, empty = newest_flight(app, run.eeprom)
+        p, flight, flights, empty = newest_flight(app, run)
         s = flight.samples
         n_rec = len(flight.records)
         per = len(s) / n_rec
@@ -102,6 +139,27 @@ def main() -> int:
               f"{st0} -> {st1} B ({st1 - st0:+d})")
         ok = r1 - r0 <= 128
         print(f"    RAM           {'PASS' if ok else 'FAIL'} ({r1 - r0} B static <= 128 B)")
+        passed += ok
+        failed += not ok
+
+        spi = variant_spi(tmp / "rocket-spi")
+        sapp, sbuilt = build(spi, tmp / "spi")
+        sapp, srun = fly(spi, sbuilt.artifact)
+        sp, sflight, _, _ = newest_flight(sapp, srun)
+        ss = sflight.samples
+        sspan = (ss[-1][0] - ss[0][0]) / 1000
+        fs, rs = elf_size(sbuilt.artifact)
+        print(f"  rocket on an SPI NOR flash (1 MiB, {sp.record} B records), every flight element "
+              f"({', '.join(f.name for f in sp.fields)}) at 100 Hz from launch:")
+        print(f"    records       {len(sflight.records)} of samples, {len(ss)} samples over {sspan:.1f} s: "
+              f"{len(ss) / len(sflight.records):.1f} samples and {sp.record * len(sflight.records) / len(ss):.2f} B "
+              f"a sample, {len(sflight.records) / sspan:.1f} records/s")
+        print(f"    store         {sp.slots} records: about "
+              f"{(sp.slots - 1) * len(ss) / len(sflight.records) / 100:.0f} s of such flight at 100 Hz")
+        print(f"    cost          flash {fs:,} B, RAM {rs:,} B static ({sp.ram} B the recorder's)")
+        missing = sum(1 for a, b in zip(ss, ss[1:]) if b[0] - a[0] > (100 if a[1]["state"] == 2 else 10))
+        ok = missing == 0 and srun.eeprom is not None
+        print(f"    gaps          {'PASS' if ok else 'FAIL'}: {missing} samples missing from launch to landing")
         passed += ok
         failed += not ok
 

@@ -429,9 +429,21 @@ def _recorder(app: Application) -> list[str]:
     c.append(f"static_assert(fsw::log_config_ok({p.record}, {p.opening}, {p.worst}, {p.ring_cap}, {p.fifo_cap}, "
              f"{p.slots}), \"{name}: the recorder's tables\");")
     c.append("fsw::Recorder rec;")
-    c.append(f"// {name}: {p.slots} records of {p.record} B from EEPROM byte {p.base}; "
-             f"RAM {p.ram} B (docs/recorder.md)")
-    c.append("")
+    if p.store == "spi_nor":
+        c.append(f"// {name}: {p.slots} records of {p.record} B on an SPI NOR flash of {p.flash_size} B, "
+                 f"chip select on pin {p.cs_pin}; RAM {p.ram} B (docs/recorder.md, on an SPI NOR flash chip)")
+    else:
+        c.append(f"// {name}: {p.slots} records of {p.record} B from EEPROM byte {p.base}; "
+                 f"RAM {p.ram} B (docs/recorder.md)")
+    c += ["}  // namespace", "}  // namespace fsw_gen", "namespace fsw {"]
+    if p.store == "spi_nor":
+        c += [f"extern const uint8_t log_nor_cs = {p.cs_pin};  // the recorder's store: an SPI NOR flash (fsw_log.h)",
+              "void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {",
+              "    log_nor_read(r, slot, off, n, out);",
+              "}"]
+    else:
+        c += ["extern const uint8_t log_nor_cs = kLogEeprom;  // the recorder's store: the EEPROM (fsw_log.h)"]
+    c += ["}  // namespace fsw", "namespace fsw_gen {", "namespace {", ""]
     return c
 
 
@@ -487,6 +499,7 @@ def _params(app: Application, params) -> list[str]:
 def _native_main(app: Application) -> list[str]:
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
     params = bool(app_parameters(app))
+    nor = app.log is not None and getattr(app.log, "store", "eeprom") == "spi_nor"
     between = (['fsw::link_poll(fsw_gen::link);'] if has_link else []) + \
         (['fsw::param_poll(fsw_gen::params);'] if params else []) + \
         (['fsw::log_poll(fsw_gen::rec);'] if app.log is not None else [])
@@ -506,60 +519,73 @@ def _native_main(app: Application) -> list[str]:
          '//   PINS: aPIN=RAW sets an ADC reading, dPIN=0|1 a digital input level.',
          '//   --first-cycle N        starts the cycle count at N (with `[time] source cycle`,',
          '//                          G too): a long run\'s 2^32 wrap without the wait',
-         '//   --eeprom FILE          the EEPROM model is loaded from FILE and written through to it',
-         'int main(int argc, char** argv) {',
-         '    unsigned long cycles = 0, baud = 0;',
-         '    unsigned long long first_cycle = 0;',
-         '    bool simulated = false, link_out = false;',
-         '    for (int i = 1; i < argc; ++i) {',
-         '        unsigned pin = 0, value = 0;',
-         '        char tail = 0;',
-         '        if (strcmp(argv[i], "--link") == 0) {',
-         '            link_out = true;',
-         '        } else if (strcmp(argv[i], "--uart") == 0 && i + 1 < argc) {',
-         '            baud = strtoul(argv[++i], 0, 10);',
-         '        } else if (strcmp(argv[i], "--first-cycle") == 0 && i + 1 < argc) {',
-         '            first_cycle = strtoull(argv[++i], 0, 10);',
-         '        } else if (strcmp(argv[i], "--eeprom") == 0 && i + 1 < argc) {',
-         '            if (!fsw::native::sim_eeprom_file(argv[++i])) {',
-         '                fprintf(stderr, "cannot open the EEPROM file %s\\n", argv[i]);',
-         '                return 2;',
-         '            }',
-         '        } else if (sscanf(argv[i], "a%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 65536) {',
-         '            fsw::native::sim_set_analog(static_cast<uint8_t>(pin), static_cast<uint16_t>(value));',
-         '        } else if (sscanf(argv[i], "d%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 2) {',
-         '            fsw::native::sim_set_digital(static_cast<uint8_t>(pin), value != 0);',
-         "        } else if (argv[i][0] >= '0' && argv[i][0] <= '9') {",
-         '            cycles = strtoul(argv[i], 0, 10);',
-         '            simulated = true;',
-         '        } else {',
-         '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [--first-cycle N] [--eeprom FILE] [aPIN=RAW] [dPIN=0|1]\\n",',
-         '                    argv[0]);',
-         '            return 2;',
-         '        }',
-         '    }',
-         '    static uint8_t discard[1];',
-         '    static uint16_t discarded;',
-         '    if (simulated && !link_out) fsw::native::console_capture(discard, 0, &discarded);',
-         '    if (baud != 0) fsw::native::console_model_uart(static_cast<uint32_t>(baud), 64);',
-         '    if (!fsw_gen::begin()) { fprintf(stderr, "the runtime refused a table\\n"); return 3; }',
-         '    fsw_gen::ex.cycles = static_cast<uint32_t>(first_cycle);',
-         '    fsw_gen::ex.cycles_high = static_cast<uint32_t>(first_cycle >> 32);',
-         '    if (!simulated) {',
-         '        // Paced by the wall clock, timed by the simulated one: cycle k runs at',
-         '        // simulated time k periods, so G grows by exactly a period a cycle even',
-         '        // when the host is slow (a late cycle runs late, never early or twice).',
-         '        fsw::native::console_use_stdin(true);',
-         '        timespec t0;',
-         '        clock_gettime(CLOCK_MONOTONIC, &t0);',
-         '        for (uint64_t k = 1;; ++k) {',
-         '            fsw_gen::run_cycle();',
-         '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs);',
-         '            for (;;) {',
-         '                timespec t;',
-         '                clock_gettime(CLOCK_MONOTONIC, &t);',
-         '                const int64_t ahead = static_cast<int64_t>(k * fsw_gen::kPeriodUs) -',
-         '                    ((t.tv_sec - t0.tv_sec) * 1000000LL + (t.tv_nsec - t0.tv_nsec) / 1000);']
+         '//   --eeprom FILE          the EEPROM model is loaded from FILE and written through to it']
+    if nor:
+        c += ['//   --flash FILE           the SPI NOR flash model (the flight recorder\'s store) is loaded',
+              '//                          from FILE and written through to it']
+    c += ['int main(int argc, char** argv) {']
+    if nor:
+        c += [f'    fsw::native::sim_flash_set_size({app.log.flash_size}UL);']
+    c += ['    unsigned long cycles = 0, baud = 0;',
+          '    unsigned long long first_cycle = 0;',
+          '    bool simulated = false, link_out = false;',
+          '    for (int i = 1; i < argc; ++i) {',
+          '        unsigned pin = 0, value = 0;',
+          '        char tail = 0;',
+          '        if (strcmp(argv[i], "--link") == 0) {',
+          '            link_out = true;',
+          '        } else if (strcmp(argv[i], "--uart") == 0 && i + 1 < argc) {',
+          '            baud = strtoul(argv[++i], 0, 10);',
+          '        } else if (strcmp(argv[i], "--first-cycle") == 0 && i + 1 < argc) {',
+          '            first_cycle = strtoull(argv[++i], 0, 10);',
+          '        } else if (strcmp(argv[i], "--eeprom") == 0 && i + 1 < argc) {',
+          '            if (!fsw::native::sim_eeprom_file(argv[++i])) {',
+          '                fprintf(stderr, "cannot open the EEPROM file %s\\n", argv[i]);',
+          '                return 2;',
+          '            }',
+          ] + ([
+          '        } else if (strcmp(argv[i], "--flash") == 0 && i + 1 < argc) {',
+          '            if (!fsw::native::sim_flash_file(argv[++i])) {',
+          '                fprintf(stderr, "cannot open the flash file %s\\n", argv[i]);',
+          '                return 2;',
+          '            }',
+          ] if nor else []) + [
+          '        } else if (sscanf(argv[i], "a%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 65536) {',
+          '            fsw::native::sim_set_analog(static_cast<uint8_t>(pin), static_cast<uint16_t>(value));',
+          '        } else if (sscanf(argv[i], "d%u=%u%c", &pin, &value, &tail) == 2 && pin < 256 && value < 2) {',
+          '            fsw::native::sim_set_digital(static_cast<uint8_t>(pin), value != 0);',
+          "        } else if (argv[i][0] >= '0' && argv[i][0] <= '9') {",
+          '            cycles = strtoul(argv[i], 0, 10);',
+          '            simulated = true;',
+          '        } else {',
+          '            fprintf(stderr, "usage: %s [CYCLES [--link] [--uart BAUD]] [--first-cycle N] [--eeprom FILE] '
+          + ('[--flash FILE] ' if nor else '') + '[aPIN=RAW] [dPIN=0|1]\\n",',
+          '                    argv[0]);',
+          '            return 2;',
+          '        }',
+          '    }',
+          '    static uint8_t discard[1];',
+          '    static uint16_t discarded;',
+          '    if (simulated && !link_out) fsw::native::console_capture(discard, 0, &discarded);',
+          '    if (baud != 0) fsw::native::console_model_uart(static_cast<uint32_t>(baud), 64);',
+          '    if (!fsw_gen::begin()) { fprintf(stderr, "the runtime refused a table\\n"); return 3; }',
+          '    fsw_gen::ex.cycles = static_cast<uint32_t>(first_cycle);',
+          '    fsw_gen::ex.cycles_high = static_cast<uint32_t>(first_cycle >> 32);',
+          '    if (!simulated) {',
+          '        // Paced by the wall clock, timed by the simulated one: cycle k runs at',
+          '        // simulated time k periods, so G grows by exactly a period a cycle even',
+          '        // when the host is slow (a late cycle runs late, never early or twice).',
+          '        fsw::native::console_use_stdin(true);',
+          '        timespec t0;',
+          '        clock_gettime(CLOCK_MONOTONIC, &t0);',
+          '        for (uint64_t k = 1;; ++k) {',
+          '            fsw_gen::run_cycle();',
+          '            fsw::native::sim_advance_us(fsw_gen::kPeriodUs);',
+          '            for (;;) {',
+          '                timespec t;',
+          '                clock_gettime(CLOCK_MONOTONIC, &t);',
+          '                const int64_t ahead = static_cast<int64_t>(k * fsw_gen::kPeriodUs) -',
+          '                    ((t.tv_sec - t0.tv_sec) * 1000000LL + (t.tv_nsec - t0.tv_nsec) / 1000);']
     c += ['                ' + x for x in between]
     c += ['                if (ahead <= 0) break;',
           '                usleep(static_cast<useconds_t>(ahead > 1000 ? 1000 : ahead));',

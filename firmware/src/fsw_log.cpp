@@ -7,7 +7,11 @@
 //     small fifo, closing the record when a sample does not fit it;
 //   - the writer (log_poll) puts one fifo byte into the EEPROM whenever it is
 //     ready: a record's first byte is cleared first and written last, so a
-//     power cut leaves every record whole or invalid.
+//     power cut leaves every record whole or invalid. On an SPI NOR flash
+//     (log_nor_cs; docs/recorder.md, "On an SPI NOR flash chip") it programs
+//     a few bytes at a time whenever the chip is not busy, erases a sector
+//     before its first record, and programs the kind last (an erased byte
+//     reads 0xFF).
 #include "fsw_log.h"
 
 #include <math.h>
@@ -56,6 +60,178 @@ uint8_t table_u8(const uint8_t* table, uint8_t i) {
 uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_cast<uint32_t>(slot) * c.record; }
 
 uint8_t store_read(uint32_t addr) { return pal::eeprom_read(static_cast<uint16_t>(addr)); }
+
+// ---- the SPI NOR flash (W25Q-class; docs/recorder.md, "On an SPI NOR flash chip") ----
+// Commands used: 05h status register 1 (BUSY bit 0), 06h write enable,
+// 03h read, 02h page program, 20h 4 KiB sector erase.
+const uint8_t kNorStatus = 0x05, kNorWriteEnable = 0x06, kNorRead = 0x03, kNorProgram = 0x02, kNorErase = 0x20;
+
+// Selects the chip and sends `op` and a 24-bit address.
+void nor_cmd(uint8_t op, uint32_t a) {
+    pal::spi_select(true);
+    pal::spi_transfer(op);
+    pal::spi_transfer(static_cast<uint8_t>(a >> 16));
+    pal::spi_transfer(static_cast<uint8_t>(a >> 8));
+    pal::spi_transfer(static_cast<uint8_t>(a));
+}
+
+void nor_read(uint32_t a, uint8_t* out, uint8_t n) {
+    nor_cmd(kNorRead, a);
+    for (uint8_t i = 0; i < n; ++i) out[i] = pal::spi_transfer(0xFF);
+    pal::spi_select(false);
+}
+
+// Whether the chip takes a command (no program or erase in progress).
+bool nor_ready() {
+    pal::spi_select(true);
+    pal::spi_transfer(kNorStatus);
+    const uint8_t st = pal::spi_transfer(0xFF);
+    pal::spi_select(false);
+    return (st & 0x01u) == 0;
+}
+
+// Write enable, then `op` at `a`, the chip left selected for a page
+// program's bytes (a program never crosses a page: records are 32..128
+// bytes, powers of two, inside one).
+void nor_start(uint8_t op, uint32_t a) {
+    pal::spi_select(true);
+    pal::spi_transfer(kNorWriteEnable);
+    pal::spi_select(false);
+    nor_cmd(op, a);
+}
+
+// Starts a page program of `n` bytes at `a` or, with n == 0, a sector erase.
+void nor_write(uint32_t a, const uint8_t* p, uint8_t n) {
+    nor_start(n == 0 ? kNorErase : kNorProgram, a);
+    for (uint8_t i = 0; i < n; ++i) pal::spi_transfer(p[i]);
+    pal::spi_select(false);
+}
+
+// Whether every byte of slot `s` is erased (0xFF): nothing was written there.
+bool nor_blank(const LogConfig& c, uint16_t s) {
+    nor_cmd(kNorRead, slot_addr(c, s));
+    bool blank = true;
+    for (uint8_t i = 0; i < c.record && blank; ++i) blank = pal::spi_transfer(0xFF) == 0xFF;
+    pal::spi_select(false);
+    return blank;
+}
+
+// Whether slot `s` holds a whole record (as slot_valid): its tail, then its
+// bytes in one read.
+bool nor_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) {
+    const uint32_t a = slot_addr(c, s);
+    uint8_t tail[kLogTail];
+    nor_read(a + c.record - kLogTail, tail, kLogTail);
+    const uint8_t used = tail[2];
+    if (used < kLogHeader || used > c.record - kLogTail) return false;
+    uint8_t head[4];
+    uint16_t crc = kCrcInit;
+    nor_cmd(kNorRead, a);
+    for (uint8_t i = 0; i < used; ++i) {
+        const uint8_t b = pal::spi_transfer(0xFF);
+        if (i < 4) head[i] = b;
+        crc = crc16_update(crc, b);
+    }
+    pal::spi_select(false);
+    for (uint8_t i = 0; i < 3; ++i) crc = crc16_update(crc, tail[i]);
+    if ((head[0] != kLogStart && head[0] != kLogData) || crc != static_cast<uint16_t>(tail[3] | (tail[4] << 8)))
+        return false;
+    seq = static_cast<uint16_t>(head[1] | (head[2] << 8));
+    flight = head[3];
+    return true;
+}
+
+// Boot on the flash: the records were written from slot 0 on, so the first
+// blank slot ends them (a binary search); the newest valid record is the
+// last one before it that checks (torn ones, their kind never programmed,
+// are skipped and never written again).
+void nor_begin(const LogConfig& c, Recorder& r) {
+    uint16_t lo = 0, hi = c.slots;  // slots below lo are written, from hi on blank
+    while (lo < hi) {
+        const uint16_t mid = static_cast<uint16_t>(lo + (hi - lo) / 2u);
+        if (nor_blank(c, mid)) hi = mid;
+        else lo = static_cast<uint16_t>(mid + 1u);
+    }
+    r.head = lo;
+    for (uint16_t s = lo; s-- > 0;) {
+        uint16_t seq;
+        uint8_t flight;
+        if (nor_valid(c, s, seq, flight)) {
+            r.seq = static_cast<uint16_t>(seq + 1u);
+            r.flight = flight;
+            break;
+        }
+    }
+    if (r.head >= c.slots) r.mode = kLogFull;
+}
+
+// The writer on the flash: one command whenever the chip is not busy (the
+// sleeping executor's loop runs about once a cycle: a program takes every
+// byte the fifo holds). A sealed record's tail, then its kind, follow in the
+// next passes.
+void nor_poll(Recorder& r) {
+    if (r.w_phase == kWIdle || !nor_ready()) return;
+    const LogConfig c = config(r);
+    const uint32_t a = slot_addr(c, r.w_slot);
+    switch (r.w_phase) {
+    case kWClear:  // a sector's first record: the sector is erased first
+        r.w_phase = kWBody;
+        r.w_pos = 1;
+        if ((a & (kLogNorSector - 1u)) == 0) {
+            nor_write(a, 0, 0);
+            return;
+        }
+        // fall through - the body's first bytes in this pass
+    case kWBody:
+        if (r.f_len != 0) {  // every queued byte in one program
+            nor_start(kNorProgram, a + r.w_pos);
+            r.w_pos = static_cast<uint8_t>(r.w_pos + r.f_len);
+            do {
+                pal::spi_transfer(c.fifo[r.f_head]);
+                r.f_head = static_cast<uint8_t>(r.f_head + 1u == c.fifo_cap ? 0u : r.f_head + 1u);
+            } while (--r.f_len != 0);
+            pal::spi_select(false);
+            if (r.flags & kSealed) r.w_phase = kWTail;  // the tail in the next pass
+            return;
+        }
+        if (!(r.flags & kSealed)) return;
+        r.w_phase = kWTail;
+        // fall through - nothing queued: the tail in this pass
+    case kWTail: {
+        const uint8_t tail3[3] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used};
+        uint16_t crc = r.crc;
+        for (uint8_t i = 0; i < 3; ++i) crc = crc16_update(crc, tail3[i]);
+        const uint8_t tail[5] = {tail3[0], tail3[1], tail3[2], static_cast<uint8_t>(crc),
+                                 static_cast<uint8_t>(crc >> 8)};
+        nor_write(a + c.record - kLogTail, tail, kLogTail);
+        r.w_phase = kWMagic;
+        return;
+    }
+    case kWMagic:  // last: the kind, and the record is whole
+        nor_write(a, &r.kind, 1);
+        r.w_phase = kWIdle;
+        r.used = 0;
+        r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
+        ++r.head;
+        ++r.seq;
+        if (r.head >= c.slots) r.mode = kLogFull;
+        return;
+    case kWErase: {  // the sectors in use, from the one of `head` down to sector 0; `head` counts down
+        const uint16_t per = static_cast<uint16_t>(kLogNorSector / c.record);
+        uint16_t s = r.head < c.slots ? r.head : static_cast<uint16_t>(c.slots - 1u);
+        s = static_cast<uint16_t>(s - s % per);
+        nor_write(slot_addr(c, s), 0, 0);
+        if (s == 0) {
+            r.w_phase = kWIdle;
+            r.mode = kLogIdle;
+        }
+        r.head = s == 0 ? 0 : static_cast<uint16_t>(s - 1u);
+        return;
+    }
+    default:
+        r.w_phase = kWIdle;
+    }
+}
 
 // Whether slot `s` holds a whole record; its sequence number and flight.
 bool slot_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) {
@@ -291,7 +467,25 @@ void trim(const LogConfig& c, Recorder& r, uint32_t now) {
 
 }  // namespace
 
-void log_begin(Recorder& r, const LogConfig* cfg) {
+void log_nor_begin(Recorder& r, const LogConfig* cfg) {
+    memset(&r, 0, sizeof r);
+    r.cfg = cfg;
+    const LogConfig c = config(r);
+    pal::spi_begin(log_nor_cs);
+    nor_begin(c, r);
+    r.state = state_of(c);
+}
+
+void log_nor_poll(Recorder& r) {
+    if (r.w_phase != kWIdle) nor_poll(r);
+}
+
+void log_nor_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
+    const LogConfig c = config(r);
+    nor_read(slot_addr(c, slot) + off, out, n);
+}
+
+void log_eeprom_begin(Recorder& r, const LogConfig* cfg) {
     memset(&r, 0, sizeof r);
     r.cfg = cfg;
     const LogConfig c = config(r);
@@ -358,9 +552,10 @@ Result log_task(void* ctx) {
     return kOk;
 }
 
-void log_poll(Recorder& r) {
-    if (r.w_phase == kWIdle || !pal::eeprom_ready()) return;
-    const LogConfig c = config(r);
+namespace {
+
+// The writer's next EEPROM byte (the EEPROM is ready).
+void eeprom_next(const LogConfig& c, Recorder& r) {
     const uint32_t a = slot_addr(c, r.w_slot);
     switch (r.w_phase) {
     case kWClear:
@@ -411,6 +606,18 @@ void log_poll(Recorder& r) {
     }
 }
 
+}  // namespace
+
+// On an AVR a byte takes 3.4 ms: one is written per call, and the
+// EEPROM-ready interrupt wakes the loop for the next. A store that is ready
+// again at once (simavr's, the host's model) takes a few per call, so the
+// simulated writer is never slower than the silicon's.
+void log_eeprom_poll(Recorder& r) {
+    if (r.w_phase == kWIdle || !pal::eeprom_ready()) return;
+    const LogConfig c = config(r);
+    for (uint8_t n = 0; n < 8 && r.w_phase != kWIdle && pal::eeprom_ready(); ++n) eeprom_next(c, r);
+}
+
 bool log_erase(Recorder& r) {
     const LogConfig c = config(r);
     if (r.mode == kLogRecording || r.mode == kLogErasing || r.w_phase != kWIdle) return false;
@@ -423,7 +630,8 @@ bool log_erase(Recorder& r) {
     return true;
 }
 
-void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
+// Weak: an application on an SPI NOR flash defines it (generated: log_nor_read).
+__attribute__((weak)) void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
     const LogConfig c = config(r);
     const uint32_t a = slot_addr(c, slot) + off;
     for (uint8_t i = 0; i < n; ++i) out[i] = store_read(a + i);

@@ -19,6 +19,16 @@ static const uint8_t kLogHeader = 8;    // magic, seq u16, flight, t0 u32 (ms); 
 static const uint8_t kLogTail = 5;      // period u16 (ms), used u8, CRC-16: the record's last bytes
 static const uint8_t kLogEscape = 0x80; // the first delta byte of a sample: a held element changes
 
+// The store: the chip select's board pin of an SPI NOR flash (docs/recorder.md, "On an SPI NOR flash chip"),
+// or kLogEeprom. The generated code of an application with a recorder
+// defines it (a strong constant: LTO folds it, so an application links only
+// its own store's code; a weak definition would not be folded right by
+// avr-gcc 5.4). The native PSL has a weak one (kLogEeprom) for host
+// programs that link the runtime without a recorder.
+static const uint8_t kLogEeprom = 0xFF;
+extern const uint8_t log_nor_cs;
+static const uint16_t kLogNorSector = 4096;  // bytes a sector erase clears; records never straddle one
+
 // How an element is stored (docs/recorder.md, "Encodings").
 enum LogEnc : uint8_t {
     kLogRaw = 0,    // its bytes, every sample (`width` of them: narrowed state numbers)
@@ -104,19 +114,39 @@ struct Recorder {
 };
 
 // Boot: finds the newest valid record (blocking reads of each record's
-// bytes: a few ms for an Uno's EEPROM) and goes on after it.
-void log_begin(Recorder& r, const LogConfig* cfg);
+// bytes: a few ms for an Uno's EEPROM) and goes on after it. On an SPI NOR
+// flash: a binary search for the first blank slot (every byte 0xFF), then
+// the newest valid record before it; a torn record there is skipped.
+void log_eeprom_begin(Recorder& r, const LogConfig* cfg);
+void log_nor_begin(Recorder& r, const LogConfig* cfg);
 // The recorder task's step (ctx = the Recorder): samples, the trigger, the
 // encoder. Never blocks, never faults.
 Result log_task(void* recorder);
-// The background writer: the next byte into the store when it is ready.
-// Called from loop() between cycles.
-void log_poll(Recorder& r);
-// Starts erasing the log (every record's first byte cleared); false when the
+// The background writer: the next byte into the store when it is ready
+// (on an SPI NOR flash, a command whenever the chip is not busy). Called
+// from loop() between cycles.
+void log_eeprom_poll(Recorder& r);
+void log_nor_poll(Recorder& r);
+// The store's entry points, chosen where log_nor_cs is known: the generated
+// code, which defines it, calls these, so the compiler drops the other
+// store's calls before the link (LTO alone does not fold the constant away).
+inline void log_begin(Recorder& r, const LogConfig* cfg) {
+    if (log_nor_cs != kLogEeprom) log_nor_begin(r, cfg);
+    else log_eeprom_begin(r, cfg);
+}
+inline void log_poll(Recorder& r) {
+    if (log_nor_cs != kLogEeprom) log_nor_poll(r);
+    else log_eeprom_poll(r);
+}
+// Starts erasing the log (every record's first byte cleared; on an SPI NOR
+// flash the sectors in use, the last first); false when the
 // machine is in a state that forbids it or a flight is being recorded.
 bool log_erase(Recorder& r);
 // `n` bytes of slot `slot` from `off` into `out` (a dump reads raw records).
+// The runtime's is the EEPROM's, weak: the generated code of an application
+// on an SPI NOR flash defines log_read as log_nor_read.
 void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out);
+void log_nor_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out);
 
 // ---- compile-time checks of the tables -----------------------------------------
 // Records of at least the header, one sample and the tail; a sample that

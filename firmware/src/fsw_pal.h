@@ -112,6 +112,18 @@ bool eeprom_ready();
 // a sleeping CPU then, so a background writer goes on at the EEPROM's pace.
 void eeprom_write(uint16_t addr, uint8_t value);
 
+// ---- SPI (master) -----------------------------------------------------------
+// The SPI bus as master, mode 0, MSB first, at the fastest clock (an AVR's
+// F_CPU / 2), with a chip select on board pin `cs_pin` driven high (idle).
+// On an AVR the bus's own SS pin is made an output too (as master it must
+// not be an input pulled low). Register level: no Arduino SPI library.
+void spi_begin(uint8_t cs_pin);
+// Chip select low (true: a transaction starts) or high (it ends).
+void spi_select(bool on);
+// Shifts `out` out and returns the byte shifted in meanwhile; waits for the
+// shift (16 CPU cycles on an AVR at F_CPU / 2).
+uint8_t spi_transfer(uint8_t out);
+
 // ---- Watchdog ---------------------------------------------------------------
 // Arms the watchdog (FSW_WATCHDOG_MS) when FSW_WATCHDOG is on.
 void watchdog_begin();

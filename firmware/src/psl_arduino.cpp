@@ -381,6 +381,42 @@ bool eeprom_ready() { return true; }
 void eeprom_write(uint16_t, uint8_t) {}
 #endif
 
+#if defined(__AVR__) && defined(SPDR)
+// The SPI through its registers (datasheet 19): the chip select's port and
+// mask are looked up once, so a select is two instructions.
+namespace {
+volatile uint8_t* g_spi_cs_port;
+uint8_t g_spi_cs_mask;
+}  // namespace
+void spi_begin(uint8_t cs_pin) {
+    g_spi_cs_port = portOutputRegister(digitalPinToPort(cs_pin));
+    g_spi_cs_mask = digitalPinToBitMask(cs_pin);
+    *g_spi_cs_port |= g_spi_cs_mask;  // high before it drives: the chip stays deselected
+    pinMode(cs_pin, OUTPUT);
+    digitalWrite(SS, HIGH);
+    pinMode(SS, OUTPUT);  // master mode holds only while SS is an output (or high)
+    pinMode(MOSI, OUTPUT);
+    pinMode(SCK, OUTPUT);
+    SPCR = static_cast<uint8_t>(_BV(SPE) | _BV(MSTR));  // mode 0, MSB first, F_CPU / 4 ...
+    SPSR = _BV(SPI2X);                                 // ... doubled: F_CPU / 2
+}
+void spi_select(bool on) {
+    if (on) *g_spi_cs_port &= static_cast<uint8_t>(~g_spi_cs_mask);
+    else *g_spi_cs_port |= g_spi_cs_mask;
+}
+uint8_t spi_transfer(uint8_t out) {
+    SPDR = out;
+    while (!(SPSR & _BV(SPIF))) {
+    }
+    return SPDR;
+}
+#else
+// Another MCU: no SPI through this layer (reads give 0xFF, as an absent chip).
+void spi_begin(uint8_t) {}
+void spi_select(bool) {}
+uint8_t spi_transfer(uint8_t) { return 0xFF; }
+#endif
+
 }  // namespace pal
 }  // namespace fsw
 

@@ -10,10 +10,14 @@
 #include <time.h>
 
 #include "fsw_clock.h"
+#include "fsw_log.h"
 #include "fsw_pal.h"
 #include "psl_native.h"
 
 namespace fsw {
+
+// The recorder's store where no generated code names it (fsw_log.h).
+extern const uint8_t log_nor_cs __attribute__((weak)) = kLogEeprom;
 
 namespace {
 
@@ -52,6 +56,22 @@ bool g_eeprom_init;
 uint32_t g_eeprom_writes;
 uint32_t g_eeprom_freeze = 0xFFFFFFFFu;
 FILE* g_eeprom_file;
+// The SPI NOR flash model (psl_native.h). Its bytes are kept inverted, so
+// that the zeroed array is an erased chip and pages never touched cost no
+// memory.
+const uint32_t kFlashMax = 16ul << 20;
+uint8_t g_flash_inv[kFlashMax];
+uint32_t g_flash_size = 8ul << 20;
+uint32_t g_flash_ops;
+uint32_t g_flash_freeze = 0xFFFFFFFFu;
+FILE* g_flash_file;
+uint64_t g_flash_busy_until;  // simulated us
+bool g_flash_wel;
+uint8_t g_spi_cmd;
+uint32_t g_spi_n;  // bytes of the transaction so far
+uint32_t g_spi_addr;
+uint8_t g_spi_page[256];
+uint16_t g_spi_page_n;
 
 void eeprom_init() {
     if (!g_eeprom_init) {
@@ -132,6 +152,9 @@ void sim_set_reset_cause(uint8_t cause) { g_reset_cause = cause; }
 
 void sim_reset() {
     g_time_us = 0;
+    g_flash_busy_until = 0;  // the flash keeps its bytes; an operation in progress ended
+    g_flash_wel = false;
+    g_spi_n = 0;
     g_real_time = false;
     memset(&g_micros_ext, 0, sizeof g_micros_ext);
     memset(&g_millis_ext, 0, sizeof g_millis_ext);
@@ -186,7 +209,84 @@ bool sim_eeprom_file(const char* path) {
     return true;
 }
 
+void sim_flash_set_size(uint32_t bytes) {
+    g_flash_size = bytes >= (64ul << 10) && bytes <= kFlashMax && (bytes & (bytes - 1)) == 0 ? bytes : 8ul << 20;
+    memset(g_flash_inv, 0, g_flash_size);
+}
+uint32_t sim_flash_size() { return g_flash_size; }
+uint8_t sim_flash_byte(uint32_t addr) { return static_cast<uint8_t>(~g_flash_inv[addr & (g_flash_size - 1)]); }
+uint32_t sim_flash_ops() { return g_flash_ops; }
+void sim_flash_freeze_after(uint32_t ops) { g_flash_freeze = g_flash_ops + ops; }
+bool sim_flash_file(const char* path) {
+    if (g_flash_file) fclose(g_flash_file);
+    g_flash_file = fopen(path, "r+b");
+    static uint8_t chunk[4096];
+    if (g_flash_file) {
+        for (uint32_t a = 0; a < g_flash_size; a += sizeof chunk) {
+            const size_t n = fread(chunk, 1, sizeof chunk, g_flash_file);
+            for (size_t i = 0; i < sizeof chunk; ++i) g_flash_inv[a + i] = static_cast<uint8_t>(i < n ? ~chunk[i] : 0);
+        }
+    } else {
+        g_flash_file = fopen(path, "w+b");
+    }
+    if (!g_flash_file || fseek(g_flash_file, 0, SEEK_SET) != 0) return false;
+    for (uint32_t a = 0; a < g_flash_size; a += sizeof chunk) {
+        for (size_t i = 0; i < sizeof chunk; ++i) chunk[i] = static_cast<uint8_t>(~g_flash_inv[a + i]);
+        if (fwrite(chunk, 1, sizeof chunk, g_flash_file) != sizeof chunk) {
+            fclose(g_flash_file);
+            g_flash_file = 0;
+            return false;
+        }
+    }
+    if (fflush(g_flash_file) != 0) {
+        fclose(g_flash_file);
+        g_flash_file = 0;
+        return false;
+    }
+    return true;
+}
+
 }  // namespace native
+
+namespace {
+
+bool flash_busy() { return now_us() < g_flash_busy_until; }
+
+// Writes bytes [a, a + n) of the model through to its file.
+void flash_write_through(uint32_t a, uint32_t n) {
+    if (!g_flash_file || fseek(g_flash_file, static_cast<long>(a), SEEK_SET) != 0) return;
+    for (uint32_t i = 0; i < n; ++i) fputc(static_cast<uint8_t>(~g_flash_inv[a + i]), g_flash_file);
+    fflush(g_flash_file);
+}
+
+// The command of the transaction that just ended (chip select high).
+void flash_end() {
+    if (g_spi_n == 0 || flash_busy()) return;
+    if (g_spi_cmd == 0x06 && g_spi_n == 1) g_flash_wel = true;
+    if (g_spi_cmd == 0x04 && g_spi_n == 1) g_flash_wel = false;
+    const bool program = g_spi_cmd == 0x02 && g_spi_n > 4, erase = g_spi_cmd == 0x20 && g_spi_n == 4;
+    if (!(program || erase) || !g_flash_wel) return;
+    g_flash_wel = false;
+    if (g_flash_ops >= g_flash_freeze) return;  // after a power cut: nothing lands
+    ++g_flash_ops;
+    const uint32_t a = g_spi_addr & (g_flash_size - 1);
+    if (program) {
+        const uint32_t page = a & ~0xFFul;
+        for (uint16_t i = 0; i < g_spi_page_n; ++i) {
+            const uint32_t at = page | ((a + i) & 0xFFu);
+            g_flash_inv[at] = static_cast<uint8_t>(g_flash_inv[at] | ~g_spi_page[i]);  // 1 -> 0 only
+        }
+        flash_write_through(page, 256);
+        g_flash_busy_until = now_us() + 400u;
+    } else {
+        const uint32_t sector = a & ~0xFFFul;
+        memset(g_flash_inv + sector, 0, 4096);
+        flash_write_through(sector, 4096);
+        g_flash_busy_until = now_us() + 45000u;
+    }
+}
+
+}  // namespace
 
 namespace pal {
 
@@ -207,6 +307,42 @@ void eeprom_write(uint16_t addr, uint8_t value) {
         fputc(value, g_eeprom_file);
         fflush(g_eeprom_file);
     }
+}
+
+void spi_begin(uint8_t cs_pin) {
+    clear_modes();
+    g_mode[cs_pin] = kOutput;
+    g_level[cs_pin] = 1;
+}
+void spi_select(bool on) {
+    if (!on) flash_end();
+    g_spi_n = 0;
+    g_spi_page_n = 0;
+}
+uint8_t spi_transfer(uint8_t out) {
+    const uint32_t i = g_spi_n++;
+    if (i == 0) {
+        g_spi_cmd = out;
+        g_spi_addr = 0;
+        return 0xFF;
+    }
+    if (g_spi_cmd == 0x05) return static_cast<uint8_t>((flash_busy() ? 1u : 0u) | (g_flash_wel ? 2u : 0u));
+    if (flash_busy()) return 0xFF;
+    if (g_spi_cmd == 0x9F) {
+        uint8_t log2 = 0;
+        while ((1ul << log2) < g_flash_size) ++log2;
+        return i == 1 ? 0xEF : i == 2 ? 0x40 : i == 3 ? log2 : 0xFF;
+    }
+    if (i <= 3) {
+        g_spi_addr = (g_spi_addr << 8) | out;
+        return 0xFF;
+    }
+    if (g_spi_cmd == 0x03) return static_cast<uint8_t>(~g_flash_inv[(g_spi_addr + (i - 4)) & (g_flash_size - 1)]);
+    if (g_spi_cmd == 0x02) {
+        if (g_spi_page_n < 256) g_spi_page[g_spi_page_n++] = out;
+        return 0xFF;
+    }
+    return 0xFF;
 }
 
 uint32_t micros32() { return static_cast<uint32_t>(now_us()); }

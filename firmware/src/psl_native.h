@@ -55,6 +55,24 @@ uint32_t sim_eeprom_writes();
 void sim_eeprom_freeze_after(uint32_t writes);
 bool sim_eeprom_file(const char* path);
 
+// The SPI NOR flash model: a W25Q-class chip on the SPI (whatever the chip
+// select's pin), kept across sim_reset(). Commands: 06h/04h write enable /
+// disable, 05h status register 1 (BUSY bit 0, WEL bit 1), 9Fh JEDEC ID
+// (EF 40 log2(size)), 03h read, 02h page program (ANDs bytes in: 1->0 only,
+// wrapping within its 256-byte page), 20h 4 KiB sector erase (0xFF). BUSY
+// lasts 0.4 ms after a program and 45 ms after an erase on the simulated
+// clock; meanwhile only 05h is answered. Its size (a power of two, 64 KiB
+// to 16 MiB: 8 MiB until set; setting it erases the chip); a byte; the
+// page programs and erases started; a power cut after `ops` more of them
+// (later ones are lost); a file it is loaded from and written through to
+// (false when it cannot be opened or written).
+void sim_flash_set_size(uint32_t bytes);
+uint32_t sim_flash_size();
+uint8_t sim_flash_byte(uint32_t addr);
+uint32_t sim_flash_ops();
+void sim_flash_freeze_after(uint32_t ops);
+bool sim_flash_file(const char* path);
+
 // Back to power-on state: time 0, pins cleared, counters zero.
 void sim_reset();
 

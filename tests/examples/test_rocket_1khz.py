@@ -26,7 +26,8 @@ def test_the_1khz_rocket_is_the_example_at_1khz(tmp_path, fsw):
     folder, source = bench_busy().variant_1khz(str(tmp_path / "rocket-1khz"))
     app = (tmp_path / "rocket-1khz" / "rocket.app").read_text()
     assert re.search(r"(?m)^rate\s+1000$", app)
-    assert len(re.findall(r"rate=1000$", app, re.M)) == 6 and "rate=100\n" not in app
+    tasks = len(re.findall(r"(?m)^\w+\s+(?:uplink|inputs|machine \w+|outputs|telemetry|recorder)\s", app))
+    assert tasks == 7 and len(re.findall(r"rate=1000$", app, re.M)) == tasks and "rate=100\n" not in app
     assert source in ("clock", "cycle") and re.search(rf"(?m)^source\s+{source}$", app)
     example = (ROOT / "examples" / "rocket")
     for name in ("nav.sm", "mission.sm", "rocket.sv", "rocket.aio", "rocket.dio", "plant.toml"):

@@ -86,7 +86,13 @@ def test_nominal_flight_passes_every_check(flights, seed):
     fl = flights[f"seed{seed}"]
     rep = fl.report
     assert rep.passed, rep.text()
-    assert [c.name.split(" ")[0] for c in rep.checks] == ["apogee", "drogue", "main", "landing", "the", "flash", "RAM"]
+    assert [c.name for c in rep.checks][5:7] == [
+        "the record covers 0.5 s before launch to landing at the log's rates (10 Hz)",
+        "the record matches the telemetry value for value where both have a sample (within half a step where the "
+        "encoding quantises)"]
+    assert [c.name.split(" ")[0] for c in rep.checks] == ["apogee", "drogue", "main", "landing", "the", "the", "the",
+                                                           "flash", "RAM"]
+    assert "flight recorder: 1 flight(s)" in rep.text() and fl.files.get("record", "").endswith("record.log")
     f = rep.facts
     assert 300 <= f["true_apogee_m"] <= 500
     assert 0 <= f["apogee_error_s"] <= 1.0 and abs(f["apogee_error_m"]) < 5
@@ -214,7 +220,7 @@ def test_the_command_flies_the_tank(flights):
     assert r.returncode == 0, r.stderr
     assert "6 of 6 checks passed" in r.stdout  # 4 of the tank, 2 of the budget
     assert Path(out / FILES["summary"]).read_text() == r.stdout
-    assert {p.name for p in out.iterdir()} == set(FILES.values())
+    assert {p.name for p in out.iterdir()} == set(FILES.values()) - {FILES["record"]}  # the tank keeps no record
     assert f"wrote {out / FILES['log']}" in r.stderr
 
 

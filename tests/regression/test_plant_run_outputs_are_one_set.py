@@ -17,7 +17,7 @@ from fswkit.plant.cosim import CosimError
 from fswkit.plant.run import FILES, INCOMPLETE, execute, prepare
 
 OLD = {"log": b"FSWLOG1\nthe previous flight", "csv": b"time_s\n0\n", "png": b"\x89PNG old",
-       "summary": b"7 of 7 checks passed\n"}
+       "record": b"FSWLOG1\nthe previous flight's record", "summary": b"7 of 7 checks passed\n"}
 
 
 @pytest.fixture(scope="module")

@@ -83,7 +83,7 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
             print(f"recorder: {inf['mode_name']}, flight {inf['flight']}, {inf['slots']} records of "
                   f"{inf['record']} B, next {inf['head']}; {inf['dropped']} samples dropped")
-            image = read_image(command, p, link_plan(app).tx_cap)
+            image = read_image(command, p, link_plan(app).tx_cap, head=inf["head"])
         except (DumpError, LinkTimeout) as e:
             _say(str(e))
             return EXIT_FAIL

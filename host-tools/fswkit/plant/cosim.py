@@ -56,6 +56,7 @@ class Run:
     profile: object = None  # fswkit.sim.board.Profile of the functions `fly` was asked to profile
     resets: list[float] = field(default_factory=list)  # when the MCU was reset (brown-outs the scenario asked for)
     eeprom: bytes | None = None  # the board's EEPROM after the flight (the flight recorder's store)
+    flash: bytes | None = None  # the SPI NOR flash's written part after the flight (`store spi_nor`)
 
 
 _cpu_lock = threading.Lock()
@@ -167,9 +168,10 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         log.commit()  # named from the start: a run killed outright still leaves its log
     telemetry = Telemetry(run, layout, scenario.state_element, log)
     try:
+        nor = _nor(getattr(scenario, "app", None), board)
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
                      eeprom=getattr(scenario, "eeprom", None),
-                     analog=analog)
+                     analog=analog, spi_flash=nor[1] if nor else None)
     except SimError as e:
         if log:
             log.close()
@@ -234,6 +236,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             run.profile = b.profile_read()
         if getattr(board, "eeprom", 0):
             run.eeprom = b.eeprom_read(0, board.eeprom)
+        if nor:  # the written part: whole 4 KiB sectors from 0 until a blank one
+            run.flash = nor_image(b, nor[0])
         for probe in ("ram_usage", "stack_high_water"):  # the first the board has
             fn = getattr(b, probe, None)
             if callable(fn):
@@ -252,6 +256,31 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         if log:
             log.close()
     return run
+
+
+def nor_image(b, p) -> bytes:
+    """The written part of the board's SPI NOR chip: whole 4 KiB sectors from
+    address 0 up to the first blank one (records fill the chip from 0)."""
+    out = b""
+    while len(out) < p.flash_size:
+        s = b.flash_read(len(out), 4096)
+        if s == b"\xff" * 4096:
+            break
+        out += s
+    return out
+
+
+def _nor(app, board):
+    """(plan, SimBoard's spi_flash "<port><bit>:<size>") when the application's
+    flight recorder logs to an SPI NOR flash (docs/recorder.md, "On an SPI NOR flash chip"), else None."""
+    if app is None or getattr(app, "log", None) is None or getattr(app.log, "store", "eeprom") != "spi_nor":
+        return None
+    from fswkit.autocode.recorder import plan
+    from fswkit.sim.board import pin_map, sim_board
+
+    p = plan(app)
+    port, bit = pin_map(sim_board(board)).digital[p.cs_pin]
+    return p, f"{port}{bit}:{p.flash_size}"
 
 
 def _mv(volts: float, vref: float) -> int:

@@ -209,7 +209,7 @@ def _recorder(sc, run: Run, rep) -> tuple | None:
     rep.lines += lines
     rep.checks += checks
     try:
-        p, flight, _, _ = newest_flight(sc.app, run.eeprom)
+        p, flight, _, _ = newest_flight(sc.app, run)
     except ValueError:
         return None
     return (p, flight) if flight is not None else None

@@ -49,7 +49,7 @@ from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
 from fswkit.sim.sensors import AnalogSensor, from_channel
 
 from . import report as reports
-from .cosim import CosimError, PinEvent, Run, Telemetry, _one_cpu, stop_words
+from .cosim import CosimError, PinEvent, Run, Telemetry, _nor, _one_cpu, nor_image, stop_words
 from .params import Field as F
 from .params import ParamsError, Table, locate
 from .params import load as load_params
@@ -158,6 +158,7 @@ class Config:
     checks: dict
     notes: list = field(default_factory=list)
     eeprom: bytes | None = None  # the EEPROM programmed before boot (fsw sim --fw-params)
+    nor: tuple | None = None  # (recorder plan, SimBoard spi_flash) of a recorder on an SPI NOR flash
 
 
 class _Origins(_Binder):
@@ -312,10 +313,12 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
     if bind.errors:
         raise ReplayError("\n".join(bind.errors))
     accel = sensors.get("accel_g")
-    return Config(path, sensors, tp["missing"], tp["silent_volts"], tp["pad_s"], tp["arm_s"], tp["run_on_s"],
-                  pin_no["arm"], pin_no["drogue"], pin_no["main"], fw["state_element"],
-                  None if fw["altitude_element"] == _UNSET else fw["altitude_element"],
-                  accel.element if accel is not None else None, states, main_alt, main_name, dict(v["checks"]))
+    cfg = Config(path, sensors, tp["missing"], tp["silent_volts"], tp["pad_s"], tp["arm_s"], tp["run_on_s"],
+                 pin_no["arm"], pin_no["drogue"], pin_no["main"], fw["state_element"],
+                 None if fw["altitude_element"] == _UNSET else fw["altitude_element"],
+                 accel.element if accel is not None else None, states, main_alt, main_name, dict(v["checks"]))
+    cfg.nor = _nor(app, app.board)  # the flight recorder's SPI NOR chip, when it logs to one
+    return cfg
 
 
 # ---- the tape and its truth -----------------------------------------------------------------
@@ -486,7 +489,7 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     initial = {pin: series[0] / 1000.0 for pin, series in mv.items()}
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial,
-                     eeprom=cfg.eeprom)
+                     eeprom=cfg.eeprom, spi_flash=cfg.nor[1] if cfg.nor else None)
     except SimError as e:
         if log:
             log.close()
@@ -522,6 +525,8 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
         run.wall_s = time.perf_counter() - wall0
         if getattr(board, "eeprom", 0):
             run.eeprom = b.eeprom_read(0, board.eeprom)  # the flight recorder's store
+        if cfg.nor:
+            run.flash = nor_image(b, cfg.nor[0])
         try:
             run.ram["ram_usage"] = b.ram_usage()
         except (SimError, TypeError, ValueError) as e:
@@ -912,7 +917,7 @@ def _recorder(app, rp, checks) -> tuple[list[str], tuple | None]:
                                   alt_element=alt)
     checks += more
     try:
-        p, flight, _, _ = newest_flight(app, run.eeprom)
+        p, flight, _, _ = newest_flight(app, run)
     except ValueError:
         return lines, None
     return lines, ((p, flight) if flight is not None else None)

@@ -10,13 +10,23 @@ import numpy as np
 from fswkit.autocode.recorder import Flight, RecordError, decode, plan
 
 
-def newest_flight(app, image: bytes | None):
-    """(plan, the newest flight, every flight, empty records) of a store
-    image of the whole EEPROM; the flight is None when there is none."""
+def newest_flight(app, run):
+    """(plan, the newest flight, every flight, empty records) of the store a
+    run read after its flight: the whole EEPROM (`run.eeprom`), or the
+    written part of an SPI NOR chip from address 0 (`run.flash`, the rest
+    blank); the flight is None when there is none."""
     p = plan(app)
-    if p is None or image is None:
+    if p is None:
         return p, None, [], 0
-    flights, empty = decode(p, image[p.base:p.base + p.size])
+    if p.store == "spi_nor":
+        image = getattr(run, "flash", None)
+        if image is not None:
+            image = image[:p.size] + b"\xff" * max(0, p.size - len(image))
+    else:
+        image = run.eeprom[p.base:p.base + p.size] if run.eeprom is not None else None
+    if image is None:
+        return p, None, [], 0
+    flights, empty = decode(p, image)
     return p, (flights[-1] if flights else None), flights, empty
 
 
@@ -27,12 +37,17 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
     flight, in the firmware's seconds; `truth`: (times in the firmware's
     seconds, true altitudes) to compare the recorded `alt_element` with."""
     try:
-        p, flight, flights, empty = newest_flight(app, run.eeprom)
+        p, flight, flights, empty = newest_flight(app, run)
     except RecordError as e:
         return [f"flight recorder: {e}"], [check_cls("the flight record decodes", False, str(e))]
+    where = (f"EEPROM {p.base}–{p.base + p.size - 1}" if p.store == "eeprom"
+             else f"an SPI NOR flash of {p.size:,} B")
     lines = [f"flight recorder: {len(flights)} flight(s) in {p.slots - empty} of {p.slots} records of "
-             f"{p.record} B (EEPROM {p.base}–{p.base + p.size - 1})"]
+             f"{p.record} B ({where})"]
     if flight is None:
+        if launch_s is None:  # the vehicle never launched: there is nothing to keep
+            return lines, [check_cls("the recorder kept no flight: the trigger state never came", True,
+                                     "no flight in the record")]
         return lines, [check_cls("the recorder kept the flight", False, "no flight in the record")]
     s = flight.samples
     used = len(flight.records) + (flight.start is not None)
@@ -43,17 +58,29 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
                  f"{s[0][0] / 1000:.3f}–{s[-1][0] / 1000:.3f} s; {per_record:.1f} samples and "
                  f"{p.record / per_record:.2f} B a sample; the store holds about {capacity:.0f} s of such flight")
     checks = []
-    rate = float(max(app.log.rates))
-    period_ms = 1000 / float(rate)
-    gaps = [b[0] - a[0] for a, b in zip(s, s[1:])]
-    worst = max(gaps) if gaps else 0
+    rates = app.log.rates
+    rate = float(max(rates))
+    period_ms = 1000 / rate
+
+    def allowed(v) -> float:  # the sample period of the state a sample was taken in
+        st = v.get(p.state_element)
+        r = rates[st] if st is not None and 0 < st < len(rates) and rates[st] else max(rates)
+        return 1000 / float(r)
+    late = [(b[0] - a[0], a[0]) for a, b in zip(s, s[1:]) if b[0] - a[0] > max(allowed(a[1]), allowed(b[1])) + 1e-9]
     before = (launch_s * 1000 - s[0][0]) / 1000 if launch_s is not None else float("nan")
-    end_ok = landed_s is None or s[-1][0] >= landed_s * 1000 - period_ms
-    ok = launch_s is not None and before >= float(app.log.before) - 1e-9 and worst <= period_ms + 1e-9 and end_ok
+    full = not p.newest and bool(flight.records) and flight.records[-1].slot == p.slots - 1  # `full stop`: no room
+    # the last sample within a sample period of the end, as telemetry saw it (its own samples come up to a
+    # stream period after the transition: 50 ms covers every stream the kit's links carry at 20 Hz or more)
+    end_ok = landed_s is None or s[-1][0] >= landed_s * 1000 - period_ms - 50 or full
+    ok = launch_s is not None and before >= float(app.log.before) - 1e-9 and not late and end_ok
+    rate_text = "/".join(f"{float(r):g}" for r in sorted(set(r for r in rates[1:] if r), reverse=True))
     checks.append(check_cls(
-        f"the record covers {float(app.log.before):g} s before launch to landing at {rate:g} Hz",
+        f"the record covers {float(app.log.before):g} s before launch to landing at the log's rates ({rate_text} Hz)",
         ok, f"from {before:.2f} s before launch to {s[-1][0] / 1000:.2f} s"
-            + (f" (landing {landed_s:.2f} s)" if landed_s is not None else "") + f", largest gap {worst} ms"))
+            + (f" (landing {landed_s:.2f} s)" if landed_s is not None else "")
+            + (", the store full" if full else "")
+            + (f", {len(late)} gaps longer than the state's period, the first {late[0][0]} ms at "
+               f"{late[0][1] / 1000:.2f} s" if late else ", no sample missing")))
     # value for value against the telemetry of the same run
     tele = {}
     for _, row in run.samples:
@@ -84,9 +111,9 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
         true_t, true_h = np.asarray(truth[0], dtype=float), np.asarray(truth[1], dtype=float)
         err = rec - np.interp(tt, true_t, true_h)
         peak_rec, peak_true = float(rec.max()), float(np.nanmax(true_h))
+        # what the firmware estimated, against the truth: a fault (a stuck barometer) shows here as it does
+        # in the telemetry, so it is reported, and the checks above hold the record to the telemetry
         lines.append(f"  {alt_element} against the truth: RMS {float(np.sqrt(np.mean(err ** 2))):.2f} m, "
                      f"largest {float(np.abs(err).max()):.2f} m; apogee recorded {peak_rec:.1f} m, true "
                      f"{peak_true:.1f} m")
-        checks.append(check_cls("the recorded apogee is within 5 % of the true one", abs(peak_rec - peak_true)
-                                <= 0.05 * abs(peak_true), f"{peak_rec:.1f} m against {peak_true:.1f} m"))
     return lines, checks

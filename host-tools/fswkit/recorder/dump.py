@@ -72,13 +72,17 @@ def info(ack: dict) -> dict:
             "slots": slots, "record": record, "dropped": dropped, "hash": h}
 
 
-def read_image(command, p: Plan, tx_cap: int, progress=None) -> bytes:
-    """Every record's bytes, read over the link: `command(op, args)` sends
-    a command and returns its ack's fields (fswkit.link.client.Ground.command)."""
+def read_image(command, p: Plan, tx_cap: int, progress=None, head: int | None = None) -> bytes:
+    """The records' bytes, read over the link: `command(op, args)` sends a
+    command and returns its ack's fields (fswkit.link.client.Ground.command).
+    On an SPI NOR chip the records are the slots before `head` (LOG_INFO's
+    next record) and the one at it: only those are read, and the rest of the
+    image is blank (0xFF); an EEPROM is read whole."""
     room = tx_cap - 24 - tx_cap // 254
     chunk = max(1, min(p.record, room - 4))
     image = bytearray()
-    for slot in range(p.slots):
+    last = p.slots if head is None or p.store != "spi_nor" else min(p.slots, head + 1)
+    for slot in range(last):
         off = 0
         while off < p.record:
             n = min(chunk, p.record - off)
@@ -93,7 +97,7 @@ def read_image(command, p: Plan, tx_cap: int, progress=None) -> bytes:
             off += got_n
         if progress is not None:
             progress(slot + 1)
-    return bytes(image)
+    return bytes(image) + b"\xff" * ((p.slots - last) * p.record)
 
 
 class DumpError(Exception):

@@ -62,10 +62,30 @@ def test_every_expected_file_has_its_input():
 
 # ---- every message the application checker can produce has a golden case ------------
 
-SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py")]
+SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py")]
 REPORTERS = {"error", "warning", "err", "at", "Problem"}
 # Messages that no golden case here can hold, and where they are tested instead.
 NOT_GOLDEN = {
+    # the flight recorder on an SPI NOR flash: projects of their own (the rig's pins and sizes)
+    "`record` on spi_nor is a power of two from 32 to 128 (records never straddle a ":
+        "tests/recorder/test_log_spi_check.py",
+    "-byte sector or a 256-byte page): found ": "tests/recorder/test_log_spi_check.py",
+    "`full newest` is not available on spi_nor: a flash sector is erased whole, so overwriting the oldest records "
+    "would drop a whole sector of them at a time, and boot finds the end of the log by a binary search that needs "
+    "the records written from the chip's start; use `full stop` and `fsw dump --erase`":
+        "tests/recorder/test_log_spi_check.py",
+    "`store spi_nor` takes the chip select's pin, then the chip's size (default 8 MiB): bytes, or a number and K or "
+    "M, e.g. `spi_nor 10 1 M`": "tests/recorder/test_log_spi_check.py",
+    " is reserved on the ": "tests/recorder/test_log_spi_check.py",
+    " is the SPI bus's ": "tests/recorder/test_log_spi_check.py",
+    ": the chip select must be another pin": "tests/recorder/test_log_spi_check.py",
+    "the flash's size is a power of two from 64 K to 16 M (bytes, or a number and K or M), found `":
+        "tests/recorder/test_log_spi_check.py",
+    " is already the channel of `": "tests/recorder/test_log_spi_check.py",
+    " on the ": "tests/recorder/test_log_spi_check.py",
+    # a board without EEPROM (none in boards/), 33 logged elements
+    " has no EEPROM": "tests/recorder/test_log_check.py",
+    "at most 32 elements are logged": "tests/recorder/test_log_check.py",
     # two machine files whose names differ only in case: one file on some file systems
     "machines `": "tests/regression/test_names_reach_cpp_safely.py",
     "` would generate the same C++ files (`": "tests/regression/test_names_reach_cpp_safely.py",

@@ -59,8 +59,6 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
                  f"{p.record / per_record:.2f} B a sample; the store holds about {capacity:.0f} s of such flight")
     checks = []
     rates = app.log.rates
-    rate = float(max(rates))
-    period_ms = 1000 / rate
 
     def allowed(v) -> float:  # the sample period of the state a sample was taken in
         st = v.get(p.state_element)
@@ -69,9 +67,9 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
     late = [(b[0] - a[0], a[0]) for a, b in zip(s, s[1:]) if b[0] - a[0] > max(allowed(a[1]), allowed(b[1])) + 1e-9]
     before = (launch_s * 1000 - s[0][0]) / 1000 if launch_s is not None else float("nan")
     full = not p.newest and bool(flight.records) and flight.records[-1].slot == p.slots - 1  # `full stop`: no room
-    # the last sample within a sample period of the end, as telemetry saw it (its own samples come up to a
+    # the last sample within a sample period (its state's) of the end, as telemetry saw it (its own samples come up to a
     # stream period after the transition: 50 ms covers every stream the kit's links carry at 20 Hz or more)
-    end_ok = landed_s is None or s[-1][0] >= landed_s * 1000 - period_ms - 50 or full
+    end_ok = landed_s is None or s[-1][0] >= landed_s * 1000 - allowed(s[-1][1]) - 50 or full
     ok = launch_s is not None and before >= float(app.log.before) - 1e-9 and not late and end_ok
     rate_text = "/".join(f"{float(r):g}" for r in sorted(set(r for r in rates[1:] if r), reverse=True))
     checks.append(check_cls(

@@ -107,3 +107,42 @@ def folder_and_firmware(project: str, board: str | None, out: str):
         say(f"cannot create the output folder {out}: {e.strerror or e}")
         return 2
     return build(project, board)
+
+
+def open_link(args, layout, baud: int, say):
+    """A target's link on `args.port` for a command that talks to it (`fsw
+    param`, `fsw dump`): the port opened, a hello asked for and its schema
+    checked against `args.project` (unless `args.ignore_schema`).
+    (port, Ground, Session); None, said through `say`, when it cannot be
+    (the port is closed again)."""
+    from fswkit.ground.monitor import schema_message, summary
+    from fswkit.link.client import Ground, LinkTimeout
+    from fswkit.link.port import PortError, open_port
+    from fswkit.link.session import Session
+
+    session = Session(layout, ignore_schema=args.ignore_schema)
+    try:
+        port = open_port(args.port, baud)
+    except PortError as e:
+        say(str(e))
+        return None
+    ground = Ground(port, session)
+    why = None
+    try:
+        ground.handshake(timeout=3.0)
+        if not session.hello["schema_ok"] and not args.ignore_schema:
+            why = schema_message(session, args.project)
+    except LinkTimeout as e:
+        why = f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session)
+    if why is not None:
+        say(why)
+        close_port(port)
+        return None
+    return port, ground, session
+
+
+def close_port(port) -> None:
+    try:
+        port.close()
+    except Exception:  # noqa: BLE001 - closing a port that went away
+        pass

@@ -45,32 +45,18 @@ def _talk(args, app, p) -> int:
     from fswkit.autocode.recorder import RecordError, decode
     from fswkit.autocode.schema import link_plan
     from fswkit.autocode.protocol import OP_LOG_ERASE
-    from fswkit.ground.monitor import schema_message, summary
-    from fswkit.link.client import Ground, LinkTimeout
+    from fswkit.cli.common import close_port, open_link
+    from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import from_app
     from fswkit.link.log import LogError
-    from fswkit.link.port import PortError, open_port
-    from fswkit.link.session import Session
+    from fswkit.link.port import port_errors
     from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
 
-    session = Session(from_app(app), ignore_schema=args.ignore_schema)
-    baud = args.baud or app.baud
-    try:
-        port = open_port(args.port, baud)
-    except PortError as e:
-        _say(str(e))
+    link = open_link(args, from_app(app), args.baud or app.baud, _say)
+    if link is None:
         return EXIT_FAIL
+    port, ground, _session = link
     try:
-        ground = Ground(port, session)
-        try:
-            ground.handshake(timeout=3.0)
-        except LinkTimeout as e:
-            _say(f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session))
-            return EXIT_FAIL
-        if not session.hello["schema_ok"] and not args.ignore_schema:
-            _say(schema_message(session, args.project))
-            return EXIT_FAIL
-
         def command(op, a):
             return ground.command(op, a, tries=5, timeout=0.5)
 
@@ -132,5 +118,11 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
             print("erasing the record on the target")
         return EXIT_OK
+    except LinkTimeout as e:
+        _say(str(e))
+        return EXIT_FAIL
+    except port_errors() as e:
+        _say(f"{args.port}: the port went away ({e})")
+        return EXIT_FAIL
     finally:
-        port.close()
+        close_port(port)

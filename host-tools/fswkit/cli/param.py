@@ -109,29 +109,16 @@ def cmd_param(args) -> int:
 
 
 def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
-    from fswkit.ground.monitor import schema_message, summary
-    from fswkit.link.client import Ground, LinkTimeout
-    from fswkit.link.port import PortError, open_port, port_errors
-    from fswkit.link.session import Session
+    from fswkit.cli.common import close_port, open_link
+    from fswkit.link.port import port_errors
     from fswkit.param.client import ParamClient, ParamError, PortTransport
 
-    session = Session(layout, ignore_schema=args.ignore_schema)
     baud = args.baud or app.baud
-    try:
-        port = open_port(args.port, baud)
-    except PortError as e:
-        _say(str(e))
+    link = open_link(args, layout, baud, _say)
+    if link is None:
         return EXIT_FAIL
+    port, ground, _session = link
     try:
-        ground = Ground(port, session)
-        try:
-            ground.handshake(timeout=3.0)
-        except LinkTimeout as e:
-            _say(f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session))
-            return EXIT_FAIL
-        if not session.hello["schema_ok"] and not args.ignore_schema:
-            _say(schema_message(session, args.project))
-            return EXIT_FAIL
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
         from fswkit.autocode.params import param_hash
 
@@ -150,10 +137,7 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
         _say(f"{args.port}: the port went away ({e})")
         return EXIT_FAIL
     finally:
-        try:
-            port.close()
-        except Exception:  # noqa: BLE001 - closing a port that went away
-            pass
+        close_port(port)
 
 
 def _action(args, client, params, by_name, wanted, file_values, params_text) -> int:

@@ -46,19 +46,6 @@ class CutReport:
     problems: list[str] = field(default_factory=list)
 
 
-def _valid(p: Plan, img: bytes) -> dict[int, bytes]:
-    out = {}
-    for s in range(p.slots):
-        raw = img[s * p.record:(s + 1) * p.record]
-        try:
-            rec = decode_slot(p, s, raw)
-        except RecordError:
-            rec = "corrupt"
-        if rec is not None:
-            out[s] = raw
-    return out
-
-
 def _check_samples(p: Plan, slot: int, raw: bytes, rep: CutReport) -> None:
     try:
         rec = decode_slot(p, slot, raw)
@@ -106,7 +93,7 @@ def power_cuts(elf: str, p: Plan, cuts: int, seed: int = 1, *, board: str = "uno
                 b.run_for(0.001)
                 rep.resets += 1
                 img = b.eeprom_read(p.base, p.size)
-                now = _valid(p, img)
+                now = valid_records(p, img)
                 expected = set(range(head)) if head <= p.slots else set(range(p.slots))
                 if set(now) != expected:
                     rep.problems.append(f"cut {i}: records {sorted(now)} after a reset with {head} written")
@@ -122,7 +109,7 @@ def power_cuts(elf: str, p: Plan, cuts: int, seed: int = 1, *, board: str = "uno
                     rep.problems.append(f"cut {i}: the EEPROM cut never came")
                 rep.write_cuts += 1
                 img = b.eeprom_read(p.base, p.size)
-                now = _valid(p, img)
+                now = valid_records(p, img)
             rep.cuts += 1
             for s, raw in before.items():
                 if now.get(s) != raw:

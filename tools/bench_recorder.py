@@ -177,6 +177,11 @@ def main() -> int:
             print(f"      {why}")
         passed += ok
         failed += not ok
+        spi_app, spi_built = build(LOGGED.parent / "spi", tmp / "spi-rig")
+        fe, re_ = elf_size(lbuilt.artifact)
+        fn, rn = elf_size(spi_built.artifact)
+        print(f"  the store's cost, the same rig on each: EEPROM {fe:,} B flash / {re_:,} B RAM; SPI NOR "
+              f"{fn:,} B / {rn:,} B ({fn - fe:+,} B flash, {rn - re_:+} B RAM)")
     print(f"recorder: {passed} passed, {failed} failed")
     return 1 if failed else 0
 

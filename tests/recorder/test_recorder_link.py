@@ -108,3 +108,18 @@ def test_a_project_without_a_recorder_is_told_so(tmp_path):
     r = run_fsw("dump", str(Path(__file__).resolve().parents[1] / "param" / "tuned"), "--port", "/dev/null",
                 "-o", str(tmp_path))
     assert r.code == 2 and "no flight recorder" in r.err
+
+
+def test_fsw_plot_and_replay_read_a_dumped_flight(exe, tmp_path):
+    out = tmp_path / "dump"
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin"), "d2=1") as t:
+        time.sleep(1.6)
+        assert dump(t.port, out).code == 0
+    log = out / "flight-1.log"
+    n = len(rows(log))
+    r = run_fsw("plot", str(log), "-e", "level", "state", "-o", str(tmp_path / "f.png"))
+    assert r.code == 0 and f"{2 * n} points" in r.err and (tmp_path / "f.png").stat().st_size > 1000, r.err
+    r = run_fsw("replay", "--headless", "--speed", "1000", str(log))
+    assert r.code == 0, r.err
+    samples = [line for line in r.out.splitlines() if " sample Record " in line]
+    assert len(samples) == n and "state=2 (Run)" in r.out

@@ -123,3 +123,25 @@ def test_fsw_plot_and_replay_read_a_dumped_flight(exe, tmp_path):
     assert r.code == 0, r.err
     samples = [line for line in r.out.splitlines() if " sample Record " in line]
     assert len(samples) == n and "state=2 (Run)" in r.out
+
+
+def test_fsw_sim_keeps_the_board_eeprom_in_a_file(tmp_path):
+    """`fsw sim PROJECT --eeprom-file FILE`: the board alone keeps its EEPROM
+    between runs (the harness's -E), so a record survives the simulator."""
+    import subprocess
+    import sys
+
+    ee = tmp_path / "ee.bin"
+    cmd = [sys.executable, "-m", "fswkit.cli", "sim", str(RIG), "--board", "uno", "--fast", "--duration", "0.5",
+           "--eeprom-file", str(ee), "--out", str(tmp_path / "b")]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert ee.stat().st_size == 1024
+    data = bytearray(ee.read_bytes())
+    data[100] = 0x5A
+    ee.write_bytes(bytes(data))
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert ee.read_bytes()[100] == 0x5A  # loaded at start, written back at the end
+    r = run_fsw("sim", str(RIG), "--plant", "rocket", "--eeprom-file", str(ee))
+    assert r.code == 2 and "--eeprom-file is for the free-running board" in r.err

@@ -145,6 +145,8 @@ def parser() -> argparse.ArgumentParser:
     sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
     sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
     sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")
+    sm.add_argument("--eeprom-file", metavar="FILE", help="the board alone: keep its EEPROM (parameters, the flight "
+                    "recorder's records) in FILE between runs; read at start when it exists")
     sm.add_argument("--out", help="build folder (default PROJECT/build/BOARD); with --plant or --tape, the folder "
                     "the flight's log, CSV, plot and summary go to (default PROJECT/build/BOARD/PLANT-flight, "
                     "PROJECT/build/BOARD/tape-NAME)")

@@ -40,6 +40,9 @@ def cmd_sim(args) -> int:
         if getattr(args, "tape", None) is not None or getattr(args, "perturb", None) is not None:
             sys.stderr.write("fsw sim: --runs, --run and --dispersion fly the rocket plant, not a --tape\n")
             return EXIT_CONFIG
+        if getattr(args, "eeprom_file", None) is not None:
+            sys.stderr.write("fsw sim: --eeprom-file is for the free-running board on a pty, not a study\n")
+            return EXIT_CONFIG
         from fswkit.cli.sim_study import study_run
         return study_run(args)
     if getattr(args, "tape", None) is not None:
@@ -108,12 +111,16 @@ def board_run(args) -> int:
         image = _fw_image(args)
         if isinstance(image, int):
             return image
+    if image is not None and args.eeprom_file is not None:
+        say("--fw-params programs the EEPROM that --eeprom-file keeps: give one of them")
+        return 2
     analog = analog_args(args.analog or [], board)
     if isinstance(analog, str):
         say(analog)
         return 2
     try:
-        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link, eeprom=image)
+        b = SimBoard(elf, board, uart="pty", analog=analog, link=args.link, eeprom=image,
+                     eeprom_file=args.eeprom_file)
     except SimError as e:
         say(str(e))
         return 1
@@ -154,7 +161,8 @@ def plant_run(args) -> int:
     from fswkit.target.build import default_out
 
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
-                       ("--analog", bool(args.analog)), ("--link", args.link is not None)):
+                       ("--analog", bool(args.analog)), ("--link", args.link is not None),
+                       ("--eeprom-file", args.eeprom_file is not None)):
         if given:
             say(f"{opt} is for the free-running board on a pty; with --plant the scenario drives the run")
             return 2
@@ -203,7 +211,8 @@ def tape_run(args) -> int:
 
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
                        ("--analog", bool(args.analog)), ("--link", args.link is not None),
-                       ("--plant", args.plant is not None), ("--fault", args.fault is not None)):
+                       ("--plant", args.plant is not None), ("--fault", args.fault is not None),
+                       ("--eeprom-file", args.eeprom_file is not None)):
         if given:
             say(f"{opt} does not go with --tape: the tape drives the run")
             return 2

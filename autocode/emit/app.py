@@ -386,13 +386,10 @@ def _link(app: Application) -> list[str]:
 
 
 def _link_stores(app: Application) -> str:
-    """The LinkConfig's last fields: the parameter store and the recorder."""
-    has_params = bool(app_parameters(app))
-    out = ""
-    if has_params or app.log is not None:
-        out += ", &params, fsw::link_param_apply, fsw::link_param_ack" if has_params else ", 0, 0, 0"
-    if app.log is not None:
-        out += ", &rec, fsw::link_log_apply, fsw::link_log_ack"
+    """The LinkConfig's last fields: the parameter store and the recorder
+    (every field written: a partial initializer warns under -Wextra)."""
+    out = ", &params, fsw::link_param_apply, fsw::link_param_ack" if app_parameters(app) else ", 0, 0, 0"
+    out += ", &rec, fsw::link_log_apply, fsw::link_log_ack" if app.log is not None else ", 0, 0, 0"
     return out
 
 

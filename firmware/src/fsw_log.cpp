@@ -242,7 +242,7 @@ bool slot_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) 
     if (used < kLogHeader || used > c.record - kLogTail) return false;
     uint16_t crc = kCrcInit;
     for (uint8_t i = 0; i < used; ++i) crc = crc16_update(crc, store_read(a + i));
-    for (uint8_t i = c.record - kLogTail; i < c.record - 2u; ++i) crc = crc16_update(crc, store_read(a + i));
+    for (uint8_t i = static_cast<uint8_t>(c.record - kLogTail); i < c.record - 2u; ++i) crc = crc16_update(crc, store_read(a + i));
     const uint16_t stored = static_cast<uint16_t>(store_read(a + c.record - 2u) | (store_read(a + c.record - 1u) << 8));
     if (crc != stored) return false;
     seq = static_cast<uint16_t>(store_read(a + 1u) | (store_read(a + 2u) << 8));

@@ -271,7 +271,7 @@ void flash_end() {
     ++g_flash_ops;
     const uint32_t a = g_spi_addr & (g_flash_size - 1);
     if (program) {
-        const uint32_t page = a & ~0xFFul;
+        const uint32_t page = a & ~static_cast<uint32_t>(0xFFu);
         for (uint16_t i = 0; i < g_spi_page_n; ++i) {
             const uint32_t at = page | ((a + i) & 0xFFu);
             g_flash_inv[at] = static_cast<uint8_t>(g_flash_inv[at] | ~g_spi_page[i]);  // 1 -> 0 only
@@ -279,7 +279,7 @@ void flash_end() {
         flash_write_through(page, 256);
         g_flash_busy_until = now_us() + 400u;
     } else {
-        const uint32_t sector = a & ~0xFFFul;
+        const uint32_t sector = a & ~static_cast<uint32_t>(0xFFFu);
         memset(g_flash_inv + sector, 0, 4096);
         flash_write_through(sector, 4096);
         g_flash_busy_until = now_us() + 45000u;

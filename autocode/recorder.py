@@ -101,7 +101,7 @@ class Plan:
         return self.slots * self.record
 
 
-RECORDER_SIZE = 34  # sizeof(fsw::Recorder) on an AVR (tests/recorder checks it against the ELF)
+RECORDER_SIZE = 35  # sizeof(fsw::Recorder) on an AVR (tests/recorder checks it against the ELF)
 
 
 def log_text(log, sv) -> str:

@@ -417,12 +417,12 @@ def _recorder(app: Application) -> list[str]:
     c.append(f"uint8_t log_fifo[{p.fifo_cap}];")
     c.append(f"uint8_t log_last[{p.sample_size - 2}];")
     time_us = "true" if app.time_unit == "us" else "false"
-    c.append(f"const fsw::LogConfig kLogConfig FSW_FLASH = {{kLogFields, kLogDividers, kLogEraseOk, log_ring, "
-             f"log_fifo, log_last, sv, 0x{app_schema_hash(app):08x}UL, 0x{p.hash:08x}UL, {p.before_ms}UL, "
-             f"E_{p.state_element}, E_{p.time_element}, {p.base}UL, {p.slots}, {int(p.period_ms)}, {p.runs_mod}, "
-             f"{p.record}, "
-             f"{len(p.fields)}, {len(p.dividers)}, {p.trigger}, {p.sample_size}, {p.ring_cap}, {p.fifo_cap}, "
-             f"{p.n_hold}, {'true' if p.escape else 'false'}, {'true' if p.newest else 'false'}, {time_us}}};")
+    c.append(f"const fsw::LogConfig kLogConfig FSW_FLASH = {{sv, kLogDividers, E_{p.state_element}, {p.runs_mod}, "
+             f"{len(p.dividers)}, {p.trigger}, kLogFields, kLogEraseOk, log_ring, log_fifo, log_last, "
+             f"0x{app_schema_hash(app):08x}UL, 0x{p.hash:08x}UL, {p.before_ms}UL, E_{p.time_element}, {p.base}UL, "
+             f"{p.slots}, {int(p.period_ms)}, {p.record}, {len(p.fields)}, {p.sample_size}, {p.ring_cap}, "
+             f"{p.fifo_cap}, {p.n_hold}, {'true' if p.escape else 'false'}, {'true' if p.newest else 'false'}, "
+             f"{time_us}}};")
     c.append(f"static_assert(fsw::log_config_ok({p.record}, {p.opening}, {p.worst}, {p.ring_cap}, {p.fifo_cap}, "
              f"{p.slots}), \"{name}: the recorder's tables\");")
     c.append("fsw::Recorder rec;")

@@ -15,12 +15,20 @@
 #include "fsw_log.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "fsw_crc.h"
 #include "fsw_pal.h"
 
 namespace fsw {
+
+static_assert(offsetof(LogConfig, sv) == offsetof(LogHot, sv) && offsetof(LogConfig, divider) == offsetof(LogHot, divider) &&
+                  offsetof(LogConfig, state_off) == offsetof(LogHot, state_off) &&
+                  offsetof(LogConfig, runs_mod) == offsetof(LogHot, runs_mod) &&
+                  offsetof(LogConfig, n_states) == offsetof(LogHot, n_states) &&
+                  offsetof(LogConfig, trigger) == offsetof(LogHot, trigger),
+              "LogHot is LogConfig's first fields");
 
 namespace {
 
@@ -38,6 +46,14 @@ enum Phase : uint8_t {
 static const uint8_t kSealed = 0x01;     // the open record takes no more bytes
 static const uint8_t kStartDue = 0x02;   // the flight's start record is still to be written
 static const uint8_t kEnding = 0x04;     // the state records nothing: close the flight once drained
+
+// Whether the writer has something to do: a phase, and in the body phase
+// queued bytes or a sealed record. The loop calls the writer at every
+// wake-up (every UART interrupt): an open record waiting for its next
+// sample costs it this test only.
+bool log_writing(const Recorder& r) {
+    return r.w_phase != kWIdle && (r.w_phase != kWBody || r.f_len != 0 || (r.flags & kSealed) != 0);
+}
 
 LogConfig config(const Recorder& r) {
     LogConfig c;
@@ -170,7 +186,7 @@ void nor_begin(const LogConfig& c, Recorder& r) {
 // byte the fifo holds). A sealed record's tail, then its kind, follow in the
 // next passes.
 void nor_poll(Recorder& r) {
-    if (r.w_phase == kWIdle || !nor_ready()) return;
+    if (!log_writing(r) || !nor_ready()) return;
     const LogConfig c = config(r);
     const uint32_t a = slot_addr(c, r.w_slot);
     switch (r.w_phase) {
@@ -514,12 +530,26 @@ void log_eeprom_begin(Recorder& r, const LogConfig* cfg) {
 
 Result log_task(void* ctx) {
     Recorder& r = *static_cast<Recorder*>(ctx);
-    const LogConfig c = config(r);
+    // Most runs take no sample and find nothing to encode: they read only
+    // the first fields of the table (LogHot) and count the run.
+    LogHot h;
+    flash_read(&h, r.cfg, sizeof h);
+    uint32_t s32;
+    memcpy(&s32, h.sv + h.state_off, sizeof s32);
+    const uint8_t st = s32 < h.n_states ? static_cast<uint8_t>(s32) : 0u;
     const uint8_t prev = r.state;
-    const uint8_t st = state_of(c);
     r.state = st;
+    const uint8_t div = table_u8(h.divider, st);
+    if (st != prev) r.countdown = static_cast<uint8_t>(div != 0 ? (div - r.runs % div) % div : 0u);  // in phase
+    const bool sample = div != 0 && r.countdown == 0;
+    if (div != 0) r.countdown = static_cast<uint8_t>((r.countdown == 0 ? div : r.countdown) - 1u);
+    if (++r.runs == h.runs_mod) r.runs = 0;
+    if (st == prev && !sample &&
+        (r.mode != kLogRecording || (r.r_len == 0 && !(r.flags & (kStartDue | kEnding)))))
+        return kOk;
+
+    const LogConfig c = config(r);
     const uint32_t now = now_ms(c);
-    const uint8_t div = table_u8(c.divider, st);
     if (r.mode == kLogIdle && st == c.trigger && prev != c.trigger) {
         r.mode = kLogRecording;
         r.flight = static_cast<uint8_t>(r.flight == 0xFF ? 1u : r.flight + 1u);
@@ -530,7 +560,7 @@ Result log_task(void* ctx) {
         if (div == 0) r.flags |= kEnding;
         else r.flags = static_cast<uint8_t>(r.flags & ~kEnding);
     }
-    if (div != 0 && r.runs % div == 0 && (r.mode == kLogIdle || r.mode == kLogRecording)) {
+    if (sample && (r.mode == kLogIdle || r.mode == kLogRecording)) {
         if (r.r_len == c.ring_cap) {
             if (r.mode == kLogIdle) {
                 ring_pop(c, r);  // before the trigger: the oldest goes
@@ -545,9 +575,8 @@ Result log_task(void* ctx) {
             take(c, s + 2);
             ++r.r_len;
         }
+        if (r.mode == kLogIdle) trim(c, r, now);  // keep only what the trigger would commit
     }
-    if (++r.runs == c.runs_mod) r.runs = 0;
-    if (r.mode == kLogIdle) trim(c, r, now);  // keep only what the trigger would commit
     encode(c, r, now);
     return kOk;
 }
@@ -613,9 +642,9 @@ void eeprom_next(const LogConfig& c, Recorder& r) {
 // again at once (simavr's, the host's model) takes a few per call, so the
 // simulated writer is never slower than the silicon's.
 void log_eeprom_poll(Recorder& r) {
-    if (r.w_phase == kWIdle || !pal::eeprom_ready()) return;
+    if (!log_writing(r) || !pal::eeprom_ready()) return;
     const LogConfig c = config(r);
-    for (uint8_t n = 0; n < 8 && r.w_phase != kWIdle && pal::eeprom_ready(); ++n) eeprom_next(c, r);
+    for (uint8_t n = 0; n < 8 && log_writing(r) && pal::eeprom_ready(); ++n) eeprom_next(c, r);
 }
 
 bool log_erase(Recorder& r) {

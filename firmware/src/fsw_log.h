@@ -48,26 +48,29 @@ struct LogField {
 
 // The recorder's tables (FSW_FLASH).
 struct LogConfig {
-    const LogField* fields;     // n_fields rows
+    // the fields every run of the task reads, first: log_task copies only
+    // these (LogHot) unless the run takes a sample or has work to do
+    const uint8_t* sv;          // the state vector
     const uint8_t* divider;     // per state id (0..n_states-1; id 0 unused): task runs between samples, 0: none
+    uint16_t state_off;         // the machine's `S` element (U32)
+    uint16_t runs_mod;          // a multiple of every divider: the run counter wraps there
+    uint8_t n_states;           // rows of divider / erase_ok
+    uint8_t trigger;            // the state whose entry starts a flight
+    // the rest
+    const LogField* fields;     // n_fields rows
     const uint8_t* erase_ok;    // per state id: 1 where an erase is allowed
     uint8_t* ring;              // RAM: ring_cap samples of sample_size bytes (time u16 first)
     uint8_t* fifo;              // RAM: fifo_cap bytes waiting for the store
     uint8_t* last;              // RAM: the previous sample's absolute values (sample_size - 2 bytes)
-    const uint8_t* sv;          // the state vector
     uint32_t schema;            // schema hash of the application
     uint32_t hash;              // log hash: fields, encodings, record size (docs/recorder.md)
     uint32_t before_ms;         // kept before the trigger
-    uint16_t state_off;         // the machine's `S` element (U32)
     uint16_t time_off;          // the time element `G` (U64, ms or us)
     uint32_t base;              // store address of slot 0
     uint16_t slots;             // records the store holds
     uint16_t period_ms;         // one task run, ms
-    uint16_t runs_mod;          // a multiple of every divider: the run counter wraps there
     uint8_t record;             // bytes per record, 32..255
     uint8_t n_fields;
-    uint8_t n_states;           // rows of divider / erase_ok
-    uint8_t trigger;            // the state whose entry starts a flight
     uint8_t sample_size;        // bytes of a ring entry: time (low 16 bits, ms), then each field's width
     uint8_t ring_cap;
     uint8_t fifo_cap;
@@ -77,6 +80,17 @@ struct LogConfig {
     bool newest;                // full: overwrite the oldest records (else stop)
     bool time_us;               // `G` counts microseconds
 };
+
+// LogConfig's first fields, as they lie in it.
+struct LogHot {
+    const uint8_t* sv;
+    const uint8_t* divider;
+    uint16_t state_off;
+    uint16_t runs_mod;
+    uint8_t n_states;
+    uint8_t trigger;
+};
+
 
 // What the recorder is doing (Recorder::mode).
 enum LogMode : uint8_t {
@@ -111,6 +125,7 @@ struct Recorder {
     uint8_t state;          // the machine's state at the last run
     uint16_t rd_slot;       // the record a LOG_READ being acknowledged reads (the link keeps
                             // its offset and count)
+    uint8_t countdown;      // task runs to the next sample in this state (runs % divider, kept)
 };
 
 // Boot: finds the newest valid record (blocking reads of each record's

@@ -732,13 +732,17 @@ class SimBoard:
     def symbol(self, name: str) -> tuple[int, int]:
         """(data address, size) of a variable of the firmware, by its
         (demangled) name, from the ELF's symbol table."""
-        r = subprocess.run(["avr-nm", "-S", "-C", self.elf], capture_output=True, text=True)
-        for line in r.stdout.splitlines():
-            parts = line.split(None, 3)
-            if len(parts) == 4 and parts[3] == name and parts[2].lower() in "bdgs":
-                addr = int(parts[0], 16)
-                if addr >= 0x800000:
-                    return addr - 0x800000, int(parts[1], 16)
+        r = subprocess.run(["avr-nm", "-S", self.elf], capture_output=True, text=True)
+        rows = [p for p in (line.split(None, 3) for line in r.stdout.splitlines())
+                if len(p) == 4 and p[2].lower() in "bdgs" and int(p[0], 16) >= 0x800000]
+        # the link-time optimiser renames some (`_ZN...recE.lto_priv.24`): the name without the suffix,
+        # demangled, is the variable's
+        bare = [re.sub(r"(\.(lto_priv|constprop|isra)\.\d+)+$", "", p[3]) for p in rows]
+        demangled = subprocess.run(["avr-c++filt"], input="\n".join(bare), capture_output=True,
+                                   text=True).stdout.splitlines()
+        for p, d in zip(rows, demangled):
+            if d == name:
+                return int(p[0], 16) - 0x800000, int(p[1], 16)
         raise SimError(f"{self.elf}: no variable `{name}`")
 
     # -- profiling --

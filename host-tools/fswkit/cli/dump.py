@@ -7,8 +7,7 @@ from __future__ import annotations
 import os
 import sys
 
-from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK
 
 
 def _say(msg: str) -> None:
@@ -17,15 +16,9 @@ def _say(msg: str) -> None:
 
 def cmd_dump(args) -> int:
     from fswkit.autocode.recorder import plan
-    from fswkit.target.build import BuildError, load
+    from fswkit.cli.common import load_app
 
-    diags = Diagnostics()
-    try:
-        app = load(args.project, diags)
-    except BuildError as e:
-        _say(str(e))
-        return EXIT_CONFIG
-    print_diags(diags)
+    app = load_app(args.project, None, "dump")
     if app is None:
         return EXIT_CONFIG
     p = plan(app)

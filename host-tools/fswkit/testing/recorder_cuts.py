@@ -46,6 +46,19 @@ class CutReport:
     problems: list[str] = field(default_factory=list)
 
 
+def _compare(p: Plan, i: int, before: dict[int, bytes], now: dict[int, bytes], rep: CutReport) -> None:
+    """After cut `i`: every record valid before is there byte for byte; the
+    new ones decode and every sample checks itself."""
+    for s, raw in before.items():
+        if now.get(s) != raw:
+            rep.problems.append(f"cut {i}: record {s}, valid before, is {'changed' if s in now else 'lost'}")
+    for s, raw in now.items():
+        if s not in before:
+            _check_samples(p, s, raw, rep)
+            if raw[0] == 0xF0:
+                rep.flights += 1
+
+
 def _check_samples(p: Plan, slot: int, raw: bytes, rep: CutReport) -> None:
     try:
         rec = decode_slot(p, slot, raw)
@@ -111,16 +124,9 @@ def power_cuts(elf: str, p: Plan, cuts: int, seed: int = 1, *, board: str = "uno
                 img = b.eeprom_read(p.base, p.size)
                 now = valid_records(p, img)
             rep.cuts += 1
-            for s, raw in before.items():
-                if now.get(s) != raw:
-                    rep.problems.append(f"cut {i}: record {s}, valid before, is {'changed' if s in now else 'lost'}")
             if sorted(now) != list(range(len(now))):
                 rep.problems.append(f"cut {i}: a hole among the valid records {sorted(now)}")
-            for s, raw in now.items():
-                if s not in before:
-                    _check_samples(p, s, raw, rep)
-                    if raw[0] == 0xF0:
-                        rep.flights += 1
+            _compare(p, i, before, now, rep)
             before = now
             if len(rep.problems) > 20:
                 break
@@ -224,16 +230,10 @@ def power_cuts_nor(elf: str, p: Plan, cuts: int, seed: int = 1, *, board: str = 
                 rep.write_cuts += 1
                 now = valid_records(p, store_image(b, p))
             rep.cuts += 1
-            for s, raw in before.items():
-                if now.get(s) != raw:
-                    rep.problems.append(f"cut {i}: record {s}, valid before, is {'changed' if s in now else 'lost'}")
-            for s, raw in now.items():
-                if s not in before:
-                    if before and s < max(before):
-                        rep.problems.append(f"cut {i}: a new record {s} among the old ones (last {max(before)})")
-                    _check_samples(p, s, raw, rep)
-                    if raw[0] == 0xF0:
-                        rep.flights += 1
+            for s in now:
+                if s not in before and before and s < max(before):
+                    rep.problems.append(f"cut {i}: a new record {s} among the old ones (last {max(before)})")
+            _compare(p, i, before, now, rep)
             before = now
             if len(rep.problems) > 20:
                 break

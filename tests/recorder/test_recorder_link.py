@@ -145,3 +145,19 @@ def test_fsw_sim_keeps_the_board_eeprom_in_a_file(tmp_path):
     assert ee.read_bytes()[100] == 0x5A  # loaded at start, written back at the end
     r = run_fsw("sim", str(RIG), "--plant", "rocket", "--eeprom-file", str(ee))
     assert r.code == 2 and "--eeprom-file is for the free-running board" in r.err
+
+
+def test_erase_needs_every_flight_dumped_first(exe, tmp_path):
+    """--erase erases every flight: with two on the target, a dump of the
+    newest alone does not erase them."""
+    eeprom = tmp_path / "eeprom.bin"
+    for _ in range(2):
+        with PtyTarget(exe, "--eeprom", str(eeprom), "d2=1") as t:
+            time.sleep(1.6)
+    with PtyTarget(exe, "--eeprom", str(eeprom)) as t:
+        time.sleep(0.3)
+        r = dump(t.port, tmp_path / "newest", "--erase", "--yes")
+        assert r.code == 1 and "flight(s) 1 were not dumped: add --all" in r.err, r.out + r.err
+        r = dump(t.port, tmp_path / "all", "--all", "--erase", "--yes")
+        assert r.code == 0 and "erasing" in r.out, r.err
+        assert (tmp_path / "all" / "flight-1.log").exists() and (tmp_path / "all" / "flight-2.log").exists()

@@ -94,6 +94,12 @@ def _talk(args, app, p) -> int:
             trig = f", trigger at {f.start.t0 / 1000:.2f} s" if f.start else ", its start record overwritten"
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
         if args.erase:
+            kept = {f.number for f in chosen}
+            left = [f.number for f in flights if f.number not in kept]
+            if left:  # nothing recorded is erased before it is dumped
+                _say(f"--erase erases every flight on the target, and flight(s) {', '.join(map(str, left))} "
+                     "were not dumped: add --all")
+                return EXIT_FAIL
             if not args.yes:
                 if not sys.stdin.isatty():
                     _say("--erase asks for a confirmation: add --yes when no one is at the terminal")

@@ -111,8 +111,43 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
         return None
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
-    return M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
-                 cs_pin, flash_size)
+    log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
+                cs_pin, flash_size)
+    return log if _sizes(log, m, once, elements, r) else None
+
+
+def _sizes(log: M.Log, m: M.Machine, once: dict[str, Setting], elements: list[Setting], r) -> bool:
+    """What the generated tables count in bytes (recorder.plan's sizes): a
+    sample within 255 bytes, a record that holds its header, a first sample
+    and one more with its tail, a RAM ring of at most 255 samples."""
+    from .recorder import HEADER, TAIL, ring_capacity
+
+    widths = sum(f.width for f in log.fields)
+    if widths + 2 > 255:
+        r.err(elements[-1].key, f"the logged elements take {widths} bytes a sample: at most 253 "
+                                "(log fewer, or encode F32 ones with delta= or quant=)")
+        return False
+    n_hold = sum(f.enc == "hold" for f in log.fields)
+    escape = n_hold < len(log.fields) and log.fields[n_hold].enc == "delta"
+    opening = max(HEADER + 8, HEADER + widths)
+    worst = sum((2 + f.width) if escape else 0 for f in log.fields[:n_hold]) + \
+        sum({"delta": 1, "quant": 2}.get(f.enc, f.width) for f in log.fields[n_hold:])
+    if opening + worst + TAIL > log.record:
+        at = once["record"].values[0] if "record" in once and once["record"].values else elements[-1].key
+        r.err(at, f"a record of {log.record} B cannot hold its header and first sample ({opening} B), one more "
+                  f"sample ({worst} B) and its tail ({TAIL} B): `record {opening + worst + TAIL}` at least, or "
+                  "fewer elements")
+        return False
+    ring = ring_capacity(log, m)
+    if ring > 255:
+        msg = (f"the RAM ring would keep {ring:,} samples (`before` at the rate of the states before the "
+               "trigger, and room while the store is busy): at most 255; lower `before` or those rates")
+        if "before" in once and once["before"].values:
+            r.err(once["before"].values[0], msg)
+        else:
+            r.at(log.line, 1, msg)
+        return False
+    return True
 
 
 def _store(s: Setting | None, board, channels: list[M.Channel] | None, r) -> tuple[str | None, int | None, int]:

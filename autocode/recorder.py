@@ -132,6 +132,18 @@ def _predecessors(m, target: int) -> set[int]:
     return out
 
 
+def ring_capacity(log, m) -> int:
+    """Samples the RAM ring holds: the `before` seconds at the rate of the
+    states that lead to the trigger and one older sample, then room for
+    what comes while the writer is busy: on the EEPROM a record's tail and
+    kind (6 writes, 20 ms); on a flash a start record and a sector erase
+    (45 ms), a pass of the loop each (one a cycle)."""
+    max_rate = max(log.rates)
+    pre_rate = max((log.rates[s] for s in _predecessors(m, log.trigger)), default=max_rate)
+    busy_s = 0.025 if log.store == "eeprom" else 0.1
+    return max(math.floor(log.before * pre_rate) + 1 + math.ceil(busy_s * max_rate) + 1, 2)
+
+
 def plan(app) -> Plan | None:
     """The recorder of an application with a `[log]`, else None."""
     log = app.log
@@ -154,13 +166,7 @@ def plan(app) -> Plan | None:
     n_hold = sum(f.enc == "hold" for f in fields)
     escape = n_hold < len(fields) and fields[n_hold].enc == "delta"
     dividers = tuple(0 if r == 0 else int(task.rate / r) for r in log.rates)
-    max_rate = max(log.rates)
-    pre_rate = max((log.rates[s] for s in _predecessors(m, log.trigger)), default=max_rate)
-    # the `before` seconds and one older sample, then room for what comes while the writer is busy: on the
-    # EEPROM a record's tail and kind (6 writes, 20 ms); on a flash a start record and a sector erase (45 ms),
-    # a pass of the loop each (one a cycle)
-    busy_s = 0.025 if log.store == "eeprom" else 0.1
-    ring_cap = math.floor(log.before * pre_rate) + 1 + math.ceil(busy_s * max_rate) + 1
+    ring_cap = ring_capacity(log, m)
     sample_size = 2 + sum(f.width for f in fields)
     opening = max(HEADER + 8, HEADER + sum(f.width for f in fields))
     worst = sum((2 + f.width) if escape else 0 for f in fields[:n_hold]) + sum(f.encoded() for f in fields[n_hold:])
@@ -169,7 +175,7 @@ def plan(app) -> Plan | None:
         fifo_cap = min(255, max(opening - 1, worst) + worst * 2)
     return Plan(fields, log.record, base, slots, log.newest, dividers,
                 tuple(1 if sid in log.erase else 0 for sid in range(len(log.rates))), log.trigger,
-                int(log.before * 1000), Fraction(1000) / task.rate, _runs_mod(dividers), max(ring_cap, 2), fifo_cap,
+                int(log.before * 1000), Fraction(1000) / task.rate, _runs_mod(dividers), ring_cap, fifo_cap,
                 sample_size,
                 opening, worst, n_hold, escape, log_hash(log, app.sv), m.vars[m.s].name, app.time_element.name,
                 m.name, tuple(st.name for st in m.states), store, log.cs_pin,

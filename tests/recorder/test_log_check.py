@@ -38,3 +38,16 @@ def test_at_most_32_elements_are_logged(tmp_path):
     assert r.code == 1 and "at most 32 elements are logged" in r.err, r.err
     line = app.splitlines().index("element x29") + 1  # the 33rd `element` row
     assert f"logged.app:{line}:1:" in r.err
+
+
+def test_a_sample_of_more_than_253_bytes_is_refused(tmp_path):
+    project = tmp_path / "wide"
+    shutil.copytree(RIG, project)
+    sv = (project / "logged.sv").read_text() + "".join(f"F64 w{i}\n" for i in range(32))
+    (project / "logged.sv").write_text(sv)
+    app = (project / "logged.app").read_text().replace("record  64", "record  255")
+    i = app.index("element level")
+    app = app[:i] + "".join(f"element w{k}\n" for k in range(32))
+    (project / "logged.app").write_text(app)
+    r = run_fsw("check", str(project / "logged.app"))
+    assert r.code == 1 and "the logged elements take 256 bytes a sample: at most 253" in r.err, r.err

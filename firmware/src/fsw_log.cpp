@@ -77,6 +77,28 @@ uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_c
 
 uint8_t store_read(uint32_t addr) { return pal::eeprom_read(static_cast<uint16_t>(addr)); }
 
+// A sealed record's last bytes: period, used, and the CRC of the record's
+// bytes (r.crc) then those three.
+void tail_bytes(const Recorder& r, uint8_t out[kLogTail]) {
+    out[0] = static_cast<uint8_t>(r.period);
+    out[1] = static_cast<uint8_t>(r.period >> 8);
+    out[2] = r.used;
+    uint16_t crc = r.crc;
+    for (uint8_t i = 0; i < 3; ++i) crc = crc16_update(crc, out[i]);
+    out[3] = static_cast<uint8_t>(crc);
+    out[4] = static_cast<uint8_t>(crc >> 8);
+}
+
+// The record's kind is written: it is whole, and the next goes in the next slot.
+void record_written(const LogConfig& c, Recorder& r) {
+    r.w_phase = kWIdle;
+    r.used = 0;
+    r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
+    ++r.head;
+    ++r.seq;
+    if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+}
+
 // ---- the SPI NOR flash (W25Q-class; docs/recorder.md, "On an SPI NOR flash chip") ----
 // Commands used: 05h status register 1 (BUSY bit 0), 06h write enable,
 // 03h read, 02h page program, 20h 4 KiB sector erase.
@@ -214,23 +236,15 @@ void nor_poll(Recorder& r) {
         r.w_phase = kWTail;
         // fall through - nothing queued: the tail in this pass
     case kWTail: {
-        const uint8_t tail3[3] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used};
-        uint16_t crc = r.crc;
-        for (uint8_t i = 0; i < 3; ++i) crc = crc16_update(crc, tail3[i]);
-        const uint8_t tail[5] = {tail3[0], tail3[1], tail3[2], static_cast<uint8_t>(crc),
-                                 static_cast<uint8_t>(crc >> 8)};
+        uint8_t tail[kLogTail];
+        tail_bytes(r, tail);
         nor_write(a + c.record - kLogTail, tail, kLogTail);
         r.w_phase = kWMagic;
         return;
     }
     case kWMagic:  // last: the kind, and the record is whole
         nor_write(a, &r.kind, 1);
-        r.w_phase = kWIdle;
-        r.used = 0;
-        r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
-        ++r.head;
-        ++r.seq;
-        if (r.head >= c.slots) r.mode = kLogFull;
+        record_written(c, r);  // `full newest` is refused on a flash: full stops it
         return;
     case kWErase: {  // the sectors in use, from the one of `head` down to sector 0; `head` counts down
         const uint16_t per = static_cast<uint16_t>(kLogNorSector / c.record);
@@ -599,28 +613,20 @@ void eeprom_next(const LogConfig& c, Recorder& r) {
             --r.f_len;
             ++r.w_pos;
         } else if (r.flags & kSealed) {
-            const uint8_t tail[3] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used};
-            for (uint8_t i = 0; i < 3; ++i) r.crc = crc16_update(r.crc, tail[i]);
             r.w_phase = kWTail;
             r.w_pos = static_cast<uint8_t>(c.record - kLogTail);
         }
         return;
     case kWTail: {
-        const uint8_t k = static_cast<uint8_t>(r.w_pos - (c.record - kLogTail));
-        const uint8_t tail[5] = {static_cast<uint8_t>(r.period), static_cast<uint8_t>(r.period >> 8), r.used,
-                                 static_cast<uint8_t>(r.crc), static_cast<uint8_t>(r.crc >> 8)};
-        pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), tail[k]);
+        uint8_t tail[kLogTail];
+        tail_bytes(r, tail);
+        pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), tail[r.w_pos - (c.record - kLogTail)]);
         if (++r.w_pos == c.record) r.w_phase = kWMagic;
         return;
     }
     case kWMagic:
         pal::eeprom_write(static_cast<uint16_t>(a), r.kind);
-        r.w_phase = kWIdle;
-        r.used = 0;
-        r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
-        ++r.head;
-        ++r.seq;
-        if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+        record_written(c, r);
         return;
     case kWErase:
         pal::eeprom_write(static_cast<uint16_t>(a), 0x00);

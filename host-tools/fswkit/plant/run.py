@@ -189,30 +189,17 @@ def _recorder(sc, run: Run, rep) -> tuple | None:
     """The flight recorder's part of the report (docs/recorder.md): the
     record read from the board's EEPROM after the flight, against the
     telemetry and the truth; (plan, flight) to write as record.log."""
-    from fswkit.recorder.check import newest_flight, recorder_report
+    from fswkit.recorder.check import flight_report
 
-    log = sc.app.log
-    m = sc.app.machines[log.machine]
-    names = {st.id: st.name for st in m.states}
-    trig = names[log.trigger]
-    launch = next((t for t, _, n in run.transitions if n == trig), None)
-    end = None
-    if launch is not None:
-        stop = {names[i] for i, r in enumerate(log.rates) if i and r == 0}
-        end = next((t for t, _, n in run.transitions if t > launch and n in stop), None)
     truth = None
     if sc.kind == "rocket":
         i, j = run.columns.index("time_s"), run.columns.index("altitude_m")
         truth = ([r[i] for r in run.rows], [r[j] for r in run.rows])
-    lines, checks = recorder_report(sc.app, run, reports.Check, launch_s=launch, landed_s=end, truth=truth,
-                                    alt_element=getattr(sc, "altitude_element", None))
+    lines, checks, record = flight_report(sc.app, run, reports.Check, truth=truth,
+                                          alt_element=getattr(sc, "altitude_element", None))
     rep.lines += lines
     rep.checks += checks
-    try:
-        p, flight, _, _ = newest_flight(sc.app, run)
-    except ValueError:
-        return None
-    return (p, flight) if flight is not None else None
+    return record
 
 
 def _install(stage: str, out: str) -> dict:

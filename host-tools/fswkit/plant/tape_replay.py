@@ -900,27 +900,13 @@ def _execute(tape, truth, cfg, app, elf, board, layout, folder) -> Outcome:
 def _recorder(app, rp, checks) -> tuple[list[str], tuple | None]:
     """The flight recorder after a replay (docs/recorder.md): the record
     against the telemetry and the tape's truth; (lines, (plan, flight))."""
-    from fswkit.recorder.check import newest_flight, recorder_report
+    from fswkit.recorder.check import flight_report
 
-    log = app.log
-    names = {st.id: st.name for st in app.machines[log.machine].states}
-    run = rp.run
-    launch = next((t for t, _, n in run.transitions if n == names[log.trigger]), None)
-    end = None
-    if launch is not None:
-        stop = {names[i] for i, r in enumerate(log.rates) if i and r == 0}
-        end = next((t for t, _, n in run.transitions if t > launch and n in stop), None)
-    fw = (lambda t: None if t is None else t + rp.offset)  # noqa: E731  (tape seconds -> the firmware's)
     truth = (rp.truth_t + rp.offset, rp.truth_h) if rp.truth_t.size else None
-    alt = next((f.element.name for f in log.fields if f.element.name == "altitude"), None)
-    lines, more = recorder_report(app, run, reports.Check, launch_s=fw(launch), landed_s=fw(end), truth=truth,
-                                  alt_element=alt)
+    alt = next((f.element.name for f in app.log.fields if f.element.name == "altitude"), None)
+    lines, more, record = flight_report(app, rp.run, reports.Check, truth=truth, alt_element=alt, offset=rp.offset)
     checks += more
-    try:
-        p, flight, _, _ = newest_flight(app, run)
-    except ValueError:
-        return lines, None
-    return lines, ((p, flight) if flight is not None else None)
+    return lines, record
 
 
 # ---- robustness runs -------------------------------------------------------------------

@@ -30,16 +30,36 @@ def newest_flight(app, run):
     return p, (flights[-1] if flights else None), flights, empty
 
 
+def flight_report(app, run, check_cls, *, truth=None, alt_element: str | None = None, offset: float = 0.0):
+    """The recorder's part of a simulated flight's report: (summary lines,
+    checks, (plan, flight) to write as record.log or None). The launch and
+    the end of the flight are the telemetry's transitions into the trigger
+    state and then into a state that records nothing; `offset` turns the
+    run's seconds into the firmware's (a tape replay's run counts tape
+    seconds)."""
+    log = app.log
+    names = {st.id: st.name for st in app.machines[log.machine].states}
+    launch = next((t for t, _, n in run.transitions if n == names[log.trigger]), None)
+    end = None
+    if launch is not None:
+        stop = {names[i] for i, r in enumerate(log.rates) if i and r == 0}
+        end = next((t for t, _, n in run.transitions if t > launch and n in stop), None)
+    fw = (lambda t: None if t is None else t + offset)  # noqa: E731
+    return recorder_report(app, run, check_cls, launch_s=fw(launch), landed_s=fw(end), truth=truth,
+                           alt_element=alt_element)
+
+
 def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: float | None,
                     truth=None, alt_element: str | None = None):
-    """(summary lines, checks) for a flight's record. `launch_s`, `landed_s`:
-    when the firmware entered its trigger state and the state that ends a
-    flight, in the firmware's seconds; `truth`: (times in the firmware's
-    seconds, true altitudes) to compare the recorded `alt_element` with."""
+    """(summary lines, checks, (plan, flight) or None) for a flight's record.
+    `launch_s`, `landed_s`: when the firmware entered its trigger state and
+    the state that ends a flight, in the firmware's seconds; `truth`: (times
+    in the firmware's seconds, true altitudes) to compare the recorded
+    `alt_element` with."""
     try:
         p, flight, flights, empty = newest_flight(app, run)
     except RecordError as e:
-        return [f"flight recorder: {e}"], [check_cls("the flight record decodes", False, str(e))]
+        return [f"flight recorder: {e}"], [check_cls("the flight record decodes", False, str(e))], None
     where = (f"EEPROM {p.base}–{p.base + p.size - 1}" if p.store == "eeprom"
              else f"an SPI NOR flash of {p.size:,} B")
     lines = [f"flight recorder: {len(flights)} flight(s) in {p.slots - empty} of {p.slots} records of "
@@ -47,8 +67,8 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
     if flight is None:
         if launch_s is None:  # the vehicle never launched: there is nothing to keep
             return lines, [check_cls("the recorder kept no flight: the trigger state never came", True,
-                                     "no flight in the record")]
-        return lines, [check_cls("the recorder kept the flight", False, "no flight in the record")]
+                                     "no flight in the record")], None
+        return lines, [check_cls("the recorder kept the flight", False, "no flight in the record")], None
     s = flight.samples
     used = len(flight.records) + (flight.start is not None)
     span = (s[-1][0] - s[0][0]) / 1000 if s else 0.0
@@ -114,4 +134,4 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
         lines.append(f"  {alt_element} against the truth: RMS {float(np.sqrt(np.mean(err ** 2))):.2f} m, "
                      f"largest {float(np.abs(err).max()):.2f} m; apogee recorded {peak_rec:.1f} m, true "
                      f"{peak_true:.1f} m")
-    return lines, checks
+    return lines, checks, (p, flight)

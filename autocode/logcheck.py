@@ -120,18 +120,13 @@ def _sizes(log: M.Log, m: M.Machine, once: dict[str, Setting], elements: list[Se
     """What the generated tables count in bytes (recorder.plan's sizes): a
     sample within 255 bytes, a record that holds its header, a first sample
     and one more with its tail, a RAM ring of at most 255 samples."""
-    from .recorder import HEADER, TAIL, ring_capacity
+    from .recorder import TAIL, record_sizes, ring_capacity
 
-    widths = sum(f.width for f in log.fields)
-    if widths + 2 > 255:
-        r.err(elements[-1].key, f"the logged elements take {widths} bytes a sample: at most 253 "
+    sample_size, _n_hold, _escape, opening, worst = record_sizes(log.fields)
+    if sample_size > 255:
+        r.err(elements[-1].key, f"the logged elements take {sample_size - 2} bytes a sample: at most 253 "
                                 "(log fewer, or encode F32 ones with delta= or quant=)")
         return False
-    n_hold = sum(f.enc == "hold" for f in log.fields)
-    escape = n_hold < len(log.fields) and log.fields[n_hold].enc == "delta"
-    opening = max(HEADER + 8, HEADER + widths)
-    worst = sum((2 + f.width) if escape else 0 for f in log.fields[:n_hold]) + \
-        sum({"delta": 1, "quant": 2}.get(f.enc, f.width) for f in log.fields[n_hold:])
     if opening + worst + TAIL > log.record:
         at = once["record"].values[0] if "record" in once and once["record"].values else elements[-1].key
         r.err(at, f"a record of {log.record} B cannot hold its header and first sample ({opening} B), one more "

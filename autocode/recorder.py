@@ -40,6 +40,11 @@ NOR_SECTOR = 4096  # an SPI NOR flash's erase sector
 EEPROM_WRITE_S = 0.0034  # one AVR EEPROM byte (datasheet: 3.3 ms typical, 3.4 ms with the margin avr-libc uses)
 
 
+def encoded_size(enc: str, width: int) -> int:
+    """Bytes a field takes in a later sample of a record."""
+    return {"delta": 1, "quant": 2}.get(enc, width)
+
+
 @dataclass(frozen=True)
 class Field:
     name: str
@@ -59,7 +64,7 @@ class Field:
         return bool(v) if self.type.is_bool else v
 
     def encoded(self) -> int:
-        return {"delta": 1, "quant": 2}.get(self.enc, self.width)
+        return encoded_size(self.enc, self.width)
 
 
 @dataclass(frozen=True)
@@ -132,6 +137,19 @@ def _predecessors(m, target: int) -> set[int]:
     return out
 
 
+def record_sizes(fields) -> tuple[int, int, bool, int, int]:
+    """Of the `[log]` fields in record order (model.LogField): (bytes of a
+    ring sample, held fields, whether held changes are escapes, bytes of a
+    record's opening: its header and first sample, or a start record's 16;
+    the most bytes a later sample takes)."""
+    widths = sum(f.width for f in fields)
+    n_hold = sum(f.enc == "hold" for f in fields)
+    escape = n_hold < len(fields) and fields[n_hold].enc == "delta"
+    worst = sum((2 + f.width) if escape else 0 for f in fields[:n_hold]) + \
+        sum(encoded_size(f.enc, f.width) for f in fields[n_hold:])
+    return 2 + widths, n_hold, escape, max(HEADER + 8, HEADER + widths), worst
+
+
 def ring_capacity(log, m) -> int:
     """Samples the RAM ring holds: the `before` seconds at the rate of the
     states that lead to the trigger and one older sample, then room for
@@ -163,13 +181,9 @@ def plan(app) -> Plan | None:
         base = 2 * (PHEADER + sum(p.type.size for p in params)) if params else 0
         slots = (app.board.eeprom - base) // log.record
     fields = tuple(Field(f.element.name, f.element.type, f.enc, f.step, f.width) for f in log.fields)
-    n_hold = sum(f.enc == "hold" for f in fields)
-    escape = n_hold < len(fields) and fields[n_hold].enc == "delta"
+    sample_size, n_hold, escape, opening, worst = record_sizes(log.fields)
     dividers = tuple(0 if r == 0 else int(task.rate / r) for r in log.rates)
     ring_cap = ring_capacity(log, m)
-    sample_size = 2 + sum(f.width for f in fields)
-    opening = max(HEADER + 8, HEADER + sum(f.width for f in fields))
-    worst = sum((2 + f.width) if escape else 0 for f in fields[:n_hold]) + sum(f.encoded() for f in fields[n_hold:])
     fifo_cap = max(opening - 1, worst)  # the kind byte is not queued: it is written last
     if log.store == "spi_nor":  # a program a cycle carries what the fifo holds: room for a record's opening and more
         fifo_cap = min(255, max(opening - 1, worst) + worst * 2)

@@ -109,7 +109,7 @@ def test_live_view_renders_every_element_and_the_link():
     from rich.console import Console
 
     from fswkit.link.session import Session
-    from fswkit.ground.monitor import render
+    from fswkit.ground.view import render
 
     lay = tank_layout()
     s = Session(lay)

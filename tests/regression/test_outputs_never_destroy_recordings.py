@@ -157,7 +157,7 @@ def test_sketch_export_never_overwrites_a_file_it_did_not_write(tmp_path):
 @pytest.mark.parametrize("signame", ["SIGTERM", "SIGHUP"])
 def test_an_output_stopped_by_a_signal_leaves_the_old_file(tmp_path, monkeypatch, signame):
     # `kill` mid-export: as Ctrl-C, the old file stays and no temporary file is left beside it
-    import fswkit.ground.monitor
+    import fswkit.ground.logs
 
     sig = getattr(signal, signame)
     log = tmp_path / "x.log"
@@ -171,7 +171,7 @@ def test_an_output_stopped_by_a_signal_leaves_the_old_file(tmp_path, monkeypatch
         signal.raise_signal(sig)
         raise AssertionError("the signal did not stop the export")
 
-    monkeypatch.setattr(fswkit.ground.monitor, "log2csv", log2csv)
+    monkeypatch.setattr(fswkit.ground.logs, "log2csv", log2csv)
     before = signal.getsignal(sig)
     r = run_fsw("log2csv", str(log), "-o", str(csv))
     assert r.code == 128 + sig, r.err

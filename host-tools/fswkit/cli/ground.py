@@ -1,5 +1,5 @@
 """The ground's commands over the serial link: `fsw monitor`, `fsw cmd`,
-`fsw log2csv`, `fsw replay`, `fsw plot` (fswkit.ground.monitor, on the
+`fsw log2csv`, `fsw replay`, `fsw plot` (fswkit.ground.monitor and .logs, on the
 link's layout of the project's configs)."""
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ def cmd_cmd(args) -> int:
 
 
 def cmd_log2csv(args) -> int:
-    from fswkit.ground.monitor import log2csv
+    from fswkit.ground.logs import log2csv
     from fswkit.outputs import output
 
     def run() -> int:
@@ -104,12 +104,12 @@ def cmd_log2csv(args) -> int:
 
 
 def cmd_replay(args) -> int:
-    from fswkit.ground.monitor import replay
+    from fswkit.ground.logs import replay
 
     return _ground("replay", replay, args.log, args.headless, args.speed, args.ignore_schema)
 
 
 def cmd_plot(args) -> int:
-    from fswkit.ground.monitor import plot
+    from fswkit.ground.logs import plot
 
     return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)

@@ -24,6 +24,7 @@ import threading
 # The head of a link recording (`fsw monitor --log`, `fsw sim --plant`):
 # fswkit.link.log writes it; recordings are never overwritten unasked.
 RECORDING_MAGIC = b"FSWLOG1\n"
+ARCHIVE_ID = 0x46535741  # "FSWA": a ground station archive's PRAGMA application_id (fswkit.ground.archive)
 
 
 class OutputError(Exception):
@@ -38,13 +39,27 @@ def same_file(a: str, b: str) -> bool:
         return os.path.realpath(a) == os.path.realpath(b)
 
 
-def is_recording(path: str) -> bool:
-    """Whether `path` is a link log (`fsw monitor --log`, `fsw sim --plant`)."""
+def recording(path: str) -> str | None:
+    """What recording `path` is: "a link log" (`fsw monitor --log`, `fsw sim
+    --plant`), "a ground station archive" (`fsw ground`: SQLite with the
+    archive's application id), or None. Only a regular file is read (a
+    FIFO or a device is never opened: that would wait for a writer)."""
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None
         with open(path, "rb") as f:
-            return f.read(len(RECORDING_MAGIC)) == RECORDING_MAGIC
+            head = f.read(100)
     except OSError:
-        return False
+        return None
+    if head.startswith(RECORDING_MAGIC):
+        return "a link log"
+    if len(head) == 100 and head.startswith(b"SQLite format 3\0") and int.from_bytes(head[68:72], "big") == ARCHIVE_ID:
+        return "a ground station archive"
+    return None
+
+
+def is_recording(path: str) -> bool:
+    return recording(path) is not None
 
 
 def is_direct(path: str) -> bool:
@@ -68,8 +83,9 @@ def check(path: str, inputs=(), *, force: bool = False, what: str = "output") ->
         raise OutputError(f"cannot write {path}: it is a folder (name a file for the {what})")
     if is_direct(path):
         return
-    if os.path.lexists(path) and not force and is_recording(path):
-        raise OutputError(f"{path}: a link log (a recording) is there: it is never overwritten; "
+    kind = recording(path) if os.path.lexists(path) and not force else None
+    if kind is not None:
+        raise OutputError(f"{path}: {kind} (a recording) is there: it is never overwritten; "
                           "choose another name, or move it away first")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):

@@ -1,22 +1,186 @@
 """Opening the serial port (pyserial): a device (/dev/ttyACM0, a pty) or a
-pyserial URL (socket://host:port, loop://)."""
+pyserial URL (socket://host:port, loop://).
+
+A device is opened for one program at a time: pyserial's `exclusive` lock
+(flock) keeps out every other fswkit command, and TIOCEXCL keeps out other
+programs (avrdude, a terminal) that open the device while we hold it.
+Whoever holds it leaves a holder record (`runtime_dir()/ports/`, its pid,
+its command and, for a ground station, its local socket), so a second
+opener is told who has it ("busy: held by fsw ground, pid 4242") and a
+client can find the station that serves the port."""
 
 from __future__ import annotations
+
+import fcntl
+import json
+import os
+import tempfile
+import termios
 
 
 class PortError(Exception):
     pass
 
 
-def open_port(name: str, baud: int):
+class PortBusy(PortError):
+    """The port is held by another program (`holder`: its record, or None)."""
+
+    def __init__(self, message: str, holder: dict | None):
+        super().__init__(message)
+        self.holder = holder
+
+
+def is_url(name: str) -> bool:
+    return "://" in name
+
+
+def runtime_dir() -> str:
+    """Where holder records and stations' sockets live: $XDG_RUNTIME_DIR/fswkit,
+    else a folder of this user's in the temporary directory (FSW_RUNTIME_DIR
+    overrides both)."""
+    base = os.environ.get("FSW_RUNTIME_DIR")
+    if not base:
+        xdg = os.environ.get("XDG_RUNTIME_DIR")
+        base = os.path.join(xdg, "fswkit") if xdg else os.path.join(tempfile.gettempdir(), f"fswkit-{os.getuid()}")
+    os.makedirs(base, mode=0o700, exist_ok=True)
+    return base
+
+
+def port_key(name: str) -> str:
+    """A port's name for its holder record: its real path (two names of one
+    device are one port), as a file name."""
+    real = name if is_url(name) else os.path.realpath(name)
+    return real.strip("/").replace("/", "_").replace(":", "_") or "port"
+
+
+def _record_path(name: str) -> str:
+    d = os.path.join(runtime_dir(), "ports")
+    os.makedirs(d, mode=0o700, exist_ok=True)
+    return os.path.join(d, port_key(name) + ".json")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def holder(name: str) -> dict | None:
+    """The record of the live program holding port `name`, or None (a record
+    left by a program that died is removed)."""
+    path = _record_path(name)
+    try:
+        with open(path, encoding="utf-8") as f:
+            rec = json.load(f)
+    except (OSError, ValueError):
+        return None
+    if not isinstance(rec, dict) or not isinstance(rec.get("pid"), int) or not _alive(rec["pid"]):
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        return None
+    return rec
+
+
+def busy_message(name: str, rec: dict | None) -> str:
+    if rec is None:
+        return f"{name} is busy: another program holds it open (close it, or find it with `fuser {name}`)"
+    what = f"held by {rec.get('command', 'a program')}, pid {rec['pid']}"
+    if rec.get("socket"):
+        what += " (a ground station: `fsw monitor`, `fsw cmd`, `fsw param`, `fsw dump` go through it)"
+    return f"{name} is busy: {what}"
+
+
+def _write_record(name: str, rec: dict) -> str:
+    path = _record_path(name)
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".rec.")
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        json.dump(rec, f)
+    os.replace(tmp, path)
+    return path
+
+
+class Held:
+    """A port opened exclusively with its holder record; `close()` ends both."""
+
+    def __init__(self, serial, name: str, record_path: str | None):
+        self.serial, self.name, self._record = serial, name, record_path
+
+    def close(self) -> None:
+        try:
+            if self.serial.is_open and not is_url(self.name):
+                fcntl.ioctl(self.serial.fileno(), termios.TIOCNXCL)
+        except (OSError, ValueError, AttributeError):
+            pass
+        try:
+            self.serial.close()
+        except Exception:  # noqa: BLE001 - closing a port that went away
+            pass
+        if self._record is not None:
+            try:
+                with open(self._record, encoding="utf-8") as f:
+                    mine = json.load(f).get("pid") == os.getpid()
+            except (OSError, ValueError):
+                mine = False
+            if mine:
+                try:
+                    os.unlink(self._record)
+                except OSError:
+                    pass
+            self._record = None
+
+
+def open_port(name: str, baud: int, *, command: str | None = None, socket: str | None = None):
+    """The port `name` at `baud`. With `command` (the fswkit command opening
+    it), a device is held exclusively and a holder record written: the
+    returned port has a `held` attribute whose `close()` releases both
+    (and the port's own `close()` does the same). PortBusy when another
+    program has it."""
     try:
         import serial
     except ImportError:
         raise PortError("pyserial is not installed: run `make setup` (or pip install pyserial)") from None
+    exclusive = command is not None and not is_url(name)
+    if exclusive:
+        rec = holder(name)
+        if rec is not None and rec["pid"] != os.getpid():
+            raise PortBusy(busy_message(name, rec), rec)
     try:
-        return serial.serial_for_url(name, baudrate=baud, timeout=0.05, write_timeout=2)
+        if exclusive:
+            port = serial.Serial(name, baudrate=baud, timeout=0.05, write_timeout=2, exclusive=True)
+        else:
+            port = serial.serial_for_url(name, baudrate=baud, timeout=0.05, write_timeout=2)
     except (serial.SerialException, ValueError, OSError) as e:
+        text = str(e)
+        if exclusive and ("exclusively lock" in text or "Resource temporarily unavailable" in text
+                          or "Device or resource busy" in text or getattr(e, "errno", None) == 16):
+            rec = holder(name)
+            raise PortBusy(busy_message(name, rec), rec) from None
         raise PortError(f"cannot open {name}: {e}") from None
+    if not exclusive:
+        return port
+    try:
+        fcntl.ioctl(port.fileno(), termios.TIOCEXCL)
+    except OSError:
+        pass  # not a terminal (a FIFO in a test): the flock alone keeps fswkit's commands out
+    rec = {"pid": os.getpid(), "command": command, "port": name, "baud": baud}
+    if socket:
+        rec["socket"] = socket
+    held = Held(port, name, _write_record(name, rec))
+    close = port.close
+
+    def close_all():
+        port.close = close
+        held.close()
+
+    port.held = held
+    port.close = close_all
+    return port
 
 
 def port_errors():

@@ -43,6 +43,17 @@ class LinkStats:
     samples: int = 0
 
 
+RESET_CAUSES = ((0x01, "power-on"), (0x02, "external reset"), (0x04, "brown-out"), (0x08, "watchdog"))
+
+
+def reset_words(cause: int | None) -> str:
+    """An AVR reset cause (MCUSR bits) in words."""
+    if cause is None:
+        return "unknown"
+    words = [w for bit, w in RESET_CAUSES if cause & bit]
+    return ", ".join(words) if words else f"none reported (0x{cause:02x})"
+
+
 class SchemaMismatch(Exception):
     pass
 
@@ -79,6 +90,32 @@ class Session:
         self._snap_at = -1  # bytes of the snapshot received in order so far (-1: none)
         self._per_second = 1000.0 if layout.time_unit == "ms" else 1e6
         self._hs = len(self.layout.tasks)
+
+    def numbering(self) -> dict:
+        """Where this session's frame numbers and times stand (for `adopt`)."""
+        return {"last_seq": self.last_seq, "seq_known": self.seq_known, "t_ref": self.t_ref}
+
+    def adopt(self, hello: dict | None, health: dict | None = None, numbering: dict | None = None) -> None:
+        """The target's last hello and health, and the numbering, as another
+        decoder (a ground station) had them just before the bytes this
+        session will be fed, for a session that attaches mid-stream: the
+        schema is judged as from a hello of its own, the frames get their
+        full numbers from the first, and frames (losses too) are counted
+        from the first this session sees."""
+        if numbering is not None and numbering.get("last_seq") is not None:
+            self.last_seq = numbering["last_seq"]
+            self.seq_known = bool(numbering.get("seq_known"))
+            self.t_ref = numbering.get("t_ref")
+        if hello is not None:
+            info = dict(hello, expected_schema=self.layout.schema)
+            ok = info["schema"] == self.layout.schema and info["protocol"] == wire.PROTOCOL
+            info["schema_ok"] = ok
+            self.hello = info
+            self.target_schema = info["schema"]
+            if not self.ignore_schema:
+                self.schema_ok = ok
+        if health is not None:
+            self.health = dict(health)
 
     # ---- wire ---------------------------------------------------------------------
 

@@ -128,6 +128,13 @@ class Deframer:
         self._synced = False  # bytes before the first delimiter are a partial frame
         self._skipping = False  # inside an oversized run: drop up to the next delimiter
 
+    def resync(self) -> None:
+        """Forgets a partial frame (the link was cut): the bytes up to the
+        next delimiter are again the tail of a frame never seen whole."""
+        self._tail = b""
+        self._synced = False
+        self._skipping = False
+
     def feed(self, data: bytes) -> list[tuple[int, int, int, bytes]]:
         self.stats.bytes += len(data)
         if self._skipping:

@@ -69,6 +69,12 @@ def check_port(port: str, baud: int) -> None:
 def _port_problem(port: str, err: int | None, text: str) -> str:
     if err in (errno.EBUSY, errno.EAGAIN, errno.EWOULDBLOCK) or "busy" in text.lower() \
             or "exclusively lock" in text:
+        from fswkit.link.port import holder
+
+        rec = holder(port)
+        if rec is not None:
+            return (f"{port} is busy: held by {rec.get('command', 'a program')}, pid {rec['pid']}: end it "
+                    "(Ctrl-C) and flash again")
         return (f"{port} is busy: another program has it open (a serial monitor, `fsw monitor`, "
                 "the Arduino IDE): close it and flash again")
     if err == errno.EACCES or "permission denied" in text.lower():

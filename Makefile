@@ -98,7 +98,7 @@ bench: setup
 	$(PY) tools/bench_tapes.py
 	$(PY) tools/bench_busy.py
 	$(PY) tools/bench_study.py
-	$(PY) tools/bench_web.py
+	$(PY) tools/bench_ground.py
 	$(PY) tools/bench_params.py
 	$(PY) tools/bench_recorder.py
 	$(MAKE) --no-print-directory bench-firmware

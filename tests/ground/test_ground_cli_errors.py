@@ -91,7 +91,7 @@ def test_truncated_log_and_unknown_plot_element(tmp_path):
     path.write_bytes(data + b"\x00\x01\x02")  # a record cut short
     r = clean(run_fsw("log2csv", str(path)))
     assert r.code == 0 and "cut short" in r.err
-    assert r.out.splitlines()[1].startswith("1,0,10,")
+    assert r.out.splitlines()[1].startswith("0.010,0.000000,1,Sensors,7,")  # 10 ms; the element `time` is 7
     r = clean(run_fsw("plot", str(path), "-e", "pressure", "-o", str(tmp_path / "p.png")))
     assert r.code == 1 and "unknown element(s) pressure" in r.err
     r = clean(run_fsw("plot", str(path), "-e", "tankPressure", "-o", str(tmp_path / "no" / "p.png")))
@@ -117,8 +117,8 @@ def test_live_view_renders_every_element_and_the_link():
     import struct
     sensors = struct.pack("<QId", 20, 2, 815.5)
     s.feed(wire.downlink(wire.HELLO, 0, 0, hello) + wire.downlink(0x80, 1, 20, sensors), 1.0)
-    con = Console(width=120, record=True)
-    con.print(render(s, 1.0, "tank"))
+    con = Console(width=120, height=40, record=True)
+    con.print(render(s, 1.0, "tank", (120, 40)))
     text = con.export_text()
     for name in ("time", "state", "tankPressure", "valveOpen", "frames/s", "CRC errors", "schema"):
         assert name in text

@@ -146,16 +146,16 @@ def test_log_replay_csv_plot(target, tmp_path):
     r = run_fsw("replay", str(log), "--headless", "--speed", "0")
     assert r.code == 0
     assert r.out.splitlines() == lines
-    # one row per sample, with its frame's sequence number
+    # one row per sample, in the target's time order
     r = run_fsw("log2csv", str(log))
     assert r.code == 0, r.err
     rows = list(csv.DictReader(io.StringIO(r.out)))
-    assert rows and {"seq", "time", "tankPressure", "valveOpen", "state"} <= set(rows[0])
-    sensor_rows = [x for x in rows if x["frame"] == "Sensors"]
+    assert rows and {"target time [s]", "time", "tankPressure", "valveOpen", "state", "state name"} <= set(rows[0])
+    sensor_rows = [x for x in rows if x["from frame"] == "Sensors"]
     assert len(sensor_rows) >= 40
     assert all(float(x["tankPressure"]) == volts_psi(RAW) for x in sensor_rows)
-    seqs = [int(x["seq"]) for x in rows]
-    assert seqs == sorted(seqs)
+    times = [float(x["target time [s]"]) for x in rows]
+    assert times == sorted(times) and {x["target boot"] for x in rows} == {"1"}
     out = tmp_path / "rows.csv"
     assert run_fsw("log2csv", str(log), "-o", str(out)).code == 0
     assert out.read_text() == r.out

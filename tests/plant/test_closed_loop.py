@@ -151,7 +151,7 @@ def test_the_log_reads_back_with_the_ground_tools(flights, tmp_path):
     assert r.code == 0, r.err
     rows = _csv(out)
     run = flights["seed2"].run
-    flight_rows = [x for x in rows if x["frame"] == "Flight"]
+    flight_rows = [x for x in rows if x["from frame"] == "Flight"]
     assert len(flight_rows) == sum(1 for _, row in run.samples if "altitude" in row)
     assert {x["state"] for x in flight_rows} == {str(sid) for _, sid, _ in run.transitions}
     r = run_fsw("plot", log, "-e", "altitude", "state", "-o", str(tmp_path / "p.png"))

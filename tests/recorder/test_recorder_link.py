@@ -46,7 +46,7 @@ def check_flight(samples: list[dict]) -> None:
     times = [int(float(s["time_ms"])) if "time_ms" in s else None for s in samples]
     prev = None
     for s in samples:
-        t = int(round(float(s[next(k for k in s if k.startswith("time"))])))
+        t = round(float(s["target time [s]"]) * 1000)  # the target's time, ms
         assert float(s["level"]) == pytest.approx(t / 4, abs=0.125)
         count = int(s["count"])
         if prev is not None and int(s["state"]) == 2:

@@ -35,5 +35,5 @@ def test_the_rocket_records_every_flight_element_at_100_hz_on_a_flash(tmp_path):
     assert "PASS  the record matches the telemetry value for value" in r.out
     log = tmp_path / "out" / "record.log"
     rows = run_fsw("log2csv", str(log)).out.splitlines()
-    assert rows[0].split(",")[5:] == ["state", "altitude", "accel", "pressure", "drogue", "main"]
+    assert rows[0].split(",")[4:] == ["state", "state name", "altitude", "accel", "pressure", "drogue", "main"]
     assert len(rows) > 4000  # 100 Hz over a 43 s flight

@@ -165,7 +165,7 @@ def test_an_output_stopped_by_a_signal_leaves_the_old_file(tmp_path, monkeypatch
     csv = tmp_path / "x.csv"
     csv.write_text("the previous export\n")
 
-    def log2csv(path, f, ignore_schema):
+    def log2csv(path, f, ignore_schema, *more, **options):
         f.write("seq,sample\n1,0\n")
         assert signal.getsignal(sig) not in (signal.SIG_DFL, signal.SIG_IGN, None), "the signal would kill it"
         signal.raise_signal(sig)
@@ -265,3 +265,23 @@ def test_test_trace_onto_its_script_or_machine_is_refused(tmp_path):
     r = run_fsw("test", str(project / "tank.ss"), "--trace", str(trace))
     assert r.code == 0 and trace.read_text().startswith("step"), r.err
     _no_parts(project)
+
+
+def test_no_output_overwrites_a_ground_station_archive(tmp_path):
+    # an archive holds every session of a station: like a log, no command's
+    # output replaces it (the class: every output goes through outputs.check)
+    from fswkit.ground.archive import Archive
+
+    log = tmp_path / "x.log"
+    _log(log)
+    project = tank_copy(tmp_path)
+    # each output named as its command would write it (the plot's format is its extension)
+    for name, args in (("ground.csv", ("log2csv", str(log), "-o")),
+                       ("ground.png", ("plot", str(log), "-e", "tankPressure", "-o")),
+                       ("ground.dot", ("graph", str(project / "tank.sm"), "-o"))):
+        arch = tmp_path / name
+        Archive(str(arch)).close()
+        before = arch.read_bytes()
+        r = run_fsw(*args, str(arch))
+        assert r.code != 0 and "a ground station archive (a recording) is there" in r.err, (args, r.err)
+        assert arch.read_bytes() == before

@@ -15,6 +15,7 @@ import time
 
 import pytest
 
+from conftest import run_fsw
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
@@ -59,12 +60,13 @@ class Station:
     def __init__(self, port: str):
         import uvicorn
 
-        from fswkit.link.port import open_port
+        from fswkit.ground.station import Station as Ground
         from fswkit.web.app import create_app
         from fswkit.web.source import LiveSource
 
-        self.serial = open_port(port, 115200)
-        self.source = LiveSource(tank_layout(), self.serial)
+        self.ground = Ground(tank_layout(), "tank", port, 115200)
+        self.ground.start()
+        self.source = LiveSource(self.ground)
         self.http = free_port()
         self.url = f"http://127.0.0.1:{self.http}/"
         self.server = uvicorn.Server(uvicorn.Config(create_app(self.source), host="127.0.0.1", port=self.http,
@@ -79,7 +81,7 @@ class Station:
     def close(self):
         self.server.should_exit = True
         self.thread.join(5)
-        self.serial.close()
+        self.ground.stop()
 
 
 def wait_for(fn, what: str, timeout: float = 10.0):
@@ -130,6 +132,12 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             item = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#history li"), "the history")[0]
             assert "set valveOpen = false" in item.text and "applied" in item.text, item.text
             assert "ok" in item.get_attribute("class")
+            # a command from another client of the station (`fsw cmd` in a terminal): in the same history
+            r = run_fsw("cmd", "-p", str(TANK), "--port", target.port, "set", "valveOpen", "true")
+            assert r.code == 0, r.err
+            item = wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
+                                     if "fsw cmd (pid" in li.text], "fsw cmd's command in the history")[0]
+            assert "set valveOpen true" in item.text and "applied" in item.text, item.text
             # docs/ground.md shows this page: `make docs-img` runs this test with FSW_SCREENSHOTS=docs/img
             shots = os.environ.get("FSW_SCREENSHOTS") or str(tmp_path)
             assert browser.save_screenshot(os.path.join(shots, "ground-web.png"))
@@ -141,18 +149,23 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             station.close()
 
 
-def test_fsw_web_serves_the_station_for_a_project(exe):
-    """`fsw web PROJECT --port P --http-port 0` prints the URL it serves;
-    the layout and the page come from it; Ctrl-C (SIGINT) ends it."""
+@pytest.mark.parametrize("name", ["ground", "web"])
+def test_fsw_ground_serves_the_page_the_terminal_tools_and_the_archive(exe, tmp_path, name):
+    """`fsw ground PROJECT --port P --http-port 0 --archive A` (and its older
+    name `fsw web`) prints the URL it serves; the layout and the page come
+    from it; `fsw monitor` and `fsw cmd` go through it; Ctrl-C (SIGINT)
+    ends it with the session in the archive, frames and command."""
     import json
     import signal
     import subprocess
     import sys
     import urllib.request
 
+    archive = tmp_path / "a.sqlite"
     with PtyTarget(exe, f"a14={RAW}") as target:
-        p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "web", str(TANK), "--port", target.port,
-                              "--http-port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", name, str(TANK), "--port", target.port,
+                              "--http-port", "0", "--archive", str(archive)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             url = p.stdout.readline().strip()
             assert url.startswith("http://127.0.0.1:"), p.stderr.read() if p.poll() is not None else url
@@ -160,9 +173,24 @@ def test_fsw_web_serves_the_station_for_a_project(exe):
             assert lay["name"] == "tank" and [e["name"] for e in lay["elements"] if e["writable"]] == ["valveOpen"]
             page = urllib.request.urlopen(url, timeout=5).read().decode()
             assert '<script src="/uplot/uPlot.iife.min.js">' in page
+            r = run_fsw("monitor", str(TANK), "--port", target.port, "--headless", "--duration", "1")
+            assert r.code == 0 and "through the ground station" in r.err, r.err
+            r = run_fsw("cmd", "-p", str(TANK), "--port", target.port, "ping")
+            assert r.code == 0, r.err
         finally:
             p.send_signal(signal.SIGINT)
             assert p.wait(10) == 0, p.stderr.read()
+    r = run_fsw("archive", "list", str(archive))
+    assert r.code == 0, r.err
+    import sqlite3
+
+    con = sqlite3.connect(archive)
+    frames, = con.execute("SELECT count(*) FROM frames").fetchone()
+    cmds = con.execute("SELECT who, text, status FROM commands WHERE who LIKE 'fsw cmd%'").fetchall()
+    ended, = con.execute("SELECT ended FROM sessions").fetchone()
+    con.close()
+    assert frames > 20 and ended is not None
+    assert len(cmds) == 1 and cmds[0][1] == "ping" and cmds[0][2] == 0
 
 
 def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
@@ -179,7 +207,7 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
     from fswkit.autocode.params import app_parameters
     from fswkit.autocode.schema import link_plan
     from fswkit.link.layout import from_app
-    from fswkit.link.port import open_port
+    from fswkit.ground.station import Station as Ground
     from fswkit.target.build import load
     from fswkit.web.app import create_app
     from fswkit.web.source import LiveSource
@@ -189,8 +217,9 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
     assert r.code == 0, r.err
     app = load(str(rig), Diagnostics())
     with PtyTarget(tmp_path / "b" / "tuned", "--eeprom", str(tmp_path / "e.bin")) as target:
-        serial = open_port(target.port, 115200)
-        source = LiveSource(from_app(app), serial, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
+        ground = Ground(from_app(app), str(rig), target.port, 115200)
+        ground.start()
+        source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
         http = free_port()
         server = uvicorn.Server(uvicorn.Config(create_app(source), host="127.0.0.1", port=http, log_level="warning",
                                                ws="websockets-sansio"))
@@ -221,4 +250,4 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
         finally:
             server.should_exit = True
             thread.join(5)
-            serial.close()
+            ground.stop()

@@ -111,22 +111,24 @@ def folder_and_firmware(project: str, board: str | None, out: str):
 
 def open_link(args, layout, baud: int, say):
     """A target's link on `args.port` for a command that talks to it (`fsw
-    param`, `fsw dump`): the port opened, a hello asked for and its schema
-    checked against `args.project` (unless `args.ignore_schema`).
-    (port, Ground, Session); None, said through `say`, when it cannot be
-    (the port is closed again)."""
+    param`, `fsw dump`): through the ground station when one holds the
+    port, else the port opened exclusively; a hello asked for and its
+    schema checked against `args.project` (unless `args.ignore_schema`).
+    (link, link, Session): the link closes with `close_port`; None, said
+    through `say`, when it cannot be had (the link is closed again)."""
+    from fswkit.ground.client import StationRefused, connect
     from fswkit.ground.monitor import schema_message, summary
-    from fswkit.link.client import Ground, LinkTimeout
-    from fswkit.link.port import PortError, open_port
+    from fswkit.link.client import LinkTimeout
+    from fswkit.link.port import PortError
     from fswkit.link.session import Session
 
     session = Session(layout, ignore_schema=args.ignore_schema)
     try:
-        port = open_port(args.port, baud)
-    except PortError as e:
+        ground = connect(args.port, baud, session, f"fsw {args.command}")
+    except (PortError, StationRefused, OSError) as e:
         say(str(e))
         return None
-    ground = Ground(port, session)
+    port = ground
     why = None
     try:
         ground.handshake(timeout=3.0)

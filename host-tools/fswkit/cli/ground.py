@@ -1,10 +1,12 @@
 """The ground's commands over the serial link: `fsw monitor`, `fsw cmd`,
 `fsw log2csv`, `fsw replay`, `fsw plot` (fswkit.ground.monitor and .logs, on the
-link's layout of the project's configs)."""
+link's layout of the project's configs), and `fsw archive list|export` on a
+ground station's archive (fswkit.ground.archive)."""
 
 from __future__ import annotations
 
 import sys
+from functools import partial
 
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, port_or_only, print_diags
@@ -46,12 +48,13 @@ def _ground(command: str, fn, *a) -> int:
     from fswkit.link.layout import LayoutError
     from fswkit.link.log import LogError
     from fswkit.link.port import PortError
+    from fswkit.ground.archive import ArchiveError
     from fswkit.ground.monitor import GroundError
     from fswkit.outputs import OutputError
 
     try:
         return fn(*a)
-    except (GroundError, PortError, LogError, LayoutError, OutputError) as e:
+    except (GroundError, PortError, LogError, LayoutError, OutputError, ArchiveError) as e:
         sys.stderr.write(f"fsw {command}: {e}\n")
         return EXIT_FAIL
 
@@ -76,8 +79,8 @@ def cmd_monitor(args) -> int:
             sys.stderr.write(f"fsw monitor: {e}\n")
             return EXIT_FAIL
     baud = _link_baud(args.baud, app_baud, "monitor")
-    return _ground("monitor", monitor, layout, args.project, port, baud, args.log, args.headless,
-                   args.ignore_schema, args.duration, args.frames, args.force)
+    return _ground("monitor", partial(monitor, spark=tuple(args.spark)), layout, args.project, port, baud,
+                   args.log, args.headless, args.ignore_schema, args.duration, args.frames, args.force)
 
 
 def cmd_cmd(args) -> int:
@@ -98,7 +101,7 @@ def cmd_log2csv(args) -> int:
 
     def run() -> int:
         with output(args.output, [args.log], newline="", what="CSV") as f:
-            return log2csv(args.log, f, args.ignore_schema)
+            return log2csv(args.log, f, args.ignore_schema, args.session)
 
     return _ground("log2csv", run)
 
@@ -106,10 +109,37 @@ def cmd_log2csv(args) -> int:
 def cmd_replay(args) -> int:
     from fswkit.ground.logs import replay
 
-    return _ground("replay", replay, args.log, args.headless, args.speed, args.ignore_schema)
+    return _ground("replay", partial(replay, spark=tuple(args.spark)), args.log, args.headless, args.speed,
+                   args.ignore_schema, args.session)
 
 
 def cmd_plot(args) -> int:
     from fswkit.ground.logs import plot
 
-    return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema)
+    return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema, args.session)
+
+
+def cmd_archive_list(args) -> int:
+    from fswkit.ground.archive import sessions, sessions_text
+
+    def run() -> int:
+        rows = sessions(args.archive)
+        if not rows:
+            sys.stderr.write(f"fsw archive list: {args.archive}: no sessions yet\n")
+            return 0
+        sys.stdout.write(sessions_text(rows))
+        return 0
+
+    return _ground("archive list", run)
+
+
+def cmd_archive_export(args) -> int:
+    from fswkit.ground.logs import export
+
+    def run() -> int:
+        rows, session = export(args.archive, args.output, session=args.session, t_from=args.t_from,
+                                t_to=args.t_to, force=args.force, ignore_schema=args.ignore_schema)
+        sys.stderr.write(f"fsw archive export: {args.output}: {rows} rows of session {session}\n")
+        return 0
+
+    return _ground("archive export", run)

@@ -70,6 +70,7 @@ def _int_upto(hi: int, what: str):
     return parse
 
 
+_SESSION_HELP = "a session of a ground station's archive (default: the newest; not for a link log)"
 _baud = _int_upto(10_000_000, "a serial speed")  # what a UART or a USB serial adapter makes
 _delta_t = _int_upto(2**64 - 1, "a time step")  # the script's U64 `delta_t`
 
@@ -216,6 +217,8 @@ def parser() -> argparse.ArgumentParser:
     m.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
     m.add_argument("--duration", type=_nonneg_float, metavar="S", help="stop after S seconds")
     m.add_argument("--frames", type=_positive_int, metavar="N", help="stop after N frames")
+    m.add_argument("--spark", action="append", default=[], metavar="ELEMENT",
+                   help="a sparkline of ELEMENT's last 60 values in the live view (repeatable)")
     m.set_defaults(func=_command("ground", "cmd_monitor"))
 
     cm = sub.add_parser("cmd", help="send a command over the uplink and wait for its acknowledgement")
@@ -231,15 +234,23 @@ def parser() -> argparse.ArgumentParser:
     cm._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     cm.set_defaults(func=_command("ground", "cmd_cmd"))
 
-    wb = sub.add_parser("web", help="the web ground station on a target's serial port (docs/ground.md)")
-    wb.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
-    wb.add_argument("--port", help="serial device or pyserial URL (default: the only serial port found)")
-    wb.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
-    wb.add_argument("--http-port", type=int, default=8000, metavar="N",
-                    help="the web server's TCP port on localhost (default 8000; 0: any free one)")
-    wb.add_argument("--host", default="127.0.0.1", help="the address to serve on (default 127.0.0.1: this machine only)")
-    wb.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
-    wb.set_defaults(func=_command("web", "cmd_web"))
+    for name, what in (("ground", "the ground station: owns a target's serial port, archives the link, serves "
+                                  "the terminal tools and the web page at once (docs/ground.md)"),
+                       ("web", "the same as `fsw ground` (its older name)")):
+        wb = sub.add_parser(name, help=what)
+        wb.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
+        wb.add_argument("--port", help="serial device or pyserial URL (default: the only serial port found)")
+        wb.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+        wb.add_argument("--archive", metavar="FILE.sqlite",
+                        help="the SQLite archive the session is added to (default PROJECT/ground-archive.sqlite)")
+        wb.add_argument("--no-archive", action="store_true", help="archive nothing")
+        wb.add_argument("--no-web", action="store_true", help="serve the local clients only, no web page")
+        wb.add_argument("--http-port", type=int, default=8000, metavar="N",
+                        help="the web server's TCP port on localhost (default 8000; 0: any free one)")
+        wb.add_argument("--host", default="127.0.0.1",
+                        help="the address to serve on (default 127.0.0.1: this machine only)")
+        wb.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
+        wb.set_defaults(func=_command("web", "cmd_ground"))
 
     pa = sub.add_parser("param", help="a target's parameters over the link: list, get, set, save, load, diff "
                                       "(docs/parameters.md)")
@@ -275,6 +286,7 @@ def parser() -> argparse.ArgumentParser:
     lc.add_argument("log", metavar="LOG")
     lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")
     lc.add_argument("--ignore-schema", action="store_true")
+    lc.add_argument("--session", type=_positive_int, metavar="N", help=_SESSION_HELP)
     lc.set_defaults(func=_command("ground", "cmd_log2csv"))
 
     rp = sub.add_parser("replay", help="the monitor's view of a link log")
@@ -283,6 +295,9 @@ def parser() -> argparse.ArgumentParser:
     rp.add_argument("--speed", type=_replay_speed, default=1.0,
                     help="1 = as recorded, 2 twice as fast (0.001 to 1000000), 0 = as fast as possible")
     rp.add_argument("--ignore-schema", action="store_true")
+    rp.add_argument("--session", type=_positive_int, metavar="N", help=_SESSION_HELP)
+    rp.add_argument("--spark", action="append", default=[], metavar="ELEMENT",
+                    help="a sparkline of ELEMENT's last 60 values in the view (repeatable)")
     rp.set_defaults(func=_command("ground", "cmd_replay"))
 
     pl = sub.add_parser("plot", help="time series of elements from a link log, state transitions marked")
@@ -290,7 +305,28 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("-e", "--element", nargs="+", required=True, metavar="ELEMENT")
     pl.add_argument("-o", "--output", required=True, metavar="OUT.png")
     pl.add_argument("--ignore-schema", action="store_true")
+    pl.add_argument("--session", type=_positive_int, metavar="N", help=_SESSION_HELP)
     pl.set_defaults(func=_command("ground", "cmd_plot"))
+
+    ar = sub.add_parser("archive", help="a ground station's SQLite archive: list its sessions, export one "
+                        "(docs/ground.md)")
+    asub = ar.add_subparsers(dest="archive_command", metavar="list|export")
+    asub.required = True
+    al = asub.add_parser("list", help="the archive's sessions: port, times, frames, commands, bytes")
+    al.add_argument("archive", metavar="FILE")
+    al.set_defaults(func=_command("ground", "cmd_archive_list"))
+    ae = asub.add_parser("export", help="a session's samples as CSV or Parquet, one row per sample")
+    ae.add_argument("archive", metavar="FILE")
+    ae.add_argument("--session", type=_positive_int, metavar="N", help="this session (default: the newest)")
+    ae.add_argument("--from", dest="t_from", type=_nonneg_float, metavar="SECONDS",
+                    help="rows from SECONDS after the session began (host clock)")
+    ae.add_argument("--to", dest="t_to", type=_nonneg_float, metavar="SECONDS",
+                    help="rows up to SECONDS after the session began")
+    ae.add_argument("-o", "--output", required=True, metavar="OUT.csv|OUT.parquet",
+                    help="the file to write; its extension says the format")
+    ae.add_argument("--force", action="store_true", help="replace OUT if it exists")
+    ae.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
+    ae.set_defaults(func=_command("ground", "cmd_archive_export"))
 
     tp = sub.add_parser("tape", help="sensor tapes of real flights: import a recorder's log, show a tape "
                         "(docs/tapes.md)")

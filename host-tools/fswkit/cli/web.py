@@ -1,11 +1,18 @@
-"""`fsw web PROJECT --port P`: the web ground station on a target's serial
-port (fswkit.web; docs/ground.md)."""
+"""`fsw ground PROJECT --port P` (and its older name, `fsw web`): the
+ground station on a target's serial port: one process owns the port,
+archives the session, serves the local clients and the web page
+(fswkit.ground.station, fswkit.web; docs/ground.md)."""
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
+import threading
 
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, port_or_only
+
+ARCHIVE = "ground-archive.sqlite"  # in the project's folder, unless --archive names another
 
 
 def _parameters(project: str):
@@ -19,47 +26,85 @@ def _parameters(project: str):
     return (app_parameters(app), link_plan(app).tx_cap) if app is not None else ((), 0)
 
 
-def cmd_web(args) -> int:
+def archive_path(args) -> str | None:
+    if args.no_archive:
+        return None
+    if args.archive:
+        return args.archive
+    base = args.project if os.path.isdir(args.project) else os.path.dirname(os.path.abspath(args.project))
+    return os.path.join(base, ARCHIVE)
+
+
+def cmd_ground(args) -> int:
     from fswkit.cli.ground import _link_baud, _link_layout
-    from fswkit.link.port import PortError, open_port
+    from fswkit.ground.archive import Archive, ArchiveError
+    from fswkit.ground.station import Station
+    from fswkit.link.port import PortError
     from fswkit.web.app import AssetsMissing, create_app, serve, uplot_dir
     from fswkit.web.source import LiveSource
 
-    link = _link_layout(args.project, "web")
+    name = args.command
+    link = _link_layout(args.project, name)
     if link is None:
         return EXIT_CONFIG
     layout, app_baud = link
-    port_name = port_or_only(args.port, "web")
+    port_name = port_or_only(args.port, name)
     if port_name is None:
         return EXIT_FAIL
+    web = not args.no_web
+    if web:
+        try:
+            uplot_dir()
+        except AssetsMissing as e:
+            sys.stderr.write(f"fsw {name}: {e}\n")
+            return EXIT_FAIL
+    baud = _link_baud(args.baud, app_baud, name)
+    path = archive_path(args)
     try:
-        uplot_dir()
-    except AssetsMissing as e:
-        sys.stderr.write(f"fsw web: {e}\n")
+        archive = Archive(path) if path else None
+    except ArchiveError as e:
+        sys.stderr.write(f"fsw {name}: {e}\n")
         return EXIT_FAIL
-    baud = _link_baud(args.baud, app_baud, "web")
+    station = Station(layout, args.project, port_name, baud, archive=archive, ignore_schema=args.ignore_schema)
+    station.notes(lambda text, up: sys.stderr.write(f"fsw {name}: {port_name}: {text}\n"))
     try:
-        port = open_port(port_name, baud)
+        station.start()
     except PortError as e:
-        sys.stderr.write(f"fsw web: {e}\n")
+        sys.stderr.write(f"fsw {name}: {e}\n")
+        if archive is not None:
+            archive.close()
         return EXIT_FAIL
-    params, tx_cap = _parameters(args.project)
-    app = create_app(LiveSource(layout, port, ignore_schema=args.ignore_schema, params=params, tx_cap=tx_cap,
-                                baud=baud), title=f"fsw web {args.project}")
-
-    def ready(url: str) -> None:
-        sys.stdout.write(f"{url}\n")
-        sys.stdout.flush()
-        sys.stderr.write(f"fsw web: the ground station of {args.project} on {port_name} at {baud} baud: open {url} "
-                         "(Ctrl-C ends it)\n")
-
+    said = f"the ground station of {args.project} on {port_name} at {baud} baud" + (
+        f", archiving into {path}" if path else "")
     try:
-        serve(app, host=args.host, port=args.http_port, on_ready=ready)
+        if not web:
+            sys.stderr.write(f"fsw {name}: {said}; `fsw monitor`, `fsw cmd`, `fsw param` and `fsw dump` on "
+                             f"{port_name} go through it (Ctrl-C ends it)\n")
+            stop = threading.Event()
+            for sig in (signal.SIGTERM, signal.SIGHUP):
+                signal.signal(sig, lambda *_: stop.set())
+            while not stop.wait(0.5):
+                pass
+            return EXIT_OK
+        params, tx_cap = _parameters(args.project)
+        app = create_app(LiveSource(station, params=params, tx_cap=tx_cap, baud=baud),
+                         title=f"fsw ground {args.project}")
+
+        def ready(url: str) -> None:
+            sys.stdout.write(f"{url}\n")
+            sys.stdout.flush()
+            sys.stderr.write(f"fsw {name}: {said}: open {url} (Ctrl-C ends it)\n")
+
+        try:
+            serve(app, host=args.host, port=args.http_port, on_ready=ready)
+        except OSError as e:
+            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
+            return EXIT_FAIL
+        return EXIT_OK
     except KeyboardInterrupt:
-        pass
-    except OSError as e:
-        sys.stderr.write(f"fsw web: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
-        return EXIT_FAIL
+        return EXIT_OK
     finally:
-        port.close()
-    return EXIT_OK
+        station.stop()
+
+
+cmd_web = cmd_ground

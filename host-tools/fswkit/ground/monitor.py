@@ -13,7 +13,7 @@ from fswkit.link import wire
 from fswkit.link.layout import Layout
 from fswkit.link.session import Session
 
-from .view import View
+from .view import View, spark_elements
 
 
 class GroundError(Exception):
@@ -38,25 +38,32 @@ def summary(session: Session) -> str:
 # ---- fsw monitor -----------------------------------------------------------------
 
 def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: str | None, headless: bool,
-            ignore_schema: bool, duration: float | None, max_frames: int | None, force: bool = False) -> int:
-    from fswkit.link.client import Ground, LinkTimeout
+            ignore_schema: bool, duration: float | None, max_frames: int | None, force: bool = False,
+            spark=()) -> int:
+    from fswkit.link.client import LinkTimeout
     from fswkit.link.log import LogError, LogWriter
-    from fswkit.link.port import open_port, port_errors
+    from fswkit.link.port import port_errors
 
+    from .client import StationRefused, connect
+
+    spark = spark_elements(layout, spark)  # an unknown element is refused before the port is opened
     session = Session(layout, ignore_schema=ignore_schema)
     # the log is checked first and takes its name only once the target is known
     # to be the right one: a refused session leaves an old recording as it was
     log = LogWriter(log_path, layout, force=force, port=port_name, project=project) if log_path else None
     try:
-        port = open_port(port_name, baud)
-    except BaseException:
+        ground = connect(port_name, baud, session, "fsw monitor", log)
+    except BaseException as e:
         if log is not None:
             log.close(keep=False)
+        if isinstance(e, StationRefused):
+            raise GroundError(str(e)) from None
         raise
-    ground = Ground(port, session, log)
+    if ground.via != "the port":
+        sys.stderr.write(f"fsw monitor: {port_name}: through {ground.via}\n")
     refused = False
     verified = False  # the target answered as the right one: the log may replace what was there
-    view = View(session, headless, f"{layout.name} on {port_name}")
+    view = View(session, headless, f"{layout.name} on {port_name}", spark=spark)
     start = time.monotonic()
     status = 0
     try:
@@ -82,6 +89,7 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
                     view.event(ev)
                     if ev.kind == "hello" and not ev.info["schema_ok"] and not ignore_schema:
                         raise GroundError(schema_message(session, project))
+                view.note = ground.note  # the station's word on its link (went away, reconnected)
                 view.update()
                 if duration is not None and time.monotonic() - start >= duration:
                     break
@@ -105,10 +113,7 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
     finally:
         if log is not None:  # stopped before the target answered: what was at the path stays
             log.close(keep=not refused and (verified or not os.path.lexists(log_path)))
-        try:
-            port.close()
-        except Exception:  # noqa: BLE001 - closing a port that went away
-            pass
+        ground.close()
     sys.stderr.write(summary(session) + "\n")
     return status
 
@@ -117,9 +122,11 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
 
 def command(layout: Layout, project: str, port_name: str, baud: int, what: str, args: list[str],
             ignore_schema: bool) -> int:
-    from fswkit.link.client import Ground, LinkTimeout
+    from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import LayoutError, encode_value
-    from fswkit.link.port import open_port, port_errors
+    from fswkit.link.port import port_errors
+
+    from .client import StationRefused, connect
     from fswkit.autocode.app import TASK_MODES
 
     if not layout.has_uplink:
@@ -155,8 +162,10 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
         raise GroundError(f"unknown command `{what}`: set, mode, ping, hello or snapshot")
 
     session = Session(layout, ignore_schema=ignore_schema)
-    port = open_port(port_name, baud)
-    ground = Ground(port, session)
+    try:
+        ground = connect(port_name, baud, session, "fsw cmd")
+    except StationRefused as e:
+        raise GroundError(str(e)) from None
     try:
         try:
             ground.handshake(timeout=3.0)
@@ -168,19 +177,17 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
             raise GroundError(schema_message(session, project))
         sent = time.monotonic()
         try:
-            ack = ground.command(op, payload)
+            ack = ground.command(op, payload, text=" ".join([what, *args]))
         except LinkTimeout as e:
             raise GroundError(str(e)) from None
         rtt = (time.monotonic() - sent) * 1000
     except port_errors() as e:
         raise GroundError(f"{port_name}: the port went away ({e})") from None
     finally:
-        try:
-            port.close()
-        except Exception:  # noqa: BLE001 - closing a port that went away
-            pass
+        ground.close()
     if ack["status"] != 0:
         sys.stderr.write(f"fsw cmd: refused: {ack['status_name']}: {ack['reason']} (command {ack['cmd_seq']})\n")
         return 1
-    print(f"fsw cmd: {what} {' '.join(args)}: OK (command {ack['cmd_seq']}, {rtt:.1f} ms round trip)".replace("  ", " "))
+    said = " ".join([what, *args])
+    print(f"fsw cmd: {said}: OK (command {ack['cmd_seq']}, {rtt:.1f} ms round trip)")
     return 0

@@ -188,7 +188,9 @@ Status     rate=1
     out[f"{name}.ss"] = _skeleton(name, out)
     out["platformio.ini"] = _platformio_ini(name, board, kit_root, _app_baud(out[f"{name}.app"]))
     out["README.md"] = _readme(name, board)
-    out[".gitignore"] = "# Generated code, builds and PlatformIO's work: all made again from the configs.\nbuild/\n"
+    out[".gitignore"] = ("# Generated code, builds and PlatformIO's work: all made again from the configs.\nbuild/\n"
+                         "# The ground station's archive (fsw ground): recordings, kept beside the project\n"
+                         "ground-archive.sqlite*\n")
     return out
 
 

@@ -10,25 +10,15 @@ the link client (fswkit.link.client.Ground) in a reader thread."""
 from __future__ import annotations
 
 import asyncio
-import threading
 import time
 from collections import deque
 
 from fswkit.autocode.protocol import OP_MODE, OP_SET, STATUS
 from fswkit.link.layout import Layout, LayoutError, encode_value
-from fswkit.link.session import Event, Session
+from fswkit.link.session import Event, reset_words
 
 STALE_S = 2.0  # no frame for this long: the link is shown stale
 HISTORY = 200  # commands kept for a browser that connects later
-RESET_WORDS = ((0x01, "power-on"), (0x02, "external reset"), (0x04, "brown-out"), (0x08, "watchdog"))
-
-
-def reset_words(cause: int | None) -> str:
-    """An AVR reset cause (MCUSR bits) in words."""
-    if cause is None:
-        return "unknown"
-    words = [w for bit, w in RESET_WORDS if cause & bit]
-    return ", ".join(words) if words else f"none reported (0x{cause:02x})"
 
 
 class CommandError(Exception):
@@ -39,7 +29,7 @@ def _message(ev: Event, layout: Layout) -> dict | None:
     """One decoded event as the browser gets it."""
     if ev.kind == "sample":
         region = layout.streams[ev.stream].region
-        return {"t": "samples", "host": ev.host_time, "names": list(region.names),
+        return {"t": "samples", "seq": ev.seq, "host": ev.host_time, "names": list(region.names),
                 "rows": [[time] + [_json(v) for v in values] for time, values in ev.samples]}
     if ev.kind in ("hello", "health", "ack"):
         info = {k: _json(v) for k, v in ev.info.items() if not isinstance(v, (list, tuple, dict))}
@@ -96,6 +86,10 @@ class Source:
         if self.loop is not None:
             self.loop.call_soon_threadsafe(self.publish, msg)
 
+    def publish_all(self, msgs: list) -> None:
+        for m in msgs:
+            self.publish(m)
+
     def link(self) -> dict:
         age = None if self.last_frame is None else time.monotonic() - self.last_frame
         return {"t": "link", "frames": self.frames, "age": age, "stale": age is None or age > STALE_S,
@@ -137,85 +131,69 @@ class Source:
 
 
 class LiveSource(Source):
-    """A port owned through the link client: a thread reads it; commands go
-    one at a time through a lock, each waiting for its acknowledgement.
-    With the application's parameter table (`params`, `tx_cap`, `baud`),
-    the firmware's parameters are listed and set through the same port
-    (fswkit.param.client)."""
+    """The page's view of a ground station (fswkit.ground.station): its
+    decoded events and notes are published to every browser, commands go
+    through its one uplink (each waiting for its acknowledgement). With the
+    application's parameter table (`params`, `tx_cap`, `baud`), the
+    firmware's parameters are listed and set through the same station
+    (fswkit.param.client), on a lease of its uplink."""
 
-    def __init__(self, layout: Layout, port, log=None, ignore_schema: bool = False, *, params=(),
-                 tx_cap: int = 0, baud: int = 115200):
-        super().__init__(layout)
-        from fswkit.link.client import Ground
-
-        self.ground = Ground(port, Session(layout, ignore_schema), log)
+    def __init__(self, station, *, params=(), tx_cap: int = 0, baud: int = 115200):
+        super().__init__(station.layout)
+        self.station = station
         self.params, self.tx_cap, self.baud = tuple(params), tx_cap, baud
-        self._lock = threading.Lock()  # one command on the wire at a time, and the port's reads
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
 
     async def start(self) -> None:
         await super().start()
-        self._thread = threading.Thread(target=self._run, name="fsw-web-reader", daemon=True)
-        self._thread.start()
+        self.note = "" if self.station.up else self.station.note
+        self.station.listen(self._events)
+        self.station.notes(self._note)
+        self.station.commands(self._commanded)
+
+    def _commanded(self, entry: dict) -> None:
+        """Every client's command (a browser's, `fsw cmd`'s, a script's) in the shared history."""
+        def add():
+            self.history.append(entry)
+            self.publish(entry)
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(add)
 
     async def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            await asyncio.get_running_loop().run_in_executor(None, self._thread.join, 2.0)
+        self.station.unlisten(self._events)
+
+    def _note(self, text: str, up: bool) -> None:
+        self.note = text
+        self.publish_threadsafe({"t": "note", "text": text, "up": up})
+        self.publish_threadsafe(self.link())
 
     def _events(self, evs) -> None:
-        for ev in evs:
-            self.frames += 1
-            self.last_frame = time.monotonic()
-            msg = _message(ev, self.layout)
-            if msg is not None:
-                self.publish_threadsafe(msg)
+        if not evs:
+            return
+        self.frames += len(evs)
+        self.last_frame = time.monotonic()
+        msgs = [m for m in (_message(ev, self.layout) for ev in evs) if m is not None]
+        if msgs and self.loop is not None:  # one wake-up of the loop for the chunk's frames
+            self.loop.call_soon_threadsafe(self.publish_all, msgs)
 
-    def _run(self) -> None:
+    def _command(self, who: str, op: int, args: bytes, text: str) -> dict:
         from fswkit.link.client import LinkTimeout
 
-        while not self._stop.is_set():
-            try:
-                with self._lock:
-                    if self.ground.session.hello is None:  # frames decode once a hello confirmed the schema
-                        try:
-                            self.ground.handshake(timeout=1.0, on_event=lambda ev: self._events([ev]))
-                            self.note = ""
-                        except LinkTimeout:
-                            self.note = "no hello from the target"
-                            self.publish_threadsafe(self.link())
-                    evs = self.ground.read(wait=0.02)
-            except OSError as e:  # the port went away
-                self.note = f"the port went away: {e}"
-                self.publish_threadsafe(self.link())
-                return
-            self._events(evs)
-            if not evs:
-                time.sleep(0.005)
+        try:
+            return self.station.command(who, op, args, tries=3, timeout=0.5, text=text)
+        except (LinkTimeout, OSError) as e:
+            return {"status": None, "words": str(e)}
 
-    def _command(self, op: int, args: bytes) -> dict:
-        from fswkit.link.client import LinkTimeout
+    def _param_client(self, transport):
+        from fswkit.param.client import ParamClient
 
-        with self._lock:
-            try:
-                return self.ground.command(op, args, tries=3, timeout=0.5, on_event=lambda ev: self._events([ev]))
-            except LinkTimeout as e:
-                return {"status": None, "words": str(e)}
-
-    def _param_client(self):
-        from fswkit.param.client import ParamClient, PortTransport
-
-        c = ParamClient(PortTransport(self.ground), self.params, self.tx_cap, baud=self.baud, deadline=10.0)
-        c.on_event = lambda ev: self._events([ev])
-        return c
+        return ParamClient(transport, self.params, self.tx_cap, baud=self.baud, deadline=10.0)
 
     def _params_now(self) -> dict:
         from fswkit.param.client import ParamError
 
-        with self._lock:
+        with _StationTransport(self.station) as transport:
             try:
-                c = self._param_client()
+                c = self._param_client(transport)
                 info = c.info()
                 values = c.get_all()
             except ParamError as e:
@@ -234,9 +212,9 @@ class LiveSource(Source):
     def _params_set(self, values: dict) -> str | None:
         from fswkit.param.client import ParamError
 
-        with self._lock:
+        with _StationTransport(self.station) as transport:
             try:
-                self._param_client().set(values)
+                self._param_client(transport).set(values)
             except ParamError as e:
                 return str(e)
         return None
@@ -267,13 +245,51 @@ class LiveSource(Source):
 
     async def command(self, who: str, kind: str, target: str, value: str) -> dict:
         op, args, text = self.encode(kind, target, value)
-        ack = await asyncio.get_running_loop().run_in_executor(None, self._command, op, args)
+        ack = await asyncio.get_running_loop().run_in_executor(None, self._command, f"web: {who}", op, args, text)
         status = ack.get("status")
-        entry = {"t": "command", "who": who, "text": text, "status": status,
-                 "ok": status == 0,
-                 "words": ack.get("words") or STATUS.get(status, ("?", "unknown status"))[1],
-                 "host_time": time.time()}
-        self.history.append(entry)
-        self.publish(entry)
-        return entry
+        # the history has it already, through the station's command listeners
+        return {"t": "command", "who": f"web: {who}", "text": text, "status": status, "ok": status == 0,
+                "words": ack.get("words") or STATUS.get(status, ("?", "unknown status"))[1],
+                "host_time": time.time()}
 
+
+
+class _StationTransport:
+    """The parameter client's transport on a station: the uplink leased
+    (nobody else's command goes between its numbered commands), the
+    decoded events of the station's reader handed over through a queue."""
+
+    def __init__(self, station):
+        import queue
+
+        self.station = station
+        self.session = station.session
+        self._q: queue.Queue = queue.Queue()
+        self._lease = station.lease()
+
+    def __enter__(self):
+        self.station.listen(self._q.put)
+        self._lease.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        self._lease.__exit__(*exc)
+        self.station.unlisten(self._q.put)
+
+    def now(self) -> float:
+        return time.monotonic()
+
+    def send(self, data: bytes) -> None:
+        self.station.write(data)
+
+    def events(self, wait: float):
+        import queue
+
+        out = []
+        try:
+            out += self._q.get(timeout=wait) if wait else self._q.get_nowait()
+            while True:
+                out += self._q.get_nowait()
+        except queue.Empty:
+            pass
+        return out

@@ -136,8 +136,14 @@ def _finite(v):
     return v
 
 
+_ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), allow_nan=False).encode
+
+
 def _json(v) -> str:
-    return json.dumps(_finite(v), sort_keys=True, separators=(",", ":"), allow_nan=False)
+    try:  # the common case, at the link's rate: numbers, all finite
+        return _ENCODE(v)
+    except (ValueError, TypeError):  # a NaN or an infinity, bytes
+        return _ENCODE(_finite(v))
 
 
 def _check_version(con: sqlite3.Connection, path) -> None:

@@ -188,6 +188,21 @@ def test_a_second_opener_is_told_who_holds_the_port(station, board):
         check_port(board.link, 115200)
 
 
+def test_without_a_station_the_tools_hold_the_port_and_say_so(board):
+    mon = subprocess.Popen([FSW, "monitor", str(TANK), "--port", board.link, "--headless", "--duration", "4"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 10
+        while not mon.stdout.readline().startswith("seq=") and time.monotonic() < deadline:
+            pass
+        r = fsw("cmd", "-p", str(TANK), "--port", board.link, "ping")
+        assert r.returncode == 1, r.stderr
+        assert f"busy: held by fsw monitor, pid {mon.pid}" in r.stderr and "fsw ground" in r.stderr, r.stderr
+    finally:
+        out, err = mon.communicate(timeout=30)
+    assert mon.returncode == 0 and "0 lost in 0 gaps" in err, err  # the refused command cost the monitor nothing
+
+
 def test_a_client_attaching_late_counts_nothing_lost(station, board):
     from fswkit.ground.client import StationLink
     from fswkit.link.session import Session
@@ -277,6 +292,17 @@ def test_param_and_cmd_go_through_the_station_while_a_monitor_watches(tmp_path):
             assert mon.returncode == 0, err
             assert re.search(r"0 lost in 0 gaps", err), err
             assert st.command("test", 0x01)["status"] == 0  # the station numbers afresh after the lease
+            # an acknowledgement's data (PARAM_INFO's: the store's state) reaches a client as bytes
+            from fswkit.autocode.protocol import OP_PARAM_INFO
+            from fswkit.ground.client import StationLink
+            from fswkit.link.session import Session
+
+            link = StationLink(st.socket_path, Session(st.layout), "a script")
+            try:
+                ack = link.command(OP_PARAM_INFO, text="param info")
+            finally:
+                link.close()
+            assert ack["status"] == 0 and isinstance(ack["data"], bytes) and len(ack["data"]) > 0
         finally:
             st.stop()
     finally:

@@ -93,6 +93,8 @@ def busy_message(name: str, rec: dict | None) -> str:
     what = f"held by {rec.get('command', 'a program')}, pid {rec['pid']}"
     if rec.get("socket"):
         what += " (a ground station: `fsw monitor`, `fsw cmd`, `fsw param`, `fsw dump` go through it)"
+    else:
+        what += " (`fsw ground` shares a port between the tools)"
     return f"{name} is busy: {what}"
 
 

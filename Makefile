@@ -36,11 +36,12 @@ demo: setup
 
 ## docs-img: the demo flight's plot shown in README.md (a test checks that
 ## docs/img/rocket-flight.png is this tree's seed-1 flight) and the web
-## station's page as the browser test sees it (docs/ground.md)
+## station's page and its archive tab as the browser tests see them (docs/ground.md)
 docs-img: setup
 	$(FSW) sim examples/rocket --plant rocket --seed 1 --out $(BUILD)/docs-img
 	mkdir -p docs/img && cp $(BUILD)/docs-img/flight.png docs/img/rocket-flight.png
-	FSW_SCREENSHOTS=docs/img $(PY) -m pytest -q -p no:cacheprovider tests/web/test_web_station.py
+	FSW_SCREENSHOTS=docs/img $(PY) -m pytest -q -p no:cacheprovider tests/web/test_web_station.py \
+	  tests/web/test_web_archive.py
 
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P

@@ -255,6 +255,11 @@ class Archive:
             except sqlite3.Error as e:
                 raise _sql_error(self.path, e, "write") from None
 
+    @property
+    def session(self) -> int | None:
+        """The session being written (None: none begun, or the archive closed)."""
+        return self._session if self._con is not None else None
+
     def begin(self, *, layout, project: str, port: str, baud: int, started: float) -> int:
         """A new session (the one open before, if any, ended); its id."""
         from fswkit import __version__

@@ -1,7 +1,8 @@
 """The web station's ASGI application (Starlette): the page and its assets,
 the layout as JSON, a WebSocket per browser that carries every message of
-the source (and the link's figures twice a second), and the command
-endpoint. Served by uvicorn (`serve`)."""
+the source (and the link's figures twice a second), the command
+endpoint, and the archive browser's read-only queries of the station's
+archive (fswkit.web.archive). Served by uvicorn (`serve`)."""
 
 from __future__ import annotations
 
@@ -9,8 +10,12 @@ import asyncio
 import contextlib
 import json
 import os
+import shutil
+import tempfile
 
 from starlette.applications import Starlette
+from starlette.background import BackgroundTask
+from starlette.concurrency import run_in_threadpool
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
@@ -19,6 +24,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from fswkit.autocode.types import TYPES
 
+from . import archive as browse
 from .source import CommandError, Source
 
 STATIC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "static")
@@ -56,8 +62,80 @@ def layout_json(source: Source) -> dict:
             "state_elements": list(lay.states), "has_uplink": lay.has_uplink}
 
 
+def archive_of(source: Source) -> tuple[str | None, object]:
+    """(the path of the station's archive or None, the archive)."""
+    archive = getattr(getattr(source, "station", None), "archive", None)
+    return getattr(archive, "path", None), archive
+
+
+NO_ARCHIVE = "this station archives nothing (it was started with --no-archive): there are no sessions to browse"
+
+
 def create_app(source: Source, title: str = "fsw ground") -> Starlette:
     assets = uplot_dir()
+    archive_path, archive = archive_of(source)
+    ignore_schema = bool(getattr(getattr(source, "station", None), "ignore_schema", False))
+
+    def live_session() -> int | None:
+        return None if archive is None else archive.session  # the session the station writes now
+
+    def refused(e: browse.BrowseError) -> Response:
+        return JSONResponse({"ok": False, "words": e.words}, status_code=e.status)
+
+    async def archive_sessions(request: Request) -> Response:
+        if archive_path is None:
+            return JSONResponse({"ok": True, "archive": None, "words": NO_ARCHIVE, "sessions": []})
+        try:
+            rows = await run_in_threadpool(browse.list_sessions, archive_path, live_session())
+        except browse.BrowseError as e:
+            return refused(e)
+        return JSONResponse({"ok": True, "archive": archive_path, "live": live_session(), "sessions": rows})
+
+    def session_of(request: Request) -> browse.Session:
+        if archive_path is None:
+            raise browse.BrowseError(404, NO_ARCHIVE)
+        return browse.Session(archive_path, request.path_params["id"], live_session())
+
+    async def archive_session(request: Request) -> Response:
+        def work():
+            s = session_of(request)
+            q = request.query_params
+            names = s.check_elements(q.get("elements"))
+            lo, hi = browse.range_args(s, q)
+            points = browse.points_arg(q)
+            return {"ok": True, "session": s.info(), "from": lo, "to": hi, "points": points,
+                    "series": s.series(names, lo, hi, points)}
+        try:
+            return JSONResponse(await run_in_threadpool(work))
+        except browse.BrowseError as e:
+            return refused(e)
+
+    async def archive_events(request: Request) -> Response:
+        try:
+            return JSONResponse({"ok": True} | await run_in_threadpool(lambda: session_of(request).events()))
+        except browse.BrowseError as e:
+            return refused(e)
+
+    async def archive_export(request: Request) -> Response:
+        fmt = request.path_params["fmt"]
+        if fmt not in ("csv", "parquet"):
+            return JSONResponse({"ok": False, "words": f"export.{fmt}: the session exports as export.csv or "
+                                 "export.parquet"}, status_code=404)
+        folder = tempfile.mkdtemp(prefix="fsw-export-")  # removed once the file is sent, or at once
+        sent = False
+        try:
+            out, name = await run_in_threadpool(lambda: browse.export(
+                archive_path, session_of(request), fmt, request.query_params, ignore_schema, folder))
+            media = "text/csv; charset=utf-8" if fmt == "csv" else "application/vnd.apache.parquet"
+            response = FileResponse(out, media_type=media, filename=name,
+                                    background=BackgroundTask(shutil.rmtree, folder, ignore_errors=True))
+            sent = True
+            return response
+        except browse.BrowseError as e:
+            return refused(e)
+        finally:
+            if not sent:
+                shutil.rmtree(folder, ignore_errors=True)
 
     async def index(request: Request) -> Response:
         return FileResponse(os.path.join(STATIC, "index.html"))
@@ -134,6 +212,10 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         Route("/api/layout", layout),
         Route("/api/command", command, methods=["POST"]),
         Route("/api/params", params, methods=["GET", "POST"]),
+        Route("/api/archive/sessions", archive_sessions),
+        Route("/api/archive/{id}", archive_session),
+        Route("/api/archive/{id}/events", archive_events),
+        Route("/api/archive/{id}/export.{fmt}", archive_export),
         WebSocketRoute("/ws", feed),
         Mount("/static", StaticFiles(directory=STATIC)),
         Mount("/uplot", StaticFiles(directory=assets)),
@@ -146,7 +228,8 @@ def serve(app: Starlette, host: str = "127.0.0.1", port: int = 8000, on_ready=No
     """Runs uvicorn in this thread until Ctrl-C; `on_ready(url)` once it listens."""
     import uvicorn
 
-    config = uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="on", ws="websockets-sansio")
+    config = uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="on", ws="websockets-sansio",
+                            ws_per_message_deflate=False)  # on localhost, compressing costs more than it saves
     server = uvicorn.Server(config)
 
     async def main():

@@ -245,10 +245,10 @@ class LiveSource(Source):
 
     async def command(self, who: str, kind: str, target: str, value: str) -> dict:
         op, args, text = self.encode(kind, target, value)
-        ack = await asyncio.get_running_loop().run_in_executor(None, self._command, f"web: {who}", op, args, text)
+        ack = await asyncio.get_running_loop().run_in_executor(None, self._command, who, op, args, text)
         status = ack.get("status")
         # the history has it already, through the station's command listeners
-        return {"t": "command", "who": f"web: {who}", "text": text, "status": status, "ok": status == 0,
+        return {"t": "command", "who": who, "text": text, "status": status, "ok": status == 0,
                 "words": ack.get("words") or STATUS.get(status, ("?", "unknown status"))[1],
                 "host_time": time.time()}
 

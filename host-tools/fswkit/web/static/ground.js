@@ -20,6 +20,7 @@ const states = {};           // S element -> {current, since, segments: [[t0, t1
 // frame-to-page latency: seconds from the frame's bytes reaching the station
 // to its message reaching this page (the same host's clock), last 10,000
 window.fswLatency = [];
+window.fswSeqs = [];
 let lastTime = null;
 
 function $(id) { return document.getElementById(id); }
@@ -127,6 +128,8 @@ function draw() {
 }
 
 function addSamples(msg) {
+  window.fswSeqs.push(msg.seq);  // what the page received, for the tests and the bench
+  if (window.fswSeqs.length > 100000) window.fswSeqs.shift();
   if (msg.host) {
     window.fswLatency.push(Date.now() / 1000 - msg.host);
     if (window.fswLatency.length > 10000) window.fswLatency.shift();
@@ -204,16 +207,35 @@ function showLink(msg) {
   const pill = $("link-status");
   if (msg.age === null) {
     pill.className = "pill waiting";
-    pill.textContent = msg.note || "waiting for the target";
+    pill.textContent = "waiting for the target";
   } else if (msg.stale) {
     pill.className = "pill stale";
-    pill.textContent = `stale: last frame ${msg.age.toFixed(1)} s ago${msg.note ? " (" + msg.note + ")" : ""}`;
+    pill.textContent = `stale: last frame ${msg.age.toFixed(1)} s ago`;
   } else {
     pill.className = "pill live";
     pill.textContent = "live";
   }
   $("link-figures").textContent = `${msg.frames} frames`;
+  if (msg.note && msg.note !== $("link-note").textContent) showNote(msg.note, !msg.stale);
+  const ms = medianLatency();
+  $("link-latency").textContent = ms === null ? "" : `latency ${ms < 10 ? ms.toFixed(1) : ms.toFixed(0)} ms`;
   if (lastTime !== null) for (const s of layout.state_elements) drawTimeline(s);
+}
+
+// the station's latest word on its link ("reconnected: …", "the target restarted: reset cause power-on")
+function showNote(text, up) {
+  const box = $("link-note");
+  box.textContent = text;
+  box.className = up ? "note" : "note down";
+  box.title = `the station's latest note on its link (this page had it at ${new Date().toLocaleTimeString()})`;
+}
+
+// the rolling median of the frame-to-page latency (ms) over the last 200 frames, null before any
+function medianLatency() {
+  const last = window.fswLatency.slice(-200).sort((a, b) => a - b);
+  if (!last.length) return null;
+  const m = last.length >> 1;
+  return 1000 * (last.length % 2 ? last[m] : (last[m - 1] + last[m]) / 2);
 }
 
 function showHealth(info) {
@@ -344,6 +366,7 @@ function handle(msg) {
     case "health": showHealth(msg.info); break;
     case "hello": break;
     case "link": showLink(msg); break;
+    case "note": showNote(msg.text, msg.up); break;
     case "command": addHistory(msg); break;
     case "history": msg.commands.forEach(addHistory); break;
   }

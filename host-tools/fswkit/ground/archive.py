@@ -136,7 +136,7 @@ def _finite(v):
     return v
 
 
-_ENCODE = json.JSONEncoder(sort_keys=True, separators=(",", ":"), allow_nan=False).encode
+_ENCODE = json.JSONEncoder(separators=(",", ":"), allow_nan=False).encode  # keys in the layout's order
 
 
 def _json(v) -> str:

@@ -50,7 +50,7 @@ REOPEN_S = 0.25  # how often a port that went away is tried again
 CLIENT_BACKLOG = 200_000  # messages queued for a client that does not read before it is dropped
 COMMAND_WHO = "fsw ground"
 FRAME_WAIT_S = 0.02  # how long a chunk that ends mid-frame waits for the frame's end
-FRAME_POLL_S = 0.003  # ... looking every 3 ms (about 35 bytes at 115200 baud)
+FRAME_POLL_S = 0.005  # ... looking every 5 ms (about 58 bytes at 115200 baud)
 
 
 def socket_path(port_name: str) -> str:

@@ -161,3 +161,35 @@ def test_erase_needs_every_flight_dumped_first(exe, tmp_path):
         r = dump(t.port, tmp_path / "all", "--all", "--erase", "--yes")
         assert r.code == 0 and "erasing" in r.out, r.err
         assert (tmp_path / "all" / "flight-1.log").exists() and (tmp_path / "all" / "flight-2.log").exists()
+
+
+def test_a_flight_is_dumped_through_the_ground_station(exe, tmp_path, monkeypatch):
+    """With `fsw ground` holding the port, `fsw dump` goes through it (its
+    LOG_READ commands one at a time among the station's), the flight comes
+    out whole, and the station archives the dump's commands as `fsw dump`'s."""
+    import sqlite3
+
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.ground.archive import Archive
+    from fswkit.ground.station import Station
+    from fswkit.link.layout import from_app
+    from fswkit.target.build import load
+
+    monkeypatch.setenv("FSW_RUNTIME_DIR", str(tmp_path / "run"))
+    out = tmp_path / "dump"
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "eeprom.bin"), "d2=1") as t:
+        st = Station(from_app(load(str(RIG), Diagnostics())), str(RIG), t.port, 115200,
+                     archive=Archive(str(tmp_path / "a.sqlite")))
+        st.start()
+        try:
+            time.sleep(1.6)
+            r = dump(t.port, out)
+            assert r.code == 0, r.err
+            assert "1 flight(s)" in r.out
+        finally:
+            st.stop()
+    check_flight(rows(out / "flight-1.log"))
+    con = sqlite3.connect(tmp_path / "a.sqlite")
+    reads = con.execute("SELECT count(*) FROM commands WHERE who LIKE 'fsw dump (pid%' AND status = 0").fetchone()[0]
+    con.close()
+    assert reads > 1

@@ -61,6 +61,19 @@ def _clip_quoted(m: re.Match) -> str:
     return f"`{text[:QUOTED // 2]}...{text[-QUOTED // 2:]}`"
 
 
+def ranges(numbers, sep: str = ", ") -> str:
+    """Whole numbers as runs, sorted: 1 2 3 5 -> "1-3, 5" (`sep` between runs)."""
+    ns = sorted(numbers)
+    out, start = [], None
+    for i, n in enumerate(ns):
+        if start is None:
+            start = n
+        if i + 1 == len(ns) or ns[i + 1] != n + 1:
+            out.append(str(start) if start == n else f"{start}-{n}")
+            start = None
+    return sep.join(out)
+
+
 def visual_col(text: str, index: int) -> int:
     """1-based column of character `index` of `text` once tabs are expanded."""
     if "\t" not in text:

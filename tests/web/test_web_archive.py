@@ -16,7 +16,6 @@ import json
 import math
 import os
 import re
-import socket
 import threading
 import time
 import urllib.error
@@ -26,11 +25,9 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import run_fsw
+from support.browser import chromium, free_port, needs_chromium
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
-CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
-needs_chromium = pytest.mark.skipif(not (os.path.exists(CHROMIUM) and os.path.exists(DRIVER)),
-                                    reason="Debian's chromium and chromium-driver are needed (make setup)")
 RAW = 770  # 815.86 psi
 
 
@@ -82,11 +79,6 @@ def test_gaps_stay_where_a_span_has_no_value_and_series_sampled_together_thin_al
 
 
 # ---- the routes, on an archive written here ----------------------------------------------------
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @contextlib.contextmanager
@@ -242,16 +234,7 @@ def exe(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def browser():
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-              "--disable-background-networking", "--disable-component-update", "--disable-sync",
-              "--disable-dev-shm-usage", "--window-size=1400,1000"):
-        opts.add_argument(a)
-    drv = webdriver.Chrome(service=Service(DRIVER), options=opts)
+    drv = chromium()
     yield drv
     drv.quit()
 

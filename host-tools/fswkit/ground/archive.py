@@ -64,6 +64,7 @@ import threading
 import time
 from pathlib import Path
 
+from fswkit.autocode.diagnostics import ranges
 from fswkit.outputs import ARCHIVE_ID as APPLICATION_ID  # "FSWA"; outputs never overwrite an archive
 from fswkit.outputs import recording
 
@@ -390,18 +391,6 @@ def _connect_ro(path) -> sqlite3.Connection:
     return con
 
 
-def _ranges(ids: list[int]) -> str:
-    """1, 2, 3, 5 -> "1-3, 5"."""
-    out, start = [], None
-    for i, n in enumerate(ids):
-        if start is None:
-            start = n
-        if i + 1 == len(ids) or ids[i + 1] != n + 1:
-            out.append(str(start) if start == n else f"{start}-{n}")
-            start = None
-    return ", ".join(out)
-
-
 class ArchiveReader:
     """One session of an archive, read as fswkit.link.log.LogReader reads a
     log: `layout`, `header`, `path`, `records()`. `session` None: the
@@ -422,7 +411,7 @@ class ArchiveReader:
                 row = self._con.execute("SELECT * FROM sessions WHERE id = ?", (session,)).fetchone()
                 if row is None:
                     ids = [r[0] for r in self._con.execute("SELECT id FROM sessions ORDER BY id")]
-                    there = f"its sessions are {_ranges(ids)}" if ids else "it has no sessions yet"
+                    there = f"its sessions are {ranges(ids)}" if ids else "it has no sessions yet"
                     raise ArchiveError(f"{path}: no session {session} in the archive: {there} "
                                        "(`fsw archive list` shows them)")
             cols = [d[0] for d in self._con.execute("SELECT * FROM sessions LIMIT 0").description]

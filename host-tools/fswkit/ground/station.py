@@ -39,7 +39,7 @@ import time
 from contextlib import contextmanager
 
 from fswkit.link import wire
-from fswkit.link.client import LinkTimeout
+from fswkit.link.client import LinkTimeout, Numbers, exchange
 from fswkit.link.layout import Layout
 from fswkit.link.log import RX, TX
 from fswkit.link.port import PortError, open_port, port_errors, port_key, runtime_dir
@@ -93,7 +93,7 @@ class Station:
         self._uplink = threading.Lock()  # one command, or one lease, on the wire at a time
         self._write_lock = threading.Lock()
         self._waiting: dict[int, dict] = {}  # command number -> {"event", "ack"}
-        self._next_seq: int | None = None
+        self.numbers = Numbers(self.session)
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._server: socket.socket | None = None
@@ -295,17 +295,6 @@ class Station:
 
     # ---- commands ------------------------------------------------------------------------
 
-    def _seq(self) -> int:
-        s = self.session
-        if self._next_seq is None:
-            known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
-            self._next_seq = (max(known) + 1) & 0xFFFF if known else 1
-        if self._next_seq == 0:
-            self._next_seq = 1
-        seq = self._next_seq
-        self._next_seq = (seq + 1) & 0xFFFF
-        return seq
-
     def command(self, who: str, op: int, args: bytes = b"", tries: int = 3, timeout: float = 0.5,
                 text: str = "") -> dict:
         """One command, acknowledged: the ack's fields (status 0: applied).
@@ -332,25 +321,17 @@ class Station:
                 fn(entry)
 
     def _exchange(self, op: int, args: bytes, tries: int, timeout: float) -> dict:
-        replays = attempt = 0
-        while attempt < tries:
-            seq = self._seq()
+        def send_and_wait(seq: int, frame: bytes) -> dict | None:
             slot = {"event": threading.Event(), "ack": None}
-            self._waiting[seq] = slot
+            self._waiting[seq] = slot  # before it goes: the reader thread fills it
             try:
-                self.write(wire.uplink(op, seq, args))
+                self.write(frame)
                 slot["event"].wait(timeout)
             finally:
                 del self._waiting[seq]
-            ack = slot["ack"]
-            if ack is not None:
-                if ack["status"] == 1 and replays < 2:  # REPLAY: its last number, and again
-                    self._next_seq = (ack["last_seq"] + 1) & 0xFFFF
-                    replays += 1
-                    continue
-                return ack
-            attempt += 1
-        raise LinkTimeout(f"no acknowledgement of `{wire.OP_NAMES.get(op, op)}` after {tries} tries")
+            return slot["ack"]
+
+        return exchange(self.numbers, op, args, tries, send_and_wait)
 
     @contextmanager
     def lease(self):
@@ -361,7 +342,7 @@ class Station:
             try:
                 yield self
             finally:
-                self._next_seq = None
+                self.numbers.forget()
 
     # ---- local clients -------------------------------------------------------------------
 

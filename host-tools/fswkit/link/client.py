@@ -15,13 +15,61 @@ class LinkTimeout(Exception):
     pass
 
 
+class Numbers:
+    """The uplink's command numbers: the next after the target's last
+    accepted one (from its hello or health), then counting up, never 0;
+    `forget()` starts again from the target's; `resync(last)` after a
+    REPLAY answer."""
+
+    def __init__(self, session: Session):
+        self.session = session
+        self._next: int | None = None
+
+    def take(self) -> int:
+        s = self.session
+        if self._next is None:
+            known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
+            self._next = (max(known) + 1) & 0xFFFF if known else 1
+        if self._next == 0:
+            self._next = 1
+        seq = self._next
+        self._next = (seq + 1) & 0xFFFF
+        return seq
+
+    def forget(self) -> None:
+        self._next = None
+
+    def resync(self, last: int) -> None:
+        self._next = (last + 1) & 0xFFFF
+
+
+def exchange(numbers: Numbers, op: int, args: bytes, tries: int, send_and_wait) -> dict:
+    """One command until acknowledged: `send_and_wait(seq, frame)` sends the
+    numbered frame and returns its acknowledgement's fields, or None when
+    none came in time. A REPLAY answer carries the target's last accepted
+    number: the command goes again after it (twice at most). LinkTimeout
+    after `tries` unanswered sends."""
+    replays = attempt = 0
+    while attempt < tries:
+        seq = numbers.take()
+        ack = send_and_wait(seq, wire.uplink(op, seq, args))
+        if ack is not None:
+            if ack["status"] == 1 and replays < 2:  # REPLAY: resynchronise on its last number
+                numbers.resync(ack["last_seq"])
+                replays += 1
+                continue
+            return ack
+        attempt += 1
+    raise LinkTimeout(f"no acknowledgement of `{wire.OP_NAMES.get(op, op)}` after {tries} tries")
+
+
 class Ground:
     def __init__(self, port, session: Session, log: LogWriter | None = None):
         self.port = port
         self.session = session
         self.log = log
         self.events: list[Event] = []  # decoded, not yet taken by the caller
-        self._next_seq: int | None = None
+        self.numbers = Numbers(session)
 
     def read(self, wait: float = 0.05) -> list[Event]:
         """Bytes waiting on the port (at most `wait` seconds for the first)."""
@@ -46,26 +94,13 @@ class Ground:
         self.port.write(data)
         self.port.flush()
 
-    def _seq(self) -> int:
-        s = self.session
-        known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
-        if self._next_seq is None:
-            self._next_seq = (max(known) + 1) & 0xFFFF if known else 1
-        if self._next_seq == 0:
-            self._next_seq = 1
-        return self._next_seq
-
     def command(self, op: int, args: bytes = b"", tries: int = 3, timeout: float = 1.0,
                 on_event=None) -> dict:
-        """Sends a command until it is acknowledged; returns the ack's fields
-        (status 0: applied). A REPLAY answer carries the target's last
-        accepted number: the command is sent again after it."""
-        replays = 0
-        attempt = 0
-        while attempt < tries:
-            seq = self._seq()
-            self._next_seq = (seq + 1) & 0xFFFF
-            self.send(wire.uplink(op, seq, args))
+        """Sends a command until it is acknowledged (fswkit.link.client.exchange);
+        returns the ack's fields (status 0: applied). Every event read
+        meanwhile goes to `on_event`, or stays for the next `read()`."""
+        def send_and_wait(seq: int, frame: bytes) -> dict | None:
+            self.send(frame)
             deadline = time.monotonic() + timeout
             ack = None
             while ack is None and time.monotonic() < deadline:
@@ -76,14 +111,9 @@ class Ground:
                         self.events.append(ev)
                     if ev.kind == "ack" and ev.info["cmd_seq"] == seq and ack is None:
                         ack = ev.info
-            if ack is not None:
-                if ack["status"] == 1 and replays < 2:  # REPLAY: resynchronise on its last number
-                    self._next_seq = (ack["last_seq"] + 1) & 0xFFFF
-                    replays += 1
-                    continue
-                return ack
-            attempt += 1
-        raise LinkTimeout(f"no acknowledgement of `{wire.OP_NAMES.get(op, op)}` after {tries} tries")
+            return ack
+
+        return exchange(self.numbers, op, args, tries, send_and_wait)
 
     def handshake(self, timeout: float = 3.0, on_event=None) -> dict:
         """Asks for a hello (when the application has an uplink) and waits for

@@ -12,7 +12,7 @@ import shutil
 import tempfile
 
 from fswkit.autocode.board import Board
-from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.autocode.diagnostics import Diagnostics, ranges
 
 from fswkit.autocode.kit import ROOT as KIT_ROOT
 KEYWORDS = {"if", "else", "and", "or", "not", "true", "false"}
@@ -32,19 +32,6 @@ def check_name(name: str) -> None:
                             "starting with a letter (it names the files and the state machine)")
     if name in KEYWORDS:
         raise ScaffoldError(f"`{name}` is a keyword of the config languages: choose another name")
-
-
-def _ranges(pins) -> str:
-    """`2-13 18 19` for a sorted pin list."""
-    pins = sorted(pins)
-    out, start = [], None
-    for i, p in enumerate(pins):
-        if start is None:
-            start = p
-        if i + 1 == len(pins) or pins[i + 1] != p + 1:
-            out.append(str(start) if start == p else f"{start}-{p}")
-            start = None
-    return " ".join(out)
 
 
 def _pins(board: Board) -> tuple[str, int]:
@@ -126,22 +113,22 @@ F32 P_Close = 700 @read_only    # psi: close it again below this
 #
 # {title}
 #   analog inputs: {analog_list}
-#   PWM pins (analog outputs): {_ranges(board.pwm_pins) or "none"}
+#   PWM pins (analog outputs): {ranges(board.pwm_pins, " ") or "none"}
 #
 # A 0.5-4.5 V transducer reading 0-1000 psi: psi = volts * 250 - 125.
 # dir  pin  element    calibration
 i      {analog:<4} pressure   scale=250 offset=-125
 """
 
-    only = f"\n#   analog inputs only (no digital I/O): {_ranges(analog_only)}" if analog_only else ""
+    only = f"\n#   analog inputs only (no digital I/O): {ranges(analog_only, ' ')}" if analog_only else ""
     names = sorted(board.analog_pins, key=lambda k: board.analog_pins[k])
-    as_digital = f"{names[0]}-{names[-1]} are {_ranges(board.analog_pins.values())}"
+    as_digital = f"{names[0]}-{names[-1]} are {ranges(board.analog_pins.values(), ' ')}"
     out[f"{name}.dio"] = f"""\
 # Digital I/O of {name}: one channel per line (docs/application.md of fswkit).
 #   i  reads the pin into a bool element; o drives the pin from one
 #
 # {title}
-#   digital pins: {_ranges(digital)} ({as_digital}){only}
+#   digital pins: {ranges(digital, " ")} ({as_digital}){only}
 #   reserved: {reserved or "none"}
 #
 # Pin {led} drives the on-board LED, so the valve's state shows without wiring.

@@ -25,6 +25,7 @@ from fswkit.autocode.protocol import crc16
 from fswkit.autocode.protocol import (OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO, OP_PARAM_SAVE,
                                       OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES, PARAM_WRITING)
 from fswkit.link import wire
+from fswkit.link.client import Numbers
 from fswkit.link.session import Session
 
 RX_CAP = 24  # the target's uplink frame buffer (FSW_LINK_RX_CAP): encoded bytes, delimiter excluded
@@ -142,17 +143,8 @@ class ParamClient:
         self.deadline = deadline
         self.rtt: float | None = None  # smoothed round trip of acknowledged commands
         self.stats = Stats()
-        s = transport.session
-        known = [x["last_seq"] for x in (s.hello, s.health) if x is not None]
-        self._seq = (max(known) + 1) & 0xFFFF if known else 1
+        self.numbers = Numbers(transport.session)
         self.on_event = None  # every decoded event is passed here (a monitor may show them)
-
-    def _next_seq(self) -> int:
-        if self._seq == 0:
-            self._seq = 1
-        seq = self._seq
-        self._seq = (seq + 1) & 0xFFFF
-        return seq
 
     def run(self, cmds: list[tuple[int, bytes]], busy_retry: bool = True) -> list[dict]:
         """Each command sent (several in flight), until each has its
@@ -193,7 +185,7 @@ class ParamClient:
                 if inflight and busy_bytes + size > RX_WINDOW:
                     break
                 queue.popleft()
-                seq = self._next_seq()
+                seq = self.numbers.take()
                 t.send(wire.uplink(op, seq, args))
                 self.stats.sent += 1
                 inflight[seq] = (i, now, size)
@@ -215,7 +207,7 @@ class ParamClient:
                     self.rtt = rtt if self.rtt is None else 0.8 * self.rtt + 0.2 * rtt
                 st = ev.info["status"]
                 if st == REPLAY:
-                    self._seq = (ev.info["last_seq"] + 1) & 0xFFFF
+                    self.numbers.resync(ev.info["last_seq"])
                     self._drop_copies(inflight, copies, i)
                     queue.appendleft(i)
                 elif st == BUSY and busy_retry:

@@ -198,7 +198,7 @@ class Session:
     is not one of them)."""
 
     def __init__(self, path: str, session: str | int, live: int | None = None):
-        from fswkit.ground.archive import _ranges
+        from fswkit.autocode.diagnostics import ranges
         from fswkit.link.layout import LayoutError, from_dict
 
         self.path = path
@@ -209,7 +209,7 @@ class Session:
                               (sid,)).fetchone()
             if row is None:
                 ids = [r[0] for r in con.execute("SELECT id FROM sessions ORDER BY id")]
-                there = f"its sessions are {_ranges(ids)}" if ids else "it has no sessions yet"
+                there = f"its sessions are {ranges(ids)}" if ids else "it has no sessions yet"
                 raise BrowseError(404, f"no session {sid} in the archive {path}: {there}")
             last, = con.execute("SELECT max(host_time) FROM frames WHERE session = ?", (sid,)).fetchone()
             return row, last

@@ -7,7 +7,9 @@ into the model's `Application`.
 The sections are checked in the order each needs the others: [application]
 (the board, the rate), [configs] (the files it names, read and checked),
 [time], [tasks], [telemetry], [uplink] (with the reset cause and the one
-writer of each element), [budget], [log] (logcheck.py)."""
+writer of each element), [budget], [log] (logcheck.py), [pyro]
+(pyrocheck.py: the channels, and the proof that no machine fires one
+unarmed)."""
 
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import check_table
 from .lexer import ID, NUM, Tok
 from .logcheck import check_log
+from .pyrocheck import check_pyro
 from .limits import U8_COUNT, hz
 from .model import TASK_KINDS, TASK_MODES, Task
 from .numeric import REALS, exact_literal
@@ -59,6 +62,7 @@ class Parts:
     sv_tok: Tok
     machine_toks: dict[str, Tok]  # by the machine's file name, without its extension
     log: M.Log | None = None
+    pyro: list[M.PyroChannel] | None = None
 
 
 class Report:
@@ -110,12 +114,15 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     streams = _telemetry(f.telemetry, sv, tasks, r)
     writable = _uplink(f.uplink, sv, tasks, machines, channels, settings.get("reset_cause"), r)
     reset_cause = _reset_cause(settings.get("reset_cause"), sv, r)
-    _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs)
+    pyro_names = {row.element.text for row in f.pyro}
+    _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs,
+                pyro_names)
     budget = _budget(f.budget, board, r)
     log = check_log(f.log, sv, tasks, machines, board, r, channels=channels)
+    pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks)
     return Parts(name, board, rate, baud, sv, machines, channels, time_source, time_unit, time_element, tasks,
                  streams, writable, reset_cause, budget, sv_file.file,
-                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log)
+                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log, pyro)
 
 
 def complete(parts: Parts, src: Source, diags: Diagnostics, before: int) -> bool:
@@ -638,14 +645,18 @@ def _reset_cause(tok: Tok | None, sv: M.StateVector, r: Report) -> M.Element | N
     return el
 
 
-def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs) -> None:
+def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs,
+                pyro_names=frozenset()) -> None:
     """Every element has at most one writer among the input channels, the
     executor (each task's mode, overruns and worst_us; the reset cause) and
     the machines (their assignments and their own `S`); a second writer is
     reported where it is written, naming the first. (`G` is the executor's
     by construction: every machine declares it read-only. The uplink is no
-    writer of this kind: see its own check.)"""
+    writer of this kind: see its own check. A second machine writing a
+    `[pyro]` element, `pyro_names`, is the pyro check's to report, with its
+    own reason.)"""
     writers: dict[str, str] = {}
+    by_machine: set[str] = set()  # elements some machine writes
 
     def write(name: str, who: str, report) -> None:
         if name in writers:
@@ -673,6 +684,9 @@ def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, mach
             if v.kind != M.ELEMENT or v.name in seen:
                 continue
             seen.add(v.name)
+            if v.name in pyro_names and v.name in by_machine:
+                continue
+            by_machine.add(v.name)
             write(v.name, f"machine `{m.name}` ({os.path.basename(m.path)}:{a.line})",
                   lambda msg, a=a: r.diags.error(msrc, SM, a.line, a.col, msg))
 

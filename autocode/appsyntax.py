@@ -31,7 +31,7 @@ class Problem:
 
 # ---- the application config (.app) ----------------------------------------------
 
-SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log")
+SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log", "pyro")
 
 
 @dataclass(frozen=True)
@@ -86,6 +86,23 @@ class WritableRow:
 
 
 @dataclass(frozen=True)
+class PyroSetting:
+    """`key=value` or `key=a,b,c` after a pyro channel's element; a `-`
+    may stand before a number."""
+    key: Tok
+    values: tuple[Tok, ...]  # IDs or NUMs, as written
+    negative: bool = False  # a `-` before the first value
+
+
+@dataclass(frozen=True)
+class PyroRow:
+    """`element key=value...` in [pyro] (pyrocheck.py)."""
+    element: Tok
+    settings: tuple[PyroSetting, ...]  # as written: a key given twice is here twice
+    stray: Problem | None  # the token that ended them, when it is not `key=value`
+
+
+@dataclass(frozen=True)
 class AppFile:
     """One .app file: the rows of each known section (empty when the
     section is absent; of a duplicate section, the first)."""
@@ -98,6 +115,7 @@ class AppFile:
     uplink: tuple[WritableRow, ...] = ()
     budget: tuple[Setting, ...] = ()
     log: tuple[Setting, ...] = ()
+    pyro: tuple[PyroRow, ...] = ()
 
 
 def parse_app(src: Source, diags: Diagnostics) -> AppFile:
@@ -129,6 +147,7 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
         uplink=rows("uplink", lambda toks: WritableRow(toks[0], toks[1] if len(toks) > 1 else None)),
         budget=rows("budget", _setting),
         log=rows("log", _setting),
+        pyro=rows("pyro", _pyro_row),
     )
 
 
@@ -182,6 +201,35 @@ def _task_row(toks: list[Tok]) -> TaskRow:
             and not (len(toks) > 3 and toks[3].text == "="):
         machine, start = toks[2], 3
     return TaskRow(toks[0], kind, machine, parse_options(toks, start))
+
+
+def _pyro_row(toks: list[Tok]) -> PyroRow:
+    """`element key=value key=a,b ...`: values are names or numbers, a list
+    is separated by commas, a number may be negative."""
+    settings: list[PyroSetting] = []
+    i, n = 1, len(toks)
+    while i < n:
+        t = toks[i]
+        if not (t.kind == ID and i + 1 < n and toks[i + 1].kind == OP and toks[i + 1].text == "="):
+            return PyroRow(toks[0], tuple(settings), Problem(t, f"unexpected {show(t)}: expected `key=value`"))
+        j = i + 2
+        negative = j < n and toks[j].kind == OP and toks[j].text == "-" and j + 1 < n and toks[j + 1].kind == NUM
+        j += negative
+        values: list[Tok] = []
+        while True:
+            if j >= n or toks[j].kind not in (ID, NUM):
+                at = toks[j] if j < n else toks[j - 1]
+                return PyroRow(toks[0], tuple(settings),
+                               Problem(at, f"expected a value after `{toks[j - 1].text}`"))
+            values.append(toks[j])
+            j += 1
+            if j < n and toks[j].kind == OP and toks[j].text == ",":
+                j += 1
+                continue
+            break
+        settings.append(PyroSetting(t, tuple(values), bool(negative)))
+        i = j
+    return PyroRow(toks[0], tuple(settings), None)
 
 
 def parse_options(toks: list[Tok], start: int) -> Options:

@@ -361,6 +361,25 @@ class Log:
 
 
 @dataclass(frozen=True)
+class PyroChannel:
+    """A pyro channel (docs/safety.md): a `[pyro]` row of the application
+    config, resolved. The channel is named by its output element."""
+    output: Channel  # the `.dio` row that drives its pin
+    arm: tuple[Channel, ...]  # the digital inputs that must all read true (armed)
+    continuity: Channel | None  # an analog input reading the igniter, or None
+    continuity_min: Fraction | None  # the reading at or above which the igniter is intact
+    pulse: Fraction  # seconds the pin stays high once fired
+    machine: int  # index into Application.machines: the one machine that writes it
+    armed: tuple[int, ...]  # state ids: entered only with the arming inputs reading true
+    fire: tuple[int, ...]  # state ids: the only states in which the machine may set it true
+    line: int  # its row in the .app
+
+    @property
+    def element(self) -> Element:
+        return self.output.element
+
+
+@dataclass(frozen=True)
 class Application:
     path: str
     name: str
@@ -380,3 +399,4 @@ class Application:
     flash_budget: int | None = None  # [budget] flash: bytes of program memory at most
     ram_budget: int | None = None  # [budget] ram: data + bss + the stack's high-water mark
     log: Log | None = None  # [log]: the flight recorder
+    pyro: tuple[PyroChannel, ...] = ()  # [pyro]: the channels that fire charges (docs/safety.md)

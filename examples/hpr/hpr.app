@@ -52,3 +52,8 @@ element state
 [budget]               # fsw build fails above these; fsw sim adds the stack's
 flash 20480            # measured high-water mark to the RAM
 ram   1280
+
+[pyro]                 # the charges (docs/safety.md): fsw check proves each fires only armed, in its states
+# output  settings
+drogue    arm=armSwitch  pulse=1  machine=mission  armed=Armed  fire=Apogee
+main      arm=armSwitch  pulse=1  machine=mission  armed=Armed  fire=Main

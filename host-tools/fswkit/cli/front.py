@@ -42,6 +42,11 @@ def cmd_check(args) -> int:
     if not files:
         sys.stderr.write("fsw check: no config files found\n")
         return EXIT_FAIL
+    pyro_report = getattr(args, "pyro_report", False)
+    if pyro_report and not any(f.endswith(".app") for f in files):
+        sys.stderr.write("fsw check: --pyro-report needs an application config (.app), or a folder holding one\n")
+        return EXIT_CONFIG
+    apps = []
     for f in files:
         if f.endswith(".sv"):
             load_sv(f, diags)
@@ -49,13 +54,16 @@ def cmd_check(args) -> int:
             load_machine(f, diags, args.sv, warnings=True)
         elif f.endswith(".app"):
             from fswkit.autocode.app import load_app as load_application
-            load_application(f, diags)
+            apps.append(load_application(f, diags))
         else:
             load_script(f, diags, args.sm, args.sv)
     print_diags(diags)
     errors, warnings = diags.error_count, diags.warning_count
     sys.stderr.write(f"fsw check: {plural(len(files), 'file')}, {plural(errors, 'error')}, "
                      f"{plural(warnings, 'warning')}\n")
+    if pyro_report and not errors:  # a report of what was proven: none where the proof failed
+        from fswkit.autocode.pyrocheck import pyro_report as report
+        sys.stdout.write("\n".join(report(app) for app in apps if app is not None))
     if errors or (args.strict and warnings):
         return EXIT_FAIL
     return EXIT_OK

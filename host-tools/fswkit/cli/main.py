@@ -98,6 +98,9 @@ def parser() -> argparse.ArgumentParser:
     c.add_argument("--strict", action="store_true", help="warnings fail the check too")
     c.add_argument("--sv", help="the state vector config to check machines against")
     c.add_argument("--sm", help="the state machine config to check scripts against")
+    c.add_argument("--pyro-report", action="store_true",
+                   help="print, for each pyro channel of the applications checked, every state and transition "
+                        "that can fire it (docs/safety.md)")
     c.set_defaults(func=_command("front", "cmd_check"))
 
     t = sub.add_parser("test", help="run a state script against its machine")

@@ -62,7 +62,7 @@ def test_every_expected_file_has_its_input():
 
 # ---- every message the application checker can produce has a golden case ------------
 
-SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py")]
+SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py", "pyrocheck.py")]
 REPORTERS = {"error", "warning", "err", "at", "Problem"}
 # Messages that no golden case here can hold, and where they are tested instead.
 NOT_GOLDEN = {

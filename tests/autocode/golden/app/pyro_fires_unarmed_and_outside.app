@@ -1,0 +1,27 @@
+# proof: the abort fires the main, unarmed and outside Main
+[application]
+board uno
+rate 100
+
+[configs]
+state_vector pyro.sv
+machine pyro_fires_unarmed_and_outside.sm
+io pyro.aio
+io pyro.dio
+
+[time]
+source clock
+unit ms
+
+[tasks]
+uplink uplink rate=100
+sense inputs rate=100
+fly machine pyro_fires_unarmed_and_outside rate=100
+act outputs rate=100
+
+[uplink]
+abortCmd
+
+[pyro]
+drogue arm=arm,arm2 continuity=sense min=0.5 pulse=1 machine=pyro_fires_unarmed_and_outside armed=Armed fire=Apogee
+main   arm=arm,arm2 pulse=0.5 machine=pyro_fires_unarmed_and_outside armed=Armed fire=Main

@@ -76,6 +76,8 @@ def compiler_identity(cxx: str) -> str:
 
 
 def _key(files: dict[str, str], real: Real) -> str:
+    """The hash of everything a build reads: the compiler, the runtime's
+    sources and headers, `files` (generated), the flags."""
     h = hashlib.sha256()
     h.update(compiler_identity(CXX).encode() + b"\0")
     for path in runtime_sources() + sorted(os.path.join(RUNTIME, n) for n in os.listdir(RUNTIME) if n.endswith(".h")):
@@ -85,6 +87,40 @@ def _key(files: dict[str, str], real: Real) -> str:
         h.update(name.encode() + b"\0" + files[name].encode())
     h.update(" ".join([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits]).encode())
     return h.hexdigest()[:20]
+
+
+def _compile(cmd: list[str], out: str, cwd: str | None = None) -> None:
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
+    if r.returncode != 0:
+        log = out + ".log"
+        with open(log, "w") as f:
+            f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+        errors = [line.strip()[:300] for line in r.stderr.splitlines() if "error:" in line]
+        raise NativeError("internal error: the generated code did not compile, although the script and "
+                          f"its machine are valid: a defect of fswkit, please report it with {log}" +
+                          "".join("\n  " + e for e in errors[:6]))
+
+
+def runtime_objects(real: Real) -> list[str]:
+    """The runtime compiled once for this compiler and evaluation type and
+    kept in the cache: nine tenths of a runner's compile, the same for
+    every script (each source is its own translation unit either way)."""
+    key = _key({"(the runtime alone)": ""}, real)
+    out = os.path.join(cache_dir(), key)
+    objs = [os.path.join(out, os.path.basename(src)[:-4] + ".o") for src in runtime_sources()]
+    if all(os.path.exists(o) for o in objs):
+        return objs
+    sweep(cache_dir())
+    tmp = out + f".tmp{os.getpid()}"
+    with removed_when_done(tmp):
+        os.makedirs(tmp, exist_ok=True)
+        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-c"]
+                 + runtime_sources(), out, cwd=tmp)
+        try:
+            os.replace(tmp, out)
+        except OSError:  # another process compiled the same runtime first
+            pass
+    return objs
 
 
 def compile_script(script: M.Script, real: Real, source_line) -> str:
@@ -105,17 +141,8 @@ def compile_script(script: M.Script, real: Real, source_line) -> str:
             with open(os.path.join(tmp, name), "w") as f:
                 f.write(text)
         cpp = [os.path.join(tmp, n) for n in sorted(files) if n.endswith(".cpp")]
-        cmd = [CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp + \
-            runtime_sources() + ["-o", os.path.join(tmp, "runner")]
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        if r.returncode != 0:
-            log = out + ".log"
-            with open(log, "w") as f:
-                f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
-            errors = [line.strip()[:300] for line in r.stderr.splitlines() if "error:" in line]
-            raise NativeError("internal error: the generated code did not compile, although the script and "
-                              f"its machine are valid: a defect of fswkit, please report it with {log}" +
-                              "".join("\n  " + e for e in errors[:6]))
+        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp
+                 + runtime_objects(real) + ["-o", os.path.join(tmp, "runner")], out)
         try:
             os.replace(tmp, out)
         except OSError:  # another process built the same runner first

@@ -4,6 +4,8 @@ a project made only of configs builds into complete firmware."""
 
 from __future__ import annotations
 
+import math
+
 from ..app import TASK_MODES, Application, Task
 from ..cnames import comment
 from ..iotables import analog_gain
@@ -47,6 +49,12 @@ def _direct_digital(app: Application, chans) -> bool:
     return all(c.pin_number in app.board.ports for c in chans)
 
 
+def _pyro_direct(app: Application) -> bool:
+    """Pyro pins and their arming pins by port and bit, like other digital
+    channels, when the board file maps them all; else through the PAL."""
+    return _direct_digital(app, [c for p in app.pyro for c in (p.output, *p.arm)])
+
+
 def _pin(app: Application, c) -> str:
     port, bit = app.board.ports[c.pin_number]
     return f"FSW_PIN({c.pin_number}, {port}, {bit})"
@@ -82,11 +90,13 @@ def _tables(app: Application, real, out: list[str]) -> dict:
     """Channel tables grouped by direction; returns {group: table name}, or
     for digital channels served one call each {group: [channels]}."""
     names = {}
+    pyro = {p.element.name for p in app.pyro}
     groups = {
         ("analog", "i"): [c for c in app.channels if c.analog and c.direction == "i"],
         ("analog", "o"): [c for c in app.channels if c.analog and c.direction == "o"],
         ("digital", "i"): [c for c in app.channels if not c.analog and c.direction == "i"],
-        ("digital", "o"): [c for c in app.channels if not c.analog and c.direction == "o"],
+        ("digital", "o"): [c for c in app.channels if not c.analog and c.direction == "o"
+                           and c.element.name not in pyro],  # pyro pins: driven through the gate
     }
     vref = real_literal(real.literal(repr(app.board.adc_vref)), real)
     for (kind, d), chans in groups.items():
@@ -150,6 +160,9 @@ def _app_cpp(app: Application) -> str:
           comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz."),
           "namespace fsw_gen {", "namespace {", ""]
     tables = _tables(app, real, c)
+    if app.pyro:
+        c.append(f"fsw::PyroGate Pyro[{len(app.pyro)}];  // the pyro channels' pulses (docs/safety.md), in [pyro] order")
+        c.append("")
     n = len(app.tasks)
     c.append(f"const uint32_t kPeriodUs = {1000000 // app.rate}UL;  // {app.rate} cycles per second")
     c.append("fsw::Executor ex;")
@@ -170,7 +183,7 @@ def _app_cpp(app: Application) -> str:
         c.append(f"FSW_NOINLINE void store_G_now(uint8_t* g) {{ fsw::store<uint64_t>(g, {_now(app)}); }}")
         c.append("")
     for t in app.tasks:
-        steps[t.name] = _direct_step(t, tables)
+        steps[t.name] = None if app.pyro and t is pyro_task(app) else _direct_step(t, tables)
         if steps[t.name] is None:
             c += _task_fn(app, t, tables)
     c.append(f"const fsw::Task kTasks[{max(n, 1)}] FSW_FLASH = {{")
@@ -205,6 +218,11 @@ def _app_cpp(app: Application) -> str:
             c.append(f"    fsw::io_analog_scan_begin({tag.tag}Pins, {len(tag.chans)}, {tag.tag}Raw);")
         elif kind in ("analog", "digital"):
             c.append(f"    if (fsw::io_{kind}_begin(&{tag}) != fsw::kOk) return false;")
+    for p in app.pyro:
+        o = p.output
+        pin = (f"fsw::io_pin_begin({_pin(app, o)}, fsw::kIoOut);" if _pyro_direct(app)
+               else f"fsw::pal::pin_mode({o.pin_number}, fsw::pal::kOutput);")
+        c.append(f"    {pin}  // {basename(o.path)}:{o.line} {o.element.name} (pyro, low until fired)")
     if has_link:
         c.append(f"    fsw::pal::console_begin({app.baud}UL);")
         c.append("    fsw::link_begin(link, &kLinkConfig);  // its tables are checked where they are defined")
@@ -267,6 +285,49 @@ def _direct_step(t: Task, tables) -> tuple[str, str] | None:
     return None
 
 
+def pyro_task(app: Application) -> Task | None:
+    """The outputs task that drives the pyro pins and counts their pulses:
+    the fastest (the first of the fastest), as autocode/pyrocheck.py holds
+    `pulse=` to at least one of its periods."""
+    outputs = [t for t in app.tasks if t.kind == "outputs"]
+    return max(outputs, key=lambda t: t.rate) if outputs else None
+
+
+def pyro_pulse_runs(p, task: Task) -> int:
+    """A channel's pulse in runs of the task that drives it: pulse x the
+    task's rate, rounded up (the host's replay counts the same)."""
+    return math.ceil(p.pulse * task.rate)  # exact: both are Fractions
+
+
+def _pyro_lines(app: Application, t: Task) -> list[str]:
+    """The outputs task's pyro pins, each through fsw::pyro_gate: the arming
+    pins read now, the machine's state, the pulse in runs of this task."""
+    direct = _pyro_direct(app)
+    name = basename(app.path)
+    out = []
+    for k, p in enumerate(app.pyro):
+        runs = pyro_pulse_runs(p, t)
+        if runs > 0xFFFF:
+            raise GenError(f"{name}:{p.line}: pyro channel `{p.element.name}`: a pulse of {float(p.pulse):g} s is "
+                           f"{runs} runs of `{t.name}`, more than 65535")
+        m = app.machines[p.machine]
+        ns = c_ident(m.name)
+        fires = [next(st.name for st in m.states if st.id == s) for s in p.fire]
+        arm = " && ".join(f"fsw::io_pin_read({_pin(app, a)})" if direct else f"fsw::pal::digital_read({a.pin_number})"
+                          for a in p.arm)
+        fire = " || ".join(f"{ns}::machine.state == {ns}::S_{st}" for st in fires)
+        gate = (f"fsw::pyro_gate(Pyro[{k}], sv[E_{p.element.name}] != 0, {arm}, {fire}, {runs}u)")
+        o = p.output
+        out.append(f"    // {name}:{p.line} pyro {p.element.name}, pin {o.pin}: armed by "
+                   + ", ".join(a.element.name for a in p.arm) + ", fires in "
+                   + ", ".join(fires) + f", {runs} runs ({float(p.pulse):g} s)")
+        if direct:
+            out.append(f"    fsw::io_pin_write({_pin(app, o)}, {gate});")
+        else:
+            out.append(f"    fsw::pal::digital_write({o.pin_number}, {gate});")
+    return out
+
+
 def _shared_time_store(app: Application) -> bool:
     """Whether machine tasks write G through one out-of-line function: two
     or more of them, no lock."""
@@ -289,7 +350,11 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
     elif t.kind in ("inputs", "outputs"):
         d = "i" if t.kind == "inputs" else "o"
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
-        if not calls:
+        if app.pyro and t is pyro_task(app):
+            out += _pyro_lines(app, t)
+            if not calls:
+                out.append("    return fsw::kOk;")
+        elif not calls:
             out.append("    return fsw::kOk;  // no channels in this direction")
         for k, (kind, tag) in enumerate(calls):
             if isinstance(tag, _Scan):

@@ -10,6 +10,17 @@ uint8_t pwm_duty_from_volts(Real volts, Real vref) {
     return U8_from_real(volts / vref * Real(255) + Real(0.5));
 }
 
+bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse) {
+    if (element && g.last == 0) g.left = pulse;  // a rise: a new pulse
+    g.last = element ? 1 : 0;
+    if (!element || !armed || !fire || g.left == 0) {
+        g.left = 0;  // ended: low until the element falls and rises again
+        return false;
+    }
+    --g.left;
+    return true;
+}
+
 static bool analog_type_ok(uint8_t t) { return t == kF32 || t == kF64; }
 
 // The scan of a table sampled in the background, once, waited for: the

@@ -133,6 +133,34 @@ inline void io_digital_in(Pin pin, uint8_t* p) { *p = pal::digital_read(pin.n) ?
 inline void io_digital_out(Pin pin, const uint8_t* p) { pal::digital_write(pin.n, *p != 0); }
 #endif
 
+// A pin's level now, and a pin driven high or low (what io_digital_in/out do
+// without an element): the pyro gate reads the arming pins and drives the
+// pyro pin through these.
+#if FSW_AVR_PORTS
+inline __attribute__((always_inline)) bool io_pin_read(Pin pin) { return (*pin.in & pin.mask) != 0; }
+inline __attribute__((always_inline)) void io_pin_write(Pin pin, bool high) { pin_reg_write(pin.out, pin.mask, high); }
+#else
+inline bool io_pin_read(Pin pin) { return pal::digital_read(pin.n); }
+inline void io_pin_write(Pin pin, bool high) { pal::digital_write(pin.n, high); }
+#endif
+
+// ---- pyro channels: the run-time gate (docs/safety.md) -----------------------
+// One per [pyro] channel, zero at boot (static storage): no pulse, the
+// element last seen false.
+struct PyroGate {
+    uint16_t left;  // runs of the outputs task the pin may still stay high
+    uint8_t last;   // 1: the element was true at the previous run
+};
+
+// The level of a pyro pin at this run of the outputs task. High only while
+// the element is true, every arming input reads armed now (`armed`: the
+// pins, read by the caller this run), the channel's machine is in one of
+// its fire states (`fire`), and for at most `pulse` runs counted from the
+// element's rise. Once low with the element still true (the pulse spent,
+// a key dropped, the machine out of its fire states) it stays low until the
+// element has been false and rises again: one pulse per rise.
+FSW_NOINLINE bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse);
+
 // ---- analog inputs, one call each (generated I/O tasks) -----------------------
 // Generated inputs tasks convert each analog input with one inline call on
 // constants the generator computed (no table read at run time), from the

@@ -15,8 +15,9 @@ for the next run of the inputs task: step k reads the pins as they were at
 step k - 1, the first step at boot); the timeline
 (the tape's first row at `pad_s`, the arming switch at `arm_s`, `run_on_s`
 after the last row); the machines stepped every 1000 / rate ms in the
-order the application lists them, sharing the state vector's elements.
-What it leaves out: the executor's clock (G is the step's time here,
+order the application lists them, sharing the state vector's elements;
+each pyro pin through the firmware's run-time gate (`_Gate`, the same rule
+as fsw::pyro_gate). What it leaves out: the executor's clock (G is the step's time here,
 millis() on the board), the UART and the telemetry (an event is seen at
 its step, not in the next frame), the other tasks. On the eight shared
 tapes its events agree with the board's within a step or two
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from fswkit.autocode.emit.app import pyro_pulse_runs, pyro_task
 from fswkit.autocode.iotables import analog_gain, analog_value
 from fswkit.autocode.numeric import F32MODE
 from fswkit.run.interp import MachineRun
@@ -43,6 +45,34 @@ def _element_of(app, pin: int | None, analog: bool = False) -> str | None:
         return None
     ch = next((c for c in app.channels if c.pin_number == pin and c.analog == analog), None)
     return ch.element.name if ch is not None else None
+
+
+class _Gate:
+    """The firmware's pyro gate (fsw::pyro_gate, docs/safety.md), the same
+    rule: the pin high only while the element is true, every arming input
+    reads armed, the machine is in a fire state, and for at most the pulse
+    from the element's rise; low until the element falls and rises again.
+    The pulse in steps: the outputs task's runs times its divider."""
+
+    def __init__(self, app, channel):
+        task = pyro_task(app)
+        self.ch = channel
+        self.arm = [c.element.name for c in channel.arm]
+        self.fire = set(channel.fire)
+        self.pulse = pyro_pulse_runs(channel, task) * task.divider
+        self.machine = channel.machine
+        self.left, self.last = 0, False
+
+    def level(self, sv, state_id: int) -> bool:
+        element = bool(sv[self.ch.element.name])
+        if element and not self.last:
+            self.left = self.pulse
+        self.last = element
+        if not element or not all(sv[a] for a in self.arm) or state_id not in self.fire or self.left == 0:
+            self.left = 0
+            return False
+        self.left -= 1
+        return True
 
 
 def _mission(app, cfg):
@@ -86,6 +116,7 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     run = Run(columns=())
     row, prev = -1, None
     high = {role: False for role, _, _ in pins}
+    gates = {role: _Gate(app, p) for role, _, pin in pins for p in app.pyro if p.output.pin_number == pin}
     for k in range(1, steps + 1):
         g = k * step_ms
         now = g / 1000.0
@@ -110,7 +141,9 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
             run.transitions.append((tt, states[st].id, states[st].name))
             prev = st
         for role, element, pin in pins:
-            level = bool(sv[element])
+            gate = gates.get(role)
+            level = (gate.level(sv, app.machines[gate.machine].states[runs[gate.machine].state].id)
+                     if gate is not None else bool(sv[element]))
             if level != high[role]:
                 run.pin_events.append(PinEvent(tt, pin, role, level, {}))
                 high[role] = level

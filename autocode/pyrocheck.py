@@ -39,6 +39,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from . import model as M
+from .check import assignments
 from .diagnostics import APP, SM
 from .evaluate import NotConstant, compare, evaluate, local_values
 from .lexer import ID, NUM
@@ -490,7 +491,7 @@ def _other_writers(owners: dict[str, tuple[int, int]], machines, machine_srcs, r
     machine's first assignment to it is refused where it is written."""
     for i, m in enumerate(machines):
         seen: set[str] = set()
-        for a in _assignments(m):
+        for a in assignments(m):
             v = m.vars[a.var]
             if v.kind != M.ELEMENT or v.name not in owners or v.name in seen or owners[v.name][0] == i:
                 continue
@@ -500,24 +501,6 @@ def _other_writers(owners: dict[str, tuple[int, int]], machines, machine_srcs, r
                           f"element `{v.name}` is pyro channel `{v.name}` ({os.path.basename(r.src.path)}:{line}), "
                           f"written by machine `{machines[mine].name}` alone: machine `{m.name}` cannot write it "
                           "(a second writer could fire the charge, or cut its pulse short, in any of its own states)")
-
-
-def _assignments(m: M.Machine) -> list[M.Assign]:
-    out: list[M.Assign] = []
-
-    def walk(stmts):
-        for s in stmts:
-            if type(s) is M.Assign:
-                out.append(s)
-            elif type(s) is M.If:
-                walk(s.then)
-                walk(s.orelse)
-
-    for st in m.states:
-        walk(st.entry)
-        walk(st.step)
-        walk(st.exit)
-    return out
 
 
 # ---- the proof ------------------------------------------------------------------

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import socket
+import time
 
 import pytest
 
@@ -32,3 +33,19 @@ def chromium():
               "--disable-dev-shm-usage", "--window-size=1400,1000"):
         opts.add_argument(a)
     return webdriver.Chrome(service=Service(DRIVER), options=opts)
+
+
+def wait_for(fn, what: str, timeout: float = 10.0):
+    """What `fn()` gives once it is truthy (an exception counts as not yet),
+    polled every 0.1 s; AssertionError after `timeout` seconds."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            v = fn()
+        except Exception:  # the page is still building what fn looks for
+            v = None
+        if v:
+            return v
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.1)

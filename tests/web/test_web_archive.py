@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import run_fsw
-from support.browser import chromium, free_port, needs_chromium
+from support.browser import chromium, free_port, needs_chromium, wait_for
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 RAW = 770  # 815.86 psi
@@ -237,20 +237,6 @@ def browser():
     drv = chromium()
     yield drv
     drv.quit()
-
-
-def wait_for(fn, what: str, timeout: float = 10.0):
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            v = fn()
-        except Exception:  # the page is still building what fn looks for
-            v = None
-        if v:
-            return v
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.1)
 
 
 @needs_cxx()

@@ -15,7 +15,7 @@ import time
 import pytest
 
 from conftest import run_fsw
-from support.browser import chromium, free_port, needs_chromium
+from support.browser import chromium, free_port, needs_chromium, wait_for
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = [needs_cxx(), needs_chromium]
@@ -63,20 +63,6 @@ class Station:
         self.server.should_exit = True
         self.thread.join(5)
         self.ground.stop()
-
-
-def wait_for(fn, what: str, timeout: float = 10.0):
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            v = fn()
-        except Exception:  # the page is still building what fn looks for
-            v = None
-        if v:
-            return v
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.1)
 
 
 def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_stale(exe, browser, tmp_path):

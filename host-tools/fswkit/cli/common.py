@@ -114,8 +114,8 @@ def open_link(args, layout, baud: int, say):
     param`, `fsw dump`): through the ground station when one holds the
     port, else the port opened exclusively; a hello asked for and its
     schema checked against `args.project` (unless `args.ignore_schema`).
-    (link, link, Session): the link closes with `close_port`; None, said
-    through `say`, when it cannot be had (the link is closed again)."""
+    The link (its `session` decoded, its `close()` never raising); None,
+    said through `say`, when it cannot be had (the link is closed again)."""
     from fswkit.ground.client import StationRefused, connect
     from fswkit.ground.monitor import schema_message, summary
     from fswkit.link.client import LinkTimeout
@@ -128,7 +128,6 @@ def open_link(args, layout, baud: int, say):
     except (PortError, StationRefused, OSError) as e:
         say(str(e))
         return None
-    port = ground
     why = None
     try:
         ground.handshake(timeout=3.0)
@@ -138,13 +137,6 @@ def open_link(args, layout, baud: int, say):
         why = f"{e}: is the firmware running on {args.port}, at {baud} baud?\n  " + summary(session)
     if why is not None:
         say(why)
-        close_port(port)
+        ground.close()
         return None
-    return port, ground, session
-
-
-def close_port(port) -> None:
-    try:
-        port.close()
-    except Exception:  # noqa: BLE001 - closing a port that went away
-        pass
+    return ground

@@ -38,17 +38,16 @@ def _talk(args, app, p) -> int:
     from fswkit.autocode.recorder import RecordError, decode
     from fswkit.autocode.schema import link_plan
     from fswkit.autocode.protocol import OP_LOG_ERASE
-    from fswkit.cli.common import close_port, open_link
+    from fswkit.cli.common import open_link
     from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import from_app
     from fswkit.link.log import LogError
     from fswkit.link.port import port_errors
     from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
 
-    link = open_link(args, from_app(app), args.baud or app.baud, _say)
-    if link is None:
+    ground = open_link(args, from_app(app), args.baud or app.baud, _say)
+    if ground is None:
         return EXIT_FAIL
-    port, ground, _session = link
     try:
         def command(op, a):
             return ground.command(op, a, tries=5, timeout=0.5)
@@ -124,4 +123,4 @@ def _talk(args, app, p) -> int:
         _say(f"{args.port}: the port went away ({e})")
         return EXIT_FAIL
     finally:
-        close_port(port)
+        ground.close()

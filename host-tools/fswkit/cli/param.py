@@ -109,15 +109,14 @@ def cmd_param(args) -> int:
 
 
 def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
-    from fswkit.cli.common import close_port, open_link
+    from fswkit.cli.common import open_link
     from fswkit.link.port import port_errors
     from fswkit.param.client import ParamClient, ParamError, PortTransport
 
     baud = args.baud or app.baud
-    link = open_link(args, layout, baud, _say)
-    if link is None:
+    ground = open_link(args, layout, baud, _say)
+    if ground is None:
         return EXIT_FAIL
-    port, ground, _session = link
     try:
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
         from fswkit.autocode.params import param_hash
@@ -137,7 +136,7 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
         _say(f"{args.port}: the port went away ({e})")
         return EXIT_FAIL
     finally:
-        close_port(port)
+        ground.close()
 
 
 def _action(args, client, params, by_name, wanted, file_values, params_text) -> int:

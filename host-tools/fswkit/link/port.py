@@ -107,42 +107,49 @@ def _write_record(name: str, rec: dict) -> str:
     return path
 
 
-class Held:
-    """A port opened exclusively with its holder record; `close()` ends both."""
-
-    def __init__(self, serial, name: str, record_path: str | None):
-        self.serial, self.name, self._record = serial, name, record_path
-
-    def close(self) -> None:
+def _release(record: str) -> None:
+    """Removes a holder record, when it is this process's."""
+    try:
+        with open(record, encoding="utf-8") as f:
+            mine = json.load(f).get("pid") == os.getpid()
+    except (OSError, ValueError):
+        return
+    if mine:
         try:
-            if self.serial.is_open and not is_url(self.name):
-                fcntl.ioctl(self.serial.fileno(), termios.TIOCNXCL)
-        except (OSError, ValueError, AttributeError):
+            os.unlink(record)
+        except OSError:
             pass
-        try:
-            self.serial.close()
-        except Exception:  # noqa: BLE001 - closing a port that went away
-            pass
-        if self._record is not None:
+
+
+def _held_serial():
+    """pyserial's port class, with a `close()` that also gives up TIOCEXCL
+    and the holder record (`record`: its path)."""
+    import serial
+
+    class Held(serial.Serial):
+        record: str | None = None
+
+        def close(self) -> None:
             try:
-                with open(self._record, encoding="utf-8") as f:
-                    mine = json.load(f).get("pid") == os.getpid()
+                if self.is_open:
+                    fcntl.ioctl(self.fileno(), termios.TIOCNXCL)
             except (OSError, ValueError):
-                mine = False
-            if mine:
-                try:
-                    os.unlink(self._record)
-                except OSError:
-                    pass
-            self._record = None
+                pass
+            try:
+                super().close()
+            except Exception:  # noqa: BLE001 - closing a port that went away
+                pass
+            if self.record is not None:
+                record, self.record = self.record, None
+                _release(record)
+
+    return Held
 
 
 def open_port(name: str, baud: int, *, command: str | None = None, socket: str | None = None):
     """The port `name` at `baud`. With `command` (the fswkit command opening
-    it), a device is held exclusively and a holder record written: the
-    returned port has a `held` attribute whose `close()` releases both
-    (and the port's own `close()` does the same). PortBusy when another
-    program has it."""
+    it), a device is held exclusively and a holder record written, both
+    given up by the port's `close()`. PortBusy when another program has it."""
     try:
         import serial
     except ImportError:
@@ -154,7 +161,7 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
             raise PortBusy(busy_message(name, rec), rec)
     try:
         if exclusive:
-            port = serial.Serial(name, baudrate=baud, timeout=0.05, write_timeout=2, exclusive=True)
+            port = _held_serial()(name, baudrate=baud, timeout=0.05, write_timeout=2, exclusive=True)
         else:
             port = serial.serial_for_url(name, baudrate=baud, timeout=0.05, write_timeout=2)
     except (serial.SerialException, ValueError, OSError) as e:
@@ -173,15 +180,7 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
     rec = {"pid": os.getpid(), "command": command, "port": name, "baud": baud}
     if socket:
         rec["socket"] = socket
-    held = Held(port, name, _write_record(name, rec))
-    close = port.close
-
-    def close_all():
-        port.close = close
-        held.close()
-
-    port.held = held
-    port.close = close_all
+    port.record = _write_record(name, rec)
     return port
 
 

@@ -49,3 +49,11 @@ def wait_for(fn, what: str, timeout: float = 10.0):
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out waiting for {what}")
         time.sleep(0.1)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """A headless Chromium for a test module (import this fixture into it)."""
+    drv = chromium()
+    yield drv
+    drv.quit()

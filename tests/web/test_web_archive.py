@@ -25,7 +25,7 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import run_fsw
-from support.browser import chromium, free_port, needs_chromium, wait_for
+from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 RAW = 770  # 815.86 psi
@@ -230,13 +230,6 @@ def test_the_archive_routes_cap_a_long_session_and_refuse_in_words(tmp_path):
 @pytest.fixture(scope="module")
 def exe(tmp_path_factory):
     return build_native(TANK, tmp_path_factory.mktemp("tank"))
-
-
-@pytest.fixture(scope="module")
-def browser():
-    drv = chromium()
-    yield drv
-    drv.quit()
 
 
 @needs_cxx()

@@ -15,7 +15,7 @@ import time
 import pytest
 
 from conftest import run_fsw
-from support.browser import chromium, free_port, needs_chromium, wait_for
+from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = [needs_cxx(), needs_chromium]
@@ -26,13 +26,6 @@ RAW = 770  # 815.86 psi: the vent valve opens
 @pytest.fixture(scope="module")
 def exe(tmp_path_factory):
     return build_native(TANK, tmp_path_factory.mktemp("tank"))
-
-
-@pytest.fixture(scope="module")
-def browser():
-    drv = chromium()
-    yield drv
-    drv.quit()
 
 
 class Station:

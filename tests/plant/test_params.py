@@ -99,7 +99,7 @@ def test_a_changed_local_changes_the_check(tmp_path):
      "`navState` is not machine `mission`'s state"),
     ("drogue = 5", "drogue = 2", "drogue = 2", "[pins] drogue: pin 2 is not a digital output of the project"),
     ("main   = 6", "main   = 7", "main   = 7", "pin 7 is not a digital output of the project (its I/O tables"),
-    ('channel      = "A1"', 'channel      = "A3"', 'channel      = "A3"', "[accelerometer] channel: pin A3 is not"),
+    ('channel      = "A1"', 'channel      = "A4"', 'channel      = "A4"', "[accelerometer] channel: pin A4 is not"),
 ])
 def test_bad_values_are_located(tmp_path, old, new, marker, message):
     p = variant(tmp_path, old, new)
@@ -210,3 +210,13 @@ def test_prepare_refuses_unknown_plants_and_faults():
         prepare(str(EXAMPLES / "rocket"), "glider")
     with pytest.raises(SetupError):
         prepare(str(EXAMPLES / "rocket"), "rocket", fault="loose-nut")
+
+
+def test_the_command_line_offers_every_fault_of_the_plant():
+    from fswkit.plant.scenario import FAULTS
+
+    r = run_fsw("sim", "--help")
+    assert r.code == 0, r.err
+    text = " ".join(r.out.split())
+    for fault in FAULTS:
+        assert fault in text, fault

@@ -177,9 +177,10 @@ def parser() -> argparse.ArgumentParser:
                     "differs from plant.toml's (motor, mass, drag, gusts, sensor errors, brown-outs)")
     sm.add_argument("--run", type=_nonneg_int, metavar="I", help="with --plant rocket: fly run I of the study with "
                     "--seed and --dispersion again, alone, writing its files")
-    sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro"),
-                    help="with --plant rocket: a sensor fault (stuck-baro: the barometer freezes at ignition; "
-                    "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit)")
+    sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro", "open-igniter"),
+                    help="with --plant rocket: a fault (stuck-baro: the barometer freezes at ignition; "
+                    "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit; open-igniter: the "
+                    "drogue's igniter is open from boot, the motor is not lit and the vehicle must refuse to arm)")
     sm.set_defaults(func=_command("sim", "cmd_sim"))
 
     fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")

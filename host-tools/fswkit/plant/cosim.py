@@ -19,7 +19,7 @@ from fswkit.link.layout import Layout
 from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session
 from fswkit.progress import progress
-from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
+from fswkit.sim.board import RESET_CAUSES, EdgeOverflow, SimBoard, SimError
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
 
@@ -40,6 +40,19 @@ class PinEvent:
     truth: dict
 
 
+@dataclass(frozen=True)
+class ResetEvent:
+    """A reset of the MCU during a run: when (simulated s), its cause (one
+    of fswkit.sim.board.RESET_CAUSES), the mission machine's state telemetry
+    showed last before it (None: none yet), and what asked for it: "time"
+    (the scenario's `reset_at`) or "state" (its `reset_state`)."""
+
+    t: float
+    cause: str
+    state: str | None
+    trigger: str
+
+
 @dataclass
 class Run:
     columns: tuple[str, ...]
@@ -54,7 +67,8 @@ class Run:
     round_trips: int = 0
     ram: dict = field(default_factory=dict)  # what the board's RAM probes said, if it has them
     profile: object = None  # fswkit.sim.board.Profile of the functions `fly` was asked to profile
-    resets: list[float] = field(default_factory=list)  # when the MCU was reset (brown-outs the scenario asked for)
+    resets: list[float] = field(default_factory=list)  # when the MCU was reset (the resets the scenario asked for)
+    reset_events: list[ResetEvent] = field(default_factory=list)  # the same resets, with cause and state
     eeprom: bytes | None = None  # the board's EEPROM after the flight (the flight recorder's store)
     flash: bytes | None = None  # the SPI NOR flash's written part after the flight (`store spi_nor`)
 
@@ -119,7 +133,16 @@ class Telemetry:
     """The firmware's UART bytes as a run's telemetry: recorded to the link
     log, decoded by a link Session into the run's samples and the state
     transitions of `state_element`, timed `offset` seconds before the
-    board's clock (closed-loop flights: 0; tape replays: the tape's time)."""
+    board's clock (closed-loop flights: 0; tape replays: the tape's time).
+
+    After a reset of the target (`restarted`) the offset is found again
+    from the new boot's first frame (its hello, as a rule): the firmware's
+    clock may have started again from 0 at the reset, or gone on from where
+    it was (firmware that resumes its flight keeps `G` across a brown-out
+    or a watchdog reset); whichever puts that frame between the reset and
+    its arrival is taken, else the frame is timed at its arrival."""
+
+    RESUME_SLACK_S = 1.0  # a clock that went on may have lost up to this much across the reset
 
     def __init__(self, run: Run, layout: Layout, state_element: str | None, log: LogWriter | None,
                  offset: float = 0.0):
@@ -130,6 +153,30 @@ class Telemetry:
         self.regions = {s.index: s.region for s in layout.streams}
         self.per_s = 1000.0 if layout.time_unit == "ms" else 1e6
         self.last_state = None
+        self.reset_t: float | None = None  # the target was reset then; its new clock not yet seen
+
+    @property
+    def state_name(self) -> str | None:
+        """The state telemetry showed last (None: none yet)."""
+        if self.last_state is None:
+            return None
+        return self.state_names.get(int(self.last_state), str(self.last_state))
+
+    def restarted(self, t: float) -> None:
+        """The target was reset at simulated second `t`: the next frame sets the time base."""
+        self.reset_t = t
+
+    def _rebase(self, fw_s: float, arrival: float) -> None:
+        """The new boot's time base from its first frame, stamped `fw_s`
+        (the firmware's seconds), read by simulated second `arrival`."""
+        t_r, self.reset_t = self.reset_t, None
+        restart, went_on = -t_r, self.offset
+        if t_r <= fw_s - restart <= arrival:  # the clock started again from 0 at the reset
+            self.offset = restart
+        elif t_r - self.RESUME_SLACK_S <= fw_s - went_on <= arrival:  # it went on across the reset
+            self.offset = went_on
+        else:  # some other time base: the frame is taken as sent when it arrived
+            self.offset = fw_s - arrival
 
     def feed(self, raw: bytes, t: float) -> None:
         """Takes the bytes the board sent up to simulated time `t` (s)."""
@@ -137,6 +184,8 @@ class Telemetry:
             self.log.record(RX, round(t * 1e9), raw)
         run = self.run
         for ev in self.session.feed(raw, t):
+            if self.reset_t is not None:
+                self._rebase(ev.time / self.per_s, t)
             if ev.kind == "hello" and not ev.info["schema_ok"]:
                 raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
                                  f"0x{self.layout.schema:08x}: rebuild it")
@@ -171,7 +220,8 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         nor = _nor(getattr(scenario, "app", None), board)
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
                      eeprom=getattr(scenario, "eeprom", None),
-                     analog=analog, spi_flash=nor[1] if nor else None)
+                     analog=analog, spi_flash=nor[1] if nor else None,
+                     ram_seed=_ram_seed(getattr(scenario, "seed", 1)))
     except SimError as e:
         if log:
             log.close()
@@ -186,16 +236,27 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             b.watch(pin)
         k = 0
         t1 = 0.0
-        reset_at = getattr(scenario, "reset_at", None)  # a brown-out: the MCU resets at this simulated second
+        # resets the scenario asks for: at a simulated second (`reset_at`: a study's brown-out), and
+        # `reset_after_s` after telemetry first shows the mission machine in `reset_state`
+        reset_at, at_cause, reset_state, state_cause, after_s = _reset_plan(scenario, telemetry)
+        state_due: float | None = None
+        seen = 0  # transitions already looked at for reset_state
         while True:
             t0 = k / rate
-            if reset_at is not None and t0 >= reset_at:
-                reset_at = None
-                b.reset()
-                run.resets.append(t0)
-                telemetry.offset = -t0  # the firmware's clock starts again from 0
-                last_mv = {name: -1 for name in last_mv}  # every input driven again
-                last_din = {}
+            if reset_at is not None or state_due is not None:
+                for due, cause, trigger in ((reset_at, at_cause, "time"), (state_due, state_cause, "state")):
+                    if due is None or t0 < due:
+                        continue
+                    if trigger == "time":
+                        reset_at = None
+                    else:
+                        state_due = None
+                    run.reset_events.append(ResetEvent(t0, cause, telemetry.state_name, trigger))
+                    run.resets.append(t0)
+                    b.reset(cause)
+                    telemetry.restarted(t0)
+                    last_mv = {name: -1 for name in last_mv}  # every input driven again
+                    last_din = {}
             if k:
                 analog, digital = scenario.inputs(t0)
             set_analog, set_digital = {}, {}  # the inputs that changed
@@ -223,6 +284,12 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                 run.pin_events.append(ev)
             if step.uart:
                 telemetry.feed(step.uart, t1)
+                if reset_state is not None:
+                    for tt, _sid, name in run.transitions[seen:]:
+                        if name == reset_state:  # the first time only
+                            state_due, reset_state = tt + after_s, None
+                            break
+                    seen = len(run.transitions)
             if k % record_every == 0:
                 run.rows.append(scenario.record())
             state = run.transitions[-1][2] if run.transitions else None
@@ -256,6 +323,39 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         if log:
             log.close()
     return run
+
+
+def _ram_seed(seed) -> int:
+    """The board's seed for the bytes a power-on reset leaves in RAM: the
+    scenario's own, so that a run is its seed's, byte for byte."""
+    if isinstance(seed, int) and 0 <= seed < 1 << 64:
+        return seed
+    import numpy as np
+
+    return int(np.random.SeedSequence(seed).generate_state(1, np.uint64)[0])
+
+
+def _reset_plan(scenario, telemetry: Telemetry):
+    """(reset_at, its cause, reset_state, its cause, reset_after_s) from the
+    scenario's attributes (plant.toml's [scenario] or set from Python; a
+    study's brown-out sets reset_at); CosimError for a cause or a state
+    that cannot be (scenario.load has checked the file's)."""
+    reset_at = getattr(scenario, "reset_at", None)
+    at_cause = getattr(scenario, "reset_at_cause", "brownout")
+    reset_state = getattr(scenario, "reset_state", None)
+    state_cause = getattr(scenario, "reset_cause", "brownout")
+    after_s = float(getattr(scenario, "reset_after_s", 0.2))
+    for cause in ((at_cause,) if reset_at is not None else ()) + ((state_cause,) if reset_state else ()):
+        if cause not in RESET_CAUSES:
+            raise CosimError(f"reset cause `{cause}`: one of {', '.join(RESET_CAUSES)}")
+    if reset_state is not None:
+        states = set(telemetry.state_names.values())
+        if reset_state not in states:
+            raise CosimError(f"reset_state `{reset_state}`: telemetry's `{scenario.state_element}` has no such state "
+                             f"(its states: {', '.join(sorted(states)) or 'none'})")
+        if not after_s >= 0:
+            raise CosimError(f"reset_after_s must be 0 or more seconds, not {after_s}")
+    return reset_at, at_cause, reset_state, state_cause, after_s
 
 
 def nor_image(b, p) -> bytes:

@@ -258,6 +258,7 @@ def apply(sc, d: Draw) -> None:
     sc.accel_noise.sigma *= d.accel.noise_scale
     if d.brownout_s is not None and sc.ignition_s is not None:
         sc.reset_at = sc.ignition_s + d.brownout_s
+        sc.reset_at_cause = "brownout"
     baro, accel = p["barometer"], p["accelerometer"]
     errs = []
     for sd, ch, per_volt in ((d.baro, sc.channels[0], 1.0 / baro["pa_per_volt"]),

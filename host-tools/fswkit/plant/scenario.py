@@ -36,7 +36,12 @@ FAULTS = {
                     "no pyro channel may fire and the vehicle never leaves its pad states",
     "pinned-baro": "the barometer reads full scale (5 V) from boot and the motor is never lit; "
                    "no pyro channel may fire and the vehicle never leaves its pad states",
+    "open-igniter": "the drogue's igniter is open from boot (broken or unconnected: its continuity input reads "
+                    "open_volts) and the motor is never lit; the vehicle must refuse to arm, no pyro channel may "
+                    "fire and it never leaves its pad states",
 }
+# Faults that keep the vehicle on the pad, armed by its key until hold_s, the motor never lit.
+PAD_FAULTS = ("pinned-accel", "pinned-baro", "open-igniter")
 
 # ---- parameter schemas ------------------------------------------------------------------
 
@@ -51,7 +56,25 @@ def _chute(what: str) -> Table:
         "cd_area_m2": F("float", "Cd × area when fully inflated, m²", above=0, hi=1000),
         "fire_ms": F("float", "the pyro pin must stay high this long to fire the charge", lo=0, hi=10000),
         "inflate_s": F("float", "from the charge firing to a full canopy", lo=0, hi=30),
+        "continuity_channel": F("pin", "the analog input that reads the igniter's continuity through a sense "
+                                "resistor, e.g. \"A2\" (absent: no continuity input, the igniter is not simulated)",
+                                required=False),
+        "intact_volts": F("float", "what the continuity input reads with the igniter intact, V", default=2.5,
+                          lo=0, hi=5),
+        "open_volts": F("float", "what it reads with the igniter open (after its charge fired, or broken), V",
+                        default=0.0, lo=0, hi=5),
     })
+
+
+# [scenario] keys of both plants: a reset of the MCU at a phase of the flight (fswkit.plant.cosim).
+_RESET = {
+    "reset_state": F("str", "the MCU resets once, reset_after_s after telemetry first shows the machine in this "
+                     "state (absent: no such reset)", required=False),
+    "reset_after_s": F("float", "with reset_state: seconds after telemetry first shows that state", default=0.2,
+                       lo=0, hi=3600),
+    "reset_cause": F("str", "with reset_state: why the MCU resets: brownout, watchdog, external or power "
+                     "(fswkit.sim.board.RESET_CAUSES)", default="brownout"),
+}
 
 
 ROCKET_SCHEMA = {
@@ -99,8 +122,9 @@ ROCKET_SCHEMA = {
         "linger_s": F("float", "simulated seconds run on after the landed state", default=1.0, lo=0, hi=600),
         "landed_timeout_s": F("float", "after touchdown, give up waiting for the landed state", default=10.0,
                               lo=0, hi=600),
-        "hold_s": F("float", "pinned-sensor faults: the vehicle sits armed on the pad until this second",
-                    default=20.0, above=0, hi=3600),
+        "hold_s": F("float", "pinned-sensor and open-igniter faults: the vehicle sits on the pad with its arming "
+                    "key on until this second", default=20.0, above=0, hi=3600),
+        **_RESET,
     }),
     "firmware": Table("where the plant and the checks find things in the project", {
         "machine": F("str", "the mission machine"),
@@ -156,6 +180,7 @@ TANK_SCHEMA = {
         "failure_s": F("float", "the regulator fails at this simulated second", lo=0, hi=3600),
         "max_s": F("float", "the run stops here whatever happens", above=0, hi=3600),
         "linger_s": F("float", "simulated seconds run on after the abort state", default=1.0, lo=0, hi=600),
+        **_RESET,
     }),
     "firmware": Table("where the plant and the checks find things in the project", {
         "machine": F("str", "the vent controller's machine"),
@@ -215,6 +240,23 @@ class Pyro:
             self.fired_at = self.high_since + self.fire_s
             return self.fired_at
         return None
+
+
+class Igniter:
+    """A pyro channel's igniter as its continuity input sees it: through a
+    sense resistor, `intact_volts` while the igniter conducts, `open_volts`
+    once its charge has fired (the bridge wire is gone) or from boot when it
+    is broken or unconnected (`broken`)."""
+
+    def __init__(self, channel: str, pyro: Pyro, intact_volts: float, open_volts: float, broken: bool = False):
+        self.channel, self.pyro = channel, pyro
+        self.intact_volts, self.open_volts, self.broken = intact_volts, open_volts, broken
+
+    def volts(self, t: float) -> float:
+        fired = self.pyro.fired_at
+        if self.broken or (fired is not None and fired <= t):
+            return self.open_volts
+        return self.intact_volts
 
 
 # ---- binding a parameters file to the project --------------------------------------------
@@ -301,6 +343,26 @@ class _Binder:
         return None
 
 
+def _bind_reset(sc, bind: _Binder, m, sc_table: dict) -> None:
+    """[scenario]'s reset at a phase of the flight, checked: a state of the
+    machine, a cause the board can simulate, no reset_after_s or
+    reset_cause without a reset_state."""
+    from fswkit.sim.board import RESET_CAUSES
+
+    sc.reset_state = sc_table["reset_state"]
+    sc.reset_after_s = sc_table["reset_after_s"]
+    sc.reset_cause = sc_table["reset_cause"]
+    if sc.reset_state is not None:
+        bind.state(m, "reset_state", sc.reset_state, table="scenario")
+    else:
+        for key in ("reset_after_s", "reset_cause"):
+            if ("scenario", key) in bind.where:
+                bind.err("scenario", key, "needs reset_state (the state whose first sighting starts the count)")
+    if sc.reset_cause not in RESET_CAUSES:
+        bind.err("scenario", "reset_cause", f"`{sc.reset_cause}` is not a reset cause (one of "
+                 + ", ".join(RESET_CAUSES) + ")")
+
+
 def load(kind: str, path: str, app, layout, seed: int, fault: str | None):
     """The scenario of a parameters file, checked against the project."""
     if kind not in SCHEMAS:
@@ -379,6 +441,7 @@ class RocketScenario:
             bind.state(m, "pad_states", name)
         for name in p["checks"]["sequence"]:
             bind.state(m, "sequence", name, table="checks")
+        _bind_reset(self, bind, m, sc)
         self.main_alt = bind.local(m, "main_altitude", fw["main_altitude"])
         backup = bind.local(m, "apogee_backup", fw["apogee_backup"])
         self.backup_s = None if backup is None else backup * _time_unit_s(bind.app)
@@ -423,18 +486,53 @@ class RocketScenario:
         self.pyros = {pins["drogue"]: Pyro(p["drogue"]["fire_ms"] / 1000),
                       pins["main"]: Pyro(p["main"]["fire_ms"] / 1000)}
         self.levels = {pin: False for pin in self.pins}
+        self.igniters = self._igniters(bind, fault, (baro, accel))
+        # each continuity input's volts in the truth rows, only when there are any (columns as before otherwise)
+        self.columns = RocketScenario.columns + tuple(f"{role}_cont_v" for role in self.igniters)
+        self.cont_v = {role: ig.volts(0.0) for role, ig in self.igniters.items()}
         self.baro_noise = Noise(baro_rng, p["barometer"]["noise_pa"])
         self.accel_noise = Noise(accel_rng, p["accelerometer"]["noise_g"])
         # the ADC channels by the names the I/O tables give them, whatever form plant.toml used
         self.channels = (baro.pin if baro is not None else p["barometer"]["channel"],
                          accel.pin if accel is not None else p["accelerometer"]["channel"])
-        self.ignition_s = None if fault in ("pinned-accel", "pinned-baro") else sc["ignition_s"]
+        self.ignition_s = None if fault in PAD_FAULTS else sc["ignition_s"]
         self.max_s = sc["hold_s"] if self.ignition_s is None else sc["max_s"]
         self.frozen_baro: float | None = None
         self.landed_seen: float | None = None
         self.t = 0.0
         self.baro_v = self.accel_v = 0.0
         self.arm = False
+
+    def _igniters(self, bind: _Binder, fault: str | None, sensors) -> dict[str, Igniter]:
+        """The igniters of the chutes whose table names a continuity input,
+        by role; open-igniter breaks the drogue's (which must then have one)."""
+        p = self.p
+        used = {c.pin_number: f"[{t}] channel" for c, t in zip(sensors, ("barometer", "accelerometer"))
+                if c is not None}
+        out = {}
+        for role in ("drogue", "main"):
+            chute = p[role]
+            pin = chute["continuity_channel"]
+            if pin is None:
+                for key in ("intact_volts", "open_volts"):
+                    if (role, key) in bind.where:
+                        bind.err(role, key, "needs continuity_channel (the analog input the igniter drives)")
+                if role == "drogue" and fault == "open-igniter":
+                    bind.err(role, "continuity_channel", "missing: --fault open-igniter opens the drogue's igniter, "
+                             "which the firmware can only see through a continuity input: name the analog input "
+                             "that reads it (continuity_channel = \"A2\")")
+                continue
+            c = bind.channel(role, "continuity_channel", pin, True, "i")
+            if c is None:
+                continue
+            if c.pin_number in used:
+                bind.err(role, "continuity_channel", f"pin {pin} is already driven by {used[c.pin_number]}: each "
+                         "sensor and igniter needs its own analog input")
+                continue
+            used[c.pin_number] = f"[{role}] continuity_channel"
+            out[role] = Igniter(c.pin, self.pyros[p["pins"][role]], chute["intact_volts"], chute["open_volts"],
+                                broken=role == "drogue" and fault == "open-igniter")
+        return out
 
     # -- sensors --
     def _baro_volts(self) -> float:
@@ -460,7 +558,11 @@ class RocketScenario:
         self.baro_v = min(max(baro, 0.0), self.vref)
         self.accel_v = min(max(accel, 0.0), self.vref)
         self.arm = t >= self.p["scenario"]["arm_s"]
-        return ({self.channels[0]: self.baro_v, self.channels[1]: self.accel_v}, {self.arm_pin: self.arm})
+        analog = {self.channels[0]: self.baro_v, self.channels[1]: self.accel_v}
+        for role, ig in self.igniters.items():
+            v = self.cont_v[role] = min(max(ig.volts(t), 0.0), self.vref)
+            analog[ig.channel] = v
+        return analog, {self.arm_pin: self.arm}
 
     # -- time --
     def advance(self, t0: float, t1: float, edges) -> list[PinEvent]:
@@ -491,7 +593,7 @@ class RocketScenario:
         return (round(t, 6), r.h, r.v, r.a, r.specific_force() / G0, r.static_pressure(), r.mass(t), r.thrust(t),
                 r.cd_area(t), r.inflation("drogue", t), r.inflation("main", t), int(self.arm),
                 int(self.levels[self.p["pins"]["drogue"]]), int(self.levels[self.p["pins"]["main"]]),
-                self.baro_v, self.accel_v)
+                self.baro_v, self.accel_v) + tuple(self.cont_v.values())
 
     def done(self, t: float, state: str | None) -> bool:
         if t >= self.max_s:
@@ -523,6 +625,7 @@ class TankScenario:
         self.state_element = fw["state_element"]
         self.pressure_element = fw["pressure_element"]
         m = bind.machine_with_state(fw)
+        _bind_reset(self, bind, m, sc)
         bind.streamed("pressure_element", fw["pressure_element"])
         for key in ("control_state", "abort_state"):
             bind.state(m, key, fw[key])

@@ -9,7 +9,9 @@ What it shares with the board's replay: the inputs (each tape column
 through the inverse of the `.aio` calibration and the converter,
 `counts_series`, an empty cell holding the last count), read back through
 the calibration in binary32 as the firmware computes it (count * gain +
-offset, iotables.analog_value), held between rows, and one step late as
+offset, iotables.analog_value), held between rows, and each igniter's
+continuity input (`Config.igniters`) at its intact count from boot to the
+end, read back the same way (`analog_inputs`); one step late as
 the firmware's inputs are (its ADC scan converts them in the background
 for the next run of the inputs task: step k reads the pins as they were at
 step k - 1, the first step at boot); the timeline
@@ -75,6 +77,28 @@ class _Gate:
         return True
 
 
+def _reading(sensor, counts: int) -> float:
+    """The element's value for a count, as the firmware computes it (binary32)."""
+    gain = analog_gain(sensor.scale, sensor.vref, sensor.bits, F32MODE)
+    return analog_value(counts, gain, F32MODE.literal(repr(float(sensor.offset))), F32MODE)
+
+
+def analog_inputs(cfg, columns: dict) -> tuple[dict, dict]:
+    """What the machines read from the analog inputs the replay drives:
+    (element -> value at each tape row, for the columns' sensors; element ->
+    value all the replay, for the igniters' continuity inputs), each the
+    board's count (the same counts and millivolts as tape_replay gives the
+    board) through the calibration in binary32."""
+    series = {}
+    for col, s in cfg.sensors.items():
+        if s is None:
+            continue
+        counts = counts_series(columns[col], s, cfg.missing, cfg.silent_volts)
+        series[s.element] = [_reading(s, k) for k in counts.tolist()]
+    constant = {ig.sensor.element: _reading(ig.sensor, ig.counts) for ig in getattr(cfg, "igniters", {}).values()}
+    return series, constant
+
+
 def _mission(app, cfg):
     names = set(cfg.states.values())
     m = next((m for m in app.machines if names <= {s.name for s in m.states}), None)
@@ -94,13 +118,7 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     t = tape.time
     cols = columns if columns is not None else _columns(tape)
     offset = cfg.pad_s - float(t[0])
-    values = {}
-    for col, s in cfg.sensors.items():
-        if s is None:
-            continue
-        counts = counts_series(cols[col], s, cfg.missing, cfg.silent_volts)
-        gain, off = analog_gain(s.scale, s.vref, s.bits, F32MODE), F32MODE.literal(repr(float(s.offset)))
-        values[s.element] = [analog_value(k, gain, off, F32MODE) for k in counts.tolist()]
+    values, constant = analog_inputs(cfg, cols)
     arm = _element_of(app, cfg.arm_pin)
     pins = [(role, _element_of(app, p), p) for role, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin))
             if p is not None]
@@ -125,6 +143,7 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
             row += 1
         for name, series in values.items():
             sv[name] = series[max(row, 0)]
+        sv.update(constant)  # the igniters: intact all the replay (open loop)
         if arm is not None:
             sv[arm] = now >= cfg.arm_s
         sv["time"] = g

@@ -17,8 +17,13 @@ applies each at its cycle itself; no plant, no lock-step) and runs a
 simulated second per `SimBoard.batch`, so a replay runs as fast as simavr
 runs the firmware.
 
+Each igniter's continuity input (`[igniters]`; plant.toml's `[drogue]`/
+`[main]` `continuity_channel` by default) reads `intact_volts` the whole
+replay, quantised as the sensors are: a replay is open loop, and nothing
+opens an igniter when its pin fires (the closed-loop plant does that).
+
 Which column feeds which input, the arming switch, the pyro pins, the
-mission machine's states and the main's configured altitude come from
+igniters, the mission machine's states and the main's configured altitude come from
 `tape.toml` beside the project (or `--params FILE`), each key defaulting
 from the project's `plant.toml` where it has one (docs/sim.md, "Replaying
 real flights").
@@ -80,6 +85,16 @@ TAPE_SCHEMA = {
         "drogue": F("pin", "the drogue's pyro channel (a digital output)", default=_UNSET),
         "main": F("pin", "the main's pyro channel (a digital output)", default=_UNSET),
     }),
+    "igniters": Table("the igniters' continuity inputs: each reads intact_volts the whole replay (open loop)", {
+        "drogue_channel": F("pin", "the analog input that reads the drogue igniter's continuity (\"A2\"), or "
+                            "\"none\"", default=_UNSET),
+        "main_channel": F("pin", "the analog input that reads the main igniter's continuity, or \"none\"",
+                          default=_UNSET),
+        "intact_volts": F("float", "what a continuity input reads with its igniter intact, V (all the replay)",
+                          default=2.5, lo=0, hi=100),
+        "open_volts": F("float", "what it reads with the igniter open, V (a replay never opens one: kept as "
+                        "plant.toml's key, and shown)", default=0.0, lo=0, hi=100),
+    }),
     "firmware": Table("where the events are found in the project", {
         "machine": F("str", "the mission machine", default=_UNSET),
         "state_element": F("str", "the telemetry element holding its state", default=_UNSET),
@@ -137,6 +152,33 @@ PERTURB = {
 
 # ---- the configuration ------------------------------------------------------------------
 
+IGNITER_ROLES = ("drogue", "main")
+
+
+@dataclass(frozen=True)
+class TapeIgniter:
+    """An igniter's continuity input in a replay: the input's `.aio`
+    calibration and the converter (`sensor`), at `volts` (intact_volts) from
+    reset to the end. Open loop: nothing opens it when its pyro pin fires.
+    Its count and the board's millivolts are the sensors' (AnalogSensor)."""
+
+    role: str
+    sensor: AnalogSensor
+    volts: float  # intact_volts
+    open_volts: float  # never applied in a replay: shown
+
+    @property
+    def counts(self) -> int:
+        return self.sensor.counts(self.volts)
+
+    @property
+    def millivolts(self) -> int:
+        return self.sensor.millivolts(self.counts)
+
+    def reading(self) -> float:
+        """What the firmware's element holds (the board's arithmetic)."""
+        return self.sensor.reading(self.counts)
+
 @dataclass
 class Config:
     path: str | None  # tape.toml, if any
@@ -156,7 +198,8 @@ class Config:
     main_alt: float | None
     main_alt_name: str
     checks: dict
-    notes: list = field(default_factory=list)
+    notes: list = field(default_factory=list)  # about the configuration: printed with the report's notes
+    igniters: dict = field(default_factory=dict)  # role -> TapeIgniter (driven continuity inputs)
     eeprom: bytes | None = None  # the EEPROM programmed before boot (fsw sim --fw-params)
     nor: tuple | None = None  # (recorder plan, SimBoard spi_flash) of a recorder on an SPI NOR flash
 
@@ -211,6 +254,13 @@ def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
     if isinstance(sc, dict) and isinstance(sc.get("arm_s"), (int, float)) and not isinstance(sc["arm_s"], bool):
         vals.setdefault("tape", {})["arm_s"] = float(sc["arm_s"])
         orig[("tape", "arm_s")] = f"{path}:{where.get(('scenario', 'arm_s'), 1)}"
+    for role in IGNITER_ROLES:  # the chutes' igniters; their volts each its own (`ROLE:intact_volts`)
+        take(role, "continuity_channel", "igniters", f"{role}_channel")
+        t = data.get(role)
+        for k in ("intact_volts", "open_volts"):
+            if isinstance(t, dict) and k in t and isinstance(t[k], (int, float, str)) and not isinstance(t[k], bool):
+                vals.setdefault("igniters", {})[f"{role}:{k}"] = t[k]
+                orig[("igniters", f"{role}:{k}")] = f"{path}:{where.get((role, k), 1)}"
     return vals, orig
 
 
@@ -270,6 +320,7 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
             sensors[col] = from_channel(ch, app.board)
         except ValueError as e:
             bind.err("tape", col, str(e))
+    igniters = _igniters(app, bind, v["igniters"], given["igniters"], defaults.get("igniters", {}), origins, used)
     pin_no = {}
     for key, direction in (("arm", "i"), ("drogue", "o"), ("main", "o")):
         pin = pins[key]
@@ -318,7 +369,80 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
                  None if fw["altitude_element"] == _UNSET else fw["altitude_element"],
                  accel.element if accel is not None else None, states, main_alt, main_name, dict(v["checks"]))
     cfg.nor = _nor(app, app.board)  # the flight recorder's SPI NOR chip, when it logs to one
+    cfg.igniters = igniters
+    cfg.notes += _continuity_notes(app, igniters)
     return cfg
+
+
+def _igniters(app, bind: _Origins, ig: dict, given: dict, defaults: dict, origins: dict, used: dict) -> dict:
+    """The igniters' continuity inputs of `[igniters]` (plant.toml's chutes
+    by default), checked: an analog input of the project that no tape
+    column and no other igniter drives, volts within the converter's range;
+    role -> TapeIgniter."""
+    vref = app.board.adc_vref
+    out = {}
+    for role in IGNITER_ROLES:
+        key = f"{role}_channel"
+        pin = ig[key]
+        if pin == _UNSET or str(pin).lower() == "none":
+            continue
+        ch = bind.channel("igniters", key, pin, True, "i")
+        volts = {}
+        for k in ("intact_volts", "open_volts"):
+            if k in given:  # tape.toml's: both igniters (checked by the schema)
+                x, where = given[k], origins.get(("igniters", k))
+            elif f"{role}:{k}" in defaults:  # this chute's in plant.toml
+                x, where = defaults[f"{role}:{k}"], origins.get(("igniters", f"{role}:{k}"))
+            else:
+                x, where = TAPE_SCHEMA["igniters"].fields[k].default, None
+            if isinstance(x, str) or not 0 <= x <= vref:
+                msg = f"{where or 'tape config'}: [igniters] {k}: " + (
+                    f'expected a number (volts), found a string "{x}"' if isinstance(x, str)
+                    else f"{x:g} V is beyond the converter's 0..{vref:g} V")
+                if msg not in bind.errors:
+                    bind.errors.append(msg)
+                x = 0.0
+            volts[k] = float(x)
+        if ch is None:
+            continue
+        if ch.pin_number in used:
+            who = used[ch.pin_number]
+            who = f"the tape's {who}" if who in TAPE_COLUMNS else who
+            bind.err("igniters", key, f"pin {pin} is already driven by {who}: each sensor and igniter needs its "
+                     "own analog input")
+            continue
+        used[ch.pin_number] = f"[igniters] {key}"
+        try:
+            out[role] = TapeIgniter(role, from_channel(ch, app.board), volts["intact_volts"], volts["open_volts"])
+        except ValueError as e:
+            bind.err("igniters", key, str(e))
+    return out
+
+
+def _continuity_notes(app, igniters: dict) -> list[str]:
+    """Notes on the project's `[pyro]` continuity inputs against the
+    replay's igniters: one no igniter drives (it reads 0 V on the board),
+    one whose intact reading is below the channel's `min=`: firmware that
+    checks continuity before arming may refuse to arm."""
+    driven = {ig.sensor.pin: ig for ig in igniters.values()}
+    notes = []
+    for p in getattr(app, "pyro", ()):
+        c = p.continuity
+        if c is None:
+            continue
+        least = f", min={float(p.continuity_min):g}" if p.continuity_min is not None else ""
+        ig = driven.get(c.pin)
+        if ig is None:
+            notes.append(f"NOTE  continuity: pyro channel `{p.element.name}` reads its igniter on {c.pin} "
+                         f"(`{c.element.name}`{least}), which no igniter of this replay drives (it reads 0 V; "
+                         "name it in tape.toml's [igniters], or as continuity_channel in plant.toml's "
+                         "[drogue]/[main]): firmware that checks continuity before arming may refuse to arm")
+        elif p.continuity_min is not None and ig.reading() < float(p.continuity_min):
+            notes.append(f"NOTE  continuity: pyro channel `{p.element.name}`'s igniter on {c.pin} reads "
+                         f"{ig.reading():.4g} (intact_volts {ig.volts:g} V), below its "
+                         f"min={float(p.continuity_min):g}: firmware that checks continuity before arming may "
+                         "refuse to arm")
+    return notes
 
 
 # ---- the tape and its truth -----------------------------------------------------------------
@@ -487,6 +611,8 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
         log.commit()
     telemetry = Telemetry(run, layout, cfg.state_element, log, offset)
     initial = {pin: series[0] / 1000.0 for pin, series in mv.items()}
+    for ig in cfg.igniters.values():  # open loop: intact from reset to the end, never scheduled
+        initial[ig.sensor.pin] = ig.millivolts / 1000.0
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial,
                      eeprom=cfg.eeprom, spi_flash=cfg.nor[1] if cfg.nor else None)
@@ -725,6 +851,7 @@ def summary(rp: Replay, cfg: Config, tape, truth, checks, notes, label: str) -> 
         lines.append(f"sensor {col} → {s.pin} (`{s.element}` = V × {s.scale:g} + {s.offset:g}): {lo:g} to {hi:g} "
                      f"between the rails, one count {s.lsb:.4g}"
                      + (f"; {sat:,} rows at a rail (saturated)" if sat else ""))
+    lines += igniter_lines(cfg)
     for col, spans in rp.missing.items():
         if not spans:
             continue
@@ -736,8 +863,19 @@ def summary(rp: Replay, cfg: Config, tape, truth, checks, notes, label: str) -> 
     lines += event_table(rp, cfg, truth, tape.end)
     lines += reports._transition_lines(_Shim(run, rp), cfg.altitude_element, "altitude_m", "m")
     lines += reports._tail_lines(run)
-    lines += notes
+    lines += cfg.notes + notes
     return reports.Report(lines, checks)
+
+
+def igniter_lines(cfg: Config) -> list[str]:
+    """One line per driven continuity input: what it reads, all the replay."""
+    out = []
+    for role, ig in cfg.igniters.items():
+        s = ig.sensor
+        out.append(f"igniter {role} → {s.pin} (`{s.element}` = V × {s.scale:g} + {s.offset:g}): intact, "
+                   f"{ig.volts:g} V (count {ig.counts}, read as {ig.reading():.6g}) from reset to the end; open "
+                   f"loop, it never opens ({ig.open_volts:g} V) when its charge fires")
+    return out
 
 
 class _Shim:
@@ -917,6 +1055,7 @@ class PerturbResult:
     numbers: dict
     checks: list
     error: str | None = None
+    notes: list = field(default_factory=list)  # the configuration's (Config.notes)
 
 
 def _one_perturbed(i, seq, tape, truth, cfg, elf, board, layout) -> PerturbResult:
@@ -925,10 +1064,10 @@ def _one_perturbed(i, seq, tape, truth, cfg, elf, board, layout) -> PerturbResul
     try:
         rp = replay(tape, cfg, elf, board, layout, truth=truth, columns=cols)
     except CosimError as e:
-        return PerturbResult(i, {}, [], str(e))
+        return PerturbResult(i, {}, [], str(e), list(cfg.notes))
     nums, checks, _notes = evaluate(rp, cfg, truth, tape)
     nums["speed"] = rp.run.sim_s / rp.run.wall_s if rp.run.wall_s else float("inf")
-    return PerturbResult(i, nums, checks)
+    return PerturbResult(i, nums, checks, notes=list(cfg.notes))
 
 
 def robustness(tape, truth, cfg: Config, elf: str, board, layout: Layout, n: int, seed: int,
@@ -965,6 +1104,7 @@ def robustness_text(results: list[PerturbResult], tape, n: int, seed: int, wall:
                  f"{c}: bias sd {p.bias:g}, noise sd {p.noise:g}, spikes p={p.spike_p:g} of {p.spike[0]:g}–"
                  f"{p.spike[1]:g}, dropouts p={p.dropout_p:g} of {p.dropout_s[0]:g}–{p.dropout_s[1]:g} s"
                  for c, p in PERTURB.items())]
+    lines += list(dict.fromkeys(n for r in results for n in r.notes))  # the configuration's, once
     ok_runs = [r for r in results if r.error is None]
     speeds = [r.numbers["speed"] for r in ok_runs if "speed" in r.numbers]
     if speeds:

@@ -111,7 +111,7 @@ def runtime_objects(real: Real) -> list[str]:
     if all(os.path.exists(o) for o in objs):
         return objs
     sweep(cache_dir())
-    tmp = out + f".tmp{os.getpid()}"
+    tmp = private_tmp(out)
     with removed_when_done(tmp):
         os.makedirs(tmp, exist_ok=True)
         _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-c"]
@@ -134,7 +134,7 @@ def compile_script(script: M.Script, real: Real, source_line) -> str:
     if os.path.exists(exe):
         return exe
     sweep(cache_dir())
-    tmp = out + f".tmp{os.getpid()}"
+    tmp = private_tmp(out)
     with removed_when_done(tmp):
         os.makedirs(tmp, exist_ok=True)
         for name, text in files.items():
@@ -152,7 +152,14 @@ def compile_script(script: M.Script, real: Real, source_line) -> str:
 
 # ---- temporary folders ----------------------------------------------------------------
 
-TMP_NAME = re.compile(r"^[0-9a-f]{20}\.tmp(\d+)$")
+TMP_NAME = re.compile(r"^[0-9a-f]{20}\.tmp(\d+)(?:\.\d+)?$")
+
+
+def private_tmp(out: str) -> str:
+    """The temporary folder a compile into `out` works in: its process's and
+    its thread's own (two threads of a pool may build the same thing at
+    once), named so that `sweep` knows the process."""
+    return out + f".tmp{os.getpid()}.{threading.get_ident()}"
 STALE_S = 24 * 3600.0  # no compile takes a day: older temporary folders are leftovers
 _mine: set[str] = set()  # this process's temporary folders, removed at exit at the latest
 

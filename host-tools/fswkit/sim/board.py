@@ -64,6 +64,9 @@ TIMER_CHANNELS = {
 }
 
 STOP_REASONS = ("target", "sim-limit", "wall-limit", "done", "crashed", "interrupted")
+# What `reset` can simulate, and the MCUSR flag each leaves (ATmega328P/2560).
+RESET_CAUSES = ("brownout", "watchdog", "external", "power")
+RESET_FLAGS = {"power": 0x01, "external": 0x02, "brownout": 0x04, "watchdog": 0x08}
 
 
 class SimError(Exception):
@@ -86,7 +89,7 @@ def harness() -> str:
     """The harness executable, compiled on first use and cached by the hash
     of its source, compiler (its identity) and command. The compile runs in
     a temporary folder removed however it ends (native.removed_when_done)."""
-    from fswkit.run.native import compiler_identity, removed_when_done, sweep
+    from fswkit.run.native import compiler_identity, private_tmp, removed_when_done, sweep
 
     with open(HARNESS_SRC, "rb") as f:
         src = f.read()
@@ -100,7 +103,7 @@ def harness() -> str:
     if not os.path.exists(SIMAVR_HEADER):
         raise SimError("simavr's development files are missing: install libsimavr-dev (`make setup`)")
     sweep(cache_dir())
-    tmp = out + f".tmp{os.getpid()}"
+    tmp = private_tmp(out)
     with removed_when_done(tmp):
         try:
             os.makedirs(tmp, exist_ok=True)
@@ -341,14 +344,15 @@ class SimBoard:
     this port pin, and optionally its size in bytes ("B2", "B2:1048576"; 8
     MiB by default). flash_file / eeprom_file: files that keep the flash's /
     the EEPROM's bytes between runs (read at start if present, written when
-    the board closes).
+    the board closes). ram_seed: the seed of the pseudo-random bytes a
+    `reset("power")` leaves in RAM (the same seed, the same bytes).
     """
 
     def __init__(self, elf: str, board: str | Board = "uno", *, uart: str = "control",
                  sim_limit: float | None = None, wall_limit: float | None = None,
                  analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None,
                  eeprom: bytes | None = None, spi_flash: str | None = None, flash_file: str | None = None,
-                 eeprom_file: str | None = None):
+                 eeprom_file: str | None = None, ram_seed: int = 1):
         self.board = sim_board(board)
         self.mcu = self.board.raw["sim"]["simavr_mcu"]
         self.f_cpu = int(f_cpu or self.board.f_cpu)
@@ -378,6 +382,10 @@ class SimBoard:
             args += ["-S", os.fspath(flash_file)]
         if eeprom_file is not None:
             args += ["-E", os.fspath(eeprom_file)]
+        if int(ram_seed) != 1:
+            if not 0 <= int(ram_seed) < 1 << 64:
+                raise ValueError(f"ram_seed must be a whole number from 0 to 2**64 - 1, not {ram_seed}")
+            args += ["-R", str(int(ram_seed))]
         self._err = tempfile.TemporaryFile()
         try:
             self._proc = subprocess.Popen(args + [elf], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -516,12 +524,20 @@ class SimBoard:
         edges = self._edges(toks[7:]) if toks[6] != "n=0" or toks[7] != "overflow=0" else []
         return Batch(run, edges, bytes.fromhex(toks[5][5:]))
 
-    def reset(self) -> None:
-        """Pulses the MCU's reset line (a brown-out): the firmware starts
-        again from its reset vector with its I/O as at power-on, RAM as it
-        was; the cycle count goes on. Inputs driven from outside read their
-        power-on levels until set again."""
-        self.command("reset")
+    def reset(self, cause: str = "brownout") -> None:
+        """Resets the MCU for `cause`, one of RESET_CAUSES: "brownout" (the
+        default), "watchdog", "external" (the reset pin) or "power" (a
+        power-on). The firmware starts again from its reset vector with its
+        I/O as at power-on and MCUSR holding that cause's flag alone (BORF,
+        WDRF, EXTRF, PORF); the cycle count goes on. RAM keeps its bytes,
+        except after "power", which fills it with pseudo-random bytes from
+        `ram_seed` (nothing kept in RAM survives a power-on). After
+        "watchdog" the watchdog runs at its shortest period, as on the part.
+        Inputs driven from outside read their power-on levels until set
+        again."""
+        if cause not in RESET_CAUSES:
+            raise ValueError(f"reset cause {cause!r}: one of {', '.join(RESET_CAUSES)}")
+        self.command(f"reset {cause}")
 
     def go(self, until: float | None = None, realtime: bool = True) -> RunResult:
         """Runs free, paced to the wall clock unless realtime=False, until
@@ -682,8 +698,8 @@ class SimBoard:
 
     def eeprom_cut(self, writes: int) -> None:
         """A power cut right after the firmware's `writes`-th EEPROM byte
-        write from now: the MCU resets there, the EEPROM keeps what was
-        written."""
+        write from now: the MCU resets there as with reset("power") (MCUSR
+        PORF, RAM pseudo-random), the EEPROM keeps what was written."""
         self.command(f"eeprom cut {int(writes)}")
 
     def eeprom_count(self) -> tuple[int, int]:
@@ -724,8 +740,8 @@ class SimBoard:
 
     def flash_cut(self, operations: int) -> None:
         """A power cut right after the `operations`-th page program or erase
-        from now starts: the MCU resets there and that operation is left
-        half done (a prefix of its bytes programmed or erased, the same for
+        from now starts: the MCU resets there as with reset("power") and
+        that operation is left half done (a prefix of its bytes programmed or erased, the same for
         the same operation count); the chip's BUSY and WEL are cleared."""
         self.command(f"flash cut {int(operations)}")
 

@@ -21,7 +21,7 @@
    usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S]
                    [-u control|pty|stdio|stdout|none] [-l LINK] [-r]
                    [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]
-                   [-s CSPIN[:SIZE] [-S FLASH_FILE]] FW.elf
+                   [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-R SEED] FW.elf
 
    -s puts an SPI NOR flash chip (a W25Q64JV's commands and timing) on the
    AVR's SPI, its chip select on pin CSPIN (B2: the Uno's D10); -S and -E
@@ -43,6 +43,7 @@
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_spi.h>
 #include <simavr/avr_uart.h>
+#include <simavr/avr_watchdog.h>
 #include <simavr/sim_avr.h>
 #include <simavr/sim_cycle_timers.h>
 #include <simavr/sim_elf.h>
@@ -737,8 +738,98 @@ static void on_fl_cs(struct avr_irq_t* irq, uint32_t value, void* param) {
     }
 }
 
-/* The board loses power: the chip's operation in progress stays half done,
-   its latches and the transaction on the wire are lost; the AVR resets. */
+/* A digital input driven from outside to `level`. simavr drops a raise of
+   the value an IRQ already holds, but a reset clears the PIN register
+   without telling the IRQ: the old value is forgotten first, so that the
+   level reaches the pin however it was driven before (every path that
+   drives a pin goes through here: din, batch, scheduled changes). */
+static void drive_pin(avr_t* a, char port, uint8_t bit, uint32_t level) {
+    avr_irq_t* irq = avr_io_getirq(a, AVR_IOCTL_IOPORT_GETIRQ(port), bit);
+    irq->value = !level;
+    avr_raise_irq(irq, level);
+}
+
+/* ---- resets and their causes ---------------------------------------------------------- */
+
+/* Firmware learns why it restarted from MCUSR (ATmega328P and ATmega2560:
+   PORF 0x01, EXTRF 0x02, BORF 0x04, WDRF 0x08), read at boot. simavr 1.6's
+   avr_reset clears every I/O register, MCUSR included, and only avr_init
+   sets PORF: after a plain avr_reset the firmware would read no cause at
+   all. mcu_reset leaves exactly its cause's flag there. */
+enum { CAUSE_BROWNOUT, CAUSE_WATCHDOG, CAUSE_EXTERNAL, CAUSE_POWER, N_CAUSES };
+static const char* const cause_names[N_CAUSES] = {"brownout", "watchdog", "external", "power"};
+
+/* -R SEED: the bytes a power-on leaves in SRAM. A real power-on leaves
+   whatever the cells settle to; zeros (simavr's) or the old contents could
+   pass a firmware's check of a value kept in RAM. One generator for the
+   run, so that the same seed gives the same bytes and a second power-on
+   others. */
+static uint64_t ram_rng = 1;
+
+static uint64_t splitmix64(uint64_t* s) {
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static avr_watchdog_t* watchdog_of(avr_t* a) {
+    for (avr_io_t* p = a->io_port; p; p = p->next)
+        if (p->kind && !strcmp(p->kind, "watchdog")) return (avr_watchdog_t*)p;
+    return NULL;
+}
+
+/* The MCU resets for `cause`: registers, I/O and the program counter as at
+   power-on; the cycle count (the co-simulation's clock) goes on. SRAM
+   keeps its bytes, except after a power-on, which fills it from -R's
+   generator. A watchdog reset goes through simavr's own path (its
+   watchdog module's reset context), so the watchdog comes back enabled
+   at its shortest period with WDRF set, as on the part: firmware must
+   clear WDRF and turn it off early, or it resets again 16 ms later. */
+static void mcu_reset(avr_t* a, int cause) {
+    avr_watchdog_t* wd = cause == CAUSE_WATCHDOG ? watchdog_of(a) : NULL;
+    if (wd && !wd->reset_context.wdrf) { /* else its own reset is already pending: the same path */
+        wd->reset_context.avr_run = a->run;
+        wd->reset_context.wdrf = 1;
+    }
+    /* Every pin becomes an input at the reset: a watched output the firmware
+       drove high is let go then (the circuit's pull-down takes it low), not
+       when the new boot writes its port again. simavr clears the registers
+       without telling the pins' IRQs, so the edge is recorded here. */
+    uint8_t let_go[MAX_WATCH] = {0};
+    for (int i = 0; i < MAX_WATCH; i++) {
+        avr_ioport_state_t st;
+        watch_t* w = &watches[i];
+        if (w->active && w->level && port_state(w->port, &st) == 0 && (st.ddr >> w->bit & 1u)) let_go[i] = 1;
+    }
+    avr_cycle_count_t cycle = a->cycle;
+    avr_reset(a);
+    a->cycle = cycle;
+    for (int i = 0; i < MAX_WATCH; i++) {
+        if (!watches[i].active) continue;
+        if (let_go[i]) {
+            on_pin(NULL, 0, &watches[i]);
+            /* and its IRQ told so: else simavr would drop the next raise to 1 as no change */
+            avr_io_getirq(a, AVR_IOCTL_IOPORT_GETIRQ(watches[i].port), watches[i].bit)->value = 0;
+        }
+    }
+    if (cause == CAUSE_POWER)
+        for (uint32_t addr = (uint32_t)a->ioend + 1; addr <= a->ramend; addr += 8) {
+            uint64_t r = splitmix64(&ram_rng);
+            for (uint32_t i = 0; i < 8 && addr + i <= a->ramend; i++) a->data[addr + i] = (uint8_t)(r >> (8 * i));
+        }
+    const avr_regbit_t flag = cause == CAUSE_POWER      ? a->reset_flags.porf
+                              : cause == CAUSE_EXTERNAL ? a->reset_flags.extrf
+                              : cause == CAUSE_WATCHDOG ? a->reset_flags.wdrf
+                                                        : a->reset_flags.borf;
+    if (flag.reg) a->data[flag.reg] = (uint8_t)(flag.mask << flag.bit); /* that flag alone */
+}
+
+/* The board loses power (`eeprom cut`, `flash cut`, `reset power`): the
+   chip's operation in progress stays half done, its latches and the
+   transaction on the wire are lost; the AVR comes back with a power-on
+   reset (MCUSR = PORF, SRAM garbage): firmware that resumes from RAM after
+   a brown-out must not find anything to resume after a power cut. */
 static void power_cut(avr_t* a) {
     cut_now = 0;
     if (fl.mem) {
@@ -747,9 +838,7 @@ static void power_cut(avr_t* a) {
         fl.busy = fl.wel = fl.powered_down = 0;
         avr_cycle_timer_cancel(a, on_fl_done, NULL);
     }
-    avr_cycle_count_t cycle = a->cycle;
-    avr_reset(a);
-    a->cycle = cycle;
+    mcu_reset(a, CAUSE_POWER);
     fl.cs_level = 1; /* CS floats: the pull-up */
     fl.n = 0;
 }
@@ -1002,7 +1091,7 @@ static int cmd_batch(int argc, char** argv) {
             avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, (int)v), (uint32_t)value);
         } else {
             parse_u64(argv[i] + 1, &v);
-            avr_raise_irq(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(argv[i][0]), (int)v), (uint32_t)value);
+            drive_pin(avr, argv[i][0], (uint8_t)v, (uint32_t)value);
         }
     }
     put_run(run_until(1, target, 0, 0));
@@ -1028,12 +1117,7 @@ static int cmd_din(int argc, char** argv) {
     unsigned long long a;
     if (argc != 4 || parse_port_bit(argv[1], argv[2], &port, &bit) || parse_u64(argv[3], &a) || a > 1)
         return fail("usage: din PORT BIT 0|1 (a port this MCU has)");
-    avr_irq_t* irq = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(port), bit);
-    /* simavr drops a raise of the value an IRQ already holds, but a reset
-       clears the PIN register without telling the IRQ: forget the old value,
-       so that the level reaches the pin however it was driven before. */
-    irq->value = !a;
-    avr_raise_irq(irq, (uint32_t)a);
+    drive_pin(avr, port, bit, (uint32_t)a);
     fprintf(proto, "ok\n");
     return 1;
 }
@@ -1139,7 +1223,7 @@ static avr_cycle_count_t on_sched(struct avr_t* a, avr_cycle_count_t when, void*
     while (sched_at < sched_n && sched_v[sched_at].cycle <= a->cycle) {
         const sched_t* e = &sched_v[sched_at++];
         if (e->port)
-            avr_raise_irq(avr_io_getirq(a, AVR_IOCTL_IOPORT_GETIRQ(e->port), e->bit), e->value);
+            drive_pin(a, e->port, e->bit, e->value);
         else
             avr_raise_irq(avr_io_getirq(a, AVR_IOCTL_ADC_GETIRQ, e->bit), e->value);
     }
@@ -1362,18 +1446,27 @@ static int cmd_stop(int argc, char** argv) {
     return 1;
 }
 
-/* A brown-out: the reset line pulsed. Registers, I/O and the program counter
-   as at power-on, RAM as it was; the cycle count (the co-simulation's clock) goes on. */
+/* `reset [brownout|watchdog|external|power]`: the MCU resets for that cause
+   (mcu_reset; brownout by default). Registers, I/O and the program counter
+   as at power-on, MCUSR holding the cause's flag alone; RAM as it was but
+   after `power`, which fills it with -R's pseudo-random bytes; the cycle
+   count (the co-simulation's clock) goes on. `power` is the whole board's:
+   the SPI flash loses power too, as in a power cut. */
 static int cmd_reset(int argc, char** argv) {
-    NO_ARGS;
-    avr_cycle_count_t cycle = avr->cycle;
-    avr_reset(avr);
-    avr->cycle = cycle;
-    halted = 0;
-    if (fl.mem && !fl.cs_level) { /* the AVR lets go of CS: the pull-up raises it, the chip sees it rise */
-        fl_tick();
-        fl_deselect();
+    int cause = argc == 1 ? CAUSE_BROWNOUT : -1;
+    for (int i = 0; argc == 2 && i < N_CAUSES; i++)
+        if (!strcmp(argv[1], cause_names[i])) cause = i;
+    if (cause < 0) return fail("usage: reset [brownout|watchdog|external|power]");
+    if (cause == CAUSE_POWER) {
+        power_cut(avr); /* the chip's operation in progress half done, its latches lost */
+    } else {
+        mcu_reset(avr, cause);
+        if (fl.mem && !fl.cs_level) { /* the AVR lets go of CS: the pull-up raises it, the chip sees it rise */
+            fl_tick();
+            fl_deselect();
+        }
     }
+    halted = 0;
     fprintf(proto, "ok\n");
     return 1;
 }
@@ -1438,7 +1531,7 @@ static void usage(void) {
     fprintf(stderr,
             "usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S] [-u control|pty|stdio|stdout|none]\n"
             "                [-l LINK] [-r] [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]\n"
-            "                [-s CSPIN[:SIZE] [-S FLASH_FILE]] FW.elf\n");
+            "                [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-R SEED] FW.elf\n");
 }
 
 int main(int argc, char** argv) {
@@ -1447,7 +1540,7 @@ int main(int argc, char** argv) {
     unsigned long long adc_init[16];
     int adc_set[16] = {0};
     const char* flash_spec = NULL;
-    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:s:S:E:")) != -1) {
+    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:s:S:E:R:")) != -1) {
         char* end;
         switch (opt) {
             case 'c': control = 1; break;
@@ -1503,6 +1596,12 @@ int main(int argc, char** argv) {
             case 's': flash_spec = optarg; break;
             case 'S': fl.file = optarg; break;
             case 'E': ee_file = optarg; break;
+            case 'R': {
+                unsigned long long v;
+                if (parse_u64(optarg, &v)) { fprintf(stderr, "simboard: -R needs a seed (a whole number)\n"); return 2; }
+                ram_rng = (uint64_t)v;
+                break;
+            }
             default: usage(); return 2;
         }
     }

@@ -54,6 +54,11 @@ HELLO_PAYLOAD = struct.Struct("<BIIIBBBBHB")
 HEALTH_PAYLOAD = struct.Struct("<IIIIHBHHHHHHHB")
 # then one HEALTH_TASK per task
 HEALTH_TASK = struct.Struct("<BBHH")    # mode, faults, overruns, worst_us
+# then one status byte per [pyro] channel (fsw_io.h kPyro*), in [pyro] order
+HEALTH_PYRO = 1
+PYRO_ARMED, PYRO_CONTINUITY, PYRO_NO_SENSE, PYRO_FIRED, PYRO_FIRING = 0x01, 0x02, 0x04, 0x08, 0x10
+# the reset cause's bit that says the flight's state was resumed (fsw_resume.h)
+RESET_RESUMED = 0x80
 ACK_PAYLOAD = struct.Struct("<HBBH")    # command seq, opcode, status, last_seq; then a parameter command's data
 PARAM_INFO = struct.Struct("<BHHBI")    # source, seq, live CRC, count, table hash
 # the parameter store's state byte: bits 0..1 the source, bit 6 unsaved changes, bit 7 a bank being written

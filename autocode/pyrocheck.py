@@ -562,6 +562,15 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
             for e in g.edges[s]:
                 if e.dst not in armed:
                     continue
+                cont = ch.continuity.element.name if ch.continuity is not None else None
+                cv = m.var(cont) if cont is not None else None
+                if cont is not None and (cv is None or not any(cv.index in _reads(c) for c, _ in e.conds)):
+                    # arming without a look at the igniter: warned once per transition and channel
+                    r.diags.warning(msrc, SM, e.goto.line, e.goto.col,
+                                    f"transition from `{m.states[e.src].name}` into armed state "
+                                    f"`{m.states[e.dst].name}` arms pyro channel `{name}` ({where}) without reading "
+                                    f"its continuity input `{cont}`: an open igniter would be armed (guard it, e.g. "
+                                    f"`... and {cont} >= {_decimal(ch.continuity_min)}`, docs/safety.md)")
                 missing = [n for n, i in arm_vars if i is None or not requires(e.conds, i, g.folder)]
                 if not missing:
                     continue

@@ -303,6 +303,9 @@ class Flight:
     number: int
     start: Record | None  # None: its start record was overwritten (`full newest`)
     records: list[Record]
+    # the start records written again for the same flight after the firmware
+    # resumed it from a reset in flight (docs/safety.md): the flight goes on
+    resumed: list[Record] = field(default_factory=list)
 
     @property
     def samples(self) -> list:
@@ -329,7 +332,9 @@ def decode(p: Plan, image: bytes) -> tuple[list[Flight], int]:
     records.sort(key=lambda r: (newest.seq - r.seq) & 0xFFFF, reverse=True)  # oldest first
     flights: list[Flight] = []
     for r in records:
-        if r.kind == START or not flights or flights[-1].number != r.flight:
+        if r.kind == START and flights and flights[-1].number == r.flight and flights[-1].start is not None:
+            flights[-1].resumed.append(r)  # the same flight, resumed after a reset in flight
+        elif r.kind == START or not flights or flights[-1].number != r.flight:
             flights.append(Flight(r.flight, r if r.kind == START else None, []))
         if r.kind == DATA:
             flights[-1].records.append(r)

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from . import model as M
-from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD, PROTOCOL,
+from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_PYRO, HEALTH_TASK, HELLO_PAYLOAD, PROTOCOL,
                        SNAPSHOT_OFFSET, encoded_max)
 
 
@@ -77,7 +77,7 @@ def link_plan(app) -> LinkPlan:
         every = int(tele_rate / s.rate)
         streams.append(LinkStream(i, s.region, s.rate, every, _batch(s.region.size, s.rate)))
     health_every = max(1, int(app.tasks[tele].rate // HEALTH_HZ)) if tele is not None else 0
-    health_payload = HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks)
+    health_payload = HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks) + HEALTH_PYRO * len(app.pyro)
     bodies = [HELLO_PAYLOAD.size, ACK_PAYLOAD.size, health_payload] + [s.batch * s.region.size for s in streams]
     longest = max(bodies)
     sv_size = max(app.sv.size, 1)
@@ -101,6 +101,8 @@ def link_text(app) -> str:
         lines.append(f"writable {e.name}")
     for m in app.machines:  # S is shown by state name
         lines.append(f"machine {m.name} {m.vars[m.s].name} " + " ".join(f"{st.id}={st.name}" for st in m.states))
+    for p in app.pyro:  # a status byte each in health frames
+        lines.append(f"pyro {p.element.name}")
     lines.append(f"health {plan.health_every} {plan.hello_every} snapshot {plan.snapshot_chunk}")
     return "\n".join(lines) + "\n"
 

@@ -160,6 +160,8 @@ def component(name: str, machines: tuple[str, ...]) -> str:
     if re.search(rf"fsw_gen::({ms})::|task_({ms})\b|fsw::machine_|fsw::roll_|ext_push|"
                  r"_read_key|fsw::(read|write)_F32|real_from_|round_to_f32|fsw::(\w+)_from_real", bare):
         return "generated machines + their runtime"
+    if re.search(r"resume|pyro|time_base", bare, re.I):
+        return "pyro gates + resuming after a reset"
     if re.search(r"link|cobs|crc|(^|::)put(_\w+)?$|frame_|send_control|(^|::)apply$|service|pump|"
                  r"executor_owns|g_rx|g_tx|g_enc|console|uart|__vector_1[89]$", bare, re.I):
         return "link + UART console"
@@ -240,6 +242,41 @@ def rocket_footprint() -> dict:
             "parts": symbol_breakdown(elf, tuple(m.name for m in app.machines))}
 
 
+def pyro_cost() -> tuple[tuple[int, int], tuple[int, int]]:
+    """((flash, RAM) of the rocket, (flash, RAM) of the same rocket without
+    its [pyro] section): what its two pyro channels cost with all that comes
+    with them -- the gates, the continuity status, the health frame's
+    status bytes, and keeping the flight across a reset (docs/safety.md).
+    RAM is .data + .bss + .noinit."""
+    import shutil
+    import tempfile
+
+    from fswkit.sim.command import build as build_for_sim
+
+    sizes = []
+    with tempfile.TemporaryDirectory(prefix="fsw-bench-pyro-") as tmp:
+        for keep in (True, False):
+            proj = os.path.join(tmp, "with" if keep else "without", "rocket")
+            shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
+            if not keep:
+                app = os.path.join(proj, "rocket.app")
+                text = open(app).read()
+                open(app, "w").write(text[:text.index("[pyro]")])
+            built = build_for_sim(proj, "uno", os.path.join(tmp, "out-with" if keep else "out-without"))
+            if isinstance(built, int):
+                sys.exit("bench: building the rocket for the pyro cost failed")
+            flash, ram = elf_size(built[0])
+            sizes.append((flash, ram + elf_noinit(built[0])))
+    return sizes[0], sizes[1]
+
+
+def print_pyro_cost() -> None:
+    (f1, r1), (f0, r0) = pyro_cost()
+    print()
+    print("the rocket's two pyro channels (gates, continuity, health status, resuming after a reset): "
+          f"+{f1 - f0:,} B flash ({f0:,} -> {f1:,}), +{r1 - r0:,} B RAM ({r0:,} -> {r1:,}, data + bss + noinit)")
+
+
 def print_rocket(r: dict) -> None:
     print()
     print("rocket example on the Uno (fsw build; stack measured through the demo flight, fsw sim --plant rocket "
@@ -270,6 +307,9 @@ def main() -> int:
     if sys.argv[1:] == ["rocket"]:
         print_rocket(rocket_footprint())
         return 0
+    if sys.argv[1:] == ["pyro"]:
+        print_pyro_cost()
+        return 0
     avg, worst = avr_cycles()
     instr = x86_instructions()
     flash, ram = avr_footprint()
@@ -284,6 +324,7 @@ def main() -> int:
     for name, ref, target, got, ok in rows:
         print(f"{name:<55} {ref:>10} {target:>12} {got:>10}  {'ok' if ok else 'MISSED'}")
     print_rocket(rocket_footprint())
+    print_pyro_cost()
     return 0
 
 

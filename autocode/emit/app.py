@@ -15,7 +15,7 @@ from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan
 from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
-from .machine import emit_machine
+from .machine import emit_machine, stored_locals
 from .sv import emit_sv
 
 # each element type's fsw::ElemType enumerator (firmware/src/fsw_types.h;
@@ -143,11 +143,68 @@ def _tables(app: Application, real, out: list[str]) -> dict:
 
 
 def _now(app: Application) -> str:
-    """C++ for the value of `G` now."""
+    """C++ for the value of `G` now: after a resume, from the time base."""
     if app.time_source == "cycle":
         per_cycle = (1000 if app.time_unit == "ms" else 1000000) // app.rate
-        return f"fsw::executor_cycles(ex) * {per_cycle}u"
-    return "fsw::pal::millis64()" if app.time_unit == "ms" else "fsw::pal::micros64()"
+        now = f"fsw::executor_cycles(ex) * {per_cycle}u"
+    else:
+        now = "fsw::pal::millis64()" if app.time_unit == "ms" else "fsw::pal::micros64()"
+    return f"time_base + {now}" if resumes(app) else now
+
+
+def resumes(app: Application) -> bool:
+    """Whether the firmware keeps its flight's state across a brown-out or
+    a watchdog reset (docs/safety.md): an application with pyro channels."""
+    return bool(app.pyro)
+
+
+def _resume(app: Application) -> list[str]:
+    """What a resume keeps (docs/safety.md, "A reset in flight"): the state
+    vector, each machine's bookkeeping and stored locals, the pyro gates and
+    the recorder's flight; the two banks in RAM the C runtime leaves alone."""
+    real = real_of(app)
+    spans = [("sv", "kSvSize", "the state vector")]
+    for m in app.machines:
+        ns = c_ident(m.name)
+        spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::machine)", "sizeof(fsw::Machine)",
+                      f"{m.name}: its state, entry time and last G"))
+        if stored_locals(m, real):
+            spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
+    spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
+    if app.log is not None:
+        spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
+    c = ["// ---- resuming the flight after a reset (docs/safety.md) ----",
+         f"const fsw::ResumeSpan kResumeSpans[{len(spans)}] FSW_FLASH = {{"]
+    for p, n, what in spans:
+        c.append(f"    {{{p}, {n}}},  // {what}")
+    c.append("};")
+    if app.log is not None:
+        c.append("static_assert(offsetof(fsw::Recorder, mode) == offsetof(fsw::Recorder, flight) + 1, "
+                 "\"the recorder's flight and mode are kept as one span\");")
+    c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
+    c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a CRC")
+    c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
+             f"0x{app_schema_hash(app):08x}UL, kResumeSize, {len(spans)}}};")
+    c.append("fsw::Resume resume;")
+    c.append("")
+    return c
+
+
+def _resume_begin(app: Application) -> list[str]:
+    """begin()'s lines after a resume: no pulse started again, the clock
+    going on from the kept G plus a cycle, the reset cause's resumed bit."""
+    per_cycle = -(-(1000 if app.time_unit == "ms" else 1000000) // app.rate)  # at least a cycle has passed
+    gs = sorted({m.vars[m.g].name for m in app.machines})
+    c = ["    if (resumed) {",
+         f"        fsw::pyro_resumed(Pyro, {len(app.pyro)});"]
+    for g in gs:
+        c.append(f"        if (fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u > time_base) "
+                 f"time_base = fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u;")
+    c.append("        ex.reset_cause = static_cast<uint8_t>(ex.reset_cause | fsw::kResetResumed);")
+    if app.reset_cause is not None:
+        c.append(f"        sv[E_{app.reset_cause.name}] = ex.reset_cause;")
+    c.append("    }")
+    return c
 
 
 def _app_cpp(app: Application) -> str:
@@ -162,6 +219,9 @@ def _app_cpp(app: Application) -> str:
     tables = _tables(app, real, c)
     if app.pyro:
         c.append(f"fsw::PyroGate Pyro[{len(app.pyro)}];  // the pyro channels' pulses (docs/safety.md), in [pyro] order")
+    if resumes(app):
+        c.append(f"uint64_t time_base;  // G when the flight resumed ({app.time_unit}): the clock goes on from there")
+    if app.pyro:
         c.append("")
     n = len(app.tasks)
     c.append(f"const uint32_t kPeriodUs = {1000000 // app.rate}UL;  // {app.rate} cycles per second")
@@ -176,6 +236,8 @@ def _app_cpp(app: Application) -> str:
         c += _recorder(app)
     if has_link:
         c += _link(app)
+    if resumes(app):
+        c += _resume(app)
     steps = {}
     if _shared_time_store(app):
         # G written by one function for every machine task (8 stores a call
@@ -206,9 +268,18 @@ def _app_cpp(app: Application) -> str:
     c.append("bool begin() {")
     if params:
         c.append("    fsw::param_begin(params, &kParamConfig);  // the newest valid EEPROM bank, else the defaults")
+    if resumes(app):
+        c.append("    // after a brown-out or a watchdog reset: the flight's state as the last cycle left it")
+        c.append("    const bool resumed = fsw::resume_begin(resume, &kResumeConfig, fsw::pal::reset_cause());")
+    if app.log is not None and resumes(app):
+        c.append("    const uint8_t log_flight = rec.flight, log_mode = rec.mode;  // as kept")
     if app.log is not None:
         c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")
+    if app.log is not None and resumes(app):
+        c.append("    if (resumed) fsw::log_resume(rec, log_flight, log_mode);  // the flight goes on being recorded")
     c.append("    if (fsw::executor_begin(ex, &kConfig) != fsw::kOk) return false;")
+    if resumes(app):
+        c += _resume_begin(app)
     for (kind, d), tag in tables.items():
         if kind in ("analog", "digital") and isinstance(tag, list):
             for ch in tag:
@@ -234,7 +305,10 @@ def _app_cpp(app: Application) -> str:
                  + (" and writes\n// the next parameter or record byte to the EEPROM when it is ready."
                     if params or app.log is not None else "."))
         c.append("void poll() {")
-        c.append("    (void)fsw::executor_poll(ex);")
+        if resumes(app):
+            c.append("    if (fsw::executor_poll(ex)) fsw::resume_save(resume);  // the cycle's state, kept")
+        else:
+            c.append("    (void)fsw::executor_poll(ex);")
         if has_link:
             c.append("    fsw::link_poll(link);")
         if params:
@@ -244,9 +318,11 @@ def _app_cpp(app: Application) -> str:
         c.append("}")
     else:
         c.append("// Runs a cycle when one is due.")
-        c.append("void poll() { (void)fsw::executor_poll(ex); }")
+        c.append("void poll() { if (fsw::executor_poll(ex)) fsw::resume_save(resume); }" if resumes(app)
+                 else "void poll() { (void)fsw::executor_poll(ex); }")
     c.append("// Runs one cycle now (hosts: simulations and tests).")
-    c.append("void run_cycle() { fsw::executor_run_cycle(ex); }")
+    c.append("void run_cycle() { fsw::executor_run_cycle(ex);" + (" fsw::resume_save(resume);" if resumes(app) else "")
+             + " }")
     c.append("")
     c.append("}  // namespace fsw_gen")
     c.append("")
@@ -301,9 +377,14 @@ def pyro_pulse_runs(p, task: Task) -> int:
 
 def _pyro_lines(app: Application, t: Task) -> list[str]:
     """The outputs task's pyro pins, each through fsw::pyro_gate: the arming
-    pins read now, the machine's state, the pulse in runs of this task."""
+    pins read now, the machine's state, the pulse in runs of this task, the
+    continuity reading against its minimum. When a pulse starts, the
+    flight's state is kept (fsw::resume_save) before any pin goes high: a
+    reset from then on, the firing current's brown-out first of all, finds
+    the channel fired and does not fire it again."""
     direct = _pyro_direct(app)
     name = basename(app.path)
+    real = real_of(app)
     out = []
     for k, p in enumerate(app.pyro):
         runs = pyro_pulse_runs(p, t)
@@ -316,15 +397,29 @@ def _pyro_lines(app: Application, t: Task) -> list[str]:
         arm = " && ".join(f"fsw::io_pin_read({_pin(app, a)})" if direct else f"fsw::pal::digital_read({a.pin_number})"
                           for a in p.arm)
         fire = " || ".join(f"{ns}::machine.state == {ns}::S_{st}" for st in fires)
-        gate = (f"fsw::pyro_gate(Pyro[{k}], sv[E_{p.element.name}] != 0, {arm}, {fire}, {runs}u)")
-        o = p.output
-        out.append(f"    // {name}:{p.line} pyro {p.element.name}, pin {o.pin}: armed by "
-                   + ", ".join(a.element.name for a in p.arm) + ", fires in "
-                   + ", ".join(fires) + f", {runs} runs ({float(p.pulse):g} s)")
-        if direct:
-            out.append(f"    fsw::io_pin_write({_pin(app, o)}, {gate});")
+        if p.continuity is not None:
+            el = p.continuity.element
+            sense = (f"(fsw::read_{el.type.name}(sv + E_{el.name}) >= "
+                     f"{real_literal(float(p.continuity_min), real)} ? fsw::kPyroContinuity : 0)")
         else:
-            out.append(f"    fsw::pal::digital_write({o.pin_number}, {gate});")
+            sense = "fsw::kPyroNoSense"
+        gate = f"fsw::pyro_gate(Pyro[{k}], sv[E_{p.element.name}] != 0, {arm}, {fire}, {runs}u, {sense})"
+        out.append(f"    // {name}:{p.line} pyro {p.element.name}, pin {p.output.pin}: armed by "
+                   + ", ".join(a.element.name for a in p.arm) + ", fires in "
+                   + ", ".join(fires) + f", {runs} runs ({float(p.pulse):g} s)"
+                   + (f", intact at {p.continuity.element.name} >= {float(p.continuity_min):g}"
+                      if p.continuity is not None else ""))
+        out.append(f"    const bool pyro{k} = {gate};")
+    if resumes(app):
+        rose = " | ".join(f"Pyro[{k}].status" for k in range(len(app.pyro)))
+        out.append(f"    if ((({rose}) & fsw::kPyroRose) != 0) fsw::resume_save(resume);  "
+                   "// kept fired before the pin goes high")
+    for k, p in enumerate(app.pyro):
+        o = p.output
+        if direct:
+            out.append(f"    fsw::io_pin_write({_pin(app, o)}, pyro{k});")
+        else:
+            out.append(f"    fsw::pal::digital_write({o.pin_number}, pyro{k});")
     return out
 
 
@@ -444,7 +539,7 @@ def _link(app: Application) -> list[str]:
              f"{plan.hello_every}, {up}, kSvLock"
              f"{_link_stores(app)}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
-             f"{len(app.tasks)}), \"the link's transmit buffer is too small for its control frames\");")
+             f"{len(app.tasks)}, {len(app.pyro)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")
     c.append("")
     return c
@@ -455,6 +550,7 @@ def _link_stores(app: Application) -> str:
     (every field written: a partial initializer warns under -Wextra)."""
     out = ", &params, fsw::link_param_apply, fsw::link_param_ack" if app_parameters(app) else ", 0, 0, 0"
     out += ", &rec, fsw::link_log_apply, fsw::link_log_ack" if app.log is not None else ", 0, 0, 0"
+    out += f", Pyro, {len(app.pyro)}" if app.pyro else ", 0, 0"
     return out
 
 

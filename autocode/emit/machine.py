@@ -27,6 +27,14 @@ def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
     return offsets, size, b"".join(value_bytes(v.type, values[v.index]) for v in vs)
 
 
+def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
+    """The locals a machine keeps in memory (its `loc` array): those that
+    change, and every one in a scriptable build; parameters are apart."""
+    ex = ExprEmitter(m, real, scriptable)
+    params = [] if scriptable else [v for v in m.vars if v.param is not None]
+    return [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
+
+
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
                  ns: str = "fsw_gen") -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`

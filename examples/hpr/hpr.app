@@ -50,8 +50,8 @@ element altitude delta=0.5       # 0.5 m counts, ±63 m between samples: 635 m/s
 element state
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 20480            # measured high-water mark to the RAM
-ram   1280
+flash 22528            # measured high-water mark to the RAM
+ram   1792
 
 [pyro]                 # the charges (docs/safety.md): fsw check proves each fires only armed, in its states
 # output  settings

@@ -14,6 +14,8 @@ G == 0 {
     accel     = 1
     altitude  = 0                         # stuck at the pad value all flight
     armSwitch = true
+    drogueSense = 2.5
+    mainSense = 2.5
     abortCmd  = false
 }
 G == 1000: accel = 6                      # ignition; the reading stays high

@@ -12,6 +12,8 @@ G == 0 {
     accel     = 1
     altitude  = 0
     armSwitch = false
+    drogueSense = 2.5
+    mainSense = 2.5
     abortCmd  = false
 }
 G == 500: armSwitch = true

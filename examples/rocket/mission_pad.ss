@@ -11,6 +11,8 @@ G == 0 {
     accel     = 1
     altitude  = 0
     armSwitch = false
+    drogueSense = 2.5
+    mainSense = 2.5
     abortCmd  = false
 }
 true: @assert not drogue and not main

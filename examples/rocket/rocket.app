@@ -6,6 +6,7 @@
 board uno
 rate  100
 name  rocket
+reset_cause resetCause  # the MCU's reset cause, +0x80 when the flight resumed (docs/safety.md)
 
 [configs]
 state_vector rocket.sv
@@ -46,12 +47,15 @@ rate    0 Safe Landed Abort
 erase   Safe Landed
 element altitude delta=0.1
 element state
+element drogueSense hold   # the igniters' continuity, held: a change (open once fired) is an escape
+element mainSense   hold
+element resetCause  hold   # held: a reset in flight shows as a change
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 22528            # measured high-water mark to the RAM
-ram   1280
+flash 24576            # measured high-water mark to the RAM
+ram   1792
 
 [pyro]                 # the charges (docs/safety.md): fsw check proves each fires only armed, in its states
 # output  settings
-drogue    arm=armSwitch  pulse=1  machine=mission  armed=Armed  fire=Apogee
-main      arm=armSwitch  pulse=1  machine=mission  armed=Armed  fire=Main
+drogue    arm=armSwitch  continuity=drogueSense min=1.0  pulse=1  machine=mission  armed=Armed  fire=Apogee
+main      arm=armSwitch  continuity=mainSense   min=1.0  pulse=1  machine=mission  armed=Armed  fire=Main

@@ -14,6 +14,9 @@ bool led                # status LED: lit while armed
 bool buzzer             # recovery beacon
 bool armSwitch          # the arming key
 bool abortCmd           # set by the ground to abort before launch
+F32  drogueSense        # V: the drogue igniter's continuity (about 2.5 intact, 0 open)
+F32  mainSense          # V: the main igniter's continuity
+U8   resetCause         # why the MCU last started, and 0x80 when it resumed its flight
 
 [Nav]
 U32  navState

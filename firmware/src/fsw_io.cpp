@@ -10,15 +10,28 @@ uint8_t pwm_duty_from_volts(Real volts, Real vref) {
     return U8_from_real(volts / vref * Real(255) + Real(0.5));
 }
 
-bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse) {
+bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse, uint8_t sense) {
+    uint8_t status = static_cast<uint8_t>((g.status & kPyroFired) | sense | (armed ? kPyroArmed : 0));
     if (element && g.last == 0) g.left = pulse;  // a rise: a new pulse
     g.last = element ? 1 : 0;
+    bool high = false;
     if (!element || !armed || !fire || g.left == 0) {
         g.left = 0;  // ended: low until the element falls and rises again
-        return false;
+    } else {
+        if (g.left == pulse) status |= kPyroRose | kPyroFired;
+        --g.left;
+        high = true;
+        status |= kPyroFiring;
     }
-    --g.left;
-    return true;
+    g.status = status;
+    return high;
+}
+
+void pyro_resumed(PyroGate* g, uint8_t n) {
+    for (uint8_t i = 0; i < n; ++i) {
+        g[i].left = 0;
+        g[i].status = static_cast<uint8_t>(g[i].status & ~(kPyroFiring | kPyroRose));
+    }
 }
 
 static bool analog_type_ok(uint8_t t) { return t == kF32 || t == kF64; }

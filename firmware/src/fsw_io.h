@@ -146,11 +146,22 @@ inline void io_pin_write(Pin pin, bool high) { pal::digital_write(pin.n, high); 
 
 // ---- pyro channels: the run-time gate (docs/safety.md) -----------------------
 // One per [pyro] channel, zero at boot (static storage): no pulse, the
-// element last seen false.
+// element last seen false. Kept across a reset in flight (fsw_resume.h),
+// when the pulse in progress is dropped (pyro_resumed).
 struct PyroGate {
-    uint16_t left;  // runs of the outputs task the pin may still stay high
-    uint8_t last;   // 1: the element was true at the previous run
+    uint16_t left;   // runs of the outputs task the pin may still stay high
+    uint8_t last;    // 1: the element was true at the previous run
+    uint8_t status;  // kPyro* bits as of the last run: the health frame's
 };
+
+// A channel's status bits (PyroGate::status, one byte a channel in the
+// health frame: docs/telemetry.md).
+static const uint8_t kPyroArmed = 0x01;       // every arming pin read armed
+static const uint8_t kPyroContinuity = 0x02;  // the continuity reading was at or above its minimum
+static const uint8_t kPyroNoSense = 0x04;     // the channel declares no continuity input
+static const uint8_t kPyroFired = 0x08;       // a pulse has started since the flight began (kept across a resume)
+static const uint8_t kPyroFiring = 0x10;      // the pin is high
+static const uint8_t kPyroRose = 0x20;        // the pin went high at this run: a new pulse
 
 // The level of a pyro pin at this run of the outputs task. High only while
 // the element is true, every arming input reads armed now (`armed`: the
@@ -158,8 +169,14 @@ struct PyroGate {
 // its fire states (`fire`), and for at most `pulse` runs counted from the
 // element's rise. Once low with the element still true (the pulse spent,
 // a key dropped, the machine out of its fire states) it stays low until the
-// element has been false and rises again: one pulse per rise.
-FSW_NOINLINE bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse);
+// element has been false and rises again: one pulse per rise. `sense` is
+// kPyroContinuity, 0 (an open igniter) or kPyroNoSense, for the status.
+FSW_NOINLINE bool pyro_gate(PyroGate& g, bool element, bool armed, bool fire, uint16_t pulse, uint8_t sense);
+
+// After a resume: a pulse a reset cut short is not started again (the
+// charge counts as fired the moment its pin went high; a brown-out caused
+// by the firing current itself would otherwise fire it at every restart).
+FSW_NOINLINE void pyro_resumed(PyroGate* g, uint8_t n);
 
 // ---- analog inputs, one call each (generated I/O tasks) -----------------------
 // Generated inputs tasks convert each analog input with one inline call on

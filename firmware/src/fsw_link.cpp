@@ -168,6 +168,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
                                     static_cast<uint8_t>(worst), static_cast<uint8_t>(worst >> 8)};
             put_bytes(row, sizeof row);
         }
+        for (uint8_t i = 0; i < c.n_pyro; ++i) put(c.pyro[i].status);  // kPyro* bits (fsw_io.h)
     } else {
         const uint16_t off = l.snapshot_at;
         uint16_t n = static_cast<uint16_t>(c.sv_size - off);
@@ -324,6 +325,11 @@ void link_begin(Link& l, const LinkConfig* cfg) {
     l.hello_countdown = c.hello_every;
     l.big_cycle = 0xFEu;  // the boot hello may go in the first cycle
     l.pending = kPendHello;
+    // A delimiter first: a reset that cut a frame short leaves the ground
+    // mid-frame, and without it the boot hello would be taken as the rest
+    // of that frame and lost with it.
+    const uint8_t delimiter = 0;
+    pal::console_write(&delimiter, 1);
 }
 
 Result link_telemetry_task(void* p) {

@@ -6,6 +6,7 @@
 #define FSW_LINK_H
 
 #include "fsw_executor.h"
+#include "fsw_io.h"
 #include "fsw_log.h"
 #include "fsw_param.h"
 #include "fsw_types.h"
@@ -130,6 +131,8 @@ struct LinkConfig {
     Recorder* log;                    // the flight recorder (null: none; docs/recorder.md)
     LinkLogApplyFn log_apply;         // link_log_apply, with a recorder
     LinkLogAckFn log_ack;             // link_log_ack, with a recorder
+    const PyroGate* pyro;             // the pyro channels' gates: a status byte each in health frames
+    uint8_t n_pyro;
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -213,9 +216,10 @@ constexpr bool link_writable_ok(uint16_t off, uint8_t type, uint16_t sv_size) {
 // The rest: at most 128 streams, snapshot chunks of at least one byte, and a
 // transmit buffer that holds a hello (the longest control frame but
 // health; a PARAM_INFO ack is shorter), a health frame for `n_tasks` tasks and a snapshot chunk.
-constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks) {
+constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks,
+                              uint8_t n_pyro = 0) {
     return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 20u) <= tx_cap &&
-           link_encoded_max(kLinkHeader + 34u + 6u * n_tasks) <= tx_cap &&
+           link_encoded_max(kLinkHeader + 34u + 6u * n_tasks + n_pyro) <= tx_cap &&
            link_encoded_max(kLinkHeader + 2u + snapshot_chunk) <= tx_cap;
 }
 

@@ -542,6 +542,13 @@ void log_eeprom_begin(Recorder& r, const LogConfig* cfg) {
     r.state = state_of(c);
 }
 
+void log_resume(Recorder& r, uint8_t flight, uint8_t mode) {
+    if (mode != kLogRecording || r.mode != kLogIdle) return;  // nothing to go on with, or the store is full
+    r.mode = kLogRecording;
+    r.flight = flight;
+    r.flags = kStartDue;
+}
+
 Result log_task(void* ctx) {
     Recorder& r = *static_cast<Recorder*>(ctx);
     // Most runs take no sample and find nothing to encode: they read only

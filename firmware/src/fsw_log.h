@@ -134,6 +134,12 @@ struct Recorder {
 // the newest valid record before it; a torn record there is skipped.
 void log_eeprom_begin(Recorder& r, const LogConfig* cfg);
 void log_nor_begin(Recorder& r, const LogConfig* cfg);
+// After the firmware resumed its flight from a reset in flight
+// (fsw_resume.h): `flight` and `mode` are the recorder's as kept. A flight
+// that was being recorded goes on with the same number: a start record is
+// written again (`fsw dump` shows the flight as resumed there), then its
+// samples; the record that was open at the reset is lost, as at a power cut.
+void log_resume(Recorder& r, uint8_t flight, uint8_t mode);
 // The recorder task's step (ctx = the Recorder): samples, the trigger, the
 // encoder. Never blocks, never faults.
 Result log_task(void* recorder);

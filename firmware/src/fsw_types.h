@@ -36,6 +36,14 @@
 #define FSW_FLASH
 #endif
 
+// RAM the C runtime does not clear at boot (AVR: .noinit), for what a
+// reset must not erase (fsw_resume.h). Hosts have no reset: plain RAM.
+#if defined(__AVR__)
+#define FSW_NOINIT __attribute__((section(".noinit")))
+#else
+#define FSW_NOINIT
+#endif
+
 namespace fsw {
 
 // The machine's evaluation type R (spec 4.5).

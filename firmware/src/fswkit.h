@@ -18,5 +18,6 @@
 #include "fsw_link.h"
 #include "fsw_param.h"
 #include "fsw_log.h"
+#include "fsw_resume.h"
 
 #endif  // FSWKIT_H

@@ -36,7 +36,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -65,8 +65,12 @@ static void collect() {
     uint16_t start = 0;
     for (uint16_t i = 0; i < out_len && n_frames < 64; ++i) {
         if (out[i] != 0) continue;
-        Frame& f = frames[n_frames++];
         const uint16_t n = static_cast<uint16_t>(i - start);
+        if (n == 0) {  // two delimiters in a row (the boot's first byte): no frame, as on the ground
+            start = static_cast<uint16_t>(i + 1);
+            continue;
+        }
+        Frame& f = frames[n_frames++];
         memcpy(f.body, out + start, n);
         int16_t d = cobs_decode(f.body, n);
         f.len = (d >= 8 && crc16(f.body, static_cast<uint16_t>(d)) == 0) ? static_cast<int16_t>(d - 2) : -1;
@@ -159,6 +163,17 @@ static void test_boot_hello_carries_the_schema(void) {
     uint32_t schema;
     memcpy(&schema, h->body + 7, 4);
     TEST_ASSERT_EQUAL_HEX32(0xA5A55A5AUL, schema);
+}
+
+// The first byte after boot is a delimiter: a reset that cut a frame short
+// leaves the ground mid-frame, and the boot hello must not be taken as the
+// rest of it.
+static void test_the_link_starts_with_a_delimiter(void) {
+    TEST_ASSERT_EQUAL_UINT16(1, out_len);
+    TEST_ASSERT_EQUAL_HEX8(0, out[0]);
+    run(1);
+    collect();
+    TEST_ASSERT_NOT_NULL(find(kFrameHello));
 }
 
 static void test_samples_batch_with_time_and_sequence(void) {
@@ -293,7 +308,7 @@ static void test_mode_commands(void) {
 // changes only by MODE.
 static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
 static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0};
 
 static void test_set_of_a_mode_element_is_locked(void) {
     link_begin(link, &kConfigMode);
@@ -428,6 +443,7 @@ static void run_all(void) {
     RUN_TEST(test_crc_is_ccitt_false);
     RUN_TEST(test_cobs_roundtrip_and_limits);
     RUN_TEST(test_boot_hello_carries_the_schema);
+    RUN_TEST(test_the_link_starts_with_a_delimiter);
     RUN_TEST(test_samples_batch_with_time_and_sequence);
     RUN_TEST(test_health_reports_tasks_and_counters);
     RUN_TEST(test_full_uart_drops_and_counts_never_blocks);

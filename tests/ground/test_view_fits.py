@@ -49,13 +49,15 @@ def rocket_view(spark=("altitude", "accel"), samples: int = 80):
                                                                  101325.0 - 12 * alt)), at)
         seq += 1
         if k % 10 == 0:
-            feed(wire.downlink(0x81, seq, 20 * k, outs.struct.pack(1, 0, 1, 0, 1, 0)), at)
+            feed(wire.downlink(0x81, seq, 20 * k, outs.struct.pack(*[(0, 1)[i % 2] if e.type == "bool" else 2.5 if e.type == "F32" else 0x04
+                                                                for i, e in enumerate(outs.elements)])), at)
             seq += 1
     head = HEALTH_PAYLOAD.pack(0, seq, 0, 1600, 2, 0x01, 3, 0, 0, 0, 0, 0, 0, 0)
     tasks = b"".join(HEALTH_TASK.pack(1 if n == "nav" else 2, 0, 3 if n == "mission" else 0, 120 + 37 * i)
                      for i, (n, _) in enumerate(lay.tasks))
+    pyro = bytes([0x01 | 0x02] * len(lay.pyro))  # armed, continuity, not fired
     at += 0.01
-    feed(wire.downlink(wire.HEALTH, seq, 20 * samples, head + tasks), at)
+    feed(wire.downlink(wire.HEALTH, seq, 20 * samples, head + tasks + pyro), at)
     return v, at
 
 
@@ -122,6 +124,8 @@ def test_a_wide_terminal_shows_every_element_with_its_detail():
     v, last = rocket_view()
     text = "\n".join(shown(v, last + 0.05, (200, 60)))
     assert "pin A0:" in text and "writable" in text and "worst µs" in text
+    # each charge's status from the health frame, in words
+    assert "pyro drogue armed, continuity, not fired" in text and "pyro main armed, continuity, not fired" in text
 
 
 def test_rendering_is_cheap():

@@ -75,11 +75,12 @@ def test_payload_sizes_and_the_encoded_bound():
     the buffer with (schema.link_plan)."""
     h = header("fsw_link.h")
     hello = re.search(r"link_encoded_max\(kLinkHeader \+ (\d+)u\)", h)
-    health = re.search(r"link_encoded_max\(kLinkHeader \+ (\d+)u \+ (\d+)u \* n_tasks\)", h)
+    health = re.search(r"link_encoded_max\(kLinkHeader \+ (\d+)u \+ (\d+)u \* n_tasks \+ n_pyro\)", h)
     snapshot = re.search(r"link_encoded_max\(kLinkHeader \+ (\d+)u \+ snapshot_chunk\)", h)
     assert hello and health and snapshot
     assert int(hello.group(1)) == P.HELLO_PAYLOAD.size
     assert (int(health.group(1)), int(health.group(2))) == (P.HEALTH_PAYLOAD.size, P.HEALTH_TASK.size)
+    assert P.HEALTH_PYRO == 1  # n_pyro bytes: a status byte a channel
     assert int(snapshot.group(1)) == P.SNAPSHOT_OFFSET
     bound = re.search(r"link_encoded_max\(uint32_t body\) \{ return (.*?); \}", h)
     assert bound
@@ -104,3 +105,14 @@ def test_element_types():
         t = TYPES[k[1:] if k != "kBool" else "bool"]
         size = 1 if t.is_bool else 1 << (code - 6 if code >= codes["kF32"] else code & 3)
         assert size == t.size, k
+
+
+def test_pyro_status_bits_and_the_resumed_bit():
+    """The health frame's pyro status bits (fsw_io.h) and the reset cause's
+    resumed bit (fsw_resume.h) are the ground's."""
+    consts = dict((k, int(v, 16)) for k, v in re.findall(r"static const uint8_t (k\w+) = (0x[0-9A-Fa-f]+);",
+                                                         header("fsw_io.h") + header("fsw_resume.h")))
+    assert (consts["kPyroArmed"], consts["kPyroContinuity"], consts["kPyroNoSense"], consts["kPyroFired"],
+            consts["kPyroFiring"]) == (P.PYRO_ARMED, P.PYRO_CONTINUITY, P.PYRO_NO_SENSE, P.PYRO_FIRED,
+                                       P.PYRO_FIRING)
+    assert consts["kResetResumed"] == P.RESET_RESUMED

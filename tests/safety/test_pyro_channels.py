@@ -19,35 +19,35 @@ GOLDEN = ROOT / "tests" / "autocode" / "golden" / "app"
 
 ROCKET_REPORT = """rocket.app: 2 pyro channels
 
-pyro channel drogue (rocket.app:56)
+pyro channel drogue (rocket.app:60)
   output:      pin 5 (rocket.dio:4), pulse 1 s
   arming:      armSwitch (pin 2, rocket.dio:3) reading true
-  continuity:  none declared
+  continuity:  drogueSense (pin A2, rocket.aio:10) at least 1
   machine:     mission; armed states Armed; fire states Apogee
   unarmed:     Safe, Abort (reached without an armed state: none sets it true)
   arming transitions (each requires armSwitch):
-    Safe -> Armed  mission.sm:57
+    Safe -> Armed  mission.sm:65
   states that can fire it:
-    Apogee  .entry  mission.sm:84  drogue = true
+    Apogee  .entry  mission.sm:93  drogue = true
       arming path: Safe -> Armed -> Boost -> Coast -> Apogee
   transitions that can fire it:
-    Coast -> Apogee  mission.sm:79  (enters Apogee)
-    Coast -> Apogee  mission.sm:80  (enters Apogee)
+    Coast -> Apogee  mission.sm:88  (enters Apogee)
+    Coast -> Apogee  mission.sm:89  (enters Apogee)
 
-pyro channel main (rocket.app:57)
+pyro channel main (rocket.app:61)
   output:      pin 6 (rocket.dio:5), pulse 1 s
   arming:      armSwitch (pin 2, rocket.dio:3) reading true
-  continuity:  none declared
+  continuity:  mainSense (pin A3, rocket.aio:11) at least 1
   machine:     mission; armed states Armed; fire states Main
   unarmed:     Safe, Abort (reached without an armed state: none sets it true)
   arming transitions (each requires armSwitch):
-    Safe -> Armed  mission.sm:57
+    Safe -> Armed  mission.sm:65
   states that can fire it:
-    Main  .entry  mission.sm:100  main = true
+    Main  .entry  mission.sm:109  main = true
       arming path: Safe -> Armed -> Boost -> Coast -> Apogee -> Drogue -> Main
   transitions that can fire it:
-    Drogue -> Main  mission.sm:95  (enters Main)
-    Drogue -> Main  mission.sm:96  (enters Main)
+    Drogue -> Main  mission.sm:104  (enters Main)
+    Drogue -> Main  mission.sm:105  (enters Main)
 """
 
 

@@ -91,6 +91,7 @@ def _talk(args, app, p) -> int:
             s = f.samples
             span = f"{s[0][0] / 1000:.2f}–{s[-1][0] / 1000:.2f} s" if s else "no samples"
             trig = f", trigger at {f.start.t0 / 1000:.2f} s" if f.start else ", its start record overwritten"
+            trig += "".join(f", resumed after a reset in flight at {r.t0 / 1000:.2f} s" for r in f.resumed)
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
         if args.erase:
             kept = {f.number for f in chosen}

@@ -10,7 +10,8 @@ from collections import deque
 from dataclasses import dataclass
 
 from fswkit.autocode.app import TASK_MODES
-from fswkit.autocode.protocol import ACK_PAYLOAD, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD
+from fswkit.autocode.protocol import (ACK_PAYLOAD, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD, PYRO_ARMED,
+                                     PYRO_CONTINUITY, PYRO_FIRED, PYRO_FIRING, PYRO_NO_SENSE, RESET_RESUMED)
 
 from . import wire
 from .layout import Layout
@@ -47,11 +48,23 @@ RESET_CAUSES = ((0x01, "power-on"), (0x02, "external reset"), (0x04, "brown-out"
 
 
 def reset_words(cause: int | None) -> str:
-    """An AVR reset cause (MCUSR bits) in words."""
+    """An AVR reset cause (MCUSR bits) in words, and whether the firmware
+    resumed its flight's state (RESET_RESUMED, docs/safety.md)."""
     if cause is None:
         return "unknown"
     words = [w for bit, w in RESET_CAUSES if cause & bit]
-    return ", ".join(words) if words else f"none reported (0x{cause:02x})"
+    text = ", ".join(words) if words else f"none reported (0x{cause & ~RESET_RESUMED:02x})"
+    return text + ", flight resumed" if cause & RESET_RESUMED else text
+
+
+def pyro_status(name: str, bits: int) -> dict:
+    """A pyro channel's status byte of a health frame (fsw_io.h kPyro*)."""
+    sense = None if bits & PYRO_NO_SENSE else bool(bits & PYRO_CONTINUITY)
+    words = ["armed" if bits & PYRO_ARMED else "disarmed",
+             "no continuity input" if sense is None else "continuity" if sense else "OPEN",
+             "FIRING" if bits & PYRO_FIRING else "fired" if bits & PYRO_FIRED else "not fired"]
+    return {"name": name, "armed": bool(bits & PYRO_ARMED), "continuity": sense, "fired": bool(bits & PYRO_FIRED),
+            "firing": bool(bits & PYRO_FIRING), "bits": bits, "words": ", ".join(words)}
 
 
 class SchemaMismatch(Exception):
@@ -320,6 +333,8 @@ class Session:
             tasks.append({"name": name, "kind": kind, "mode": mode, "mode_name": TASK_MODE_NAMES.get(mode, "safed"),
                           "faults": faults, "overruns": over, "worst_us": worst})
         info["tasks"] = tasks
+        at = _HEALTH.size + len(self.layout.tasks) * _TASK.size
+        info["pyro"] = [pyro_status(name, payload[at + i]) for i, name in enumerate(self.layout.pyro)]
         self.health = info
         self._delay(time, host_time)
         return Event("health", seq, time, host_time, info=info)
@@ -367,7 +382,8 @@ def describe(ev: Event, layout: Layout) -> str:
         return (f"{head} health frames={i['frames']} dropped={i['dropped']} cycles={i['cycles']} late={i['late']} "
                 f"reset_cause=0x{i['reset_cause']:02x} rx_ok={i['rx_ok']} rx_crc={i['rx_crc']} "
                 f"rx_malformed={i['rx_malformed']} rx_oversized={i['rx_oversized']} "
-                f"rx_replayed={i['rx_replayed']} rx_refused={i['rx_refused']} {tasks}")
+                f"rx_replayed={i['rx_replayed']} rx_refused={i['rx_refused']} {tasks}"
+                + "".join(f" pyro {p['name']}: {p['words']}" for p in i.get("pyro", ())))
     if ev.kind == "ack":
         return f"{head} ack cmd={i['cmd_seq']} {i['op_name']} {i['status_name']}"
     if ev.kind == "snapshot":

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fswkit.link.session import reset_words
+
 from .cosim import Run
 
 
@@ -69,12 +71,19 @@ def _run_lines(run: Run, sc, what: str) -> list[str]:
 
 def _tail_lines(run: Run) -> list[str]:
     out = []
+    for ev in run.reset_events:
+        why = "reset_at" if ev.trigger == "time" else "reset_state"
+        out.append(f"reset: {ev.cause} at {ev.t:.3f} s ({why}; telemetry showed state {ev.state or 'none yet'})")
     s = run.session
+    if s.hello is not None and run.reset_events:
+        out.append(f"target after the reset: {reset_words(s.hello['reset_cause'])} (its last hello)")
     st, ws = s.stats, s.deframer.stats
     h = s.health or {}
     out.append(f"link: {st.frames:,} frames, {st.samples:,} samples, {st.lost} lost, {ws.crc_errors} CRC errors, "
                f"{ws.framing_errors} framing errors; target dropped {h.get('dropped', '?')}, "
                f"late cycles {h.get('late', '?')}")
+    for p in h.get("pyro", ()):  # what the last health frame said of each charge
+        out.append(f"pyro {p['name']} (last health frame): {p['words']}")
     if h.get("tasks"):
         worst = max(h["tasks"], key=lambda x: x["worst_us"])
         out.append(f"executor: overruns {sum(x['overruns'] for x in h['tasks'])}, "
@@ -197,7 +206,7 @@ def rocket(run: Run, sc) -> Report:
 
     landed = fw["landed_state"] in names
     facts["landed"] = landed
-    if sc.fault in ("pinned-accel", "pinned-baro"):
+    if sc.fault in ("pinned-accel", "pinned-baro", "open-igniter"):
         fired = [e for e in run.pin_events if e.level]
         checks.append(Check("no pyro channel fired", not fired,
                             "none" if not fired else ", ".join(f"{e.role} at {e.t:.3f} s" for e in fired)))
@@ -205,9 +214,12 @@ def rocket(run: Run, sc) -> Report:
         checks.append(Check(f"the vehicle stayed in its pad states ({', '.join(fw['pad_states'])})", not off,
                             f"states seen: {', '.join(dict.fromkeys(names)) or 'none'}"))
         armed = fw["armed_state"] in names
-        checks.append(Check(f"the vehicle was armed (state {fw['armed_state']})", armed,
-                            next((f"at {t:.3f} s" for t, _, n in run.transitions if n == fw["armed_state"]),
-                                 "never")))
+        when = next((f"at {t:.3f} s" for t, _, n in run.transitions if n == fw["armed_state"]), "never")
+        if sc.fault == "open-igniter":  # the key is on, but an open igniter must keep the vehicle from arming
+            checks.append(Check(f"the vehicle refused to arm with the drogue's igniter open (never in state "
+                                f"{fw['armed_state']})", not armed, f"armed {when}" if armed else "never armed"))
+        else:
+            checks.append(Check(f"the vehicle was armed (state {fw['armed_state']})", armed, when))
     elif sc.fault == "stuck-baro":
         if not drogue or r.liftoff is None or sc.backup_s is None:
             checks.append(Check("drogue fired by the backup timer", False,

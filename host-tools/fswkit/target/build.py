@@ -103,8 +103,8 @@ class Size:
             pct = 100.0 * used / budget if budget else 0.0
             return f"  {name:<6}{used:>8,} / {budget:>8,} B  {pct:5.1f} %{note}"
         note = f"  ({self.owner} budget)" if self.owner else ""
-        ram_note = ("  (data + bss; the budget counts the stack too: fsw sim measures it)" if self.owner
-                    else "  (data + bss; the stack uses the rest)")
+        ram_note = ("  (data + bss + noinit; the budget counts the stack too: fsw sim measures it)" if self.owner
+                    else "  (data + bss + noinit; the stack uses the rest)")
         return "\n".join([row("flash", self.flash, self.flash_budget, note),
                           row("RAM", self.ram, self.ram_budget, ram_note)])
 
@@ -112,7 +112,7 @@ class Size:
 def budget(app: Application) -> dict[str, tuple[int, str]]:
     """{"flash": (bytes, whose), "RAM": (bytes, whose)}: what the firmware
     may use of each memory, the application's `[budget]` where it sets one,
-    else the board's memory (RAM: data + bss + the stack)."""
+    else the board's memory (RAM: data + bss + noinit + the stack)."""
     b = app.board
 
     def one(mine: int | None, board: int) -> tuple[int, str]:
@@ -129,7 +129,9 @@ def size_of(app, flash: int, ram: int) -> Size:
 
 
 def elf_size(elf: str) -> tuple[int, int]:
-    """(flash, RAM) bytes of an AVR ELF: .text + .data, .data + .bss."""
+    """(flash, RAM) bytes of an AVR ELF: .text + .data, and .data + .bss +
+    .noinit (RAM the C runtime leaves as it was at a reset: the banks a
+    flight resumes from, docs/safety.md)."""
     r = subprocess.run(["avr-size", "-A", elf], capture_output=True, text=True)
     if r.returncode != 0:
         raise BuildError(f"avr-size failed: {r.stderr.strip()}")
@@ -138,7 +140,7 @@ def elf_size(elf: str) -> tuple[int, int]:
         parts = line.split()
         if len(parts) >= 2 and parts[0].startswith(".") and parts[1].isdigit():
             sec[parts[0]] = int(parts[1])
-    return sec.get(".text", 0) + sec.get(".data", 0), sec.get(".data", 0) + sec.get(".bss", 0)
+    return sec.get(".text", 0) + sec.get(".data", 0), sec.get(".data", 0) + sec.get(".bss", 0) + sec.get(".noinit", 0)
 
 
 # ---- the service ------------------------------------------------------------------------

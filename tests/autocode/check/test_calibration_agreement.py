@@ -70,10 +70,12 @@ def test_generated_tables_carry_the_hosts_gain(fsw, tmp_path):
                       r"([-0-9.e]+)f, \(?([-0-9.e]+)f\)?\)\);", text)
     assert [(e, f32(float(g)), float(o)) for e, g, o in rows] == [
         ("pressure", analog_gain(6250.0, 5.0, 10, F32MODE), 76875.0),
-        ("accel", analog_gain(8.0, 5.0, 10, F32MODE), -20.0)]
-    assert "volatile uint16_t kAnalogInRaw[2];" in text
-    assert "fsw::io_analog_scan_begin(kAnalogInPins, 2, kAnalogInRaw);" in text
-    assert "fsw::io_analog_scan(kAnalogInPins, 2, kAnalogInRaw);" in text
+        ("accel", analog_gain(8.0, 5.0, 10, F32MODE), -20.0),
+        ("drogueSense", analog_gain(1.0, 5.0, 10, F32MODE), 0.0),
+        ("mainSense", analog_gain(1.0, 5.0, 10, F32MODE), 0.0)]
+    assert "volatile uint16_t kAnalogInRaw[4];" in text
+    assert "fsw::io_analog_scan_begin(kAnalogInPins, 4, kAnalogInRaw);" in text
+    assert "fsw::io_analog_scan(kAnalogInPins, 4, kAnalogInRaw);" in text
 
 
 def test_the_simulated_sensor_reads_what_the_firmware_computes():

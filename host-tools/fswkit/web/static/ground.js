@@ -242,7 +242,8 @@ function showHealth(info) {
   const rows = [["reset cause", info.reset_words], ["cycles", info.cycles], ["late starts", info.late],
                 ["frames sent", info.frames], ["frames dropped (busy)", info.dropped],
                 ["commands applied", info.rx_ok], ["CRC errors", info.rx_crc], ["malformed", info.rx_malformed],
-                ["refused", info.rx_refused], ["replayed", info.rx_replayed]];
+                ["refused", info.rx_refused], ["replayed", info.rx_replayed]]
+    .concat((info.pyro || []).map(p => [`pyro ${p.name}`, p.words]));
   $("link-table").tBodies[0].replaceChildren(...rows.map(([k, v]) => {
     const tr = el("tr"); tr.append(el("th", {}, k), el("td", {}, fmt(v))); return tr; }));
   $("task-table").tBodies[0].replaceChildren(...info.tasks.map(t => {

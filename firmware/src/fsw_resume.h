@@ -1,0 +1,68 @@
+// Resuming a flight after a reset (docs/safety.md, "A reset in flight"): the
+// flight's state -- the state vector, every machine's state, entry time and
+// locals, the pyro channels' gates, the recorder's flight -- copied at the
+// end of every cycle (and before a pyro pin goes high) into one of two banks
+// of RAM the C runtime does not clear at boot (.noinit), each closed by a
+// sequence number and a CRC. After a brown-out or a watchdog reset the
+// newest whole bank is copied back before the first cycle; after a power-on
+// or an external reset (the reset button, a host opening the port) nothing
+// is, and the firmware starts on the pad as always.
+#ifndef FSW_RESUME_H
+#define FSW_RESUME_H
+
+#include "fsw_types.h"
+
+namespace fsw {
+
+// The reset cause's bit (Executor::reset_cause, the hello and health
+// frames, the `reset_cause` element) that says the flight's state was
+// resumed from a bank. The MCU's own causes use the low four bits (AVR
+// MCUSR: power-on 0x01, external 0x02, brown-out 0x04, watchdog 0x08).
+static const uint8_t kResetResumed = 0x80;
+// The causes after which RAM holds what it held: brown-out and watchdog.
+static const uint8_t kResetKeepsRam = 0x04 | 0x08;
+// The causes after which a person asked for a fresh start (or RAM is lost).
+static const uint8_t kResetFresh = 0x01 | 0x02;
+
+// One piece of RAM kept across a reset (FSW_FLASH table).
+struct ResumeSpan {
+    uint8_t* p;
+    uint16_t n;
+};
+
+// The kept state's description (FSW_FLASH). `banks` is 2 * (size + 3)
+// bytes of .noinit RAM: each bank is the spans' bytes in table order, a
+// sequence number, and the CRC-16 (fsw_crc.h, seeded with the schema hash)
+// of both, low byte first.
+struct ResumeConfig {
+    const ResumeSpan* spans;
+    uint8_t* banks;
+    uint32_t schema;   // the application's link schema: another firmware's bank is not ours
+    uint16_t size;     // the spans' bytes together
+    uint8_t n_spans;
+};
+
+// The bank written next, and the sequence number it gets (RAM, zeroed at boot).
+struct Resume {
+    const ResumeConfig* cfg;  // FSW_FLASH
+    uint8_t seq;              // the newest bank's sequence number
+    uint8_t next;             // 0 or 1: the bank the next save writes
+};
+
+// Boot: when `cause` is a brown-out or a watchdog reset (and neither a
+// power-on nor an external reset), copies the newest whole bank back into
+// the spans and returns true; otherwise changes nothing and returns false.
+// Otherwise both banks are made invalid, so that no bank from before a
+// fresh start is ever taken for one of this run. Later saves alternate
+// from the bank after the newest.
+bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause);
+// Copies the spans into the older bank, then its sequence number, then its
+// CRC: a reset part way through leaves that bank invalid and the other one
+// whole. About 30 cycles a byte on AVR.
+FSW_NOINLINE void resume_save(Resume& r);
+// The newest whole bank: 0 or 1, or -1 when neither is (tests, the link).
+int8_t resume_newest(const ResumeConfig* cfg);
+
+}  // namespace fsw
+
+#endif  // FSW_RESUME_H

@@ -1,0 +1,178 @@
+// Scenario: resuming a flight after a reset (fsw_resume.h, docs/safety.md):
+// the kept RAM copied into two banks with a sequence number and a CRC,
+// copied back after a brown-out or a watchdog reset only, from the newest
+// whole bank; a save cut short leaves the other bank to resume from.
+#include "test_support.h"
+
+using namespace fsw;
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static const uint8_t kPowerOn = 0x01, kExternal = 0x02, kBrownOut = 0x04, kWatchdog = 0x08;
+
+// What an application keeps: two pieces of RAM.
+static uint8_t a[5];
+static uint8_t b[3];
+static const ResumeSpan kSpans[2] FSW_FLASH = {{a, sizeof a}, {b, sizeof b}};
+static uint8_t banks[2 * (sizeof a + sizeof b + 3)];
+static const ResumeConfig kConfig FSW_FLASH = {kSpans, banks, 0x12345678UL, sizeof a + sizeof b, 2};
+static const ResumeConfig kOther FSW_FLASH = {kSpans, banks, 0x12345679UL, sizeof a + sizeof b, 2};
+
+static void fill(uint8_t v) {
+    for (uint8_t i = 0; i < sizeof a; ++i) a[i] = static_cast<uint8_t>(v + i);
+    for (uint8_t i = 0; i < sizeof b; ++i) b[i] = static_cast<uint8_t>(v + 0x40 + i);
+}
+static void clear() {  // what the C runtime does to .bss at boot
+    memset(a, 0, sizeof a);
+    memset(b, 0, sizeof b);
+}
+static bool holds(uint8_t v) {
+    for (uint8_t i = 0; i < sizeof a; ++i) if (a[i] != static_cast<uint8_t>(v + i)) return false;
+    for (uint8_t i = 0; i < sizeof b; ++i) if (b[i] != static_cast<uint8_t>(v + 0x40 + i)) return false;
+    return true;
+}
+// A first boot: banks of whatever RAM held at power-on.
+static void power_on(Resume& r) {
+    for (uint16_t i = 0; i < sizeof banks; ++i) banks[i] = static_cast<uint8_t>(i * 37u + 11u);
+    clear();
+    TEST_ASSERT_FALSE(resume_begin(r, &kConfig, kPowerOn));
+}
+
+static void test_a_brown_out_resumes_the_last_save(void) {
+    Resume r;
+    power_on(r);
+    fill(1);
+    resume_save(r);
+    fill(2);
+    resume_save(r);
+    fill(3);  // changed after the last save: lost with the reset
+    clear();
+    TEST_ASSERT_TRUE(resume_begin(r, &kConfig, kBrownOut));
+    TEST_ASSERT_TRUE(holds(2));
+}
+
+static void test_a_watchdog_reset_resumes_and_saves_go_on(void) {
+    Resume r;
+    power_on(r);
+    for (uint8_t k = 1; k <= 9; ++k) {  // odd and even banks alike
+        fill(k);
+        resume_save(r);
+        clear();
+        TEST_ASSERT_TRUE(resume_begin(r, &kConfig, kWatchdog));
+        TEST_ASSERT_TRUE(holds(k));
+    }
+}
+
+static void test_power_on_and_external_resets_start_fresh(void) {
+    const uint8_t fresh[] = {kPowerOn, kExternal, 0, kBrownOut | kExternal, kWatchdog | kPowerOn};
+    for (uint8_t k = 0; k < sizeof fresh; ++k) {
+        Resume r;
+        power_on(r);
+        fill(7);
+        resume_save(r);
+        clear();
+        TEST_ASSERT_FALSE(resume_begin(r, &kConfig, fresh[k]));
+        TEST_ASSERT_EQUAL_UINT8(0, a[0]);  // nothing copied back
+        TEST_ASSERT_EQUAL_UINT8(0, b[2]);
+        // and the banks from before the fresh start are never taken later
+        TEST_ASSERT_EQUAL_INT8(-1, resume_newest(&kConfig));
+        TEST_ASSERT_FALSE(resume_begin(r, &kConfig, kBrownOut));
+    }
+}
+
+static void test_nothing_saved_yet_starts_fresh(void) {
+    Resume r;
+    power_on(r);
+    TEST_ASSERT_FALSE(resume_begin(r, &kConfig, kBrownOut));  // reset before the first save
+    TEST_ASSERT_EQUAL_UINT8(0, a[0]);
+}
+
+static void test_another_firmwares_banks_are_not_taken(void) {
+    Resume r;
+    power_on(r);
+    fill(4);
+    resume_save(r);
+    clear();
+    TEST_ASSERT_FALSE(resume_begin(r, &kOther, kBrownOut));
+    TEST_ASSERT_EQUAL_UINT8(0, a[0]);
+}
+
+// A reset part way through a save: the bank being written is invalid from
+// its first byte on, and the other holds the save before.
+static void test_a_save_cut_short_resumes_the_one_before(void) {
+    const uint16_t bank = sizeof a + sizeof b + 3;
+    for (uint16_t cut = 0; cut <= bank; ++cut) {
+        Resume r;
+        power_on(r);
+        fill(5);
+        resume_save(r);
+        fill(6);
+        uint8_t before[sizeof banks];
+        memcpy(before, banks, sizeof banks);
+        resume_save(r);  // the whole save; then the bank as it was `cut` bytes in
+        const uint8_t w = static_cast<uint8_t>(r.next ^ 1u);  // the bank just written
+        uint8_t* const at = banks + w * bank;
+        uint8_t torn[sizeof banks];
+        memcpy(torn, before, sizeof banks);
+        // the save's order: the CRC's low byte flipped first, then the bytes in order
+        torn[w * bank + bank - 2] = static_cast<uint8_t>(~before[w * bank + bank - 2]);
+        for (uint16_t i = 0; i < cut; ++i) torn[w * bank + i] = at[i];  // bytes, sequence number, CRC
+        memcpy(banks, torn, sizeof banks);
+        clear();
+        TEST_ASSERT_TRUE(resume_begin(r, &kConfig, kBrownOut));
+        if (cut == bank) {
+            TEST_ASSERT_TRUE(holds(6));
+        } else if (cut == bank - 1) {  // the CRC's high byte still the old one: whole only if it matched
+            TEST_ASSERT_TRUE(holds(5) || holds(6));
+        } else {
+            TEST_ASSERT_TRUE(holds(5));
+        }
+    }
+}
+
+static void test_a_flipped_bit_is_refused(void) {
+    Resume r;
+    power_on(r);
+    fill(8);
+    resume_save(r);
+    const int8_t k = resume_newest(&kConfig);
+    TEST_ASSERT_TRUE(k >= 0);
+    for (uint16_t bit = 0; bit < 8u * (sizeof a + sizeof b + 3); ++bit) {
+        uint8_t* const p = banks + k * (sizeof a + sizeof b + 3) + bit / 8;
+        *p = static_cast<uint8_t>(*p ^ (1u << (bit % 8)));
+        TEST_ASSERT_EQUAL_INT8(-1, resume_newest(&kConfig));  // the other bank was never written
+        *p = static_cast<uint8_t>(*p ^ (1u << (bit % 8)));
+    }
+    TEST_ASSERT_EQUAL_INT8(k, resume_newest(&kConfig));
+}
+
+// Sequence numbers wrap: the newer of two whole banks is taken across 255 -> 0.
+static void test_the_sequence_number_wraps(void) {
+    Resume r;
+    power_on(r);
+    for (uint16_t k = 0; k < 600; ++k) {
+        fill(static_cast<uint8_t>(k));
+        resume_save(r);
+        if (k % 61 == 0 || (k > 250 && k < 260)) {
+            clear();
+            TEST_ASSERT_TRUE(resume_begin(r, &kConfig, kBrownOut));
+            TEST_ASSERT_TRUE(holds(static_cast<uint8_t>(k)));
+        }
+    }
+}
+
+static void run(void) {
+    UNITY_BEGIN();
+    RUN_TEST(test_a_brown_out_resumes_the_last_save);
+    RUN_TEST(test_a_watchdog_reset_resumes_and_saves_go_on);
+    RUN_TEST(test_power_on_and_external_resets_start_fresh);
+    RUN_TEST(test_nothing_saved_yet_starts_fresh);
+    RUN_TEST(test_another_firmwares_banks_are_not_taken);
+    RUN_TEST(test_a_save_cut_short_resumes_the_one_before);
+    RUN_TEST(test_a_flipped_bit_is_refused);
+    RUN_TEST(test_the_sequence_number_wraps);
+    (void)UNITY_END();
+}
+
+FSW_TEST_MAIN(run)

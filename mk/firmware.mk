@@ -23,8 +23,8 @@ FW_AVR_CXX    ?= avr-g++
 FW_AVR_CC     ?= avr-gcc
 
 # Suites: one file per scenario, tests/firmware/test_<name>.cpp.
-FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume
-FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume
+FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume parts
+FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts
 
 FW_RT_SRCS    := $(wildcard $(FW_SRC)/*.cpp)
 FW_RT_HDRS    := $(wildcard $(FW_SRC)/*.h)

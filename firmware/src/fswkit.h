@@ -19,5 +19,6 @@
 #include "fsw_param.h"
 #include "fsw_log.h"
 #include "fsw_resume.h"
+#include "fsw_parts.h"
 
 #endif  // FSWKIT_H

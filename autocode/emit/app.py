@@ -182,7 +182,7 @@ def _resume(app: Application) -> list[str]:
         c.append("static_assert(offsetof(fsw::Recorder, mode) == offsetof(fsw::Recorder, flight) + 1, "
                  "\"the recorder's flight and mode are kept as one span\");")
     c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
-    c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a CRC")
+    c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a check")
     c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
              f"0x{app_schema_hash(app):08x}UL, kResumeSize, {len(spans)}}};")
     c.append("fsw::Resume resume;")

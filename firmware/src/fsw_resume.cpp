@@ -1,8 +1,6 @@
 // Resuming a flight after a reset (fsw_resume.h, docs/safety.md).
 #include "fsw_resume.h"
 
-#include "fsw_crc.h"
-
 namespace fsw {
 
 namespace {
@@ -15,16 +13,65 @@ ResumeConfig config(const ResumeConfig* cfg) {
 
 uint8_t* bank_at(const ResumeConfig& c, uint8_t b) { return c.banks + b * static_cast<uint16_t>(c.size + 3u); }
 
-// The CRC of a bank's bytes and sequence number, seeded with the schema.
-uint16_t bank_crc(const ResumeConfig& c, const uint8_t* bank) {
-    uint8_t s[4];
-    memcpy(s, &c.schema, sizeof s);
-    return crc16(bank, static_cast<uint16_t>(c.size + 1u), crc16(s, sizeof s));
+// The check: Fletcher-16, two sums modulo 255 kept with an end-around carry
+// (each in 0..255, where 255 and 0 both mean 0: the save and the check
+// compute them alike), seeded with the schema hash so that another
+// firmware's bank does not check. Every single-bit and two-bit error of a
+// bank changes it.
+struct Check {
+    uint8_t a, b;
+    inline __attribute__((always_inline)) void add(uint8_t v) {
+        const uint8_t t = static_cast<uint8_t>(a + v);
+        a = static_cast<uint8_t>(t + (t < v ? 1u : 0u));
+        const uint8_t u = static_cast<uint8_t>(b + a);
+        b = static_cast<uint8_t>(u + (u < a ? 1u : 0u));
+    }
+};
+
+// `n` bytes from `p` copied to `at` and into the check: the save's loop, 12
+// cycles a byte on AVR (the same sums as Check::add, in assembly: the
+// compiler's version took twice as long, and the save runs every cycle).
+inline uint8_t* copy_checked(uint8_t* at, const uint8_t* p, uint16_t n, Check& k) {
+    if (n == 0) return at;
+#if defined(__AVR__)
+    uint8_t a = k.a, b = k.b;
+    __asm__ __volatile__(
+        "1: ld __tmp_reg__, Z+\n\t"
+        "st X+, __tmp_reg__\n\t"
+        "add %[a], __tmp_reg__\n\t"
+        "adc %[a], __zero_reg__\n\t"
+        "add %[b], %[a]\n\t"
+        "adc %[b], __zero_reg__\n\t"
+        "sbiw %[n], 1\n\t"
+        "brne 1b\n\t"
+        : [a] "+r"(a), [b] "+r"(b), [n] "+w"(n), [p] "+z"(p), [at] "+x"(at)
+        :
+        : "memory");
+    k.a = a;
+    k.b = b;
+#else
+    for (; n != 0; --n) {
+        const uint8_t v = *p++;
+        *at++ = v;
+        k.add(v);
+    }
+#endif
+    return at;
 }
 
+Check seeded(const ResumeConfig& c) {
+    Check k = {0, 0};
+    uint8_t s[4];
+    memcpy(s, &c.schema, sizeof s);
+    for (uint8_t i = 0; i < 4; ++i) k.add(s[i]);
+    return k;
+}
+
+// A bank's bytes and sequence number checked against its last two bytes.
 bool bank_ok(const ResumeConfig& c, const uint8_t* bank) {
-    const uint16_t crc = bank_crc(c, bank);
-    return bank[c.size + 1u] == static_cast<uint8_t>(crc) && bank[c.size + 2u] == static_cast<uint8_t>(crc >> 8);
+    Check k = seeded(c);
+    for (uint16_t i = 0; i <= c.size; ++i) k.add(bank[i]);
+    return bank[c.size + 1u] == k.a && bank[c.size + 2u] == k.b;
 }
 
 int8_t newest(const ResumeConfig& c) {
@@ -50,9 +97,7 @@ bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause) {
     if (b < 0) {  // a fresh start: no bank from before it may ever be taken for one of this run's
         for (uint8_t k = 0; k < 2; ++k) {
             uint8_t* const bank = bank_at(c, k);
-            const uint16_t crc = static_cast<uint16_t>(~bank_crc(c, bank));
-            bank[c.size + 1u] = static_cast<uint8_t>(crc);
-            bank[c.size + 2u] = static_cast<uint8_t>(crc >> 8);
+            if (bank_ok(c, bank)) bank[c.size + 1u] = static_cast<uint8_t>(~bank[c.size + 1u]);
         }
         return false;
     }
@@ -73,17 +118,17 @@ void resume_save(Resume& r) {
     uint8_t* const bank = bank_at(c, r.next);
     bank[c.size + 1u] = static_cast<uint8_t>(~bank[c.size + 1u]);  // invalid while it is written
     uint8_t* at = bank;
-    for (uint8_t i = 0; i < c.n_spans; ++i) {
+    Check k = seeded(c);
+    for (uint8_t i = 0; i < c.n_spans; ++i) {  // copied and checked in one pass
         ResumeSpan s;
         flash_read(&s, &c.spans[i], sizeof s);
-        memcpy(at, s.p, s.n);
-        at += s.n;
+        at = copy_checked(at, s.p, s.n, k);
     }
     r.seq = static_cast<uint8_t>(r.seq + 1u);
-    bank[c.size] = r.seq;
-    const uint16_t crc = bank_crc(c, bank);
-    bank[c.size + 1u] = static_cast<uint8_t>(crc);
-    bank[c.size + 2u] = static_cast<uint8_t>(crc >> 8);
+    *at = r.seq;
+    k.add(r.seq);
+    bank[c.size + 1u] = k.a;  // the check last: once it matches, every byte before it is this save's
+    bank[c.size + 2u] = k.b;
     r.next = static_cast<uint8_t>(r.next ^ 1u);
 }
 

@@ -3,7 +3,7 @@
 // locals, the pyro channels' gates, the recorder's flight -- copied at the
 // end of every cycle (and before a pyro pin goes high) into one of two banks
 // of RAM the C runtime does not clear at boot (.noinit), each closed by a
-// sequence number and a CRC. After a brown-out or a watchdog reset the
+// sequence number and a check (Fletcher-16). After a brown-out or a watchdog reset the
 // newest whole bank is copied back before the first cycle; after a power-on
 // or an external reset (the reset button, a host opening the port) nothing
 // is, and the firmware starts on the pad as always.
@@ -32,7 +32,7 @@ struct ResumeSpan {
 
 // The kept state's description (FSW_FLASH). `banks` is 2 * (size + 3)
 // bytes of .noinit RAM: each bank is the spans' bytes in table order, a
-// sequence number, and the CRC-16 (fsw_crc.h, seeded with the schema hash)
+// sequence number, and the Fletcher-16 check (seeded with the schema hash)
 // of both, low byte first.
 struct ResumeConfig {
     const ResumeSpan* spans;
@@ -57,7 +57,7 @@ struct Resume {
 // from the bank after the newest.
 bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause);
 // Copies the spans into the older bank, then its sequence number, then its
-// CRC: a reset part way through leaves that bank invalid and the other one
+// check: a reset part way through leaves that bank invalid and the other one
 // whole. About 30 cycles a byte on AVR.
 FSW_NOINLINE void resume_save(Resume& r);
 // The newest whole bank: 0 or 1, or -1 when neither is (tests, the link).

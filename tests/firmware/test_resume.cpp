@@ -1,5 +1,5 @@
 // Scenario: resuming a flight after a reset (fsw_resume.h, docs/safety.md):
-// the kept RAM copied into two banks with a sequence number and a CRC,
+// the kept RAM copied into two banks with a sequence number and a check,
 // copied back after a brown-out or a watchdog reset only, from the newest
 // whole bank; a save cut short leaves the other bank to resume from.
 #include "test_support.h"
@@ -115,15 +115,15 @@ static void test_a_save_cut_short_resumes_the_one_before(void) {
         uint8_t* const at = banks + w * bank;
         uint8_t torn[sizeof banks];
         memcpy(torn, before, sizeof banks);
-        // the save's order: the CRC's low byte flipped first, then the bytes in order
+        // the save's order: the check's first byte flipped first, then the bytes in order
         torn[w * bank + bank - 2] = static_cast<uint8_t>(~before[w * bank + bank - 2]);
-        for (uint16_t i = 0; i < cut; ++i) torn[w * bank + i] = at[i];  // bytes, sequence number, CRC
+        for (uint16_t i = 0; i < cut; ++i) torn[w * bank + i] = at[i];  // bytes, sequence number, check
         memcpy(banks, torn, sizeof banks);
         clear();
         TEST_ASSERT_TRUE(resume_begin(r, &kConfig, kBrownOut));
         if (cut == bank) {
             TEST_ASSERT_TRUE(holds(6));
-        } else if (cut == bank - 1) {  // the CRC's high byte still the old one: whole only if it matched
+        } else if (cut == bank - 1) {  // the check's second byte still the old one: whole only if it matched
             TEST_ASSERT_TRUE(holds(5) || holds(6));
         } else {
             TEST_ASSERT_TRUE(holds(5));

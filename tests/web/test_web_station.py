@@ -31,14 +31,14 @@ def exe(tmp_path_factory):
 class Station:
     """The web station on a port, serving in a thread."""
 
-    def __init__(self, port: str):
+    def __init__(self, port: str, project=TANK):
         import uvicorn
 
         from fswkit.ground.station import Station as Ground
         from fswkit.web.app import create_app
         from fswkit.web.source import LiveSource
 
-        self.ground = Ground(tank_layout(), "tank", port, 115200)
+        self.ground = Ground(tank_layout(project), project.name, port, 115200)
         self.ground.start()
         self.source = LiveSource(self.ground)
         self.http = free_port()
@@ -109,6 +109,31 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             assert "last frame" in text("link-status")
         finally:
             station.close()
+
+
+def test_the_page_shows_each_charges_status_from_the_health_frame(browser, tmp_path):
+    """The rocket built for the host, its key on, both igniters reading
+    intact (2.5 V: count 512) and then the drogue's open: the page's link
+    table says so in words (docs/safety.md, "Continuity")."""
+    from selenium.webdriver.common.by import By
+
+    from conftest import EXAMPLES
+
+    rocket = EXAMPLES / "rocket"
+    r = run_fsw("build", str(rocket), "--board", "native", "--out", str(tmp_path / "rocket"))
+    assert r.code == 0, r.err
+    exe = tmp_path / "rocket" / "rocket"
+    for drogue, words in ((512, "armed, continuity, not fired"), (0, "armed, OPEN, not fired")):
+        with PtyTarget(exe, "d2=1", f"a16={drogue}", "a17=512") as target:
+            station = Station(target.port, rocket)
+            try:
+                browser.get(station.url)
+                table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
+                wait_for(lambda: "pyro drogue" in table(), "the pyro rows of the health frame", timeout=10)
+                assert f"pyro drogue {words}" in table(), table()
+                assert "pyro main armed, continuity, not fired" in table(), table()
+            finally:
+                station.close()
 
 
 @pytest.mark.parametrize("name", ["ground", "web"])

@@ -35,6 +35,7 @@ def _message(ev: Event, layout: Layout) -> dict | None:
         info = {k: _json(v) for k, v in ev.info.items() if not isinstance(v, (list, tuple, dict))}
         if ev.kind == "health":
             info["tasks"] = [dict(t) for t in ev.info.get("tasks", ())]
+            info["pyro"] = [dict(p) for p in ev.info.get("pyro", ())]  # each charge's status (docs/safety.md)
         if ev.kind == "ack":
             info["words"] = STATUS.get(ev.info.get("status"), ("?", "unknown status"))[1]
         if "reset_cause" in ev.info:

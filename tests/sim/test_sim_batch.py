@@ -118,7 +118,7 @@ def test_the_command_table(spin_uno):
             b.command("bogus")
         names = re.search(r"\((.*)\)", str(e.value)).group(1).split()
         assert names == ["info", "step", "until", "go", "batch", "adc", "din", "ports", "watch", "edges", "uart",
-                         "send", "peek", "stop", "reset", "prof", "eeprom", "flash", "sched", "quit"]
+                         "send", "peek", "stop", "reset", "prof", "eeprom", "flash", "sched", "part", "quit"]
         with pytest.raises(SimError, match="more than 64 words"):
             b.command("info" + " x" * 64)
         assert b.info()["mcu"] == "atmega328p"

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from support.uartprobe import UartProbe
 from fswkit.sim.board import SimBoard, SimError, harness
 
 pytestmark = pytest.mark.skipif(
@@ -63,21 +64,11 @@ def sample_at(seconds: float) -> str:
     return f"S{round(seconds / TICK):08x}"
 
 
-class Probe:
+class Probe(UartProbe):
     """Talks to probe.c on a SimBoard's UART0, advancing simulated time."""
 
     def __init__(self, board: SimBoard):
-        self.b = board
-        self.buf = b""
-
-    def line(self, limit_s: float = 2.0, step_s: float = 0.002) -> str:
-        deadline = self.b.cycle + self.b.cycles_for(limit_s)
-        while b"\n" not in self.buf:
-            assert self.b.cycle < deadline, f"no line from the probe in {limit_s} s: {self.buf!r}"
-            self.b.step(self.b.cycles_for(step_s))
-            self.buf += self.b.uart_read()
-        line, self.buf = self.buf.split(b"\n", 1)
-        return line.decode()
+        super().__init__(board)
 
     def boot(self) -> list[str]:
         line = self.line()

@@ -345,14 +345,20 @@ class SimBoard:
     MiB by default). flash_file / eeprom_file: files that keep the flash's /
     the EEPROM's bytes between runs (read at start if present, written when
     the board closes). ram_seed: the seed of the pseudo-random bytes a
-    `reset("power")` leaves in RAM (the same seed, the same bytes).
+    `reset("power")` leaves in RAM (the same seed, the same bytes). parts:
+    sensors on the MCU's I2C (TWI) or SPI, each (kind, where): a kind of
+    `PART_KINDS` and its 7-bit I2C address, or for a part with SPI its chip
+    select's port pin (`[("bmp280", 0x76), ("mpu6050", 0x68), ("adxl345",
+    "B1")]`; harness `-I`, docs/sim.md "Parts on I2C and SPI"); the `part_*`
+    methods drive them.
     """
 
     def __init__(self, elf: str, board: str | Board = "uno", *, uart: str = "control",
                  sim_limit: float | None = None, wall_limit: float | None = None,
                  analog: dict[str, float] | None = None, link: str | None = None, f_cpu: int | None = None,
                  eeprom: bytes | None = None, spi_flash: str | None = None, flash_file: str | None = None,
-                 eeprom_file: str | None = None, ram_seed: int = 1):
+                 eeprom_file: str | None = None, ram_seed: int = 1,
+                 parts: list[tuple[str, int | str]] | None = None):
         self.board = sim_board(board)
         self.mcu = self.board.raw["sim"]["simavr_mcu"]
         self.f_cpu = int(f_cpu or self.board.f_cpu)
@@ -382,6 +388,10 @@ class SimBoard:
             args += ["-S", os.fspath(flash_file)]
         if eeprom_file is not None:
             args += ["-E", os.fspath(eeprom_file)]
+        for kind, where in parts or ():
+            if kind not in PART_KINDS:
+                raise ValueError(f"a part is one of {', '.join(PART_KINDS)}, not {kind!r}")
+            args += ["-I", f"{kind}@{_part_id(where)}"]
         if int(ram_seed) != 1:
             if not 0 <= int(ram_seed) < 1 << 64:
                 raise ValueError(f"ram_seed must be a whole number from 0 to 2**64 - 1, not {ram_seed}")
@@ -745,6 +755,55 @@ class SimBoard:
         the same operation count); the chip's BUSY and WEL are cleared."""
         self.command(f"flash cut {int(operations)}")
 
+    # -- sensors on I2C and SPI (parts=...) --
+    def parts(self) -> dict[int | str, str]:
+        """The parts on the board: {I2C address or SPI chip-select pin: kind}."""
+        out: dict[int | str, str] = {}
+        for tok in self.command("part").split()[1:]:
+            where, kind = tok.split("=")
+            out[int(where, 16) if where.startswith("0x") else where] = kind
+        return out
+
+    def part_calibration(self, part: int | str, data: bytes | None = None) -> bytes:
+        """The part's calibration block (the BMP280's 24 bytes at 0x88..0x9F;
+        the MS5611's PROM, 8 big-endian words, word 7's low 4 bits its CRC-4;
+        the MPU-6050's self-test registers 0x0D..0x10; the ADXL345's offsets
+        0x1E..0x20); with `data`, first replaces its first len(data) bytes
+        (no CRC is recomputed: a test may store a bad one). `part` is the
+        part's I2C address or SPI chip-select pin."""
+        line = f"part {_part_id(part)} cal" + (f" {bytes(data).hex()}" if data is not None else "")
+        return bytes.fromhex(self.command(line)[3:])
+
+    def part_raw(self, part: int | str, **values: int) -> None:
+        """Sets raw counts, by name, that the part's next conversion or sample
+        to end puts in its result registers (those already ended keep the
+        old ones): bmp280 adc_P, adc_T (20 bits); ms5611 D1, D2 (24 bits);
+        mpu6050 ax, ay, az, temp, gx, gy, gz and adxl345 x, y, z (signed
+        16 bits). Names not given keep their values."""
+        if values:
+            self.command(f"part {_part_id(part)} raw " + " ".join(f"{k}={int(v)}" for k, v in values.items()))
+
+    def part_fail(self, part: int | str, mode: str) -> None:
+        """A failure of the part, one of `PART_FAILS`: "nack" (it stops
+        answering: its address, or its SPI select, gets no answer), "stuck"
+        (its results stop changing; conversions still end), "ok" (works
+        again). Noise is the host's to add to the raw counts."""
+        if mode not in PART_FAILS:
+            raise ValueError(f"a part's failure is one of {', '.join(PART_FAILS)}, not {mode!r}")
+        self.command(f"part {_part_id(part)} fail {mode}")
+
+    def part_info(self, part: int | str) -> dict:
+        """{kind, bus ("i2c"/"spi"), fail, busy (a conversion runs),
+        conversions (ended since its power-on), and the raw counts by name}."""
+        f = _fields(self.command(f"part {_part_id(part)} info"))
+        return {k: (v if k in ("kind", "bus", "fail") else int(v)) for k, v in f.items()}
+
+    def part_registers(self, part: int | str, register: int, count: int) -> bytes:
+        """`count` of the part's registers from `register`, as they are (no
+        read side effects, no conversion brought up to date by the read
+        itself); not for the MS5611, which has commands."""
+        return bytes.fromhex(self.command(f"part {_part_id(part)} reg {int(register)} {int(count)}")[3:])
+
     def symbol(self, name: str) -> tuple[int, int]:
         """(data address, size) of a variable of the firmware, by its
         (demangled) name, from the ELF's symbol table."""
@@ -874,6 +933,19 @@ class SimBoard:
                 self._proc.kill()
         except Exception:
             pass
+
+
+PART_KINDS = ("bmp280", "ms5611", "mpu6050", "adxl345")
+PART_FAILS = ("ok", "nack", "stuck")
+
+
+def _part_id(where: int | str) -> str:
+    """A part's name in the protocol: its I2C address (0x76) or its SPI chip-select pin (B1)."""
+    if isinstance(where, int):
+        return f"0x{where:02x}"
+    if isinstance(where, str) and re.fullmatch(r"[A-L][0-7]", where):
+        return where
+    raise ValueError(f"a part is at an I2C address (0x76) or an SPI chip-select pin (\"B1\"), not {where!r}")
 
 
 def _ignore_sigint() -> None:

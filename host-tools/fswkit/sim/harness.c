@@ -21,7 +21,11 @@
    usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S]
                    [-u control|pty|stdio|stdout|none] [-l LINK] [-r]
                    [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]
-                   [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-R SEED] FW.elf
+                   [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-I KIND@ADDR]... [-R SEED] FW.elf
+
+   -I puts a sensor (bmp280, ms5611, mpu6050, adxl345) on the AVR's TWI at
+   a 7-bit address, or on its SPI with its chip select on a pin (-I
+   adxl345@B1): register models driven by the host (`part`).
 
    -s puts an SPI NOR flash chip (a W25Q64JV's commands and timing) on the
    AVR's SPI, its chip select on pin CSPIN (B2: the Uno's D10); -S and -E
@@ -42,6 +46,7 @@
 #include <simavr/avr_eeprom.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_spi.h>
+#include <simavr/avr_twi.h>
 #include <simavr/avr_uart.h>
 #include <simavr/avr_watchdog.h>
 #include <simavr/sim_avr.h>
@@ -536,7 +541,6 @@ static struct {
     char cs_port;
     uint8_t cs_bit;
     const char* file; /* -S: NULL for none */
-    avr_irq_t* miso;  /* SPI_IRQ_INPUT */
     /* the transaction while CS is low */
     uint8_t cs_level; /* as the chip sees it: high (deselected) until the AVR drives it low */
     uint8_t op;
@@ -716,13 +720,587 @@ static uint8_t fl_byte(uint8_t in) {
     }
 }
 
-static void on_fl_mosi(struct avr_irq_t* irq, uint32_t value, void* param) {
+/* ---- parts on I2C (TWI) and SPI ------------------------------------------------------ */
+
+/* -I KIND@ADDR puts a sensor on the AVR's TWI at a 7-bit address (0x76),
+   or, for a part that has an SPI interface, on its SPI with the chip
+   select (active low) on an AVR pin (`adxl345@B1`). Each part is a
+   register model after its datasheet: an ID register, calibration bytes
+   (NVM or PROM) the host may replace, conversions that last the datasheet's
+   maximum time in simulated time, and result registers that take the raw
+   counts the host set (`part ADDR raw ...`) when a conversion ends.
+
+   The bus: simavr's TWI module (avr_twi.c) raises TWI_IRQ_OUTPUT with
+   TWI_COND_START and the SLA+R/W byte as the master sends an address, then
+   TWI_COND_WRITE or TWI_COND_READ for each data byte (ACK set when the
+   master acknowledges a byte it reads), and TWI_COND_STOP. It expects the
+   addressed slave to answer at once on TWI_IRQ_INPUT: TWI_COND_ACK with
+   data bit 0 set to acknowledge an address or a written byte (else the
+   master sees NACK), TWI_COND_READ with the byte for a read. One handler
+   here plays every slave on the bus: the part whose address matches
+   answers; an address no part has (or a part told to `fail nack`) gets no
+   ACK, and a read from nobody returns 0xFF (SDA's pull-up). simavr 1.6
+   takes 9 us per address or data byte whatever TWBR says.
+
+   Conversions are computed when someone looks (a transaction's START, a
+   register write, a host command), from the simulated cycle: nothing runs
+   between. A host command first brings the part up to date, so that raw
+   values set now are the ones the next conversion to end latches, and
+   conversions that ended before keep the old ones. A read transaction sees
+   the registers as they were at its START, as the BMP280's and MPU-6050's
+   data shadowing promise for a burst read. */
+#define MAX_PARTS 8
+#define MAX_RAW 7
+enum { PK_BMP280, PK_MS5611, PK_MPU6050, PK_ADXL345, N_PART_KINDS };
+enum { PF_OK, PF_NACK, PF_STUCK, N_PART_FAILS };
+static const char* const part_fail_names[N_PART_FAILS] = {"ok", "nack", "stuck"};
+
+typedef struct {
+    const char* name;
+    uint8_t addr[2];            /* the 7-bit addresses its pins allow */
+    int spi;                    /* it also has an SPI interface */
+    uint8_t cal_reg, cal_len;   /* the calibration block (the MS5611: its PROM's 16 bytes) */
+    int n_raw;
+    const char* raw_names[MAX_RAW];
+    long raw_min, raw_max;
+} part_kind_t;
+
+static const part_kind_t part_kinds[N_PART_KINDS] = {
+    {"bmp280", {0x76, 0x77}, 0, 0x88, 24, 2, {"adc_P", "adc_T"}, 0, 0xFFFFF},
+    {"ms5611", {0x76, 0x77}, 0, 0, 16, 2, {"D1", "D2"}, 0, 0xFFFFFF},
+    {"mpu6050", {0x68, 0x69}, 0, 0x0D, 4, 7, {"ax", "ay", "az", "temp", "gx", "gy", "gz"}, -32768, 32767},
+    {"adxl345", {0x53, 0x1D}, 1, 0x1E, 3, 3, {"x", "y", "z"}, -32768, 32767},
+};
+
+typedef struct {
+    int kind;
+    uint8_t addr;       /* 7-bit I2C address; 0 on SPI */
+    char cs_port;       /* SPI: the chip select's pin */
+    uint8_t cs_bit, cs_level;
+    int fail;
+    uint8_t reg[256];   /* the register file (the MS5611 has none) */
+    uint8_t prom[16];   /* the MS5611's PROM, 8 words big-endian */
+    long raw[MAX_RAW];  /* what the host set: the next conversion's result */
+    long held[MAX_RAW]; /* the MS5611's last conversion result of D1 and D2 */
+    /* the transaction in progress */
+    uint8_t ptr, spi_read, spi_mb;
+    uint32_t n;
+    uint8_t out[3], out_n, out_i; /* the MS5611's answer to its last command */
+    /* conversions */
+    int busy;                        /* a BMP280 measurement or an MS5611 conversion runs */
+    avr_cycle_count_t t0, end, period, t_meas;
+    unsigned long long done;         /* conversions since t0 (periodic ones) */
+    unsigned long long conversions;  /* conversions ended since power-on: `part ADDR info` */
+    int ch, ready;                   /* the MS5611: the channel converted, a result unread */
+    uint32_t result;
+} part_t;
+
+static part_t parts[MAX_PARTS];
+static int parse_u64(const char* s, unsigned long long* out);
+static int n_parts;
+static avr_irq_t* twi_in;   /* TWI_IRQ_INPUT: the slaves' answers */
+static part_t* twi_peer;    /* the part addressed since the last START, or NULL */
+static int twi_reading;
+static avr_irq_t* spi_miso; /* SPI_IRQ_INPUT, shared by the flash and the SPI parts */
+
+static avr_cycle_count_t ns_to_cycles(uint64_t ns) {
+    return (avr_cycle_count_t)((ns * f_cpu + 500000000ull) / 1000000000ull);
+}
+
+static void put_be16(uint8_t* p, long v) {
+    p[0] = (uint8_t)((unsigned long)v >> 8);
+    p[1] = (uint8_t)v;
+}
+
+/* BMP280 (Bosch datasheet BST-BMP280-DS001): its example calibration
+   (section 8.2's worked example: dig_T1 = 27504 ... dig_P9 = 6000) and raw
+   counts (adc_T = 519888, adc_P = 415148: 25.08 C, 1006.53 hPa). */
+static const uint8_t bmp280_cal[24] = {0x70, 0x6B, 0x43, 0x67, 0x18, 0xFC, 0x7D, 0x8E, 0x43, 0xD6, 0xD0, 0x0B,
+                                       0x27, 0x0B, 0x8C, 0x00, 0xF9, 0xFF, 0x8C, 0x3C, 0xF8, 0xC6, 0x70, 0x17};
+/* t_standby in normal mode, us, by config's t_sb (BMP280; the BME280's differ) */
+static const uint32_t bmp280_t_sb_us[8] = {500, 62500, 125000, 250000, 500000, 1000000, 2000000, 4000000};
+
+/* The measurement time for ctrl_meas's oversampling, the datasheet's
+   maximum (section 9.1): 1.25 ms + 2.3 ms x osrs_t + (2.3 ms x osrs_p +
+   0.575 ms when pressure is measured): 6.4 ms at x1/x1 ... 43.2 ms at
+   x2/x16 (typical 5.5 ... 37.5 ms). */
+static avr_cycle_count_t bmp280_t_meas(const part_t* p) {
+    static const uint8_t os[8] = {0, 1, 2, 4, 8, 16, 16, 16};
+    const uint64_t t = os[p->reg[0xF4] >> 5 & 7], pr = os[p->reg[0xF4] >> 2 & 7];
+    return ns_to_cycles(1250000 + 2300000 * t + (pr ? 2300000 * pr + 575000 : 0));
+}
+
+static void bmp280_put20(uint8_t* r, uint32_t v) {
+    r[0] = (uint8_t)(v >> 12);
+    r[1] = (uint8_t)(v >> 4);
+    r[2] = (uint8_t)((v & 0xF) << 4);
+}
+
+/* A measurement ends: adc_P and adc_T take the host's counts (0x80000 for
+   a measurement skipped, osrs 0, as on the part); `stuck`: they keep theirs. */
+static void bmp280_latch(part_t* p) {
+    p->conversions++;
+    if (p->fail == PF_STUCK) return;
+    bmp280_put20(&p->reg[0xF7], (p->reg[0xF4] >> 2 & 7) ? (uint32_t)p->raw[0] : 0x80000u);
+    bmp280_put20(&p->reg[0xFA], (p->reg[0xF4] >> 5 & 7) ? (uint32_t)p->raw[1] : 0x80000u);
+}
+
+/* MS5611-01BA03 (TE datasheet): its example PROM (C1 = 40127 ... C6 =
+   28312) and counts (D1 = 9085466, D2 = 8569150: 20.07 C, 1000.09 mbar);
+   word 7's low 4 bits are the CRC-4 of AN520 over the 8 words. */
+static const uint16_t ms5611_prom[8] = {0x0000, 40127, 36924, 23317, 23282, 33464, 28312, 0x3400};
+/* conversion time by OSR 256, 512, 1024, 2048, 4096: the datasheet's maximum, us */
+static const uint32_t ms5611_conv_us[5] = {600, 1170, 2280, 4540, 9040};
+
+static uint8_t ms5611_crc4(const uint8_t* prom) {
+    uint16_t w[8], rem = 0;
+    for (int i = 0; i < 8; i++) w[i] = (uint16_t)(prom[2 * i] << 8 | prom[2 * i + 1]);
+    w[7] &= 0xFF00;
+    for (int i = 0; i < 16; i++) {
+        rem ^= (i & 1) ? (w[i >> 1] & 0x00FF) : (w[i >> 1] >> 8);
+        for (int b = 0; b < 8; b++) rem = (rem & 0x8000) ? (uint16_t)((rem << 1) ^ 0x3000) : (uint16_t)(rem << 1);
+    }
+    return (uint8_t)(rem >> 12 & 0xF);
+}
+
+/* MPU-6050 (register map RM-MPU-6000A-00): samples come at the sample
+   rate, the gyro's output rate (8 kHz with the DLPF off, CONFIG 0 or 7;
+   else 1 kHz) / (1 + SMPLRT_DIV), while PWR_MGMT_1's SLEEP bit is clear. */
+static avr_cycle_count_t mpu6050_period(const part_t* p) {
+    const uint8_t dlpf = p->reg[0x1A] & 7;
+    const uint64_t gyro_hz = (dlpf == 0 || dlpf == 7) ? 8000 : 1000;
+    return (avr_cycle_count_t)((uint64_t)f_cpu * (1u + p->reg[0x19]) / gyro_hz);
+}
+
+/* ADXL345 (Analog Devices datasheet, rev. G): in measure mode (POWER_CTL
+   bit 3) samples come at BW_RATE's output data rate, 3200 Hz / 2^(15 - rate). */
+static avr_cycle_count_t adxl345_period(const part_t* p) {
+    const unsigned rate = p->reg[0x2C] & 15;
+    return (avr_cycle_count_t)(((uint64_t)f_cpu << (15 - rate)) / 3200);
+}
+
+/* A sample of the MPU-6050 or the ADXL345: its data-ready flag set, the
+   data registers the host's counts (`stuck`: theirs kept). */
+static void sample_latch(part_t* p) {
+    p->conversions++;
+    if (p->kind == PK_MPU6050) {
+        p->reg[0x3A] |= 0x01; /* INT_STATUS DATA_RDY_INT */
+        if (p->fail != PF_STUCK)
+            for (int i = 0; i < 7; i++) put_be16(&p->reg[0x3B + 2 * i], p->raw[i]);
+    } else {
+        p->reg[0x30] |= 0x80; /* INT_SOURCE DATA_READY */
+        if (p->fail != PF_STUCK)
+            for (int i = 0; i < 3; i++) {
+                p->reg[0x32 + 2 * i] = (uint8_t)p->raw[i];
+                p->reg[0x33 + 2 * i] = (uint8_t)((unsigned long)p->raw[i] >> 8);
+            }
+    }
+}
+
+/* The part's registers as at power-on (or its soft reset): the calibration
+   block (non-volatile on the BMP280 and MS5611; on the others the host's
+   fixture) and the host's raw values stay. */
+static void part_power_on(part_t* p) {
+    const part_kind_t* k = &part_kinds[p->kind];
+    uint8_t cal[24];
+    memcpy(cal, p->reg + k->cal_reg, k->cal_len);
+    memset(p->reg, 0, sizeof p->reg);
+    if (p->kind != PK_MS5611) memcpy(p->reg + k->cal_reg, cal, k->cal_len);
+    p->busy = p->ready = 0;
+    p->done = 0;
+    p->t0 = avr->cycle;
+    p->n = 0;
+    p->out_n = p->out_i = 0;
+    p->ptr = 0;
+    p->conversions = 0;
+    switch (p->kind) {
+        case PK_BMP280:
+            p->reg[0xD0] = 0x58;
+            bmp280_put20(&p->reg[0xF7], 0x80000u); /* the data registers' reset values */
+            bmp280_put20(&p->reg[0xFA], 0x80000u);
+            break;
+        case PK_MPU6050:
+            p->reg[0x6B] = 0x40; /* SLEEP */
+            p->reg[0x75] = 0x68; /* WHO_AM_I: 0x68 whatever AD0 says */
+            break;
+        case PK_ADXL345:
+            p->reg[0x00] = 0xE5;
+            p->reg[0x2C] = 0x0A; /* 100 Hz */
+            p->reg[0x30] = 0x02;
+            break;
+        default: break;
+    }
+}
+
+/* Brings the part's conversions up to the current cycle. */
+static void part_tick(part_t* p) {
+    const avr_cycle_count_t now = avr->cycle;
+    if (now < p->t0) p->t0 = now; /* cannot happen; keeps the arithmetic safe */
+    switch (p->kind) {
+        case PK_BMP280:
+            if ((p->reg[0xF4] & 3) == 3) { /* normal: t_meas, t_standby, t_meas, ... from t0 */
+                const avr_cycle_count_t el = now - p->t0;
+                const unsigned long long done = el / p->period + (el % p->period >= p->t_meas);
+                if (done > p->done) {
+                    p->conversions += done - p->done - 1;
+                    bmp280_latch(p);
+                    p->done = done;
+                }
+                p->busy = el % p->period < p->t_meas;
+            } else if (p->busy && now >= p->end) { /* forced: back to sleep */
+                bmp280_latch(p);
+                p->busy = 0;
+                p->reg[0xF4] &= (uint8_t)~3u;
+            }
+            p->reg[0xF3] = p->busy ? 0x08 : 0x00; /* status: measuring */
+            break;
+        case PK_MS5611:
+            if (p->busy && now >= p->end) {
+                p->busy = 0;
+                p->conversions++;
+                if (p->fail != PF_STUCK) p->held[p->ch] = p->raw[p->ch];
+                p->result = (uint32_t)p->held[p->ch];
+                p->ready = 1;
+            }
+            break;
+        case PK_MPU6050:
+        case PK_ADXL345: {
+            const int on = p->kind == PK_MPU6050 ? !(p->reg[0x6B] & 0x40) : (p->reg[0x2D] & 0x08) != 0;
+            if (!on) break;
+            const unsigned long long done = (now - p->t0) / p->period;
+            if (done > p->done) {
+                p->conversions += done - p->done - 1;
+                sample_latch(p);
+                p->done = done;
+            }
+            break;
+        }
+        default: break;
+    }
+}
+
+/* Periodic sampling (re)starts now: the first sample one period later. */
+static void part_restart(part_t* p) {
+    p->t0 = avr->cycle;
+    p->done = 0;
+    if (p->kind == PK_MPU6050) p->period = mpu6050_period(p);
+    if (p->kind == PK_ADXL345) p->period = adxl345_period(p);
+    if (p->kind == PK_BMP280) {
+        p->t_meas = bmp280_t_meas(p);
+        p->period = p->t_meas + ns_to_cycles(1000ull * bmp280_t_sb_us[p->reg[0xF5] >> 5]);
+    }
+}
+
+/* The master writes register r of a register-file part. */
+static void part_reg_write(part_t* p, uint8_t r, uint8_t v) {
+    part_tick(p);
+    switch (p->kind) {
+        case PK_BMP280:
+            if (r == 0xE0) {
+                if (v == 0xB6) part_power_on(p); /* soft reset */
+            } else if (r == 0xF4) {
+                p->reg[r] = v;
+                if ((v & 3) == 3) { /* normal: the first measurement starts now */
+                    part_restart(p);
+                    p->busy = 1;
+                } else if (v & 3) { /* forced: one measurement */
+                    p->t_meas = bmp280_t_meas(p);
+                    p->end = avr->cycle + p->t_meas;
+                    p->busy = 1;
+                } else {
+                    p->busy = 0;
+                }
+                p->reg[0xF3] = p->busy ? 0x08 : 0x00;
+            } else if (r == 0xF5) {
+                p->reg[r] = v;
+                if ((p->reg[0xF4] & 3) == 3) part_restart(p);
+            }
+            break; /* the rest (ID, calibration, data, status) is read-only */
+        case PK_MPU6050:
+            if (r == 0x6B) {
+                if (v & 0x80) { /* DEVICE_RESET */
+                    part_power_on(p);
+                    break;
+                }
+                const int woke = (p->reg[r] & 0x40) && !(v & 0x40);
+                p->reg[r] = v;
+                if (woke) part_restart(p);
+            } else if (r == 0x19 || r == 0x1A) {
+                p->reg[r] = v;
+                part_restart(p);
+            } else if (r != 0x75 && (r < 0x3A || r > 0x60)) {
+                p->reg[r] = v;
+            }
+            break;
+        case PK_ADXL345:
+            if (r == 0x2D) {
+                const int starts = !(p->reg[r] & 0x08) && (v & 0x08);
+                p->reg[r] = v;
+                if (starts) part_restart(p);
+            } else if (r == 0x2C) {
+                p->reg[r] = v;
+                part_restart(p);
+            } else if (r >= 0x1D && r <= 0x38 && r != 0x30 && (r < 0x32 || r > 0x37)) {
+                p->reg[r] = v;
+            }
+            break;
+        default: break;
+    }
+}
+
+/* The master reads register r: reading clears data-ready flags. */
+static uint8_t part_reg_read(part_t* p, uint8_t r) {
+    const uint8_t v = p->reg[r];
+    if (p->kind == PK_MPU6050 && r == 0x3A) p->reg[0x3A] &= (uint8_t)~0x01u;
+    if (p->kind == PK_ADXL345 && r >= 0x32 && r <= 0x37) p->reg[0x30] &= (uint8_t)~0x80u;
+    return v;
+}
+
+/* The MS5611's commands (one byte written). */
+static void ms5611_command(part_t* p, uint8_t c) {
+    part_tick(p);
+    p->out_n = p->out_i = 0;
+    if (c == 0x1E) { /* RESET: the PROM reloaded, a conversion dropped */
+        p->busy = p->ready = 0;
+    } else if (c == 0x00) { /* ADC read: 0 during a conversion, with none, or read a second time */
+        const uint32_t v = (!p->busy && p->ready) ? p->result : 0;
+        if (!p->busy) p->ready = 0;
+        p->out[0] = (uint8_t)(v >> 16), p->out[1] = (uint8_t)(v >> 8), p->out[2] = (uint8_t)v;
+        p->out_n = 3;
+    } else if ((c & 0xF1) == 0xA0) { /* PROM read, word (c >> 1) & 7 */
+        memcpy(p->out, p->prom + 2 * ((c >> 1) & 7), 2);
+        p->out_n = 2;
+    } else if ((c & 0xE1) == 0x40 && (c & 0x0F) <= 8) { /* CONVERT D1 (0x40..0x48) or D2 (0x50..0x58) */
+        if (p->busy) return; /* one conversion at a time */
+        p->ch = (c & 0x10) ? 1 : 0;
+        p->end = avr->cycle + ns_to_cycles(1000ull * ms5611_conv_us[(c & 0x0F) >> 1]);
+        p->busy = 1;
+        p->ready = 0;
+    }
+}
+
+/* An I2C transaction starts (START or repeated START with its address). */
+static void part_begin(part_t* p) {
+    part_tick(p);
+    p->n = 0;
+}
+
+/* A byte written to the part over I2C: the register pointer, then data
+   (the BMP280: pairs of register and data; the others auto-increment). */
+static void part_i2c_write(part_t* p, uint8_t v) {
+    const uint32_t i = p->n++;
+    if (p->kind == PK_MS5611) {
+        if (i == 0) ms5611_command(p, v);
+        return;
+    }
+    if (i == 0 || (p->kind == PK_BMP280 && i % 2 == 0)) {
+        p->ptr = v;
+        return;
+    }
+    part_reg_write(p, p->ptr, v);
+    if (p->kind != PK_BMP280) p->ptr++;
+}
+
+/* A byte the part returns over I2C: registers from the pointer on. */
+static uint8_t part_i2c_read(part_t* p) {
+    if (p->kind == PK_MS5611) return p->out_i < p->out_n ? p->out[p->out_i++] : 0x00;
+    return part_reg_read(p, p->ptr++);
+}
+
+/* A byte over SPI while selected (ADXL345: a command byte, R/W bit 7,
+   multi-byte bit 6, the register in bits 5-0; then data). */
+static uint8_t part_spi_byte(part_t* p, uint8_t in) {
+    const uint32_t i = p->n++;
+    if (i == 0) {
+        p->spi_read = in >> 7 & 1;
+        p->spi_mb = in >> 6 & 1;
+        p->ptr = in & 0x3F;
+        return 0xFF;
+    }
+    uint8_t out = 0xFF;
+    if (p->spi_read)
+        out = part_reg_read(p, p->ptr);
+    else
+        part_reg_write(p, p->ptr, in);
+    if (p->spi_mb) p->ptr = (p->ptr + 1) & 0x3F;
+    return out;
+}
+
+static part_t* part_at(uint8_t addr7) {
+    for (int i = 0; i < n_parts; i++)
+        if (parts[i].addr && parts[i].addr == addr7) return &parts[i];
+    return NULL;
+}
+
+/* Two fixes to simavr 1.6's TWI master, made with parts on the bus so that
+   firmware sees what an ATmega does (without -I the TWI is simavr's own):
+   - TWINT is a "sticky" flag there that nothing clears: once set it reads
+     1 for ever, and a polling master (`while (!(TWCR & _BV(TWINT)))`)
+     reads the status before the byte is done. Writing a one to TWINT clears
+     it, as on the part; the TWI module sets it again when the next status
+     comes (a handler after the module's own on TWCR).
+   - An SLA+W (the address byte is written to TWDR, which simavr takes for
+     a data byte) ends with the data-byte statuses 0x28 / 0x30; the part's
+     are 0x18 (SLA+W sent, ACK) and 0x20 (NACK), so the first status after
+     an SLA+W is corrected (TWI_IRQ_STATUS comes as TWSR is set). It still
+     comes at once where the other bytes take simavr's 9 us. */
+#define TWSR_ADDR 0xB9 /* data-space addresses of TWSR and TWCR on the ATmega328P and ATmega2560 */
+#define TWCR_ADDR 0xBC
+static int twi_sla_w; /* an SLA+W went out; its status is still to come */
+
+static void on_twcr_write(struct avr_t* a, avr_io_addr_t addr, uint8_t v, void* param) {
+    (void)addr, (void)param;
+    if (v & 0x80) a->data[TWCR_ADDR] &= 0x7F;
+}
+
+static void on_twi_status(struct avr_irq_t* irq, uint32_t value, void* param) {
     (void)irq, (void)param;
-    fl_tick();
-    /* deselected, the chip leaves MISO alone and the pull-up reads 0xFF;
-       it answers anyway, because simavr 1.6 completes a master's transfer
-       (SPIF) only when a byte comes in */
-    avr_raise_irq(fl.miso, fl.cs_level ? 0xFF : fl_byte((uint8_t)value));
+    if (!twi_sla_w) return;
+    twi_sla_w = 0;
+    if (value == 0x28 || value == 0x30)
+        avr->data[TWSR_ADDR] = (uint8_t)((avr->data[TWSR_ADDR] & 0x07) | (value == 0x28 ? 0x18 : 0x20));
+}
+
+static void twi_answer(uint8_t msg, uint8_t addr, uint8_t data) {
+    avr_twi_msg_irq_t m;
+    m.u.v = 0;
+    m.u.twi.msg = msg;
+    m.u.twi.addr = addr;
+    m.u.twi.data = data;
+    avr_raise_irq(twi_in, m.u.v);
+}
+
+/* Every slave on the bus: see the section's comment. */
+static void on_twi_out(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq, (void)param;
+    avr_twi_msg_irq_t m;
+    m.u.v = value;
+    const uint8_t msg = m.u.twi.msg, addr = m.u.twi.addr;
+    if (msg & (TWI_COND_STOP | TWI_COND_START)) twi_peer = NULL;
+    twi_sla_w = (msg & TWI_COND_START) && !(addr & 1);
+    if (msg & TWI_COND_START) {
+        part_t* p = part_at(addr >> 1);
+        if (!p || p->fail == PF_NACK) return; /* nobody pulls SDA low: NACK */
+        twi_peer = p;
+        twi_reading = addr & 1;
+        part_begin(p);
+        twi_answer(TWI_COND_ACK, addr, 1);
+        return;
+    }
+    part_t* p = twi_peer && twi_peer->fail != PF_NACK ? twi_peer : NULL;
+    if ((msg & TWI_COND_WRITE) && p && !twi_reading) {
+        part_i2c_write(p, m.u.twi.data);
+        twi_answer(TWI_COND_ACK, addr, 1);
+    } else if (msg & TWI_COND_READ) {
+        twi_answer(TWI_COND_READ, addr, p && twi_reading ? part_i2c_read(p) : 0xFF);
+    }
+}
+
+static void on_part_cs(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq;
+    part_t* p = (part_t*)param;
+    const uint8_t level = value ? 1 : 0;
+    if (level == p->cs_level) return;
+    p->cs_level = level;
+    if (!level) {
+        part_tick(p);
+        p->n = 0;
+    }
+}
+
+/* The byte the SPI parts drive on MISO for `in`, ANDed as on an open bus
+   (one selected at a time is the firmware's business). */
+static uint8_t parts_spi_byte(uint8_t in) {
+    uint8_t out = 0xFF;
+    for (int i = 0; i < n_parts; i++) {
+        part_t* p = &parts[i];
+        if (p->cs_port && !p->cs_level && p->fail != PF_NACK) out &= part_spi_byte(p, in);
+    }
+    return out;
+}
+
+/* The board loses power, or the MCU resets (`power` 0): transactions on
+   the wires end (the AVR lets go of the lines); after a power cut every
+   part comes back as at power-on. */
+static void parts_reset(int power) {
+    twi_peer = NULL;
+    for (int i = 0; i < n_parts; i++) {
+        parts[i].cs_level = 1;
+        parts[i].n = 0;
+        if (power) part_power_on(&parts[i]);
+    }
+}
+
+/* -I KIND@ADDR: 0 when added, else a message on standard error. */
+static int part_add(const char* spec) {
+    char kind[16];
+    const char* at = strchr(spec, '@');
+    if (!at || (size_t)(at - spec) >= sizeof kind) goto usage;
+    memcpy(kind, spec, (size_t)(at - spec));
+    kind[at - spec] = 0;
+    int k = -1;
+    for (int i = 0; i < N_PART_KINDS; i++)
+        if (!strcmp(kind, part_kinds[i].name)) k = i;
+    if (k < 0) goto usage;
+    if (n_parts == MAX_PARTS) {
+        fprintf(stderr, "simboard: -I: at most %d parts\n", MAX_PARTS);
+        return -1;
+    }
+    part_t* p = &parts[n_parts];
+    memset(p, 0, sizeof *p);
+    p->kind = k;
+    p->cs_level = 1;
+    const char* a = at + 1;
+    unsigned long long v;
+    if (strlen(a) == 2 && a[0] >= 'A' && a[0] <= 'L' && a[1] >= '0' && a[1] <= '7') {
+        if (!part_kinds[k].spi) {
+            fprintf(stderr, "simboard: -I %s: the %s is on I2C only: give its address\n", spec, kind);
+            return -1;
+        }
+        p->cs_port = a[0];
+        p->cs_bit = (uint8_t)(a[1] - '0');
+        for (int i = 0; i < n_parts; i++)
+            if (parts[i].cs_port == p->cs_port && parts[i].cs_bit == p->cs_bit) goto taken;
+    } else if (!parse_u64(a, &v) && (v == part_kinds[k].addr[0] || v == part_kinds[k].addr[1])) {
+        p->addr = (uint8_t)v;
+        if (part_at(p->addr)) goto taken;
+    } else {
+        fprintf(stderr, "simboard: -I %s: the %s answers at 0x%02x or 0x%02x%s\n", spec, kind, part_kinds[k].addr[0],
+                part_kinds[k].addr[1], part_kinds[k].spi ? ", or on SPI with its chip select on a pin (B1)" : "");
+        return -1;
+    }
+    if (k == PK_BMP280) memcpy(p->reg + 0x88, bmp280_cal, sizeof bmp280_cal), p->raw[0] = 415148, p->raw[1] = 519888;
+    if (k == PK_MS5611) {
+        for (int i = 0; i < 8; i++) put_be16(p->prom + 2 * i, ms5611_prom[i]);
+        p->prom[15] |= ms5611_crc4(p->prom);
+        p->raw[0] = 9085466;
+        p->raw[1] = 8569150;
+    }
+    if (k == PK_MPU6050) p->raw[2] = 16384, p->raw[3] = -3920; /* 1 g at +-2 g; 25 C: raw / 340 + 36.53 */
+    if (k == PK_ADXL345) p->raw[2] = 256;                        /* 1 g at +-2 g, 10 bits */
+    n_parts++;
+    return 0;
+taken:
+    fprintf(stderr, "simboard: -I %s: another part is there already\n", spec);
+    return -1;
+usage:
+    fprintf(stderr, "simboard: -I KIND@ADDR: KIND one of bmp280 ms5611 mpu6050 adxl345, ADDR a 7-bit address "
+                    "(0x76) or an SPI chip-select pin (B1)\n");
+    return -1;
+}
+
+/* Every byte the AVR's SPI shifts out: the flash and the SPI parts (-I)
+   answer when selected. Deselected, a chip leaves MISO alone and the
+   pull-up reads 0xFF; the board answers anyway, because simavr 1.6
+   completes a master's transfer (SPIF) only when a byte comes in. */
+static void on_spi_mosi(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq, (void)param;
+    uint8_t out = parts_spi_byte((uint8_t)value);
+    if (fl.mem) {
+        fl_tick();
+        if (!fl.cs_level) out &= fl_byte((uint8_t)value);
+    }
+    avr_raise_irq(spi_miso, out);
 }
 
 static void on_fl_cs(struct avr_irq_t* irq, uint32_t value, void* param) {
@@ -841,6 +1419,7 @@ static void power_cut(avr_t* a) {
     mcu_reset(a, CAUSE_POWER);
     fl.cs_level = 1; /* CS floats: the pull-up */
     fl.n = 0;
+    parts_reset(1);
 }
 
 /* ---- files that keep a memory between runs (-S, -E) ------------------------------------ */
@@ -1461,6 +2040,7 @@ static int cmd_reset(int argc, char** argv) {
         power_cut(avr); /* the chip's operation in progress half done, its latches lost */
     } else {
         mcu_reset(avr, cause);
+        parts_reset(0);
         if (fl.mem && !fl.cs_level) { /* the AVR lets go of CS: the pull-up raises it, the chip sees it rise */
             fl_tick();
             fl_deselect();
@@ -1469,6 +2049,107 @@ static int cmd_reset(int argc, char** argv) {
     halted = 0;
     fprintf(proto, "ok\n");
     return 1;
+}
+
+/* `part`: the parts of -I (docs/sim.md, "Parts on I2C and SPI"):
+   `part` lists them; `part ID info|cal [HEX]|raw NAME=V...|fail MODE|reg R N`
+   with ID a part's I2C address or SPI chip-select pin. */
+static int cmd_part(int argc, char** argv) {
+    static const char usage[] =
+        "usage: part [ID info | ID cal [HEX] | ID raw NAME=VALUE... | ID fail ok|nack|stuck | ID reg REG N] "
+        "(ID: an I2C address or an SPI chip-select pin)";
+    if (argc == 1) {
+        fprintf(proto, "ok");
+        for (int i = 0; i < n_parts; i++) {
+            if (parts[i].addr)
+                fprintf(proto, " 0x%02x=%s", parts[i].addr, part_kinds[parts[i].kind].name);
+            else
+                fprintf(proto, " %c%u=%s", parts[i].cs_port, parts[i].cs_bit, part_kinds[parts[i].kind].name);
+        }
+        fprintf(proto, "\n");
+        return 1;
+    }
+    if (argc < 3) return fail("%s", usage);
+    part_t* p = NULL;
+    unsigned long long v, n;
+    if (strlen(argv[1]) == 2 && argv[1][0] >= 'A' && argv[1][0] <= 'L') {
+        for (int i = 0; i < n_parts; i++)
+            if (parts[i].cs_port == argv[1][0] && parts[i].cs_bit == (uint8_t)(argv[1][1] - '0')) p = &parts[i];
+    } else if (!parse_u64(argv[1], &v) && v < 0x80) {
+        p = part_at((uint8_t)v);
+    }
+    if (!p) return fail("part: no part at %s (start the harness with -I KIND@ADDR)", argv[1]);
+    const part_kind_t* k = &part_kinds[p->kind];
+    part_tick(p); /* conversions that ended so far latch what the host had set */
+    uint8_t* cal = p->kind == PK_MS5611 ? p->prom : p->reg + k->cal_reg;
+    if (argc == 3 && !strcmp(argv[2], "info")) {
+        fprintf(proto, "ok kind=%s bus=%s fail=%s busy=%d conversions=%llu", k->name, p->addr ? "i2c" : "spi",
+                part_fail_names[p->fail], p->busy, p->conversions);
+        for (int i = 0; i < k->n_raw; i++) fprintf(proto, " %s=%ld", k->raw_names[i], p->raw[i]);
+        fprintf(proto, "\n");
+        return 1;
+    }
+    if ((argc == 3 || argc == 4) && !strcmp(argv[2], "cal")) {
+        if (argc == 4) {
+            bytes_t data = {0};
+            if (hex_in(argv[3], &data) || data.len > k->cal_len) {
+                free(data.buf);
+                return fail("part cal HEX: at most %u bytes (hex) from the calibration block's first", k->cal_len);
+            }
+            if (data.len) memcpy(cal, data.buf, data.len);
+            free(data.buf);
+        }
+        fprintf(proto, "ok ");
+        hex_out(cal, k->cal_len);
+        fprintf(proto, "\n");
+        return 1;
+    }
+    if (argc >= 4 && !strcmp(argv[2], "raw")) {
+        long vals[MAX_RAW];
+        memcpy(vals, p->raw, sizeof vals);
+        for (int i = 3; i < argc; i++) { /* all checked before any is applied */
+            char* eq = strchr(argv[i], '=');
+            int r = -1;
+            if (eq) {
+                *eq = 0;
+                for (int j = 0; j < k->n_raw; j++)
+                    if (!strcmp(argv[i], k->raw_names[j])) r = j;
+                *eq = '=';
+            }
+            char* end;
+            errno = 0;
+            const long x = eq ? strtol(eq + 1, &end, 0) : 0;
+            if (r < 0 || errno || !eq[1] || *end || x < k->raw_min || x > k->raw_max) {
+                fprintf(proto, "err part raw: the %s takes", k->name);
+                for (int j = 0; j < k->n_raw; j++) fprintf(proto, " %s=", k->raw_names[j]);
+                fprintf(proto, " (%ld..%ld), not `%s`\n", k->raw_min, k->raw_max, argv[i]);
+                return 1;
+            }
+            vals[r] = x;
+        }
+        memcpy(p->raw, vals, sizeof vals);
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (argc == 4 && !strcmp(argv[2], "fail")) {
+        int f = -1;
+        for (int i = 0; i < N_PART_FAILS; i++)
+            if (!strcmp(argv[3], part_fail_names[i])) f = i;
+        if (f < 0) return fail("part fail ok|nack|stuck");
+        p->fail = f;
+        fprintf(proto, "ok\n");
+        return 1;
+    }
+    if (argc == 5 && !strcmp(argv[2], "reg")) {
+        if (p->kind == PK_MS5611) return fail("part reg: the ms5611 has commands, not registers");
+        if (parse_u64(argv[3], &v) || parse_u64(argv[4], &n) || v + n > 256)
+            return fail("part reg REG N: registers 0-0xff");
+        fprintf(proto, "ok ");
+        hex_out(p->reg + v, (size_t)n);
+        fprintf(proto, "\n");
+        return 1;
+    }
+    return fail("%s", usage);
 }
 
 static int cmd_quit(int argc, char** argv) {
@@ -1486,7 +2167,8 @@ static const struct {
     {"batch", cmd_batch}, {"adc", cmd_adc},     {"din", cmd_din},     {"ports", cmd_ports},
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
     {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
-    {"eeprom", cmd_eeprom}, {"flash", cmd_flash}, {"sched", cmd_sched}, {"quit", cmd_quit},
+    {"eeprom", cmd_eeprom}, {"flash", cmd_flash}, {"sched", cmd_sched}, {"part", cmd_part},
+    {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 
@@ -1531,7 +2213,7 @@ static void usage(void) {
     fprintf(stderr,
             "usage: simboard [-c] [-m MCU] [-f HZ] [-t SIM_S] [-w WALL_S] [-u control|pty|stdio|stdout|none]\n"
             "                [-l LINK] [-r] [-x crash|done|unity] [-a CH=MV]... [-E EEPROM_FILE]\n"
-            "                [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-R SEED] FW.elf\n");
+            "                [-s CSPIN[:SIZE] [-S FLASH_FILE]] [-I KIND@ADDR]... [-R SEED] FW.elf\n");
 }
 
 int main(int argc, char** argv) {
@@ -1540,7 +2222,7 @@ int main(int argc, char** argv) {
     unsigned long long adc_init[16];
     int adc_set[16] = {0};
     const char* flash_spec = NULL;
-    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:s:S:E:R:")) != -1) {
+    while ((opt = getopt(argc, argv, "cm:f:t:w:u:l:rx:a:s:S:E:R:I:")) != -1) {
         char* end;
         switch (opt) {
             case 'c': control = 1; break;
@@ -1595,6 +2277,9 @@ int main(int argc, char** argv) {
             }
             case 's': flash_spec = optarg; break;
             case 'S': fl.file = optarg; break;
+            case 'I':
+                if (part_add(optarg) != 0) return 2;
+                break;
             case 'E': ee_file = optarg; break;
             case 'R': {
                 unsigned long long v;
@@ -1706,21 +2391,41 @@ int main(int argc, char** argv) {
         free(buf);
     }
 
+    int spi_parts = 0, i2c_parts = 0;
+    for (int i = 0; i < n_parts; i++) {
+        avr_ioport_state_t st;
+        if (parts[i].cs_port) {
+            spi_parts++;
+            if (port_state(parts[i].cs_port, &st) != 0) {
+                fprintf(stderr, "simboard: -I: the %s has no port %c\n", mcu_name, parts[i].cs_port);
+                return 2;
+            }
+            if (flash_spec && parts[i].cs_port == fl.cs_port && parts[i].cs_bit == fl.cs_bit) {
+                fprintf(stderr, "simboard: -I: the SPI flash's chip select is %c%u already\n", fl.cs_port, fl.cs_bit);
+                return 2;
+            }
+        } else {
+            i2c_parts++;
+        }
+    }
+    avr_irq_t* mosi = NULL;
+    if (flash_spec || spi_parts) {
+        /* the SPI's name in its ioctl is 0 on simavr 1.6's megas, '0' on others */
+        mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_OUTPUT);
+        spi_miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_INPUT);
+        if (!mosi || !spi_miso) {
+            mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_OUTPUT);
+            spi_miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_INPUT);
+        }
+        if (!mosi || !spi_miso) {
+            fprintf(stderr, "simboard: %s: simavr's %s has no SPI\n", flash_spec ? "-s" : "-I", mcu_name);
+            return 2;
+        }
+    }
     if (flash_spec) {
         avr_ioport_state_t st;
         if (port_state(fl.cs_port, &st) != 0) {
             fprintf(stderr, "simboard: -s: the %s has no port %c\n", mcu_name, fl.cs_port);
-            return 2;
-        }
-        /* the SPI's name in its ioctl is 0 on simavr 1.6's megas, '0' on others */
-        avr_irq_t* mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_OUTPUT);
-        fl.miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ(0), SPI_IRQ_INPUT);
-        if (!mosi || !fl.miso) {
-            mosi = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_OUTPUT);
-            fl.miso = avr_io_getirq(avr, AVR_IOCTL_SPI_GETIRQ('0'), SPI_IRQ_INPUT);
-        }
-        if (!mosi || !fl.miso) {
-            fprintf(stderr, "simboard: -s: simavr's %s has no SPI\n", mcu_name);
             return 2;
         }
         fl.size = (uint32_t)flash_size;
@@ -1733,8 +2438,32 @@ int main(int argc, char** argv) {
         memset(fl.mem, 0xFF, fl.size); /* from the factory: erased */
         if (fl.file && image_load(fl.file, fl.mem, fl.size, "SPI flash") != 0) return 2;
         fl.cs_level = 1;
-        avr_irq_register_notify(mosi, on_fl_mosi, NULL);
         avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(fl.cs_port), fl.cs_bit), on_fl_cs, NULL);
+    }
+    if (mosi) avr_irq_register_notify(mosi, on_spi_mosi, NULL);
+    if (i2c_parts) {
+        /* the TWI's name in its ioctl is 0 on simavr 1.6's megas, '0' on others */
+        avr_irq_t* out = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ(0), TWI_IRQ_OUTPUT);
+        twi_in = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ(0), TWI_IRQ_INPUT);
+        if (!out || !twi_in) {
+            out = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ('0'), TWI_IRQ_OUTPUT);
+            twi_in = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ('0'), TWI_IRQ_INPUT);
+        }
+        if (!out || !twi_in) {
+            fprintf(stderr, "simboard: -I: simavr's %s has no TWI\n", mcu_name);
+            return 2;
+        }
+        avr_irq_register_notify(out, on_twi_out, NULL);
+        avr_irq_t* status = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ(0), TWI_IRQ_STATUS);
+        if (!status) status = avr_io_getirq(avr, AVR_IOCTL_TWI_GETIRQ('0'), TWI_IRQ_STATUS);
+        if (status) avr_irq_register_notify(status, on_twi_status, NULL);
+        avr_register_io_write(avr, TWCR_ADDR, on_twcr_write, NULL); /* after the TWI module's own */
+    }
+    for (int i = 0; i < n_parts; i++) {
+        part_power_on(&parts[i]);
+        if (parts[i].cs_port)
+            avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(parts[i].cs_port), parts[i].cs_bit),
+                                    on_part_cs, &parts[i]);
     }
 
     /* UART0: raw bytes, not simavr's line printer. */

@@ -51,3 +51,14 @@ def test_a_sample_of_more_than_253_bytes_is_refused(tmp_path):
     (project / "logged.app").write_text(app)
     r = run_fsw("check", str(project / "logged.app"))
     assert r.code == 1 and "the logged elements take 256 bytes a sample: at most 253" in r.err, r.err
+
+
+def test_a_recorded_value_agrees_with_telemetry_within_half_a_step_and_binary32s_rounding():
+    from fswkit.recorder.check import agrees
+
+    # seed 20 of the rocket: 306.1499938964844 x 10 is 3061.5 in binary32, a count of 3062
+    assert agrees(306.2, 306.1499938964844, 0.05 + 1e-6)
+    assert agrees(306.1, 306.14, 0.05 + 1e-6)
+    assert not agrees(306.3, 306.1499938964844, 0.05 + 1e-6)  # a whole step out
+    assert not agrees(306.21, 306.15, 0.05 + 1e-6)
+    assert agrees(7.0, 7.0, 0.0) and not agrees(7.0, 7.000001, 0.0)  # held and raw values: equal

@@ -49,6 +49,16 @@ def flight_report(app, run, check_cls, *, truth=None, alt_element: str | None = 
                            alt_element=alt_element)
 
 
+def agrees(recorded: float, telemetered: float, half_step: float) -> bool:
+    """Whether a recorded value is the telemetered one as the encoding kept
+    it: equal (half_step 0), or within half a step, plus the rounding of the
+    firmware's value x (1 / step) to binary32 before it is rounded to a
+    count, which can put a value a hair under half a step from one count on
+    the count above (306.14999 -> 306.2 with step 0.1)."""
+    slack = abs(telemetered) * 2.0 ** -23 if half_step else 0.0
+    return abs(recorded - telemetered) <= half_step + slack
+
+
 def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: float | None,
                     truth=None, alt_element: str | None = None):
     """(summary lines, checks, (plan, flight) or None) for a flight's record.
@@ -116,7 +126,7 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
             if name not in row:
                 continue
             y = row[name]
-            if not (abs(float(x) - float(y)) <= steps[name]):
+            if not agrees(float(x), float(y), steps[name]):
                 bad += 1
                 if not first_bad:
                     first_bad = f"; first at {t} ms: {name} recorded {x}, telemetered {y}"

@@ -485,6 +485,9 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
     return out
 
 
+LINK_BUFFER2_LOAD = 0.8  # the share of the line above which the link gets two frames' buffer
+
+
 def _link(app: Application) -> list[str]:
     """The serial link's tables (docs/telemetry.md): streams, writable
     elements, buffers and the configuration, all constant data."""
@@ -494,8 +497,16 @@ def _link(app: Application) -> list[str]:
          f"// Link schema: the layout, the tasks, {len(plan.streams)} stream(s) and "
          f"{len(plan.writable)} writable element(s).",
          f"const uint32_t kLinkSchema = 0x{app_schema_hash(app):08x}UL;",
-         f"const uint16_t kLinkTxSize = {plan.tx_cap};  // the longest encoded frame",
-         "uint8_t link_tx[kLinkTxSize];"]
+         f"const uint16_t kLinkTxSize = {plan.tx_cap};  // the longest encoded frame"]
+    # A link loaded near its line rate gets a transmit buffer of two longest
+    # frames: a sample frame then waits behind the rest of the one before (a
+    # health frame pushes the next sample past its turn) instead of being
+    # dropped. Below LINK_BUFFER2_LOAD of the line, one frame's buffer.
+    load, capacity = link_load(app)  # the checker refuses a link that cannot carry it (autocode/limits.py)
+    tx_buffer = (2 * plan.tx_cap if plan.streams and load > LINK_BUFFER2_LOAD * capacity and 2 * plan.tx_cap <= 0xFFFF
+                 else plan.tx_cap)
+    c.append(f"uint8_t link_tx[{tx_buffer}];  // " + ("two longest frames: the link is loaded near its line rate"
+                                                    if tx_buffer != plan.tx_cap else "one longest frame"))
     for s in plan.streams:
         if s.batch > 1:
             c.append(f"uint8_t link_store_{s.index}[{(s.batch - 1) * s.region.size}];  "
@@ -525,7 +536,6 @@ def _link(app: Application) -> list[str]:
             c.append(f"static_assert(fsw::link_writable_ok(E_{e.name}, {ELEM_CODE[e.type.name]}, kSvSize), "
                      f"\"writable element {e.name} lies outside the state vector\");")
     c.append(f"uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, {app.time_unit}")
-    load, capacity = link_load(app)  # the checker refuses a link that cannot carry it (autocode/limits.py)
     c.append(f"// Link load: about {round(load)} B/s of {round(capacity)} B/s at {app.baud} baud "
              f"({100 * load / capacity:.0f} %).")
     if load > capacity:
@@ -537,7 +547,7 @@ def _link(app: Application) -> list[str]:
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
              f"{plan.hello_every}, {up}, kSvLock"
-             f"{_link_stores(app)}}};")
+             f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}, {len(app.pyro)}), \"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")

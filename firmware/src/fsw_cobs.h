@@ -1,6 +1,8 @@
-// COBS framing of the telemetry link (docs/telemetry.md): an incremental
-// encoder that writes a frame body and its CRC-16 straight into a buffer,
-// ending with the 0x00 delimiter, and an in-place decoder.
+// COBS framing of the telemetry link (docs/telemetry.md): an in-place
+// framer (the body written raw where its encoding goes, then its CRC-16 and
+// COBS in one pass: what the link uses), an incremental encoder (the same
+// bytes, built a call at a time: the tests' reference) and an in-place
+// decoder.
 #ifndef FSW_COBS_H
 #define FSW_COBS_H
 
@@ -10,6 +12,16 @@ namespace fsw {
 
 // Encoded size bound of a frame of `n` bytes (body + CRC), delimiter included.
 inline uint16_t cobs_max_encoded(uint16_t n) { return static_cast<uint16_t>(n + n / 254u + 2u); }
+
+// Frames a body in place: the body lies raw at buf[1..n] (buf[0] is the
+// first code byte's), and `src_n` more bytes from `src` are copied in after
+// it as they are framed (no second pass over them). Appends the CRC-16
+// (high byte first), COBS-encodes body ‖ CRC where it lies (a non-zero byte
+// stays where it is: only zeros, and a byte after every full block of 254,
+// move) and writes the delimiter. `buf` holds cobs_max_encoded(n + src_n +
+// 2) bytes. Returns the encoded length, delimiter included: the same bytes
+// as cobs_begin, cobs_put_bytes(body), cobs_end.
+uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src = 0, uint16_t src_n = 0);
 
 struct CobsEncoder {
     uint8_t* out;      // the encoded frame so far

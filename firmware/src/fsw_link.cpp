@@ -1,6 +1,7 @@
 // The serial link: telemetry (samples, hello, health, acks, snapshots) and
-// the uplink command parser. Frames are composed straight into one transmit
-// buffer by the COBS encoder; nothing here waits for the UART.
+// the uplink command parser. Frames are composed straight into the transmit
+// buffer and framed there in one pass (cobs_frame); nothing here waits for
+// the UART.
 #include "fsw_link.h"
 
 #include "fsw_cobs.h"
@@ -52,37 +53,62 @@ void pump(Link& l) {
     if (l.tx_pos >= l.tx_len) l.tx_len = l.tx_pos = 0;
 }
 
-bool tx_free(Link& l) {
+// Room for a frame of up to `need` encoded bytes behind what the transmit
+// buffer still holds; the rest is moved to the front when the frame would
+// not fit after it. The buffer is max(tx_cap, tx_size) bytes (tx_size: two
+// longest frames for a link near its line rate, the generator's choice): a
+// sample frame goes behind any rest it fits behind; a control frame, whose
+// size is known only once composed, needs room for the longest frame
+// (with one frame's buffer: an empty buffer, as it always did).
+bool tx_room(Link& l, uint16_t need) {
     pump(l);
-    return l.tx_len == 0;
+    if (l.tx_len == 0) return true;
+    const uint16_t rest = static_cast<uint16_t>(l.tx_len - l.tx_pos);
+    if (need > l.tx_size - rest) return false;
+    if (need > l.tx_size - l.tx_len) {
+        memmove(l.tx, l.tx + l.tx_pos, rest);
+        l.tx_len = rest;
+        l.tx_pos = 0;
+    }
+    return true;
 }
 
-// The frame being composed. A frame is composed whole within one call, so
-// one encoder serves every link; the helpers below keep each field of a
-// frame to one short call.
-CobsEncoder g_enc;
+// The frame being composed: its body is written raw where its encoding
+// goes (one byte after the frame's start, cobs_frame), then framed in one
+// pass. A frame is composed whole within one call, so one write pointer
+// serves every link; the helpers below keep each field to one short call.
+uint8_t* g_at;  // the frame's first byte in the transmit buffer
+uint8_t* g_w;   // where the next body byte goes
 
-FSW_NOINLINE void put(uint8_t b) { cobs_put(g_enc, b); }
-FSW_NOINLINE void put_u16(uint16_t v) { cobs_put_u16(g_enc, v); }
-FSW_NOINLINE void put_u32(uint32_t v) { cobs_put_u32(g_enc, v); }
+FSW_NOINLINE void put(uint8_t b) { *g_w++ = b; }
 FSW_NOINLINE void put_bytes(const void* p, uint16_t n) {
-    cobs_put_bytes(g_enc, static_cast<const uint8_t*>(p), n);
+    memcpy(g_w, p, n);
+    g_w += n;
 }
+void put_u16(uint16_t v) { put_bytes(&v, 2); }  // little-endian targets (fsw_config.h)
+void put_u32(uint32_t v) { put_bytes(&v, 4); }
 
 // The header: type, the frame counter's low byte, the low 32 bits of the
-// time (`time` points at its little-endian bytes).
+// time (`time` points at its little-endian bytes). The frame goes after
+// the bytes the transmit buffer still holds.
 FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
-    cobs_begin(g_enc, l.tx);
-    put(type);
-    put(static_cast<uint8_t>(l.n.frames));
-    put_bytes(time, 4);
+    g_at = l.tx + l.tx_len;
+    uint8_t* w = g_at + 1;
+    w[0] = type;
+    w[1] = static_cast<uint8_t>(l.n.frames);
+    memcpy(w + 2, time, 4);
+    g_w = w + 6;
 }
 
-void frame_end(Link& l) {
-    l.tx_len = cobs_end(g_enc);
-    l.tx_pos = 0;
+// Frames the body in place, and `src`'s `n` bytes after it, copied in as
+// they are framed (a sample frame's current region: no second pass over
+// it). A sample frame is handed to the UART by the next pump (the next
+// frame's, or link_poll's right after the cycle: not copied into the UART's
+// ring within the telemetry task's step); a control frame at once.
+void frame_end(Link& l, bool pump_now, const uint8_t* src = 0, uint16_t n = 0) {
+    l.tx_len = static_cast<uint16_t>(l.tx_len + cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n));
     ++l.n.frames;
-    pump(l);
+    if (pump_now) pump(l);
 }
 
 // State vector bytes into the frame, atomically when the lock is on.
@@ -97,14 +123,21 @@ void send_batch(Link& l, const LinkConfig& c, const LinkStream& s, LinkStreamSta
                 bool with_now) {
     const uint8_t stored = st.count;
     st.count = 0;
-    if (!tx_free(l)) {
+    // the frame's encoded size bound: body, CRC, code bytes (body / 128: a
+    // bound of body / 254 without a division), delimiter
+    const uint16_t body = static_cast<uint16_t>(kLinkHeader + (stored + (with_now ? 1u : 0u)) * s.size);
+    if (!tx_room(l, static_cast<uint16_t>(body + 4u + (body >> 7)))) {
         ++l.n.dropped;
         return;
     }
     frame_begin(l, static_cast<uint8_t>(kFrameSample | i), &st.t0);
-    put_bytes(s.store, static_cast<uint16_t>(stored * s.size));
-    if (with_now) put_sv(c, s.off, s.size);
-    frame_end(l);
+    if (stored != 0) put_bytes(s.store, static_cast<uint16_t>(stored * s.size));
+    if (with_now && !c.lock) {
+        frame_end(l, false, c.sv + s.off, s.size);  // the region copied in as it is framed
+        return;
+    }
+    if (with_now) put_sv(c, s.off, s.size);  // atomically, then framed
+    frame_end(l, false);
 }
 
 void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, uint32_t now32) {
@@ -177,19 +210,20 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_sv(c, off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= c.sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
-    frame_end(l);
+    frame_end(l, true);
 }
 
-// Sends waiting control frames while the transmit buffer is free:
-// acknowledgements first, then hello, health, snapshot chunks. After a
-// hello or a health frame (the two long ones) the next waits for a whole
-// executor cycle to pass, so no step, and no cycle with the gap after it,
-// composes both.
-void service(Link& l, const LinkConfig& c) {
-    while (tx_free(l)) {
+// Sends waiting control frames while the transmit buffer has room:
+// acknowledgements first, then hello, health, snapshot chunks. Hello and
+// health frames (the two long ones) are composed only between cycles
+// (`big`: from link_poll, never in a task's step), and after one the next
+// waits for a whole executor cycle to pass, so no cycle with the gap after
+// it composes both.
+void service(Link& l, const LinkConfig& c, bool big) {
+    while (tx_room(l, c.tx_cap)) {
         const uint8_t p = l.pending;
         const uint8_t cycle = static_cast<uint8_t>(c.ex->cycles);
-        const bool big_ok = static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;
+        const bool big_ok = big && static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;
         uint8_t type;
         if (p & kPendAck) {
             type = kFrameAck;
@@ -320,6 +354,8 @@ void link_begin(Link& l, const LinkConfig* cfg) {
         st.countdown = first;
     }
     l.tx = c.tx;
+    l.tx_size = c.tx_size > c.tx_cap ? c.tx_size : c.tx_cap;
+    l.ctl_rest = static_cast<uint16_t>(l.tx_size - c.tx_cap);
     l.snapshot_at = kNoSnapshot;
     l.health_countdown = c.health_every;
     l.hello_countdown = c.hello_every;
@@ -332,17 +368,25 @@ void link_begin(Link& l, const LinkConfig* cfg) {
     pal::console_write(&delimiter, 1);
 }
 
+// The telemetry task's step: samples the streams due and sends the sample
+// frames; control frames wait for link_poll, right after the cycle. It reads
+// the configuration up to `lock` only (what sampling uses).
 Result link_telemetry_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     LinkConfig c;
-    read_config(l, c);
+    flash_read(&c, l.cfg, offsetof(LinkConfig, params));
     pump(l);
-    const uint32_t now32 = static_cast<uint32_t>(c.now());
+    uint32_t now32 = 0;
+    bool have_now = false;
     for (uint8_t i = 0; i < c.n_streams; ++i) {
         LinkStreamState& st = c.stream_state[i];
         if (st.countdown != 0) {
             --st.countdown;
             continue;
+        }
+        if (!have_now) {  // the time, once a stream is due
+            now32 = static_cast<uint32_t>(c.now());
+            have_now = true;
         }
         LinkStream s;
         flash_read(&s, &c.streams[i], sizeof s);
@@ -357,7 +401,6 @@ Result link_telemetry_task(void* p) {
             l.pending |= kPendHello;
         }
     }
-    service(l, c);
     return kOk;
 }
 
@@ -365,7 +408,7 @@ Result link_uplink_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     LinkConfig c;
     read_config(l, c);
-    service(l, c);
+    service(l, c, false);
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
         if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
         const int16_t b = pal::console_read();
@@ -378,7 +421,7 @@ Result link_uplink_task(void* p) {
             }
             l.rx_len = 0;
             l.rx_over = false;
-            service(l, c);
+            service(l, c, false);
         } else if (l.rx_len < sizeof l.rx) {
             l.rx[l.rx_len++] = static_cast<uint8_t>(b);
         } else {
@@ -391,10 +434,11 @@ Result link_uplink_task(void* p) {
 void link_poll(Link& l) {
     if (l.cfg == 0) return;
     pump(l);
-    if (l.tx_len != 0 || (l.pending == 0 && l.snapshot_at == kNoSnapshot)) return;
+    if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;
+    if (l.tx_len != 0 && static_cast<uint16_t>(l.tx_len - l.tx_pos) > l.ctl_rest) return;  // no room yet
     LinkConfig c;
     read_config(l, c);
-    service(l, c);
+    service(l, c, true);
 }
 
 // What a parameter command's ack carries after its 6 bytes: GET's values

@@ -114,7 +114,7 @@ struct LinkConfig {
     const LinkWritable* writable;     // n_writable rows
     Executor* ex;                     // task health and modes (required)
     LinkClockFn now;                  // the time `G` is written from
-    uint8_t* tx;                      // transmit buffer of tx_cap bytes
+    uint8_t* tx;                      // transmit buffer of max(tx_cap, tx_size) bytes
     uint32_t schema;                  // schema hash of layout + link configuration
     uint16_t sv_size;
     uint16_t tx_cap;                  // >= the longest encoded frame
@@ -133,6 +133,9 @@ struct LinkConfig {
     LinkLogAckFn log_ack;             // link_log_ack, with a recorder
     const PyroGate* pyro;             // the pyro channels' gates: a status byte each in health frames
     uint8_t n_pyro;
+    uint16_t tx_size;                 // bytes of `tx` (0: tx_cap). Above tx_cap, a sample frame may wait
+                                      // behind the unsent rest of the one before (a link near its line
+                                      // rate); a control frame behind a rest of tx_size - tx_cap
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -152,8 +155,10 @@ struct LinkCounters {
 struct Link {
     const LinkConfig* cfg;  // FSW_FLASH
     uint8_t* tx;
-    uint16_t tx_len;        // bytes of the frame in tx (0: free)
+    uint16_t tx_len;        // bytes of the frames in tx, sent or not (0: free)
     uint16_t tx_pos;        // bytes of it handed to the console
+    uint16_t tx_size;       // bytes of tx: max(tx_cap, tx_size) of the configuration
+    uint16_t ctl_rest;      // the most a control frame fits behind: tx_size - tx_cap
     LinkCounters n;
     uint16_t health_countdown;
     uint16_t snapshot_at;   // next snapshot offset (0xFFFF: no snapshot under way)
@@ -179,8 +184,9 @@ void link_begin(Link& link, const LinkConfig* cfg);
 // Executor task steps (ctx = the Link): never block, never fault.
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
-// From loop(), between cycles: sends waiting control frames and feeds the
-// transmit buffer to the console as it drains.
+// From loop(), between cycles: sends waiting control frames (hello and
+// health frames only here, never in a task's step) and feeds the transmit
+// buffer to the console as it drains.
 void link_poll(Link& link);
 // A parameter command (kOpParamGet..kOpParamInfo) on the store, and what its
 // acknowledgement carries after its 6 bytes (GET's values, INFO's state,

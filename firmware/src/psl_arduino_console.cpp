@@ -88,17 +88,22 @@ void console_begin(uint32_t baud) {
 }
 
 // Never waits: bytes that do not fit are dropped (callers stay within
-// console_write_space()).
+// console_write_space()). Copied in at most two runs (up to the ring's
+// end, then from its start), not a byte at a time.
 void console_write(const uint8_t* data, uint16_t len) {
-    uint8_t h = g_tx_head;
-    while (len != 0) {
-        const uint8_t next = static_cast<uint8_t>((h + 1u) & kTxMask);
-        if (next == g_tx_tail) break;
-        g_tx[h] = *data++;
-        h = next;
-        --len;
+    const uint8_t h = g_tx_head;
+    const uint8_t space = static_cast<uint8_t>((g_tx_tail - h - 1u) & kTxMask);
+    if (len > space) len = space;
+    if (len == 0) return;
+    const uint8_t n = static_cast<uint8_t>(len);
+    const uint8_t first = static_cast<uint8_t>(FSW_CONSOLE_TX_SIZE - h);  // 0: h is 0 in a ring of 256
+    if (first == 0 || n <= first) {
+        memcpy(g_tx + h, data, n);
+    } else {
+        memcpy(g_tx + h, data, first);
+        memcpy(g_tx, data + first, static_cast<uint8_t>(n - first));
     }
-    g_tx_head = h;
+    g_tx_head = static_cast<uint8_t>((h + n) & kTxMask);
     // Read-modify-write against the interrupt clearing UDRIE0: at worst it
     // fires once more on an empty ring and turns itself off.
     UCSR0B = static_cast<uint8_t>(UCSR0B | _BV(UDRIE0));

@@ -36,7 +36,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -149,6 +149,52 @@ static void test_cobs_roundtrip_and_limits(void) {
     TEST_ASSERT_EQUAL_INT16(-1, cobs_decode(zero, 3));
 }
 
+// The in-place framer (whole, and a part in place with the rest copied in)
+// against the incremental encoder (the one the link used before, kept as
+// the reference): the same bytes for random bodies of
+// every length 0..600 (zeros often, runs of 254 and more non-zero bytes, a
+// full block at the body's or the CRC's end), and the inline CRC step
+// against crc16_update for every CRC value's high byte and every data byte.
+static void test_framer_matches_the_incremental_encoder(void) {
+    static uint8_t raw[600], enc[700], framed[700];
+    uint32_t x = 777;
+    for (uint16_t n = 0; n <= 600; ++n) {
+        const uint8_t zeros = static_cast<uint8_t>(n % 4 == 0 ? 0 : n % 4 == 1 ? 2 : n % 4 == 2 ? 50 : 255);
+        for (uint16_t i = 0; i < n; ++i) {
+            x = x * 1103515245u + 12345u;
+            const uint8_t b = static_cast<uint8_t>(x >> 16);
+            raw[i] = static_cast<uint8_t>(x >> 24) < zeros ? 0 : (b == 0 ? 1 : b);
+        }
+        CobsEncoder e;
+        cobs_begin(e, enc);
+        cobs_put_bytes(e, raw, n);
+        const uint16_t len = cobs_end(e);
+        memset(framed, 0xEE, sizeof framed);
+        memcpy(framed + 1, raw, n);
+        const uint16_t flen = cobs_frame(framed, n);
+        TEST_ASSERT_EQUAL_UINT16(len, flen);
+        TEST_ASSERT_EQUAL_MEMORY(enc, framed, len);
+        TEST_ASSERT_TRUE(flen <= cobs_max_encoded(static_cast<uint16_t>(n + 2)));
+        TEST_ASSERT_EQUAL_HEX8(0xEE, framed[flen]);  // nothing written past the frame
+        // a part framed in place, the rest copied in as it is framed
+        const uint16_t split = static_cast<uint16_t>(n * 3u / 7u);
+        memset(framed, 0xEE, sizeof framed);
+        memcpy(framed + 1, raw, split);
+        const uint16_t clen = cobs_frame(framed, split, raw + split, static_cast<uint16_t>(n - split));
+        TEST_ASSERT_EQUAL_UINT16(len, clen);
+        TEST_ASSERT_EQUAL_MEMORY(enc, framed, len);
+        TEST_ASSERT_EQUAL_HEX8(0xEE, framed[clen]);
+    }
+    for (uint16_t hi = 0; hi < 256; ++hi) {
+        for (uint16_t b = 0; b < 256; ++b) {
+            const uint16_t crc = static_cast<uint16_t>(hi << 8 | (hi * 37u + b) % 256u);
+            uint8_t h = static_cast<uint8_t>(crc >> 8), l = static_cast<uint8_t>(crc);
+            crc16_step(h, l, static_cast<uint8_t>(b));
+            TEST_ASSERT_EQUAL_HEX16(crc16_update(crc, static_cast<uint8_t>(b)), static_cast<uint16_t>(h << 8 | l));
+        }
+    }
+}
+
 // ---- telemetry -------------------------------------------------------------------
 
 static void test_boot_hello_carries_the_schema(void) {
@@ -200,7 +246,8 @@ static void test_health_reports_tasks_and_counters(void) {
     const Frame* h = find(kFrameHealth);
     TEST_ASSERT_NOT_NULL(h);
     TEST_ASSERT_EQUAL_INT16(6 + 34 + 6 * 2, h->len);
-    TEST_ASSERT_EQUAL_UINT32(9, load<uint32_t>(h->body + 6 + 12));  // executor cycles so far
+    // executor cycles so far: composed between cycles (link_poll), after the 10th
+    TEST_ASSERT_EQUAL_UINT32(10, load<uint32_t>(h->body + 6 + 12));
     TEST_ASSERT_EQUAL_UINT8(kParamNone, h->body[6 + 33]);           // no parameter store
     TEST_ASSERT_EQUAL_UINT8(kModeEnabled, h->body[6 + 34]);         // task 0 mode
 }
@@ -217,6 +264,55 @@ static void test_full_uart_drops_and_counts_never_blocks(void) {
         if (frames[i].len < 0) continue;
         TEST_ASSERT_TRUE(frames[i].len >= 6);
     }
+}
+
+// A sample frame waits behind the unsent rest of the one before when the
+// transmit buffer has room for it, instead of being dropped; a buffer of
+// two frames (tx_size: a link near its line rate) always has, so a health
+// frame no longer costs the next sample; the bytes on the wire are still a
+// gap-free sequence of verified frames. Two streams of the whole state
+// vector sampled every run (30 B encoded each), a health frame every 10th
+// run (56 B) and a hello every 30th (30 B): about 67 B a cycle on a line
+// that carries 75 B a cycle (75,000 baud) into a UART that holds 16 B, and
+// a longest frame of 60 B.
+static const LinkStream kStreams2[2] FSW_FLASH = {{0, 20, 1, 1, 0}, {0, 20, 1, 1, 0}};
+static uint8_t tx2[120];
+static const LinkConfig kConfig1 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+static const LinkConfig kConfig2 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 120};
+static_assert(link_stream_ok(0, 20, 1, 1, false, 20, 60) && link_config_ok(60, 20, 2, 2), "the tables are valid");
+
+static uint32_t dropped_near_line_rate(const LinkConfig* cfg) {
+    link_begin(link, cfg);
+    native::console_model_uart(75000, 16);
+    for (uint16_t i = 0; i < 300; ++i) {
+        executor_run_cycle(ex);
+        clock_ms += 10;
+        for (uint8_t k = 0; k < 10; ++k) {  // loop() between cycles: the link polled every millisecond
+            native::sim_advance_us(1000);
+            link_poll(link);
+        }
+    }
+    native::console_model_uart(0, 0);
+    TEST_ASSERT_EQUAL_UINT32(0, native::console_overruns());
+    return link.n.dropped;
+}
+
+static void test_second_frame_waits_behind_the_first(void) {
+    const uint32_t one = dropped_near_line_rate(&kConfig1);
+    TEST_ASSERT_TRUE(one >= 25);  // one frame's buffer: a sample after nearly every health frame
+    out_len = 0;
+    TEST_ASSERT_EQUAL_UINT32(0, dropped_near_line_rate(&kConfig2));
+    collect();
+    uint16_t samples = 0;
+    for (uint8_t i = 0; i < n_frames; ++i) {
+        TEST_ASSERT_TRUE(frames[i].len >= 6);
+        if (i != 0) TEST_ASSERT_EQUAL_UINT8(static_cast<uint8_t>(frames[i - 1].body[1] + 1), frames[i].body[1]);
+        if (frames[i].body[0] & kFrameSample) ++samples;
+    }
+    TEST_ASSERT_TRUE(n_frames >= 60);  // collect() keeps 64 frames
+    TEST_ASSERT_TRUE(samples > 40);
 }
 
 // ---- uplink --------------------------------------------------------------------
@@ -308,7 +404,7 @@ static void test_mode_commands(void) {
 // changes only by MODE.
 static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
 static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 
 static void test_set_of_a_mode_element_is_locked(void) {
     link_begin(link, &kConfigMode);
@@ -442,11 +538,13 @@ static void run_all(void) {
     UNITY_BEGIN();
     RUN_TEST(test_crc_is_ccitt_false);
     RUN_TEST(test_cobs_roundtrip_and_limits);
+    RUN_TEST(test_framer_matches_the_incremental_encoder);
     RUN_TEST(test_boot_hello_carries_the_schema);
     RUN_TEST(test_the_link_starts_with_a_delimiter);
     RUN_TEST(test_samples_batch_with_time_and_sequence);
     RUN_TEST(test_health_reports_tasks_and_counters);
     RUN_TEST(test_full_uart_drops_and_counts_never_blocks);
+    RUN_TEST(test_second_frame_waits_behind_the_first);
     RUN_TEST(test_writable_element_is_written);
     RUN_TEST(test_every_other_element_is_refused);
     RUN_TEST(test_wrong_length_is_refused);

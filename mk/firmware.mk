@@ -25,6 +25,18 @@ FW_AVR_CC     ?= avr-gcc
 # Suites: one file per scenario, tests/firmware/test_<name>.cpp.
 FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume parts
 FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts
+# Suites that talk to the simulated board's sensor parts on the AVR (harness
+# -I): built and run natively and on AVR like the others, but not in the
+# PlatformIO view (tests/integrations/pio has one folder per FW_SUITES
+# entry above), whose plain simavr has no parts on its TWI.
+FW_PART_SUITES := baro
+FW_SUITES     += $(FW_PART_SUITES)
+FW_AVR_SUITES += $(FW_PART_SUITES)
+# Extra harness options per AVR suite (FW_HARNESS_OPTS_<suite>): the simulated
+# parts a suite talks to on the TWI.
+FW_HARNESS_OPTS_baro := -I bmp280@0x76 -I ms5611@0x77
+fw_rparen     := )
+FW_HARNESS_CASE = $(foreach s,$(FW_AVR_SUITES),$(if $(FW_HARNESS_OPTS_$(s)),*/test_$(s).elf$(fw_rparen) opts="$(FW_HARNESS_OPTS_$(s))";;))
 
 FW_RT_SRCS    := $(wildcard $(FW_SRC)/*.cpp)
 FW_RT_HDRS    := $(wildcard $(FW_SRC)/*.h)
@@ -208,7 +220,8 @@ test-firmware-avr: $(FW_ABINS)
 	@sim=$$($(FW_PY) -c 'from fswkit.sim.board import harness; print(harness())') || exit 1; \
 	fail=0; for t in $(FW_ABINS); do \
 	  echo "== $$t (simavr $(FW_AVR_MCU))"; \
-	  $$sim -u stdout -x unity -m $(FW_AVR_MCU) -t 30 -w 30 $$t || fail=1; done; exit $$fail
+	  opts=; case $$t in $(FW_HARNESS_CASE) esac; \
+	  $$sim -u stdout -x unity -m $(FW_AVR_MCU) -t 30 -w 30 $$opts $$t || fail=1; done; exit $$fail
 
 # ---- benchmarks (report only; not part of the test run) ------------------------
 FW_BENCH := $(FW_BUILD)/bench

@@ -20,5 +20,7 @@
 #include "fsw_log.h"
 #include "fsw_resume.h"
 #include "fsw_parts.h"
+#include "fsw_twi.h"
+#include "fsw_baro.h"
 
 #endif  // FSWKIT_H

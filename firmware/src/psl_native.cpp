@@ -150,6 +150,12 @@ uint32_t watchdog_kicks() { return g_kicks; }
 bool watchdog_armed() { return g_wdt_armed; }
 void sim_set_reset_cause(uint8_t cause) { g_reset_cause = cause; }
 
+namespace {
+TwiResponder g_twi_responder = 0;
+}  // namespace
+void twi_set_responder(TwiResponder r) { g_twi_responder = r; }
+TwiResponder twi_responder() { return g_twi_responder; }
+
 void sim_reset() {
     g_time_us = 0;
     g_flash_busy_until = 0;  // the flash keeps its bytes; an operation in progress ended

@@ -73,6 +73,16 @@ uint32_t sim_flash_ops();
 void sim_flash_freeze_after(uint32_t ops);
 bool sim_flash_file(const char* path);
 
+// The TWI (fsw_twi.h) on the host: a scripted responder plays every slave.
+// It is called once per transaction, on the first twi_busy() poll after
+// twi_start(), with the address, the bytes written and the buffer for the
+// nr bytes to read, and returns a TwiStatus (kTwiOk, kTwiNackAddr,
+// kTwiNackData, kTwiBusError). 0 (the default): every address is NACKed.
+// Not reset by sim_reset().
+typedef uint8_t (*TwiResponder)(uint8_t addr7, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr);
+void twi_set_responder(TwiResponder r);
+TwiResponder twi_responder();
+
 // Back to power-on state: time 0, pins cleared, counters zero.
 void sim_reset();
 

@@ -1,0 +1,279 @@
+// BMP280 and MS5611 drivers (fsw_baro.h): state machines over fsw_twi.
+#include "fsw_baro.h"
+
+#include "fsw_pal.h"
+#include "fsw_twi.h"
+
+namespace fsw {
+
+namespace {
+
+inline bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
+
+void core_init(BaroCore& c, uint8_t addr, uint8_t stuck_n, uint8_t timeout_steps) {
+    c.addr = addr;
+    c.state = 0;
+    c.health = kBaroInit;
+    c.pending = 0;
+    c.txn = kTwiIdle;
+    c.waited = 0;
+    c.timeout_steps = timeout_steps == 0 ? 1 : timeout_steps;
+    c.stuck_n = stuck_n;
+    c.started = 0;
+    c.same = 0;
+    c.faults = 0;
+    c.readings = 0;
+    c.due_us = 0;
+    c.pressure_pa = 0.0f;
+    c.temp_c = 0.0f;
+}
+
+// Whether our transaction ended (its status in `st`); abandons it once it
+// has run for more than timeout_steps steps.
+// Our own status byte, not twi_result(): another driver's transaction may
+// have started and ended since ours did.
+bool core_poll(BaroCore& c, uint8_t& st) {
+    (void)twi_busy();  // the host's bus runs a transaction here; on an AVR a barrier
+    st = c.txn;
+    if (st == kTwiBusy) {
+        c.waited = static_cast<uint8_t>(c.waited + 1u);
+        if (c.waited <= c.timeout_steps) return false;
+        twi_abort();  // still busy, so the transaction on the bus is ours
+        st = kTwiTimeout;
+    }
+    c.pending = 0;
+    return true;
+}
+
+bool core_start(BaroCore& c, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr) {
+    if (!twi_start(c.addr, w, nw, r, nr, &c.txn)) return false;  // the bus is another's: next step
+    c.pending = 1;
+    c.waited = 0;
+    return true;
+}
+
+void core_fault(BaroCore& c, uint8_t health, uint32_t now) {
+    c.health = health;
+    if (c.faults != 0xFFFFu) c.faults = static_cast<uint16_t>(c.faults + 1u);
+    c.state = 0;  // both drivers: state 0 resets the part
+    c.same = 0;
+    c.due_us = now + kBaroRetryUs;
+}
+
+// A conversion's raw counts compared with the previous ones: health Ok, or
+// Stuck (counted as a fault once) after stuck_n unchanged conversions in a row.
+void core_reading(BaroCore& c, bool unchanged) {
+    if (unchanged && c.readings != 0) {
+        if (c.same != 0xFFu) c.same = static_cast<uint8_t>(c.same + 1u);
+    } else {
+        c.same = 0;
+    }
+    if (c.stuck_n != 0 && c.same >= c.stuck_n) {
+        if (c.health != kBaroStuck && c.faults != 0xFFFFu) c.faults = static_cast<uint16_t>(c.faults + 1u);
+        c.health = kBaroStuck;
+    } else {
+        c.health = kBaroOk;
+    }
+    c.readings = static_cast<uint16_t>(c.readings + 1u);
+}
+
+}  // namespace
+
+// ---- BMP280 ------------------------------------------------------------------
+
+namespace {
+enum : uint8_t { kBReset = 0, kBId, kBCal, kBCfg, kBTrig, kBRead };
+const uint8_t kBmp280RegReset = 0xE0;
+const uint8_t kBmp280ResetWord = 0xB6;
+const uint8_t kBmp280RegCtrlMeas = 0xF4;
+const uint8_t kBmp280RegConfig = 0xF5;
+const uint32_t kBmp280StartupUs = 2000u;  // datasheet 1.1: start-up time 2 ms
+
+inline uint8_t os_code(uint8_t v) { return v > 5 ? 5 : v; }
+inline uint32_t os_times(uint8_t code) { return code == 0 ? 0u : static_cast<uint32_t>(1u << (code - 1u)); }
+}  // namespace
+
+Bmp280::Bmp280(uint8_t addr7, uint8_t osrs_t, uint8_t osrs_p, uint8_t stuck_n, uint8_t timeout_steps)
+    : ctrl_(static_cast<uint8_t>(os_code(osrs_t) << 5 | os_code(osrs_p) << 2 | 1u)),
+      cal_(), adc_P_(0), adc_T_(0), t_centi_(0), p_q8_(0), buf_() {
+    core_init(c_, addr7, stuck_n, timeout_steps);
+}
+
+uint32_t Bmp280::measure_us() const {
+    const uint8_t ot = static_cast<uint8_t>(ctrl_ >> 5 & 7u), op = static_cast<uint8_t>(ctrl_ >> 2 & 7u);
+    // Datasheet 3.8.1 (max): 1.25 + 2.3 * osrs_t + (2.3 * osrs_p + 0.575) ms.
+    const uint32_t t = 1250u + 2300u * os_times(ot);
+    return op != 0 ? t + 2300u * os_times(op) + 575u : t;
+}
+
+void Bmp280::step() {
+    const uint32_t now = pal::micros32();
+    if (!c_.started) {
+        c_.started = 1;
+        c_.due_us = now;
+    }
+    if (c_.pending) {
+        uint8_t st;
+        if (!core_poll(c_, st)) return;
+        done(st, now);
+    }
+    if (!c_.pending && due(now, c_.due_us)) issue(now);
+}
+
+void Bmp280::issue(uint32_t now) {
+    (void)now;
+    uint8_t w[2];
+    switch (c_.state) {
+        case kBReset: w[0] = kBmp280RegReset; w[1] = kBmp280ResetWord; (void)core_start(c_, w, 2, 0, 0); break;
+        case kBId: w[0] = kBmp280RegId; (void)core_start(c_, w, 1, buf_, 1); break;
+        case kBCal: w[0] = kBmp280RegCalib; (void)core_start(c_, w, 1, buf_, kBmp280CalibLen); break;
+        case kBCfg: w[0] = kBmp280RegConfig; w[1] = 0; (void)core_start(c_, w, 2, 0, 0); break;
+        case kBTrig: w[0] = kBmp280RegCtrlMeas; w[1] = ctrl_; (void)core_start(c_, w, 2, 0, 0); break;
+        default: w[0] = kBmp280RegData; (void)core_start(c_, w, 1, buf_, kBmp280DataLen); break;
+    }
+}
+
+void Bmp280::done(uint8_t status, uint32_t now) {
+    if (status != kTwiOk) {
+        core_fault(c_, kBaroNoAnswer, now);
+        return;
+    }
+    c_.due_us = now;
+    switch (c_.state) {
+        case kBReset:
+            c_.state = kBId;
+            c_.due_us = now + kBmp280StartupUs;
+            break;
+        case kBId:
+            if (buf_[0] != kBmp280ChipId) { core_fault(c_, kBaroBadId, now); break; }
+            c_.state = kBCal;
+            break;
+        case kBCal:
+            if (bmp280_parse_calib(buf_, cal_) != kOk) { core_fault(c_, kBaroBadCalib, now); break; }
+            c_.state = kBCfg;
+            break;
+        case kBCfg: c_.state = kBTrig; break;
+        case kBTrig:
+            c_.state = kBRead;
+            c_.due_us = now + measure_us();
+            break;
+        default: {
+            int32_t p, t, t_fine;
+            bmp280_parse_raw(buf_, p, t);
+            core_reading(c_, p == adc_P_ && t == adc_T_);
+            adc_P_ = p;
+            adc_T_ = t;
+            t_centi_ = bmp280_compensate_T(cal_, t, t_fine);
+            p_q8_ = bmp280_compensate_P64(cal_, p, t_fine);
+            c_.temp_c = static_cast<float>(t_centi_) / 100.0f;
+            c_.pressure_pa = static_cast<float>(p_q8_) / 256.0f;
+            c_.state = kBTrig;
+            break;
+        }
+    }
+}
+
+// ---- MS5611 ------------------------------------------------------------------
+
+namespace {
+enum : uint8_t { kMReset = 0, kMPromCmd, kMPromRead, kMConv, kMAdcCmd, kMAdcRead };
+const uint32_t kMs5611ReloadUs = 3000u;  // datasheet: reset reloads the PROM, 2.8 ms
+// Datasheet maximum conversion times for OSR 256..4096.
+const uint16_t kMs5611ConvUs[5] = {600, 1170, 2280, 4540, 9040};
+}  // namespace
+
+Ms5611::Ms5611(uint8_t addr7, uint8_t osr, uint8_t stuck_n, uint8_t timeout_steps)
+    : osr_(osr > 4 ? 4 : osr), word_(0), cal_(), d1_(0), d2_(0), last_d1_(0), last_d2_(0),
+      t_centi_(0), p_(0), buf_() {
+    core_init(c_, addr7, stuck_n, timeout_steps);
+}
+
+uint32_t Ms5611::conversion_us() const { return kMs5611ConvUs[osr_]; }
+
+void Ms5611::step() {
+    const uint32_t now = pal::micros32();
+    if (!c_.started) {
+        c_.started = 1;
+        c_.due_us = now;
+    }
+    if (c_.pending) {
+        uint8_t st;
+        if (!core_poll(c_, st)) return;
+        done(st, now);
+    }
+    if (!c_.pending && due(now, c_.due_us)) issue(now);
+}
+
+void Ms5611::issue(uint32_t now) {
+    (void)now;
+    uint8_t w;
+    switch (c_.state) {
+        case kMReset: w = kMs5611CmdReset; (void)core_start(c_, &w, 1, 0, 0); break;
+        case kMPromCmd:
+            w = static_cast<uint8_t>(kMs5611CmdProm + 2u * word_);
+            (void)core_start(c_, &w, 1, 0, 0);
+            break;
+        case kMPromRead: (void)core_start(c_, 0, 0, buf_ + 2u * word_, 2); break;
+        case kMConv:  // word_: 0 converts D2 (temperature), 1 D1 (pressure)
+            w = static_cast<uint8_t>((word_ == 0 ? kMs5611CmdD2 : kMs5611CmdD1) + 2u * osr_);
+            (void)core_start(c_, &w, 1, 0, 0);
+            break;
+        case kMAdcCmd: w = kMs5611CmdAdcRead; (void)core_start(c_, &w, 1, 0, 0); break;
+        default: (void)core_start(c_, 0, 0, buf_, 3); break;
+    }
+}
+
+void Ms5611::done(uint8_t status, uint32_t now) {
+    if (status != kTwiOk) {
+        core_fault(c_, kBaroNoAnswer, now);
+        return;
+    }
+    c_.due_us = now;
+    switch (c_.state) {
+        case kMReset:
+            c_.state = kMPromCmd;
+            word_ = 0;
+            c_.due_us = now + kMs5611ReloadUs;
+            break;
+        case kMPromCmd: c_.state = kMPromRead; break;
+        case kMPromRead:
+            if (++word_ < 8) { c_.state = kMPromCmd; break; }
+            if (ms5611_parse_prom_bytes(buf_, cal_) != kOk) { core_fault(c_, kBaroBadCalib, now); break; }
+            word_ = 0;
+            c_.state = kMConv;
+            break;
+        case kMConv:
+            c_.state = kMAdcCmd;
+            c_.due_us = now + conversion_us();
+            break;
+        case kMAdcCmd: c_.state = kMAdcRead; break;
+        default: {
+            const uint32_t d = ms5611_parse_adc(buf_);
+            if (d == 0) {  // read with no conversion done: the part lost it (reset?)
+                core_fault(c_, kBaroNoAnswer, now);
+                break;
+            }
+            if (word_ == 0) {
+                d2_ = d;
+                word_ = 1;
+                c_.state = kMConv;
+                break;
+            }
+            d1_ = d;
+            word_ = 0;
+            c_.state = kMConv;
+            core_reading(c_, d1_ == last_d1_ && d2_ == last_d2_);
+            last_d1_ = d1_;
+            last_d2_ = d2_;
+            Ms5611Result r;
+            ms5611_compensate(cal_, d1_, d2_, true, r);
+            t_centi_ = r.TEMP;
+            p_ = r.P;
+            c_.temp_c = static_cast<float>(t_centi_) / 100.0f;
+            c_.pressure_pa = static_cast<float>(p_);
+            break;
+        }
+    }
+}
+
+}  // namespace fsw

@@ -99,6 +99,24 @@ Bmp280::Bmp280(uint8_t addr7, uint8_t osrs_t, uint8_t osrs_p, uint8_t stuck_n, u
     core_init(c_, addr7, stuck_n, timeout_steps);
 }
 
+// One step of either driver: the transaction in flight polled (and its
+// result handled), then the next one started when its wait is over.
+template <class Driver>
+void step_driver(Driver& d) {
+    BaroCore& c = d.c_;
+    const uint32_t now = pal::micros32();
+    if (!c.started) {
+        c.started = 1;
+        c.due_us = now;
+    }
+    if (c.pending) {
+        uint8_t st;
+        if (!core_poll(c, st)) return;
+        d.done(st, now);
+    }
+    if (!c.pending && due(now, c.due_us)) d.issue(now);
+}
+
 uint32_t Bmp280::measure_us() const {
     const uint8_t ot = static_cast<uint8_t>(ctrl_ >> 5 & 7u), op = static_cast<uint8_t>(ctrl_ >> 2 & 7u);
     // Datasheet 3.8.1 (max): 1.25 + 2.3 * osrs_t + (2.3 * osrs_p + 0.575) ms.
@@ -106,19 +124,7 @@ uint32_t Bmp280::measure_us() const {
     return op != 0 ? t + 2300u * os_times(op) + 575u : t;
 }
 
-void Bmp280::step() {
-    const uint32_t now = pal::micros32();
-    if (!c_.started) {
-        c_.started = 1;
-        c_.due_us = now;
-    }
-    if (c_.pending) {
-        uint8_t st;
-        if (!core_poll(c_, st)) return;
-        done(st, now);
-    }
-    if (!c_.pending && due(now, c_.due_us)) issue(now);
-}
+void Bmp280::step() { step_driver(*this); }
 
 void Bmp280::issue(uint32_t now) {
     (void)now;
@@ -190,19 +196,7 @@ Ms5611::Ms5611(uint8_t addr7, uint8_t osr, uint8_t stuck_n, uint8_t timeout_step
 
 uint32_t Ms5611::conversion_us() const { return kMs5611ConvUs[osr_]; }
 
-void Ms5611::step() {
-    const uint32_t now = pal::micros32();
-    if (!c_.started) {
-        c_.started = 1;
-        c_.due_us = now;
-    }
-    if (c_.pending) {
-        uint8_t st;
-        if (!core_poll(c_, st)) return;
-        done(st, now);
-    }
-    if (!c_.pending && due(now, c_.due_us)) issue(now);
-}
+void Ms5611::step() { step_driver(*this); }
 
 void Ms5611::issue(uint32_t now) {
     (void)now;

@@ -49,7 +49,22 @@ struct BaroCore {
     float temp_c;
 };
 
-class Bmp280 {
+// What the two drivers share: the health, the counters and the last
+// reading, and the step that polls a transaction and starts the next
+// (step_driver in fsw_baro.cpp).
+class BaroDriver {
+public:
+    uint8_t health() const { return c_.health; }
+    uint16_t faults() const { return c_.faults; }
+    uint16_t readings() const { return c_.readings; }
+    float pressure_pa() const { return c_.pressure_pa; }
+    float temp_c() const { return c_.temp_c; }
+
+protected:
+    BaroCore c_;
+};
+
+class Bmp280 : public BaroDriver {
 public:
     // `osrs_t`, `osrs_p`: the oversampling codes of ctrl_meas (1..5: x1..x16);
     // forced mode, one measurement per trigger, IIR filter off.
@@ -58,13 +73,9 @@ public:
     // One step of the state machine (once per executor cycle; never waits).
     void step();
 
-    uint8_t health() const { return c_.health; }
-    uint16_t faults() const { return c_.faults; }
-    uint16_t readings() const { return c_.readings; }
-    // The last reading (valid once readings() > 0): Pa from the datasheet's
-    // 64-bit formula (Q24.8 / 256), degC from the 0.01 degC integer / 100.
-    float pressure_pa() const { return c_.pressure_pa; }
-    float temp_c() const { return c_.temp_c; }
+    // The last reading (valid once readings() > 0): pressure_pa() from the
+    // datasheet's 64-bit formula (Q24.8 / 256), temp_c() from the 0.01 degC
+    // integer / 100.
     uint32_t pressure_q24_8() const { return p_q8_; }
     int32_t temp_centi() const { return t_centi_; }
     int32_t adc_P() const { return adc_P_; }
@@ -74,10 +85,10 @@ public:
     uint32_t measure_us() const;
 
 private:
+    template <class Driver> friend void step_driver(Driver& d);
     void issue(uint32_t now);
     void done(uint8_t status, uint32_t now);
     void fault(uint8_t health, uint32_t now);
-    BaroCore c_;
     uint8_t ctrl_;           // ctrl_meas value with mode 01 (forced)
     Bmp280Calib cal_;
     int32_t adc_P_, adc_T_;
@@ -86,19 +97,14 @@ private:
     uint8_t buf_[kBmp280CalibLen];
 };
 
-class Ms5611 {
+class Ms5611 : public BaroDriver {
 public:
     // `osr`: 0..4 for OSR 256..4096 (conversion 0.60 .. 9.04 ms, datasheet max).
     explicit Ms5611(uint8_t addr7 = 0x77, uint8_t osr = 4, uint8_t stuck_n = 0, uint8_t timeout_steps = 3);
     void step();
 
-    uint8_t health() const { return c_.health; }
-    uint16_t faults() const { return c_.faults; }
-    uint16_t readings() const { return c_.readings; }
-    // Pa (the datasheet's P in 0.01 mbar is 1 Pa) and degC (TEMP / 100),
-    // second-order temperature compensation applied.
-    float pressure_pa() const { return c_.pressure_pa; }
-    float temp_c() const { return c_.temp_c; }
+    // pressure_pa(): the datasheet's P in 0.01 mbar, which is 1 Pa;
+    // temp_c(): TEMP / 100; second-order temperature compensation applied.
     int32_t pressure_int() const { return p_; }
     int32_t temp_centi() const { return t_centi_; }
     uint32_t d1() const { return d1_; }
@@ -107,10 +113,10 @@ public:
     uint32_t conversion_us() const;
 
 private:
+    template <class Driver> friend void step_driver(Driver& d);
     void issue(uint32_t now);
     void done(uint8_t status, uint32_t now);
     void fault(uint8_t health, uint32_t now);
-    BaroCore c_;
     uint8_t osr_;
     uint8_t word_;           // PROM word being read (0..7)
     Ms5611Calib cal_;

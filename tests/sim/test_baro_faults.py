@@ -46,8 +46,10 @@ MS_CONVERT_S = 2.28e-3     # OSR 1024
 
 @pytest.fixture(scope="module")
 def elf(tmp_path_factory) -> str:
+    # the targets as mk/firmware.mk names them (relative to the tree: it defines its build rules only for
+    # goals under its own build/firmware/, and an absolute path is not one of those)
     r = subprocess.run(["make", "--no-print-directory", "-f", "mk/firmware.mk",
-                        str(AVR / "libfswkit.a"), str(AVR / "core.a")],
+                        str((AVR / "libfswkit.a").relative_to(ROOT)), str((AVR / "core.a").relative_to(ROOT))],
                        cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
     out = tmp_path_factory.mktemp("baro") / "probe.elf"

@@ -44,6 +44,20 @@ void finish(uint8_t st) {
     }
 }
 
+// A new transaction's description, and its owner told it runs (both
+// platforms' twi_start, once they know the bus is theirs).
+void load(uint8_t addr7, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr, volatile uint8_t* status) {
+    for (uint8_t i = 0; i < nw; ++i) g_twi.w[i] = w[i];
+    g_twi.addr = addr7;
+    g_twi.nw = nw;
+    g_twi.nr = nr;
+    g_twi.r = r;
+    g_twi.owner = status;
+    if (status != 0) *status = kTwiBusy;
+    g_twi.result = kTwiBusy;
+    g_twi.busy = true;
+}
+
 }  // namespace
 
 TwiCounters twi_counters() {
@@ -97,17 +111,9 @@ bool twi_busy() {
 
 bool twi_start(uint8_t addr7, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr, volatile uint8_t* status) {
     if (nw > kTwiMaxWrite || nr > kTwiMaxRead || twi_busy()) return false;
-    for (uint8_t i = 0; i < nw; ++i) g_twi.w[i] = w[i];
-    g_twi.addr = addr7;
-    g_twi.nw = nw;
-    g_twi.nr = nr;
-    g_twi.r = r;
-    g_twi.owner = status;
-    if (status != 0) *status = kTwiBusy;
     g_twi.wi = 0;
     g_twi.ri = 0;
-    g_twi.result = kTwiBusy;
-    g_twi.busy = true;
+    load(addr7, w, nw, r, nr, status);
     bump(g_twi_count.transactions);
     TWCR = static_cast<uint8_t>(_BV(TWINT) | _BV(TWSTA) | kCtlOn);
     return true;
@@ -203,15 +209,7 @@ bool twi_busy() {
 bool twi_start(uint8_t addr7, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr, volatile uint8_t* status) {
     if (nw > kTwiMaxWrite || nr > kTwiMaxRead) return false;
     (void)twi_busy();  // time has passed: the previous transaction (if any) ends first
-    for (uint8_t i = 0; i < nw; ++i) g_twi.w[i] = w[i];
-    g_twi.addr = addr7;
-    g_twi.nw = nw;
-    g_twi.nr = nr;
-    g_twi.r = r;
-    g_twi.owner = status;
-    if (status != 0) *status = kTwiBusy;
-    g_twi.result = kTwiBusy;
-    g_twi.busy = true;
+    load(addr7, w, nw, r, nr, status);
     bump(g_twi_count.transactions);
     return true;
 }

@@ -284,36 +284,33 @@ static void test_native_nack_then_ok(void) {
     TEST_ASSERT_EQUAL_INT32(2508, b.temp_centi());
 }
 
+// `n` cycles with the parts' raw pressure counts changing every cycle (noise).
+static void run_changing(Bmp280* b, Ms5611* m, uint16_t n) {
+    for (uint16_t k = 0; k < n; ++k) {
+        g_bmp.adc_P = 415148L + k;
+        g_ms.D1 = 9085466UL + k;
+        run_cycles(b, m, 1);
+    }
+}
+
 // Changing counts (noise) are never stuck; `stuck` is seen after stuck_n
 // unchanged conversions and clears with the next changed one.
 static void test_native_stuck_then_ok(void) {
     Bmp280 b(0x76, 1, 1, 4);
     Ms5611 m(0x77, 0, 4);
-    for (uint16_t k = 0; k < 200; ++k) {
-        g_bmp.adc_P = 415148L + k;
-        g_ms.D1 = 9085466UL + k;
-        run_cycles(&b, &m, 1);
-    }
+    run_changing(&b, &m, 200);
     TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
     TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
     g_bmp.fail = kModelStuck;
     g_ms.fail = kModelStuck;
-    for (uint16_t k = 0; k < 100; ++k) {
-        g_bmp.adc_P = 415148L + k;
-        g_ms.D1 = 9085466UL + k;
-        run_cycles(&b, &m, 1);
-    }
+    run_changing(&b, &m, 100);
     TEST_ASSERT_EQUAL_UINT8(kBaroStuck, b.health());
     TEST_ASSERT_EQUAL_UINT8(kBaroStuck, m.health());
     TEST_ASSERT_EQUAL_UINT16(1, b.faults());
     TEST_ASSERT_EQUAL_UINT16(1, m.faults());
     g_bmp.fail = kModelOk;
     g_ms.fail = kModelOk;
-    for (uint16_t k = 0; k < 50; ++k) {
-        g_bmp.adc_P = 415148L + k;
-        g_ms.D1 = 9085466UL + k;
-        run_cycles(&b, &m, 1);
-    }
+    run_changing(&b, &m, 50);
     TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
     TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
     g_bmp.adc_P = 415148L;

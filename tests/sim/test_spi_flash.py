@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from support.uartprobe import UartProbe
+from support.uartprobe import UartProbe, build_probe
 from fswkit.sim.board import SimBoard, SimError, harness
 
 pytestmark = pytest.mark.skipif(
@@ -31,11 +31,7 @@ MIB = 1 << 20
 
 @pytest.fixture(scope="module")
 def probe(tmp_path_factory) -> str:
-    elf = tmp_path_factory.mktemp("spiflash") / "probe.elf"
-    r = subprocess.run(["avr-gcc", "-mmcu=atmega328p", "-DF_CPU=16000000UL", "-Os", "-Wall", "-Wextra", "-Werror",
-                        "-o", str(elf), str(PROBE_C)], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
-    return str(elf)
+    return build_probe(PROBE_C, tmp_path_factory.mktemp("spiflash"))
 
 
 def op(code: int, addr: int | None = None, data: bytes = b"", read: int = 0) -> str:

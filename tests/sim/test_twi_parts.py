@@ -16,12 +16,11 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
 
-from support.uartprobe import UartProbe
+from support.uartprobe import UartProbe, build_probe
 from fswkit.sim.board import SimBoard, SimError
 
 pytestmark = pytest.mark.skipif(
@@ -40,11 +39,7 @@ MT_SLA_NACK, MR_SLA_NACK, DONE = 0x20, 0x48, 0x58
 
 @pytest.fixture(scope="module")
 def probe(tmp_path_factory) -> str:
-    elf = tmp_path_factory.mktemp("twi") / "probe.elf"
-    r = subprocess.run(["avr-gcc", "-mmcu=atmega328p", "-DF_CPU=16000000UL", "-Os", "-Wall", "-Wextra", "-Werror",
-                        "-o", str(elf), str(PROBE_C)], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
-    return str(elf)
+    return build_probe(PROBE_C, tmp_path_factory.mktemp("twi"))
 
 
 class Probe(UartProbe):

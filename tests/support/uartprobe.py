@@ -1,7 +1,21 @@
-"""A test sketch's line protocol on a SimBoard's UART0 (tests/sim's probes:
-spiflash_probe, twi_probe): lines read as simulated time advances."""
+"""A test sketch's build and its line protocol on a SimBoard's UART0
+(tests/sim's probes: spiflash_probe, twi_probe): lines read as simulated
+time advances."""
 
 from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+
+def build_probe(source: Path, out_dir: Path) -> str:
+    """A probe sketch compiled for the simulated Uno (avr-gcc, warnings as
+    errors); the ELF's path."""
+    elf = out_dir / "probe.elf"
+    r = subprocess.run(["avr-gcc", "-mmcu=atmega328p", "-DF_CPU=16000000UL", "-Os", "-Wall", "-Wextra", "-Werror",
+                        "-o", str(elf), str(source)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return str(elf)
 
 
 class UartProbe:

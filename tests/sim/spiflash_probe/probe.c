@@ -26,6 +26,8 @@
    the result. */
 #include <avr/interrupt.h>
 #include <avr/io.h>
+
+#include "../probe_ticks.h"
 #include <avr/pgmspace.h>
 
 #define CS (1 << PB2)
@@ -38,21 +40,8 @@ static const char boot_script[] PROGMEM =
     "0300010000000000000000000000000000000000";
 
 static char line[1400]; /* a full page program's hex fits */
-static volatile uint16_t t1_overflows;
 static uint32_t t_cs; /* when CS last rose after a HEX step */
 
-ISR(TIMER1_OVF_vect) { t1_overflows++; }
-
-/* Timer1 ticks (clk/8: 0.5 us) on 32 bits. */
-static uint32_t ticks(void) {
-    uint8_t sreg = SREG;
-    cli();
-    uint16_t lo = TCNT1;
-    uint16_t hi = t1_overflows;
-    if ((TIFR1 & (1 << TOV1)) && lo < 0x8000) hi++; /* wrapped since interrupts went off */
-    SREG = sreg;
-    return ((uint32_t)hi << 16) | lo;
-}
 
 static uint8_t spi(uint8_t out) {
     SPDR = out;

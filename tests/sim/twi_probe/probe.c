@@ -26,6 +26,8 @@
      S<hex>         one SPI transaction on CS PB1: `S<hex>`, the bytes shifted in */
 #include <avr/interrupt.h>
 #include <avr/io.h>
+
+#include "../probe_ticks.h"
 #include <string.h>
 
 #define CS (1 << PB1)
@@ -33,21 +35,8 @@
 static char line[600];
 static char out[1200];
 static uint16_t o;
-static volatile uint16_t t1_overflows;
 static uint32_t t_mark;
 
-ISR(TIMER1_OVF_vect) { t1_overflows++; }
-
-/* Timer1 ticks (clk/8: 0.5 us) on 32 bits. */
-static uint32_t ticks(void) {
-    uint8_t sreg = SREG;
-    cli();
-    uint16_t lo = TCNT1;
-    uint16_t hi = t1_overflows;
-    if ((TIFR1 & (1 << TOV1)) && lo < 0x8000) hi++; /* wrapped since interrupts went off */
-    SREG = sreg;
-    return ((uint32_t)hi << 16) | lo;
-}
 
 static uint8_t twi_wait(void) {
     while (!(TWCR & (1 << TWINT))) {}

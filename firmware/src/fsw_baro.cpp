@@ -11,21 +11,11 @@ namespace {
 inline bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
 
 void core_init(BaroCore& c, uint8_t addr, uint8_t stuck_n, uint8_t timeout_steps) {
+    memset(&c, 0, sizeof c);  // state 0, kBaroInit, nothing pending, counters and reading zero
     c.addr = addr;
-    c.state = 0;
-    c.health = kBaroInit;
-    c.pending = 0;
     c.txn = kTwiIdle;
-    c.waited = 0;
     c.timeout_steps = timeout_steps == 0 ? 1 : timeout_steps;
     c.stuck_n = stuck_n;
-    c.started = 0;
-    c.same = 0;
-    c.faults = 0;
-    c.readings = 0;
-    c.due_us = 0;
-    c.pressure_pa = 0.0f;
-    c.temp_c = 0.0f;
 }
 
 // Whether our transaction ended (its status in `st`); abandons it once it

@@ -13,7 +13,7 @@ from conftest import EXAMPLES
 EXPECTED = {
     "rocket": {"mission_flight.ss", "mission_backup.ss", "mission_pad.ss", "mission_continuity.ss", "nav.ss"},
     "hpr": {"nav.ss", "mission_flight.ss", "mission_pad.ss", "mission_lockout.ss", "mission_backup.ss",
-            "mission_stuck.ss", "mission_ballistic.ss"},
+            "mission_stuck.ss", "mission_ballistic.ss", "nav_fault.ss"},
 }
 SCRIPTS = {name: sorted(p.name for p in (EXAMPLES / name).glob("*.ss")) for name in EXPECTED}
 CASES = [(name, script) for name in EXPECTED for script in SCRIPTS[name]]

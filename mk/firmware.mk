@@ -29,12 +29,13 @@ FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resum
 # -I): built and run natively and on AVR like the others, but not in the
 # PlatformIO view (tests/integrations/pio has one folder per FW_SUITES
 # entry above), whose plain simavr has no parts on its TWI.
-FW_PART_SUITES := baro
+FW_PART_SUITES := baro accel
 FW_SUITES     += $(FW_PART_SUITES)
 FW_AVR_SUITES += $(FW_PART_SUITES)
 # Extra harness options per AVR suite (FW_HARNESS_OPTS_<suite>): the simulated
 # parts a suite talks to on the TWI.
 FW_HARNESS_OPTS_baro := -I bmp280@0x76 -I ms5611@0x77
+FW_HARNESS_OPTS_accel := -I adxl345@0x53 -I adxl345@B1 -I mpu6050@0x68 -I bmp280@0x76 -I ms5611@0x77
 fw_rparen     := )
 FW_HARNESS_CASE = $(foreach s,$(FW_AVR_SUITES),$(if $(FW_HARNESS_OPTS_$(s)),*/test_$(s).elf$(fw_rparen) opts="$(FW_HARNESS_OPTS_$(s))";;))
 

@@ -11,6 +11,7 @@ target.
 
     tools/bench_firmware.py            # everything
     tools/bench_firmware.py rocket     # the rocket's footprint only
+    tools/bench_firmware.py sensors    # the sensor drivers' flash and RAM only
 """
 
 from __future__ import annotations
@@ -277,6 +278,42 @@ def print_pyro_cost() -> None:
           f"+{f1 - f0:,} B flash ({f0:,} -> {f1:,}), +{r1 - r0:,} B RAM ({r0:,} -> {r1:,}, data + bss + noinit)")
 
 
+SENSOR_ROWS = (  # (FSW_SENSOR of tools/bench/sensor_probe.cpp, row, the build it is measured over)
+    (1, "TWI master (fsw_twi: ISR, queue of 4)", 0),
+    (2, "BMP280 driver (over the TWI master)", 1),
+    (3, "MS5611 driver (over the TWI master)", 1),
+    (4, "ADXL345 driver on I2C (over the TWI master)", 1),
+    (5, "ADXL345 driver on SPI (over the TWI master)", 1),
+    (6, "MPU-6050 driver (over the TWI master)", 1),
+)
+
+
+def sensor_costs() -> list[tuple[str, int, int]]:
+    """(row, flash, RAM) each sensor driver adds to an Uno sketch that
+    steps it (tools/bench/sensor_probe.cpp, LTO as fsw build links), over
+    the sketch with the TWI master alone; the TWI master's over an empty
+    sketch. RAM is .data + .bss: the driver object and its share of the
+    bus's state. The shared step references the TWI (its poll), so the
+    SPI driver links the TWI master too: its row is over the TWI master."""
+    libs = core_and_runtime("atmega328p", "standard", "ARDUINO_AVR_UNO")
+    sizes = {}
+    for n in range(7):
+        elf = os.path.join(OUT, f"sensor_{n}.elf")
+        sh(["avr-g++"] + avr_flags("atmega328p", "standard", "ARDUINO_AVR_UNO") +
+           [f"-DFSW_SENSOR={n}", os.path.join(BENCH, "sensor_probe.cpp")] + libs +
+           ["-fuse-linker-plugin", "-Wl,--gc-sections", "-o", elf])
+        sizes[n] = elf_size(elf)
+    return [(name, sizes[n][0] - sizes[base][0], sizes[n][1] - sizes[base][1]) for n, name, base in SENSOR_ROWS]
+
+
+def print_sensor_costs() -> None:
+    print()
+    print("sensor drivers on the Uno (a sketch stepping one driver; flash .text + .data, RAM .data + .bss)")
+    print(f"{'driver':<55} {'flash':>10} {'RAM':>8}")
+    for name, flash, ram in sensor_costs():
+        print(f"{name:<55} {flash:>8,} B {ram:>6,} B")
+
+
 def print_rocket(r: dict) -> None:
     print()
     print("rocket example on the Uno (fsw build; stack measured through the demo flight, fsw sim --plant rocket "
@@ -310,6 +347,9 @@ def main() -> int:
     if sys.argv[1:] == ["pyro"]:
         print_pyro_cost()
         return 0
+    if sys.argv[1:] == ["sensors"]:
+        print_sensor_costs()
+        return 0
     avg, worst = avr_cycles()
     instr = x86_instructions()
     flash, ram = avr_footprint()
@@ -325,6 +365,7 @@ def main() -> int:
         print(f"{name:<55} {ref:>10} {target:>12} {got:>10}  {'ok' if ok else 'MISSED'}")
     print_rocket(rocket_footprint())
     print_pyro_cost()
+    print_sensor_costs()
     return 0
 
 

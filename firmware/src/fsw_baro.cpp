@@ -6,69 +6,6 @@
 
 namespace fsw {
 
-namespace {
-
-inline bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
-
-void core_init(BaroCore& c, uint8_t addr, uint8_t stuck_n, uint8_t timeout_steps) {
-    memset(&c, 0, sizeof c);  // state 0, kBaroInit, nothing pending, counters and reading zero
-    c.addr = addr;
-    c.txn = kTwiIdle;
-    c.timeout_steps = timeout_steps == 0 ? 1 : timeout_steps;
-    c.stuck_n = stuck_n;
-}
-
-// Whether our transaction ended (its status in `st`); abandons it once it
-// has run for more than timeout_steps steps.
-// Our own status byte, not twi_result(): another driver's transaction may
-// have started and ended since ours did.
-bool core_poll(BaroCore& c, uint8_t& st) {
-    (void)twi_busy();  // the host's bus runs a transaction here; on an AVR a barrier
-    st = c.txn;
-    if (st == kTwiBusy) {
-        c.waited = static_cast<uint8_t>(c.waited + 1u);
-        if (c.waited <= c.timeout_steps) return false;
-        twi_abort();  // still busy, so the transaction on the bus is ours
-        st = kTwiTimeout;
-    }
-    c.pending = 0;
-    return true;
-}
-
-bool core_start(BaroCore& c, const uint8_t* w, uint8_t nw, uint8_t* r, uint8_t nr) {
-    if (!twi_start(c.addr, w, nw, r, nr, &c.txn)) return false;  // the bus is another's: next step
-    c.pending = 1;
-    c.waited = 0;
-    return true;
-}
-
-void core_fault(BaroCore& c, uint8_t health, uint32_t now) {
-    c.health = health;
-    if (c.faults != 0xFFFFu) c.faults = static_cast<uint16_t>(c.faults + 1u);
-    c.state = 0;  // both drivers: state 0 resets the part
-    c.same = 0;
-    c.due_us = now + kBaroRetryUs;
-}
-
-// A conversion's raw counts compared with the previous ones: health Ok, or
-// Stuck (counted as a fault once) after stuck_n unchanged conversions in a row.
-void core_reading(BaroCore& c, bool unchanged) {
-    if (unchanged && c.readings != 0) {
-        if (c.same != 0xFFu) c.same = static_cast<uint8_t>(c.same + 1u);
-    } else {
-        c.same = 0;
-    }
-    if (c.stuck_n != 0 && c.same >= c.stuck_n) {
-        if (c.health != kBaroStuck && c.faults != 0xFFFFu) c.faults = static_cast<uint16_t>(c.faults + 1u);
-        c.health = kBaroStuck;
-    } else {
-        c.health = kBaroOk;
-    }
-    c.readings = static_cast<uint16_t>(c.readings + 1u);
-}
-
-}  // namespace
-
 // ---- BMP280 ------------------------------------------------------------------
 
 namespace {
@@ -77,6 +14,8 @@ const uint8_t kBmp280RegReset = 0xE0;
 const uint8_t kBmp280ResetWord = 0xB6;
 const uint8_t kBmp280RegCtrlMeas = 0xF4;
 const uint8_t kBmp280RegConfig = 0xF5;
+const uint8_t kBmp280RegStatus = 0xF3;
+const uint8_t kBmp280Measuring = 0x08;  // status bit 3: a conversion runs
 const uint32_t kBmp280StartupUs = 2000u;  // datasheet 1.1: start-up time 2 ms
 
 inline uint8_t os_code(uint8_t v) { return v > 5 ? 5 : v; }
@@ -84,27 +23,9 @@ inline uint32_t os_times(uint8_t code) { return code == 0 ? 0u : static_cast<uin
 }  // namespace
 
 Bmp280::Bmp280(uint8_t addr7, uint8_t osrs_t, uint8_t osrs_p, uint8_t stuck_n, uint8_t timeout_steps)
-    : ctrl_(static_cast<uint8_t>(os_code(osrs_t) << 5 | os_code(osrs_p) << 2 | 1u)),
+    : ctrl_(static_cast<uint8_t>(os_code(osrs_t) << 5 | os_code(osrs_p) << 2 | 1u)), status_(0),
       cal_(), adc_P_(0), adc_T_(0), t_centi_(0), p_q8_(0), buf_() {
-    core_init(c_, addr7, stuck_n, timeout_steps);
-}
-
-// One step of either driver: the transaction in flight polled (and its
-// result handled), then the next one started when its wait is over.
-template <class Driver>
-void step_driver(Driver& d) {
-    BaroCore& c = d.c_;
-    const uint32_t now = pal::micros32();
-    if (!c.started) {
-        c.started = 1;
-        c.due_us = now;
-    }
-    if (c.pending) {
-        uint8_t st;
-        if (!core_poll(c, st)) return;
-        d.done(st, now);
-    }
-    if (!c.pending && due(now, c.due_us)) d.issue(now);
+    sensor_init(c_, addr7, stuck_n, timeout_steps);
 }
 
 uint32_t Bmp280::measure_us() const {
@@ -114,24 +35,43 @@ uint32_t Bmp280::measure_us() const {
     return op != 0 ? t + 2300u * os_times(op) + 575u : t;
 }
 
-void Bmp280::step() { step_driver(*this); }
+void Bmp280::step() { sensor_step(*this); }
+
+bool Bmp280::waiting() const { return c_.state == kBRead; }
+
+bool Bmp280::heartbeat(uint32_t now) {
+    (void)now;
+    const uint8_t w = kBmp280RegStatus;
+    return sensor_start(c_, &w, 1, &status_, 1);
+}
+
+// The status read while measuring: a failure is no answer; `measuring`
+// clear (the measurement is over before its datasheet maximum) makes the
+// data due now.
+void Bmp280::beat_done(uint8_t status, uint32_t now) {
+    if (status != kTwiOk) {
+        sensor_fault(c_, kSensorNoAnswer, now);
+        return;
+    }
+    if (!(status_ & kBmp280Measuring)) c_.due_us = now;
+}
 
 void Bmp280::issue(uint32_t now) {
     (void)now;
     uint8_t w[2];
     switch (c_.state) {
-        case kBReset: w[0] = kBmp280RegReset; w[1] = kBmp280ResetWord; (void)core_start(c_, w, 2, 0, 0); break;
-        case kBId: w[0] = kBmp280RegId; (void)core_start(c_, w, 1, buf_, 1); break;
-        case kBCal: w[0] = kBmp280RegCalib; (void)core_start(c_, w, 1, buf_, kBmp280CalibLen); break;
-        case kBCfg: w[0] = kBmp280RegConfig; w[1] = 0; (void)core_start(c_, w, 2, 0, 0); break;
-        case kBTrig: w[0] = kBmp280RegCtrlMeas; w[1] = ctrl_; (void)core_start(c_, w, 2, 0, 0); break;
-        default: w[0] = kBmp280RegData; (void)core_start(c_, w, 1, buf_, kBmp280DataLen); break;
+        case kBReset: w[0] = kBmp280RegReset; w[1] = kBmp280ResetWord; (void)sensor_start(c_, w, 2, 0, 0); break;
+        case kBId: w[0] = kBmp280RegId; (void)sensor_start(c_, w, 1, buf_, 1); break;
+        case kBCal: w[0] = kBmp280RegCalib; (void)sensor_start(c_, w, 1, buf_, kBmp280CalibLen); break;
+        case kBCfg: w[0] = kBmp280RegConfig; w[1] = 0; (void)sensor_start(c_, w, 2, 0, 0); break;
+        case kBTrig: w[0] = kBmp280RegCtrlMeas; w[1] = ctrl_; (void)sensor_start(c_, w, 2, 0, 0); break;
+        default: w[0] = kBmp280RegData; (void)sensor_start(c_, w, 1, buf_, kBmp280DataLen); break;
     }
 }
 
 void Bmp280::done(uint8_t status, uint32_t now) {
     if (status != kTwiOk) {
-        core_fault(c_, kBaroNoAnswer, now);
+        sensor_fault(c_, kSensorNoAnswer, now);
         return;
     }
     c_.due_us = now;
@@ -141,11 +81,11 @@ void Bmp280::done(uint8_t status, uint32_t now) {
             c_.due_us = now + kBmp280StartupUs;
             break;
         case kBId:
-            if (buf_[0] != kBmp280ChipId) { core_fault(c_, kBaroBadId, now); break; }
+            if (buf_[0] != kBmp280ChipId) { sensor_fault(c_, kSensorBadId, now); break; }
             c_.state = kBCal;
             break;
         case kBCal:
-            if (bmp280_parse_calib(buf_, cal_) != kOk) { core_fault(c_, kBaroBadCalib, now); break; }
+            if (bmp280_parse_calib(buf_, cal_) != kOk) { sensor_fault(c_, kSensorBadCalib, now); break; }
             c_.state = kBCfg;
             break;
         case kBCfg: c_.state = kBTrig; break;
@@ -156,13 +96,13 @@ void Bmp280::done(uint8_t status, uint32_t now) {
         default: {
             int32_t p, t, t_fine;
             bmp280_parse_raw(buf_, p, t);
-            core_reading(c_, p == adc_P_ && t == adc_T_);
+            sensor_reading(c_, p == adc_P_ && t == adc_T_);
             adc_P_ = p;
             adc_T_ = t;
             t_centi_ = bmp280_compensate_T(cal_, t, t_fine);
             p_q8_ = bmp280_compensate_P64(cal_, p, t_fine);
-            c_.temp_c = static_cast<float>(t_centi_) / 100.0f;
-            c_.pressure_pa = static_cast<float>(p_q8_) / 256.0f;
+            temp_c_ = static_cast<float>(t_centi_) / 100.0f;
+            pressure_pa_ = static_cast<float>(p_q8_) / 256.0f;
             c_.state = kBTrig;
             break;
         }
@@ -181,35 +121,37 @@ const uint16_t kMs5611ConvUs[5] = {600, 1170, 2280, 4540, 9040};
 Ms5611::Ms5611(uint8_t addr7, uint8_t osr, uint8_t stuck_n, uint8_t timeout_steps)
     : osr_(osr > 4 ? 4 : osr), word_(0), cal_(), d1_(0), d2_(0), last_d1_(0), last_d2_(0),
       t_centi_(0), p_(0), buf_() {
-    core_init(c_, addr7, stuck_n, timeout_steps);
+    sensor_init(c_, addr7, stuck_n, timeout_steps);
 }
 
 uint32_t Ms5611::conversion_us() const { return kMs5611ConvUs[osr_]; }
 
-void Ms5611::step() { step_driver(*this); }
+void Ms5611::step() { sensor_step(*this); }
+
+bool Ms5611::waiting() const { return c_.state == kMAdcCmd; }
 
 void Ms5611::issue(uint32_t now) {
     (void)now;
     uint8_t w;
     switch (c_.state) {
-        case kMReset: w = kMs5611CmdReset; (void)core_start(c_, &w, 1, 0, 0); break;
+        case kMReset: w = kMs5611CmdReset; (void)sensor_start(c_, &w, 1, 0, 0); break;
         case kMPromCmd:
             w = static_cast<uint8_t>(kMs5611CmdProm + 2u * word_);
-            (void)core_start(c_, &w, 1, 0, 0);
+            (void)sensor_start(c_, &w, 1, 0, 0);
             break;
-        case kMPromRead: (void)core_start(c_, 0, 0, buf_ + 2u * word_, 2); break;
+        case kMPromRead: (void)sensor_start(c_, 0, 0, buf_ + 2u * word_, 2); break;
         case kMConv:  // word_: 0 converts D2 (temperature), 1 D1 (pressure)
             w = static_cast<uint8_t>((word_ == 0 ? kMs5611CmdD2 : kMs5611CmdD1) + 2u * osr_);
-            (void)core_start(c_, &w, 1, 0, 0);
+            (void)sensor_start(c_, &w, 1, 0, 0);
             break;
-        case kMAdcCmd: w = kMs5611CmdAdcRead; (void)core_start(c_, &w, 1, 0, 0); break;
-        default: (void)core_start(c_, 0, 0, buf_, 3); break;
+        case kMAdcCmd: w = kMs5611CmdAdcRead; (void)sensor_start(c_, &w, 1, 0, 0); break;
+        default: (void)sensor_start(c_, 0, 0, buf_, 3); break;
     }
 }
 
 void Ms5611::done(uint8_t status, uint32_t now) {
     if (status != kTwiOk) {
-        core_fault(c_, kBaroNoAnswer, now);
+        sensor_fault(c_, kSensorNoAnswer, now);
         return;
     }
     c_.due_us = now;
@@ -222,7 +164,7 @@ void Ms5611::done(uint8_t status, uint32_t now) {
         case kMPromCmd: c_.state = kMPromRead; break;
         case kMPromRead:
             if (++word_ < 8) { c_.state = kMPromCmd; break; }
-            if (ms5611_parse_prom_bytes(buf_, cal_) != kOk) { core_fault(c_, kBaroBadCalib, now); break; }
+            if (ms5611_parse_prom_bytes(buf_, cal_) != kOk) { sensor_fault(c_, kSensorBadCalib, now); break; }
             word_ = 0;
             c_.state = kMConv;
             break;
@@ -234,7 +176,7 @@ void Ms5611::done(uint8_t status, uint32_t now) {
         default: {
             const uint32_t d = ms5611_parse_adc(buf_);
             if (d == 0) {  // read with no conversion done: the part lost it (reset?)
-                core_fault(c_, kBaroNoAnswer, now);
+                sensor_fault(c_, kSensorNoAnswer, now);
                 break;
             }
             if (word_ == 0) {
@@ -246,15 +188,15 @@ void Ms5611::done(uint8_t status, uint32_t now) {
             d1_ = d;
             word_ = 0;
             c_.state = kMConv;
-            core_reading(c_, d1_ == last_d1_ && d2_ == last_d2_);
+            sensor_reading(c_, d1_ == last_d1_ && d2_ == last_d2_);
             last_d1_ = d1_;
             last_d2_ = d2_;
             Ms5611Result r;
             ms5611_compensate(cal_, d1_, d2_, true, r);
             t_centi_ = r.TEMP;
             p_ = r.P;
-            c_.temp_c = static_cast<float>(t_centi_) / 100.0f;
-            c_.pressure_pa = static_cast<float>(p_);
+            temp_c_ = static_cast<float>(t_centi_) / 100.0f;
+            pressure_pa_ = static_cast<float>(p_);
             break;
         }
     }

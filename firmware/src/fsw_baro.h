@@ -1,67 +1,34 @@
 // Barometer drivers on the TWI (fsw_twi.h): Bosch BMP280 and TE MS5611,
-// each a small state machine stepped once per executor cycle. A step never
-// waits: it looks at the transaction it started, starts at most the next
-// one, and takes the datasheets' conversion times across cycles (micros32).
-// The data conversions are fsw_parts.h's. docs/sensors.md, "Bus and drivers".
+// each a small state machine stepped once per executor cycle
+// (fsw_sensor.h: the shared core, the health codes and the step). A step
+// never waits: it looks at the transaction it started, starts at most the
+// next one, and takes the datasheets' conversion times across cycles
+// (micros32). The data conversions are fsw_parts.h's. docs/sensors.md,
+// "Bus and drivers".
 //
-// Both drivers share the one TWI: a driver whose transaction cannot start
-// (the bus is another's) tries again at its next step. A transaction still
-// running after `timeout_steps` further steps is abandoned (twi_abort) and
-// counts as no answer, so the step period must exceed the longest
-// transaction (a 24-byte read: 0.7 ms at 400 kHz).
+// While a conversion runs the BMP280 driver reads the part's status
+// register each step (0xF3, `measuring`) and reads the data as soon as the
+// measurement is over; the MS5611 driver probes its address. Either way a
+// part that stops answering is seen at the next step.
 #ifndef FSW_BARO_H
 #define FSW_BARO_H
 
 #include "fsw_parts.h"
+#include "fsw_sensor.h"
 #include "fsw_types.h"
 
 namespace fsw {
 
-enum BaroHealth : uint8_t {
-    kBaroInit = 0,       // not yet through its first initialisation
-    kBaroOk = 1,         // the last conversion gave a new reading
-    kBaroNoAnswer = 2,   // a transaction failed (NACK, bus error, timeout); re-initialising
-    kBaroBadId = 3,      // BMP280: chip ID not 0x58; re-initialising
-    kBaroBadCalib = 4,   // calibration / PROM refused by fsw_parts' parser; re-initialising
-    kBaroStuck = 5       // the raw counts unchanged for stuck_n conversions in a row
-};
-
-// Time before a driver that saw a fault initialises again (reset, ID, calibration).
-static const uint32_t kBaroRetryUs = 20000UL;
-
-// The part of a driver common to both: the transaction in flight and the
-// health bookkeeping. Not used on its own.
-struct BaroCore {
-    uint8_t addr;
-    uint8_t state;
-    uint8_t health;         // BaroHealth
-    uint8_t pending;        // a transaction of ours was started
-    volatile uint8_t txn;   // its status (TwiStatus; kTwiBusy while it runs)
-    uint8_t waited;         // steps it has been running
-    uint8_t timeout_steps;
-    uint8_t stuck_n;        // 0: no stuck detection
-    uint8_t started;        // the first step has set due_us (micros32 may be anywhere then)
-    uint8_t same;           // conversions in a row with the raw counts unchanged
-    uint16_t faults;        // fault events (saturating)
-    uint16_t readings;      // new readings (wraps)
-    uint32_t due_us;        // micros32() when the wait in progress ends
-    float pressure_pa;
-    float temp_c;
-};
-
-// What the two drivers share: the health, the counters and the last
-// reading, and the step that polls a transaction and starts the next
-// (step_driver in fsw_baro.cpp).
-class BaroDriver {
+// What the two barometers share besides the core: the last reading.
+class BaroDriver : public SensorDriver {
 public:
-    uint8_t health() const { return c_.health; }
-    uint16_t faults() const { return c_.faults; }
-    uint16_t readings() const { return c_.readings; }
-    float pressure_pa() const { return c_.pressure_pa; }
-    float temp_c() const { return c_.temp_c; }
+    float pressure_pa() const { return pressure_pa_; }
+    float temp_c() const { return temp_c_; }
 
 protected:
-    BaroCore c_;
+    BaroDriver() : pressure_pa_(0.0f), temp_c_(0.0f) {}
+    float pressure_pa_;
+    float temp_c_;
 };
 
 class Bmp280 : public BaroDriver {
@@ -85,11 +52,15 @@ public:
     uint32_t measure_us() const;
 
 private:
-    template <class Driver> friend void step_driver(Driver& d);
+    template <class Driver> friend void sensor_step(Driver& d);
     void issue(uint32_t now);
     void done(uint8_t status, uint32_t now);
-    void fault(uint8_t health, uint32_t now);
-    uint8_t ctrl_;           // ctrl_meas value with mode 01 (forced)
+    // While a measurement runs: the status register read, `measuring` seen.
+    bool waiting() const;
+    bool heartbeat(uint32_t now);
+    void beat_done(uint8_t status, uint32_t now);
+    uint8_t ctrl_;
+    uint8_t status_;         // the last status register read (0xF3)           // ctrl_meas value with mode 01 (forced)
     Bmp280Calib cal_;
     int32_t adc_P_, adc_T_;
     int32_t t_centi_;
@@ -113,10 +84,10 @@ public:
     uint32_t conversion_us() const;
 
 private:
-    template <class Driver> friend void step_driver(Driver& d);
+    template <class Driver> friend void sensor_step(Driver& d);
     void issue(uint32_t now);
     void done(uint8_t status, uint32_t now);
-    void fault(uint8_t health, uint32_t now);
+    bool waiting() const;    // a conversion runs: the heartbeat probes the address
     uint8_t osr_;
     uint8_t word_;           // PROM word being read (0..7)
     Ms5611Calib cal_;

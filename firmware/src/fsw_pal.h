@@ -113,15 +113,36 @@ bool eeprom_ready();
 void eeprom_write(uint16_t addr, uint8_t value);
 
 // ---- SPI (master) -----------------------------------------------------------
-// The SPI bus as master, mode 0, MSB first, at the fastest clock (an AVR's
-// F_CPU / 2), with a chip select on board pin `cs_pin` driven high (idle).
-// On an AVR the bus's own SS pin is made an output too (as master it must
-// not be an input pulled low). Register level: no Arduino SPI library.
+// The SPI bus as master, MSB first, shared by several devices, each with its
+// own chip select (a board pin, active low) and its own mode and clock,
+// applied as it is selected. Register level: no Arduino SPI library.
+//
+// A device: its chip select and the SPI's control bits for it (filled by
+// spi_device; on the host only cs_pin is used).
+struct SpiDevice {
+    volatile uint8_t* cs_port;
+    uint8_t cs_pin, cs_mask;
+    uint8_t spcr, spsr;  // AVR: SPCR (mode, clock) and SPSR's SPI2X for it
+};
+// The bus alone: MOSI, SCK and (on an AVR) the bus's own SS pin made
+// outputs (as master it must not be an input pulled low), master on.
+// Idempotent; selects no device.
+void spi_bus_begin();
+// Describes the device on `cs_pin` (its chip select made an output, high:
+// deselected) at SPI `mode` (0..3: CPOL << 1 | CPHA) and the fastest clock
+// F_CPU / 2^k (k = 1..7) not above `max_hz`: ADXL345 mode 3, 5 MHz ->
+// F_CPU / 4 = 4 MHz on a 16 MHz Uno.
+void spi_device(SpiDevice& d, uint8_t cs_pin, uint8_t mode, uint32_t max_hz);
+// Selects the device (its mode and clock set, then its chip select low),
+// or deselects it (chip select high).
+void spi_select(const SpiDevice& d, bool on);
+// The bus (spi_bus_begin) and its default device on `cs_pin` at mode 0,
+// the fastest clock (F_CPU / 2): the flight recorder's NOR flash.
 void spi_begin(uint8_t cs_pin);
-// Chip select low (true: a transaction starts) or high (it ends).
+// Selects (true) or deselects the default device.
 void spi_select(bool on);
 // Shifts `out` out and returns the byte shifted in meanwhile; waits for the
-// shift (16 CPU cycles on an AVR at F_CPU / 2).
+// shift (16 CPU cycles on an AVR at F_CPU / 2, 32 at F_CPU / 4).
 uint8_t spi_transfer(uint8_t out);
 
 // ---- Watchdog ---------------------------------------------------------------

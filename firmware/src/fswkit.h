@@ -21,6 +21,8 @@
 #include "fsw_resume.h"
 #include "fsw_parts.h"
 #include "fsw_twi.h"
+#include "fsw_sensor.h"
 #include "fsw_baro.h"
+#include "fsw_accel.h"
 
 #endif  // FSWKIT_H

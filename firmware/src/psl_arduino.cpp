@@ -382,28 +382,47 @@ void eeprom_write(uint16_t, uint8_t) {}
 #endif
 
 #if defined(__AVR__) && defined(SPDR)
-// The SPI through its registers (datasheet 19): the chip select's port and
-// mask are looked up once, so a select is two instructions.
+// The SPI through its registers (datasheet 19): a device's chip select
+// port and mask are looked up once, so a select is a few instructions.
 namespace {
-volatile uint8_t* g_spi_cs_port;
-uint8_t g_spi_cs_mask;
+SpiDevice g_spi_default;
 }  // namespace
-void spi_begin(uint8_t cs_pin) {
-    g_spi_cs_port = portOutputRegister(digitalPinToPort(cs_pin));
-    g_spi_cs_mask = digitalPinToBitMask(cs_pin);
-    *g_spi_cs_port |= g_spi_cs_mask;  // high before it drives: the chip stays deselected
-    pinMode(cs_pin, OUTPUT);
+void spi_bus_begin() {
     digitalWrite(SS, HIGH);
     pinMode(SS, OUTPUT);  // master mode holds only while SS is an output (or high)
     pinMode(MOSI, OUTPUT);
     pinMode(SCK, OUTPUT);
-    SPCR = static_cast<uint8_t>(_BV(SPE) | _BV(MSTR));  // mode 0, MSB first, F_CPU / 4 ...
-    SPSR = _BV(SPI2X);                                 // ... doubled: F_CPU / 2
+    if (!(SPCR & _BV(SPE))) SPCR = static_cast<uint8_t>(_BV(SPE) | _BV(MSTR));  // mode 0, F_CPU / 4 until a select
 }
-void spi_select(bool on) {
-    if (on) *g_spi_cs_port &= static_cast<uint8_t>(~g_spi_cs_mask);
-    else *g_spi_cs_port |= g_spi_cs_mask;
+void spi_device(SpiDevice& d, uint8_t cs_pin, uint8_t mode, uint32_t max_hz) {
+    d.cs_pin = cs_pin;
+    d.cs_port = portOutputRegister(digitalPinToPort(cs_pin));
+    d.cs_mask = digitalPinToBitMask(cs_pin);
+    *d.cs_port |= d.cs_mask;  // high before it drives: the chip stays deselected
+    pinMode(cs_pin, OUTPUT);
+    // F_CPU / 2^k, k = 1..7: SPI2X for odd k, SPR1:0 = (k - 1) / 2 (k = 7: 11, /128).
+    uint8_t k = 1;
+    while (k < 7u && static_cast<uint32_t>(F_CPU) >> k > max_hz) ++k;
+    const uint8_t spr = k == 7u ? 3u : static_cast<uint8_t>((k - 1u) / 2u);
+    d.spcr = static_cast<uint8_t>(_BV(SPE) | _BV(MSTR) | (mode & 3u) << CPHA | spr);
+    d.spsr = (k & 1u) != 0 && k != 7u ? static_cast<uint8_t>(_BV(SPI2X)) : static_cast<uint8_t>(0);
 }
+void spi_select(const SpiDevice& d, bool on) {
+    if (on) {
+        SPCR = d.spcr;  // the clock's idle level follows CPOL before the chip sees it
+        SPSR = d.spsr;
+        *d.cs_port &= static_cast<uint8_t>(~d.cs_mask);
+    } else {
+        *d.cs_port |= d.cs_mask;
+    }
+}
+void spi_begin(uint8_t cs_pin) {
+    spi_bus_begin();
+    spi_device(g_spi_default, cs_pin, 0, static_cast<uint32_t>(F_CPU) / 2u);
+    SPCR = g_spi_default.spcr;
+    SPSR = g_spi_default.spsr;
+}
+void spi_select(bool on) { spi_select(g_spi_default, on); }
 uint8_t spi_transfer(uint8_t out) {
     SPDR = out;
     while (!(SPSR & _BV(SPIF))) {
@@ -412,6 +431,14 @@ uint8_t spi_transfer(uint8_t out) {
 }
 #else
 // Another MCU: no SPI through this layer (reads give 0xFF, as an absent chip).
+void spi_bus_begin() {}
+void spi_device(SpiDevice& d, uint8_t cs_pin, uint8_t, uint32_t) {
+    d.cs_port = 0;
+    d.cs_pin = cs_pin;
+    d.cs_mask = 0;
+    d.spcr = d.spsr = 0;
+}
+void spi_select(const SpiDevice&, bool) {}
 void spi_begin(uint8_t) {}
 void spi_select(bool) {}
 uint8_t spi_transfer(uint8_t) { return 0xFF; }

@@ -72,6 +72,12 @@ uint32_t g_spi_n;  // bytes of the transaction so far
 uint32_t g_spi_addr;
 uint8_t g_spi_page[256];
 uint16_t g_spi_page_n;
+// The default device's chip select (spi_begin: the flash's) and the one
+// selected now (0xFF: none); other devices answer through the responder.
+uint8_t g_spi_flash_cs = 0xFF;
+uint8_t g_spi_sel = 0xFF;
+uint16_t g_spi_dev_n;  // bytes since the other device's select
+native::SpiResponder g_spi_responder = 0;
 
 void eeprom_init() {
     if (!g_eeprom_init) {
@@ -155,6 +161,7 @@ TwiResponder g_twi_responder = 0;
 }  // namespace
 void twi_set_responder(TwiResponder r) { g_twi_responder = r; }
 TwiResponder twi_responder() { return g_twi_responder; }
+void spi_set_responder(SpiResponder r) { g_spi_responder = r; }
 
 void sim_reset() {
     g_time_us = 0;
@@ -315,17 +322,43 @@ void eeprom_write(uint16_t addr, uint8_t value) {
     }
 }
 
+void spi_bus_begin() {}
+void spi_device(SpiDevice& d, uint8_t cs_pin, uint8_t mode, uint32_t max_hz) {
+    (void)mode;
+    (void)max_hz;
+    d.cs_port = 0;
+    d.cs_pin = cs_pin;
+    d.cs_mask = 0;
+    d.spcr = d.spsr = 0;
+    g_mode[cs_pin] = kOutput;
+    g_level[cs_pin] = 1;
+}
+void spi_select(const SpiDevice& d, bool on) {
+    if (d.cs_pin == g_spi_flash_cs) {
+        spi_select(on);
+        return;
+    }
+    g_level[d.cs_pin] = on ? 0 : 1;
+    g_spi_sel = on ? d.cs_pin : 0xFF;
+    g_spi_dev_n = 0;
+}
 void spi_begin(uint8_t cs_pin) {
     clear_modes();
     g_mode[cs_pin] = kOutput;
     g_level[cs_pin] = 1;
+    g_spi_flash_cs = cs_pin;
 }
 void spi_select(bool on) {
     if (!on) flash_end();
+    g_spi_sel = on ? g_spi_flash_cs : 0xFF;
     g_spi_n = 0;
     g_spi_page_n = 0;
 }
 uint8_t spi_transfer(uint8_t out) {
+    if (g_spi_sel != g_spi_flash_cs) {  // another device (or none selected)
+        if (g_spi_sel == 0xFF || g_spi_responder == 0) return 0xFF;
+        return g_spi_responder(g_spi_sel, g_spi_dev_n++, out);
+    }
     const uint32_t i = g_spi_n++;
     if (i == 0) {
         g_spi_cmd = out;

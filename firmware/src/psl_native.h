@@ -83,6 +83,15 @@ typedef uint8_t (*TwiResponder)(uint8_t addr7, const uint8_t* w, uint8_t nw, uin
 void twi_set_responder(TwiResponder r);
 TwiResponder twi_responder();
 
+// The SPI's other devices (spi_device / spi_select(device), any chip
+// select but the default device's, which is the flash model): a scripted
+// responder called for each byte shifted while one is selected, with its
+// chip-select pin, the byte's index since the select and the byte out;
+// it returns the byte in. 0 (the default): every byte reads 0xFF (nobody
+// drives MISO). Not reset by sim_reset().
+typedef uint8_t (*SpiResponder)(uint8_t cs_pin, uint16_t index, uint8_t out);
+void spi_set_responder(SpiResponder r);
+
 // Back to power-on state: time 0, pins cleared, counters zero.
 void sim_reset();
 

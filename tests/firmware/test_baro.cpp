@@ -109,6 +109,12 @@ static void print_u32(const char* what, uint32_t v) {
     UNITY_PRINT_EOL();
 }
 
+// Until the transactions started (and queued) have ended (at most 20 ms).
+static void wait_bus(void) {
+    const uint32_t t0 = pal::micros32();
+    while (twi_busy() && pal::micros32() - t0 < 20000UL) {}
+}
+
 // Runs `cycles` executor cycles of 1 ms, stepping the drivers given (either
 // may be null) once each per cycle; returns the worst step (us).
 static uint32_t run_cycles(Bmp280* b, Ms5611* m, uint16_t cycles) {
@@ -134,6 +140,7 @@ static uint32_t run_cycles(Bmp280* b, Ms5611* m, uint16_t cycles) {
 #endif
     }
     if (worst > g_worst_us) g_worst_us = worst;
+    wait_bus();  // the drivers (a test's locals) outlive their last transactions
     return worst;
 }
 
@@ -141,7 +148,7 @@ static void test_bmp280_datasheet(void) {
     Bmp280 b(0x76, 1, 1, 0);
     TEST_ASSERT_EQUAL_UINT32(6425UL, b.measure_us());
     run_cycles(&b, 0, 40);  // reset 2 ms, ID, calibration, config, one 6.4 ms measurement
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
     TEST_ASSERT_EQUAL_UINT16(0, b.faults());
     TEST_ASSERT_TRUE(b.readings() >= 1);
     TEST_ASSERT_EQUAL_UINT16(27504, b.calib().dig_T1);
@@ -155,14 +162,14 @@ static void test_bmp280_datasheet(void) {
     const uint16_t n = b.readings();
     run_cycles(&b, 0, 100);  // ~7.4 ms a reading: 13 or so more
     TEST_ASSERT_TRUE(b.readings() >= n + 10);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
 }
 
 static void test_ms5611_datasheet(void) {
     Ms5611 m(0x77, 4, 0);
     TEST_ASSERT_EQUAL_UINT32(9040UL, m.conversion_us());
     run_cycles(0, &m, 60);  // reset 3 ms, 16 PROM transactions, D2 and D1 at 9.04 ms
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     TEST_ASSERT_EQUAL_UINT16(0, m.faults());
     TEST_ASSERT_TRUE(m.readings() >= 1);
     TEST_ASSERT_EQUAL_UINT16(40127, m.calib().C1);
@@ -180,8 +187,8 @@ static void test_both_share_the_bus(void) {
     Bmp280 b(0x76, 1, 1, 0);
     Ms5611 m(0x77, 2, 0);  // OSR 1024: 2.28 ms
     run_cycles(&b, &m, 200);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     TEST_ASSERT_EQUAL_UINT16(0, b.faults() + m.faults());
     TEST_ASSERT_TRUE(b.readings() >= 15);
     print_u32("200 cycles shared: BMP280 readings ", b.readings());
@@ -196,8 +203,8 @@ static void test_no_answer(void) {
     Bmp280 b(0x50);
     Ms5611 m(0x51);
     run_cycles(&b, &m, 2);
-    TEST_ASSERT_EQUAL_UINT8(kBaroNoAnswer, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroNoAnswer, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, m.health());
     TEST_ASSERT_EQUAL_UINT16(1, b.faults());
     TEST_ASSERT_EQUAL_UINT16(1, m.faults());
     run_cycles(&b, &m, 100);  // retries every 20 ms
@@ -212,8 +219,8 @@ static void test_wrong_part(void) {
     Bmp280 b(0x77);
     Ms5611 m(0x76);
     run_cycles(&b, &m, 30);
-    TEST_ASSERT_EQUAL_UINT8(kBaroBadId, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroBadCalib, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorBadId, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorBadCalib, m.health());
     TEST_ASSERT_EQUAL_UINT16(0, b.readings() + m.readings());
 }
 
@@ -223,34 +230,57 @@ static void test_stuck(void) {
     Bmp280 b(0x76, 1, 1, 3);
     Ms5611 m(0x77, 0, 3);  // OSR 256: 0.6 ms
     run_cycles(&b, &m, 100);
-    TEST_ASSERT_EQUAL_UINT8(kBaroStuck, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroStuck, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, m.health());
     TEST_ASSERT_EQUAL_UINT16(1, b.faults());
     TEST_ASSERT_EQUAL_UINT16(1, m.faults());
     TEST_ASSERT_EQUAL_INT32(2508, b.temp_centi());  // the values are still there
 }
 
-// The abort path a driver takes when its transaction outlives timeout_steps
-// (the simulated parts always answer, so it is called directly here): one
-// transaction at a time, abandoned, then the bus works again.
-static void test_abort(void) {
-    uint8_t r[24];
-    const uint8_t reg = 0x88;
-    TEST_ASSERT_TRUE(twi_start(0x76, &reg, 1, r, 24));
-#if defined(__AVR__)
-    TEST_ASSERT_TRUE(twi_busy());  // (the host's bus runs it at the first poll)
-    TEST_ASSERT_FALSE(twi_start(0x76, &reg, 1, r, 1));  // one at a time
-#endif
+// The queue and the abort path a driver takes when its transaction
+// outlives timeout_steps (the simulated parts always answer, so it is
+// called directly here): a transaction started while another runs waits
+// behind it; abandoning one (by its status byte) touches only that one,
+// queued or on the bus; then the bus works on.
+static void test_queue_and_abort(void) {
+    wait_bus();  // the earlier tests' drivers may have left a transaction
+    uint8_t cal[24], id1[1] = {0}, id2[1] = {0}, ms[2] = {0, 0};
+    volatile uint8_t s_cal = kTwiIdle, s_id1 = kTwiIdle, s_id2 = kTwiIdle, s_ms = kTwiIdle;
+    const uint8_t reg = 0x88, id = 0xD0, prom = 0xA2;
+    TEST_ASSERT_TRUE(twi_start(0x76, &reg, 1, cal, 24, &s_cal));
+    TEST_ASSERT_TRUE(twi_start(0x76, &id, 1, id1, 1, &s_id1));   // queued behind it
+    TEST_ASSERT_TRUE(twi_start(0x77, &prom, 1, 0, 0, &s_ms));    // and this
+    TEST_ASSERT_EQUAL_UINT8(kTwiBusy, s_id1);
+    TEST_ASSERT_EQUAL_UINT8(kTwiBusy, s_ms);
+    twi_abort(&s_id1);  // still queued: it leaves the queue, nothing else is touched
+    TEST_ASSERT_EQUAL_UINT8(kTwiTimeout, s_id1);
+    TEST_ASSERT_EQUAL_UINT8(kTwiBusy, s_ms);
+    TEST_ASSERT_EQUAL_UINT8(kTwiBusy, s_cal);  // (the host's bus runs them at the first twi_busy poll)
+    TEST_ASSERT_TRUE(twi_start(0x76, &id, 1, id2, 1, &s_id2));
+    twi_abort(&s_cal);  // on the bus: abandoned, and the next in line starts
+    TEST_ASSERT_EQUAL_UINT8(kTwiTimeout, s_cal);
+    wait_bus();
+    TEST_ASSERT_EQUAL_UINT8(kTwiOk, s_ms);
+    TEST_ASSERT_EQUAL_UINT8(kTwiOk, s_id2);
+    TEST_ASSERT_EQUAL_HEX8(0x58, id2[0]);
+    TEST_ASSERT_EQUAL_HEX8(0x00, id1[0]);  // the abandoned read stored nothing
+    // The MS5611's PROM word 1 (the command above selected it) reads C1.
+    TEST_ASSERT_TRUE(twi_start(0x77, 0, 0, ms, 2, &s_ms));
+    wait_bus();
+    TEST_ASSERT_EQUAL_UINT8(kTwiOk, s_ms);
+    TEST_ASSERT_EQUAL_UINT16(40127, static_cast<uint16_t>(ms[0] << 8 | ms[1]));
+    // One on the bus and kTwiQueueLen waiting: the next start is refused.
+    volatile uint8_t st[kTwiQueueLen + 2];
+    uint8_t n = 0;
+    while (n < kTwiQueueLen + 2 && twi_start(0x76, &reg, 1, cal, 24, &st[n])) ++n;
+    TEST_ASSERT_EQUAL_UINT8(kTwiQueueLen + 1, n);
+    wait_bus();
+    for (uint8_t i = 0; i < n; ++i) TEST_ASSERT_EQUAL_UINT8(kTwiOk, st[i]);
+    // The legacy form: no status byte: the transaction on the bus, whoever's.
+    TEST_ASSERT_TRUE(twi_start(0x76, &reg, 1, cal, 24));
     twi_abort();
     TEST_ASSERT_FALSE(twi_busy());
     TEST_ASSERT_EQUAL_UINT8(kTwiTimeout, twi_result());
-    // The bus works again.
-    const uint8_t id = 0xD0;
-    TEST_ASSERT_TRUE(twi_start(0x76, &id, 1, r, 1));
-    const uint32_t t0 = pal::micros32();
-    while (twi_busy() && pal::micros32() - t0 < 5000UL) {}
-    TEST_ASSERT_EQUAL_UINT8(kTwiOk, twi_result());
-    TEST_ASSERT_EQUAL_HEX8(0x58, r[0]);
 }
 
 #if !defined(__AVR__)
@@ -259,27 +289,27 @@ static void test_native_nack_then_ok(void) {
     Bmp280 b(0x76, 1, 1, 0);
     Ms5611 m(0x77, 2, 0);
     run_cycles(&b, &m, 50);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     g_bmp.fail = kModelNack;
     // The BMP280's next transaction comes within a measurement (6.4 ms) and
     // a cycle; its failure is seen at the step after it.
     uint16_t k = 0;
-    while (b.health() == kBaroOk && k < 20) { run_cycles(&b, &m, 1); ++k; }
-    TEST_ASSERT_EQUAL_UINT8(kBaroNoAnswer, b.health());
+    while (b.health() == kSensorOk && k < 20) { run_cycles(&b, &m, 1); ++k; }
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, b.health());
     TEST_ASSERT_TRUE(k <= 9);
     run_cycles(&b, &m, 60);
-    TEST_ASSERT_EQUAL_UINT8(kBaroNoAnswer, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());  // the other goes on
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());  // the other goes on
     TEST_ASSERT_EQUAL_UINT16(0, m.faults());
     g_bmp.fail = kModelOk;
     g_ms.fail = kModelNack;
     run_cycles(&b, &m, 60);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroNoAnswer, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, m.health());
     g_ms.fail = kModelOk;
     run_cycles(&b, &m, 60);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     TEST_ASSERT_EQUAL_INT32(100009L, m.pressure_int());
     TEST_ASSERT_EQUAL_INT32(2508, b.temp_centi());
 }
@@ -299,20 +329,20 @@ static void test_native_stuck_then_ok(void) {
     Bmp280 b(0x76, 1, 1, 4);
     Ms5611 m(0x77, 0, 4);
     run_changing(&b, &m, 200);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     g_bmp.fail = kModelStuck;
     g_ms.fail = kModelStuck;
     run_changing(&b, &m, 100);
-    TEST_ASSERT_EQUAL_UINT8(kBaroStuck, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroStuck, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, m.health());
     TEST_ASSERT_EQUAL_UINT16(1, b.faults());
     TEST_ASSERT_EQUAL_UINT16(1, m.faults());
     g_bmp.fail = kModelOk;
     g_ms.fail = kModelOk;
     run_changing(&b, &m, 50);
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, b.health());
-    TEST_ASSERT_EQUAL_UINT8(kBaroOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, b.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
     g_bmp.adc_P = 415148L;
     g_ms.D1 = 9085466UL;
 }
@@ -343,7 +373,7 @@ static void run(void) {
     RUN_TEST(test_no_answer);
     RUN_TEST(test_wrong_part);
     RUN_TEST(test_stuck);
-    RUN_TEST(test_abort);
+    RUN_TEST(test_queue_and_abort);
 #if !defined(__AVR__)
     RUN_TEST(test_native_nack_then_ok);
     RUN_TEST(test_native_stuck_then_ok);

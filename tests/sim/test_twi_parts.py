@@ -338,6 +338,33 @@ def test_fail_nack_stops_answering_and_ok_brings_it_back(probe):
         assert p.read(BMP, 0xD0, 1) == b"\x58"
 
 
+def test_address_probe_is_acked_and_disturbs_nothing(probe):
+    """The drivers' heartbeat, a zero-length write (START, SLA+W, STOP), is
+    ACKed by every part (status 18) and NACKed (20) by one told to `fail
+    nack` or by an empty address; probing an MS5611 and a BMP280 while they
+    convert neither ends nor spoils their conversions."""
+    with board(probe) as b:
+        p = Probe(b)
+        r = p.run(write(BMP, b""), write(MS, b""), write(MPU, b""), write(ADXL, b""), write(0x50, b""))
+        assert r == ["W18", "W18", "W18", "W18", f"W{MT_SLA_NACK:02x}"]
+        b.part_raw(MS, D1=9085466)
+        b.part_raw(BMP, adc_P=415148, adc_T=519888)
+        r = p.run(write(MS, bytes([0x44])), write(BMP, bytes([0xF4, 0x25])),  # D1 at OSR 1024; forced x1/x1
+                  write(MS, b""), write(BMP, b""), xread(BMP, 0xF3, 1), wait_until(7e-3),
+                  write(MS, b""), write(BMP, b""), xread(BMP, 0xF3, 1),
+                  write(MS, b"\x00"), f"R{MS:02x}03", xread(BMP, 0xF7, 6))
+        assert r[2] == r[3] == "W18"
+        assert xresult(r[4]) == (DONE, b"\x08")  # measuring
+        assert r[6] == r[7] == "W18"
+        assert xresult(r[8]) == (DONE, b"\x00")  # done
+        assert be24(xresult(r[10])[1]) == 9085466
+        assert bmp_adc(xresult(r[11])[1]) == 415148
+        b.part_fail(MS, "nack")
+        assert p.run(write(MS, b""))[0] == f"W{MT_SLA_NACK:02x}"
+        b.part_fail(MS, "ok")
+        assert p.run(write(MS, b""))[0] == "W18"
+
+
 def test_stuck_freezes_the_data_and_ok_releases_it(probe):
     with board(probe, parts=[("bmp280", BMP), ("ms5611", MS)]) as b:
         p = Probe(b)

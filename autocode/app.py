@@ -61,4 +61,5 @@ def application(path: str, parts: Parts) -> Application:
     return Application(path, parts.name, parts.board, parts.rate, parts.baud, parts.sv, tuple(parts.machines),
                        tuple(parts.channels), tuple(parts.tasks), parts.time_element, parts.time_source,
                        parts.time_unit, tuple(parts.streams), tuple(parts.writable), parts.reset_cause,
-                       parts.budget.get("flash"), parts.budget.get("ram"), parts.log, tuple(parts.pyro or ()))
+                       parts.budget.get("flash"), parts.budget.get("ram"), parts.log, tuple(parts.pyro or ()),
+                       tuple(parts.sensors or ()))

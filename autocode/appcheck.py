@@ -28,6 +28,7 @@ from .iotables import check_table
 from .lexer import ID, NUM, Tok
 from .logcheck import check_log
 from .pyrocheck import check_pyro
+from .sensors import SensorState, check_sensor_table, sensor_name
 from .limits import U8_COUNT, hz
 from .model import TASK_KINDS, TASK_MODES, Task
 from .numeric import REALS, exact_literal
@@ -63,6 +64,7 @@ class Parts:
     machine_toks: dict[str, Tok]  # by the machine's file name, without its extension
     log: M.Log | None = None
     pyro: list[M.PyroChannel] | None = None
+    sensors: list[M.Sensor] | None = None  # `.sns` tables' parts (sensors.py)
 
 
 class Report:
@@ -101,7 +103,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
     machines, machine_srcs = _machines(machine_files, sv, board, r)
     _parameters(machines, machine_files, board, r)
-    channels = _channels(io_files, sv, board, r) if board is not None else []
+    channels, sensors = _channels(io_files, sv, board, r) if board is not None else ([], [])
 
     time_source, time_unit = _time(f.time, r)
     time_element = _time_element(machines, sv, r)
@@ -110,19 +112,22 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
                    f"(one cycle must be a whole number of ms); rate is {rate}")
 
     tasks, task_opts = _tasks(f.tasks, sv, rate, machines, machine_files, r)
+    if sensors and not any(t.kind == "inputs" for t in tasks):
+        tok = next(c.file for c in io_files if c.path.endswith(".sns"))
+        r.err(tok, "the sensor parts are read by the `inputs` task: add one to [tasks] (e.g. `sense inputs rate=100`)")
     _clock_steps(tasks, board, time_source, time_unit, r)
     streams = _telemetry(f.telemetry, sv, tasks, r)
-    writable = _uplink(f.uplink, sv, tasks, machines, channels, settings.get("reset_cause"), r)
+    writable = _uplink(f.uplink, sv, tasks, machines, channels, settings.get("reset_cause"), r, sensors)
     reset_cause = _reset_cause(settings.get("reset_cause"), sv, r)
     pyro_names = {row.element.text for row in f.pyro}
     _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs,
-                pyro_names)
+                pyro_names, sensors)
     budget = _budget(f.budget, board, r)
-    log = check_log(f.log, sv, tasks, machines, board, r, channels=channels)
+    log = check_log(f.log, sv, tasks, machines, board, r, channels=channels, sensors=sensors)
     pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks)
     return Parts(name, board, rate, baud, sv, machines, channels, time_source, time_unit, time_element, tasks,
                  streams, writable, reset_cause, budget, sv_file.file,
-                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log, pyro)
+                 {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log, pyro, sensors)
 
 
 def complete(parts: Parts, src: Source, diags: Diagnostics, before: int) -> bool:
@@ -323,19 +328,28 @@ def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]
     return None
 
 
-def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board, r: Report) -> list[M.Channel]:
+def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
+              r: Report) -> tuple[list[M.Channel], list[M.Sensor]]:
+    """The channels of the `.aio`/`.dio` tables and the parts of the `.sns`
+    tables, in [configs] order: a pin or an input element is taken once
+    across all of them."""
     channels: list[M.Channel] = []
+    sensors: list[M.Sensor] = []
     used_pins: dict = {}
     used_inputs: dict = {}
+    state = SensorState()
     for c in files:
-        if not c.path.endswith((".aio", ".dio")):
-            r.err(c.file, "an I/O table is a `.aio` (analog) or `.dio` (digital) file")
+        if not c.path.endswith((".aio", ".dio", ".sns")):
+            r.err(c.file, "an I/O table is a `.aio` (analog), `.dio` (digital) or `.sns` (sensor parts) file")
             continue
         isrc = read_source(c.path, r.diags, APP)
         if isrc is None:
             continue
-        channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs)
-    return channels
+        if c.path.endswith(".sns"):
+            sensors += check_sensor_table(isrc, sv, board, r.diags, channels, used_pins, used_inputs, state)
+        else:
+            channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs)
+    return channels, sensors
 
 
 # ---- [time] ---------------------------------------------------------------------
@@ -597,7 +611,8 @@ def _stream(row: StreamRow, sv: M.StateVector, tele: Task | None, r: Report) -> 
 # ---- [uplink], the reset cause, one writer per element -----------------------------
 
 def _uplink(rows: tuple[WritableRow, ...], sv: M.StateVector, tasks: list[Task], machines: list[M.Machine],
-            channels: list[M.Channel], reset_tok: Tok | None, r: Report) -> list[M.Element]:
+            channels: list[M.Channel], reset_tok: Tok | None, r: Report,
+            sensors: list[M.Sensor] = ()) -> list[M.Element]:
     """The elements the ground may write: none that the executor, a machine's
     `G`/`S` or an input channel writes."""
     owners = {m.vars[m.g].name: f"`G` of machine `{m.name}`" for m in machines}
@@ -609,6 +624,9 @@ def _uplink(rows: tuple[WritableRow, ...], sv: M.StateVector, tasks: list[Task],
     if reset_tok is not None:
         owners.setdefault(reset_tok.text, "the reset cause")
     inputs = {c.element.name: f"input channel {c.path}:{c.line}" for c in channels if c.direction == "i"}
+    for p in sensors:
+        for el in _sensor_elements(p):
+            inputs[el.name] = f"sensor {sensor_name(p)} {p.path}:{p.line}"
     if rows and not any(t.kind == "uplink" for t in tasks):  # once: the list is what is idle, not each line
         et = rows[0].element
         r.diags.warning(r.src, APP, et.line, et.col, "writable elements without an `uplink` task in [tasks]: "
@@ -646,7 +664,7 @@ def _reset_cause(tok: Tok | None, sv: M.StateVector, r: Report) -> M.Element | N
 
 
 def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, machines, machine_srcs,
-                pyro_names=frozenset()) -> None:
+                pyro_names=frozenset(), sensors=()) -> None:
     """Every element has at most one writer among the input channels, the
     executor (each task's mode, overruns and worst_us; the reset cause) and
     the machines (their assignments and their own `S`); a second writer is
@@ -667,6 +685,9 @@ def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, mach
     for c in channels:
         if c.direction == "i":  # two input channels: the table checker's own error
             writers.setdefault(c.element.name, f"input channel {c.path}:{c.line}")
+    for p in sensors:  # likewise: a part's element taken by an input is the sensor table's error
+        for el in _sensor_elements(p):
+            writers.setdefault(el.name, f"sensor {sensor_name(p)} ({os.path.basename(p.path)}:{p.line})")
     for t in tasks:
         for key, el in (("mode", t.mode), ("overruns", t.overruns), ("worst_us", t.worst_us)):
             if el is not None:
@@ -689,6 +710,11 @@ def _one_writer(r: Report, channels, tasks, task_opts, reset_tok, reset_el, mach
             by_machine.add(v.name)
             write(v.name, f"machine `{m.name}` ({os.path.basename(m.path)}:{a.line})",
                   lambda msg, a=a: r.diags.error(msrc, SM, a.line, a.col, msg))
+
+
+def _sensor_elements(p: M.Sensor) -> list[M.Element]:
+    """The elements a sensor part writes: its readings, fault and health."""
+    return [el for _, el in p.outputs] + [el for el in (p.fault, p.health) if el is not None]
 
 
 # ---- [budget] -------------------------------------------------------------------

@@ -26,6 +26,7 @@ from os.path import basename
 
 from . import model as M
 from .appsyntax import Setting
+from .buses import i2c_bus, spi_bus
 from .lexer import ID, NUM, OP, Tok
 from .limits import hz
 from .numeric import exact_literal
@@ -40,18 +41,16 @@ NOR_SIZES = (64 << 10, 16 << 20)  # a power of two between these
 NOR_DEFAULT = 8 << 20  # the W25Q64JV
 UNITS = {"K": 1 << 10, "KiB": 1 << 10, "M": 1 << 20, "MiB": 1 << 20}
 MAX_SLOTS = 65535  # record indexes are u16
-# The SPI bus's pins by MCU, as port and bit (the board's `arduino.ports` maps
-# them to its pin numbers): (MOSI, MISO, SCK).
-SPI_BUS = {"atmega328p": (("B", 3), ("B", 4), ("B", 5)), "atmega2560": (("B", 2), ("B", 3), ("B", 1))}
-SPI_BUS_UNO_PINS = {11: "MOSI", 12: "MISO", 13: "SCK"}  # boards without a port map (native: the Uno's pins)
 
 
 
 def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine],
-              board, r, channels: list[M.Channel] | None = None) -> M.Log | None:
+              board, r, channels: list[M.Channel] | None = None, sensors=()) -> M.Log | None:
     """The checked `[log]` section, None when it is absent or has errors
     (reported through `r`, appcheck's Report). `channels`: the I/O channels,
-    whose pins an SPI flash's chip select must not take."""
+    whose pins an SPI flash's chip select must not take; `sensors`: the
+    sensor tables' parts, whose chip selects and I2C pins it must not take
+    either."""
     rec_task = next((t for t in tasks if t.kind == "recorder"), None)
     if not rows:
         if rec_task is not None:
@@ -83,7 +82,7 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if not elements:
         r.err(first, "[log] needs at least one `element`")
 
-    store, cs_pin, flash_size = _store(once.get("store"), board, channels, r)
+    store, cs_pin, flash_size = _store(once.get("store"), board, channels, r, sensors)
     if store == "eeprom" and board is not None and board.eeprom == 0:
         r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
     record = _record(once.get("record"), r)
@@ -145,7 +144,8 @@ def _sizes(log: M.Log, m: M.Machine, once: dict[str, Setting], elements: list[Se
     return True
 
 
-def _store(s: Setting | None, board, channels: list[M.Channel] | None, r) -> tuple[str | None, int | None, int]:
+def _store(s: Setting | None, board, channels: list[M.Channel] | None, r,
+           sensors=()) -> tuple[str | None, int | None, int]:
     """(store, chip-select pin, flash bytes) of `store eeprom` / `store spi_nor PIN [SIZE]`."""
     if s is None:
         return "eeprom", None, 0
@@ -162,7 +162,7 @@ def _store(s: Setting | None, board, channels: list[M.Channel] | None, r) -> tup
               "number and K or M, e.g. `spi_nor 10 1 M`")
         return None, None, 0
     ok = True
-    pin = _cs_pin(rest[0], board, channels, r)
+    pin = _cs_pin(rest[0], board, channels, r, sensors)
     if pin is None:
         ok = False
     size = NOR_DEFAULT
@@ -173,7 +173,7 @@ def _store(s: Setting | None, board, channels: list[M.Channel] | None, r) -> tup
     return ("spi_nor", pin, size) if ok else (None, None, 0)
 
 
-def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r) -> int | None:
+def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r, sensors=()) -> int | None:
     if board is None:
         return None
     if t.kind != NUM or not t.text.isdigit() or len(t.text) > 3 or int(t.text) not in board.digital_pins:
@@ -185,7 +185,7 @@ def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r) -> int | None:
     if pin in board.reserved:
         r.err(t, f"pin {pin} is reserved on the {board.name}: {board.reserved[pin]}")
         return None
-    bus = _spi_bus(board)
+    bus = spi_bus(board)
     if pin in bus:
         r.err(t, f"pin {pin} is the SPI bus's {bus[pin]} on the {board.name}: the chip select must be another pin")
         return None
@@ -193,16 +193,17 @@ def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r) -> int | None:
         if c.pin_number == pin:
             r.err(t, f"pin {pin} is already the channel of `{c.element.name}` ({basename(c.path)}:{c.line})")
             return None
+    for p in sensors:
+        if p.cs_pin == pin:
+            r.err(t, f"pin {pin} is already the chip select of the {p.part} ({basename(p.path)}:{p.line})")
+            return None
+    if any(p.bus == "i2c" for p in sensors):
+        twi = i2c_bus(board)
+        if pin in twi:
+            r.err(t, f"pin {pin} is the I2C bus's {twi[pin]} on the {board.name} (the sensor parts' bus): the chip "
+                     "select must be another pin")
+            return None
     return pin
-
-
-def _spi_bus(board) -> dict[int, str]:
-    """The board's SPI bus pins: pin -> MOSI / MISO / SCK."""
-    bus = SPI_BUS.get(board.mcu)
-    if bus is None or not board.ports:
-        return dict(SPI_BUS_UNO_PINS)
-    by_port = {pb: pin for pin, pb in board.ports.items()}
-    return {by_port[pb]: name for pb, name in zip(bus, ("MOSI", "MISO", "SCK")) if pb in by_port}
 
 
 def _size(t: Tok, unit: Tok | None, r) -> int | None:

@@ -305,6 +305,30 @@ class Channel:
     line: int
 
 
+# ---- sensor tables (`.sns`; docs/sensors.md, "The sensor table") -------------------
+
+SENSOR_PARTS = ("bmp280", "ms5611", "adxl345", "mpu6050")
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """A digital sensor part: one row of a `.sns` table, resolved."""
+    part: str  # one of SENSOR_PARTS
+    bus: str  # "i2c" or "spi"
+    address: int | None  # i2c: the 7-bit address
+    cs_pin: int | None  # spi: the chip select's board pin
+    where: str  # as written after the colon: "0x76", "10"
+    settings: tuple[tuple[str, int], ...]  # (key, value) resolved for the part, defaults included, in a fixed order
+    outputs: tuple[tuple[str, Element], ...]  # (quantity, element): pressure, temperature, x, y, z
+    fault: Element | None  # bool: true while the part's health is a fault
+    health: Element | None  # U8: the part's health code (fsw_sensor.h kSensor*)
+    path: str
+    line: int
+
+    def setting(self, key: str) -> int:
+        return dict(self.settings)[key]
+
+
 # ---- the application (spec §7) ----------------------------------------------------
 
 TASK_KINDS = ("inputs", "outputs", "machine", "telemetry", "uplink", "recorder")
@@ -400,3 +424,4 @@ class Application:
     ram_budget: int | None = None  # [budget] ram: data + bss + the stack's high-water mark
     log: Log | None = None  # [log]: the flight recorder
     pyro: tuple[PyroChannel, ...] = ()  # [pyro]: the channels that fire charges (docs/safety.md)
+    sensors: tuple[Sensor, ...] = ()  # `.sns` tables: digital sensor parts (docs/sensors.md)

@@ -57,6 +57,11 @@ HEALTH_TASK = struct.Struct("<BBHH")    # mode, faults, overruns, worst_us
 # then one status byte per [pyro] channel (fsw_io.h kPyro*), in [pyro] order
 HEALTH_PYRO = 1
 PYRO_ARMED, PYRO_CONTINUITY, PYRO_NO_SENSE, PYRO_FIRED, PYRO_FIRING = 0x01, 0x02, 0x04, 0x08, 0x10
+# then one health code per sensor part (fsw_sensor.h kSensor*), in `.sns` table order
+HEALTH_SENSOR = 1
+SENSOR_INIT, SENSOR_OK, SENSOR_NO_ANSWER, SENSOR_BAD_ID, SENSOR_BAD_CALIB, SENSOR_STUCK = 0, 1, 2, 3, 4, 5
+SENSOR_HEALTH = {SENSOR_INIT: "init", SENSOR_OK: "ok", SENSOR_NO_ANSWER: "NO ANSWER", SENSOR_BAD_ID: "BAD ID",
+                 SENSOR_BAD_CALIB: "BAD CALIBRATION", SENSOR_STUCK: "STUCK"}  # a fault: SENSOR_NO_ANSWER and above
 # the reset cause's bit that says the flight's state was resumed (fsw_resume.h)
 RESET_RESUMED = 0x80
 ACK_PAYLOAD = struct.Struct("<HBBH")    # command seq, opcode, status, last_seq; then a parameter command's data

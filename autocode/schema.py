@@ -9,8 +9,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from . import model as M
-from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_PYRO, HEALTH_TASK, HELLO_PAYLOAD, PROTOCOL,
-                       SNAPSHOT_OFFSET, encoded_max)
+from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_PYRO, HEALTH_SENSOR, HEALTH_TASK,
+                       HELLO_PAYLOAD, PROTOCOL, SNAPSHOT_OFFSET, encoded_max)
+from .sensors import sensor_name
 
 
 def layout_text(sv: M.StateVector) -> str:
@@ -77,7 +78,8 @@ def link_plan(app) -> LinkPlan:
         every = int(tele_rate / s.rate)
         streams.append(LinkStream(i, s.region, s.rate, every, _batch(s.region.size, s.rate)))
     health_every = max(1, int(app.tasks[tele].rate // HEALTH_HZ)) if tele is not None else 0
-    health_payload = HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks) + HEALTH_PYRO * len(app.pyro)
+    health_payload = (HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks) + HEALTH_PYRO * len(app.pyro)
+                      + HEALTH_SENSOR * len(app.sensors))
     bodies = [HELLO_PAYLOAD.size, ACK_PAYLOAD.size, health_payload] + [s.batch * s.region.size for s in streams]
     longest = max(bodies)
     sv_size = max(app.sv.size, 1)
@@ -103,6 +105,8 @@ def link_text(app) -> str:
         lines.append(f"machine {m.name} {m.vars[m.s].name} " + " ".join(f"{st.id}={st.name}" for st in m.states))
     for p in app.pyro:  # a status byte each in health frames
         lines.append(f"pyro {p.element.name}")
+    for p in app.sensors:  # a health code each in health frames, after the pyro bytes
+        lines.append(f"sensor {sensor_name(p)}")
     lines.append(f"health {plan.health_every} {plan.hello_every} snapshot {plan.snapshot_chunk}")
     return "\n".join(lines) + "\n"
 

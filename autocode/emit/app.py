@@ -210,13 +210,21 @@ def _resume_begin(app: Application) -> list[str]:
 def _app_cpp(app: Application) -> str:
     real = real_of(app)
     sources = [app.path, app.sv.path] + [m.path for m in app.machines] + sorted({c.path for c in app.channels})
-    c = [banner(sources, app.sv), '#include "fswkit.h"', '#include "sv.gen.h"']
+    sources += sorted({p.path for p in app.sensors})
+    c = [banner(sources, app.sv), '#include "fswkit.h"']
+    if app.sensors:  # the drivers (firmware/src/fsw_sensor.h, fsw_accel.h)
+        c.append('#include "fsw_sensor.h"')
+    if any(p.part in ACCEL_PARTS for p in app.sensors):
+        c.append('#include "fsw_accel.h"')
+    c.append('#include "sv.gen.h"')
     for m in app.machines:
         c.append(f'#include "{c_ident(m.name)}.gen.h"')
     c += ["", version_check("app.gen.cpp"), real_check(basename(app.path), real),
           comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz."),
           "namespace fsw_gen {", "namespace {", ""]
     tables = _tables(app, real, c)
+    if app.sensors:
+        c += _sensor_objects(app)
     if app.pyro:
         c.append(f"fsw::PyroGate Pyro[{len(app.pyro)}];  // the pyro channels' pulses (docs/safety.md), in [pyro] order")
     if resumes(app):
@@ -245,7 +253,8 @@ def _app_cpp(app: Application) -> str:
         c.append(f"FSW_NOINLINE void store_G_now(uint8_t* g) {{ fsw::store<uint64_t>(g, {_now(app)}); }}")
         c.append("")
     for t in app.tasks:
-        steps[t.name] = None if app.pyro and t is pyro_task(app) else _direct_step(t, tables)
+        steps[t.name] = (None if (app.pyro and t is pyro_task(app)) or (app.sensors and t is sensor_task(app))
+                         else _direct_step(t, tables))
         if steps[t.name] is None:
             c += _task_fn(app, t, tables)
     c.append(f"const fsw::Task kTasks[{max(n, 1)}] FSW_FLASH = {{")
@@ -294,9 +303,16 @@ def _app_cpp(app: Application) -> str:
         pin = (f"fsw::io_pin_begin({_pin(app, o)}, fsw::kIoOut);" if _pyro_direct(app)
                else f"fsw::pal::pin_mode({o.pin_number}, fsw::pal::kOutput);")
         c.append(f"    {pin}  // {basename(o.path)}:{o.line} {o.element.name} (pyro, low until fired)")
+    if app.sensors:
+        i2c, spi = (int(any(p.bus == bus for p in app.sensors)) for bus in ("i2c", "spi"))
+        c.append(f"    fsw::sensors_begin({i2c}, {spi});  // the buses the parts are on: I2C {'yes' if i2c else 'no'}, "
+                 f"SPI {'yes' if spi else 'no'}")
     if has_link:
         c.append(f"    fsw::pal::console_begin({app.baud}UL);")
         c.append("    fsw::link_begin(link, &kLinkConfig);  // its tables are checked where they are defined")
+        if app.sensors:
+            c.append(f"    fsw::link_sensors(link, sensor_health, {len(app.sensors)});  "
+                     "// a health byte per sensor part in health frames")
     c.append("    return true;")
     c.append("}")
     c.append("")
@@ -423,6 +439,83 @@ def _pyro_lines(app: Application, t: Task) -> list[str]:
     return out
 
 
+# ---- sensor parts (`.sns` tables; docs/sensor-table.md) ----
+
+ACCEL_PARTS = ("adxl345", "mpu6050")  # drivers of firmware/src/fsw_accel.h
+DRIVER = {"bmp280": "Bmp280", "ms5611": "Ms5611", "adxl345": "Adxl345", "mpu6050": "Mpu6050"}
+READING = {"pressure": "pressure_pa()", "temperature": "temp_c()", "x": "x_g()", "y": "y_g()", "z": "z_g()"}
+_OSRS = {1: 1, 2: 2, 4: 3, 8: 4, 16: 5}  # BMP280 ctrl_meas oversampling codes
+_MS_OSR = {256: 0, 512: 1, 1024: 2, 2048: 3, 4096: 4}
+_RANGE = {2: 0, 4: 1, 8: 2, 16: 3}  # ADXL345 DATA_FORMAT range, MPU6050 AFS_SEL
+_BW_RATE = {25: 0x8, 50: 0x9, 100: 0xA, 200: 0xB, 400: 0xC, 800: 0xD, 1600: 0xE, 3200: 0xF}  # ADXL345 BW_RATE
+
+
+def sensor_task(app: Application) -> Task | None:
+    """The inputs task that steps the sensor parts: the fastest (the first
+    of the fastest)."""
+    inputs = [t for t in app.tasks if t.kind == "inputs"]
+    return max(inputs, key=lambda t: t.rate) if inputs else None
+
+
+def sensor_args(p) -> str:
+    """The driver's constructor arguments (firmware/src/fsw_sensor.h): the
+    table's settings as the driver's codes."""
+    st = dict(p.settings)
+    tail = f"{st['stuck']}, {st['timeout']}"
+    if p.part == "bmp280":
+        return f"0x{p.address:02X}, {_OSRS[st['osrs_t']]}, {_OSRS[st['osrs_p']]}, {tail}"
+    if p.part == "ms5611":
+        return f"0x{p.address:02X}, {_MS_OSR[st['osr']]}, {tail}"
+    if p.part == "adxl345":
+        where, spi = (f"0x{p.address:02X}", 0) if p.bus == "i2c" else (str(p.cs_pin), 1)
+        return f"{where}, {spi}, {_RANGE[st['range']]}, 0x{_BW_RATE[st['rate']]:X}, {tail}"
+    return f"0x{p.address:02X}, {_RANGE[st['range']]}, {st['dlpf']}, {tail}"
+
+
+def _sensor_objects(app: Application) -> list[str]:
+    from ..sensors import sensor_name
+
+    out = ["// The sensor parts (docs/sensor-table.md), in table order: the inputs task steps each"]
+    for k, p in enumerate(app.sensors):
+        settings = " ".join(f"{key}={v}" for key, v in p.settings)
+        out.append(f"fsw::{DRIVER[p.part]} sensor{k}({sensor_args(p)});  "
+                   f"// {basename(p.path)}:{p.line} {sensor_name(p)}: {settings}")
+    out.append(f"uint8_t sensor_health[{len(app.sensors)}];  // their health codes (kSensor*) as the last step left "
+               "them: the health frame's")
+    out.append("")
+    return out
+
+
+def _sensor_lines(app: Application) -> list[str]:
+    """The inputs task's lines for the sensor parts: each steps (never
+    waits), then each reading goes to its element once the part has one,
+    and the health code to the fault and health elements."""
+    out = []
+    for k, p in enumerate(app.sensors):
+        out.append(f"    sensor{k}.step();  // {basename(p.path)}:{p.line} {p.part}")
+    guard = "fsw::SvGuard<true> lock; " if app.sv.lock else ""
+    for k, p in enumerate(app.sensors):
+        out.append(f"    {{  // {basename(p.path)}:{p.line} {p.part}")
+        out.append(f"        {guard}const uint8_t h = sensor{k}.health();")
+        out.append(f"        sensor_health[{k}] = h;")
+        if p.outputs:
+            out.append(f"        if (sensor{k}.readings() != 0) {{  // before its first reading: the initial values")
+            for q, el in p.outputs:
+                value = ("-" if q.startswith("-") else "") + f"sensor{k}.{READING[q.lstrip('-')]}"
+                if el.type.name == "F32":
+                    write = f"fsw::store<float>(sv + E_{el.name}, {value});"
+                else:
+                    write = f"fsw::write_F64(sv + E_{el.name}, {value});"
+                out.append(f"            {write}  // {q}")
+            out.append("        }")
+        if p.fault is not None:
+            out.append(f"        fsw::store_bool(sv + E_{p.fault.name}, h >= fsw::kSensorNoAnswer);  // fault")
+        if p.health is not None:
+            out.append(f"        sv[E_{p.health.name}] = h;  // health")
+        out.append("    }")
+    return out
+
+
 def _shared_time_store(app: Application) -> bool:
     """Whether machine tasks write G through one out-of-line function: two
     or more of them, no lock."""
@@ -447,6 +540,10 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
         if app.pyro and t is pyro_task(app):
             out += _pyro_lines(app, t)
+            if not calls:
+                out.append("    return fsw::kOk;")
+        elif app.sensors and t is sensor_task(app):
+            out += _sensor_lines(app)
             if not calls:
                 out.append("    return fsw::kOk;")
         elif not calls:
@@ -549,7 +646,8 @@ def _link(app: Application) -> list[str]:
              f"{plan.hello_every}, {up}, kSvLock"
              f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}}};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
-             f"{len(app.tasks)}, {len(app.pyro)}), \"the link's transmit buffer is too small for its control frames\");")
+             f"{len(app.tasks)}, {len(app.pyro) + len(app.sensors)}), "
+             "\"the link's transmit buffer is too small for its control frames\");")
     c.append("fsw::Link link;")
     c.append("")
     return c

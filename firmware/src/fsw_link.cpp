@@ -202,6 +202,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
             put_bytes(row, sizeof row);
         }
         for (uint8_t i = 0; i < c.n_pyro; ++i) put(c.pyro[i].status);  // kPyro* bits (fsw_io.h)
+        for (uint8_t i = 0; i < l.n_sensors; ++i) put(l.sensors[i]);  // kSensor* codes (fsw_sensor.h)
     } else {
         const uint16_t off = l.snapshot_at;
         uint16_t n = static_cast<uint16_t>(c.sv_size - off);

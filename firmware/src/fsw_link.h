@@ -172,6 +172,8 @@ struct Link {
     uint8_t big_cycle;      // low byte of the executor cycle count at the last hello or health frame
     uint8_t rx_len;
     bool rx_over;
+    uint8_t n_sensors;      // health bytes of sensor parts (link_sensors; 0: none)
+    const uint8_t* sensors; // their health codes (fsw_sensor.h kSensor*), in table order
     uint8_t rx[FSW_LINK_RX_CAP];
 };
 
@@ -181,6 +183,14 @@ struct Link {
 // were checked when they were compiled (link_*_ok below): nothing is
 // checked at run time.
 void link_begin(Link& link, const LinkConfig* cfg);
+// Sends `n` sensor health codes (fsw_sensor.h kSensor*) in each health
+// frame, after the pyro status bytes: `health` is RAM the inputs task keeps
+// current. Called after link_begin (which clears it); generated code passes
+// the sensor parts' codes in table order (docs/sensor-table.md).
+inline void link_sensors(Link& link, const uint8_t* health, uint8_t n) {
+    link.sensors = health;
+    link.n_sensors = n;
+}
 // Executor task steps (ctx = the Link): never block, never fault.
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
@@ -222,6 +232,8 @@ constexpr bool link_writable_ok(uint16_t off, uint8_t type, uint16_t sv_size) {
 // The rest: at most 128 streams, snapshot chunks of at least one byte, and a
 // transmit buffer that holds a hello (the longest control frame but
 // health; a PARAM_INFO ack is shorter), a health frame for `n_tasks` tasks and a snapshot chunk.
+// `n_pyro`: the health frame's trailing bytes, a pyro status per channel and a
+// sensor health code per part (link_sensors).
 constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks,
                               uint8_t n_pyro = 0) {
     return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 20u) <= tx_cap &&

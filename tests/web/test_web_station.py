@@ -136,6 +136,35 @@ def test_the_page_shows_each_charges_status_from_the_health_frame(browser, tmp_p
                 station.close()
 
 
+def test_the_page_shows_each_sensor_parts_health(browser, tmp_path):
+    """An application with a barometer and an accelerometer built for the
+    host, where nobody answers on either bus: the link table names each
+    part with its health in words (docs/sensor-table.md)."""
+    from selenium.webdriver.common.by import By
+
+    project = tmp_path / "parts"
+    project.mkdir()
+    (project / "p.sv").write_text("[Data]\nU64 time\nU32 state\nF32 baroP\nF32 accelZ\nbool high\n")
+    (project / "p.sm").write_text("[state_vector]\nU64 time @alias G\nU32 state @alias S\nF32 baroP @read_only\n"
+                                  "bool high\n\n[Run]\n.step\n    high = baroP > 100000\n")
+    (project / "p.sns").write_text("bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:7 z=accelZ\n")
+    (project / "p.app").write_text("[application]\nboard native\nrate 100\n[configs]\nstate_vector p.sv\n"
+                                   "machine p.sm\nio p.sns\n[tasks]\nsense inputs rate=100\n"
+                                   "control machine p rate=100\ndown telemetry rate=50\n[telemetry]\nData rate=10\n")
+    r = run_fsw("build", str(project), "--board", "native", "--out", str(tmp_path / "build"))
+    assert r.code == 0, r.err
+    with PtyTarget(tmp_path / "build" / "p") as target:
+        station = Station(target.port, project)
+        try:
+            browser.get(station.url)
+            table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
+            wait_for(lambda: "sensor adxl345@spi:7" in table(), "the sensor rows of the health frame", timeout=10)
+            assert "sensor bmp280@0x76 NO ANSWER" in table(), table()
+            assert "sensor adxl345@spi:7 NO ANSWER" in table(), table()
+        finally:
+            station.close()
+
+
 @pytest.mark.parametrize("name", ["ground", "web"])
 def test_fsw_ground_serves_the_page_the_terminal_tools_and_the_archive(exe, tmp_path, name):
     """`fsw ground PROJECT --port P --http-port 0 --archive A` (and its older

@@ -12,6 +12,7 @@ from fswkit.cli.common import (EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, l
                                write_output)
 
 CONFIG_EXTS = (".sv", ".sm", ".ss", ".app")
+TABLE_EXTS = (".aio", ".dio", ".sns")  # checked through the .app that names them (board, state vector, pins)
 
 
 def collect(paths: list[str], diags: Diagnostics) -> list[str] | None:
@@ -24,6 +25,10 @@ def collect(paths: list[str], diags: Diagnostics) -> list[str] | None:
                           for n in sorted(names) if n.endswith(CONFIG_EXTS)]
         elif p.endswith(CONFIG_EXTS) or not os.path.exists(p):
             files.append(p)
+        elif p.endswith(TABLE_EXTS):
+            sys.stderr.write(f"fsw check: {p}: an I/O table ({', '.join(TABLE_EXTS)}) is checked with the application "
+                             "that lists it in [configs]: give its .app, or the project's folder\n")
+            return None
         else:
             sys.stderr.write(f"fsw check: {p}: not a config file (expected {', '.join(CONFIG_EXTS)} or a folder)\n")
             return None

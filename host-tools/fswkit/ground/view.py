@@ -245,6 +245,8 @@ def _link_items(session: Session, now: float, last_frame, started):
         items.append(_kv("target restarts", st.restarts, True))
     for p in (h or {}).get("pyro", ()):  # each charge's status: an open igniter stands out
         items.append(_kv(f"pyro {p['name']}", p["words"], p["continuity"] is False or p["firing"]))
+    for s in (h or {}).get("sensors", ()):  # each part's health: a fault stands out
+        items.append(_kv(f"sensor {s['name']}", s["words"], s["fault"]))
     if hello is None:
         items.append(_item(("waiting for hello", "yellow")))
     else:

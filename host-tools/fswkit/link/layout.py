@@ -87,6 +87,7 @@ class Layout:
     health_payload: int
     raw: dict  # the JSON form
     pyro: tuple[str, ...] = ()  # the [pyro] channels' elements: a status byte each in health frames
+    sensors: tuple[str, ...] = ()  # the sensor parts (`bmp280@0x76`): a health code each, after the pyro bytes
 
     def element(self, name: str) -> Element | None:
         return next((e for e in self.elements if e.name == name), None)
@@ -168,9 +169,10 @@ def check_dict(d) -> None:
             "writable": (lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v), "a list of names"),
             "states": (lambda v: isinstance(v, dict), "an object"),
             "analog": (lambda v: isinstance(v, dict), "an object")}
-    if "pyro" in d:  # logs written before pyro channels reached health frames have none
-        need(isinstance(d["pyro"], list) and all(isinstance(x, str) for x in d["pyro"]), "layout.pyro", d["pyro"],
-             "a list of names")
+    for key in ("pyro", "sensors"):  # absent: no pyro channels (older logs) / no sensor parts
+        if key in d:
+            need(isinstance(d[key], list) and all(isinstance(x, str) for x in d[key]), f"layout.{key}", d[key],
+                 "a list of names")
     for key, (ok, want) in spec.items():
         if key not in d:
             raise LayoutError(f"field `layout.{key}` is missing")
@@ -224,7 +226,8 @@ def from_dict(d: dict) -> Layout:
         return Layout(int(d["schema"]), d["name"], d["sv_size"], d["time_unit"], d["rate"], elements, regions,
                       streams, tuple((t["name"], t["kind"]) for t in d["tasks"]), tuple(d["writable"]),
                       {k: {int(i): n for i, n in v.items()} for k, v in d["states"].items()},
-                      d["analog"], d["health_payload"], d, tuple(d.get("pyro", ())))
+                      d["analog"], d["health_payload"], d, tuple(d.get("pyro", ())),
+                      tuple(d.get("sensors", ())))
     except (KeyError, TypeError, ValueError, ZeroDivisionError) as e:
         raise LayoutError(f"not a link layout: {type(e).__name__}: {e}") from None
 
@@ -265,6 +268,9 @@ def from_app(app) -> Layout:
         "health_payload": plan.health_payload,
         "pyro": [p.element.name for p in app.pyro],
     }
+    if app.sensors:  # only then: the layouts of applications without sensor parts are as they were
+        from fswkit.autocode.sensors import sensor_name
+        d["sensors"] = [sensor_name(p) for p in app.sensors]
     return from_dict(d)
 
 

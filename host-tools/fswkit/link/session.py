@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 from fswkit.autocode.app import TASK_MODES
 from fswkit.autocode.protocol import (ACK_PAYLOAD, HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD, PYRO_ARMED,
-                                     PYRO_CONTINUITY, PYRO_FIRED, PYRO_FIRING, PYRO_NO_SENSE, RESET_RESUMED)
+                                     PYRO_CONTINUITY, PYRO_FIRED, PYRO_FIRING, PYRO_NO_SENSE, RESET_RESUMED,
+                                     SENSOR_HEALTH, SENSOR_NO_ANSWER)
 
 from . import wire
 from .layout import Layout
@@ -55,6 +56,12 @@ def reset_words(cause: int | None) -> str:
     words = [w for bit, w in RESET_CAUSES if cause & bit]
     text = ", ".join(words) if words else f"none reported (0x{cause & ~RESET_RESUMED:02x})"
     return text + ", flight resumed" if cause & RESET_RESUMED else text
+
+
+def sensor_status(name: str, code: int) -> dict:
+    """A sensor part's health code of a health frame (fsw_sensor.h kSensor*)."""
+    words = SENSOR_HEALTH.get(code, f"UNKNOWN CODE {code}")
+    return {"name": name, "code": code, "fault": code >= SENSOR_NO_ANSWER, "words": words}
 
 
 def pyro_status(name: str, bits: int) -> dict:
@@ -335,6 +342,9 @@ class Session:
         info["tasks"] = tasks
         at = _HEALTH.size + len(self.layout.tasks) * _TASK.size
         info["pyro"] = [pyro_status(name, payload[at + i]) for i, name in enumerate(self.layout.pyro)]
+        at += len(self.layout.pyro)
+        info["sensors"] = [sensor_status(name, payload[at + i]) for i, name in enumerate(self.layout.sensors)
+                           if at + i < len(payload)]
         self.health = info
         self._delay(time, host_time)
         return Event("health", seq, time, host_time, info=info)
@@ -383,7 +393,8 @@ def describe(ev: Event, layout: Layout) -> str:
                 f"reset_cause=0x{i['reset_cause']:02x} rx_ok={i['rx_ok']} rx_crc={i['rx_crc']} "
                 f"rx_malformed={i['rx_malformed']} rx_oversized={i['rx_oversized']} "
                 f"rx_replayed={i['rx_replayed']} rx_refused={i['rx_refused']} {tasks}"
-                + "".join(f" pyro {p['name']}: {p['words']}" for p in i.get("pyro", ())))
+                + "".join(f" pyro {p['name']}: {p['words']}" for p in i.get("pyro", ()))
+                + "".join(f" sensor {s['name']}: {s['words']}" for s in i.get("sensors", ())))
     if ev.kind == "ack":
         return f"{head} ack cmd={i['cmd_seq']} {i['op_name']} {i['status_name']}"
     if ev.kind == "snapshot":

@@ -36,6 +36,7 @@ def _message(ev: Event, layout: Layout) -> dict | None:
         if ev.kind == "health":
             info["tasks"] = [dict(t) for t in ev.info.get("tasks", ())]
             info["pyro"] = [dict(p) for p in ev.info.get("pyro", ())]  # each charge's status (docs/safety.md)
+            info["sensors"] = [dict(s) for s in ev.info.get("sensors", ())]  # each part's health (docs/sensor-table.md)
         if ev.kind == "ack":
             info["words"] = STATUS.get(ev.info.get("status"), ("?", "unknown status"))[1]
         if "reset_cause" in ev.info:

@@ -243,7 +243,8 @@ function showHealth(info) {
                 ["frames sent", info.frames], ["frames dropped (busy)", info.dropped],
                 ["commands applied", info.rx_ok], ["CRC errors", info.rx_crc], ["malformed", info.rx_malformed],
                 ["refused", info.rx_refused], ["replayed", info.rx_replayed]]
-    .concat((info.pyro || []).map(p => [`pyro ${p.name}`, p.words]));
+    .concat((info.pyro || []).map(p => [`pyro ${p.name}`, p.words]))
+    .concat((info.sensors || []).map(s => [`sensor ${s.name}`, s.words]));
   $("link-table").tBodies[0].replaceChildren(...rows.map(([k, v]) => {
     const tr = el("tr"); tr.append(el("th", {}, k), el("td", {}, fmt(v))); return tr; }));
   $("task-table").tBodies[0].replaceChildren(...info.tasks.map(t => {

@@ -1,10 +1,13 @@
 """Golden files for every diagnostic of the application languages: the
-`.app` config and the `.aio`/`.dio` channel tables it names.
+`.app` config and the `.aio`/`.dio` channel tables and `.sns` sensor tables
+it names.
 
 tests/autocode/golden/app/ holds one small application per diagnostic,
 `NAME.app`, beside `NAME.expected`: exactly what `fsw check NAME.app` writes
 to standard error, run from this folder. A case about a channel table names
-its own `NAME.aio` or `NAME.dio`; the other files (rig.sv, rig.sm, rig.aio,
+its own `NAME.aio` or `NAME.dio`, a sensor case (`sensors_*`) its
+`NAME.sns` and the state vector sns.sv (rig.sv with the parts' elements),
+changing `sensors_valid.app`; the other files (rig.sv, rig.sm, rig.aio,
 rig.dio, ...) are the companions the cases share. Each case is the same
 valid application (`valid.app`) with one thing changed, so its diagnostics
 are those of that change.
@@ -62,8 +65,9 @@ def test_every_expected_file_has_its_input():
 
 # ---- every message the application checker can produce has a golden case ------------
 
-SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py", "pyrocheck.py")]
-REPORTERS = {"error", "warning", "err", "at", "Problem"}
+SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py", "pyrocheck.py",
+                                           "sensors.py")]
+REPORTERS = {"error", "warning", "err", "at", "Problem", "_Refused"}
 # Messages that no golden case here can hold, and where they are tested instead.
 NOT_GOLDEN = {
     # the flight recorder on an SPI NOR flash: projects of their own (the rig's pins and sizes)

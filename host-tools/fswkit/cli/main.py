@@ -177,10 +177,12 @@ def parser() -> argparse.ArgumentParser:
                     "differs from plant.toml's (motor, mass, drag, gusts, sensor errors, brown-outs)")
     sm.add_argument("--run", type=_nonneg_int, metavar="I", help="with --plant rocket: fly run I of the study with "
                     "--seed and --dispersion again, alone, writing its files")
-    sm.add_argument("--fault", choices=("stuck-baro", "pinned-accel", "pinned-baro", "open-igniter"),
+    sm.add_argument("--fault", metavar="FAULT",
                     help="with --plant rocket: a fault (stuck-baro: the barometer freezes at ignition; "
                     "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit; open-igniter: the "
-                    "drogue's igniter is open from boot, the motor is not lit and the vehicle must refuse to arm)")
+                    "drogue's igniter is open from boot, the motor is not lit and the vehicle must refuse to arm; "
+                    "with digital sensor parts, baro-nack, baro-stuck, accel-nack, accel-stuck, each at ignition or "
+                    "@SECONDS: the part stops answering, or its results stop changing)")
     sm.set_defaults(func=_command("sim", "cmd_sim"))
 
     fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")

@@ -1,7 +1,8 @@
 """The lock-step loop: the firmware on the simulated board (fswkit.sim.board)
 and a plant scenario advance together at the scenario's rate. Each step is
 one `SimBoard.batch` — one command and one pipe round trip: the sensors'
-volts and switch levels that changed, a run to the step's last cycle, the
+volts, the digital parts' raw counts and the switch levels that changed, a
+run to the step's last cycle, the
 pyro/valve pins' edges and the UART's bytes — then the plant integrates the
 same interval with the pins as they were, to the cycle. The UART's bytes go through the ground's decoder
 (fswkit.link.Session), as `fsw monitor` decodes them, and into a link log
@@ -20,6 +21,7 @@ from fswkit.link.log import RX, LogWriter
 from fswkit.link.session import Session
 from fswkit.progress import progress
 from fswkit.sim.board import RESET_CAUSES, EdgeOverflow, SimBoard, SimError
+from fswkit.sim.sensors import PartFeed, board_parts, part_name
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
 
@@ -71,6 +73,9 @@ class Run:
     reset_events: list[ResetEvent] = field(default_factory=list)  # the same resets, with cause and state
     eeprom: bytes | None = None  # the board's EEPROM after the flight (the flight recorder's store)
     flash: bytes | None = None  # the SPI NOR flash's written part after the flight (`store spi_nor`)
+    part_failures: list = field(default_factory=list)  # (simulated s, part "bmp280@0x76", "nack" | "stuck")
+    # per digital part: [health frames, frames that said it had a fault, arrival (s) of the first such frame]
+    part_health: dict = field(default_factory=dict)
 
 
 _cpu_lock = threading.Lock()
@@ -189,6 +194,14 @@ class Telemetry:
             if ev.kind == "hello" and not ev.info["schema_ok"]:
                 raise CosimError(f"the firmware's schema 0x{ev.info['schema']:08x} is not the configs' "
                                  f"0x{self.layout.schema:08x}: rebuild it")
+            if ev.kind == "health":
+                for part in ev.info.get("sensors", ()):
+                    seen = run.part_health.setdefault(part["name"], [0, 0, None])
+                    seen[0] += 1
+                    if part["fault"]:
+                        seen[1] += 1
+                        if seen[2] is None:
+                            seen[2] = t
             if ev.kind != "sample":
                 continue
             names = self.regions[ev.stream].names
@@ -216,12 +229,15 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
     if log:
         log.commit()  # named from the start: a run killed outright still leaves its log
     telemetry = Telemetry(run, layout, scenario.state_element, log)
+    sensors = tuple(getattr(getattr(scenario, "app", None), "sensors", ()) or ())
     try:
         nor = _nor(getattr(scenario, "app", None), board)
+        where = dict(zip(sensors, (w for _k, w in board_parts(sensors, board))))
         b = SimBoard(elf, board, uart="control", sim_limit=scenario.max_s + 1.0, wall_limit=wall_limit,
                      eeprom=getattr(scenario, "eeprom", None),
                      analog=analog, spi_flash=nor[1] if nor else None,
-                     ram_seed=_ram_seed(getattr(scenario, "seed", 1)))
+                     ram_seed=_ram_seed(getattr(scenario, "seed", 1)),
+                     parts=[(s.part, where[s]) for s in sensors] or None)
     except SimError as e:
         if log:
             log.close()
@@ -230,6 +246,11 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
     try:
         if profile:
             b.profile(profile)
+        # the parts the plant feeds, with the calibration each holds (read once)
+        feeds = {s: PartFeed(s, where[s], b.part_calibration(where[s]))
+                 for s in getattr(scenario, "parts", ()) if s in where}
+        last_raw: dict = {}  # harness id -> the raw counts set last
+        fail_plan = list(getattr(scenario, "part_fail_plan", ()))
         last_mv = {name: _mv(v, vref) for name, v in analog.items()}
         last_din: dict[int, bool] = {}
         for pin in scenario.outputs:
@@ -257,8 +278,25 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     telemetry.restarted(t0)
                     last_mv = {name: -1 for name in last_mv}  # every input driven again
                     last_din = {}
+            while fail_plan and t0 >= fail_plan[0][0]:  # a part fails (its mode set before the step runs)
+                _at, part, mode = fail_plan.pop(0)
+                if part in where:
+                    b.part_fail(where[part], mode)
+                    run.part_failures.append((t0, part_name(part), mode))
             if k:
                 analog, digital = scenario.inputs(t0)
+            set_parts = {}  # the parts' raw counts that changed
+            if feeds:
+                for part, values in scenario.part_values.items():
+                    feed = feeds.get(part)
+                    if feed is None:
+                        continue
+                    raw = feed.raw(**values)
+                    old = last_raw.get(feed.where, {})
+                    changed = {n: v for n, v in raw.items() if old.get(n) != v}
+                    if changed:
+                        last_raw[feed.where] = raw
+                        set_parts[feed.where] = changed
             set_analog, set_digital = {}, {}  # the inputs that changed
             for name, v in analog.items():
                 mv = _mv(v, vref)
@@ -271,7 +309,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     set_digital[pin] = level
             k += 1
             try:
-                step = b.batch(k * cycles, set_analog, set_digital)
+                step = b.batch(k * cycles, set_analog, set_digital, set_parts)
             except EdgeOverflow:
                 raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to "
                                  "watch") from None

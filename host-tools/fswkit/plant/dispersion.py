@@ -261,20 +261,46 @@ def apply(sc, d: Draw) -> None:
         sc.reset_at_cause = "brownout"
     baro, accel = p["barometer"], p["accelerometer"]
     errs = []
-    for sd, ch, per_volt in ((d.baro, sc.channels[0], 1.0 / baro["pa_per_volt"]),
-                             (d.accel, sc.channels[1], accel["volts_per_g"])):
-        if sd.bias or sd.spikes or sd.dropouts:
-            errs.append((ch, sd.bias * per_volt, _Windows([(t_ign + a, t_ign + b, s * per_volt)
-                                                           for a, b, s in sd.spikes]),
-                         _Windows([(t_ign + a, t_ign + b, 0.0) for a, b in sd.dropouts]),
-                         sd.dropout_volts, sd is d.baro))
-    if not errs:
+    part_errs = []  # a digital part's: in its physical unit, a dropout holds the part's last value
+    for sd, ch, part, per_volt in ((d.baro, sc.channels[0], getattr(sc, "baro_part", None),
+                                    1.0 / baro["pa_per_volt"] if baro["pa_per_volt"] else 1.0),
+                                   (d.accel, sc.channels[1], getattr(sc, "accel_part", None),
+                                    accel["volts_per_g"] or 1.0)):
+        if not (sd.bias or sd.spikes or sd.dropouts):
+            continue
+        if part is not None:
+            part_errs.append((part, sd.bias, _Windows([(t_ign + a, t_ign + b, s) for a, b, s in sd.spikes]),
+                              _Windows([(t_ign + a, t_ign + b, 0.0) for a, b in sd.dropouts]), sd is d.baro))
+            continue
+        errs.append((ch, sd.bias * per_volt, _Windows([(t_ign + a, t_ign + b, s * per_volt)
+                                                       for a, b, s in sd.spikes]),
+                     _Windows([(t_ign + a, t_ign + b, 0.0) for a, b in sd.dropouts]),
+                     sd.dropout_volts, sd is d.baro))
+    if not errs and not part_errs:
         return
     inputs = sc.inputs
     vref = sc.vref
+    held: dict = {}  # part -> its values when a dropout started
 
     def dispersed_inputs(t: float):
         analog, digital = inputs(t)
+        for part, bias, spikes, dropouts, is_baro in part_errs:
+            vals = sc.part_values[part]
+            key = "pressure" if is_baro else next(k for k in vals if k in ("x", "y", "z"))
+            sign = 1.0 if is_baro else sc.accel_axis[1]
+            v = vals[key] + sign * bias
+            s = spikes.at(t)
+            if s is not None:
+                v += sign * s[2]
+            if dropouts.at(t) is not None:
+                v = held.setdefault(part, v)
+            else:
+                held.pop(part, None)
+            vals[key] = v
+            if is_baro:
+                sc.baro_v = v
+            else:
+                sc.accel_v = sign * v
         for ch, bias, spikes, dropouts, drop_v, is_baro in errs:
             v = analog[ch] + bias
             s = spikes.at(t)

@@ -6,11 +6,19 @@ every error of the file reported at once.
 
 tomllib keeps no positions, so `locate` maps each `[table]` header and
 `key =` line of the text to its line number.
+
+`extends = "../hpr/plant.toml"` at a file's top starts it from another
+parameters file (which may extend another in turn): the extending file's
+tables override the base's key by key, and keys that are alternatives of
+the one it sets (a table's `alternatives`: `part` instead of an analog
+`channel` and its transfer function) are dropped from the base's. Every
+message names the file and line that gave the key.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -51,6 +59,25 @@ class Field:
 class Table:
     doc: str
     fields: dict[str, Field] = field(default_factory=dict)
+    # groups of keys that are alternatives of each other: a file that extends
+    # another and sets a key of one group drops the base's keys of the others
+    alternatives: tuple[tuple[str, ...], ...] = ()
+
+
+class Line(int):
+    """A line number of another file than the one loaded (a key inherited
+    through `extends`): messages name that file."""
+
+    path: str
+
+    def __new__(cls, n: int, path: str):
+        line = super().__new__(cls, n)
+        line.path = path
+        return line
+
+
+def _at(path: str, line) -> str:
+    return f"{getattr(line, 'path', path)}:{int(line)}"
 
 
 Schema = dict  # table name ("" for the top level) -> Table
@@ -217,12 +244,11 @@ def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, lis
                 else:
                     err(where.get((tname, key), tline), f"{label}unknown key `{key}` (known: {known})")
         out[tname] = vals
-    return out, [f"{path}:{line}: {msg}" for line, msg in sorted(errors, key=lambda e: e[0])]
+    return out, [f"{_at(path, line)}: {msg}" for line, msg in sorted(errors, key=lambda e: e[0])]
 
 
-def load(path: str, schema: Schema) -> tuple[dict, dict]:
-    """Reads and checks a parameters file; (values, locations). ParamsError
-    with every located error."""
+def read(path: str) -> tuple[dict, str]:
+    """A parameters file's TOML and text; ParamsError located in it."""
     try:
         raw = read_input(path)
     except FileNotFoundError:
@@ -248,7 +274,67 @@ def load(path: str, schema: Schema) -> tuple[dict, dict]:
         digits = sum(ch.isdigit() for ch in m.group())
         raise ParamsError([f"{path}:{line}:{col}: an integer of {digits:,} digits: far beyond any parameter "
                            "(write a number in the physical range, e.g. 1e3)"]) from None
-    where = locate(text)
+    return data, text
+
+
+MAX_EXTENDS = 8  # files in one chain of `extends`
+
+
+def resolve(path: str, schema: Schema | None = None, _chain: tuple[str, ...] = ()) -> tuple[dict, dict]:
+    """A parameters file with its `extends` chain merged: (data, where),
+    where's lines of the base files `Line`s naming their file. `schema`
+    gives the tables' alternatives (None: none). ParamsError located at the
+    `extends` key for a base that cannot be read, a cycle, a chain too long."""
+    data, text = read(path)
+    where: dict = locate(text)
+    if "extends" not in data:
+        return data, where
+    base_rel = data.pop("extends")
+    line = where.get(("", "extends"), 1)
+    here = f"{_at(path, line)}: extends"
+    if not isinstance(base_rel, str) or not base_rel:
+        raise ParamsError([f"{here}: expected the path of another parameters file (\"../hpr/plant.toml\"), "
+                           f"found {_kind_of(base_rel)} {_show(base_rel)}"])
+    base = os.path.normpath(os.path.join(os.path.dirname(path), base_rel))
+    chain = _chain + (os.path.realpath(path),)
+    if os.path.realpath(base) in chain:
+        raise ParamsError([f"{here}: {base} extends, in the end, this file again (a cycle)"])
+    if len(chain) >= MAX_EXTENDS:
+        raise ParamsError([f"{here}: more than {MAX_EXTENDS} files in one chain of `extends`"])
+    if not os.path.isfile(base):
+        raise ParamsError([f"{here}: no such file {base}"])
+    bdata, bwhere = resolve(base, schema, chain)
+    out = dict(bdata)
+    loc = {k: (v if isinstance(v, Line) else Line(v, base)) for k, v in bwhere.items()}
+    for tname, tval in data.items():
+        table = (schema or {}).get(tname)
+        if isinstance(tval, dict) and isinstance(out.get(tname), dict):
+            merged = dict(out[tname])
+            for group in (table.alternatives if table else ()):
+                others = [k for k in group if k in tval]
+                if others:
+                    for g in table.alternatives:
+                        if g is not group:
+                            for k in g:
+                                if k not in tval:
+                                    merged.pop(k, None)
+                                    loc.pop((tname, k), None)
+            merged.update(tval)
+            out[tname] = merged
+        else:
+            out[tname] = tval
+            for k in [k for k in loc if k[0] == tname and k[1]]:
+                del loc[k]
+    for k, v in where.items():
+        if k[1] or k not in loc or k[0] in data:
+            loc[k] = v
+    return out, loc
+
+
+def load(path: str, schema: Schema) -> tuple[dict, dict]:
+    """Reads and checks a parameters file (its `extends` chain merged);
+    (values, locations). ParamsError with every located error."""
+    data, where = resolve(path, schema)
     values, errors = check(data, schema, where, path)
     if errors:
         raise ParamsError(errors)
@@ -260,4 +346,4 @@ def error_at(path: str, where: dict, table: str, key: str, msg: str) -> str:
     check across files (a pin the project does not have, ...)."""
     line = where.get((table, key)) or where.get((table, ""), 1)
     label = f"[{table}] {key}" if table else key
-    return f"{path}:{line}: {label}: {msg}"
+    return f"{_at(path, line)}: {label}: {msg}"

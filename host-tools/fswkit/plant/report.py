@@ -64,6 +64,10 @@ def _interp(run: Run, name: str, t: float) -> float:
 
 def _run_lines(run: Run, sc, what: str) -> list[str]:
     fault = f"fault {sc.fault}" if sc.fault else "no fault"
+    if not sc.fault and getattr(sc, "part_fail_plan", None):  # plant.toml's [scenario] part_fail
+        from fswkit.sim.sensors import part_name
+
+        fault = ", ".join(f"part {part_name(part)} {mode} at {t:g} s" for t, part, mode in sc.part_fail_plan)
     speed = run.sim_s / run.wall_s if run.wall_s else float("inf")
     return [f"{what}: seed {sc.seed}, {fault}; {run.sim_s:.3f} s simulated in {run.wall_s:.1f} s wall "
             f"({run.steps:,} plant steps at {sc.rate} Hz, {run.round_trips:,} round trips, {speed:.2f}× real time)"]
@@ -84,6 +88,15 @@ def _tail_lines(run: Run) -> list[str]:
                f"late cycles {h.get('late', '?')}")
     for p in h.get("pyro", ()):  # what the last health frame said of each charge
         out.append(f"pyro {p['name']} (last health frame): {p['words']}")
+    for t, name, mode in getattr(run, "part_failures", ()):  # what the plant did to a digital part
+        what = "stops answering (nack)" if mode == "nack" else "results stuck" if mode == "stuck" else mode
+        out.append(f"sensor {name}: failed at {t:.3f} s simulated: {what}")
+    for p in h.get("sensors", ()):  # what the last health frame said of each digital part, and the others
+        line = f"sensor {p['name']} (last health frame): {p['words']}"
+        frames, faulty, first = run.part_health.get(p["name"], (0, 0, None))
+        if faulty:
+            line += f"; a fault in {faulty} of {frames} health frames, the first arriving at {first:.3f} s"
+        out.append(line)
     if h.get("tasks"):
         worst = max(h["tasks"], key=lambda x: x["worst_us"])
         out.append(f"executor: overruns {sum(x['overruns'] for x in h['tasks'])}, "
@@ -93,6 +106,20 @@ def _tail_lines(run: Run) -> list[str]:
     else:
         out.append("RAM: not measured (this SimBoard has no RAM probe)")
     return out
+
+
+def _baro_lost(sc, run: Run) -> bool:
+    """Whether the barometer part failed (nack or stuck) before the true
+    apogee: the flight is then checked as with a stuck barometer (the drogue
+    by the backup timer)."""
+    part = getattr(sc, "baro_part", None)
+    if part is None:
+        return False
+    from fswkit.sim.sensors import part_name
+
+    apogee = sc.rocket.apogee_t
+    return any(name == part_name(part) and (apogee is None or t <= apogee)
+               for t, name, _mode in getattr(run, "part_failures", ()))
 
 
 def _ram(v) -> str:
@@ -220,7 +247,7 @@ def rocket(run: Run, sc) -> Report:
                                 f"{fw['armed_state']})", not armed, f"armed {when}" if armed else "never armed"))
         else:
             checks.append(Check(f"the vehicle was armed (state {fw['armed_state']})", armed, when))
-    elif sc.fault == "stuck-baro":
+    elif sc.fault == "stuck-baro" or _baro_lost(sc, run):
         if not drogue or r.liftoff is None or sc.backup_s is None:
             checks.append(Check("drogue fired by the backup timer", False,
                                 "the drogue never fired" if not drogue else "no liftoff"))

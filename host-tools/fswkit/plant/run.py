@@ -23,7 +23,7 @@ from fswkit.outputs import Stopped, stopped_by_signals
 from . import report as reports
 from .cosim import Run, fly
 from .params import ParamsError
-from .scenario import FAULTS, PLANTS
+from .scenario import PLANTS, parse_fault
 from .scenario import load as load_scenario
 
 FILES = {"log": "telemetry.log", "csv": "flight.csv", "png": "flight.png", "record": "record.log",
@@ -59,8 +59,11 @@ def prepare(project: str, plant: str, *, params: str | None = None, seed: int = 
 
     if plant not in PLANTS:
         raise SetupError(f"--plant {plant}: one of {', '.join(PLANTS)}")
-    if fault is not None and fault not in FAULTS:
-        raise SetupError(f"--fault {fault}: one of {', '.join(FAULTS)}")
+    if fault is not None:
+        try:
+            parse_fault(fault)
+        except ValueError as e:
+            raise SetupError(str(e)) from None
     diags = Diagnostics()
     try:
         app = load(project, diags, board)

@@ -7,7 +7,8 @@ the telemetry elements, the pins of the .dio/.aio — and returns the
 scenario; every problem is a located ParamsError.
 
 The cosim loop calls `inputs(t)` (sensor volts by analog pin, levels of the
-digital inputs the scenario drives), `advance(t0, t1, edges)` (integrate
+digital inputs the scenario drives; and `part_values`, the physical values
+of the digital parts it feeds: `parts`, failing as `part_fail_plan` says), `advance(t0, t1, edges)` (integrate
 the step with the watched pins' edges; returns PinEvents), `record()` (a
 truth row) and `done(t, state)`.
 """
@@ -20,6 +21,9 @@ from fswkit.autocode import model as M
 from fswkit.autocode.evaluate import NotConstant, local_values
 from fswkit.autocode.numeric import REALS
 
+from fswkit.sim.sensors import ACCELEROMETERS, AXES, BAROMETERS, find_part
+
+from . import atmosphere
 from .atmosphere import G0
 from .cosim import PinEvent
 from .params import Field as F
@@ -42,6 +46,33 @@ FAULTS = {
 }
 # Faults that keep the vehicle on the pad, armed by its key until hold_s, the motor never lit.
 PAD_FAULTS = ("pinned-accel", "pinned-baro", "open-igniter")
+# Failures of a digital part (plant.toml's [barometer] / [accelerometer] `part`), written
+# `--fault baro-nack@12.5`: at a simulated second, or at ignition without `@T`.
+PART_FAULTS = {
+    "baro-nack": "the barometer part stops answering on its bus (no ACK; on SPI, MISO reads 0xFF)",
+    "baro-stuck": "the barometer part's results stop changing (its conversions still end)",
+    "accel-nack": "the accelerometer part stops answering on its bus",
+    "accel-stuck": "the accelerometer part's results stop changing",
+}
+
+
+def parse_fault(text: str) -> tuple[str, float | None]:
+    """(fault, second or None) of a `--fault` value; ValueError with the reason."""
+    name, at, when = text.partition("@")
+    if name in FAULTS and not at:
+        return name, None
+    if name not in PART_FAULTS:
+        raise ValueError(f"--fault {text}: one of {', '.join(FAULTS)}, or a digital part's failure "
+                         f"{', '.join(k + '[@SECONDS]' for k in PART_FAULTS)}")
+    if not at:
+        return name, None
+    try:
+        t = float(when)
+    except ValueError:
+        t = float("nan")
+    if not 0 <= t <= 3600:
+        raise ValueError(f"--fault {text}: `@{when}` must be a simulated second from 0 to 3600 (baro-nack@12.5)")
+    return name, t
 
 # ---- parameter schemas ------------------------------------------------------------------
 
@@ -98,18 +129,26 @@ ROCKET_SCHEMA = {
     "atmosphere": Table("the standard atmosphere", {
         "pad_altitude_m": F("float", "the pad's altitude above sea level, m", lo=-400, hi=8000),
     }),
-    "barometer": Table("the analog barometer", {
-        "channel": F("pin", "the analog input it drives, e.g. \"A0\""),
-        "pa_per_volt": F("float", "its slope, Pa per volt", lo=1, hi=1e7),
-        "pa_at_0v": F("float", "the pressure that would read 0 V, Pa", lo=-1e7, hi=1e7),
+    "barometer": Table("the barometer: an analog sensor on an input (channel) or a digital part (part)", {
+        "channel": F("pin", "the analog input it drives, e.g. \"A0\"", required=False),
+        "pa_per_volt": F("float", "with channel: its slope, Pa per volt", lo=1, hi=1e7, required=False),
+        "pa_at_0v": F("float", "with channel: the pressure that would read 0 V, Pa", lo=-1e7, hi=1e7,
+                      required=False),
+        "part": F("str", "a barometer of the project's sensor tables whose raw counts the plant sets: "
+                  "\"bmp280@0x76\", or \"bmp280\" when the project has one", required=False),
         "noise_pa": F("float", "Gaussian noise, standard deviation in Pa", lo=0, hi=1e5),
-    }),
-    "accelerometer": Table("the analog accelerometer on the vehicle's axis", {
-        "channel": F("pin", "the analog input it drives, e.g. \"A1\""),
-        "volts_per_g": F("float", "its slope, V per g", lo=1e-4, hi=100),
-        "zero_g_volts": F("float", "its output at 0 g, V", lo=0, hi=5),
+    }, alternatives=(("channel", "pa_per_volt", "pa_at_0v"), ("part",))),
+    "accelerometer": Table("the accelerometer on the vehicle's axis: analog (channel) or a digital part (part)", {
+        "channel": F("pin", "the analog input it drives, e.g. \"A1\"", required=False),
+        "volts_per_g": F("float", "with channel: its slope, V per g", lo=1e-4, hi=100, required=False),
+        "zero_g_volts": F("float", "with channel: its output at 0 g, V", lo=0, hi=5, required=False),
+        "part": F("str", "an accelerometer of the project's sensor tables whose raw counts the plant sets: "
+                  "\"adxl345@0x53\", \"adxl345@spi:7\", or \"adxl345\" when the project has one",
+                  required=False),
+        "axis": F("str", "with part: the part's axis along the vehicle's (x, y, z; \"-z\" when it points down); "
+                  "the other two read 0 g", required=False),
         "noise_g": F("float", "Gaussian noise, standard deviation in g", lo=0, hi=100),
-    }),
+    }, alternatives=(("channel", "volts_per_g", "zero_g_volts"), ("part", "axis"))),
     "pins": Table("the flight computer's digital pins the plant uses", {
         "arm": F("int", "the arming switch (a digital input the scenario drives: high = armed)", lo=0, hi=255),
         "drogue": F("int", "the drogue's pyro channel (a digital output)", lo=0, hi=255),
@@ -124,6 +163,11 @@ ROCKET_SCHEMA = {
                               lo=0, hi=600),
         "hold_s": F("float", "pinned-sensor and open-igniter faults: the vehicle sits on the pad with its arming "
                     "key on until this second", default=20.0, above=0, hi=3600),
+        "part_fail": F("str", "a digital part that fails mid-flight: \"bmp280@0x76\" (one of the project's "
+                       "sensor tables'; absent: none)", required=False),
+        "part_fail_s": F("float", "with part_fail: the simulated second it fails at", lo=0, hi=3600, required=False),
+        "part_fail_mode": F("str", "with part_fail: \"nack\" (it stops answering) or \"stuck\" (its results stop "
+                            "changing)", default="nack"),
         **_RESET,
     }),
     "firmware": Table("where the plant and the checks find things in the project", {
@@ -363,6 +407,65 @@ def _bind_reset(sc, bind: _Binder, m, sc_table: dict) -> None:
                  + ", ".join(RESET_CAUSES) + ")")
 
 
+SENSOR_KINDS = BAROMETERS + ACCELEROMETERS
+
+
+def _sensor(bind: _Binder, t: dict, role: str, transfer: tuple[str, str], kinds: tuple[str, ...]):
+    """[barometer] / [accelerometer]: (the project's analog channel, None)
+    or (None, the project's digital part), checked: one of channel and
+    part, an analog sensor's transfer function, a part of the project's
+    sensor tables of a kind that measures this. `t`: the table's values."""
+    if t["channel"] is not None and t["part"] is not None:
+        bind.err(role, "part", "an analog `channel` or a digital `part`, not both")
+        return None, None
+    if t["part"] is not None:
+        for key in transfer:
+            if t[key] is not None:
+                bind.err(role, key, "belongs to an analog `channel`; this sensor is a digital `part`")
+        part, why = find_part(getattr(bind.app, "sensors", ()) or (), t["part"], kinds)
+        if part is None:
+            bind.err(role, "part", why)
+        return None, part
+    if t["channel"] is None:
+        bind.err(role, "", f"missing: channel (the analog input it drives, with {' and '.join(transfer)}) or part "
+                 f"(a digital {role} of the project's sensor tables, \"{kinds[0]}@...\")")
+        return None, None
+    for key in transfer:
+        if t[key] is None:
+            bind.err(role, key, f"missing (with channel: {_transfer_doc(role, key)})")
+    return bind.channel(role, "channel", t["channel"], True, "i"), None
+
+
+def _transfer_doc(role: str, key: str) -> str:
+    return ROCKET_SCHEMA[role].fields[key].doc.removeprefix("with channel: ")
+
+
+def _axis(bind: _Binder, t: dict, part) -> tuple[str, float]:
+    """[accelerometer] axis: (x|y|z, +1 or -1); "z" by default."""
+    axis = t["axis"]
+    if axis is None:
+        return "z", 1.0
+    if part is None and t["channel"] is not None:
+        bind.err("accelerometer", "axis", "belongs to a digital `part`; an analog accelerometer has one axis")
+    a = axis.strip().lower()
+    sign = -1.0 if a.startswith("-") else 1.0
+    a = a.lstrip("+-")
+    if a not in AXES:
+        bind.err("accelerometer", "axis", f"\"{axis}\": one of x, y, z (\"-z\": the axis points down)")
+        return "z", 1.0
+    return a, sign
+
+
+def _output(part, quantity: str) -> str | None:
+    """The element a part's quantity goes to (`z=accel` or `-z=accel`), or None."""
+    if part is None:
+        return None
+    for q, el in part.outputs:
+        if q.lstrip("-") == quantity:
+            return el.name
+    return None
+
+
 def load(kind: str, path: str, app, layout, seed: int, fault: str | None):
     """The scenario of a parameters file, checked against the project."""
     if kind not in SCHEMAS:
@@ -445,10 +548,14 @@ class RocketScenario:
         self.main_alt = bind.local(m, "main_altitude", fw["main_altitude"])
         backup = bind.local(m, "apogee_backup", fw["apogee_backup"])
         self.backup_s = None if backup is None else backup * _time_unit_s(bind.app)
-        baro = bind.channel("barometer", "channel", p["barometer"]["channel"], True, "i")
-        accel = bind.channel("accelerometer", "channel", p["accelerometer"]["channel"], True, "i")
-        self.accel_element = accel.element.name if accel is not None else None
-        self.baro_element = baro.element.name if baro is not None else None
+        baro, self.baro_part = _sensor(bind, p["barometer"], "barometer", ("pa_per_volt", "pa_at_0v"), BAROMETERS)
+        accel, self.accel_part = _sensor(bind, p["accelerometer"], "accelerometer", ("volts_per_g", "zero_g_volts"),
+                                         ACCELEROMETERS)
+        self.accel_axis = _axis(bind, p["accelerometer"], self.accel_part)
+        self.accel_element = accel.element.name if accel is not None else _output(self.accel_part,
+                                                                                  self.accel_axis[0])
+        self.baro_element = baro.element.name if baro is not None else _output(self.baro_part, "pressure")
+        self._part_faults(bind, fault, sc)
         if baro is not None and accel is not None and baro.pin_number == accel.pin_number:
             bind.err("accelerometer", "channel", "the barometer and the accelerometer must drive two different "
                      f"analog inputs (both name pin {baro.pin})")
@@ -493,8 +600,15 @@ class RocketScenario:
         self.baro_noise = Noise(baro_rng, p["barometer"]["noise_pa"])
         self.accel_noise = Noise(accel_rng, p["accelerometer"]["noise_g"])
         # the ADC channels by the names the I/O tables give them, whatever form plant.toml used
+        # (None: that sensor is a digital part)
         self.channels = (baro.pin if baro is not None else p["barometer"]["channel"],
                          accel.pin if accel is not None else p["accelerometer"]["channel"])
+        self.parts = tuple(x for x in (self.baro_part, self.accel_part) if x is not None)
+        if self.baro_part is not None or self.accel_part is not None:  # what the parts were fed, physical units
+            self.columns = tuple({"baro_v": "baro_pa" if self.baro_part is not None else "baro_v",
+                                  "accel_v": "accel_g" if self.accel_part is not None else "accel_v"}.get(c, c)
+                                 for c in self.columns)
+        self.part_values: dict = {}  # part -> {quantity: value} of the last inputs(t)
         self.ignition_s = None if fault in PAD_FAULTS else sc["ignition_s"]
         self.max_s = sc["hold_s"] if self.ignition_s is None else sc["max_s"]
         self.frozen_baro: float | None = None
@@ -535,30 +649,83 @@ class RocketScenario:
         return out
 
     # -- sensors --
-    def _baro_volts(self) -> float:
-        b = self.p["barometer"]
-        return (self.rocket.static_pressure() + self.baro_noise() - b["pa_at_0v"]) / b["pa_per_volt"]
-
-    def _accel_volts(self) -> float:
-        a = self.p["accelerometer"]
-        g = self.rocket.specific_force() / G0 + self.accel_noise()
-        return a["zero_g_volts"] + g * a["volts_per_g"]
+    def _part_faults(self, bind: _Binder, fault: str | None, sc: dict) -> None:
+        """`part_fail_plan`: [(simulated second, part, "nack" | "stuck")] from
+        --fault (baro-nack@T ...; stuck-baro on a barometer part: stuck at
+        ignition) and [scenario] part_fail; errors for faults of an analog
+        sensor asked of a part and the reverse."""
+        self.part_fail_plan: list = []
+        try:
+            name, at = (None, None) if fault is None else parse_fault(fault)
+        except ValueError as e:
+            raise ParamsError([str(e)]) from None
+        parts = {"barometer": self.baro_part, "accelerometer": self.accel_part}
+        if name in ("pinned-baro", "pinned-accel"):
+            role = "barometer" if name == "pinned-baro" else "accelerometer"
+            if parts[role] is not None:
+                bind.err(role, "part", f"--fault {name} pins an analog sensor's output at full scale; this "
+                         f"{role} is a digital part: its failures are {role[:5]}-nack and {role[:5]}-stuck")
+        if name in PART_FAULTS:
+            role = "barometer" if name.startswith("baro") else "accelerometer"
+            if parts[role] is None:
+                bind.err(role, "channel", f"--fault {fault} fails a digital part; this {role} is analog "
+                         f"(set [{role}] part to one of the project's sensor tables' parts)")
+            else:
+                when = at if at is not None else sc["ignition_s"]
+                self.part_fail_plan.append((when, parts[role], name.split("-")[1]))
+        if name == "stuck-baro" and self.baro_part is not None:
+            self.part_fail_plan.append((sc["ignition_s"], self.baro_part, "stuck"))
+        if sc["part_fail"] is not None:
+            part, why = find_part(getattr(bind.app, "sensors", ()) or (), sc["part_fail"], SENSOR_KINDS)
+            if part is None:
+                bind.err("scenario", "part_fail", why)
+            if sc["part_fail_s"] is None:
+                bind.err("scenario", "part_fail_s", "missing: the simulated second the part fails at")
+            if sc["part_fail_mode"] not in ("nack", "stuck"):
+                bind.err("scenario", "part_fail_mode", f"\"{sc['part_fail_mode']}\": one of \"nack\", \"stuck\"")
+            elif part is not None and sc["part_fail_s"] is not None:
+                self.part_fail_plan.append((sc["part_fail_s"], part, sc["part_fail_mode"]))
+        else:
+            for key in ("part_fail_s", "part_fail_mode"):
+                if ("scenario", key) in bind.where:
+                    bind.err("scenario", key, "needs part_fail (the part that fails)")
+        self.part_fail_plan.sort(key=lambda f: f[0])
 
     def inputs(self, t: float):
-        baro = self._baro_volts()
-        accel = self._accel_volts()
+        pa = self.rocket.static_pressure() + self.baro_noise()
+        g = self.rocket.specific_force() / G0 + self.accel_noise()
+        self.part_values = {}
+        if self.baro_part is not None:
+            h = self.rocket.pad_altitude + self.rocket.h
+            self.part_values[self.baro_part] = {"pressure": pa, "temperature": atmosphere.temperature(h) - 273.15}
+            self.baro_v = pa
+            baro = None
+        else:
+            b = self.p["barometer"]
+            baro = (pa - b["pa_at_0v"]) / b["pa_per_volt"]
+        if self.accel_part is not None:
+            axis, sign = self.accel_axis
+            self.part_values[self.accel_part] = {axis: sign * g}
+            self.accel_v = g
+            accel = None
+        else:
+            a = self.p["accelerometer"]
+            accel = a["zero_g_volts"] + g * a["volts_per_g"]
         if self.fault == "pinned-baro":
             baro = self.vref
         elif self.fault == "pinned-accel":
             accel = self.vref
-        elif self.fault == "stuck-baro" and self.ignition_s is not None and t >= self.ignition_s:
+        elif (self.fault == "stuck-baro" and baro is not None and self.ignition_s is not None
+              and t >= self.ignition_s):
             if self.frozen_baro is None:
                 self.frozen_baro = baro
             baro = self.frozen_baro
-        self.baro_v = min(max(baro, 0.0), self.vref)
-        self.accel_v = min(max(accel, 0.0), self.vref)
+        analog = {}
+        if baro is not None:
+            self.baro_v = analog[self.channels[0]] = min(max(baro, 0.0), self.vref)
+        if accel is not None:
+            self.accel_v = analog[self.channels[1]] = min(max(accel, 0.0), self.vref)
         self.arm = t >= self.p["scenario"]["arm_s"]
-        analog = {self.channels[0]: self.baro_v, self.channels[1]: self.accel_v}
         for role, ig in self.igniters.items():
             v = self.cont_v[role] = min(max(ig.volts(t), 0.0), self.vref)
             analog[ig.channel] = v

@@ -96,7 +96,61 @@ def analog_inputs(cfg, columns: dict) -> tuple[dict, dict]:
         counts = counts_series(columns[col], s, cfg.missing, cfg.silent_volts)
         series[s.element] = [_reading(s, k) for k in counts.tolist()]
     constant = {ig.sensor.element: _reading(ig.sensor, ig.counts) for ig in getattr(cfg, "igniters", {}).values()}
+    series.update(part_inputs(cfg, columns))
     return series, constant
+
+
+def part_inputs(cfg, columns: dict) -> dict:
+    """What the machines read from the digital parts the replay feeds
+    (`Config.parts`): element -> value at each tape row, each the part's
+    counts for the row (PartFeed, with the calibration the simulated part
+    starts with: the datasheet's example) through the driver's conversion
+    in binary32 — pressure (Pa), temperature (°C), an axis (g), negated for
+    a `-z=` output. The board's replay also redraws a held value's lowest
+    bit (tape_replay._part_changes); that dither is left out here."""
+    from fswkit.sim import parts as P
+    from fswkit.sim.sensors import PartFeed
+
+    f32 = _f32
+    out: dict = {}
+    for col, tp in getattr(cfg, "parts", {}).items():
+        sensor = tp.sensor
+        cal = {"bmp280": P.bmp280_calib_bytes(P.BMP280_EXAMPLE[0]),
+               "ms5611": b"".join(w.to_bytes(2, "big") for w in P.ms5611_prom_words(P.MS5611_EXAMPLE[0]))
+               }.get(sensor.part, b"\0" * 4)
+        feed = PartFeed(sensor, 0, cal)
+        values = np.asarray(columns[col], dtype=float)
+        have = ~np.isnan(values)
+        if not have.any():
+            continue
+        rows: dict = {}
+        last = float(values[have][0])
+        for v in values.tolist():
+            last = v if v == v else last
+            raw = feed.raw(**tp.values(last))
+            if sensor.part == "bmp280":
+                t_centi, t_fine = P.bmp280_compensate_T(feed.calib, raw["adc_T"])
+                got = {"pressure": P.bmp280_compensate_P64(feed.calib, raw["adc_P"], t_fine) / 256.0,
+                       "temperature": t_centi / 100.0}
+            elif sensor.part == "ms5611":
+                r = P.ms5611_compensate(feed.calib, raw["D1"], raw["D2"], True)
+                got = {"pressure": float(r.P), "temperature": r.TEMP / 100.0}
+            elif sensor.part == "adxl345":
+                per = P.adxl345_g_per_count(feed.data_format)
+                got = {q: raw[q] * per for q in "xyz"}
+            else:
+                per = P.mpu6050_g_per_count({2: 0, 4: 1, 8: 2, 16: 3}[feed.settings.get("range", 16)])
+                got = {q: raw["a" + q] * per for q in "xyz"}
+            for q, el in sensor.outputs:
+                x = got.get(q.lstrip("-"))
+                if x is not None:
+                    rows.setdefault(el.name, []).append(f32(-x if q.startswith("-") else x))
+        out.update(rows)
+    return out
+
+
+def _f32(x: float) -> float:
+    return float(np.float32(x))
 
 
 def _mission(app, cfg):

@@ -42,7 +42,6 @@ import math
 import os
 import statistics
 import time
-import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -51,14 +50,18 @@ from fswkit.link.layout import Layout
 from fswkit.link.log import LogWriter
 from fswkit.progress import progress
 from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
-from fswkit.sim.sensors import AnalogSensor, from_channel
+from fswkit.autocode.model import SENSOR_PARTS
+from fswkit.sim.sensors import (ACCELEROMETERS, AXES, BAROMETERS, AnalogSensor, PartFeed, board_parts, find_part,
+                                from_channel, part_name)
 
+from . import atmosphere
 from . import report as reports
 from .cosim import CosimError, PinEvent, Run, Telemetry, _nor, _one_cpu, nor_image, stop_words
 from .params import Field as F
-from .params import ParamsError, Table, locate
+from .params import ParamsError, Table, _at
 from .params import load as load_params
-from .scenario import _Binder
+from .params import resolve as resolve_params
+from .scenario import ROCKET_SCHEMA, _Binder
 
 TAPE_COLUMNS = ("pressure_pa", "accel_g")  # the sensor columns of tape v1
 RECORD_HZ = 100  # CSV rows per second of tape time
@@ -69,8 +72,11 @@ _UNSET = ""  # an optional string/pin key not given
 TAPE_SCHEMA = {
     "tape": Table("the tape's columns and the replay's timeline", {
         "pressure_pa": F("pin", "the analog input the tape's pressure_pa feeds, as the .aio names it (\"A0\"), "
-                         "or \"none\"", default=_UNSET),
-        "accel_g": F("pin", "the analog input the tape's accel_g feeds, or \"none\"", default=_UNSET),
+                         "a barometer part of the sensor tables (\"bmp280@0x76\"), or \"none\"", default=_UNSET),
+        "accel_g": F("pin", "the analog input the tape's accel_g feeds, an accelerometer part (\"adxl345@0x53\"), "
+                     "or \"none\"", default=_UNSET),
+        "accel_axis": F("str", "with an accelerometer part: its axis along the vehicle's (x, y, z, \"-z\")",
+                        default="z"),
         "missing": F("str", "an empty cell: \"hold\" the sensor's last value, or \"silent\": it outputs "
                      "silent_volts", default="hold"),
         "silent_volts": F("float", "a silent sensor's output, V", default=0.0, lo=0, hi=100),
@@ -202,6 +208,31 @@ class Config:
     igniters: dict = field(default_factory=dict)  # role -> TapeIgniter (driven continuity inputs)
     eeprom: bytes | None = None  # the EEPROM programmed before boot (fsw sim --fw-params)
     nor: tuple | None = None  # (recorder plan, SimBoard spi_flash) of a recorder on an SPI NOR flash
+    parts: dict = field(default_factory=dict)  # column -> TapePart (a digital part the column feeds)
+    app_sensors: tuple = ()  # every part of the project's sensor tables: all are on the simulated board
+
+
+@dataclass(frozen=True)
+class TapePart:
+    """A digital part a tape column feeds: the project's sensor part and the
+    quantity the column's values become (pressure, or an axis with its sign;
+    the other axes read 0 g)."""
+
+    sensor: object  # autocode's Sensor
+    quantity: str  # "pressure", "x", "y", "z"
+    sign: float = 1.0
+
+    @property
+    def name(self) -> str:
+        return part_name(self.sensor)
+
+    def values(self, v: float) -> dict:
+        """PartFeed.raw's arguments for a tape value: a pressure's
+        temperature is the ISA temperature at its pressure altitude."""
+        if self.quantity == "pressure":
+            h = atmosphere.altitude(max(v, 1.0))  # (a pressure at or below 0: the model's top)
+            return {"pressure": v, "temperature": atmosphere.temperature(h) - 273.15}
+        return {self.quantity: self.sign * v}
 
 
 class _Origins(_Binder):
@@ -221,13 +252,16 @@ def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
     """Keys of plant.toml a tape replay can take as defaults (read without
     its schema: a tank's file has none of them); (values, origins)."""
     path = os.path.join(project_dir, "plant.toml")
-    try:
-        with open(path, "rb") as f:
-            text = f.read().decode("utf-8")
-        data = tomllib.loads(text)
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, ValueError):
+    if not os.path.exists(path):
         return {}, {}
-    where = locate(text)
+    try:
+        data, where = resolve_params(path, ROCKET_SCHEMA)  # its `extends` chain merged
+    except ParamsError:
+        return {}, {}
+
+    def at(table, key):
+        line = where.get((table, key), 1)
+        return f"{getattr(line, 'path', path)}:{int(line)}"
     vals: dict = {}
     orig: dict = {}
 
@@ -235,10 +269,13 @@ def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
         t = data.get(src_t) if src_t else data
         if isinstance(t, dict) and src_k in t and isinstance(t[src_k], (str, int)) and not isinstance(t[src_k], bool):
             vals.setdefault(dst_t, {})[dst_k] = conv(t[src_k])
-            orig[(dst_t, dst_k)] = f"{path}:{where.get((src_t, src_k), 1)}"
+            orig[(dst_t, dst_k)] = at(src_t, src_k)
 
     take("barometer", "channel", "tape", "pressure_pa")
     take("accelerometer", "channel", "tape", "accel_g")
+    take("barometer", "part", "tape", "pressure_pa")  # a digital part instead of an analog input
+    take("accelerometer", "part", "tape", "accel_g")
+    take("accelerometer", "axis", "tape", "accel_axis")
     take("pins", "arm", "pins", "arm")
     take("pins", "drogue", "pins", "drogue")
     take("pins", "main", "pins", "main")
@@ -249,18 +286,18 @@ def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
     fw = data.get("firmware") if isinstance(data.get("firmware"), dict) else {}
     if isinstance(fw.get("main_altitude"), str) and isinstance(fw.get("machine"), str):
         vals.setdefault("firmware", {})["main_alt"] = f"{fw['machine']}.{fw['main_altitude']}"
-        orig[("firmware", "main_alt")] = f"{path}:{where.get(('firmware', 'main_altitude'), 1)}"
+        orig[("firmware", "main_alt")] = at("firmware", "main_altitude")
     sc = data.get("scenario")
     if isinstance(sc, dict) and isinstance(sc.get("arm_s"), (int, float)) and not isinstance(sc["arm_s"], bool):
         vals.setdefault("tape", {})["arm_s"] = float(sc["arm_s"])
-        orig[("tape", "arm_s")] = f"{path}:{where.get(('scenario', 'arm_s'), 1)}"
+        orig[("tape", "arm_s")] = at("scenario", "arm_s")
     for role in IGNITER_ROLES:  # the chutes' igniters; their volts each its own (`ROLE:intact_volts`)
         take(role, "continuity_channel", "igniters", f"{role}_channel")
         t = data.get(role)
         for k in ("intact_volts", "open_volts"):
             if isinstance(t, dict) and k in t and isinstance(t[k], (int, float, str)) and not isinstance(t[k], bool):
                 vals.setdefault("igniters", {})[f"{role}:{k}"] = t[k]
-                orig[("igniters", f"{role}:{k}")] = f"{path}:{where.get((role, k), 1)}"
+                orig[("igniters", f"{role}:{k}")] = at(role, k)
     return vals, orig
 
 
@@ -279,13 +316,12 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
             values, where = load_params(path, TAPE_SCHEMA)
         except ParamsError as e:
             raise ReplayError("\n".join(e.errors)) from None
-        with open(path, "rb") as f:
-            raw = tomllib.loads(f.read().decode("utf-8"))
+        raw, _ = resolve_params(path, TAPE_SCHEMA)
         for t in TAPE_SCHEMA:
-            origins[(t, "")] = f"{path}:{where.get((t, ''), 1)}"
+            origins[(t, "")] = _at(path, where.get((t, ''), 1))
             for k in (raw.get(t) or {}):
                 given[t][k] = values[t][k]
-                origins[(t, k)] = f"{path}:{where.get((t, k), 1)}"
+                origins[(t, k)] = _at(path, where.get((t, k), 1))
     else:
         for t in TAPE_SCHEMA:
             origins.setdefault((t, ""), os.path.join(project_dir, "tape.toml (absent)"))
@@ -301,6 +337,7 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
     if not 0 <= tp["silent_volts"] <= app.board.adc_vref:
         bind.err("tape", "silent_volts", f"{tp['silent_volts']:g} V is beyond the converter's 0..{app.board.adc_vref:g} V")
     sensors: dict = {}
+    parts: dict = {}
     used: dict = {}
     for col in TAPE_COLUMNS:
         pin = tp[col]
@@ -308,6 +345,22 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
             continue  # checked against the tape's columns later
         if str(pin).lower() == "none":
             sensors[col] = None
+            continue
+        if isinstance(pin, str) and (pin.split("@")[0].strip().lower() in SENSOR_PARTS or "@" in pin):
+            kinds = BAROMETERS if col == "pressure_pa" else ACCELEROMETERS
+            part, why = find_part(getattr(app, "sensors", ()) or (), pin, kinds)
+            if part is None:
+                bind.err("tape", col, why)
+                continue
+            axis = ("pressure", 1.0)
+            if col == "accel_g":
+                a = str(tp["accel_axis"]).strip().lower()
+                if a.lstrip("+-") not in AXES:
+                    bind.err("tape", "accel_axis", f"\"{tp['accel_axis']}\": one of x, y, z (\"-z\": the axis "
+                             "points down)")
+                    continue
+                axis = (a.lstrip("+-"), -1.0 if a.startswith("-") else 1.0)
+            parts[col] = TapePart(part, *axis)
             continue
         ch = bind.channel("tape", col, pin, True, "i")
         if ch is None:
@@ -364,10 +417,16 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
     if bind.errors:
         raise ReplayError("\n".join(bind.errors))
     accel = sensors.get("accel_g")
+    accel_element = accel.element if accel is not None else None
+    if "accel_g" in parts:
+        tpart = parts["accel_g"]
+        accel_element = next((el.name for q, el in tpart.sensor.outputs if q.lstrip("-") == tpart.quantity), None)
     cfg = Config(path, sensors, tp["missing"], tp["silent_volts"], tp["pad_s"], tp["arm_s"], tp["run_on_s"],
                  pin_no["arm"], pin_no["drogue"], pin_no["main"], fw["state_element"],
                  None if fw["altitude_element"] == _UNSET else fw["altitude_element"],
-                 accel.element if accel is not None else None, states, main_alt, main_name, dict(v["checks"]))
+                 accel_element, states, main_alt, main_name, dict(v["checks"]))
+    cfg.parts = parts
+    cfg.app_sensors = tuple(getattr(app, "sensors", ()) or ())
     cfg.nor = _nor(app, app.board)  # the flight recorder's SPI NOR chip, when it logs to one
     cfg.igniters = igniters
     cfg.notes += _continuity_notes(app, igniters)
@@ -478,7 +537,7 @@ def load_tape(path: str, cfg: Config):
     errors = []
     line = _column_line(path)
     for col in tape.columns_available():
-        if col not in cfg.sensors:
+        if col not in cfg.sensors and col not in cfg.parts:
             errors.append(f"{path}:{line}: column `{col}` has values but feeds no analog input of the project "
                           f"(name one in tape.toml, [tape] {col} = \"A0\", or {col} = \"none\" to leave it out)")
     for key in ("apogee_s", "burnout_s"):
@@ -613,9 +672,12 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     initial = {pin: series[0] / 1000.0 for pin, series in mv.items()}
     for ig in cfg.igniters.values():  # open loop: intact from reset to the end, never scheduled
         initial[ig.sensor.pin] = ig.millivolts / 1000.0
+    sensors = cfg.app_sensors or tuple(tp.sensor for tp in cfg.parts.values())
+    where = dict(zip(sensors, (w for _k, w in board_parts(sensors, board))))
     try:
         b = SimBoard(elf, board, uart="control", sim_limit=end_s + 1.0, wall_limit=wall_limit, analog=initial,
-                     eeprom=cfg.eeprom, spi_flash=cfg.nor[1] if cfg.nor else None)
+                     eeprom=cfg.eeprom, spi_flash=cfg.nor[1] if cfg.nor else None,
+                     parts=[(x.part, where[x]) for x in sensors] or None)
     except SimError as e:
         if log:
             log.close()
@@ -624,18 +686,29 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
     try:
         for pin in roles:
             b.watch(pin)
-        # every input change goes to the board at once: it applies each at its
-        # cycle itself, and the replay runs a simulated second per round trip
+        # every analog input change goes to the board at once: it applies each
+        # at its cycle itself, and the replay runs a simulated second per round
+        # trip; the digital parts' raw counts go in a `batch` at each change
         b.schedule([(c, *changes[c]) for c in stops])
+        part_changes = _part_changes(b, cfg, cols, cyc, end_cycle, where, counts)
+        part_stops = sorted(c for c in part_changes if 0 < c < end_cycle)
+        pending = part_changes.get(0, {})
         first = changes.get(0, ({}, {}))
         now = 0
+        j = 0
         while now < end_cycle:
             until = min(end_cycle, now + chunk)
+            if j < len(part_stops) and part_stops[j] < until:
+                until = part_stops[j]
             try:
-                step = b.batch(until, first[0], first[1])
+                step = b.batch(until, first[0], first[1], pending)
             except EdgeOverflow:
                 raise CosimError("the board recorded more pin edges than it keeps") from None
             first = ({}, {})
+            pending = {}
+            if j < len(part_stops) and part_stops[j] == until:
+                pending = part_changes[until]
+                j += 1
             run.round_trips += 1
             if step.run.stop != "target":
                 raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {now / f_cpu - offset:.3f} s tape time")
@@ -665,6 +738,60 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
             log.close()
     th = smoothed_altitude(tape, _pad(tape, truth))
     return Replay(run, offset, counts, {c: missing_spans(t, v) for c, v in _columns(tape).items()}, *th)
+
+
+PART_DITHER_S = 0.005  # a fed part's lowest count is redrawn this often (see _part_changes)
+
+
+def _part_changes(b: SimBoard, cfg: Config, cols: dict, cyc: list, end_cycle: int, where: dict,
+                  counts: dict) -> dict:
+    """The parts' raw counts by cycle, {cycle: {harness id: {name: counts}}},
+    only those that change; each column's main count per row (adc_P, D1, or
+    the axis's count) goes to `counts`. Each row's value is held until the
+    next row; an empty cell holds the last value (before the first value,
+    the first value's) whatever `missing` says: a part has no output volts
+    to go silent with.
+
+    A held value is not frozen: every PART_DITHER_S of simulated time the
+    main count's lowest bit is redrawn (a seeded draw, the same every
+    replay), as a real part's noise keeps its lowest bits moving, so that
+    the driver's stuck check (`stuck=N` identical conversions in a row) is
+    not set off by the tape's sample-and-hold, its pad time or its run-on."""
+    out: dict = {}
+    f_cpu = int(b.f_cpu)
+    step = max(1, int(round(PART_DITHER_S * f_cpu)))
+    grid = np.arange(0, end_cycle, step, dtype=np.int64)
+    rows = np.asarray(cyc, dtype=np.int64)
+    rng = np.random.Generator(np.random.PCG64(0x5EED))
+    for col, tp in cfg.parts.items():
+        w = where[tp.sensor]
+        feed = PartFeed(tp.sensor, w, b.part_calibration(w))
+        values = np.asarray(cols[col], dtype=float)
+        have = ~np.isnan(values)
+        if not have.any():
+            continue
+        main = {"bmp280": "adc_P", "ms5611": "D1"}.get(tp.sensor.part) or (
+            tp.quantity if tp.sensor.part == "adxl345" else "a" + tp.quantity)
+        per_row = []
+        last_v = float(values[have][0])
+        for v in values.tolist():
+            if v == v:
+                last_v = v
+            per_row.append(feed.raw(**tp.values(last_v)))
+        counts[col] = np.array([r[main] for r in per_row], dtype=np.int64)
+        # the instants a value is set: each row's (the first from reset) and the dither's grid
+        points = np.union1d(grid, rows[1:][(rows[1:] > 0) & (rows[1:] < end_cycle)])
+        row_at = np.clip(np.searchsorted(rows, points, side="right") - 1, 0, len(per_row) - 1)
+        bits = rng.integers(0, 2, points.size).tolist()
+        last: dict = {}
+        for c, r, bit in zip(points.tolist(), row_at.tolist(), bits):
+            raw = dict(per_row[r])
+            raw[main] ^= bit
+            changed = {n: x for n, x in raw.items() if last.get(n) != x}
+            if changed:
+                last = raw
+                out.setdefault(c, {}).setdefault(w, {}).update(changed)
+    return out
 
 
 def _pad(tape, truth) -> float:
@@ -842,6 +969,12 @@ def summary(rp: Replay, cfg: Config, tape, truth, checks, notes, label: str) -> 
              f"arm at {cfg.arm_s:g} s" + ("" if cfg.arm_pin is not None else " (no arming pin)")]
     for col in TAPE_COLUMNS:
         s = cfg.sensors.get(col)
+        tp = cfg.parts.get(col)
+        if tp is not None:
+            q = tp.quantity if tp.quantity == "pressure" else ("-" if tp.sign < 0 else "") + tp.quantity
+            lines.append(f"sensor {col} → part {tp.name} ({q}): raw counts through the datasheet's inverse with "
+                         "the part's calibration")
+            continue
         if s is None:
             lines.append(f"sensor {col}: feeds no input")
             continue
@@ -855,10 +988,11 @@ def summary(rp: Replay, cfg: Config, tape, truth, checks, notes, label: str) -> 
     for col, spans in rp.missing.items():
         if not spans:
             continue
-        how = "held at the last value" if cfg.missing == "hold" else f"sensor silent at {cfg.silent_volts:g} V"
+        how = ("held at the last value" if cfg.missing == "hold" or col in cfg.parts
+               else f"sensor silent at {cfg.silent_volts:g} V")
         shown = ", ".join(f"{a:g}–{b:g} s ({n:,} rows)" for a, b, n in spans[:5])
         more = f" and {len(spans) - 5} more runs" if len(spans) > 5 else ""
-        fed = "" if cfg.sensors.get(col) is not None else " (not fed)"
+        fed = "" if cfg.sensors.get(col) is not None or col in cfg.parts else " (not fed)"
         lines.append(f"missing {col}{fed}: {shown}{more}; {how}")
     lines += event_table(rp, cfg, truth, tape.end)
     lines += reports._transition_lines(_Shim(run, rp), cfg.altitude_element, "altitude_m", "m")

@@ -510,13 +510,17 @@ class SimBoard:
         return self.step(self.cycles_for(seconds))
 
     def batch(self, until: int, analog: dict[str, float] | None = None,
-              digital: dict[int, bool] | None = None) -> Batch:
+              digital: dict[int, bool] | None = None,
+              parts: dict[int | str, dict[str, int]] | None = None) -> Batch:
         """One lock-step of a co-simulation in one command and one round
         trip: sets analog inputs (volts), then drives digital input pins,
+        then sets parts' raw counts (`{0x76: {"adc_P": 415148}, "B1": {"z":
+        256}}`: by I2C address or SPI chip-select port pin, the names
+        `part_raw` takes; latched by each part's next conversion to end),
         runs to the absolute cycle `until`, and returns the run's result with
         the watched pins' edges and the UART's bytes since the last read
-        (what `set_analog`s, `set_digital`s, `until`, `edges` and
-        `uart_read` do in turn)."""
+        (what `set_analog`s, `set_digital`s, `part_raw`s, `until`, `edges`
+        and `uart_read` do in turn)."""
         line = f"batch {int(until)}"
         if analog:
             for p, v in analog.items():
@@ -525,6 +529,10 @@ class SimBoard:
             for pin, level in digital.items():
                 port, bit = self._port_bit(pin)
                 line += f" {port}{bit}={1 if level else 0}"
+        if parts:
+            for where, values in parts.items():
+                if values:
+                    line += f" @{_part_id(where)}:" + ",".join(f"{k}={int(v)}" for k, v in values.items())
         # `ok cycle=C time=S state=ST stop=R uart=HEX n=K overflow=F EDGE...`, read
         # by position: one step of a co-simulation, kept cheap
         self._send(line + "\n")

@@ -1640,14 +1640,85 @@ static int cmd_go(int argc, char** argv) {
     return 1;
 }
 
+/* A `batch` word `@ID:NAME=V[,NAME=V]...`: raw counts of the part at ID (its
+   I2C address, 0x76, or its SPI chip-select pin, B1) by the names `part ID
+   raw` takes. Returns 0 for a good word, else 1 with *bad_part the part
+   whose counts are bad (NULL: no part at ID). With apply 1, a good word's
+   part is first brought up to date (conversions that ended keep the old
+   counts), then takes the counts. */
+static int batch_part(char* word, int apply, part_t** bad_part) {
+    char* colon = strchr(word, ':');
+    part_t* p = NULL;
+    *bad_part = NULL;
+    if (!colon || !colon[1]) return 1;
+    *colon = 0;
+    const char* id = word + 1;
+    unsigned long long a;
+    if (strlen(id) == 2 && id[0] >= 'A' && id[0] <= 'L') {
+        for (int i = 0; i < n_parts; i++)
+            if (!parts[i].addr && parts[i].cs_port == id[0] && parts[i].cs_bit == (uint8_t)(id[1] - '0')) p = &parts[i];
+    } else if (!parse_u64(id, &a) && a > 0 && a < 0x80) {
+        p = part_at((uint8_t)a);
+    }
+    *colon = ':';
+    if (!p) return 1;
+    const part_kind_t* k = &part_kinds[p->kind];
+    long vals[MAX_RAW];
+    memcpy(vals, p->raw, sizeof vals);
+    char* s = colon + 1;
+    for (;;) {
+        char* comma = strchr(s, ',');
+        if (comma) *comma = 0;
+        char* eq = strchr(s, '=');
+        int r = -1;
+        if (eq) {
+            *eq = 0;
+            for (int j = 0; j < k->n_raw; j++)
+                if (!strcmp(s, k->raw_names[j])) r = j;
+            *eq = '=';
+        }
+        char* end = NULL;
+        errno = 0;
+        const long x = eq ? strtol(eq + 1, &end, 0) : 0;
+        const int ok = r >= 0 && !errno && eq[1] && !*end && x >= k->raw_min && x <= k->raw_max;
+        if (comma) *comma = ',';
+        if (!ok) {
+            *bad_part = p;
+            return 1;
+        }
+        vals[r] = x;
+        if (!comma) break;
+        s = comma + 1;
+    }
+    if (apply) {
+        part_tick(p);
+        memcpy(p->raw, vals, sizeof vals);
+    }
+    return 0;
+}
+
 /* One lock-step of a co-simulation: inputs set in the order given, a run to
    absolute cycle C, then the run's result, the UART's bytes and the edges:
-   what `adc`..., `din`..., `until C`, `uart`, `edges` do, in one line. */
+   what `adc`..., `din`..., `part ID raw`..., `until C`, `uart`, `edges` do,
+   in one line. */
 static int cmd_batch(int argc, char** argv) {
-    static const char usage[] = "usage: batch CYCLE [CH=MV]... [PB=0|1]... (ADC channel 0-15, port A-L bit 0-7)";
+    static const char usage[] = "usage: batch CYCLE [CH=MV]... [PB=0|1]... [@ID:NAME=V[,NAME=V]...]... "
+                                "(ADC channel 0-15, port A-L bit 0-7, a part's I2C address or SPI chip-select pin)";
     unsigned long long target, v;
     if (argc < 2 || parse_u64(argv[1], &target)) return fail("%s", usage);
     for (int i = 2; i < argc; i++) { /* all checked before any is applied */
+        if (argv[i][0] == '@') {
+            part_t* bp;
+            if (batch_part(argv[i], 0, &bp)) {
+                if (!bp) return fail("batch: no part at `%s` (start the harness with -I KIND@ADDR); %s", argv[i], usage);
+                const part_kind_t* k = &part_kinds[bp->kind];
+                fprintf(proto, "err batch: bad raw counts `%s`: the %s takes", argv[i], k->name);
+                for (int j = 0; j < k->n_raw; j++) fprintf(proto, " %s=", k->raw_names[j]);
+                fprintf(proto, " (%ld..%ld)\n", k->raw_min, k->raw_max);
+                return 1;
+            }
+            continue;
+        }
         char* eq = strchr(argv[i], '=');
         if (!eq) return fail("%s", usage);
         *eq = 0;
@@ -1661,6 +1732,11 @@ static int cmd_batch(int argc, char** argv) {
         if (bad) return fail("batch: bad input `%s`; %s", argv[i], usage);
     }
     for (int i = 2; i < argc; i++) {
+        if (argv[i][0] == '@') {
+            part_t* bp;
+            (void)batch_part(argv[i], 1, &bp); /* checked above */
+            continue;
+        }
         char* eq = strchr(argv[i], '=');
         *eq = 0;
         unsigned long long value; /* millivolts or a level */

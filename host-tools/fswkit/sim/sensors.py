@@ -12,7 +12,11 @@ firmware's, fswkit.autocode.iotables.analog_value).
 The simulated board takes an input in whole millivolts and converts it as
 `floor(mV * (2^bits - 1) / Vref_mV)` (simavr); `millivolts(counts)` is the
 smallest input that gives exactly `counts` there, so the simulated MCU reads
-the count the real one would. Used by tape replays (fswkit.sim.tape_replay).
+the count the real one would. Used by tape replays (fswkit.plant.tape_replay).
+
+A digital part of the `.sns` tables (`PartFeed`, below) is fed the other
+way: a physical value becomes the raw counts the part's result registers
+hold, by its datasheet's compensation run backwards with its calibration.
 """
 
 from __future__ import annotations
@@ -91,3 +95,212 @@ def from_channel(channel, board) -> AnalogSensor:
     """The sensor of a project's analog input channel (autocode's Channel)."""
     return AnalogSensor(channel.pin, channel.element.name, float(channel.scale), float(channel.offset),
                         float(board.adc_vref), int(board.adc_bits), board.real)
+
+
+# ---- digital parts (a `.sns` table's rows) ---------------------------------------------
+# A digital sensor part fed physical values: the raw counts its result
+# registers must hold for the firmware's driver to read those values, by the
+# datasheet's own compensation run backwards (fswkit.sim.parts' inverse
+# helpers) with the part's calibration as the simulated board holds it
+# (`SimBoard.part_calibration`).
+
+BAROMETERS = ("bmp280", "ms5611")
+ACCELEROMETERS = ("adxl345", "mpu6050")
+AXES = ("x", "y", "z")
+
+
+def part_name(sensor) -> str:
+    """A part as the `.sns` table and the health frame name it: `bmp280@0x76`, `adxl345@spi:7`."""
+    if sensor.bus == "spi":
+        return f"{sensor.part}@spi:{sensor.cs_pin}"
+    return f"{sensor.part}@0x{sensor.address:02x}"
+
+
+def harness_id(sensor, board) -> int | str:
+    """The part's name on the simulated board: its I2C address, or its SPI
+    chip select's port pin (`"B1"` for the Uno's pin 9), from the board's
+    pin table (fswkit.sim.board.pin_map)."""
+    if sensor.bus != "spi":
+        return int(sensor.address)
+    from fswkit.sim.board import pin_map, sim_board
+
+    port, bit = pin_map(sim_board(board)).digital[sensor.cs_pin]
+    return f"{port}{bit}"
+
+
+def board_parts(sensors, board) -> list[tuple[str, int | str]]:
+    """`SimBoard(parts=...)` for an application's sensor parts."""
+    return [(s.part, harness_id(s, board)) for s in sensors]
+
+
+def find_part(sensors, text: str, kinds: tuple[str, ...]):
+    """The application's part that plant.toml / tape.toml names: `bmp280`
+    (the only one of its kind), `bmp280@0x76`, `adxl345@spi:7` (also
+    `@i2c:0x53`); (sensor, None) or (None, the reason)."""
+    kind, at, where = text.strip().partition("@")
+    kind = kind.strip().lower()
+    if kind not in kinds:
+        return None, f"\"{text}\": a part of kind {' or '.join(kinds)} (\"{kinds[0]}@0x76\"), not `{kind}`"
+    same = [s for s in sensors if s.part == kind]
+    listed = ", ".join(part_name(s) for s in sensors) or "none"
+    if not at:
+        if len(same) == 1:
+            return same[0], None
+        if not same:
+            return None, f"the project's sensor tables have no {kind} (its parts: {listed})"
+        return None, f"the project has {len(same)} {kind} parts ({', '.join(part_name(s) for s in same)}): name one"
+    where = where.strip().lower()
+    bus, colon, rest = where.partition(":")
+    try:
+        if colon and bus == "spi":
+            pin = int(rest, 0)
+            hit = [s for s in same if s.bus == "spi" and s.cs_pin == pin]
+        else:
+            addr = int(rest if colon and bus == "i2c" else where, 0)
+            hit = [s for s in same if s.bus == "i2c" and s.address == addr]
+    except ValueError:
+        return None, (f"\"{text}\": expected KIND@ADDRESS (\"{kind}@0x76\") or KIND@spi:PIN "
+                      f"(\"{kind}@spi:7\")")
+    if not hit:
+        return None, f"\"{text}\" is not in the project's sensor tables (its parts: {listed})"
+    return hit[0], None
+
+
+def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bool) -> int:
+    """parts._nearest_search's answer, found by galloping from `guess`
+    (steps 1, 2, 4, ... until the answer is bracketed, then bisection): a
+    few evaluations when the guess is close."""
+    def reached(x):  # the full search's condition: its answer is the first x that reaches
+        v = f(x)
+        return v >= target if increasing else v <= target
+    x = min(max(guess, lo), hi)
+    step = 1
+    if reached(x):  # the first reaching x is at or below x
+        b = x
+        while True:
+            a = max(lo, b - step)
+            if a == lo or not reached(a):
+                break
+            b, step = a, step * 2
+        if a == lo and reached(lo):
+            b = lo
+    else:  # above x
+        a = x
+        while True:
+            b = min(hi, a + step)
+            if b == hi or reached(b):
+                break
+            a, step = b, step * 2
+    while a < b:  # the first reaching x in (a, b], `a` not reaching (or lo)
+        m = (a + b) // 2
+        if reached(m):
+            b = m
+        else:
+            a = m + 1
+    x = b
+    if x > lo and abs(f(x - 1) - target) <= abs(f(x) - target):
+        return x - 1
+    return x
+
+
+class _Inverse:
+    """A monotonic integer function's nearest inverse, remembering its last
+    answers: a plant step's value is near the last one, so the answer is a
+    few steps from a secant guess (the same answer as a full search)."""
+
+    def __init__(self, lo: int, hi: int, increasing: bool):
+        self.lo, self.hi, self.increasing = lo, hi, increasing
+        self.last: tuple[float, int] | None = None
+        self.slope: float | None = None  # counts per unit of target
+
+    def __call__(self, f, target: float, full) -> int:
+        x = None
+        if self.last is not None and self.slope is not None:
+            t0, x0 = self.last
+            x = _walk_nearest(f, target, int(round(x0 + (target - t0) * self.slope)), self.lo, self.hi,
+                              self.increasing)
+        else:
+            x = full()
+        if self.last is not None and target != self.last[0] and x != self.last[1]:
+            s = (x - self.last[1]) / (target - self.last[0])
+            if s and (s > 0) == self.increasing:
+                self.slope = s
+        self.last = (target, x)
+        return x
+
+
+class PartFeed:
+    """One part of the application as the plant or a tape feeds it: `raw`
+    turns physical values into the part's raw counts (`SimBoard.part_raw`
+    names), with the calibration the board holds for it.
+
+    Barometers: pressure (Pa) and temperature (°C) → bmp280 adc_P, adc_T
+    (the temperature first, its t_fine then the pressure's, by the 64-bit
+    formula the driver uses) or ms5611 D2, D1 (second-order compensation
+    as the driver applies it). Accelerometers: x, y, z (g; an axis not
+    given reads 0 g) → adxl345 counts at its `range` in full resolution,
+    right-justified (3.9 mg a count), or mpu6050 counts at its `range`
+    (16384 / 2^AFS_SEL a g) and its temperature register for `temperature`;
+    counts round to the nearest and stop at the output's limits."""
+
+    def __init__(self, sensor, where: int | str, calibration: bytes | None):
+        from . import parts as P
+
+        self.sensor, self.where, self.part = sensor, where, sensor.part
+        self.name = part_name(sensor)
+        self.settings = dict(sensor.settings)
+        self.calib = None
+        if self.part == "bmp280":
+            self.calib = P.bmp280_parse_calib(calibration)
+        elif self.part == "ms5611":
+            words = [int.from_bytes(calibration[i:i + 2], "big") for i in range(0, 16, 2)]
+            self.calib = P.Ms5611Calib(*words[1:7])
+        self._t: tuple[float, int, int] | None = None  # (°C, raw temperature, t_fine / D2)
+        self._p = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, self.part != "bmp280")
+
+    @property
+    def data_format(self) -> int:
+        """The ADXL345's DATA_FORMAT for its settings: full resolution and the range."""
+        return 0x08 | {2: 0, 4: 1, 8: 2, 16: 3}[self.settings.get("range", 16)]
+
+    def raw(self, pressure: float | None = None, temperature: float | None = None,
+            x: float = 0.0, y: float = 0.0, z: float = 0.0) -> dict[str, int]:
+        from . import parts as P
+
+        if self.part in BAROMETERS:
+            out = {}
+            t_c = 15.0 if temperature is None else float(temperature)
+            if self._t is None or self._t[0] != t_c:
+                if self.part == "bmp280":
+                    adc_T = P.bmp280_adc_T_for(self.calib, t_c)
+                    self._t = (t_c, adc_T, P.bmp280_compensate_T(self.calib, adc_T)[1])
+                else:
+                    self._t = (t_c, P.ms5611_D2_for(self.calib, t_c), 0)
+            if self.part == "bmp280":
+                out["adc_T"] = self._t[1]
+                if pressure is not None:
+                    c, tf = self.calib, self._t[2]
+                    out["adc_P"] = self._p(lambda a: P.bmp280_compensate_P64(c, a, tf), float(pressure) * 256.0,
+                                           lambda: P.bmp280_adc_P_for(c, float(pressure), tf))
+            else:
+                out["D2"] = d2 = self._t[1]
+                if pressure is not None:
+                    c = self.calib
+                    out["D1"] = self._p(lambda d: P.ms5611_compensate(c, d, d2, True).P, float(pressure),
+                                        lambda: P._nearest_search(lambda d: P.ms5611_compensate(c, d, d2, True).P,
+                                                                     float(pressure), 0, 0xFFFFFF, True))
+            return out
+        if self.part == "adxl345":
+            fmt = self.data_format
+            per, bits = P.adxl345_g_per_count(fmt), P.adxl345_bits(fmt)
+            lim = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
+        else:
+            afs = {2: 0, 4: 1, 8: 2, 16: 3}[self.settings.get("range", 16)]
+            per, lim = P.mpu6050_g_per_count(afs), (-32768, 32767)
+        out = {}
+        for name, g in ((("x", x), ("y", y), ("z", z)) if self.part == "adxl345" else
+                        (("ax", x), ("ay", y), ("az", z))):
+            out[name] = min(max(int(round(float(g) / per)), lim[0]), lim[1])
+        if self.part == "mpu6050" and temperature is not None:
+            out["temp"] = min(max(int(round((float(temperature) - 36.53) * 340.0)), -32768), 32767)
+        return out

@@ -94,7 +94,12 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
         st = v.get(p.state_element)
         r = rates[st] if st is not None and 0 < st < len(rates) and rates[st] else max(rates)
         return 1000 / float(r)
-    late = [(b[0] - a[0], a[0]) for a, b in zip(s, s[1:]) if b[0] - a[0] > max(allowed(a[1]), allowed(b[1])) + 1e-9]
+    # a sample's time is G as a machine task stored it, up to one executor cycle after the cycle began (the
+    # tasks before it take their time: examples/hpr_digital's inputs task crosses a millisecond now and then), so
+    # the period plus a cycle; a missing sample makes a gap of two periods
+    cycle_ms = 1000 / float(app.rate)
+    late = [(b[0] - a[0], a[0]) for a, b in zip(s, s[1:])
+            if b[0] - a[0] > max(allowed(a[1]), allowed(b[1])) + cycle_ms + 1e-9]
     before = (launch_s * 1000 - s[0][0]) / 1000 if launch_s is not None else float("nan")
     full = not p.newest and bool(flight.records) and flight.records[-1].slot == p.slots - 1  # `full stop`: no room
     # the last sample within a sample period (its state's) of the end, as telemetry saw it (its own samples come up to a

@@ -29,10 +29,13 @@ setup: $(STAMP) $(UPLOT)
 ## demo: the example rocket's firmware built for an Uno from its configs,
 ## flown in closed loop on the simulated board (a 1-D rocket model at 1 kHz),
 ## its telemetry streamed over the simulated serial link; prints the flight
-## summary and where the plot, logs and CSV are (build/demo/)
+## summary and where the plot, logs and CSV are (build/demo/).
+## DEMO_EXAMPLE=hpr (analog barometer and accelerometer) or hpr_digital (a
+## BMP280 and an ADXL345 on I2C) flies the high-power computer instead
 DEMO_SEED ?= 1
+DEMO_EXAMPLE ?= rocket
 demo: setup
-	$(FSW) sim examples/rocket --plant rocket --seed $(DEMO_SEED) --out $(BUILD)/demo
+	$(FSW) sim examples/$(DEMO_EXAMPLE) --plant rocket --seed $(DEMO_SEED) --out $(BUILD)/demo
 
 ## docs-img: the demo flight's plot shown in README.md (a test checks that
 ## docs/img/rocket-flight.png is this tree's seed-1 flight) and the web

@@ -8,7 +8,10 @@ barometric (truth) apogee, the drogue pin's time and its error against it
 beside the error measured before the apogee detector waited for the
 barometer to settle (2026-11-23) and the recording altimeter's own apogee
 error, the main pin's altitude error against MAIN_ALT, the landing error,
-the checks passed/failed — then `tape replays: N passed, M failed`.
+the checks passed/failed — and beside them the same tape through
+examples/hpr_digital (a simulated BMP280 and ADXL345 on I2C instead of
+the 10-bit ADC): its apogee error, main error and checks; then
+`tape replays: N passed, M failed` and the digital variant's line.
 
 Then the perturbed replays (`--perturb`: noise, spikes, dropouts and bias
 on both sensors, docs/sim.md) of EVERY tape: FSW_TAPE_PERTURB (default
@@ -40,6 +43,7 @@ from concurrent.futures import ThreadPoolExecutor
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FLIGHTS = os.path.join(os.path.dirname(ROOT), "shared", "flights")
 PROJECT = os.path.join(ROOT, "examples", "hpr")
+DIGITAL = os.path.join(ROOT, "examples", "hpr_digital")  # the same computer with a BMP280 and an ADXL345 on I2C
 OUT = os.path.join(ROOT, "build", "bench", "tapes")
 FIRMWARE = os.path.join(OUT, "firmware")  # a build of its own: nobody rebuilds it mid-run
 # drogue pin − barometric apogee, s, before the detector waited for the barometer to settle (2026-11-23)
@@ -55,7 +59,7 @@ def fmt(x, spec: str) -> str:
     return format(x, spec)
 
 
-def setup():
+def setup(project: str = PROJECT, firmware: str = FIRMWARE):
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.plant import tape_replay as tr
@@ -63,25 +67,26 @@ def setup():
     from fswkit.target.build import load
 
     diags = Diagnostics()
-    app = load(PROJECT, diags)
+    what = "examples/" + os.path.basename(project)
+    app = load(project, diags)
     if app is None:
-        sys.exit("bench_tapes: examples/hpr does not load:\n" + diags.render())
+        sys.exit(f"bench_tapes: {what} does not load:\n" + diags.render())
     layout = from_app(app)
     cfg = tr.load_config(app, layout, None)
-    built = build(PROJECT, out=FIRMWARE)
+    built = build(project, out=firmware)
     if isinstance(built, int):
-        sys.exit("bench_tapes: examples/hpr's firmware did not build")
+        sys.exit(f"bench_tapes: {what}'s firmware did not build")
     elf, board = built
     return app, layout, cfg, elf, board
 
 
-def replay(path: str, app, layout, cfg, elf, board):
+def replay(path: str, app, layout, cfg, elf, board, suffix: str = ""):
     from fswkit.plant import tape_replay as tr
 
     tape, truth = tr.load_tape(path, cfg)
     name = os.path.splitext(os.path.basename(path))[0]
     t0 = time.perf_counter()
-    o = tr.execute(tape, truth, cfg, app, elf, board, layout, os.path.join(OUT, name))
+    o = tr.execute(tape, truth, cfg, app, elf, board, layout, os.path.join(OUT, name + suffix))
     return tape, truth, o, time.perf_counter() - t0
 
 
@@ -104,24 +109,29 @@ def main() -> int:
     from fswkit.plant import tape_replay as tr
 
     app, layout, cfg, elf, board = setup()
+    digital = setup(DIGITAL, os.path.join(OUT, "firmware-digital"))
     crashed = 0
     t0 = time.perf_counter()
     with ThreadPoolExecutor(max(1, args.jobs)) as pool:
         futures = {p: pool.submit(replay, p, app, layout, cfg, elf, board) for p in paths}
-        results = {}
-        for p, fut in futures.items():
-            try:
-                results[p] = fut.result()
-            except Exception as e:  # a replay that could not run: a crash of the bench
-                results[p] = e
+        d_futures = {p: pool.submit(replay, p, *digital, "-digital") for p in paths}
+        results, d_results = {}, {}
+        for into, futs in ((results, futures), (d_results, d_futures)):
+            for p, fut in futs.items():
+                try:
+                    into[p] = fut.result()
+                except Exception as e:  # a replay that could not run: a crash of the bench
+                    into[p] = e
     wall = time.perf_counter() - t0
     print(f"real-flight tape replays of examples/hpr on the simulated Uno (fsw sim --tape), whole, "
           f"from {args.tapes}")
     head = (f"{'tape':<22} {'apogee m':>8} {'apogee s':>8} {'drogue s':>8} {'err s':>6} {'recorder':>8} "
-            f"{'before':>6} {'main m':>7} {'landing s':>9} {'checks':>7} {'flight s':>8} {'wall s':>6}  result")
+            f"{'before':>6} {'main m':>7} {'landing s':>9} {'checks':>7} {'digital':>7} {'d.main':>6} {'d.checks':>8} "
+            f"{'flight s':>8} {'wall s':>6}  result")
     print(head)
     print("-" * len(head))
     passed = failed = 0
+    d_passed = d_failed = 0
     flown = walls = 0.0
     for p in paths:
         name = os.path.splitext(os.path.basename(p))[0]
@@ -145,22 +155,44 @@ def main() -> int:
         bad = "; ".join(f"{c.name.split(' (')[0]}: {c.detail}" for c in checks if not c.passed)
         flown += tape.span
         walls += w
+        d = d_results[p]
+        if isinstance(d, Exception):
+            crashed += 1
+            d_failed += 1
+            d_err = d_main = None
+            d_checks = "ERROR"
+            bad += f"; digital: {type(d).__name__}: {d}"
+        else:
+            d_o = d[2]
+            d_ok = all(c.passed for c in d_o.report.checks)
+            d_passed += d_ok
+            d_failed += not d_ok
+            d_err, d_main = d_o.numbers.get("apogee_err_s"), d_o.numbers.get("main_err_m")
+            d_checks = f"{sum(c.passed for c in d_o.report.checks)}/{len(d_o.report.checks)}"
+            if not d_ok:
+                ok = False
+                bad += "; digital: " + "; ".join(f"{c.name.split(' (')[0]}: {c.detail}"
+                                                 for c in d_o.report.checks if not c.passed)
         print(f"{name:<22} {fmt(truth.apogee_m_agl, '8.1f')} {fmt(truth.apogee_s, '8.3f')} {fmt(drogue_t, '8.3f')} "
               f"{fmt(drogue, '+6.2f')} {fmt(rec_err, '+8.2f')} {fmt(BEFORE.get(name), '+6.2f')} "
               f"{fmt(n.get('main_err_m'), '+7.1f')} "
-              f"{fmt(n.get('landing_err_s'), '+9.2f')} {f'{good}/{len(checks)}':>7} {tape.span:8.1f} {w:6.1f}  "
-              + ("pass" if ok else "FAIL " + bad))
+              f"{fmt(n.get('landing_err_s'), '+9.2f')} {f'{good}/{len(checks)}':>7} {fmt(d_err, '+7.2f')} "
+              f"{fmt(d_main, '+6.1f')} {d_checks:>8} {tape.span:8.1f} {w:6.1f}  "
+              + ("pass" if ok else "FAIL " + bad.lstrip("; ")))
         for line in o.report.lines:
             if line.strip().startswith("SKIP"):
                 print(f"{'':<22} {line.strip()}")
     print("columns: apogee m/s = the tape's barometric apogee (truth); drogue s = the firmware's drogue pin; "
           "err s = drogue − apogee (target: −0.5 to +1.0, and nearer 0 than the recorder's); recorder = the recording "
           "altimeter's own apogee event − apogee; before = err s before this detector (2026-11-23); "
-          "main m = truth altitude at the main pin − MAIN_ALT; landing s = landing state − the tape's landing")
+          "main m = truth altitude at the main pin − MAIN_ALT; landing s = landing state − the tape's landing; "
+          "digital, d.main, d.checks = err s, main m and the checks of examples/hpr_digital (the tape's pressure "
+          "and acceleration through a simulated BMP280 and ADXL345 instead of the 10-bit ADC)")
     if walls:
         print(f"{flown:.0f} s of flight replayed in {wall:.0f} s wall with {args.jobs} at a time "
               f"({flown / walls:.2f}× real time per replay); files in {OUT}")
     print(f"tape replays: {passed} passed, {failed} failed")
+    print(f"digital tape replays (examples/hpr_digital): {d_passed} passed, {d_failed} failed")
     crashed += perturbed(args.tapes, paths, layout, cfg, elf, board, args.jobs)
     return 1 if crashed else 0
 

@@ -43,7 +43,9 @@ def tapes(of: str) -> list[str]:
     return [t for t in TAPES if group(t) == of]
 
 
-def build_hpr(tmp_path_factory):
+def build_hpr(tmp_path_factory, project=HPR):
+    """(app, layout, tape config, elf, board) of examples/hpr, or of another
+    project that replays tapes (examples/hpr_digital), built once."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.plant import tape_replay as tr
@@ -51,12 +53,12 @@ def build_hpr(tmp_path_factory):
     from fswkit.target.build import load
 
     diags = Diagnostics()
-    app = load(str(HPR), diags)
+    app = load(str(project), diags)
     assert app is not None, diags.render()
     layout = from_app(app)
     cfg = tr.load_config(app, layout, None)
-    built = build(str(HPR), out=str(tmp_path_factory.mktemp("hpr") / "firmware"))
-    assert not isinstance(built, int), "examples/hpr's firmware did not build"
+    built = build(str(project), out=str(tmp_path_factory.mktemp(project.name) / "firmware"))
+    assert not isinstance(built, int), f"examples/{project.name}'s firmware did not build"
     elf, board = built
     return app, layout, cfg, elf, board
 

@@ -27,11 +27,12 @@
 
 using namespace fsw;
 
+#include "part_suite.inc"
+
 static const uint8_t kAdxlCs = 9;  // Uno D9 = PB1
 
 #if !defined(__AVR__)
 // ---- the host's parts: ADXL345 at 0x53 and on SPI (D9), MPU-6050 at 0x68 ----------
-enum ModelFail : uint8_t { kModelOk = 0, kModelNack = 1, kModelStuck = 2 };
 struct RegPart {
     uint8_t fail, ptr, id_reg, id;
     int16_t raw[4];     // x, y, z (and the MPU-6050's temp): the next sample
@@ -147,15 +148,6 @@ static void models_begin(void) {
 }
 #endif
 
-void setUp(void) {}
-void tearDown(void) {}
-
-static void print_u32(const char* what, uint32_t v) {
-    UnityPrint(what);
-    UnityPrintNumberUnsigned(v);
-    UNITY_PRINT_EOL();
-}
-
 // The time stamp for a step's length: Timer1's count (clk/8) on the AVR.
 #if defined(__AVR__)
 static uint16_t stamp(void) { return TCNT1; }
@@ -180,11 +172,6 @@ struct Drivers {
     Mpu6050* mpu;
 };
 
-static void wait_bus(void) {
-    const uint32_t t0 = pal::micros32();
-    while (twi_busy() && pal::micros32() - t0 < 20000UL) {}
-}
-
 template <class D>
 static void timed_step(D* d, uint8_t which) {
     if (d == 0) return;
@@ -197,23 +184,45 @@ static void timed_step(D* d, uint8_t which) {
 // Runs `cycles` executor cycles of 1 ms, stepping every driver given once each.
 static void run_cycles(const Drivers& d, uint16_t cycles) {
     for (uint16_t k = 0; k < cycles; ++k) {
-#if FSW_SLEEP
-        uint8_t skipped;
-        while (pal::cycle_wait(skipped) == pal::kCycleNotDue) {}
-#else
-        native::sim_advance_us(1000);
-#endif
+        cycle_start();
         timed_step(d.bmp, kWBmp);
         timed_step(d.ms, kWMs);
         timed_step(d.adxl, kWAdxl);
         timed_step(d.adxl_spi, kWAdxlSpi);
         timed_step(d.mpu, kWMpu);
-#if FSW_SLEEP
-        pal::cycle_end();
-#endif
+        cycle_done();
     }
     wait_bus();  // the drivers (a test's locals) outlive their last transactions
 }
+
+// The three accelerometers at their parts' places: the ADXL345s at 0x53 and
+// on the SPI (D9) at +-16 g full resolution, 400 Hz; the MPU-6050 at 0x68 at
+// +-2 g, DLPF 3; each stuck after `stuck_n` unchanged readings (0: never).
+struct Accels {
+    Adxl345 i2c, spi;
+    Mpu6050 mpu;
+    explicit Accels(uint8_t stuck_n)
+        : i2c(0x53, 0, 3, 0xC, stuck_n), spi(kAdxlCs, 1, 3, 0xC, stuck_n), mpu(0x68, 0, 3, stuck_n) {}
+    Drivers drivers() {
+        Drivers d = {0, 0, &i2c, &spi, &mpu};
+        return d;
+    }
+};
+
+// Each of the three's health code is `code` / fault count is `n`; a
+// failure names the driver, at the caller's line.
+#define ASSERT_HEALTH3(code, x)                                                   \
+    do {                                                                          \
+        TEST_ASSERT_EQUAL_UINT8_MESSAGE((code), (x).i2c.health(), "ADXL345 I2C"); \
+        TEST_ASSERT_EQUAL_UINT8_MESSAGE((code), (x).spi.health(), "ADXL345 SPI"); \
+        TEST_ASSERT_EQUAL_UINT8_MESSAGE((code), (x).mpu.health(), "MPU-6050");    \
+    } while (0)
+#define ASSERT_FAULTS3(n, x)                                                      \
+    do {                                                                          \
+        TEST_ASSERT_EQUAL_UINT16_MESSAGE((n), (x).i2c.faults(), "ADXL345 I2C");   \
+        TEST_ASSERT_EQUAL_UINT16_MESSAGE((n), (x).spi.faults(), "ADXL345 SPI");   \
+        TEST_ASSERT_EQUAL_UINT16_MESSAGE((n), (x).mpu.faults(), "MPU-6050");      \
+    } while (0)
 
 static Drivers only(Adxl345* a, Adxl345* s, Mpu6050* m) {
     Drivers d = {0, 0, a, s, m};
@@ -300,18 +309,11 @@ static void test_bad_id_and_absent(void) {
 
 // The parts' counts stay at their defaults: stuck after stuck_n unchanged readings.
 static void test_stuck_on_constant_counts(void) {
-    Adxl345 a(0x53, 0, 3, 0xC, 3);
-    Adxl345 s(kAdxlCs, 1, 3, 0xC, 3);
-    Mpu6050 m(0x68, 0, 3, 3);
-    Drivers d = {0, 0, &a, &s, &m};
-    run_cycles(d, 140);
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, m.health());
-    TEST_ASSERT_EQUAL_UINT16(1, a.faults());
-    TEST_ASSERT_EQUAL_UINT16(1, s.faults());
-    TEST_ASSERT_EQUAL_UINT16(1, m.faults());
-    TEST_ASSERT_EQUAL_UINT32(bits_of(1.0f), bits_of(a.z_g()));  // the values are still there
+    Accels x(3);
+    run_cycles(x.drivers(), 140);
+    ASSERT_HEALTH3(kSensorStuck, x);
+    ASSERT_FAULTS3(1, x);
+    TEST_ASSERT_EQUAL_UINT32(bits_of(1.0f), bits_of(x.i2c.z_g()));  // the values are still there
 }
 
 #if defined(__AVR__)
@@ -359,70 +361,56 @@ static void test_all_on_one_bus(void) {
 // Host only: the parts fail and come back mid-run; each failure is seen
 // at the step after it, the others go on.
 static void test_native_nack_then_ok(void) {
-    Adxl345 a(0x53, 0, 3, 0xC, 0);
-    Adxl345 s(kAdxlCs, 1, 3, 0xC, 0);
-    Mpu6050 m(0x68, 0, 3, 0);
-    Drivers d = {0, 0, &a, &s, &m};
+    Accels x(0);
+    const Drivers d = x.drivers();
     run_cycles(d, 130);
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
+    ASSERT_HEALTH3(kSensorOk, x);
     g_adxl.fail = kModelNack;
     g_adxl_spi.fail = kModelNack;
     g_mpu.fail = kModelNack;
     run_cycles(d, 1);  // the step's transaction fails (SPI: in the step itself)
-    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, s.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, x.spi.health());
     run_cycles(d, 1);  // the TWI's failures are seen at the next step
-    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, x.i2c.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, x.mpu.health());
     run_cycles(d, 50);
-    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, a.health());
-    TEST_ASSERT_TRUE(a.faults() >= 3);
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, x.i2c.health());
+    TEST_ASSERT_TRUE(x.i2c.faults() >= 3);
     g_adxl.fail = kModelOk;
     g_adxl_spi.fail = kModelOk;
     g_mpu.fail = kModelOk;
     run_cycles(d, 30);
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, m.health());  // in its 100 ms after the reset
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, x.i2c.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, x.spi.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorNoAnswer, x.mpu.health());  // in its 100 ms after the reset
     run_cycles(d, 110);
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
-    TEST_ASSERT_EQUAL_UINT32(bits_of(1.0f), bits_of(m.z_g()));
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, x.mpu.health());
+    TEST_ASSERT_EQUAL_UINT32(bits_of(1.0f), bits_of(x.mpu.z_g()));
 }
 
 // Changing counts are never stuck; stuck after stuck_n unchanged
 // readings; Ok again with the next changed one.
 static void test_native_stuck_then_ok(void) {
-    Adxl345 a(0x53, 0, 3, 0xC, 4);
-    Adxl345 s(kAdxlCs, 1, 3, 0xC, 4);
-    Mpu6050 m(0x68, 0, 3, 4);
-    Drivers d = {0, 0, &a, &s, &m};
+    Accels x(4);
+    const Drivers d = x.drivers();
     for (uint16_t k = 0; k < 200; ++k) {
         g_adxl.raw[0] = g_adxl_spi.raw[0] = g_mpu.raw[0] = static_cast<int16_t>(k);
         run_cycles(d, 1);
     }
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
+    ASSERT_HEALTH3(kSensorOk, x);
     g_adxl.fail = g_adxl_spi.fail = g_mpu.fail = kModelStuck;
     run_cycles(d, 3);
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, a.health());  // not yet: 4 unchanged readings after the last changed one
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, x.i2c.health());  // not yet: 4 unchanged readings after the last changed one
+    TEST_ASSERT_EQUAL_UINT8(kSensorOk, x.mpu.health());
     run_cycles(d, 12);  // 400 Hz: 5 samples; MPU-6050: 12
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorStuck, m.health());
-    TEST_ASSERT_EQUAL_UINT16(1, a.faults());
+    ASSERT_HEALTH3(kSensorStuck, x);
+    TEST_ASSERT_EQUAL_UINT16(1, x.i2c.faults());
     g_adxl.fail = g_adxl_spi.fail = g_mpu.fail = kModelOk;
     g_adxl.raw[0] = g_adxl_spi.raw[0] = g_mpu.raw[0] = 1000;
     run_cycles(d, 4);  // the next sample of each
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, a.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, s.health());
-    TEST_ASSERT_EQUAL_UINT8(kSensorOk, m.health());
-    TEST_ASSERT_EQUAL_INT16(1000, a.counts(0));
-    TEST_ASSERT_EQUAL_UINT16(1, a.faults());
-    TEST_ASSERT_EQUAL_UINT16(1, s.faults());
-    TEST_ASSERT_EQUAL_UINT16(1, m.faults());
+    ASSERT_HEALTH3(kSensorOk, x);
+    TEST_ASSERT_EQUAL_INT16(1000, x.i2c.counts(0));
+    ASSERT_FAULTS3(1, x);
     g_adxl.raw[0] = g_adxl_spi.raw[0] = g_mpu.raw[0] = 0;
 }
 #endif
@@ -441,11 +429,7 @@ static void test_report(void) {
 }
 
 static void run(void) {
-#if FSW_SLEEP
-    pal::cycle_timer_begin(1000UL);
-#else
-    models_begin();
-#endif
+    parts_suite_begin();
     sensors_begin(1, 1);
     UNITY_BEGIN();
     RUN_TEST(test_adxl345_i2c);

@@ -25,9 +25,10 @@
 
 using namespace fsw;
 
+#include "part_suite.inc"
+
 #if !defined(__AVR__)
 // ---- the host's parts: BMP280 at 0x76, MS5611 at 0x77 ---------------------------
-enum ModelFail : uint8_t { kModelOk = 0, kModelNack = 1, kModelStuck = 2 };
 static const uint8_t kBmpCalibBytes[24] = {0x70, 0x6B, 0x43, 0x67, 0x18, 0xFC, 0x7D, 0x8E, 0x43, 0xD6, 0xD0, 0x0B,
                                            0x27, 0x0B, 0x8C, 0x00, 0xF9, 0xFF, 0x8C, 0x3C, 0xF8, 0xC6, 0x70, 0x17};
 static struct {
@@ -98,34 +99,14 @@ static void models_begin(void) {
 }
 #endif
 
-void setUp(void) {}
-void tearDown(void) {}
-
 static uint32_t g_worst_us, g_worst_bmp_us, g_worst_ms_us;
-
-static void print_u32(const char* what, uint32_t v) {
-    UnityPrint(what);
-    UnityPrintNumberUnsigned(v);
-    UNITY_PRINT_EOL();
-}
-
-// Until the transactions started (and queued) have ended (at most 20 ms).
-static void wait_bus(void) {
-    const uint32_t t0 = pal::micros32();
-    while (twi_busy() && pal::micros32() - t0 < 20000UL) {}
-}
 
 // Runs `cycles` executor cycles of 1 ms, stepping the drivers given (either
 // may be null) once each per cycle; returns the worst step (us).
 static uint32_t run_cycles(Bmp280* b, Ms5611* m, uint16_t cycles) {
     uint32_t worst = 0;
     for (uint16_t k = 0; k < cycles; ++k) {
-#if FSW_SLEEP
-        uint8_t skipped;
-        while (pal::cycle_wait(skipped) == pal::kCycleNotDue) {}
-#else
-        native::sim_advance_us(1000);
-#endif
+        cycle_start();
         uint32_t t0 = pal::micros32();
         if (b != 0) b->step();
         uint32_t t1 = pal::micros32();
@@ -135,9 +116,7 @@ static uint32_t run_cycles(Bmp280* b, Ms5611* m, uint16_t cycles) {
         t0 = pal::micros32();
         if (t0 - t1 > worst) worst = t0 - t1;
         if (m != 0 && t0 - t1 > g_worst_ms_us) g_worst_ms_us = t0 - t1;
-#if FSW_SLEEP
-        pal::cycle_end();
-#endif
+        cycle_done();
     }
     if (worst > g_worst_us) g_worst_us = worst;
     wait_bus();  // the drivers (a test's locals) outlive their last transactions
@@ -360,11 +339,7 @@ static void test_report(void) {
 }
 
 static void run(void) {
-#if FSW_SLEEP
-    pal::cycle_timer_begin(1000UL);
-#else
-    models_begin();
-#endif
+    parts_suite_begin();
     twi_begin(400000UL);
     UNITY_BEGIN();
     RUN_TEST(test_bmp280_datasheet);

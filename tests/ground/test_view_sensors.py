@@ -8,44 +8,18 @@ import io
 
 from rich.console import Console
 
-from fswkit.autocode.app import load_app
-from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.protocol import HEALTH_PAYLOAD, HEALTH_TASK, HELLO_PAYLOAD
 from fswkit.ground.view import render
 from fswkit.link import wire
 from fswkit.link.layout import from_app
 from fswkit.link.session import Session
 from fswkit.web.source import _message
-
-SV = "[Data]\nU64 time\nU32 state\nF32 baroP\nF32 accelZ\nbool high\n"
-SM = "[state_vector]\nU64 time @alias G\nU32 state @alias S\nF32 baroP @read_only\nbool high\n\n[Run]\n.step\n" \
-     "    high = baroP > 100000\n"
-APP = """\
-[application]
-board native
-rate 100
-[configs]
-state_vector p.sv
-machine p.sm
-io p.sns
-[tasks]
-sense inputs rate=100
-control machine p rate=100
-down telemetry rate=50
-[telemetry]
-Data rate=10
-"""
+from support.sensor_project import load, write_project
 
 
 def session(tmp_path) -> tuple[Session, list]:
-    (tmp_path / "p.sv").write_text(SV)
-    (tmp_path / "p.sm").write_text(SM)
-    (tmp_path / "p.sns").write_text("bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:7 z=accelZ\n")
-    (tmp_path / "p.app").write_text(APP)
-    d = Diagnostics()
-    app = load_app(str(tmp_path / "p.app"), d)
-    assert app is not None, d.render()
-    lay = from_app(app)
+    lay = from_app(load(write_project(tmp_path, "bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:7 z=accelZ\n",
+                                      telemetry=True)))
     s = Session(lay)
     events = s.feed(wire.downlink(wire.HELLO, 0, 0, HELLO_PAYLOAD.pack(wire.PROTOCOL, lay.schema, 0, 0, 1, 0, 0,
                                                                         0x01, 0, 0)), 100.0)

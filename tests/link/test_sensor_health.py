@@ -20,59 +20,11 @@ from fswkit.link import wire
 from fswkit.link.layout import LayoutError, from_app, from_dict
 from fswkit.link.session import Session, describe, sensor_status
 from support.linkfw import needs_cxx, simulated_link
-
-SV = """\
-[Data]
-U64 time
-U32 state
-F32 baroP
-F32 accelZ
-bool baroFault
-bool high
-"""
-SM = """\
-[state_vector]
-U64 time @alias G
-U32 state @alias S
-F32 baroP @read_only
-bool high
-
-[Run]
-.step
-    high = baroP > 100000
-"""
-APP = """\
-[application]
-board native
-rate 100
-baud 115200
-
-[configs]
-state_vector p.sv
-machine p.sm
-{io}
-
-[tasks]
-sense inputs rate=100
-control machine p rate=100
-down telemetry rate=50
-
-[telemetry]
-Data rate=10
-"""
-SNS = "bmp280 i2c:0x76 pressure=baroP fault=baroFault\nadxl345 spi:7 -z=accelZ\n"
+from support.sensor_project import SNS, load, write_project
 
 
 def project(tmp, sns: str | None = SNS):
-    (tmp / "p.sv").write_text(SV)
-    (tmp / "p.sm").write_text(SM)
-    if sns is not None:
-        (tmp / "p.sns").write_text(sns)
-    (tmp / "p.app").write_text(APP.format(io="io p.sns" if sns is not None else ""))
-    d = Diagnostics()
-    app = load_app(str(tmp / "p.app"), d)
-    assert app is not None, d.render()
-    return app
+    return load(write_project(tmp, sns, baud=115200, telemetry=True))
 
 
 def test_the_health_codes_are_the_firmwares():

@@ -21,16 +21,12 @@ Two flights at a time on one build of the firmware."""
 
 from __future__ import annotations
 
-import os
-import shutil
-from concurrent.futures import ThreadPoolExecutor
-
 import pytest
 
 from conftest import EXAMPLES
+from support.closed_loop import build_project, fly_all, needs_avr_sim
 
-pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
-                                reason="gcc-avr and libsimavr-dev are needed (make setup)")
+pytestmark = needs_avr_sim
 
 DIGITAL = EXAMPLES / "hpr_digital"
 FAIL_S = 15.0
@@ -39,24 +35,12 @@ CUT_S = 90.0
 
 @pytest.fixture(scope="module")
 def flights(tmp_path_factory):
-    from fswkit.plant.run import execute, prepare
-    from fswkit.sim.command import build
-
     tmp = tmp_path_factory.mktemp("digital")
-    built = build(str(DIGITAL), out=str(tmp / "build"))
-    assert not isinstance(built, int), "examples/hpr_digital did not build"
-    elf, board = built
     cut = tmp / "cut.toml"  # the project's plant, flown to CUT_S only
     cut.write_text(f'extends = "{DIGITAL / "plant.toml"}"\n\n[scenario]\nmax_s = {CUT_S}\n')
-
-    def fly(fault=None, params=None):
-        _app, layout, sc = prepare(str(DIGITAL), "rocket", seed=1, fault=fault, params=params)
-        return execute(sc, elf, board, layout, None, quiet=True)
-
-    with ThreadPoolExecutor(2) as pool:
-        nominal = pool.submit(fly)
-        nack = pool.submit(fly, f"baro-nack@{FAIL_S:g}", str(cut))
-        return {"nominal": nominal.result(), "nack": nack.result()}
+    flown = fly_all(DIGITAL, build_project(DIGITAL, tmp),
+                    {"nominal": {}, "nack": {"fault": f"baro-nack@{FAIL_S:g}", "params": str(cut)}})
+    return {name: flight for name, (_app, flight) in flown.items()}
 
 
 def _executor_kept_time(flight) -> None:

@@ -18,16 +18,12 @@ Nine flights, two at a time, on one build of the firmware."""
 
 from __future__ import annotations
 
-import os
-import shutil
-from concurrent.futures import ThreadPoolExecutor
-
 import pytest
 
 from conftest import EXAMPLES
+from support.closed_loop import build_project, fly_all, needs_avr_sim
 
-pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
-                                reason="gcc-avr and libsimavr-dev are needed (make setup)")
+pytestmark = needs_avr_sim
 
 ROCKET = EXAMPLES / "rocket"
 SEQUENCE = ["Safe", "Armed", "Boost", "Coast", "Apogee", "Drogue", "Main", "Descent", "Landed"]
@@ -48,30 +44,15 @@ RESETS = {
 
 @pytest.fixture(scope="module")
 def flights(tmp_path_factory):
-    from fswkit.plant.run import execute, prepare
-    from fswkit.sim.command import build
-
     tmp = tmp_path_factory.mktemp("resumes")
-    built = build(str(ROCKET), out=str(tmp / "build"))
-    assert not isinstance(built, int), "examples/rocket did not build"
-    elf, board = built
     short = tmp / "short-hold.toml"
     text = (ROCKET / "plant.toml").read_text()
     assert "hold_s     = 20" in text
     short.write_text(text.replace("hold_s     = 20", "hold_s     = 4"))
-
-    def fly(name, state=None, after=0.0, cause="brownout", fault=None, params=None):
-        app, layout, sc = prepare(str(ROCKET), "rocket", seed=1, fault=fault, params=params)
-        if state is not None:
-            sc.reset_state, sc.reset_after_s, sc.reset_cause = state, after, cause
-        return app, execute(sc, elf, board, layout, None, quiet=True)
-
-    jobs = {name: (name, *spec) for name, spec in RESETS.items()}
-    jobs["pad-power"] = ("pad-power", "Armed", 0.5, "power")
-    jobs["open-igniter"] = ("open-igniter", None, 0.0, "brownout", "open-igniter", str(short))
-    with ThreadPoolExecutor(2) as pool:
-        futures = {k: pool.submit(fly, *a) for k, a in jobs.items()}
-        return {k: f.result() for k, f in futures.items()}
+    jobs = {name: {"reset": spec} for name, spec in RESETS.items()}
+    jobs["pad-power"] = {"reset": ("Armed", 0.5, "power")}
+    jobs["open-igniter"] = {"fault": "open-igniter", "params": str(short)}
+    return fly_all(ROCKET, build_project(ROCKET, tmp), jobs)
 
 
 def _states(run) -> list[str]:

@@ -12,77 +12,22 @@ from __future__ import annotations
 import glob
 import shutil
 import subprocess
-from pathlib import Path
 
 import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
-from fswkit.autocode.app import load_app
-from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.emit.app import emit_app, sensor_args
 from fswkit.autocode.sensors import sensor_name
-
-SV = """\
-[Data]
-U64 time
-U32 state
-F32 baroP
-F64 baroT
-bool baroFault
-U8 baroHealth
-F32 accelZ
-F32 accelY
-bool high
-"""
-SM = """\
-[state_vector]
-U64 time @alias G
-U32 state @alias S
-F32 baroP @read_only
-bool high
-
-[Run]
-.step
-    high = baroP > 100000
-"""
-APP = """\
-[application]
-board {board}
-rate 100
-
-[configs]
-state_vector p.sv
-machine p.sm
-io p.sns
-
-[tasks]
-sense inputs rate=100
-control machine p rate=100
-"""
-
-
-def project(tmp: Path, sns: str, board: str = "native", app: str = APP) -> Path:
-    (tmp / "p.sv").write_text(SV)
-    (tmp / "p.sm").write_text(SM)
-    (tmp / "p.sns").write_text(sns)
-    (tmp / "p.app").write_text(app.format(board=board))
-    return tmp / "p.app"
-
-
-def load(path: Path):
-    d = Diagnostics()
-    app = load_app(str(path), d)
-    assert app is not None, d.render()
-    return app
+from support.sensor_project import load, write_project
 
 
 # ---- rows into the model ---------------------------------------------------------
 
 def test_defaults_and_the_order_of_the_settings(tmp_path):
-    app = load(project(tmp_path, "bmp280 i2c:0x77 pressure=baroP   # a comment\n"
-                                 "adxl345 spi:7 stuck=0 rate=100 -z=accelZ\n"
-                                 "ms5611 i2c:118 timeout=9 pressure=baroT\n"
-                                 "mpu6050\ti2c:0x68 dlpf=6 temperature=accelY\n"))
+    app = load(write_project(tmp_path, "bmp280 i2c:0x77 pressure=baroP   # a comment\n"
+                                       "adxl345 spi:7 stuck=0 rate=100 -z=accelZ\n"
+                                       "ms5611 i2c:118 timeout=9 pressure=baroT\n"
+                                       "mpu6050\ti2c:0x68 dlpf=6 temperature=accelY\n"))
     bmp, adxl, ms, mpu = app.sensors
     assert (bmp.part, bmp.bus, bmp.address, bmp.cs_pin, bmp.where) == ("bmp280", "i2c", 0x77, None, "0x77")
     assert bmp.settings == (("osrs_p", 4), ("osrs_t", 1), ("stuck", 50), ("timeout", 3))
@@ -97,10 +42,10 @@ def test_defaults_and_the_order_of_the_settings(tmp_path):
 
 
 def test_the_drivers_arguments_are_the_datasheets_codes(tmp_path):
-    app = load(project(tmp_path, "bmp280 i2c:0x76 osrs_p=16 osrs_t=2 stuck=7 timeout=4 pressure=baroP\n"
-                                 "ms5611 i2c:0x77 osr=256 pressure=baroT\n"
-                                 "adxl345 spi:8 range=2 rate=3200 z=accelZ\n"
-                                 "adxl345 i2c:0x1D range=4 rate=25 y=accelY\n"))
+    app = load(write_project(tmp_path, "bmp280 i2c:0x76 osrs_p=16 osrs_t=2 stuck=7 timeout=4 pressure=baroP\n"
+                                       "ms5611 i2c:0x77 osr=256 pressure=baroT\n"
+                                       "adxl345 spi:8 range=2 rate=3200 z=accelZ\n"
+                                       "adxl345 i2c:0x1D range=4 rate=25 y=accelY\n"))
     assert [sensor_args(s) for s in app.sensors] == [
         "0x76, 2, 5, 7, 4",  # address, osrs_t code, osrs_p code (x16: 5), stuck, timeout
         "0x77, 0, 50, 3",  # OSR 256: 0
@@ -112,8 +57,8 @@ def test_the_drivers_arguments_are_the_datasheets_codes(tmp_path):
 # ---- the generated code --------------------------------------------------------
 
 def test_the_inputs_task_steps_every_part_then_writes_its_elements(tmp_path):
-    app = load(project(tmp_path, "bmp280 i2c:0x76 pressure=baroP temperature=baroT fault=baroFault "
-                                 "health=baroHealth\nadxl345 spi:7 -z=accelZ\n"))
+    app = load(write_project(tmp_path, "bmp280 i2c:0x76 pressure=baroP temperature=baroT fault=baroFault "
+                                       "health=baroHealth\nadxl345 spi:7 -z=accelZ\n"))
     cpp = emit_app(app)["app.gen.cpp"]
     assert '#include "fsw_sensor.h"\n#include "fsw_accel.h"\n' in cpp
     assert "fsw::Bmp280 sensor0(0x76, 1, 3, 50, 3);" in cpp and "fsw::Adxl345 sensor1(7, 1, 3, 0xC, 50, 3);" in cpp
@@ -133,7 +78,7 @@ def test_the_inputs_task_steps_every_part_then_writes_its_elements(tmp_path):
 
 
 def test_a_barometer_only_app_includes_no_accelerometer_header(tmp_path):
-    cpp = emit_app(load(project(tmp_path, "ms5611 i2c:0x77 pressure=baroP\n")))["app.gen.cpp"]
+    cpp = emit_app(load(write_project(tmp_path, "ms5611 i2c:0x77 pressure=baroP\n")))["app.gen.cpp"]
     assert '#include "fsw_sensor.h"' in cpp and "fsw_accel.h" not in cpp
     assert "fsw::sensors_begin(1, 0);" in cpp
 
@@ -204,8 +149,8 @@ int main() {
 
 @pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
 def test_a_native_bmp280_app_writes_the_pressure_element(tmp_path):
-    app = load(project(tmp_path, "bmp280 i2c:0x76 pressure=baroP temperature=baroT fault=baroFault "
-                                 "health=baroHealth\n"))
+    app = load(write_project(tmp_path, "bmp280 i2c:0x76 pressure=baroP temperature=baroT fault=baroFault "
+                                       "health=baroHealth\n"))
     gen = tmp_path / "gen"
     gen.mkdir()
     for name, text in emit_app(app).items():
@@ -229,7 +174,7 @@ def test_a_native_bmp280_app_writes_the_pressure_element(tmp_path):
 # ---- fsw check ------------------------------------------------------------------
 
 def test_fsw_check_a_project_with_a_sensor_table(tmp_path):
-    project(tmp_path, "bmp280 i2c:0x76 pressure=baroP\n", board="uno")
+    write_project(tmp_path, "bmp280 i2c:0x76 pressure=baroP\n", board="uno")
     r = run_fsw("check", str(tmp_path))
     assert (r.code, r.err) == (0, "fsw check: 3 files, 0 errors, 0 warnings\n")  # p.app, p.sm, p.sv
     (tmp_path / "p.sns").write_text("bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:13 z=accelZ\n")
@@ -240,7 +185,7 @@ def test_fsw_check_a_project_with_a_sensor_table(tmp_path):
 
 
 def test_fsw_check_of_a_table_alone_says_what_to_give(tmp_path):
-    project(tmp_path, "bmp280 i2c:0x76 pressure=baroP\n")
+    write_project(tmp_path, "bmp280 i2c:0x76 pressure=baroP\n")
     r = run_fsw("check", "p.sns", cwd=tmp_path)
     assert r.code == 2
     assert r.err == ("fsw check: p.sns: an I/O table (.aio, .dio, .sns) is checked with the application that lists "

@@ -5,7 +5,7 @@ rate 100
 reset_cause resetCause
 
 [configs]
-state_vector sns.sv
+state_vector rig.sv
 machine rig.sm
 io rig.aio
 io rig.dio

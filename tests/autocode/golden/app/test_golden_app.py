@@ -6,7 +6,7 @@ tests/autocode/golden/app/ holds one small application per diagnostic,
 `NAME.app`, beside `NAME.expected`: exactly what `fsw check NAME.app` writes
 to standard error, run from this folder. A case about a channel table names
 its own `NAME.aio` or `NAME.dio`, a sensor case (`sensors_*`) its
-`NAME.sns` and the state vector sns.sv (rig.sv with the parts' elements),
+`NAME.sns` (writing the elements of rig.sv's [Parts] group),
 changing `sensors_valid.app`; the other files (rig.sv, rig.sm, rig.aio,
 rig.dio, ...) are the companions the cases share. Each case is the same
 valid application (`valid.app`) with one thing changed, so its diagnostics

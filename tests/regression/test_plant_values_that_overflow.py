@@ -84,7 +84,7 @@ class _Board:
     def watch(self, pin):
         pass
 
-    def batch(self, until, analog=None, digital=None):
+    def batch(self, until, analog=None, digital=None, parts=None):
         return Batch(RunResult(until, 0.0, "running", "target"), [], b"")
 
     def close(self):

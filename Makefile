@@ -105,6 +105,7 @@ bench: setup
 	$(PY) tools/bench_ground.py
 	$(PY) tools/bench_params.py
 	$(PY) tools/bench_recorder.py
+	$(PY) tools/bench_vm.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -24,5 +24,6 @@
 #include "fsw_sensor.h"
 #include "fsw_baro.h"
 #include "fsw_accel.h"
+#include "fsw_vm.h"
 
 #endif  // FSWKIT_H

@@ -128,6 +128,15 @@ def parser() -> argparse.ArgumentParser:
     g.add_argument("-o", "--output", help="write here instead of standard output")
     g.set_defaults(func=_command("front", "cmd_graph"))
 
+    cp = sub.add_parser("compile", help="a machine as a bytecode image for the runtime's VM (docs/bytecode.md)")
+    cp.add_argument("machine", metavar="MACHINE.sm")
+    cp.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
+    cp.add_argument("--real", choices=("f64", "f32"), default=None,
+                    help="evaluation type R of the runtime that runs it (default f64)")
+    cp.add_argument("--board", help="for this board's evaluation type (e.g. uno: binary32)")
+    cp.add_argument("-o", "--output", required=True, metavar="FILE.fsm", help="the image to write (- for standard output)")
+    cp.set_defaults(func=_command("compile", "cmd_compile"))
+
     gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
     gn.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
     gn.add_argument("--board", help="build for this board instead of the one the .app names")

@@ -1,0 +1,285 @@
+"""The bytecode image's format constants and its verifier, the host's copy
+of firmware/src/fsw_vm.cpp's vm_verify: the same rules in the same order,
+returning the same reason codes (docs/bytecode.md, "The verifier").
+`fsw compile` runs it before it writes an image."""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+from . import model as M
+
+MAGIC = b"FSMB"
+VERSION = 1
+HEADER = 28
+NONE = 0xFFFF  # a state without this block
+FLAG_LOCK = 1
+VM_STACK = 12  # FSW_VM_STACK's default
+VM_PENDING = 16  # FSW_VM_PENDING's default
+
+# Opcodes (docs/bytecode.md, "Instructions").
+END, GOTO, JMP, JF, AND, OR = 0x00, 0x01, 0x02, 0x03, 0x04, 0x05
+CONST, LDE, STE, LDL, STL, LDT, ROLL, WPUSH = 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C, 0x0D
+NEG, ADD, SUB, MUL, DIV = 0x10, 0x11, 0x12, 0x13, 0x14
+LT, LE, GT, GE, EQ, NE, NOT, TRUTH = 0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E, 0x1F
+ARITH = {"+": ADD, "-": SUB, "*": MUL, "/": DIV}
+COMPARE = {"<": LT, "<=": LE, ">": GT, ">=": GE, "==": EQ, "!=": NE}
+
+WINDOW_FUNCS = {"avg": 0, "min": 1, "max": 2, "range": 3, "median": 4}
+# Element types as the runtime numbers them (fsw_types.h ElemType).
+TYPE_CODES = {n: k for k, n in enumerate(("I8", "I16", "I32", "I64", "U8", "U16", "U32", "U64",
+                                          "F32", "F64", "bool"))}
+TYPE_SIZES = (1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1)
+
+# Reason codes (fsw_vm.h VmReason), with what each means.
+REASONS = {
+    0: "ok",
+    1: "bad magic (not a state-machine image)",
+    2: "a format version or flags this runtime does not read",
+    3: "compiled for the other evaluation type (f32/f64)",
+    4: "bound to another state vector (schema hash or element count)",
+    5: "the lengths in the header do not add up to the image",
+    6: "an element index out of range, or its type not the layout's",
+    7: "a local index out of range, or a local outside the locals",
+    8: "no states, a state index out of range, or a code offset out of range",
+    9: "a window index, function or size out of range, or pushed out of order",
+    10: "a jump backward, out of its block, or into an instruction",
+    11: "stack underflow, deeper than the VM's stack or than declared, or not empty at the end",
+    12: "an unknown opcode, or an operand past the code",
+    13: "a block that does not end, unreachable code, or an offset not at a block's start",
+    14: "goto outside .entry/.step, or a window push outside the prelude",
+    15: "more pending forward jumps than the verifier tracks",
+    16: "the RAM buffer is smaller than the image needs",
+}
+(OK, BAD_MAGIC, BAD_VERSION, BAD_REAL, BAD_SCHEMA, BAD_SIZE, BAD_ELEMENT, BAD_LOCAL, BAD_STATE,
+ BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM) = range(17)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The state vector an image is bound to: (offset, type code) per
+    element in layout order, and its schema hash."""
+    elems: tuple[tuple[int, int], ...]
+    schema: int
+
+
+def layout_of(sv: M.StateVector) -> Layout:
+    from .schema import schema_hash
+    return Layout(tuple((e.offset, TYPE_CODES[e.type.name]) for e in sv.elements), schema_hash(sv))
+
+
+def operand_bytes(op: int, real: int) -> int | None:
+    if op in (END, LDT, NEG, ADD, SUB, MUL, DIV, LT, LE, GT, GE, EQ, NE, NOT, TRUTH):
+        return 0
+    if op in (GOTO, ROLL, WPUSH):
+        return 1
+    if op in (JMP, JF, AND, OR, LDL, STL):
+        return 2
+    if op in (LDE, STE):
+        return 3
+    if op == CONST:
+        return real
+    return None
+
+
+@dataclass
+class Parts:
+    states: int
+    windows: int
+    locals: int
+    loc_size: int
+    prelude: int
+    code_size: int
+    st: int  # byte offsets in the image
+    loc: int
+    win: int
+    init: int
+    code: int
+    total: int
+
+
+def parts(im: bytes) -> Parts:
+    states, windows = im[18], im[19]
+    nloc, loc_size, prelude, code_size = struct.unpack_from("<HHHH", im, 20)
+    st = HEADER
+    loc = st + 6 * states
+    win = loc + 3 * nloc
+    init = win + 4 * windows
+    code = init + loc_size
+    return Parts(states, windows, nloc, loc_size, prelude, code_size, st, loc, win, init, code, code + code_size)
+
+
+def _u16(im: bytes, at: int) -> int:
+    return im[at] | (im[at + 1] << 8)
+
+
+def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) -> tuple[int, int]:
+    """(reason, deepest stack) of the code pass."""
+    real = im[5]
+    offsets = [_u16(im, p.st + 2 * k) for k in range(3 * p.states)]
+    declared = 1 if p.prelude != NONE else 0
+    for off in offsets:
+        if off == NONE:
+            continue
+        if off >= p.code_size:
+            return BAD_STATE, 0
+        declared += 1
+    if p.prelude == NONE or p.prelude >= p.code_size:
+        return BAD_END, 0
+    moving_offs = [off for k, off in enumerate(offsets) if k % 3 != 2]
+    still_offs = [off for k, off in enumerate(offsets) if k % 3 == 2]
+    pend: list[list[int]] = []
+    depth = deepest = pushed = 0
+    reachable, at_start, may_move, prelude = True, True, False, False
+    matched = pc = 0
+    code = im[p.code:p.code + p.code_size]
+    while pc < p.code_size:
+        if at_start:
+            moving = moving_offs.count(pc)
+            still = still_offs.count(pc) + (p.prelude == pc)
+            if moving and still:
+                return BAD_PLACE, deepest
+            matched += moving + still
+            may_move = moving != 0
+            prelude = p.prelude == pc
+            pushed = 0
+            at_start = False
+            reachable = True
+        k = 0
+        while k < len(pend):  # the same order as the C loop (swap-remove)
+            target, d = pend[k]
+            if target < pc:
+                return BAD_JUMP, deepest
+            if target == pc:
+                if pc in moving_offs or pc in still_offs or pc == p.prelude:
+                    return BAD_JUMP, deepest  # into another block
+                if reachable and depth != d:
+                    return BAD_STACK, deepest
+                depth = d
+                reachable = True
+                pend[k] = pend[-1]
+                pend.pop()
+            else:
+                k += 1
+        if not reachable:
+            return BAD_END, deepest
+        op = code[pc]
+        n = operand_bytes(op, real)
+        if n is None or pc + 1 + n > p.code_size:
+            return BAD_OPCODE, deepest
+        a = pc + 1
+        pc += 1 + n
+        pops = pushes = 0
+        ends = False
+        if op == END:
+            ends = True
+        elif op == GOTO:
+            if not may_move:
+                return BAD_PLACE, deepest
+            if code[a] >= p.states:
+                return BAD_STATE, deepest
+            ends = True
+        elif op in (JMP, JF, AND, OR):
+            pops = 0 if op == JMP else 1
+            if depth < pops:
+                return BAD_STACK, deepest
+            target = pc + _u16(code, a)
+            if target >= p.code_size:
+                return BAD_JUMP, deepest
+            if len(pend) == pending:
+                return TOO_NESTED, deepest
+            pend.append([target, depth - 1 if op == JF else depth])
+            if op == JMP:
+                reachable = False
+        elif op in (CONST, LDT):
+            pushes = 1
+        elif op in (LDE, STE):
+            e = _u16(code, a)
+            if e >= len(layout.elems) or layout.elems[e][1] != code[a + 2]:
+                return BAD_ELEMENT, deepest
+            pushes, pops = (1, 0) if op == LDE else (0, 1)
+        elif op in (LDL, STL):
+            if _u16(code, a) >= p.locals:
+                return BAD_LOCAL, deepest
+            pushes, pops = (1, 0) if op == LDL else (0, 1)
+        elif op == ROLL:
+            if code[a] >= p.windows or (prelude and code[a] >= pushed):
+                return BAD_WINDOW, deepest
+            pushes = 1
+        elif op == WPUSH:
+            if not prelude:
+                return BAD_PLACE, deepest
+            if code[a] != pushed:
+                return BAD_WINDOW, deepest
+            pushed += 1
+            pops = 1
+        elif op in (NEG, NOT, TRUTH):
+            pops = pushes = 1
+        else:
+            pops, pushes = 2, 1
+        if depth < pops:
+            return BAD_STACK, deepest
+        depth = depth - pops + pushes
+        deepest = max(deepest, depth)
+        if deepest > stack:
+            return BAD_STACK, deepest
+        if ends:
+            if depth != 0:
+                return BAD_STACK, deepest
+            reachable = False
+            if not pend:
+                if prelude and pushed != p.windows:
+                    return BAD_WINDOW, deepest
+                at_start = True
+    if pend:
+        return BAD_JUMP, deepest
+    if not at_start or matched != declared:
+        return BAD_END, deepest
+    if deepest != im[7]:
+        return BAD_STACK, deepest
+    return OK, deepest
+
+
+def code_depth(im: bytes, layout: Layout, stack: int = 255) -> tuple[int, int]:
+    """The code pass alone: (reason, deepest stack). The compiler takes the
+    deepest figure for the header (whose own figure may differ: BAD_STACK
+    then says only that)."""
+    return _verify_code(im, parts(im), layout, stack, VM_PENDING)
+
+
+def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pending: int = VM_PENDING) -> int:
+    """vm_verify on the host: the reason code (0: the image may run).
+    `real_bytes` is the runtime's sizeof(Real); RAM is not checked here
+    (the board's buffer is the board's)."""
+    if len(im) > 0xFFFF or len(im) < HEADER:
+        return BAD_SIZE
+    if im[:4] != MAGIC:
+        return BAD_MAGIC
+    if im[4] != VERSION:
+        return BAD_VERSION
+    if im[5] != real_bytes:
+        return BAD_REAL
+    if im[6] & ~FLAG_LOCK:
+        return BAD_VERSION
+    schema, count = struct.unpack_from("<IH", im, 8)
+    if schema != layout.schema or count != len(layout.elems):
+        return BAD_SCHEMA
+    p = parts(im)
+    if p.total != len(im):
+        return BAD_SIZE
+    g, s = struct.unpack_from("<HH", im, 14)
+    if g >= count or s >= count or layout.elems[g][1] != TYPE_CODES["U64"] or layout.elems[s][1] != TYPE_CODES["U32"]:
+        return BAD_ELEMENT
+    if p.states == 0:
+        return BAD_STATE
+    for k in range(p.locals):
+        t = im[p.loc + 3 * k]
+        off = _u16(im, p.loc + 3 * k + 1)
+        if t >= len(TYPE_SIZES) or off + TYPE_SIZES[t] > p.loc_size:
+            return BAD_LOCAL
+    for w in range(p.windows):
+        n = _u16(im, p.win + 4 * w + 2)
+        if im[p.win + 4 * w] > 4 or im[p.win + 4 * w + 1] != 0 or n == 0:
+            return BAD_WINDOW
+    return _verify_code(im, p, layout, stack, pending)[0]

@@ -1,0 +1,81 @@
+// A state machine as a bytecode image (docs/bytecode.md): the verifier that
+// refuses a bad image before it runs, and the VM that steps a verified one
+// with the semantics of a generated machine's step().
+#ifndef FSW_VM_H
+#define FSW_VM_H
+
+#include "fsw_machine.h"
+#include "fsw_types.h"
+
+// Operand stack of the VM, in Reals (on the C stack while a step runs). An
+// image that needs more is refused by the verifier (kVmBadStack).
+#ifndef FSW_VM_STACK
+#define FSW_VM_STACK 12
+#endif
+// Forward jumps the verifier tracks at once (nesting of if/and/or); more is
+// refused (kVmTooNested). Each costs 4 bytes of the verifier's C stack.
+#ifndef FSW_VM_PENDING
+#define FSW_VM_PENDING 16
+#endif
+#if FSW_VM_STACK < 2 || FSW_VM_STACK > 255
+#error "fswkit: FSW_VM_STACK must be 2..255"
+#endif
+
+namespace fsw {
+
+// Values are stable: the host verifier (autocode/vmverify.py) returns the same.
+enum VmReason : uint8_t {
+    kVmOk = 0,
+    kVmBadMagic = 1,     // not "FSMB"
+    kVmBadVersion = 2,   // a format version this runtime does not read
+    kVmBadReal = 3,      // compiled for the other evaluation type (f32 / f64)
+    kVmBadSchema = 4,    // bound to another state vector (schema hash, element count)
+    kVmBadSize = 5,      // the lengths in the header do not add up to the image
+    kVmBadElement = 6,   // an element index out of range, or its type not the layout's
+    kVmBadLocal = 7,     // a local index out of range, or a local outside the locals
+    kVmBadState = 8,     // no states, a state index out of range, a code offset out of range
+    kVmBadWindow = 9,    // a window index, function or size out of range, or pushed out of order
+    kVmBadJump = 10,     // a jump backward, out of its block, or into an instruction
+    kVmBadStack = 11,    // underflow, deeper than the VM's stack or than declared, not empty at the end
+    kVmBadOpcode = 12,   // an unknown opcode, or an operand past the code
+    kVmBadEnd = 13,      // a block that does not end, unreachable code, an offset not at a block's start
+    kVmBadPlace = 14,    // goto outside .entry/.step, a window push outside the prelude
+    kVmTooNested = 15,   // more pending forward jumps than FSW_VM_PENDING
+    kVmNoRam = 16,       // the caller's buffer is smaller than the image needs
+};
+
+// An element of the state vector the image is bound to: offset and type.
+struct VmElem {
+    uint16_t off;
+    uint8_t type;  // ElemType
+};
+
+// The layout of the running firmware's state vector, in element order.
+struct VmLayout {
+    const VmElem* elems;
+    uint16_t count;
+    uint32_t schema;  // the state vector's schema hash
+};
+
+// Bytes of RAM the image needs (windows, then locals): 0 for an image whose
+// header cannot be read. vm_verify checks it against the caller's buffer,
+// which must be aligned for Real (alignas(8) serves every board).
+uint32_t vm_ram_size(const uint8_t* image, uint16_t len);
+
+// Checks every rule of docs/bytecode.md; kVmOk means vm_step may run it.
+FSW_MUST_CHECK VmReason vm_verify(const uint8_t* image, uint16_t len, const VmLayout& layout, uint32_t ram_len);
+
+// The image's locals inside `ram` (packed little-endian, in declaration order).
+uint8_t* vm_locals(const uint8_t* image, uint8_t* ram);
+
+// Back to the state before the first step in `initial` (a state id, 1..):
+// the machine reset, locals at their initial values, windows empty.
+void vm_reset(const uint8_t* image, uint8_t* ram, Machine& m, uint32_t initial);
+
+// One step of a verified image (spec 4.6), as a generated step(): kErrTime
+// (and nothing changed) when G did not increase.
+FSW_MUST_CHECK Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m);
+
+}  // namespace fsw
+
+#endif  // FSW_VM_H

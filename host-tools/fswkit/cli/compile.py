@@ -1,0 +1,76 @@
+"""`fsw compile`: a machine as a bytecode image for the runtime's VM
+(docs/bytecode.md), verified on the host before it is written."""
+
+from __future__ import annotations
+
+import sys
+
+from fswkit.autocode.diagnostics import SM, Diagnostics, Source
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags
+
+
+def _real(args):
+    """The evaluation type from --real / --board, or None after a message."""
+    from fswkit.autocode.numeric import REALS
+
+    name = args.real
+    if args.board is not None:
+        from fswkit.autocode.board import BoardError, load_board
+        try:
+            board = load_board(args.board)
+        except BoardError as e:
+            sys.stderr.write(f"fsw compile: {e}\n")
+            return None
+        if name is not None and name != board.real:
+            sys.stderr.write(f"fsw compile: --real {name} contradicts board `{board.name}`, "
+                             f"whose evaluation type is {board.real}\n")
+            return None
+        name = board.real
+    return REALS[name or "f64"]
+
+
+def cmd_compile(args) -> int:
+    from fswkit.autocode import vmverify as V
+    from fswkit.autocode.emit.bytecode import BytecodeError, compile_machine
+    from fswkit.autocode.project import load_machine
+    from fswkit.outputs import OutputError, output
+
+    real = _real(args)
+    if real is None:
+        return EXIT_CONFIG
+    diags = Diagnostics()
+    m = load_machine(args.machine, diags, args.sv)
+    print_diags(diags)
+    if m is None:
+        return EXIT_CONFIG
+    try:
+        image = compile_machine(m, real)
+    except BytecodeError as e:
+        try:
+            with open(args.machine, encoding="utf-8", errors="surrogateescape") as f:
+                src = Source.from_text(args.machine, f.read())
+        except OSError:
+            src = Source.from_text(args.machine, "")
+        d = Diagnostics()
+        d.error(src, SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        print_diags(d)
+        return EXIT_CONFIG
+    reason = V.verify(image, V.layout_of(m.sv), real.bits // 8)
+    if reason != V.OK:  # the compiler's own fault: never written
+        sys.stderr.write(f"fsw compile: internal error: the image of {args.machine} fails the verifier "
+                         f"(reason {reason}: {V.REASONS[reason]})\n")
+        return EXIT_INTERNAL
+    try:
+        if args.output == "-":
+            sys.stdout.buffer.write(image)
+            sys.stdout.buffer.flush()
+        else:
+            with output(args.output, (args.machine, m.sv.path), binary=True) as out:
+                out.write(image)
+    except OutputError as e:
+        sys.stderr.write(f"fsw compile: {e}\n")
+        return EXIT_FAIL
+    if args.output != "-":
+        sys.stderr.write(f"fsw compile: {args.output}: {len(image)} bytes, {plural(len(m.states), 'state')}, "
+                         f"binary{real.bits}, schema 0x{V.layout_of(m.sv).schema:08x}\n")
+    return EXIT_OK

@@ -1,0 +1,347 @@
+// Scenario: the bytecode verifier (docs/bytecode.md, "The verifier") refuses
+// an image that breaks each of its rules, with that rule's reason code, and
+// the VM steps a verified image as a generated machine steps.
+#include "test_support.h"
+
+using namespace fsw;
+
+void setUp(void) {}
+void tearDown(void) {}
+
+namespace {
+
+// The state vector the images are bound to: G, S, x (F32), n (I16).
+const VmElem kElems[] = {{0, kU64}, {8, kU32}, {12, kF32}, {16, kI16}};
+const VmLayout kLayout = {kElems, 4, 0x12345678UL};
+uint8_t sv[18];
+alignas(8) uint8_t ram[128];
+
+enum : uint8_t {
+    END = 0x00, GOTO = 0x01, JMP = 0x02, JF = 0x03, AND = 0x04, OR = 0x05, CONST = 0x06, LDE = 0x07,
+    STE = 0x08, LDL = 0x09, STL = 0x0A, LDT = 0x0B, ROLL = 0x0C, WPUSH = 0x0D, NEG = 0x10, ADD = 0x11,
+    LT = 0x18, GT = 0x1A, NOT = 0x1E, TRUTH = 0x1F,
+};
+const uint16_t NO = 0xFFFFu;
+
+// The good image's code. Blocks, at code offsets:
+//   0  [A] .step: x > n: -> B; else l = l + l
+//  25  [A] .exit: n = T
+//  31  [B] .step: (x and l) or not l: -> A
+//  55  prelude: push x into window 0 (roll_avg, N 4)
+const uint8_t kCode[] = {
+    LDE, 2, 0, kF32, LDE, 3, 0, kI16, GT, JF, 2, 0, GOTO, 1,  // 0..13
+    LDL, 0, 0, LDL, 0, 0, ADD, STL, 0, 0, END,                 // 14..24 (l = l + l)
+    LDT, STE, 3, 0, kI16, END,                                 // 25..30
+    LDE, 2, 0, kF32, AND, 4, 0, LDL, 0, 0, TRUTH, OR, 4, 0,    // 31..44
+    LDL, 0, 0, NOT, JF, 2, 0, GOTO, 0, END,                    // 45..54
+    LDE, 2, 0, kF32, WPUSH, 0, END,                            // 55..61
+};
+const uint16_t kStep0 = 0, kExit0 = 25, kStep1 = 31, kPrelude = 55;
+
+struct Image {
+    uint8_t b[200];
+    uint16_t len;
+    uint16_t code;  // where the code starts in b
+};
+
+void put16(uint8_t* p, uint16_t v) {
+    p[0] = static_cast<uint8_t>(v);
+    p[1] = static_cast<uint8_t>(v >> 8);
+}
+
+// An image of the two states above with `code` (its blocks where `offs`,
+// `prelude` say), one U8 local (initial 3) and one roll_avg over 4 samples.
+void build(Image& im, const uint8_t* code, uint16_t n, const uint16_t offs[6], uint16_t prelude, uint8_t stack) {
+    memset(im.b, 0, sizeof im.b);
+    uint8_t* h = im.b;
+    h[0] = 'F'; h[1] = 'S'; h[2] = 'M'; h[3] = 'B';
+    h[4] = 1;
+    h[5] = sizeof(Real);
+    h[6] = 0;
+    h[7] = stack;
+    put16(h + 8, 0x5678);
+    put16(h + 10, 0x1234);
+    put16(h + 12, 4);  // elements
+    put16(h + 14, 0);  // G
+    put16(h + 16, 1);  // S
+    h[18] = 2;         // states
+    h[19] = 1;         // windows
+    put16(h + 20, 1);  // locals
+    put16(h + 22, 1);  // bytes of locals
+    put16(h + 24, prelude);
+    put16(h + 26, n);
+    uint8_t* p = h + 28;
+    for (int k = 0; k < 6; ++k, p += 2) put16(p, offs[k]);
+    *p++ = kU8;  // local 0: U8 at 0
+    put16(p, 0);
+    p += 2;
+    *p++ = 0;  // window 0: roll_avg, N 4
+    *p++ = 0;
+    put16(p, 4);
+    p += 2;
+    *p++ = 3;  // the local's initial value
+    im.code = static_cast<uint16_t>(p - h);
+    memcpy(p, code, n);
+    im.len = static_cast<uint16_t>(im.code + n);
+}
+
+const uint16_t kOffs[6] = {NO, kStep0, kExit0, NO, kStep1, NO};
+
+void good(Image& im) { build(im, kCode, sizeof kCode, kOffs, kPrelude, 2); }
+
+VmReason verify(const Image& im) { return vm_verify(im.b, im.len, kLayout, sizeof ram); }
+
+// The code of `good` with the byte at `at` (a code offset) set to `v`.
+VmReason patched(uint16_t at, uint8_t v) {
+    Image im;
+    good(im);
+    im.b[im.code + at] = v;
+    return verify(im);
+}
+
+// An image whose state A's .step is `code` (ending the code but for the prelude).
+VmReason with_step(const uint8_t* code, uint16_t n, uint8_t stack) {
+    uint8_t all[120];
+    memcpy(all, code, n);
+    const uint8_t prelude[] = {LDE, 2, 0, kF32, WPUSH, 0, END};
+    memcpy(all + n, prelude, sizeof prelude);
+    const uint16_t offs[6] = {NO, 0, NO, NO, NO, NO};
+    Image im;
+    build(im, all, static_cast<uint16_t>(n + sizeof prelude), offs, n, stack);
+    return verify(im);
+}
+
+}  // namespace
+
+void test_the_good_image_verifies(void) {
+    Image im;
+    good(im);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    TEST_ASSERT_EQUAL_UINT(48, im.code);  // header 28, states 12, local 3, window 4, initial value 1
+    TEST_ASSERT_TRUE(vm_ram_size(im.b, im.len) <= sizeof ram);
+}
+
+void test_header_rules(void) {
+    Image im;
+    good(im);
+    im.b[0] = 'X';
+    TEST_ASSERT_EQUAL_UINT(kVmBadMagic, verify(im));
+    good(im);
+    im.b[4] = 2;
+    TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
+    good(im);
+    im.b[6] = 0x80;  // an unknown flag
+    TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
+    good(im);
+    im.b[5] = sizeof(Real) == 4 ? 8 : 4;
+    TEST_ASSERT_EQUAL_UINT(kVmBadReal, verify(im));
+    good(im);
+    const VmLayout other = {kElems, 4, 0x12345679UL};
+    TEST_ASSERT_EQUAL_UINT(kVmBadSchema, vm_verify(im.b, im.len, other, sizeof ram));
+    const VmLayout fewer = {kElems, 3, 0x12345678UL};
+    TEST_ASSERT_EQUAL_UINT(kVmBadSchema, vm_verify(im.b, im.len, fewer, sizeof ram));
+    TEST_ASSERT_EQUAL_UINT(kVmBadSize, vm_verify(im.b, static_cast<uint16_t>(im.len - 1u), kLayout, sizeof ram));
+    TEST_ASSERT_EQUAL_UINT(kVmBadSize, vm_verify(im.b, static_cast<uint16_t>(im.len + 1u), kLayout, sizeof ram));
+    TEST_ASSERT_EQUAL_UINT(kVmBadSize, vm_verify(im.b, 27, kLayout, sizeof ram));
+    TEST_ASSERT_EQUAL_UINT(kVmNoRam, vm_verify(im.b, im.len, kLayout, vm_ram_size(im.b, im.len) - 1u));
+    TEST_ASSERT_EQUAL_UINT(kVmOk, vm_verify(im.b, im.len, kLayout, vm_ram_size(im.b, im.len)));
+}
+
+void test_element_rules(void) {
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, patched(1, 4));     // element 4 of 4
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, patched(3, kF64));  // x is F32
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, patched(29, kI32)); // a store of n as I32
+    Image im;
+    good(im);
+    put16(im.b + 14, 2);  // G bound to x (F32)
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    good(im);
+    put16(im.b + 16, 0);  // S bound to G (U64)
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+}
+
+void test_local_rules(void) {
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, patched(15, 1));  // local 1 of 1
+    Image im;
+    good(im);
+    im.b[28 + 12] = kU16;  // the U8 local declared U16: outside the 1 byte of locals
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, verify(im));
+    good(im);
+    im.b[28 + 12] = 11;  // no such type
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, verify(im));
+}
+
+void test_state_rules(void) {
+    TEST_ASSERT_EQUAL_UINT(kVmBadState, patched(13, 2));  // goto state 2 of 2
+    Image im;
+    good(im);
+    put16(im.b + 28 + 2, static_cast<uint16_t>(sizeof kCode));  // a .step past the code
+    TEST_ASSERT_EQUAL_UINT(kVmBadState, verify(im));
+    good(im);
+    im.b[18] = 0;  // no states (and no state table)
+    memmove(im.b + 28, im.b + 40, im.len - 40u);
+    im.len = static_cast<uint16_t>(im.len - 12u);
+    TEST_ASSERT_EQUAL_UINT(kVmBadState, verify(im));
+}
+
+void test_window_rules(void) {
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, patched(60, 1));  // push window 1 of 1
+    Image im;
+    good(im);
+    im.b[28 + 15] = 5;  // no such function
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, verify(im));
+    good(im);
+    put16(im.b + 28 + 17, 0);  // N = 0
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, verify(im));
+    const uint8_t roll_missing[] = {ROLL, 1, STE, 3, 0, kI16, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, with_step(roll_missing, sizeof roll_missing, 1));
+    // A prelude that reads its window before pushing it, or never pushes it.
+    const uint8_t early[] = {END, ROLL, 0, WPUSH, 0, END};
+    const uint16_t offs[6] = {NO, 0, NO, NO, NO, NO};
+    build(im, early, sizeof early, offs, 1, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, verify(im));
+    const uint8_t none[] = {END, END};
+    build(im, none, sizeof none, offs, 1, 0);
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, verify(im));
+}
+
+void test_jump_rules(void) {
+    // Past the code, and into the middle of an instruction (the goto's operand).
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, patched(10, 200));
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, patched(10, 1));
+    // Out of its block: over the .step's END to the prelude that follows.
+    const uint8_t out[] = {LDT, JF, 1, 0, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, with_step(out, sizeof out, 1));
+    // Over the GOTO into the .exit: the code between (the .step's else
+    // branch) is then reached by nothing.
+    TEST_ASSERT_EQUAL_UINT(kVmBadEnd, patched(10, 13));
+    // A backward jump cannot be written: the displacement is unsigned, and
+    // 0xFFFF forward leaves the code.
+    Image im;
+    good(im);
+    put16(im.b + im.code + 10, 0xFFFFu);
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, verify(im));
+}
+
+void test_stack_rules(void) {
+    const uint8_t underflow[] = {LDT, ADD, STE, 3, 0, kI16, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(underflow, sizeof underflow, 1));
+    const uint8_t left[] = {LDT, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(left, sizeof left, 1));
+    const uint8_t ok[] = {LDT, LDT, ADD, STE, 3, 0, kI16, END};
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(ok, sizeof ok, 2));
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(ok, sizeof ok, 3));  // declared deeper than it is
+    uint8_t deep[2 * FSW_VM_STACK + 8];
+    uint16_t n = 0;
+    for (int k = 0; k <= FSW_VM_STACK; ++k) deep[n++] = LDT;
+    for (int k = 0; k < FSW_VM_STACK; ++k) deep[n++] = ADD;
+    deep[n++] = STE; deep[n++] = 3; deep[n++] = 0; deep[n++] = kI16; deep[n++] = END;
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(deep, n, FSW_VM_STACK + 1));
+    // Two paths reaching one place with different depths.
+    const uint8_t uneven[] = {LDT, LDT, JF, 1, 0, LDT, STE, 3, 0, kI16, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(uneven, sizeof uneven, 2));
+}
+
+void test_opcode_and_end_rules(void) {
+    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, patched(8, 0x77));
+    const uint8_t cut[] = {CONST, 0};  // its value runs past the code
+    const uint16_t offs[6] = {NO, 0, NO, NO, NO, NO};
+    const uint16_t none[6] = {NO, NO, NO, NO, NO, NO};
+    Image im;
+    build(im, cut, sizeof cut, none, 0, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, verify(im));
+    // The code not ending with END.
+    const uint8_t unended[] = {LDE, 2, 0, kF32, WPUSH, 0, END, LDT, STE, 3, 0, kI16};
+    build(im, unended, sizeof unended, offs, 0, 1);
+    put16(im.b + 28 + 2, 7);
+    TEST_ASSERT_EQUAL_UINT(kVmBadEnd, verify(im));
+    // A block offset in the middle of a block, and code nothing reaches.
+    good(im);
+    put16(im.b + 28 + 4, 26);  // A's .exit at the STE after LDT
+    TEST_ASSERT_EQUAL_UINT(kVmBadEnd, verify(im));
+    const uint8_t dead[] = {LDT, JF, 3, 0, GOTO, 0, LDT, END};  // LDT after the goto: never reached
+    TEST_ASSERT_EQUAL_UINT(kVmBadEnd, with_step(dead, sizeof dead, 1));
+}
+
+void test_place_rules(void) {
+    // A goto in .exit, and in the prelude; a window push in a .step.
+    Image im;
+    const uint8_t ex[] = {GOTO, 0, LDE, 2, 0, kF32, WPUSH, 0, END};
+    const uint16_t offs[6] = {NO, NO, 0, NO, NO, NO};
+    build(im, ex, sizeof ex, offs, 2, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmBadPlace, verify(im));
+    const uint8_t pre[] = {LDE, 2, 0, kF32, WPUSH, 0, GOTO, 0};
+    const uint16_t none[6] = {NO, NO, NO, NO, NO, NO};
+    build(im, pre, sizeof pre, none, 0, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmBadPlace, verify(im));
+    const uint8_t push[] = {LDT, WPUSH, 0, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadPlace, with_step(push, sizeof push, 1));
+    // One block both a .step (may transition) and an .exit (may not).
+    const uint8_t both[] = {END, LDE, 2, 0, kF32, WPUSH, 0, END};
+    const uint16_t shared[6] = {NO, 0, 0, NO, NO, NO};
+    build(im, both, sizeof both, shared, 1, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmBadPlace, verify(im));
+}
+
+void test_nesting_rule(void) {
+    // FSW_VM_PENDING + 1 jumps pending at once (all to the END).
+    uint8_t code[4 * (FSW_VM_PENDING + 1) + 8];
+    uint16_t n = 0;
+    const int jumps = FSW_VM_PENDING + 1;
+    for (int k = 0; k < jumps; ++k) {
+        code[n++] = LDT;
+        code[n++] = JF;
+        put16(code + n, static_cast<uint16_t>(4 * (jumps - 1 - k)));
+        n = static_cast<uint16_t>(n + 2u);
+    }
+    code[n++] = END;
+    TEST_ASSERT_EQUAL_UINT(kVmTooNested, with_step(code, n, 1));
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(code + 4, static_cast<uint16_t>(n - 4u), 1));
+}
+
+void test_the_vm_steps_the_good_image(void) {
+    Image im;
+    good(im);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    Machine m;
+    memset(sv, 0, sizeof sv);
+    vm_reset(im.b, ram, m, 1);
+    uint8_t* loc = vm_locals(im.b, ram);
+    TEST_ASSERT_EQUAL_UINT8(3, loc[0]);
+    store<float>(sv + 12, 0.0f);  // x 0, n 0: not x > n: l doubles (3 -> 6)
+    store<uint64_t>(sv, 10);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_UINT32(1, load<uint32_t>(sv + 8));
+    TEST_ASSERT_EQUAL_UINT8(6, loc[0]);
+    TEST_ASSERT_EQUAL_UINT(kErrTime, vm_step(im.b, kLayout, sv, ram, m));  // G did not increase
+    TEST_ASSERT_EQUAL_UINT8(6, loc[0]);
+    store<float>(sv + 12, 2.5f);  // x > n: to B, .exit writes n = T (20)
+    store<uint64_t>(sv, 30);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_INT16(20, load<int16_t>(sv + 16));
+    TEST_ASSERT_EQUAL_UINT32(2, m.state);
+    TEST_ASSERT_EQUAL_UINT8(6, loc[0]);  // l unchanged on the transition
+    // In B: x and l are true: (x and l) or not l holds: back to A.
+    store<uint64_t>(sv, 40);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_UINT32(2, load<uint32_t>(sv + 8));
+    TEST_ASSERT_EQUAL_UINT32(1, m.state);
+    TEST_ASSERT_EQUAL_UINT8(1, m.pending);
+}
+
+FSW_TEST_MAIN([] {
+    UNITY_BEGIN();
+    RUN_TEST(test_the_good_image_verifies);
+    RUN_TEST(test_header_rules);
+    RUN_TEST(test_element_rules);
+    RUN_TEST(test_local_rules);
+    RUN_TEST(test_state_rules);
+    RUN_TEST(test_window_rules);
+    RUN_TEST(test_jump_rules);
+    RUN_TEST(test_stack_rules);
+    RUN_TEST(test_opcode_and_end_rules);
+    RUN_TEST(test_place_rules);
+    RUN_TEST(test_nesting_rule);
+    RUN_TEST(test_the_vm_steps_the_good_image);
+    (void)UNITY_END();
+})

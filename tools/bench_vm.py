@@ -56,7 +56,7 @@ def cycles(elf: str) -> tuple[int, int, int]:
                        capture_output=True, text=True)
     m = re.search(r"cycles (\d+) worst (\d+) overhead (\d+) state (\d+)", r.stdout + r.stderr)
     if not m:
-        sys.exit(f"vm_bench: no measurement:\n{r.stdout}{r.stderr}")
+        sys.exit(f"bench_vm: no measurement:\n{r.stdout}{r.stderr}")
     avg, worst, over, state = (int(x) for x in m.groups())
     return avg - over, worst - over, state
 

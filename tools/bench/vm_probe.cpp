@@ -10,7 +10,7 @@
 #if FSW_VM_PROBE == 1
 #include "tank.gen.h"
 #elif FSW_VM_PROBE == 2
-#include "tank_image.h"  // kImage, kElems, kElemCount (vm_bench.py writes it)
+#include "tank_image.h"  // kImage, kElems, kElemCount (tools/bench_vm.py writes it)
 namespace {
 alignas(8) uint8_t ram[kRam];
 fsw::Machine machine;

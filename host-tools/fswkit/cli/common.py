@@ -140,3 +140,24 @@ def open_link(args, layout, baud: int, say):
         ground.close()
         return None
     return ground
+
+
+def real_of(args, command: str):
+    """The evaluation type `--real` and `--board` name (a board's own; the two
+    must agree; f64 when neither is given), or None after a message."""
+    from fswkit.autocode.board import BoardError, load_board
+    from fswkit.autocode.numeric import REALS
+
+    name = args.real
+    if args.board is not None:
+        try:
+            board = load_board(args.board)
+        except BoardError as e:
+            sys.stderr.write(f"fsw {command}: {e}\n")
+            return None
+        if name is not None and name != board.real:
+            sys.stderr.write(f"fsw {command}: --real {name} contradicts board `{board.name}`, "
+                             f"whose evaluation type is {board.real}\n")
+            return None
+        name = board.real
+    return REALS[name or "f64"]

@@ -6,27 +6,7 @@ from __future__ import annotations
 import sys
 
 from fswkit.autocode.diagnostics import SM, Diagnostics, Source
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags
-
-
-def _real(args):
-    """The evaluation type from --real / --board, or None after a message."""
-    from fswkit.autocode.numeric import REALS
-
-    name = args.real
-    if args.board is not None:
-        from fswkit.autocode.board import BoardError, load_board
-        try:
-            board = load_board(args.board)
-        except BoardError as e:
-            sys.stderr.write(f"fsw compile: {e}\n")
-            return None
-        if name is not None and name != board.real:
-            sys.stderr.write(f"fsw compile: --real {name} contradicts board `{board.name}`, "
-                             f"whose evaluation type is {board.real}\n")
-            return None
-        name = board.real
-    return REALS[name or "f64"]
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags, real_of
 
 
 def cmd_compile(args) -> int:
@@ -35,7 +15,7 @@ def cmd_compile(args) -> int:
     from fswkit.autocode.project import load_machine
     from fswkit.outputs import OutputError, output
 
-    real = _real(args)
+    real = real_of(args, "compile")
     if real is None:
         return EXIT_CONFIG
     diags = Diagnostics()

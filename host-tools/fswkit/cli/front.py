@@ -9,7 +9,7 @@ import sys
 
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.cli.common import (EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, load_app, plural, print_diags,
-                               write_output)
+                               real_of, write_output)
 
 CONFIG_EXTS = (".sv", ".sm", ".ss", ".app")
 TABLE_EXTS = (".aio", ".dio", ".sns")  # checked through the .app that names them (board, state vector, pins)
@@ -92,22 +92,9 @@ def _scripts(paths: list[str]) -> list[str] | None:
 
 
 def cmd_test(args) -> int:
-    from fswkit.autocode.numeric import REALS
-
-    real_name = args.real
-    if args.board is not None:
-        from fswkit.autocode.board import BoardError, load_board
-        try:
-            board = load_board(args.board)
-        except BoardError as e:
-            sys.stderr.write(f"fsw test: {e}\n")
-            return EXIT_CONFIG
-        if real_name is not None and real_name != board.real:
-            sys.stderr.write(f"fsw test: --real {real_name} contradicts board `{board.name}`, "
-                             f"whose evaluation type is {board.real}\n")
-            return EXIT_CONFIG
-        real_name = board.real
-    real = REALS[real_name or "f64"]
+    real = real_of(args, "test")
+    if real is None:
+        return EXIT_CONFIG
     if args.coverage and args.native:
         sys.stderr.write("fsw test: --coverage follows the interpreter's run: leave out --native\n")
         return EXIT_CONFIG

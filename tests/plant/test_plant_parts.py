@@ -188,11 +188,34 @@ def test_part_faults_make_a_plan(tmp_path):
     assert sc.p["scenario"]["max_s"] == 400  # the base's, the rest of [scenario] kept
 
 
+def test_a_noisy_part_reads_the_plants_extra_noise_and_nothing_else():
+    """`baro-noisy`: the plant adds NOISY_PA of noise to what it feeds the
+    barometer part (the part itself keeps working: nothing is asked of the
+    board); the accelerometer and the rest of the draws are the nominal
+    run's."""
+    import numpy as np
+
+    from fswkit.plant.scenario import NOISY_PA
+
+    _app, _lay, sc = prepare(str(DIGITAL), "rocket", fault="baro-noisy@2")
+    assert [(t, part.part, mode) for t, part, mode in sc.part_fail_plan] == [(2.0, "bmp280", "noisy")]
+    _app, _lay, nominal = prepare(str(DIGITAL), "rocket")
+    sc.noisy_parts.add(sc.baro_part)  # as the co-simulation does when the plan says so
+    diff, accel = [], []
+    for k in range(2000):  # on the pad: the plant does not move
+        sc.inputs(k / 1000)
+        nominal.inputs(k / 1000)
+        diff.append(sc.part_values[sc.baro_part]["pressure"] - nominal.part_values[nominal.baro_part]["pressure"])
+        accel.append(sc.part_values[sc.accel_part] == nominal.part_values[nominal.accel_part])
+    assert 0.9 * NOISY_PA < float(np.std(diff)) < 1.1 * NOISY_PA
+    assert all(accel)
+
+
 @pytest.mark.parametrize("extra, marker, message", [
     ('[scenario]\npart_fail = "bmp280"\n', "[scenario]",  # a key not written: located at its table
      "[scenario] part_fail_s: missing: the simulated second the part fails at"),
     ('[scenario]\npart_fail = "bmp280"\npart_fail_s = 3\npart_fail_mode = "smoke"\n', "smoke",
-     '[scenario] part_fail_mode: "smoke": one of "nack", "stuck"'),
+     '[scenario] part_fail_mode: "smoke": one of "nack", "stuck", "noisy"'),
     ('[scenario]\npart_fail_s = 3\n', "part_fail_s", "[scenario] part_fail_s: needs part_fail"),
     ('[scenario]\npart_fail = "ms5611@0x77"\npart_fail_s = 3\n', "ms5611",
      '[scenario] part_fail: "ms5611@0x77" is not in the project\'s sensor tables (its parts: bmp280@0x76, '

@@ -190,8 +190,9 @@ def parser() -> argparse.ArgumentParser:
                     help="with --plant rocket: a fault (stuck-baro: the barometer freezes at ignition; "
                     "pinned-accel, pinned-baro: reads 5 V from boot, the motor is not lit; open-igniter: the "
                     "drogue's igniter is open from boot, the motor is not lit and the vehicle must refuse to arm; "
-                    "with digital sensor parts, baro-nack, baro-stuck, accel-nack, accel-stuck, each at ignition or "
-                    "@SECONDS: the part stops answering, or its results stop changing)")
+                    "with digital sensor parts, baro-nack, baro-stuck, baro-noisy, accel-nack, accel-stuck, "
+                    "accel-noisy, each at ignition or @SECONDS: the part stops answering, its results stop changing, "
+                    "or they turn noisy)")
     sm.set_defaults(func=_command("sim", "cmd_sim"))
 
     fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")

@@ -73,7 +73,7 @@ class Run:
     reset_events: list[ResetEvent] = field(default_factory=list)  # the same resets, with cause and state
     eeprom: bytes | None = None  # the board's EEPROM after the flight (the flight recorder's store)
     flash: bytes | None = None  # the SPI NOR flash's written part after the flight (`store spi_nor`)
-    part_failures: list = field(default_factory=list)  # (simulated s, part "bmp280@0x76", "nack" | "stuck")
+    part_failures: list = field(default_factory=list)  # (simulated s, part "bmp280@0x76", "nack" | "stuck" | "noisy")
     # per digital part: [health frames, frames that said it had a fault, arrival (s) of the first such frame]
     part_health: dict = field(default_factory=dict)
 
@@ -281,7 +281,10 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             while fail_plan and t0 >= fail_plan[0][0]:  # a part fails (its mode set before the step runs)
                 _at, part, mode = fail_plan.pop(0)
                 if part in where:
-                    b.part_fail(where[part], mode)
+                    if mode == "noisy":  # the plant's doing: the part itself works
+                        scenario.noisy_parts.add(part)
+                    else:
+                        b.part_fail(where[part], mode)
                     run.part_failures.append((t0, part_name(part), mode))
             if k:
                 analog, digital = scenario.inputs(t0)

@@ -89,7 +89,8 @@ def _tail_lines(run: Run) -> list[str]:
     for p in h.get("pyro", ()):  # what the last health frame said of each charge
         out.append(f"pyro {p['name']} (last health frame): {p['words']}")
     for t, name, mode in getattr(run, "part_failures", ()):  # what the plant did to a digital part
-        what = "stops answering (nack)" if mode == "nack" else "results stuck" if mode == "stuck" else mode
+        what = {"nack": "stops answering (nack)", "stuck": "results stuck",
+                "noisy": "results noisy (the plant adds its NOISY_PA / NOISY_G)"}.get(mode, mode)
         out.append(f"sensor {name}: failed at {t:.3f} s simulated: {what}")
     for p in h.get("sensors", ()):  # what the last health frame said of each digital part, and the others
         line = f"sensor {p['name']} (last health frame): {p['words']}"
@@ -109,7 +110,7 @@ def _tail_lines(run: Run) -> list[str]:
 
 
 def _baro_lost(sc, run: Run) -> bool:
-    """Whether the barometer part failed (nack or stuck) before the true
+    """Whether the barometer part failed (nack, stuck or noisy) before the true
     apogee: the flight is then checked as with a stuck barometer (the drogue
     by the backup timer)."""
     part = getattr(sc, "baro_part", None)

@@ -53,7 +53,13 @@ PART_FAULTS = {
     "baro-stuck": "the barometer part's results stop changing (its conversions still end)",
     "accel-nack": "the accelerometer part stops answering on its bus",
     "accel-stuck": "the accelerometer part's results stop changing",
+    "baro-noisy": "the barometer part's results turn noisy: NOISY_PA of Gaussian noise on its pressure",
+    "accel-noisy": "the accelerometer part's results turn noisy: NOISY_G of Gaussian noise on its axis",
 }
+# A `noisy` part (a cracked package, a loose connector, a failing supply): what it reads, on top of its own noise.
+# The part still answers and its counts change, so no driver can see it: the navigation must.
+NOISY_PA = 1000.0  # about 90 m of altitude at the pad's 1,400 m
+NOISY_G = 2.0
 
 
 def parse_fault(text: str) -> tuple[str, float | None]:
@@ -166,8 +172,8 @@ ROCKET_SCHEMA = {
         "part_fail": F("str", "a digital part that fails mid-flight: \"bmp280@0x76\" (one of the project's "
                        "sensor tables'; absent: none)", required=False),
         "part_fail_s": F("float", "with part_fail: the simulated second it fails at", lo=0, hi=3600, required=False),
-        "part_fail_mode": F("str", "with part_fail: \"nack\" (it stops answering) or \"stuck\" (its results stop "
-                            "changing)", default="nack"),
+        "part_fail_mode": F("str", "with part_fail: \"nack\" (it stops answering), \"stuck\" (its results stop "
+                            "changing) or \"noisy\" (the plant adds NOISY_PA / NOISY_G of noise)", default="nack"),
         **_RESET,
     }),
     "firmware": Table("where the plant and the checks find things in the project", {
@@ -599,6 +605,10 @@ class RocketScenario:
         self.cont_v = {role: ig.volts(0.0) for role, ig in self.igniters.items()}
         self.baro_noise = Noise(baro_rng, p["barometer"]["noise_pa"])
         self.accel_noise = Noise(accel_rng, p["accelerometer"]["noise_g"])
+        # the parts that have turned noisy (part_fail_plan's "noisy", set by the co-simulation when due), and
+        # their noise's own generator, so that a noisy run's other draws are its nominal run's
+        self.noisy_parts: set = set()
+        self.noisy_noise = Noise(np.random.default_rng([seed, 0x4E4F4953]), 1.0)
         # the ADC channels by the names the I/O tables give them, whatever form plant.toml used
         # (None: that sensor is a digital part)
         self.channels = (baro.pin if baro is not None else p["barometer"]["channel"],
@@ -681,8 +691,9 @@ class RocketScenario:
                 bind.err("scenario", "part_fail", why)
             if sc["part_fail_s"] is None:
                 bind.err("scenario", "part_fail_s", "missing: the simulated second the part fails at")
-            if sc["part_fail_mode"] not in ("nack", "stuck"):
-                bind.err("scenario", "part_fail_mode", f"\"{sc['part_fail_mode']}\": one of \"nack\", \"stuck\"")
+            if sc["part_fail_mode"] not in ("nack", "stuck", "noisy"):
+                bind.err("scenario", "part_fail_mode",
+                         f"\"{sc['part_fail_mode']}\": one of \"nack\", \"stuck\", \"noisy\"")
             elif part is not None and sc["part_fail_s"] is not None:
                 self.part_fail_plan.append((sc["part_fail_s"], part, sc["part_fail_mode"]))
         else:
@@ -694,6 +705,10 @@ class RocketScenario:
     def inputs(self, t: float):
         pa = self.rocket.static_pressure() + self.baro_noise()
         g = self.rocket.specific_force() / G0 + self.accel_noise()
+        if self.baro_part is not None and self.baro_part in self.noisy_parts:
+            pa += self.noisy_noise() * NOISY_PA
+        if self.accel_part is not None and self.accel_part in self.noisy_parts:
+            g += self.noisy_noise() * NOISY_G
         self.part_values = {}
         if self.baro_part is not None:
             h = self.rocket.pad_altitude + self.rocket.h

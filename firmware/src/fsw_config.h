@@ -231,6 +231,21 @@
 #  define FSW_PARAM_QUEUE 24
 #endif
 
+// The bytecode VM (fsw_vm.h, docs/bytecode.md). Its operand stack, in Reals
+// (on the C stack while a step runs): an image that needs more is refused by
+// the verifier (kVmBadStack).
+#ifndef FSW_VM_STACK
+#  define FSW_VM_STACK 12
+#endif
+// Forward jumps the verifier tracks at once (nesting of if/and/or); more is
+// refused (kVmTooNested). Each costs 4 bytes of the verifier's C stack.
+#ifndef FSW_VM_PENDING
+#  define FSW_VM_PENDING 16
+#endif
+#if FSW_VM_STACK < 2 || FSW_VM_STACK > 255
+#  error "fswkit: FSW_VM_STACK must be 2..255"
+#endif
+
 // Elements and regions are little-endian in memory (spec 2); typed access
 // copies bytes straight into locals, so the host must be little-endian too.
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

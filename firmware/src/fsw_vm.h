@@ -4,22 +4,9 @@
 #ifndef FSW_VM_H
 #define FSW_VM_H
 
+#include "fsw_config.h"  // FSW_VM_STACK, FSW_VM_PENDING
 #include "fsw_machine.h"
 #include "fsw_types.h"
-
-// Operand stack of the VM, in Reals (on the C stack while a step runs). An
-// image that needs more is refused by the verifier (kVmBadStack).
-#ifndef FSW_VM_STACK
-#define FSW_VM_STACK 12
-#endif
-// Forward jumps the verifier tracks at once (nesting of if/and/or); more is
-// refused (kVmTooNested). Each costs 4 bytes of the verifier's C stack.
-#ifndef FSW_VM_PENDING
-#define FSW_VM_PENDING 16
-#endif
-#if FSW_VM_STACK < 2 || FSW_VM_STACK > 255
-#error "fswkit: FSW_VM_STACK must be 2..255"
-#endif
 
 namespace fsw {
 

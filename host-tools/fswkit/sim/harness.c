@@ -298,6 +298,30 @@ static void on_uart_xoff(struct avr_irq_t* irq, uint32_t value, void* param) {
     uart_xoff = 1;
 }
 
+/* simavr 1.6 times a UART byte as start + data + a parity bit + stop bits, whatever UCSRnC says
+   (avr_uart.c, avr_uart_baud_write): 11 bit times for 8N1 instead of 10, so the simulated line carried
+   10/11 of the real rate. Its handler of a UBRRnL write sets cycles_per_byte; this one, chained after it
+   on the same register, takes the parity bit out again unless UPMn1 (UCSRnC bit 5) turns parity on. */
+static avr_uart_t* uart0;
+
+static void on_ubrr_write(struct avr_t* a, avr_io_addr_t addr, uint8_t v, void* param) {
+    (void)addr;
+    (void)v;
+    (void)param;
+    static const int data_bits[8] = {5, 6, 7, 8, 8, 8, 8, 9};
+    avr_uart_t* p = uart0;
+    const int db = data_bits[avr_regbit_get(a, p->ucsz) | (avr_regbit_get(a, p->ucsz2) << 2)];
+    const int sb = 1 + avr_regbit_get(a, p->usbs);
+    const int parity = (a->data[p->r_ucsrc] >> 5) & 1;
+    p->cycles_per_byte = p->cycles_per_byte / (avr_cycle_count_t)(1 + db + 1 + sb) * (avr_cycle_count_t)(1 + db + parity + sb);
+}
+
+static void uart_bit_times(void) {
+    for (avr_io_t* io = avr->io_port; io; io = io->next)
+        if (io->kind && strcmp(io->kind, "uart") == 0 && ((avr_uart_t*)io)->name == '0') uart0 = (avr_uart_t*)io;
+    if (uart0) avr_register_io_write(avr, uart0->ubrrl.reg, on_ubrr_write, NULL);
+}
+
 /* Hands waiting host bytes to the AVR's UART while its FIFO has room. */
 static void uart_feed(void) {
     while (!uart_xoff && bytes_pending(&uart_in)) avr_raise_irq(uart_in_irq, uart_in.buf[uart_in.head++]);
@@ -2551,6 +2575,7 @@ int main(int argc, char** argv) {
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON), on_uart_xon, NULL);
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), on_uart_xoff, NULL);
     uart_in_irq = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+    uart_bit_times();
     if (uart_mode == UART_PTY && pty_open() != 0) return 2;
     if (uart_mode == UART_STDIO) fcntl(1, F_SETFL, fcntl(1, F_GETFL) | O_NONBLOCK);
 

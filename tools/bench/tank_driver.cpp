@@ -5,8 +5,7 @@
 #include "tank.gen.h"
 
 #if defined(ARDUINO)
-#include <Arduino.h>
-#include <avr/sleep.h>
+#include "cycle_report.h"
 #else
 #include <stdlib.h>
 #endif
@@ -48,21 +47,7 @@ void setup() {
         total += dt;
         if (dt > worst) worst = dt;
     }
-    // Two reads back to back: the timing's own cost, subtracted by the bench.
-    const uint16_t t0 = TCNT1;
-    const uint16_t t1 = TCNT1;
-    Serial.print("cycles ");
-    Serial.print(total / kSteps);
-    Serial.print(" worst ");
-    Serial.print(worst);
-    Serial.print(" overhead ");
-    Serial.print(static_cast<uint16_t>(t1 - t0));
-    Serial.print(" state ");
-    Serial.println(fsw_gen::sv[fsw_gen::E_state]);
-    Serial.flush();
-    cli();
-    sleep_enable();
-    sleep_cpu();
+    report_cycles(total / kSteps, worst, fsw_gen::sv[fsw_gen::E_state]);
 }
 void loop() {}
 #else

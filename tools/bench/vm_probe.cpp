@@ -3,7 +3,7 @@
 // fsw::vm_step (2); 0 is the empty sketch. With FSW_VM_TIMING it times 1000
 // steps on Timer1 and prints them as tools/bench/tank_driver.cpp does.
 #include <Arduino.h>
-#include <avr/sleep.h>
+#include "cycle_report.h"
 
 #include "fswkit.h"
 #include "sv.gen.h"
@@ -56,20 +56,7 @@ void setup() {
         total += dt;
         if (dt > worst) worst = dt;
     }
-    const uint16_t t0 = TCNT1;
-    const uint16_t t1 = TCNT1;
-    Serial.print("cycles ");
-    Serial.print(total / 1000);
-    Serial.print(" worst ");
-    Serial.print(worst);
-    Serial.print(" overhead ");
-    Serial.print(static_cast<uint16_t>(t1 - t0));
-    Serial.print(" state ");
-    Serial.println(fsw_gen::sv[fsw_gen::E_state]);
-    Serial.flush();
-    cli();
-    sleep_enable();
-    sleep_cpu();
+    report_cycles(total / 1000, worst, fsw_gen::sv[fsw_gen::E_state]);
 #endif
 }
 

@@ -218,9 +218,7 @@ int main(void) {
     UCSR0A = 1 << U2X0;
     UCSR0B = (1 << TXEN0) | (1 << RXEN0);
     UCSR0C = 3 << UCSZ00;
-    TCCR1A = 0;
-    TCCR1B = 1 << CS11;
-    TIMSK1 = 1 << TOIE1;
+    ticks_begin();
     sei();
     print("ready", 5);
     for (;;) {

@@ -57,13 +57,14 @@ def probe(tmp_path_factory) -> str:
 
 def test_barometer_counts_are_the_datasheet_inverse():
     """PartFeed's counts equal parts.py's full-search inverse for a falling,
-    noisy pressure (its secant-and-gallop search finds the same answer), and
+    noisy pressure and a changing temperature, with jumps (its
+    secant-and-gallop search finds the same answer), and
     the firmware's forward formula reads them back within a count's worth."""
     c = P.BMP280_EXAMPLE[0]
     feed = PartFeed(BMP, 0x76, P.bmp280_calib_bytes(c))
     rng = random.Random(5)
     for i in range(400):
-        pa, t_c = 101325.0 - 40.0 * i + rng.gauss(0, 30), 15.0 - 0.01 * i
+        pa, t_c = 101325.0 - 40.0 * i + rng.gauss(0, 30), 15.0 - 0.01 * i + (5.0 if i % 97 == 0 else 0.0)
         raw = feed.raw(pressure=pa, temperature=t_c)
         assert raw["adc_T"] == P.bmp280_adc_T_for(c, t_c)
         t_fine = P.bmp280_compensate_T(c, raw["adc_T"])[1]
@@ -72,10 +73,10 @@ def test_barometer_counts_are_the_datasheet_inverse():
     m = P.MS5611_EXAMPLE[0]
     prom = b"".join(w.to_bytes(2, "big") for w in P.ms5611_prom_words(m))
     feed = PartFeed(MS, 0x77, prom)
-    for i in range(200):
-        pa = 100000.0 - 55.0 * i + rng.gauss(0, 10)
-        raw = feed.raw(pressure=pa, temperature=5.0)
-        assert raw["D2"] == P.ms5611_D2_for(m, 5.0)
+    for i in range(200):  # the temperature through both second-order corrections (below 20 and -15 degC)
+        pa, t_c = 100000.0 - 55.0 * i + rng.gauss(0, 10), 25.0 - 0.22 * i + rng.gauss(0, 0.05)
+        raw = feed.raw(pressure=pa, temperature=t_c)
+        assert raw["D2"] == P.ms5611_D2_for(m, t_c)
         assert raw["D1"] == P.ms5611_D1_for(m, pa / 100.0, raw["D2"])
         assert abs(P.ms5611_compensate(m, raw["D1"], raw["D2"]).P - pa) <= 0.5
 

@@ -170,8 +170,16 @@ def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bo
     """parts._nearest_search's answer, found by galloping from `guess`
     (steps 1, 2, 4, ... until the answer is bracketed, then bisection): a
     few evaluations when the guess is close."""
+    seen: dict[int, float] = {}
+
+    def value(x):  # each x evaluated once: the last comparison reuses the search's values
+        v = seen.get(x)
+        if v is None:
+            v = seen[x] = f(x)
+        return v
+
     def reached(x):  # the full search's condition: its answer is the first x that reaches
-        v = f(x)
+        v = value(x)
         return v >= target if increasing else v <= target
     x = min(max(guess, lo), hi)
     step = 1
@@ -198,7 +206,7 @@ def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bo
         else:
             a = m + 1
     x = b
-    if x > lo and abs(f(x - 1) - target) <= abs(f(x) - target):
+    if x > lo and abs(value(x - 1) - target) <= abs(value(x) - target):
         return x - 1
     return x
 
@@ -256,6 +264,8 @@ class PartFeed:
             words = [int.from_bytes(calibration[i:i + 2], "big") for i in range(0, 16, 2)]
             self.calib = P.Ms5611Calib(*words[1:7])
         self._t: tuple[float, int, int] | None = None  # (°C, raw temperature, t_fine / D2)
+        # the raw temperature (BMP280 adc_T, MS5611 D2): the temperature changes at every plant step
+        self._temp = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, True)
         self._p = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, self.part != "bmp280")
 
     @property
@@ -272,10 +282,14 @@ class PartFeed:
             t_c = 15.0 if temperature is None else float(temperature)
             if self._t is None or self._t[0] != t_c:
                 if self.part == "bmp280":
-                    adc_T = P.bmp280_adc_T_for(self.calib, t_c)
+                    c = self.calib
+                    adc_T = self._temp(lambda a: P.bmp280_compensate_T(c, a)[0], t_c * 100.0,
+                                       lambda: P.bmp280_adc_T_for(c, t_c))
                     self._t = (t_c, adc_T, P.bmp280_compensate_T(self.calib, adc_T)[1])
                 else:
-                    self._t = (t_c, P.ms5611_D2_for(self.calib, t_c), 0)
+                    c = self.calib
+                    self._t = (t_c, self._temp(lambda d: P.ms5611_compensate(c, 0, d, True).TEMP, t_c * 100.0,
+                                               lambda: P.ms5611_D2_for(c, t_c)), 0)
             if self.part == "bmp280":
                 out["adc_T"] = self._t[1]
                 if pressure is not None:

@@ -62,4 +62,4 @@ def application(path: str, parts: Parts) -> Application:
                        tuple(parts.channels), tuple(parts.tasks), parts.time_element, parts.time_source,
                        parts.time_unit, tuple(parts.streams), tuple(parts.writable), parts.reset_cause,
                        parts.budget.get("flash"), parts.budget.get("ram"), parts.log, tuple(parts.pyro or ()),
-                       tuple(parts.sensors or ()))
+                       tuple(parts.sensors or ()), parts.reload)

@@ -31,7 +31,7 @@ class Problem:
 
 # ---- the application config (.app) ----------------------------------------------
 
-SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log", "pyro")
+SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log", "pyro", "reload")
 
 
 @dataclass(frozen=True)
@@ -116,6 +116,7 @@ class AppFile:
     budget: tuple[Setting, ...] = ()
     log: tuple[Setting, ...] = ()
     pyro: tuple[PyroRow, ...] = ()
+    reload: tuple[Setting, ...] = ()
 
 
 def parse_app(src: Source, diags: Diagnostics) -> AppFile:
@@ -148,6 +149,7 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
         budget=rows("budget", _setting),
         log=rows("log", _setting),
         pyro=rows("pyro", _pyro_row),
+        reload=rows("reload", _setting),
     )
 
 

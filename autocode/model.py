@@ -385,6 +385,17 @@ class Log:
 
 
 @dataclass(frozen=True)
+class Reload:
+    """The `[reload]` section (docs/reload.md): a machine task that may run
+    a bytecode image uploaded over the link instead of its generated code."""
+    machine: int  # index into Application.machines
+    size: int  # bytes of a slot: an image and its state mask
+    ram: int  # bytes for an image's windows and locals
+    activate: tuple[str, ...]  # state names in which another machine may take over
+    line: int  # the section's first row
+
+
+@dataclass(frozen=True)
 class PyroChannel:
     """A pyro channel (docs/safety.md): a `[pyro]` row of the application
     config, resolved. The channel is named by its output element."""
@@ -425,3 +436,4 @@ class Application:
     log: Log | None = None  # [log]: the flight recorder
     pyro: tuple[PyroChannel, ...] = ()  # [pyro]: the channels that fire charges (docs/safety.md)
     sensors: tuple[Sensor, ...] = ()  # `.sns` tables: digital sensor parts (docs/sensors.md)
+    reload: Reload | None = None  # [reload]: machines replaced at run time (docs/reload.md)

@@ -23,11 +23,15 @@ OP_PARAM_GET, OP_PARAM_SET, OP_PARAM_SAVE, OP_PARAM_BEGIN = 0x06, 0x07, 0x08, 0x
 OP_PARAM_STAGE, OP_PARAM_COMMIT, OP_PARAM_INFO = 0x0A, 0x0B, 0x0C
 # the flight recorder (docs/recorder.md)
 OP_LOG_INFO, OP_LOG_READ, OP_LOG_ERASE = 0x0D, 0x0E, 0x0F
+# machines replaced at run time (docs/reload.md)
+OP_MACHINE_INFO, OP_MACHINE_BEGIN, OP_MACHINE_WRITE, OP_MACHINE_COMMIT, OP_MACHINE_ACTIVATE = 0x10, 0x11, 0x12, 0x13, 0x14
 OP_NAMES = {OP_PING: "ping", OP_HELLO: "hello", OP_SNAPSHOT: "snapshot", OP_SET: "set", OP_MODE: "mode",
             OP_PARAM_GET: "param_get", OP_PARAM_SET: "param_set", OP_PARAM_SAVE: "param_save",
             OP_PARAM_BEGIN: "param_begin", OP_PARAM_STAGE: "param_stage", OP_PARAM_COMMIT: "param_commit",
             OP_PARAM_INFO: "param_info", OP_LOG_INFO: "log_info", OP_LOG_READ: "log_read",
-            OP_LOG_ERASE: "log_erase"}
+            OP_LOG_ERASE: "log_erase", OP_MACHINE_INFO: "machine_info", OP_MACHINE_BEGIN: "machine_begin",
+            OP_MACHINE_WRITE: "machine_write", OP_MACHINE_COMMIT: "machine_commit",
+            OP_MACHINE_ACTIVATE: "machine_activate"}
 # acknowledgement status: 0 applied, anything else refused
 STATUS = {
     0: ("OK", "applied"),
@@ -45,6 +49,9 @@ STATUS = {
     11: ("BUSY", "a parameter bank is being written, or the stage queue is full: try again"),
     12: ("NO_LOAD", "no parameter load is open (PARAM_BEGIN first)"),
     13: ("MISMATCH", "the staged set's CRC is not the one committed"),
+    14: ("TOO_BIG", "the image and its state mask do not fit a slot ([reload] size)"),
+    15: ("BAD_IMAGE", "the board's verifier refused the image"),
+    16: ("NO_IMAGE", "that slot holds no committed image"),
 }
 
 # payloads, little-endian
@@ -69,6 +76,12 @@ PARAM_INFO = struct.Struct("<BHHBI")    # source, seq, live CRC, count, table ha
 # the parameter store's state byte: bits 0..1 the source, bit 6 unsaved changes, bit 7 a bank being written
 PARAM_SOURCES = {0: "no parameters", 1: "defaults", 2: "bank A", 3: "bank B"}
 PARAM_DIRTY, PARAM_WRITING = 0x40, 0x80
+# MACHINE_INFO's data (docs/reload.md): active, pending, refused slot, its reason, writer busy, slot size,
+# image RAM, the open upload (slot, image bytes, mask bytes, CRC, bytes written), then RELOAD_SLOT twice
+RELOAD_INFO = struct.Struct("<BBBBBHHBHBHH")
+RELOAD_SLOT = struct.Struct("<BHHBH")   # status, seq, image bytes, mask bytes, CRC
+RELOAD_INFO_SIZE = RELOAD_INFO.size + 2 * RELOAD_SLOT.size
+RELOAD_CRC_FAILS = 0x80  # a refusal's reason beyond the verifier's: the slot's bytes lost their CRC
 SNAPSHOT_OFFSET = 2  # a snapshot frame's payload: offset (u16), then state vector bytes
 
 

@@ -179,6 +179,9 @@ def plan(app) -> Plan | None:
         slots = min(log.flash_size // log.record, MAX_SLOTS)
     else:
         base = 2 * (PHEADER + sum(p.type.size for p in params)) if params else 0
+        if app.reload is not None:  # the uploaded machines' slots come next (docs/reload.md)
+            from .reloadcheck import eeprom_bytes
+            base += eeprom_bytes(app.reload.size)
         slots = (app.board.eeprom - base) // log.record
     fields = tuple(Field(f.element.name, f.element.type, f.enc, f.step, f.width) for f in log.fields)
     sample_size, n_hold, escape, opening, worst = record_sizes(log.fields)

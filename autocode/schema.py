@@ -10,7 +10,7 @@ from fractions import Fraction
 
 from . import model as M
 from .protocol import (ACK_PAYLOAD, CRC, HEADER, HEALTH_PAYLOAD, HEALTH_PYRO, HEALTH_SENSOR, HEALTH_TASK,
-                       HELLO_PAYLOAD, PROTOCOL, SNAPSHOT_OFFSET, encoded_max)
+                       HELLO_PAYLOAD, PROTOCOL, RELOAD_INFO_SIZE, SNAPSHOT_OFFSET, encoded_max)
 from .sensors import sensor_name
 
 
@@ -81,6 +81,8 @@ def link_plan(app) -> LinkPlan:
     health_payload = (HEALTH_PAYLOAD.size + HEALTH_TASK.size * len(app.tasks) + HEALTH_PYRO * len(app.pyro)
                       + HEALTH_SENSOR * len(app.sensors))
     bodies = [HELLO_PAYLOAD.size, ACK_PAYLOAD.size, health_payload] + [s.batch * s.region.size for s in streams]
+    if getattr(app, "reload", None) is not None:  # MACHINE_INFO's ack (docs/reload.md)
+        bodies.append(ACK_PAYLOAD.size + RELOAD_INFO_SIZE)
     longest = max(bodies)
     sv_size = max(app.sv.size, 1)
     snapshot_chunk = max(1, min(sv_size, longest - SNAPSHOT_OFFSET))
@@ -107,6 +109,9 @@ def link_text(app) -> str:
         lines.append(f"pyro {p.element.name}")
     for p in app.sensors:  # a health code each in health frames, after the pyro bytes
         lines.append(f"sensor {sensor_name(p)}")
+    if getattr(app, "reload", None) is not None:  # MACHINE_* commands: the slots and their size
+        rl = app.reload
+        lines.append(f"reload {app.machines[rl.machine].name} {rl.size} {rl.ram} " + " ".join(rl.activate))
     lines.append(f"health {plan.health_every} {plan.hello_every} snapshot {plan.snapshot_chunk}")
     return "\n".join(lines) + "\n"
 

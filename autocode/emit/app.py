@@ -38,7 +38,7 @@ def emit_app(app: Application) -> dict[str, str]:
     real = real_of(app)
     files = dict(emit_sv(app.sv))
     for m in app.machines:
-        files.update(emit_machine(m, real))
+        files.update(emit_machine(m, real, leave=app.reload is not None and app.machines[app.reload.machine] is m))
     files["app.gen.cpp"] = _app_cpp(app)
     return files
 
@@ -242,6 +242,8 @@ def _app_cpp(app: Application) -> str:
         c += _params(app, params)
     if app.log is not None:
         c += _recorder(app)
+    if app.reload is not None:
+        c += _reload(app)
     if has_link:
         c += _link(app)
     if resumes(app):
@@ -282,6 +284,8 @@ def _app_cpp(app: Application) -> str:
         c.append("    const bool resumed = fsw::resume_begin(resume, &kResumeConfig, fsw::pal::reset_cause());")
     if app.log is not None and resumes(app):
         c.append("    const uint8_t log_flight = rec.flight, log_mode = rec.mode;  // as kept")
+    if app.reload is not None:
+        c.append("    fsw::reload_begin(reload, &kReloadConfig);  // the newest activated image, else the generated machine")
     if app.log is not None:
         c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")
     if app.log is not None and resumes(app):
@@ -316,10 +320,10 @@ def _app_cpp(app: Application) -> str:
     c.append("    return true;")
     c.append("}")
     c.append("")
-    if has_link or params or app.log is not None:
+    if has_link or params or app.log is not None or app.reload is not None:
         c.append("// Runs a cycle when one is due; between cycles, feeds the serial link"
-                 + (" and writes\n// the next parameter or record byte to the EEPROM when it is ready."
-                    if params or app.log is not None else "."))
+                 + (" and writes\n// the next parameter, image or record byte to the EEPROM when it is ready."
+                    if params or app.log is not None or app.reload is not None else "."))
         c.append("void poll() {")
         if resumes(app):
             c.append("    if (fsw::executor_poll(ex)) fsw::resume_save(resume);  // the cycle's state, kept")
@@ -329,6 +333,8 @@ def _app_cpp(app: Application) -> str:
             c.append("    fsw::link_poll(link);")
         if params:
             c.append("    fsw::param_poll(params);")
+        if app.reload is not None:
+            c.append("    fsw::reload_poll(reload);")
         if app.log is not None:
             c.append("    fsw::log_poll(rec);")
         c.append("}")
@@ -534,7 +540,10 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
             out.append(f"    store_G_now(sv + E_{g});")
         else:
             out.append(f"    fsw::store<uint64_t>(sv + E_{g}, {_now(app)});")
-        out.append(f"    return {c_ident(m.name)}::step();")
+        if app.reload is not None and app.reload.machine == t.machine:
+            out.append("    return fsw::reload_step(reload);  // the generated machine, or an uploaded image")
+        else:
+            out.append(f"    return {c_ident(m.name)}::step();")
     elif t.kind in ("inputs", "outputs"):
         d = "i" if t.kind == "inputs" else "o"
         calls = [(kind, tables[(kind, d)]) for kind in ("analog", "digital") if (kind, d) in tables]
@@ -644,7 +653,9 @@ def _link(app: Application) -> list[str]:
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
     c.append(f"    kLinkTxSize, {plan.health_every}, {plan.snapshot_chunk}, {len(plan.streams)}, {len(rows)}, "
              f"{plan.hello_every}, {up}, kSvLock"
-             f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}}};")
+             f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}"
+             + (", &reload, fsw::link_reload_apply, fsw::link_reload_ack" if app.reload is not None else ", 0, 0, 0")
+             + "};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}, {len(app.pyro) + len(app.sensors)}), "
              "\"the link's transmit buffer is too small for its control frames\");")
@@ -713,6 +724,40 @@ def _recorder(app: Application) -> list[str]:
     return c
 
 
+def _reload(app: Application) -> list[str]:
+    """The reload store (docs/reload.md): the layout the VM checks images
+    against, the generated machine's state mask, RAM for the running image
+    and its windows and locals, and the slots' place in the EEPROM."""
+    from ..params import HEADER as PHEADER
+    from ..reloadcheck import eeprom_bytes
+
+    rl = app.reload
+    m = app.machines[rl.machine]
+    ns = c_ident(m.name)
+    name = basename(app.path)
+    params = app_parameters(app)
+    base = 2 * (PHEADER + sum(p.type.size for p in params)) if params else 0
+    mask = bytearray((len(m.states) + 7) // 8)
+    for st in m.states:
+        if st.name in rl.activate:
+            mask[(st.id - 1) // 8] |= 1 << ((st.id - 1) % 8)
+    elems = ", ".join(f"{{E_{e.name}, {ELEM_CODE[e.type.name]}}}" for e in app.sv.elements)
+    return ["// ---- machines replaced at run time (docs/reload.md) ----",
+            f"// {name}:{rl.line}: machine {m.name}; two slots of {rl.size} B in the EEPROM from byte {base} "
+            f"({eeprom_bytes(rl.size)} B); another machine may take over in " + ", ".join(rl.activate),
+            f"const fsw::VmElem kReloadElems[{len(app.sv.elements)}] = {{{elems}}};  // RAM: the VM reads it",
+            f"const fsw::VmLayout kReloadLayout = {{kReloadElems, {len(app.sv.elements)}, kSchemaHash}};",
+            f"const uint8_t kReloadAllow[{len(mask)}] FSW_FLASH = {{{', '.join(f'0x{b:02x}' for b in mask)}}};"
+            f"  // {' '.join(rl.activate)}",
+            f"alignas(8) uint8_t reload_image[{rl.size}];  // the running image and its state mask",
+            f"alignas(8) uint8_t reload_ram[{max(rl.ram, 1)}];  // its windows and locals",
+            "const fsw::ReloadConfig kReloadConfig FSW_FLASH = {",
+            f"    reload_image, reload_ram, sv, &kReloadLayout, &{ns}::machine, {ns}::step, {ns}::leave, {ns}::reset,",
+            f"    kReloadAllow, {rl.size}, {rl.ram}, {base}, {len(mask)}}};",
+            "fsw::ReloadStore reload;",
+            ""]
+
+
 def _params(app: Application, params) -> list[str]:
     """The parameter table (docs/parameters.md): where each value lives (its
     machine's `prm` block), its place in the value block, its range and
@@ -768,6 +813,7 @@ def _native_main(app: Application) -> list[str]:
     nor = app.log is not None and getattr(app.log, "store", "eeprom") == "spi_nor"
     between = (['fsw::link_poll(fsw_gen::link);'] if has_link else []) + \
         (['fsw::param_poll(fsw_gen::params);'] if params else []) + \
+        (['fsw::reload_poll(fsw_gen::reload);'] if app.reload is not None else []) + \
         (['fsw::log_poll(fsw_gen::rec);'] if app.log is not None else [])
     c = ['#include <stdio.h>',
          '#include <stdlib.h>',

@@ -36,11 +36,13 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
 
 
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
-                 ns: str = "fsw_gen") -> dict[str, str]:
+                 ns: str = "fsw_gen", leave: bool = False) -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
     keeps every local in memory, for a state script that writes locals;
     otherwise locals that never change are folded into the code. `ns` is
-    the outer namespace (the state vector's, see emit_sv)."""
+    the outer namespace (the state vector's, see emit_sv). `leave` adds
+    leave(), the current state's .exit, for a machine that an uploaded
+    image may take over from (`[reload]`, docs/reload.md)."""
     name = c_ident(m.name)
     src = basename(m.path)
     ex = ExprEmitter(m, real, scriptable)
@@ -80,6 +82,10 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     h.append("FSW_MUST_CHECK fsw::Result step();")
     h.append("// Back to the state before the first step, starting in `initial`.")
     h.append("void reset(uint32_t initial);")
+    if leave:
+        h.append("// The current state's .exit, when it was entered and not yet left: an")
+        h.append("// uploaded machine takes over from this one (docs/reload.md).")
+        h.append("void leave();")
     h += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", "", f"#endif  // {guard}", ""]
 
     c = [banner([m.path, m.sv.path], m.sv), f'#include "{name}.gen.h"', '#include "sv.gen.h"', "",
@@ -172,6 +178,14 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     for w in m.windows:
         c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
     c.append("}")
+    if leave:
+        c += ["", "void leave() {",
+              "    if (machine.started == 0 || machine.pending != 0) return;  // no state entered, or it was left",
+              "    switch (machine.state) {"]
+        for st in m.states:
+            if st.exit:
+                c.append(f"    case S_{st.name}: s{st.id}_exit(); break;")
+        c += ["    default: break;", "    }", "}"]
     c += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", ""]
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}
 

@@ -246,6 +246,15 @@
 #  error "fswkit: FSW_VM_STACK must be 2..255"
 #endif
 
+// Machines replaced at run time (fsw_reload.h, docs/reload.md): the most
+// image bytes one WRITE command carries (the writer's buffer, RAM).
+#ifndef FSW_RELOAD_QUEUE
+#  define FSW_RELOAD_QUEUE 32
+#endif
+#if FSW_RELOAD_QUEUE < 10 || FSW_RELOAD_QUEUE > 200
+#  error "fswkit: FSW_RELOAD_QUEUE must be 10..200"
+#endif
+
 // Elements and regions are little-endian in memory (spec 2); typed access
 // copies bytes straight into locals, so the host must be little-endian too.
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

@@ -172,6 +172,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_u16(l.n.last_seq);
         if (c.params != 0 && c.param_ack != 0) c.param_ack(l, *c.params);
         if (c.log != 0 && c.log_ack != 0) c.log_ack(l, *c.log);
+        if (c.reload != 0 && c.reload_ack != 0) c.reload_ack(l, *c.reload);
     } else if (type == kFrameHello) {
         put(kLinkProtocol);
         put_u32(c.schema);
@@ -290,6 +291,10 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
     if (op >= kOpLogInfo && op <= kOpLogErase) {
         if (c.log == 0 || c.log_apply == 0) return kAckUnknownOp;
         return c.log_apply(l, *c.log, op, a, alen);
+    }
+    if (op >= kOpMachineInfo && op <= kOpMachineActivate) {
+        if (c.reload == 0 || c.reload_apply == 0) return kAckUnknownOp;
+        return c.reload_apply(l, *c.reload, op, a, alen);
     }
     if (op == kOpMode) {
         if (alen != 2) return kAckBadLength;
@@ -551,6 +556,62 @@ uint8_t link_log_apply(Link& l, Recorder& r, uint8_t op, const uint8_t* a, uint8
     if (alen != 0) return kAckBadLength;
     if (op == kOpLogErase) return log_erase(r) ? static_cast<uint8_t>(kAckOk) : static_cast<uint8_t>(kAckWrongState);
     return kAckOk;
+}
+
+// What a reload command's ack carries after its 6 bytes: INFO's state of
+// the store (docs/reload.md), COMMIT's verifier reason when it refused.
+void link_reload_ack(Link& l, const ReloadStore& s) {
+    if (l.ack_op == kOpMachineCommit && l.ack_status == kAckBadImage) {
+        put(l.ack_x);
+        return;
+    }
+    if (l.ack_op != kOpMachineInfo || l.ack_status != kAckOk) return;
+    ReloadConfig rc;
+    flash_read(&rc, s.cfg, sizeof rc);
+    put(s.active);
+    put(s.pending);
+    put(s.refused);
+    put(s.reason);
+    put(reload_writing(s) ? 1u : 0u);
+    put_u16(rc.size);
+    put_u16(rc.ram_size);
+    put(s.up_slot);
+    put_u16(s.up_len);
+    put(s.up_nmask);
+    put_u16(s.up_crc);
+    put_u16(s.up_next);
+    for (uint8_t i = 0; i < 2; ++i) {
+        const ReloadSlot& sl = s.slot[i];
+        put(sl.status);
+        put_u16(sl.seq);
+        put_u16(sl.len);
+        put(sl.nmask);
+        put_u16(sl.crc);
+    }
+}
+
+// A reload command (kOpMachineInfo..kOpMachineActivate) on the store.
+uint8_t link_reload_apply(Link& l, ReloadStore& s, uint8_t op, const uint8_t* a, uint8_t alen) {
+    switch (op) {
+        case kOpMachineBegin:
+            if (alen != 5) return kAckBadLength;
+            return reload_upload_begin(s, load<uint16_t>(a), a[2], load<uint16_t>(a + 3));
+        case kOpMachineWrite:
+            if (alen < 3) return kAckBadLength;
+            return reload_write(s, load<uint16_t>(a), a + 2, static_cast<uint8_t>(alen - 2u));
+        case kOpMachineCommit: {
+            if (alen != 0) return kAckBadLength;
+            uint8_t reason;
+            const uint8_t st = reload_commit(s, reason);
+            l.ack_x = reason;
+            return st;
+        }
+        case kOpMachineActivate:
+            if (alen != 1) return kAckBadLength;
+            return reload_activate(s, a[0]);
+        default:
+            return alen == 0 ? static_cast<uint8_t>(kAckOk) : static_cast<uint8_t>(kAckBadLength);
+    }
 }
 
 }  // namespace fsw

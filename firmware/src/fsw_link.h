@@ -9,6 +9,7 @@
 #include "fsw_io.h"
 #include "fsw_log.h"
 #include "fsw_param.h"
+#include "fsw_reload.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -44,6 +45,12 @@ enum LinkOp : uint8_t {
     kOpLogInfo = 0x0D,   // no arguments: the ack carries the recorder's state
     kOpLogRead = 0x0E,   // record (u16), offset (u8), count (u8): the ack carries the bytes
     kOpLogErase = 0x0F,  // no arguments: erase every record (only in the states `[log] erase` names)
+    // machines replaced at run time (docs/reload.md); without `[reload]`: UNKNOWN_OP
+    kOpMachineInfo = 0x10,      // no arguments: the ack carries the slots and the upload's state
+    kOpMachineBegin = 0x11,     // image bytes (u16), mask bytes (u8), CRC-16 of both (u16)
+    kOpMachineWrite = 0x12,     // offset (u16), bytes (1..FSW_RELOAD_QUEUE)
+    kOpMachineCommit = 0x13,    // no arguments: the CRC and the verifier; BAD_IMAGE carries the reason
+    kOpMachineActivate = 0x14,  // 0 the generated machine, 1 or 2 a slot: at the next allowed step
 };
 
 // Acknowledgement status: 0 applied, anything else refused (a NACK).
@@ -64,6 +71,10 @@ enum LinkStatus : uint8_t {
     kAckBusy = 11,        // a bank is being written, or the stage queue is full
     kAckNoLoad = 12,      // STAGE or COMMIT without BEGIN
     kAckMismatch = 13,    // the staged set's CRC is not the committed one
+    // the reload store's (ReloadStatus, fsw_reload.h)
+    kAckTooBig = 14,      // the image does not fit a slot
+    kAckBadImage = 15,    // the verifier refused the image (its reason follows in the ack)
+    kAckNoImage = 16,     // no committed image in that slot
 };
 
 static const uint8_t kLinkHeader = 6;  // type, sequence number, time (low 32 bits)
@@ -104,6 +115,9 @@ typedef void (*LinkParamAckFn)(Link& link, const ParamStore& store);
 // The recorder's commands, likewise: generated code passes link_log_apply and link_log_ack.
 typedef uint8_t (*LinkLogApplyFn)(Link& link, Recorder& rec, uint8_t op, const uint8_t* args, uint8_t len);
 typedef void (*LinkLogAckFn)(Link& link, const Recorder& rec);
+// The reload commands, likewise: generated code passes link_reload_apply and link_reload_ack.
+typedef uint8_t (*LinkReloadApplyFn)(Link& link, ReloadStore& store, uint8_t op, const uint8_t* args, uint8_t len);
+typedef void (*LinkReloadAckFn)(Link& link, const ReloadStore& store);
 
 // The link's configuration: constant data generated from the application
 // config (FSW_FLASH), pointing at the RAM it works in.
@@ -136,6 +150,9 @@ struct LinkConfig {
     uint16_t tx_size;                 // bytes of `tx` (0: tx_cap). Above tx_cap, a sample frame may wait
                                       // behind the unsent rest of the one before (a link near its line
                                       // rate); a control frame behind a rest of tx_size - tx_cap
+    ReloadStore* reload;              // machines replaced at run time (null: none; docs/reload.md)
+    LinkReloadApplyFn reload_apply;   // link_reload_apply, with a store
+    LinkReloadAckFn reload_ack;       // link_reload_ack, with a store
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -206,6 +223,9 @@ void link_param_ack(Link& link, const ParamStore& store);
 // A recorder command (kOpLogInfo..kOpLogErase), and what its ack carries.
 uint8_t link_log_apply(Link& link, Recorder& rec, uint8_t op, const uint8_t* args, uint8_t len);
 void link_log_ack(Link& link, const Recorder& rec);
+// A reload command (kOpMachineInfo..kOpMachineActivate), and what its ack carries.
+uint8_t link_reload_apply(Link& link, ReloadStore& store, uint8_t op, const uint8_t* args, uint8_t len);
+void link_reload_ack(Link& link, const ReloadStore& store);
 
 // ---- compile-time checks of the tables -------------------------------------
 // The generator emits a static_assert of each for its tables; a hand-written

@@ -6,6 +6,7 @@
 
 #include "fsw_convert.h"
 #include "fsw_element.h"
+#include "fsw_pal.h"
 #include "fsw_sv.h"
 #include "fsw_window.h"
 
@@ -38,31 +39,77 @@ inline uint32_t u32(const uint8_t* p) {
     return static_cast<uint32_t>(u16(p)) | (static_cast<uint32_t>(u16(p + 2)) << 16);
 }
 
-// Where the parts of an image start (valid once the header was checked).
+// The verifier reads an image through a reader: in RAM (vm_verify), or in
+// the EEPROM a loader keeps it in (vm_verify_eeprom), byte by byte.
+struct RamImage {
+    const uint8_t* im;
+    uint8_t operator[](uint32_t i) const { return im[i]; }
+};
+struct EepromImage {
+    uint16_t base;
+    uint8_t operator[](uint32_t i) const { return pal::eeprom_read(static_cast<uint16_t>(base + i)); }
+};
+template <class Im>
+inline uint16_t r16(const Im& im, uint32_t i) { return static_cast<uint16_t>(im[i] | (im[i + 1u] << 8)); }
+template <class Im>
+inline uint32_t r32(const Im& im, uint32_t i) {
+    return static_cast<uint32_t>(r16(im, i)) | (static_cast<uint32_t>(r16(im, i + 2u)) << 16);
+}
+
+// Where the parts of an image start, as offsets into it (valid once the
+// header was checked).
+struct Offs {
+    uint8_t states, windows;
+    uint16_t locals, loc_size, prelude, code_size;
+    uint32_t st;     // states: entry, step, exit code offsets (u16 each)
+    uint32_t loc;    // locals: type (u8), offset (u16)
+    uint32_t win;    // windows: function (u8), 0 (u8), N (u16)
+    uint32_t init;   // the locals' initial bytes
+    uint32_t code;
+    uint32_t total;  // bytes the header says the image has
+};
+
+template <class Im>
+void offsets(const Im& im, Offs& o) {
+    o.states = im[18];
+    o.windows = im[19];
+    o.locals = r16(im, 20);
+    o.loc_size = r16(im, 22);
+    o.prelude = r16(im, 24);
+    o.code_size = r16(im, 26);
+    o.st = kHeader;
+    o.loc = o.st + 6u * o.states;
+    o.win = o.loc + 3u * o.locals;
+    o.init = o.win + 4u * o.windows;
+    o.code = o.init + o.loc_size;
+    o.total = o.code + o.code_size;
+}
+
+// The same, as pointers into an image in RAM (the step's view).
 struct Parts {
     uint8_t states, windows;
     uint16_t locals, loc_size, prelude, code_size;
-    const uint8_t* st;    // states: entry, step, exit code offsets (u16 each)
-    const uint8_t* loc;   // locals: type (u8), offset (u16)
-    const uint8_t* win;   // windows: function (u8), 0 (u8), N (u16)
-    const uint8_t* init;  // the locals' initial bytes
+    const uint8_t* st;
+    const uint8_t* loc;
+    const uint8_t* win;
+    const uint8_t* init;
     const uint8_t* code;
-    uint32_t total;       // bytes the header says the image has
 };
 
 void parts(const uint8_t* im, Parts& p) {
-    p.states = im[18];
-    p.windows = im[19];
-    p.locals = u16(im + 20);
-    p.loc_size = u16(im + 22);
-    p.prelude = u16(im + 24);
-    p.code_size = u16(im + 26);
-    p.st = im + kHeader;
-    p.loc = p.st + 6u * p.states;
-    p.win = p.loc + 3u * p.locals;
-    p.init = p.win + 4u * p.windows;
-    p.code = p.init + p.loc_size;
-    p.total = static_cast<uint32_t>(p.code + p.code_size - im);
+    Offs o;
+    offsets(RamImage{im}, o);
+    p.states = o.states;
+    p.windows = o.windows;
+    p.locals = o.locals;
+    p.loc_size = o.loc_size;
+    p.prelude = o.prelude;
+    p.code_size = o.code_size;
+    p.st = im + o.st;
+    p.loc = im + o.loc;
+    p.win = im + o.win;
+    p.init = im + o.init;
+    p.code = im + o.code;
 }
 
 // Storage of a window of n samples in the VM's RAM: the state struct and its
@@ -82,6 +129,12 @@ uint32_t window_size(uint8_t func, uint32_t n) {
     }
 }
 
+template <class Im>
+uint32_t windows_size(const Im& im, const Offs& o) {
+    uint32_t size = 0;
+    for (uint8_t w = 0; w < o.windows; ++w) size += window_size(im[o.win + 4u * w], r16(im, o.win + 4u * w + 2u));
+    return size;
+}
 uint32_t windows_size(const Parts& p) {
     uint32_t size = 0;
     for (uint8_t w = 0; w < p.windows; ++w) size += window_size(p.win[4u * w], u16(p.win + 4u * w + 2u));
@@ -104,12 +157,13 @@ uint8_t operand_bytes(uint8_t op, uint8_t real) {
 
 // How many of the image's declared block offsets equal `pc` (exit and prelude
 // blocks counted apart: they may not transition).
-void count_offsets(const Parts& p, uint16_t pc, uint16_t& moving, uint16_t& still) {
+template <class Im>
+void count_offsets(const Im& im, const Offs& p, uint16_t pc, uint16_t& moving, uint16_t& still) {
     moving = 0;
     still = p.prelude == pc ? 1u : 0u;
     for (uint8_t s = 0; s < p.states; ++s) {
-        moving = static_cast<uint16_t>(moving + (u16(p.st + 6u * s) == pc) + (u16(p.st + 6u * s + 2u) == pc));
-        still = static_cast<uint16_t>(still + (u16(p.st + 6u * s + 4u) == pc));
+        moving = static_cast<uint16_t>(moving + (r16(im, p.st + 6u * s) == pc) + (r16(im, p.st + 6u * s + 2u) == pc));
+        still = static_cast<uint16_t>(still + (r16(im, p.st + 6u * s + 4u) == pc));
     }
 }
 
@@ -118,11 +172,12 @@ struct Pending {
     uint8_t depth;
 };
 
-VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) {
+template <class Im>
+VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
     const uint8_t real = im[5];
     uint16_t declared = p.prelude != kNone ? 1u : 0u;
     for (uint16_t k = 0; k < 3u * p.states; ++k) {
-        const uint16_t off = u16(p.st + 2u * k);
+        const uint16_t off = r16(im, p.st + 2u * k);
         if (off == kNone) continue;
         if (off >= p.code_size) return kVmBadState;
         ++declared;
@@ -135,7 +190,7 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
     while (pc < p.code_size) {
         if (at_start) {  // a block starts here: what may it do?
             uint16_t moving, still;
-            count_offsets(p, pc, moving, still);
+            count_offsets(im, p, pc, moving, still);
             if (moving != 0 && still != 0) return kVmBadPlace;
             matched = static_cast<uint16_t>(matched + moving + still);
             may_move = moving != 0;
@@ -148,7 +203,7 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
             if (pend[k].target < pc) return kVmBadJump;  // into an instruction
             if (pend[k].target == pc) {
                 uint16_t moving, still;
-                count_offsets(p, pc, moving, still);
+                count_offsets(im, p, pc, moving, still);
                 if (moving != 0 || still != 0) return kVmBadJump;  // into another block
                 if (reachable && depth != pend[k].depth) return kVmBadStack;
                 depth = pend[k].depth;
@@ -159,10 +214,10 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
             }
         }
         if (!reachable) return kVmBadEnd;
-        const uint8_t op = p.code[pc];
+        const uint8_t op = im[p.code + pc];
         const uint8_t n = operand_bytes(op, real);
         if (n == 0xFF || static_cast<uint32_t>(pc) + 1u + n > p.code_size) return kVmBadOpcode;
-        const uint8_t* a = p.code + pc + 1;
+        const uint32_t a = p.code + pc + 1u;  // the operands
         pc = static_cast<uint16_t>(pc + 1u + n);
         uint8_t pops = 0, pushes = 0;
         bool ends = false;
@@ -170,13 +225,13 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
             case kEnd: ends = true; break;
             case kGoto:
                 if (!may_move) return kVmBadPlace;
-                if (a[0] >= p.states) return kVmBadState;
+                if (im[a] >= p.states) return kVmBadState;
                 ends = true;
                 break;
             case kJmp: case kJf: case kAnd: case kOr: {
                 pops = op == kJmp ? 0 : 1;
                 if (depth < pops) return kVmBadStack;
-                const uint32_t target = static_cast<uint32_t>(pc) + u16(a);
+                const uint32_t target = static_cast<uint32_t>(pc) + r16(im, a);
                 if (target >= p.code_size) return kVmBadJump;
                 if (np == FSW_VM_PENDING) return kVmTooNested;
                 // and/or keep their left operand when they jump; jf drops it.
@@ -188,22 +243,22 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
             }
             case kConst: case kLdt: pushes = 1; break;
             case kLde: case kSte: {
-                const uint16_t e = u16(a);
-                if (e >= layout.count || layout.elems[e].type != a[2]) return kVmBadElement;
+                const uint16_t e = r16(im, a);
+                if (e >= layout.count || layout.elems[e].type != im[a + 2u]) return kVmBadElement;
                 if (op == kLde) pushes = 1; else pops = 1;
                 break;
             }
             case kLdl: case kStl:
-                if (u16(a) >= p.locals) return kVmBadLocal;
+                if (r16(im, a) >= p.locals) return kVmBadLocal;
                 if (op == kLdl) pushes = 1; else pops = 1;
                 break;
             case kRoll:
-                if (a[0] >= p.windows || (prelude && a[0] >= pushed)) return kVmBadWindow;
+                if (im[a] >= p.windows || (prelude && im[a] >= pushed)) return kVmBadWindow;
                 pushes = 1;
                 break;
             case kWpush:
                 if (!prelude) return kVmBadPlace;
-                if (a[0] != pushed) return kVmBadWindow;
+                if (im[a] != pushed) return kVmBadWindow;
                 ++pushed;
                 pops = 1;
                 break;
@@ -232,41 +287,54 @@ VmReason verify_code(const uint8_t* im, const Parts& p, const VmLayout& layout) 
 
 }  // namespace
 
-uint32_t vm_ram_size(const uint8_t* image, uint16_t len) {
-    if (len < kHeader) return 0;
-    Parts p;
-    parts(image, p);
-    if (p.total > len) return 0;
-    return windows_size(p) + p.loc_size;
-}
+namespace {
 
-VmReason vm_verify(const uint8_t* im, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
+template <class Im>
+VmReason verify(const Im& im, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
     if (len < kHeader) return kVmBadSize;
     if (im[0] != 'F' || im[1] != 'S' || im[2] != 'M' || im[3] != 'B') return kVmBadMagic;
     if (im[4] != kVersion) return kVmBadVersion;
     if (im[5] != sizeof(Real)) return kVmBadReal;
     if ((im[6] & ~kFlagLock) != 0) return kVmBadVersion;
-    if (u32(im + 8) != layout.schema || u16(im + 12) != layout.count) return kVmBadSchema;
-    Parts p;
-    parts(im, p);
+    if (r32(im, 8) != layout.schema || r16(im, 12) != layout.count) return kVmBadSchema;
+    Offs p;
+    offsets(im, p);
     if (p.total != len) return kVmBadSize;
-    const uint16_t g = u16(im + 14), s = u16(im + 16);
+    const uint16_t g = r16(im, 14), s = r16(im, 16);
     if (g >= layout.count || s >= layout.count || layout.elems[g].type != kU64 || layout.elems[s].type != kU32)
         return kVmBadElement;
     if (p.states == 0) return kVmBadState;
     for (uint16_t k = 0; k < p.locals; ++k) {
-        const uint8_t t = p.loc[3u * k];
-        const uint16_t off = u16(p.loc + 3u * k + 1u);
+        const uint8_t t = im[p.loc + 3u * k];
+        const uint16_t off = r16(im, p.loc + 3u * k + 1u);
         if (elem_size(t) == 0 || static_cast<uint32_t>(off) + elem_size(t) > p.loc_size) return kVmBadLocal;
     }
     for (uint8_t w = 0; w < p.windows; ++w) {
-        const uint16_t n = u16(p.win + 4u * w + 2u);
-        if (p.win[4u * w] > kMedian || p.win[4u * w + 1u] != 0 || n == 0) return kVmBadWindow;
+        const uint16_t n = r16(im, p.win + 4u * w + 2u);
+        if (im[p.win + 4u * w] > kMedian || im[p.win + 4u * w + 1u] != 0 || n == 0) return kVmBadWindow;
     }
     const VmReason r = verify_code(im, p, layout);
     if (r != kVmOk) return r;
-    if (windows_size(p) + p.loc_size > ram_len) return kVmNoRam;
+    if (windows_size(im, p) + p.loc_size > ram_len) return kVmNoRam;
     return kVmOk;
+}
+
+}  // namespace
+
+uint32_t vm_ram_size(const uint8_t* image, uint16_t len) {
+    if (len < kHeader) return 0;
+    Offs o;
+    offsets(RamImage{image}, o);
+    if (o.total > len) return 0;
+    return windows_size(RamImage{image}, o) + o.loc_size;
+}
+
+VmReason vm_verify(const uint8_t* im, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
+    return verify(RamImage{im}, len, layout, ram_len);
+}
+
+VmReason vm_verify_eeprom(uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
+    return verify(EepromImage{addr}, len, layout, ram_len);
 }
 
 uint8_t* vm_locals(const uint8_t* image, uint8_t* ram) {
@@ -455,8 +523,9 @@ uint32_t run_block(const Run& r, uint16_t pc) {
 
 }  // namespace
 
-Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
-    Run r;
+namespace {
+
+void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     r.im = image;
     parts(image, r.p);
     r.layout = &layout;
@@ -465,6 +534,13 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
     r.loc = ram + windows_size(r.p);
     r.m = &m;
     r.lock = (image[6] & kFlagLock) != 0;
+}
+
+}  // namespace
+
+Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
+    Run r;
+    run_init(r, image, layout, sv, ram, m);
     uint8_t* g = sv + layout.elems[u16(image + 14)].off;
     uint8_t* s = sv + layout.elems[u16(image + 16)].off;
     if (r.lock) {  // as a generated step() over a locked state vector
@@ -493,6 +569,15 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
         machine_transition(m, next);
     }
     return kOk;
+}
+
+void vm_leave(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
+    if (m.started == 0 || m.pending != 0) return;  // no state entered, or the last one already left
+    Run r;
+    run_init(r, image, layout, sv, ram, m);
+    if (m.state == 0 || m.state > r.p.states) return;
+    const uint16_t exit = u16(r.p.st + 6u * (m.state - 1u) + 4u);
+    if (exit != kNone) (void)run_block(r, exit);
 }
 
 }  // namespace fsw

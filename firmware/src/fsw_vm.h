@@ -52,6 +52,11 @@ uint32_t vm_ram_size(const uint8_t* image, uint16_t len);
 // Checks every rule of docs/bytecode.md; kVmOk means vm_step may run it.
 FSW_MUST_CHECK VmReason vm_verify(const uint8_t* image, uint16_t len, const VmLayout& layout, uint32_t ram_len);
 
+// The same rules for an image kept in the EEPROM at `addr` (a loader's slot,
+// fsw_reload.h), read there byte by byte: an image is checked before it is
+// copied over the one that runs.
+FSW_MUST_CHECK VmReason vm_verify_eeprom(uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len);
+
 // The image's locals inside `ram` (packed little-endian, in declaration order).
 uint8_t* vm_locals(const uint8_t* image, uint8_t* ram);
 
@@ -62,6 +67,10 @@ void vm_reset(const uint8_t* image, uint8_t* ram, Machine& m, uint32_t initial);
 // One step of a verified image (spec 4.6), as a generated step(): kErrTime
 // (and nothing changed) when G did not increase.
 FSW_MUST_CHECK Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m);
+
+// Runs the current state's `.exit` (when the state was entered and not yet
+// left): another machine takes over from this one (fsw_reload.h).
+void vm_leave(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m);
 
 }  // namespace fsw
 

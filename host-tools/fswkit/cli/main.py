@@ -283,6 +283,22 @@ def parser() -> argparse.ArgumentParser:
     pa._negative_number_matcher = re.compile(r"^-(\d|\.\d|inf|nan)", re.IGNORECASE)
     pa.set_defaults(func=_command("param", "cmd_param"))
 
+    mc = sub.add_parser("machine", help="replace a running target's machine over the link without reflashing: "
+                                        "list, upload, activate, revert (docs/reload.md)")
+    mc.add_argument("project", metavar="PROJECT", help="the project the firmware was built from (its [reload])")
+    mc.add_argument("action", choices=("list", "upload", "activate", "revert"), metavar="ACTION",
+                    help="list | upload MACHINE.sm [--activate] | activate 1|2|builtin | revert")
+    mc.add_argument("args", nargs="*", metavar="ARG")
+    mc.add_argument("--port", required=True, help="serial device or pyserial URL")
+    mc.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
+    mc.add_argument("--activate", action="store_true", help="upload: activate the image once it is committed")
+    mc.add_argument("--restart", action="store_true", help="upload: start over instead of resuming an interrupted "
+                    "upload of the same image")
+    mc.add_argument("--wait", type=float, default=10.0, metavar="S", help="activate, revert: seconds to wait for "
+                    "the machine to reach a state that allows the switch (default 10)")
+    mc.add_argument("--ignore-schema", action="store_true", help="talk to the target even when the schema differs")
+    mc.set_defaults(func=_command("machine", "cmd_machine"))
+
     du = sub.add_parser("dump", help="a target's flight record over the link, each flight as a link log "
                                      "(docs/recorder.md)")
     du.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")

@@ -100,7 +100,7 @@ def test_parse_reports_only_the_file_structure():
         (8, 1, "malformed section header: expected `[Name]` alone on its line"),
         (1, 1, "unexpected `stray` before the first section"),
         (2, 2, "unknown section `[bogus]`: expected one of [application], [configs], [time], [tasks], "
-               "[telemetry], [uplink], [budget], [log], [pyro]"),
+               "[telemetry], [uplink], [budget], [log], [pyro], [reload]"),
         (6, 2, "duplicate section `[tasks]`"),
     ]
     assert [t.name.text for t in tree.tasks] == ["a"]  # the first of a duplicate section

@@ -66,7 +66,7 @@ def test_every_expected_file_has_its_input():
 # ---- every message the application checker can produce has a golden case ------------
 
 SOURCES = [ROOT / "autocode" / n for n in ("appsyntax.py", "appcheck.py", "iotables.py", "logcheck.py", "pyrocheck.py",
-                                           "sensors.py")]
+                                           "reloadcheck.py", "sensors.py")]
 REPORTERS = {"error", "warning", "err", "at", "Problem", "_Refused"}
 # Messages that no golden case here can hold, and where they are tested instead.
 NOT_GOLDEN = {
@@ -93,6 +93,9 @@ NOT_GOLDEN = {
     "the logged elements take ": "tests/recorder/test_log_check.py",
     " bytes a sample: at most 253 (log fewer, or encode F32 ones with delta= or quant=)":
         "tests/recorder/test_log_check.py",
+    # [reload] on a board without EEPROM; `activate` with no state (tests/reload/test_reload_check.py)
+    " has no EEPROM to keep uploaded machines in": "tests/reload/test_reload_check.py",
+    "`activate` takes states of machine `": "tests/reload/test_reload_check.py",
     # two machine files whose names differ only in case: one file on some file systems
     "machines `": "tests/regression/test_names_reach_cpp_safely.py",
     "` would generate the same C++ files (`": "tests/regression/test_names_reach_cpp_safely.py",

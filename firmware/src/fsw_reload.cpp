@@ -1,0 +1,293 @@
+// Machines replaced at run time (fsw_reload.h, docs/reload.md).
+#include "fsw_reload.h"
+
+#include "fsw_crc.h"
+#include "fsw_pal.h"
+
+namespace fsw {
+
+namespace {
+
+const uint8_t kNoSeg = 2;
+
+ReloadConfig config(const ReloadStore& s) {
+    ReloadConfig c;
+    flash_read(&c, s.cfg, sizeof c);
+    return c;
+}
+
+uint16_t slot_addr(const ReloadConfig& c, uint8_t which) {  // which: 1 or 2
+    return static_cast<uint16_t>(c.eeprom_base + (which - 1u) * (kReloadHeader + c.size));
+}
+
+uint16_t payload_crc(uint16_t addr, uint16_t n) {
+    uint16_t crc = kCrcInit;
+    for (uint16_t i = 0; i < n; ++i) crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(addr + i)));
+    return crc;
+}
+
+// Reads slot `which`'s header and checks its payload's CRC: false when the
+// slot holds nothing whole.
+bool read_slot(const ReloadConfig& c, uint8_t which, ReloadSlot& out) {
+    const uint16_t a = slot_addr(c, which);
+    uint8_t h[kReloadHeader];
+    for (uint8_t i = 0; i < kReloadHeader; ++i) h[i] = pal::eeprom_read(static_cast<uint16_t>(a + i));
+    out.status = kSlotEmpty;
+    out.seq = static_cast<uint16_t>(h[2] | (h[3] << 8));
+    out.len = static_cast<uint16_t>(h[4] | (h[5] << 8));
+    out.nmask = h[6];
+    out.crc = static_cast<uint16_t>(h[7] | (h[8] << 8));
+    if (h[0] != kReloadMagic || out.len == 0 || static_cast<uint32_t>(out.len) + out.nmask > c.size ||
+        payload_crc(static_cast<uint16_t>(a + kReloadHeader), static_cast<uint16_t>(out.len + out.nmask)) != out.crc) {
+        memset(&out, 0, sizeof out);  // kSlotEmpty
+        return false;
+    }
+    out.status = h[1] == kSlotBoot ? kSlotBoot : kSlotStored;
+    return true;
+}
+
+// The image in slot `which` checked where it lies (CRC again, then the verifier).
+uint8_t check_slot(const ReloadConfig& c, const ReloadSlot& sl, uint8_t which) {
+    const uint16_t a = static_cast<uint16_t>(slot_addr(c, which) + kReloadHeader);
+    if (payload_crc(a, static_cast<uint16_t>(sl.len + sl.nmask)) != sl.crc) return kReloadCrcFails;
+    return vm_verify_eeprom(a, sl.len, *c.layout, c.ram_size);
+}
+
+// Copies slot `which` (checked) into the running image's buffer and starts
+// it from its first state.
+void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
+    const ReloadSlot& sl = s.slot[which - 1u];
+    const uint16_t a = static_cast<uint16_t>(slot_addr(c, which) + kReloadHeader);
+    for (uint16_t i = 0; i < sl.len + sl.nmask; ++i) c.image[i] = pal::eeprom_read(static_cast<uint16_t>(a + i));
+    vm_reset(c.image, c.ram, *c.machine, 1);
+    s.active = which;
+}
+
+// Whether the running machine's current state allows another to take over.
+bool allowed(const ReloadStore& s, const ReloadConfig& c) {
+    const uint32_t st = c.machine->state;
+    if (c.machine->started == 0 || st == 0) return true;  // nothing has run yet
+    const uint32_t byte = (st - 1u) / 8u;
+    const uint8_t bit = static_cast<uint8_t>(1u << ((st - 1u) % 8u));
+    if (s.active == kReloadBuiltIn) {
+        if (byte >= c.n_allow) return false;
+        uint8_t b;
+        flash_read(&b, c.allow + byte, 1);
+        return (b & bit) != 0;
+    }
+    const ReloadSlot& sl = s.slot[s.active - 1u];
+    return byte < sl.nmask && (c.image[sl.len + byte] & bit) != 0;
+}
+
+void leave(const ReloadStore& s, const ReloadConfig& c) {
+    if (s.active == kReloadBuiltIn) c.leave();
+    else vm_leave(c.image, *c.layout, c.sv, c.ram, *c.machine);
+}
+
+void activate_now(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
+    if (which == s.active) return;
+    if (which == kReloadBuiltIn) {
+        leave(s, c);
+        s.active = kReloadBuiltIn;
+        c.reset(1);
+        for (uint8_t i = 0; i < 2; ++i)
+            if (s.slot[i].status == kSlotBoot) s.slot[i].status = kSlotStored;  // boot the generated machine
+        s.sync = true;
+        return;
+    }
+    ReloadSlot& sl = s.slot[which - 1u];
+    const uint8_t r = check_slot(c, sl, which);
+    if (r != kVmOk) {  // the running machine goes on untouched
+        s.refused = which;
+        s.reason = r;
+        if (r == kReloadCrcFails) sl.status = kSlotEmpty;  // the bytes changed in the EEPROM
+        return;
+    }
+    leave(s, c);
+    run_slot(s, c, which);
+    const ReloadSlot& o = s.slot[2u - which];
+    const uint16_t other = o.status != kSlotEmpty ? o.seq : 0u;
+    sl.seq = static_cast<uint16_t>((sl.seq > other ? sl.seq : other) + 1u);
+    sl.status = kSlotBoot;
+    s.sync = true;
+}
+
+// Queues a run of bytes for the writer (`seg` 0 or 1; run 0 starts first).
+void queue_run(ReloadStore& s, uint8_t seg, uint16_t addr, uint8_t n) {
+    s.w_addr[seg] = addr;
+    s.w_n[seg] = n;
+}
+
+void start_writer(ReloadStore& s) {
+    s.w_seg = 0;
+    s.w_i = 0;
+}
+
+}  // namespace
+
+void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
+    memset(&s, 0, sizeof s);
+    s.cfg = cfg;
+    s.pending = kReloadNone;
+    s.w_seg = kNoSeg;
+    const ReloadConfig c = config(s);
+    for (uint8_t w = 1; w <= 2; ++w) read_slot(c, w, s.slot[w - 1u]);
+    for (uint8_t tries = 0; tries < 2; ++tries) {  // the newest activated image first
+        uint8_t best = 0;
+        for (uint8_t w = 1; w <= 2; ++w) {
+            const ReloadSlot& sl = s.slot[w - 1u];
+            if (sl.status == kSlotBoot && (best == 0 || sl.seq > s.slot[best - 1u].seq)) best = w;
+        }
+        if (best == 0) return;  // the generated machine
+        const uint8_t r = check_slot(c, s.slot[best - 1u], best);
+        if (r == kVmOk) {
+            run_slot(s, c, best);
+            return;
+        }
+        s.refused = best;
+        s.reason = r;
+        s.slot[best - 1u].status = kSlotStored;  // not booted again (until activated)
+        s.sync = true;
+    }
+}
+
+Result reload_step(ReloadStore& s) {
+    const ReloadConfig c = config(s);
+    if (s.pending != kReloadNone && allowed(s, c)) {
+        const uint8_t which = s.pending;
+        s.pending = kReloadNone;
+        activate_now(s, c, which);
+    }
+    if (s.active == kReloadBuiltIn) return c.step();
+    return vm_step(c.image, *c.layout, c.sv, c.ram, *c.machine);
+}
+
+bool reload_writing(const ReloadStore& s) { return s.w_seg != kNoSeg || s.sync; }
+
+uint8_t reload_upload_begin(ReloadStore& s, uint16_t len, uint8_t nmask, uint16_t crc) {
+    const ReloadConfig c = config(s);
+    if (static_cast<uint32_t>(len) + nmask > c.size) return kReloadTooBig;
+    if (len == 0) return kReloadBadLength;
+    if (reload_writing(s)) return kReloadBusy;
+    // never the slot that runs: an empty one, else the older
+    uint8_t to;
+    if (s.active != kReloadBuiltIn) {
+        to = static_cast<uint8_t>(3u - s.active);
+    } else if (s.slot[0].status == kSlotEmpty || s.slot[1].status == kSlotEmpty) {
+        to = s.slot[0].status == kSlotEmpty ? 1u : 2u;
+    } else {
+        to = s.slot[0].seq <= s.slot[1].seq ? 1u : 2u;
+    }
+    if (s.pending == to) return kReloadWrongState;
+    memset(&s.slot[to - 1u], 0, sizeof s.slot[0]);  // kSlotEmpty from the first byte written
+    s.up_slot = to;
+    s.up_len = len;
+    s.up_nmask = nmask;
+    s.up_crc = crc;
+    s.up_next = 0;
+    s.queue[0] = 0;  // the header's magic goes first: a cut from here on leaves the slot empty
+    queue_run(s, 0, slot_addr(c, to), 1);
+    queue_run(s, 1, 0, 0);
+    start_writer(s);
+    return kReloadOk;
+}
+
+uint8_t reload_write(ReloadStore& s, uint16_t off, const uint8_t* data, uint8_t n) {
+    if (s.up_slot == 0) return kReloadNoLoad;
+    if (n == 0 || n > FSW_RELOAD_QUEUE) return kReloadBadLength;
+    if (static_cast<uint32_t>(off) + n > static_cast<uint32_t>(s.up_len) + s.up_nmask) return kReloadOutOfRange;
+    if (reload_writing(s)) return kReloadBusy;
+    const ReloadConfig c = config(s);
+    memcpy(s.queue, data, n);
+    queue_run(s, 0, static_cast<uint16_t>(slot_addr(c, s.up_slot) + kReloadHeader + off), n);
+    queue_run(s, 1, 0, 0);
+    start_writer(s);
+    if (off <= s.up_next && off + n > s.up_next) s.up_next = static_cast<uint16_t>(off + n);
+    return kReloadOk;
+}
+
+uint8_t reload_commit(ReloadStore& s, uint8_t& reason) {
+    reason = kVmOk;
+    if (s.up_slot == 0) return kReloadNoLoad;
+    if (reload_writing(s)) return kReloadBusy;
+    const uint16_t total = static_cast<uint16_t>(s.up_len + s.up_nmask);
+    if (s.up_next < total) return kReloadNoLoad;
+    const ReloadConfig c = config(s);
+    const uint8_t to = s.up_slot;
+    const uint16_t a = slot_addr(c, to);
+    if (payload_crc(static_cast<uint16_t>(a + kReloadHeader), total) != s.up_crc) return kReloadMismatch;
+    s.up_slot = 0;  // whatever follows, the upload is over
+    reason = vm_verify_eeprom(static_cast<uint16_t>(a + kReloadHeader), s.up_len, *c.layout, c.ram_size);
+    if (reason != kVmOk) {
+        s.refused = to;
+        s.reason = reason;
+        return kReloadBadImage;
+    }
+    ReloadSlot& sl = s.slot[to - 1u];
+    sl.status = kSlotStored;
+    sl.seq = 0;
+    sl.len = s.up_len;
+    sl.nmask = s.up_nmask;
+    sl.crc = s.up_crc;
+    // the header's body, then its magic
+    const uint8_t h[kReloadHeader - 1] = {kSlotStored, 0, 0, static_cast<uint8_t>(sl.len), static_cast<uint8_t>(sl.len >> 8),
+                                          sl.nmask, static_cast<uint8_t>(sl.crc), static_cast<uint8_t>(sl.crc >> 8)};
+    memcpy(s.queue, h, sizeof h);
+    s.queue[sizeof h] = kReloadMagic;
+    queue_run(s, 0, static_cast<uint16_t>(a + 1u), sizeof h);
+    queue_run(s, 1, a, 1);
+    start_writer(s);
+    return kReloadOk;
+}
+
+uint8_t reload_activate(ReloadStore& s, uint8_t which) {
+    if (which > 2) return kReloadOutOfRange;
+    if (which != kReloadBuiltIn && s.slot[which - 1u].status == kSlotEmpty) return kReloadNoImage;
+    if (which != kReloadBuiltIn && s.up_slot == which) return kReloadNoImage;
+    s.pending = which == s.active ? kReloadNone : which;
+    return kReloadOk;
+}
+
+void reload_poll(ReloadStore& s) {
+    if (!pal::eeprom_ready()) return;
+    if (s.w_seg == kNoSeg) {
+        if (!s.sync) return;
+        // the status and seq bytes of each whole slot, as the store has them
+        // (status first: a cut before the seq leaves the slots in their old
+        // order, so the machine that ran before keeps its place at boot)
+        s.sync = false;
+        const ReloadConfig c = config(s);
+        uint8_t r = 0;
+        for (uint8_t w = 1; w <= 2; ++w) {
+            const ReloadSlot& sl = s.slot[w - 1u];
+            if (sl.status == kSlotEmpty) continue;
+            s.queue[3u * r] = sl.status;
+            s.queue[3u * r + 1u] = static_cast<uint8_t>(sl.seq);
+            s.queue[3u * r + 2u] = static_cast<uint8_t>(sl.seq >> 8);
+            queue_run(s, r, static_cast<uint16_t>(slot_addr(c, w) + 1u), 3);
+            ++r;
+        }
+        if (r == 0) return;
+        if (r < 2) queue_run(s, 1, 0, 0);
+        start_writer(s);
+    }
+    // the next byte that differs from the EEPROM's
+    while (s.w_seg < kNoSeg) {
+        const uint8_t seg = s.w_seg;
+        if (s.w_i >= s.w_n[seg]) {
+            s.w_seg = static_cast<uint8_t>(seg + 1u);
+            s.w_i = 0;
+            if (s.w_seg < kNoSeg && s.w_n[s.w_seg] == 0) s.w_seg = kNoSeg;
+            continue;
+        }
+        const uint8_t qi = static_cast<uint8_t>((seg == 0 ? 0u : s.w_n[0]) + s.w_i);
+        const uint16_t addr = static_cast<uint16_t>(s.w_addr[seg] + s.w_i);
+        ++s.w_i;
+        if (pal::eeprom_read(addr) != s.queue[qi]) {
+            pal::eeprom_write(addr, s.queue[qi]);
+            return;  // one byte a call: the next when the EEPROM is ready
+        }
+    }
+}
+
+}  // namespace fsw

@@ -1,0 +1,169 @@
+"""`fsw machine PROJECT list|upload|activate|revert`: the machine that an
+application's `[reload]` names, replaced on a running target over the link
+without reflashing (docs/reload.md, fswkit.reload)."""
+
+from __future__ import annotations
+
+import sys
+
+from fswkit.autocode.diagnostics import Diagnostics
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+
+
+def _say(msg: str) -> None:
+    sys.stderr.write(f"fsw machine: {msg}\n")
+
+
+def image_for(app, path: str, diags: Diagnostics):
+    """(image, state mask, machine) of the machine in `path`, compiled
+    against the application's state vector for its board's evaluation type;
+    None with the reasons in `diags` or said."""
+    from fswkit.autocode import vmverify as V
+    from fswkit.autocode.diagnostics import SM, Source
+    from fswkit.autocode.emit.app import real_of
+    from fswkit.autocode.emit.bytecode import BytecodeError, compile_machine
+    from fswkit.autocode.project import load_machine
+
+    m = load_machine(path, diags, app.sv.path)
+    if m is None:
+        return None
+    real = real_of(app)
+    try:
+        image = compile_machine(m, real)
+    except BytecodeError as e:
+        try:
+            with open(path, encoding="utf-8", errors="surrogateescape") as f:
+                src = Source.from_text(path, f.read())
+        except OSError:
+            src = Source.from_text(path, "")
+        diags.error(src, SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        return None
+    reason = V.verify(image, V.layout_of(app.sv), real.bits // 8)
+    if reason != V.OK:
+        _say(f"internal error: the image of {path} fails the verifier ({V.REASONS[reason]})")
+        return None
+    allow = app.reload.activate
+    mask = bytearray((len(m.states) + 7) // 8)
+    for st in m.states:
+        if st.name in allow:
+            mask[(st.id - 1) // 8] |= 1 << ((st.id - 1) % 8)
+    if not any(mask):
+        _say(f"{path}: machine `{m.name}` has none of the states in which [reload] lets another machine take over "
+             f"({', '.join(allow)}): once running it could never be replaced again; add one of them")
+        return None
+    return bytes(image), bytes(mask), m
+
+
+def cmd_machine(args) -> int:
+    from fswkit.target.build import BuildError, load
+
+    diags = Diagnostics()
+    try:
+        app = load(args.project, diags)
+    except BuildError as e:
+        _say(str(e))
+        return EXIT_CONFIG
+    print_diags(diags)
+    if app is None:
+        return EXIT_CONFIG
+    if app.reload is None:
+        _say(f"{args.project}: the application has no [reload] section: no machine of it can be replaced at run "
+             "time (docs/reload.md)")
+        return EXIT_CONFIG
+    a = args.action
+    built = None
+    which = None
+    if a == "upload":
+        if len(args.args) != 1 or not args.args[0].endswith(".sm"):
+            _say("usage: fsw machine PROJECT upload MACHINE.sm [--activate] (the machine's .sm: its state names "
+                 "decide where another machine may take over)")
+            return EXIT_CONFIG
+        d = Diagnostics()
+        built = image_for(app, args.args[0], d)
+        print_diags(d)
+        if built is None:
+            return EXIT_CONFIG
+        size = len(built[0]) + len(built[1])
+        if size > app.reload.size:
+            _say(f"{args.args[0]}: the image and its state mask take {size} B: more than the slots' "
+                 f"{app.reload.size} B ([reload] size in {args.project})")
+            return EXIT_CONFIG
+    elif a == "activate":
+        if len(args.args) != 1 or args.args[0] not in ("1", "2", "builtin"):
+            _say("usage: fsw machine PROJECT activate 1|2|builtin")
+            return EXIT_CONFIG
+        which = 0 if args.args[0] == "builtin" else int(args.args[0])
+    elif args.args:
+        _say(f"`{a}` takes no arguments")
+        return EXIT_CONFIG
+    return _talk(args, app, built, which)
+
+
+def _describe(app, inf) -> list[str]:
+    from fswkit.reload.client import NONE, reason_words
+
+    name = app.machines[app.reload.machine].name
+
+    def what(k: int) -> str:
+        return f"the generated `{name}`" if k == 0 else f"the image in slot {k}"
+
+    lines = [f"machine `{name}` of {app.name}: {what(inf.active)} runs"
+             + (f"; switching to {what(inf.pending)} at its next allowed state" if inf.pending != NONE else "")]
+    for s in inf.slots:
+        if s.status == 0:
+            lines.append(f"  slot {s.number}: empty")
+        else:
+            lines.append(f"  slot {s.number}: {s.status_name}, image of {s.length} B, CRC 0x{s.crc:04x}"
+                         + (f", activation {s.seq}" if s.seq else "") + ("  (running)" if inf.active == s.number
+                                                                         else ""))
+    if inf.up_slot:
+        lines.append(f"  an upload into slot {inf.up_slot} is open: {inf.up_next} of {inf.up_len + inf.up_nmask} B "
+                     "written (`upload` resumes it)")
+    if inf.refused:
+        lines.append(f"  refused last: slot {inf.refused}, {reason_words(inf.reason)}")
+    lines.append(f"  slots of {inf.size} B; {inf.ram} B for an image's windows and locals; another machine may take "
+                 f"over in {', '.join(app.reload.activate)}")
+    return lines
+
+
+def _talk(args, app, built, which) -> int:
+    from fswkit.autocode.schema import link_plan
+    from fswkit.cli.common import open_link
+    from fswkit.link.layout import from_app
+    from fswkit.link.port import port_errors
+    from fswkit.param.client import ParamError, PortTransport
+    from fswkit.reload.client import MachineClient, MachineError
+
+    baud = args.baud or app.baud
+    ground = open_link(args, from_app(app), baud, _say)
+    if ground is None:
+        return EXIT_FAIL
+    try:
+        client = MachineClient(PortTransport(ground), link_plan(app).tx_cap, baud=baud)
+        a = args.action
+        if a == "upload":
+            image, mask, m = built
+            slot, resumed = client.upload(image, mask, restart=args.restart)
+            print(f"fsw machine: {args.args[0]} (machine `{m.name}`, {len(image)} B) "
+                  f"{'resumed and ' if resumed else ''}committed in slot {slot}, verified by the target")
+            if args.activate:
+                client.activate(slot, args.wait)
+                print(f"fsw machine: slot {slot} runs")
+        elif a == "activate":
+            client.activate(which, args.wait)
+            print(f"fsw machine: {'the generated machine' if which == 0 else f'slot {which}'} runs")
+        elif a == "revert":
+            target, _inf = client.revert(args.wait)
+            print(f"fsw machine: reverted: {'the generated machine' if target == 0 else f'slot {target}'} runs")
+        inf = client.info()
+        for line in _describe(app, inf):
+            print(line)
+        return EXIT_OK
+    except (MachineError, ParamError) as e:
+        _say(str(e))
+        return EXIT_FAIL
+    except port_errors() as e:
+        _say(f"{args.port}: the port went away ({e})")
+        return EXIT_FAIL
+    finally:
+        ground.close()

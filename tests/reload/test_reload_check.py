@@ -1,0 +1,90 @@
+"""[reload] messages no golden case holds (tests/autocode/golden/app/reload_*.app
+hold the rest), the EEPROM the slots share with the parameters and the
+flight recorder, and what a [reload] adds to the generated code."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import shutil
+from pathlib import Path
+
+from conftest import EXAMPLES
+
+from fswkit.autocode.appcheck import check_app
+from fswkit.autocode.appsyntax import parse_app
+from fswkit.autocode.board import load_board
+from fswkit.autocode.diagnostics import APP, Diagnostics, read_source
+
+GOLDEN = Path(__file__).resolve().parents[1] / "autocode" / "golden" / "app"
+
+
+def _rig(tmp: Path, reload: str) -> Path:
+    for name in ("rig.sv", "rig.sm", "rig.aio", "rig.dio"):
+        shutil.copy(GOLDEN / name, tmp / name)
+    text = (GOLDEN / "valid.app").read_text()
+    app = tmp / "rig.app"
+    app.write_text(text + "\n[reload]\n" + reload)
+    return app
+
+
+def _errors(app: Path, board=load_board) -> list[tuple[int, str]]:
+    diags = Diagnostics()
+    src = read_source(str(app), diags, APP)
+    check_app(parse_app(src, diags), diags, None, board)
+    return [(d.line, d.message) for d in diags.errors]
+
+
+def test_activate_without_states_is_refused(tmp_path):
+    assert _errors(_rig(tmp_path, "machine rig\nactivate\n")) == [(36, "`activate` takes states of machine `rig`")]
+
+
+def test_a_board_without_eeprom_is_told_so(tmp_path):
+    errs = _errors(_rig(tmp_path, "machine rig\n"), lambda name: dataclasses.replace(load_board(name), eeprom=0))
+    assert errs == [(35, "the uno has no EEPROM to keep uploaded machines in")]
+
+
+def test_the_slots_share_the_eeprom_with_the_parameters_and_the_recorder(tmp_path):
+    """The rocket keeps 6 parameters (2 banks of 9 + 24 B) and its record in
+    the Uno's 1,024 B: slots of 440 B leave the recorder less than a record;
+    of 300 B, the recorder's area starts after them."""
+    from fswkit.autocode.recorder import plan
+    from fswkit.target.build import load
+
+    folder = tmp_path / "rocket"
+    shutil.copytree(EXAMPLES / "rocket", folder, ignore=shutil.ignore_patterns("build"))
+    app_path = folder / "rocket.app"
+    base = app_path.read_text()
+    app_path.write_text(base + "\n[reload]\nmachine mission\nsize 440\nactivate Safe\n")
+    diags = Diagnostics()
+    assert load(str(folder), diags) is None
+    [err] = [d for d in diags.errors]
+    assert re.fullmatch(r"the two slots take 898 B \(2 x \(9 \+ 440\)\), the parameters' banks 66 B, the recorder at "
+                        r"least a 64 B record: more than the uno's 1,024 B of EEPROM; lower `size`", err.message), \
+        err.message
+    app_path.write_text(base + "\n[reload]\nmachine mission\nsize 300\nactivate Safe\n")
+    diags = Diagnostics()
+    app = load(str(folder), diags)
+    assert app is not None, diags.render()
+    assert plan(app).base == 66 + 2 * (9 + 300)  # the parameters' banks, then the two slots
+
+
+def test_the_generated_code_runs_the_machine_through_the_store():
+    """The reloadable machine's task steps fsw::reload_step; its machine
+    gets leave(); the slots follow the parameters in the EEPROM; another
+    machine's code is as without [reload]."""
+    from fswkit.autocode.emit.app import emit_app
+    from fswkit.target.build import load
+
+    app = load(str(EXAMPLES / "stand"), Diagnostics())
+    files = emit_app(app)
+    cpp = files["app.gen.cpp"]
+    assert "return fsw::reload_step(reload);" in cpp and "tank::step();" not in cpp.split("task_control")[1][:200]
+    assert "fsw::reload_begin(reload, &kReloadConfig);" in cpp and "fsw::reload_poll(reload);" in cpp
+    assert "kReloadAllow[1] FSW_FLASH = {0x05};  // TankVentControl Idle" in cpp
+    assert "384, 64, 0, 1};" in cpp  # size, ram, EEPROM base (no parameters), mask bytes
+    assert "&reload, fsw::link_reload_apply, fsw::link_reload_ack};" in cpp
+    assert "void leave();" in files["tank.gen.h"] and "case S_TankVentControl: s1_exit(); break;" in files["tank.gen.cpp"]
+    plain = emit_app(load(str(EXAMPLES / "tank"), Diagnostics()))
+    assert "leave" not in plain["tank.gen.h"] and "reload" not in plain["app.gen.cpp"]
+    assert ", 0, 0, 0};" in plain["app.gen.cpp"]  # the link's reload fields, empty

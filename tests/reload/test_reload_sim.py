@@ -1,0 +1,287 @@
+"""Machines replaced at run time on the simulated Uno (docs/reload.md):
+examples/stand (the tank rig with a `[reload]` section) runs its
+generated vent controller; the ground uploads examples/stand/tank_700.sm
+(the valve opening at 700 instead of 775) over the link and activates it,
+and the valve follows the new threshold with no reset. A corrupted image,
+one bound to another state vector and one the verifier refuses are each
+refused with their reason while the old machine keeps running; an upload
+cut short resumes; an activation waits for an allowed state; the board
+boots the newest activated image after a power cut, and the generated
+machine once reverted; an upload through a link that drops a fifth of the
+frames each way completes."""
+
+from __future__ import annotations
+
+import os
+import random
+import shutil
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import EXAMPLES, ROOT
+
+pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
+                                reason="gcc-avr and libsimavr-dev are needed (make setup)")
+
+STAND = EXAMPLES / "stand"
+NEW = STAND / "tank_700.sm"
+VALVE_PIN = 4  # tank.dio: valveOpen on pin 4
+
+
+def volts(psi: float) -> float:
+    """The transducer's output for a tank pressure (tank.aio: 250 per volt, -125)."""
+    return (psi + 125.0) / 250.0
+
+
+@pytest.fixture(scope="module")
+def stand(tmp_path_factory):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.target.build import firmware, load
+
+    app = load(str(STAND), Diagnostics())
+    assert app is not None and app.reload is not None
+    built = firmware(app, str(tmp_path_factory.mktemp("stand")))
+    assert built.fits, built.report
+    return app, built.artifact
+
+
+@pytest.fixture(scope="module")
+def new_image(stand):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.cli.machine import image_for
+
+    app, _ = stand
+    d = Diagnostics()
+    built = image_for(app, str(NEW), d)
+    assert built is not None, d.render()
+    return built[0], built[1]
+
+
+class Rig:
+    """The stand's firmware on a simulated Uno, the tank pressure set on its
+    transducer's pin, the ground's machine client on its UART."""
+
+    def __init__(self, app, elf, loss: float = 0.0, seed: int = 1, eeprom: str | None = None):
+        from fswkit.autocode.schema import link_plan
+        from fswkit.link.layout import from_app
+        from fswkit.link.session import Session
+        from fswkit.param.client import Lossy, SimTransport
+        from fswkit.reload.client import MachineClient
+        from fswkit.sim.board import SimBoard
+
+        self.b = SimBoard(elf, "uno", uart="control", sim_limit=600, eeprom=eeprom)
+        self.session = Session(from_app(app))
+        rnd = random.Random(seed)
+        self.up = Lossy(loss, rnd) if loss else None
+        self.down = Lossy(loss, rnd) if loss else None
+        self.t = SimTransport(self.b, self.session, self.up, self.down)
+        self.psi(740)
+        while self.session.hello is None and self.b.time < 5:
+            self.t.events(0.05)
+        assert self.session.hello is not None
+        self.c = MachineClient(self.t, link_plan(app).tx_cap, baud=app.baud, timeout=0.3)
+
+    def psi(self, p: float) -> None:
+        self.b.set_analog("A0", volts(p))
+
+    def valve_at(self, p: float, settle: float = 0.1) -> bool:
+        self.psi(p)
+        self.t.events(settle)
+        return self.b.digital(VALVE_PIN)
+
+    def close(self) -> None:
+        self.b.close()
+
+
+@pytest.fixture
+def rig(stand):
+    r = Rig(*stand)
+    yield r
+    r.close()
+
+
+def test_the_valve_follows_the_uploaded_threshold_without_a_reset(rig, new_image):
+    assert rig.valve_at(740) is False and rig.valve_at(790) is True  # the generated controller: 775
+    inf = rig.c.info()
+    assert inf.active == 0 and [s.status for s in inf.slots] == [0, 0]
+    hellos = rig.session.hellos if hasattr(rig.session, "hellos") else None
+    cycles0 = rig.session.health["cycles"] if rig.session.health else 0
+    slot, resumed = rig.c.upload(*new_image)
+    assert slot == 1 and not resumed
+    assert rig.valve_at(740) is False  # committed, not yet running
+    inf = rig.c.activate(slot)
+    assert inf.active == 1 and inf.slots[0].status == 2 and inf.slots[0].seq == 1
+    assert rig.valve_at(740) is True and rig.valve_at(720) is True and rig.valve_at(690) is False
+    rig.t.events(1.2)  # a health frame or more since
+    assert rig.session.health["cycles"] > cycles0 + 100  # the executor went on counting: no reset
+    assert rig.session.health["reset_cause"] == rig.session.hello["reset_cause"]
+    if hellos is not None:
+        assert rig.session.hellos == hellos
+    # and back to the generated machine
+    target, inf = rig.c.revert()
+    assert target == 0 and inf.active == 0 and [s.status for s in inf.slots] == [1, 0]
+    assert rig.valve_at(740) is False and rig.valve_at(790) is True
+
+
+def _begin_and_write(rig, data: bytes, crc: int, nmask: int = 1):
+    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_COMMIT, OP_MACHINE_WRITE
+    from fswkit.reload.client import CHUNK
+
+    ack = rig.c._one(OP_MACHINE_BEGIN, struct.pack("<HBH", len(data) - nmask, nmask, crc))
+    assert ack["status"] == 0, ack
+    for off in range(0, len(data), CHUNK):
+        ack = rig.c._one(OP_MACHINE_WRITE, struct.pack("<H", off) + data[off:off + CHUNK])
+        assert ack["status"] == 0, ack
+        rig.t.events(CHUNK * 0.0035)
+    return rig.c._one(OP_MACHINE_COMMIT)
+
+
+def test_a_corrupted_image_is_refused_and_the_old_machine_keeps_running(rig, new_image):
+    from fswkit.autocode.protocol import crc16
+
+    image, mask = new_image
+    good = image + mask
+    bad = bytearray(good)
+    bad[60] ^= 0x10  # a byte changed on the way, after the ground computed the CRC
+    ack = _begin_and_write(rig, bytes(bad), crc16(good))
+    assert ack["status_name"] == "MISMATCH"
+    inf = rig.c.info()
+    assert inf.active == 0 and [s.status for s in inf.slots] == [0, 0]
+    assert rig.valve_at(740) is False and rig.valve_at(790) is True
+
+
+def test_an_image_of_another_state_vector_is_refused_with_its_reason(rig, stand, new_image, tmp_path):
+    """The verifier's reason reaches the ground: reason 4, the schema."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.emit.app import real_of
+    from fswkit.autocode.emit.bytecode import compile_machine
+    from fswkit.autocode.project import load_machine
+    from fswkit.reload.client import MachineError
+
+    app, _ = stand
+    sv = tmp_path / "other.sv"
+    sv.write_text((EXAMPLES / "tank" / "tank.sv").read_text() + "\n[Spare]\nF32 spare\n")
+    m = load_machine(str(NEW), Diagnostics(), str(sv))
+    assert m is not None
+    other = compile_machine(m, real_of(app))
+    with pytest.raises(MachineError, match=r"another state vector|schema|verifier reason 4"):
+        rig.c.upload(bytes(other), new_image[1])
+    inf = rig.c.info()
+    assert inf.refused == 1 and inf.reason == 4 and inf.active == 0 and inf.slots[0].status == 0
+    assert rig.valve_at(740) is False
+
+
+def test_an_image_the_verifier_refuses_never_runs(rig, new_image):
+    """A jump pointed past the code: the CRC holds (the ground computed it),
+    the board's own verifier says no."""
+    from fswkit.autocode.protocol import crc16
+    from fswkit.autocode.vmverify import REASONS
+
+    image, mask = new_image
+    bad = bytearray(image)
+    code_size = struct.unpack_from("<H", bad, 26)[0]
+    struct.pack_into("<H", bad, 26, code_size + 7)  # the header's code length no longer the image's
+    data = bytes(bad) + mask
+    ack = _begin_and_write(rig, data, crc16(data))
+    assert ack["status_name"] == "BAD_IMAGE" and ack["data"][:1] == bytes((5,)), ack
+    assert "lengths" in REASONS[5] or REASONS[5]
+    inf = rig.c.info()
+    assert inf.refused == 1 and inf.reason == 5 and inf.active == 0
+    assert rig.valve_at(740) is False
+
+
+def test_an_interrupted_upload_resumes(rig, new_image):
+    class Cut(Exception):
+        pass
+
+    def stop_after_half(done, total):
+        if done >= total // 2:
+            raise Cut
+
+    rig.c.on_progress = stop_after_half
+    with pytest.raises(Cut):
+        rig.c.upload(*new_image)
+    inf = rig.c.info()
+    assert inf.up_slot == 1 and 0 < inf.up_next < inf.up_len + inf.up_nmask
+    rig.c.on_progress = None
+    sent = rig.c.stats.sent
+    slot, resumed = rig.c.upload(*new_image)
+    assert slot == 1 and resumed
+    assert rig.c.stats.sent - sent < 16  # the second half only, and the commit
+    rig.c.activate(slot)
+    assert rig.valve_at(740) is True
+
+
+def test_an_activation_waits_for_an_allowed_state(rig, new_image):
+    """In Abort (not in [reload] activate) the switch waits; the old
+    machine runs on."""
+    from fswkit.reload.client import MachineError
+
+    slot, _ = rig.c.upload(*new_image)
+    assert rig.valve_at(900, settle=0.2) is True  # over 825: Abort (its exit opened the valve)
+    with pytest.raises(MachineError, match="stays pending"):
+        rig.c.activate(slot, wait=0.5)
+    inf = rig.c.info()
+    assert inf.pending == slot and inf.active == 0
+
+
+def test_the_board_boots_the_newest_activated_image_after_a_power_cut(rig, new_image):
+    slot, _ = rig.c.upload(*new_image)
+    rig.c.activate(slot)
+    rig.b.reset("power")
+    rig.t.events(0.5)
+    inf = rig.c.info()
+    assert inf.active == slot and inf.slots[0].status == 2
+    assert rig.valve_at(740) is True
+    rig.c.activate(0)
+    rig.b.reset("power")
+    rig.t.events(0.5)
+    assert rig.c.info().active == 0 and rig.valve_at(740) is False
+
+
+def test_an_upload_through_a_lossy_link(stand, new_image):
+    r = Rig(*stand, loss=0.2, seed=3)
+    try:
+        slot, _ = r.c.upload(*new_image)
+        r.c.activate(slot)
+        assert r.up.dropped > 0 and r.down.dropped > 0 and r.c.stats.resent > 0
+        assert r.valve_at(740) is True
+    finally:
+        r.close()
+
+
+def test_fsw_machine_on_the_simulated_port(stand):
+    """The command a crew types, against `fsw sim`'s pty: list, upload
+    --activate, revert; and a machine file the project cannot take is
+    refused before any port is opened."""
+    app, elf = stand
+    p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "sim", elf, "--board", "uno", "--duration", "60",
+                          "--analog", f"A0={volts(740):.3f}"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, start_new_session=True)
+    try:
+        port = p.stdout.readline().strip()
+        assert port.startswith("/dev/pts/"), p.stderr.read()
+
+        def fsw(*a):
+            return subprocess.run([sys.executable, "-m", "fswkit.cli", "machine", str(STAND), *a, "--port", port],
+                                  capture_output=True, text=True, cwd=ROOT, timeout=120)
+
+        r = fsw("list")
+        assert r.returncode == 0, r.stderr
+        assert "the generated `tank` runs" in r.stdout and "slot 1: empty" in r.stdout
+        r = fsw("upload", str(NEW), "--activate")
+        assert r.returncode == 0, r.stderr
+        assert "committed in slot 1, verified by the target" in r.stdout and "slot 1 runs" in r.stdout
+        assert "the image in slot 1 runs" in r.stdout
+        r = fsw("revert")
+        assert r.returncode == 0, r.stderr
+        assert "reverted: the generated machine runs" in r.stdout
+        r = fsw("upload", str(EXAMPLES / "tank" / "tank_typo.sm"))
+        assert r.returncode == 2 and "tank_typo.sm:" in r.stderr and "Traceback" not in r.stderr
+    finally:
+        p.kill()
+        p.wait()

@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup demo docs-img test test-python fuzz fuzz-uplink bench clean
+.PHONY: all setup demo docs-img test test-python fuzz fuzz-uplink fuzz-vm bench clean
 
 include mk/firmware.mk
 
@@ -61,7 +61,7 @@ test-python: setup
 ## differential tests, and 20,000 random applications that the checker must
 ## refuse or that must compile for their board and natively (FSW_GEN_CASES),
 ## and the front end's property tests at ten times their `make test` count
-fuzz: setup fuzz-uplink
+fuzz: setup fuzz-uplink fuzz-vm
 	$(PY) tools/fuzz_frontend.py --cases $${FSW_FUZZ_EXAMPLES:-1000000} --out $(BUILD)/fuzz/frontend
 	FSW_DIFF_SEED=$${FSW_DIFF_SEED:-2} FSW_DIFF_CASES=$${FSW_DIFF_CASES:-20000} \
 	  FSW_DIFF_RAW_CASES=$${FSW_DIFF_RAW_CASES:-5000} FSW_DIFF_AVR_CASES=$${FSW_DIFF_AVR_CASES:-400} \
@@ -91,6 +91,32 @@ fuzz-uplink: $(FUZZ_UPLINK)
 	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|invariant" $(BUILD)/fuzz/uplink/log.txt; \
 	  if [ $$st -eq 0 ]; then echo "uplink fuzz: 1 passed, 0 failed"; else tail -30 $(BUILD)/fuzz/uplink/log.txt; \
 	  echo "uplink fuzz: 0 passed, 1 failed"; fi; exit $$st
+
+## fuzz-vm: the bytecode verifier and VM under libFuzzer with ASan + UBSan
+## (clang): no image the verifier accepts reads or writes outside the state
+## vector, and the EEPROM verifier agrees with the RAM one (docs/reload.md).
+## Seeds: tests/fuzz/vm/seeds/ compiled against the target's state vector, and
+## every example machine (fsw compile). FUZZ_RUNS, FUZZ_SECONDS
+## as for fuzz-uplink
+FUZZ_VM := $(BUILD)/fuzz/vm/fuzz_vm
+FUZZ_VM_SRCS := tests/fuzz/vm/fuzz_vm.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp,$(wildcard firmware/src/*.cpp))
+$(FUZZ_VM): $(FUZZ_VM_SRCS) $(wildcard firmware/src/*.h)
+	@mkdir -p $(@D)
+	clang++ -std=c++11 -g -O1 -fno-exceptions -fno-rtti -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=all -Ifirmware/src -o $@ $(FUZZ_VM_SRCS)
+fuzz-vm: $(FUZZ_VM) | $(STAMP)
+	@mkdir -p $(BUILD)/fuzz/vm/corpus
+	@for sm in tests/fuzz/vm/seeds/*.sm; do \
+	  $(FSW) compile $$sm --sv tests/fuzz/vm/seeds/fuzz.sv --real f64 -o $(BUILD)/fuzz/vm/corpus/seed-$$(basename $$sm .sm).fsm \
+	    >/dev/null || exit 1; done
+	@for sm in examples/*/*.sm; do \
+	  $(FSW) compile $$sm --real f64 -o $(BUILD)/fuzz/vm/corpus/$$(basename $$(dirname $$sm))-$$(basename $$sm .sm).fsm \
+	    >/dev/null 2>&1 || true; done
+	@$(FUZZ_VM) -runs=$(FUZZ_RUNS) -max_total_time=$(FUZZ_SECONDS) -seed=1 -max_len=4096 -print_final_stats=1 \
+	    -artifact_prefix=$(BUILD)/fuzz/vm/ $(BUILD)/fuzz/vm/corpus 2>$(BUILD)/fuzz/vm/log.txt; st=$$?; \
+	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|vm_verify says" $(BUILD)/fuzz/vm/log.txt; \
+	  if [ $$st -eq 0 ]; then echo "vm fuzz: 1 passed, 0 failed"; else tail -30 $(BUILD)/fuzz/vm/log.txt; \
+	  echo "vm fuzz: 0 passed, 1 failed"; fi; exit $$st
 
 ## bench: measured numbers against targets.md (deterministic counts)
 bench: setup

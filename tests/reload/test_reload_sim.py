@@ -285,3 +285,16 @@ def test_fsw_machine_on_the_simulated_port(stand):
     finally:
         p.kill()
         p.wait()
+
+
+def test_a_power_cut_at_any_eeprom_write_boots_the_old_machine_or_the_new(stand, new_image):
+    """Every 17th EEPROM byte write of an upload and its activation, and each
+    of the last nine (the header, its magic, the boot order), cut by a power
+    loss; `make bench` cuts at every one."""
+    from fswkit.reload.sim import power_cuts
+
+    app, elf = stand
+    r = power_cuts(elf, "uno", app, *new_image, stride=17, analog={"A0": volts(740)})
+    assert r.writes > len(new_image[0])  # the bytes, the header, its magic, the order
+    assert r.bad == []
+    assert r.old > 0 and r.new > 0 and r.old + r.new == r.cases

@@ -132,6 +132,7 @@ bench: setup
 	$(PY) tools/bench_params.py
 	$(PY) tools/bench_recorder.py
 	$(PY) tools/bench_vm.py
+	$(PY) tools/bench_reload.py
 	$(MAKE) --no-print-directory bench-firmware
 
 clean:

@@ -88,3 +88,22 @@ def test_the_generated_code_runs_the_machine_through_the_store():
     plain = emit_app(load(str(EXAMPLES / "tank"), Diagnostics()))
     assert "leave" not in plain["tank.gen.h"] and "reload" not in plain["app.gen.cpp"]
     assert ", 0, 0, 0};" in plain["app.gen.cpp"]  # the link's reload fields, empty
+
+
+def test_an_upload_the_board_could_not_run_is_refused_on_the_ground(capsys):
+    """Before any port is opened: a machine needing more RAM than [reload]
+    ram, and one with none of the states [reload] activate names (once
+    running it could never be replaced)."""
+    from fswkit.cli.machine import image_for
+    from fswkit.target.build import load
+
+    app = load(str(EXAMPLES / "stand"), Diagnostics())
+    new = str(EXAMPLES / "stand" / "tank_700.sm")
+    assert image_for(app, new, Diagnostics()) is not None
+    small = dataclasses.replace(app, reload=dataclasses.replace(app.reload, ram=16))
+    assert image_for(small, new, Diagnostics()) is None
+    assert "needs 20 B for its windows and locals: more than the 16 B [reload] ram" in capsys.readouterr().err
+    stuck = dataclasses.replace(app, reload=dataclasses.replace(app.reload, activate=("Nowhere",)))
+    assert image_for(stuck, new, Diagnostics()) is None
+    assert "has none of the states in which [reload] lets another machine take over (Nowhere)" in \
+        capsys.readouterr().err

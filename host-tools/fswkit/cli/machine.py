@@ -42,6 +42,15 @@ def image_for(app, path: str, diags: Diagnostics):
     if reason != V.OK:
         _say(f"internal error: the image of {path} fails the verifier ({V.REASONS[reason]})")
         return None
+    from fswkit.autocode.emit.bytecode import window_ram
+
+    # the RAM the board's VM gives its windows and locals (16-bit window
+    # indices and byte alignment on an AVR): the board would refuse more
+    need = window_ram(m, real) if app.board.name == "native" else window_ram(m, real, idx_bytes=2, align=1)
+    if need > app.reload.ram:
+        _say(f"{path}: machine `{m.name}` needs {need} B for its windows and locals: more than the {app.reload.ram} B "
+             f"[reload] ram gives an uploaded machine")
+        return None
     allow = app.reload.activate
     mask = bytearray((len(m.states) + 7) // 8)
     for st in m.states:

@@ -40,17 +40,32 @@ def cmd_compile(args) -> int:
         sys.stderr.write(f"fsw compile: internal error: the image of {args.machine} fails the verifier "
                          f"(reason {reason}: {V.REASONS[reason]})\n")
         return EXIT_INTERNAL
+    layout = getattr(args, "layout", None)
+    if layout is not None and (layout == "-" or layout == args.output):
+        sys.stderr.write(f"fsw compile: --layout {layout}: " + ("the image goes to standard output; the layout "
+                         "needs a file" if layout == "-" else "the image's own path: name another file") + "\n")
+        return EXIT_CONFIG
     try:
+        if layout is not None:  # checked before anything is written
+            from fswkit.outputs import check
+            check(layout, (args.machine, m.sv.path))
         if args.output == "-":
             sys.stdout.buffer.write(image)
             sys.stdout.buffer.flush()
         else:
             with output(args.output, (args.machine, m.sv.path), binary=True) as out:
                 out.write(image)
+        if layout is not None:
+            from fswkit.sm import layout_text
+            with output(layout, (args.machine, m.sv.path), newline="\n", what="layout") as out:
+                out.write(layout_text(m, real.bits, None if args.output == "-" else args.output))
     except OutputError as e:
         sys.stderr.write(f"fsw compile: {e}\n")
         return EXIT_FAIL
     if args.output != "-":
         sys.stderr.write(f"fsw compile: {args.output}: {len(image)} bytes, {plural(len(m.states), 'state')}, "
                          f"binary{real.bits}, schema 0x{V.layout_of(m.sv).schema:08x}\n")
+    if layout is not None:
+        sys.stderr.write(f"fsw compile: {layout}: the layout of {plural(len(m.sv.elements), 'element')} "
+                         f"({m.sv.size} bytes) and {plural(len(m.states), 'state')}\n")
     return EXIT_OK

@@ -135,6 +135,8 @@ def parser() -> argparse.ArgumentParser:
                     help="evaluation type R of the runtime that runs it (default f64)")
     cp.add_argument("--board", help="for this board's evaluation type (e.g. uno: binary32)")
     cp.add_argument("-o", "--output", required=True, metavar="FILE.fsm", help="the image to write (- for standard output)")
+    cp.add_argument("--layout", metavar="FILE", help="also write the state vector's layout and the state names, as "
+                    "libfswsm reads them (docs/bytecode.md)")
     cp.set_defaults(func=_command("compile", "cmd_compile"))
 
     gn = sub.add_parser("gen", help="generate an application's C++ from its configs")

@@ -153,7 +153,8 @@ void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
 
 Result reload_step(ReloadStore& s) {
     const ReloadConfig c = config(s);
-    if (s.pending != kReloadNone && allowed(s, c)) {
+    // (with the writer idle: the checks read the EEPROM, and a read waits for a byte being written)
+    if (s.pending != kReloadNone && s.w_seg == kNoSeg && allowed(s, c)) {
         const uint8_t which = s.pending;
         s.pending = kReloadNone;
         activate_now(s, c, which);

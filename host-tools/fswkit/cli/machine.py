@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app, print_diags
 
 
 def _say(msg: str) -> None:
@@ -64,15 +64,7 @@ def image_for(app, path: str, diags: Diagnostics):
 
 
 def cmd_machine(args) -> int:
-    from fswkit.target.build import BuildError, load
-
-    diags = Diagnostics()
-    try:
-        app = load(args.project, diags)
-    except BuildError as e:
-        _say(str(e))
-        return EXIT_CONFIG
-    print_diags(diags)
+    app = load_app(args.project, None, "machine")
     if app is None:
         return EXIT_CONFIG
     if app.reload is None:

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, print_diags
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app
 
 
 def _say(msg: str) -> None:
@@ -26,15 +25,8 @@ def cmd_param(args) -> int:
     from fswkit.autocode.schema import link_plan
     from fswkit.link.layout import from_app
     from fswkit.param.files import ParamFileError, params_text, read_params
-    from fswkit.target.build import BuildError, load
 
-    diags = Diagnostics()
-    try:
-        app = load(args.project, diags)
-    except BuildError as e:
-        _say(str(e))
-        return EXIT_CONFIG
-    print_diags(diags)
+    app = load_app(args.project, None, "param")
     if app is None:
         return EXIT_CONFIG
     params = app_parameters(app)

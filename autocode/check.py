@@ -5,6 +5,7 @@ certainly a mistake (`fsw check`)."""
 from __future__ import annotations
 
 import math
+import re
 from fractions import Fraction
 
 from . import memo
@@ -643,11 +644,19 @@ def script_exprs(s: M.Script):
                     yield c.expr
 
 
+# A decimal literal beyond binary32's range has an exponent or 39 digits or
+# more; a file without either has no literal to refuse (comments may give
+# a false alarm: the expressions are walked then).
+_MAY_OVERFLOW_F32 = re.compile(r"[0-9.][eE][+-]?[0-9]|[0-9]{39}")
+
+
 def check_literals(exprs, real, src: Source, diags: Diagnostics, lang: str, whose: str = "this run's") -> bool:
     """Every literal of `exprs` is finite in the evaluation type `real`
     (the parser already holds them to binary64): `1e39` is infinity in
     binary32, so on a board whose `R` is binary32 it is an error where it
     stands. False after reporting any."""
+    if real.bits == 64 or not _MAY_OVERFLOW_F32.search(src.text):
+        return True  # every literal is in range: no walk of the expressions
     before = diags.error_count
     todo = list(exprs)
     while todo:

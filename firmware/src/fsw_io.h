@@ -207,8 +207,17 @@ void io_analog_scan_begin(const uint8_t* pins, uint8_t n, volatile uint16_t* raw
 // The conversions the analog task applies (exposed for tests and docs).
 // value = count * gain + offset, in R (two roundings: the host mirrors it
 // exactly, fswkit.autocode.iotables.analog_value).
+// An offset of +0 known when compiling (a generated call's literal) costs
+// no float addition: adding +0 only turns -0 into +0, done here on the bits.
 inline Real analog_value(uint16_t count, Real gain, Real offset) {
     const Real scaled = static_cast<Real>(count) * gain;  // one rounding, never fused with the add
+#if FSW_REAL_IS_FLOAT && defined(__GNUC__)
+    if (__builtin_constant_p(offset) && offset == 0 && !__builtin_signbit(offset)) {
+        uint32_t b;
+        memcpy(&b, &scaled, sizeof b);
+        return b == 0x80000000UL ? Real(0) : scaled;
+    }
+#endif
     return scaled + offset;
 }
 // duty = trunc(clamp(volts / vref * 255 + 0.5, 0, 255)); NaN -> 0.

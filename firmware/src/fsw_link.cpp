@@ -410,16 +410,30 @@ Result link_telemetry_task(void* p) {
     return kOk;
 }
 
+// Most runs have nothing to send and receive nothing: with no control
+// frame waiting, service would only hand the transmit buffer to the
+// console, so such a run does that, and copies the configuration out of
+// flash only when a frame has been received whole.
 Result link_uplink_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     LinkConfig c;
-    read_config(l, c);
-    service(l, c, false);
+    bool have_c = false;
+    if (l.pending != 0 || l.snapshot_at != kNoSnapshot) {
+        read_config(l, c);
+        have_c = true;
+        service(l, c, false);
+    } else {
+        pump(l);
+    }
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
         if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
         const int16_t b = pal::console_read();
         if (b < 0) break;
         if (b == 0) {
+            if (!have_c) {
+                read_config(l, c);
+                have_c = true;
+            }
             if (l.rx_over) {
                 inc16(l.n.rx_oversized);
             } else if (l.rx_len != 0) {

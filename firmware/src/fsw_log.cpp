@@ -61,17 +61,17 @@ LogConfig config(const Recorder& r) {
     return c;
 }
 
-LogField field(const LogConfig& c, uint8_t i) {
-    LogField f;
-    flash_read(&f, &c.fields[i], sizeof f);
-    return f;
+// One byte of an FSW_FLASH table: a single load, no copy routine (the
+// encoder reads two per field and sample).
+inline uint8_t flash_u8(const uint8_t* p) {
+#if FSW_USE_PROGMEM
+    return pgm_read_byte(p);
+#else
+    return *p;
+#endif
 }
 
-uint8_t table_u8(const uint8_t* table, uint8_t i) {
-    uint8_t v;
-    flash_read(&v, table + i, 1);
-    return v;
-}
+uint8_t table_u8(const uint8_t* table, uint8_t i) { return flash_u8(table + i); }
 
 uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_cast<uint32_t>(slot) * c.record; }
 
@@ -293,27 +293,37 @@ uint8_t state_of(const LogConfig& c) {
     return s < c.n_states ? static_cast<uint8_t>(s) : 0u;
 }
 
-int32_t quantise(float v, float scale, int32_t lim) {
+// round(v * scale), saturated at +-lim: 0x7FFFFFFF (`wide`, a delta's
+// absolute value) or 0x7FFF (quant); NaN gives -lim. The limits are
+// compared as binary32 constants (2^31 - 1 rounds to 2^31), not converted
+// at each call.
+int32_t quantise(float v, float scale, bool wide) {
     const float q = v * scale;
-    if (!(q > -static_cast<float>(lim))) return -lim;  // NaN too
-    if (q > static_cast<float>(lim)) return lim;
+    const int32_t lim = wide ? 0x7FFFFFFFL : 0x7FFFL;
+    const float flim = wide ? static_cast<float>(0x7FFFFFFFL) : static_cast<float>(0x7FFFL);
+    if (!(q > -flim)) return -lim;  // NaN too
+    if (q > flim) return lim;
     return static_cast<int32_t>(lroundf(q));
 }
 
 // One sample of every field, absolute, into `out` (sample_size - 2 bytes).
+// A field's step is read only for the fields that are rounded to it.
 void take(const LogConfig& c, uint8_t* out) {
     for (uint8_t i = 0; i < c.n_fields; ++i) {
-        const LogField f = field(c, i);
-        const uint8_t* p = c.sv + f.off;
-        if (f.enc == kLogDelta || f.enc == kLogQuant) {
-            float v;
+        const LogField* f = &c.fields[i];
+        const uint8_t* o = reinterpret_cast<const uint8_t*>(&f->off);  // little-endian targets
+        const uint8_t* p = c.sv + static_cast<uint16_t>(flash_u8(o) | flash_u8(o + 1) << 8);
+        const uint8_t enc = flash_u8(&f->enc), width = flash_u8(&f->width);
+        if (enc == kLogDelta || enc == kLogQuant) {
+            float scale, v;
+            flash_read(&scale, &f->scale, sizeof scale);
             memcpy(&v, p, sizeof v);
-            const int32_t q = quantise(v, f.scale, f.enc == kLogDelta ? 0x7FFFFFFFL : 0x7FFFL);
-            memcpy(out, &q, f.width);  // little-endian: the low bytes
+            const int32_t q = quantise(v, scale, enc == kLogDelta);
+            memcpy(out, &q, width);  // little-endian: the low bytes
         } else {
-            memcpy(out, p, f.width);
+            memcpy(out, p, width);
         }
-        out += f.width;
+        out += width;
     }
 }
 
@@ -335,22 +345,65 @@ uint32_t sample_time(const uint8_t* s, uint32_t now) {
     return now - static_cast<uint16_t>(static_cast<uint16_t>(now) - t16);
 }
 
-void push(const LogConfig& c, Recorder& r, uint8_t b) {
-    uint8_t i = static_cast<uint8_t>(r.f_head + r.f_len);
-    if (i >= c.fifo_cap) i = static_cast<uint8_t>(i - c.fifo_cap);
-    c.fifo[i] = b;
-    ++r.f_len;
-    ++r.used;
-    r.crc = crc16_update(r.crc, b);
+// The fifo position after the queued bytes (16-bit sum: a fifo may hold up to 255).
+uint8_t fifo_end(const LogConfig& c, const Recorder& r) {
+    uint16_t i = static_cast<uint16_t>(r.f_head + r.f_len);
+    if (i >= c.fifo_cap) i = static_cast<uint16_t>(i - c.fifo_cap);
+    return static_cast<uint8_t>(i);
 }
 
-void push_n(const LogConfig& c, Recorder& r, const void* p, uint8_t n) {
-    const uint8_t* b = static_cast<const uint8_t*>(p);
-    for (uint8_t i = 0; i < n; ++i) push(c, r, b[i]);
+// Copies `n` bytes into the fifo from position `at`: the position after them.
+FSW_NOINLINE uint8_t fifo_put(uint8_t* fifo, uint8_t cap, uint8_t at, const uint8_t* p, uint8_t n) {
+    for (uint8_t k = 0; k < n; ++k) {
+        fifo[at] = p[k];
+        at = static_cast<uint8_t>(at + 1u == cap ? 0u : at + 1u);
+    }
+    return at;
 }
 
-// Opens a record of `kind` in the head slot: false when the store is full.
-bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0) {
+// Bytes staged after the queued ones in the fifo, not yet part of the
+// record: as many as the fifo has room for are written, all are counted.
+// `commit` then takes them into the record (its size and CRC).
+struct Stage {
+    uint8_t* fifo;
+    uint8_t cap;
+    uint8_t at;    // where the next one goes
+    uint8_t room;  // free bytes of the fifo
+    uint8_t n;     // bytes staged
+    void put_n(const uint8_t* p, uint8_t k) {
+        if (n < room) at = fifo_put(fifo, cap, at, p, static_cast<uint8_t>(room - n < k ? room - n : k));
+        n = static_cast<uint8_t>(n + k);
+    }
+    void put(uint8_t b) { put_n(&b, 1); }
+};
+
+Stage stage(const LogConfig& c, const Recorder& r) {
+    Stage w;
+    w.fifo = c.fifo;
+    w.cap = c.fifo_cap;
+    w.at = fifo_end(c, r);
+    w.room = static_cast<uint8_t>(c.fifo_cap - r.f_len);
+    w.n = 0;
+    return w;
+}
+
+// The `n` staged bytes (all written: n <= the fifo's room) join the record.
+void commit(const LogConfig& c, Recorder& r, uint8_t n) {
+    uint8_t i = fifo_end(c, r);
+    uint8_t hi = static_cast<uint8_t>(r.crc >> 8), lo = static_cast<uint8_t>(r.crc);
+    for (uint8_t k = 0; k < n; ++k) {
+        crc16_step(hi, lo, c.fifo[i]);
+        i = static_cast<uint8_t>(i + 1u == c.fifo_cap ? 0u : i + 1u);
+    }
+    r.crc = static_cast<uint16_t>(hi << 8 | lo);
+    r.f_len = static_cast<uint8_t>(r.f_len + n);
+    r.used = static_cast<uint8_t>(r.used + n);
+}
+
+// Opens a record of `kind` in the head slot with its header and the `n`
+// bytes at `body` after it (a record's opening fits the empty fifo,
+// log_config_ok): false when the store is full.
+bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0, const uint8_t* body, uint8_t n) {
     if (r.head >= c.slots) {
         if (!c.newest) {
             r.mode = kLogFull;
@@ -365,9 +418,13 @@ bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0) {
     r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
     r.w_slot = r.head;
     r.w_phase = kWClear;
-    push_n(c, r, &r.seq, 2);
-    push(c, r, r.flight);
-    push_n(c, r, &t0, 4);
+    // seq, flight, t0 (little-endian targets, fsw_config.h), then the body:
+    // into the empty fifo, then into the record
+    uint8_t at = fifo_put(c.fifo, c.fifo_cap, fifo_end(c, r), reinterpret_cast<const uint8_t*>(&r.seq), 2);
+    at = fifo_put(c.fifo, c.fifo_cap, at, &r.flight, 1);
+    at = fifo_put(c.fifo, c.fifo_cap, at, reinterpret_cast<const uint8_t*>(&t0), 4);
+    fifo_put(c.fifo, c.fifo_cap, at, body, n);
+    commit(c, r, static_cast<uint8_t>(7u + n));
     return true;
 }
 
@@ -375,76 +432,60 @@ void seal(Recorder& r) { r.flags |= kSealed; }
 
 // The flight's start record: trigger time, schema and log hashes.
 void write_start(const LogConfig& c, Recorder& r, uint32_t now) {
-    if (!open_record(c, r, kLogStart, now)) return;
-    push_n(c, r, &c.schema, 4);
-    push_n(c, r, &c.hash, 4);
+    static_assert(offsetof(LogConfig, hash) == offsetof(LogConfig, schema) + 4, "LogConfig: schema, hash");
+    if (!open_record(c, r, kLogStart, now, reinterpret_cast<const uint8_t*>(&c.schema), 8)) return;
     seal(r);
     r.flags = static_cast<uint8_t>(r.flags & ~kStartDue);
 }
 
-// Bytes the sample `s` takes appended to the open record (escapes
-// included), 0 when it cannot be appended: another period, a difference out
-// of range, a held change without escapes, or no room.
-uint8_t append_size(const LogConfig& c, const Recorder& r, const uint8_t* s, uint32_t t) {
+// Stages the bytes the sample `s` (time t) takes appended to the open
+// record, in one pass over the fields: a changed held value's escape
+// ([0x80, field, value]; the held fields come first), then each delta's
+// difference and the other fields' values. Returns their number, 0 when it
+// cannot be appended: another period, a difference out of range, a held
+// change without escapes, or no room in the record.
+uint8_t stage_sample(const LogConfig& c, const Recorder& r, const uint8_t* s, uint32_t t, Stage& w) {
     if (r.period == 0 ? t == r.t_next || t - r.t_next > 0xFFFFu : t != r.t_next + r.period) return 0;
-    uint8_t n = 0;
     const uint8_t* v = s + 2;
     const uint8_t* l = c.last;
     for (uint8_t i = 0; i < c.n_fields; ++i) {
-        const LogField f = field(c, i);
-        if (f.enc == kLogHold) {
-            if (memcmp(v, l, f.width) != 0) {
+        const uint8_t enc = flash_u8(&c.fields[i].enc), width = flash_u8(&c.fields[i].width);
+        if (enc == kLogHold) {
+            uint8_t k = 0;  // a held value is a few bytes: compared here, not by a library call
+            while (k < width && v[k] == l[k]) ++k;
+            if (k != width) {
                 if (!c.escape) return 0;
-                n = static_cast<uint8_t>(n + 2u + f.width);
+                w.put(kLogEscape);
+                w.put(i);
+                w.put_n(v, width);
             }
-        } else if (f.enc == kLogDelta) {
+        } else if (enc == kLogDelta) {
             int32_t q, p;
             memcpy(&q, v, 4);
             memcpy(&p, l, 4);
             const int32_t d = q - p;
             if (d < -127 || d > 127) return 0;
-            ++n;
+            w.put(static_cast<uint8_t>(static_cast<int8_t>(d)));
         } else {
-            n = static_cast<uint8_t>(n + f.width);
+            w.put_n(v, width);
         }
-        v += f.width;
-        l += f.width;
+        v += width;
+        l += width;
     }
-    return r.used + n + kLogTail <= c.record ? n : 0;
+    return r.used + w.n + kLogTail <= c.record ? w.n : 0;
 }
 
-void append(const LogConfig& c, Recorder& r, const uint8_t* s) {
-    const uint8_t* v = s + 2;
-    uint8_t* l = c.last;
-    for (uint8_t i = 0; i < c.n_hold; ++i) {  // escapes first: [0x80, field, value]
-        const LogField f = field(c, i);
-        if (memcmp(v, l, f.width) != 0) {
-            push(c, r, kLogEscape);
-            push(c, r, i);
-            push_n(c, r, v, f.width);
-        }
-        v += f.width;
-        l += f.width;
-    }
-    for (uint8_t i = c.n_hold; i < c.n_fields; ++i) {
-        const LogField f = field(c, i);
-        if (f.enc == kLogDelta) {
-            int32_t q, p;
-            memcpy(&q, v, 4);
-            memcpy(&p, l, 4);
-            push(c, r, static_cast<uint8_t>(static_cast<int8_t>(q - p)));
-        } else {
-            push_n(c, r, v, f.width);
-        }
-        v += f.width;
-        l += f.width;
-    }
-    memcpy(c.last, s + 2, c.sample_size - 2u);
-}
+// Samples the encoder appends to the open record in one run of the task
+// at most; a run that opens a record (its header and first sample) does
+// only that. The ring queues the rest: the seconds kept before the trigger
+// drain over the next runs, faster than samples come (at most one a run),
+// and no run does all of it.
+const uint8_t kEncodePerRun = 2;
 
-// Moves queued samples into records while the fifo has room.
+// Moves queued samples into records while the fifo has room: a record's
+// opening, or at most kEncodePerRun samples appended.
 void encode(const LogConfig& c, Recorder& r, uint32_t now) {
-    for (;;) {
+    for (uint8_t moved = 0; moved < kEncodePerRun; ++moved) {
         if (r.w_phase >= kWTail || (r.flags & kSealed)) return;  // the sealed record is being finished
         if (r.w_phase == kWIdle) {  // nothing open
             if (r.mode != kLogRecording) return;
@@ -458,17 +499,12 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
             }
             const uint8_t* s = ring_at(c, r, 0);
             const uint32_t t = sample_time(s, now);
-            if (!open_record(c, r, kLogData, t)) return;
-            const uint8_t* v = s + 2;
-            for (uint8_t i = 0; i < c.n_fields; ++i) {  // held values, then the first sample
-                const LogField f = field(c, i);
-                push_n(c, r, v, f.width);
-                v += f.width;
-            }
+            // held values, then the first sample: the sample's bytes as they lie
+            if (!open_record(c, r, kLogData, t, s + 2, static_cast<uint8_t>(c.sample_size - 2u))) return;
             memcpy(c.last, s + 2, c.sample_size - 2u);
             r.t_next = t;
             ring_pop(c, r);
-            continue;
+            return;  // an opening is a whole run's work
         }
         if (r.r_len == 0) {
             if (r.flags & kEnding) seal(r);
@@ -476,15 +512,17 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
         }
         const uint8_t* s = ring_at(c, r, 0);
         const uint32_t t = sample_time(s, now);
-        const uint8_t n = append_size(c, r, s, t);
+        Stage w = stage(c, r);
+        const uint8_t n = stage_sample(c, r, s, t, w);
         if (n == 0) {
             seal(r);
             return;
         }
-        if (r.f_len + n > c.fifo_cap) return;  // the writer catches up first
+        if (n > w.room) return;  // the writer catches up first
         if (r.period == 0) r.period = static_cast<uint16_t>(t - r.t_next);
         r.t_next = t;
-        append(c, r, s);
+        commit(c, r, n);
+        memcpy(c.last, s + 2, c.sample_size - 2u);
         ring_pop(c, r);
     }
 }

@@ -141,7 +141,8 @@ void log_nor_begin(Recorder& r, const LogConfig* cfg);
 // samples; the record that was open at the reset is lost, as at a power cut.
 void log_resume(Recorder& r, uint8_t flight, uint8_t mode);
 // The recorder task's step (ctx = the Recorder): samples, the trigger, the
-// encoder. Never blocks, never faults.
+// encoder (a record's opening, or at most two queued samples appended, a
+// run: the ring holds the rest). Never blocks, never faults.
 Result log_task(void* recorder);
 // The background writer: the next byte into the store when it is ready
 // (on an SPI NOR flash, a command whenever the chip is not busy). Called

@@ -65,7 +65,9 @@ fuzz: setup fuzz-uplink fuzz-vm
 	$(PY) tools/fuzz_frontend.py --cases $${FSW_FUZZ_EXAMPLES:-1000000} --out $(BUILD)/fuzz/frontend
 	FSW_DIFF_SEED=$${FSW_DIFF_SEED:-2} FSW_DIFF_CASES=$${FSW_DIFF_CASES:-20000} \
 	  FSW_DIFF_RAW_CASES=$${FSW_DIFF_RAW_CASES:-5000} FSW_DIFF_AVR_CASES=$${FSW_DIFF_AVR_CASES:-400} \
-	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py
+	  FSW_VM_AVR_CASES=$${FSW_VM_AVR_CASES:-400} \
+	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py \
+	  tests/differential/test_bytecode_avr.py
 	FSW_GEN_CASES=$${FSW_GEN_CASES:-20000} $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/regression/test_accepted_configs_build.py
 	FSW_PROPERTY_SCALE=$${FSW_PROPERTY_SCALE:-5} $(PY) -m pytest -q -p no:cacheprovider \

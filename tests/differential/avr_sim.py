@@ -19,17 +19,23 @@ import os
 import shutil
 import struct
 import subprocess
+import threading
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Callable
 
-from fswkit.run import native
+from fswkit.run import native, windows
 from fswkit.autocode import model as M
+from fswkit.autocode.check import failure_diagnostics
+from fswkit.autocode.emit.common import c_ident
 from fswkit.autocode.emit.machine import emit_machine
 from fswkit.autocode.emit.script import emit_script_avr, script_writes_locals
 from fswkit.autocode.emit.sv import emit_sv
 from fswkit.autocode.numeric import F32MODE
 
 from fswkit.sim.board import harness as sim_harness
+import harness as H
 from harness import cache_dir
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -82,9 +88,11 @@ def _cached_object(text: str, name: str, workdir: str, include: list[str], key: 
     src = os.path.join(workdir, name)
     with open(src, "w") as f:
         f.write(text)
+    # test_simavr.py and test_bytecode_avr.py share the runtime's objects and may build them at once
+    tmp = f"{obj}.{os.getpid()}.{threading.get_ident()}.tmp"
     _run([AVR_CXX] + AVR_FLAGS + ["-I", native.RUNTIME] + [x for d in include for x in ("-I", d)]
-         + ["-c", src, "-o", obj + ".tmp"])
-    os.replace(obj + ".tmp", obj)
+         + ["-c", src, "-o", tmp])
+    os.replace(tmp, obj)
     return obj
 
 
@@ -131,11 +139,15 @@ def _main_cpp(keys: list[int]) -> str:
 
 
 def build_elf(workdir: str, items: list[tuple[int, M.Script]], pool: ThreadPoolExecutor,
-              per_tu: int = 4) -> str:
-    """One ELF running every case of `items` in turn."""
+              per_tu: int = 4, machine_cpp: Callable[[M.Script, str], str] | None = None) -> str:
+    """One ELF running every case of `items` in turn. `machine_cpp(script,
+    ns)`, when given, writes the `<machine>.gen.cpp` that replaces the
+    generated one (the header stays as emitted), and the runtime's VM
+    (fsw_vm.cpp) is linked in: vm_harness.vm_shim with avr=True."""
     key = _runtime_key()
+    runtime = RUNTIME_FILES + (("fsw_vm.cpp",) if machine_cpp is not None else ())
     rt = [pool.submit(_cached_object, open(os.path.join(native.RUNTIME, n)).read(), "rt_" + n, workdir,
-                      [native.RUNTIME], key) for n in RUNTIME_FILES]
+                      [native.RUNTIME], key) for n in runtime]
     tus = []
     for start in range(0, len(items), per_tu):
         lines, tkey = [], hashlib.sha256(key)
@@ -145,6 +157,8 @@ def build_elf(workdir: str, items: list[tuple[int, M.Script]], pool: ThreadPoolE
             files.update(emit_sv(m.sv, f"fsw_c{k}"))
             files.update(emit_machine(m, F32MODE, scriptable=script_writes_locals(script), ns=f"fsw_c{k}"))
             files.update(emit_script_avr(script, F32MODE, ns=f"fsw_c{k}"))
+            if machine_cpp is not None:
+                files[f"{c_ident(m.name)}.gen.cpp"] = machine_cpp(script, f"fsw_c{k}")
             d = os.path.join(workdir, f"c{k}")
             os.makedirs(d, exist_ok=True)
             for name in sorted(files):
@@ -199,9 +213,114 @@ def run_elf(elf: str, items: list[tuple[int, M.Script]], wall: float = 120) -> d
         while data[pos:pos + 1] == b"R":
             rows += data[pos + 1:pos + 1 + size]
             pos += 1 + size
+        if data[pos:pos + 1] == b"V":  # vm_harness.vm_shim: the board's vm_verify refused the image
+            raise native.NativeError(f"case {k}: vm_verify refused the image on the board: reason {data[pos + 1]}")
         if data[pos:pos + 1] != b"E":
             raise native.NativeError(f"case {k}: no end record at byte {pos}: {data[pos:pos + 16]!r}")
         outcome, failed, steps, asserts = struct.unpack_from("<BhQQ", data, pos + 1)
         pos += 20
         out[k] = AvrOutcome(bytes(rows), outcome, failed, steps, asserts)
     return out
+
+
+# ---- a sample of generated cases against the interpreter ----------------------------
+
+TINY = 2.0 ** -126  # the smallest normal binary32
+
+
+class SubnormalQuotients:
+    """Counts the divisions of an interpreter run whose exact quotient is a
+    non-zero value below 2^-126 in magnitude: expression `/`, roll_avg's
+    sum / count and roll_median's (b - a) / 2."""
+
+    def __init__(self, monkeypatch):
+        from fswkit.run import interp
+        self.n = 0
+        div = interp.GLOBALS["_div"]
+
+        def counting_div(a, b):
+            self.note(a, b)
+            return div(a, b)
+        monkeypatch.setitem(interp.GLOBALS, "_div", counting_div)
+        avg_push, med_push = windows.AvgWindow.push, windows.MedianWindow.push
+
+        def avg(w, x):
+            v = avg_push(w, x)
+            self.note(w.real.rnd(w.base + w.fresh), w.count)
+            return v
+
+        def med(w, x):
+            v = med_push(w, x)
+            if len(w.sorted) % 2 == 0:
+                a, b = w.sorted[len(w.sorted) // 2 - 1], w.sorted[len(w.sorted) // 2]
+                self.note(w.real.rnd(b - a), 2.0)
+            return v
+        monkeypatch.setattr(windows.AvgWindow, "push", avg)
+        monkeypatch.setattr(windows.MedianWindow, "push", med)
+
+    def note(self, a, b) -> None:
+        if b != 0 and a == a and b == b and abs(a) != float("inf") and abs(b) != float("inf"):
+            q = abs(Fraction(a) / Fraction(b))
+            if 0 < q < TINY:
+                self.n += 1
+
+
+def run_sample(work: str, loaded: list, pool: ThreadPoolExecutor, per_elf: int,
+               machine_cpp: Callable[[M.Script, str], str] | None = None) -> tuple[dict[int, AvrOutcome], list[str]]:
+    """Builds and runs `loaded` ((case, script, source_line) of gen_programs)
+    on simavr, `per_elf` cases an ELF (`machine_cpp`: see build_elf); each
+    case's outcome and each ELF's size."""
+    outcomes, sizes = {}, []
+    for start in range(0, len(loaded), per_elf):
+        chunk = loaded[start:start + per_elf]
+        d = os.path.join(work, f"elf{start}")
+        os.makedirs(d)
+        items = [(c.index, s) for c, s, _ in chunk]
+        elf = build_elf(d, items, pool, machine_cpp=machine_cpp)
+        flash, ram = memory(elf)
+        assert flash < 240 * 1024 and ram < 7 * 1024, (flash, ram)  # ATmega2560: 256 KB, 8 KB
+        sizes.append(f"{flash} B flash, {ram} B RAM")
+        outcomes.update(run_elf(elf, items))
+    return outcomes, sizes
+
+
+@dataclass
+class Comparison:
+    bad: list = field(default_factory=list)  # (case, difference)
+    documented: list = field(default_factory=list)  # the same, for a run dividing into the subnormal range
+    dividing: int = 0  # cases whose interpreter run divides into the subnormal range
+    steps: int = 0  # trace rows compared
+
+
+def compare(loaded: list, outcomes: dict[int, AvrOutcome], work: str, monkeypatch) -> Comparison:
+    """Each case's AVR outcome against the interpreter's binary32 run: the
+    per-step trace, the ending, steps and asserts. A difference in a case
+    whose run divides into the subnormal range is `documented` (avr-libc's
+    division there, test_simavr.py), any other `bad`."""
+    r = Comparison()
+    for c, s, sl in loaded:
+        quotients = SubnormalQuotients(monkeypatch)
+        res = H.interp_run(s, F32MODE, trace_path=os.path.join(work, "i.csv"), source_line=sl)
+        monkeypatch.undo()
+        r.dividing += quotients.n > 0
+        with open(os.path.join(work, "i.csv")) as f:
+            it = H.Outcome(0 if res.passed else 1, res.report(), f.read())
+        r.steps += it.trace.count("\n") - 1
+        o = outcomes[c.index]
+        raw = os.path.join(work, "a.raw")
+        with open(raw, "wb") as f:
+            f.write(o.rows)
+        native._raw_to_csv(s.machine, raw, os.path.join(work, "a.csv"))
+        # The ending, as the report would show it.
+        fails = failure_diagnostics(s, sl)
+        ending = {0: None, 1: fails["asserts"][o.failed_assert].render() if o.outcome == 1 else None,
+                  2: fails["max_steps"].render(), 3: fails["step_error"].render()}[o.outcome]
+        mine = (res.passed, res.steps, res.asserts, res.failure.render() if res.failure else None)
+        theirs = (o.outcome == 0, o.steps, o.asserts, ending)
+        with open(os.path.join(work, "a.csv")) as f:
+            d = H.first_difference(it, H.Outcome(it.code, it.report, f.read()))
+        if d is None and mine != theirs:
+            d = f"ending: interpreter {mine}, AVR {theirs}"
+        if d is not None:
+            (r.documented if quotients.n else r.bad).append((c, d))
+    return r

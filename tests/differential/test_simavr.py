@@ -24,9 +24,7 @@ import pytest
 import avr_sim as A
 import gen_programs as gp
 import harness as H
-from fswkit.run import native, windows
-from fswkit.autocode.numeric import F32MODE, f32
-from fswkit.autocode.check import failure_diagnostics
+from fswkit.autocode.numeric import f32
 
 AVR_CASES = int(os.environ.get("FSW_DIFF_AVR_CASES", "40"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))
@@ -35,89 +33,20 @@ PER_ELF = 20  # RAM: each case's state vector, locals and windows are static
 missing = A.available()
 pytestmark = pytest.mark.skipif(missing is not None, reason=f"AVR toolchain or simavr missing: {missing}")
 
-TINY = 2.0 ** -126  # the smallest normal binary32
-
-
-class SubnormalQuotients:
-    """Counts the divisions of an interpreter run whose exact quotient is a
-    non-zero value below 2^-126 in magnitude: expression `/`, roll_avg's
-    sum / count and roll_median's (b - a) / 2."""
-
-    def __init__(self, monkeypatch):
-        from fswkit.run import interp
-        self.n = 0
-        div = interp.GLOBALS["_div"]
-
-        def counting_div(a, b):
-            self.note(a, b)
-            return div(a, b)
-        monkeypatch.setitem(interp.GLOBALS, "_div", counting_div)
-        avg_push, med_push = windows.AvgWindow.push, windows.MedianWindow.push
-
-        def avg(w, x):
-            v = avg_push(w, x)
-            self.note(w.real.rnd(w.base + w.fresh), w.count)
-            return v
-
-        def med(w, x):
-            v = med_push(w, x)
-            if len(w.sorted) % 2 == 0:
-                a, b = w.sorted[len(w.sorted) // 2 - 1], w.sorted[len(w.sorted) // 2]
-                self.note(w.real.rnd(b - a), 2.0)
-            return v
-        monkeypatch.setattr(windows.AvgWindow, "push", avg)
-        monkeypatch.setattr(windows.MedianWindow, "push", med)
-
-    def note(self, a, b) -> None:
-        if b != 0 and a == a and b == b and abs(a) != float("inf") and abs(b) != float("inf"):
-            q = abs(Fraction(a) / Fraction(b))
-            if 0 < q < TINY:
-                self.n += 1
+TINY = A.TINY  # the smallest normal binary32
 
 
 def test_generated_cases_on_simavr(tmp_path, monkeypatch):
     t0 = time.monotonic()
     cases = gp.cases(SEED, AVR_CASES)
     loaded = [(c, *H.load(c)) for c in cases]
-    work = str(tmp_path)
-    outcomes, sizes = {}, []
     with ThreadPoolExecutor(H.JOBS) as pool:
-        for start in range(0, len(loaded), PER_ELF):
-            chunk = loaded[start:start + PER_ELF]
-            d = os.path.join(work, f"elf{start}")
-            os.makedirs(d)
-            items = [(c.index, s) for c, s, _ in chunk]
-            elf = A.build_elf(d, items, pool)
-            flash, ram = A.memory(elf)
-            assert flash < 240 * 1024 and ram < 7 * 1024, (flash, ram)  # ATmega2560: 256 KB, 8 KB
-            sizes.append(f"{flash} B flash, {ram} B RAM")
-            outcomes.update(A.run_elf(elf, items))
+        outcomes, sizes = A.run_sample(str(tmp_path), loaded, pool, PER_ELF)
     built = time.monotonic() - t0
-    bad, documented, dividing = [], [], 0
-    for c, s, sl in loaded:
-        quotients = SubnormalQuotients(monkeypatch)
-        res = H.interp_run(s, F32MODE, trace_path=str(tmp_path / "i.csv"), source_line=sl)
-        monkeypatch.undo()
-        dividing += quotients.n > 0
-        it = H.Outcome(0 if res.passed else 1, res.report(), (tmp_path / "i.csv").read_text())
-        o = outcomes[c.index]
-        raw = tmp_path / "a.raw"
-        raw.write_bytes(o.rows)
-        native._raw_to_csv(s.machine, str(raw), str(tmp_path / "a.csv"))
-        # The ending, as the report would show it.
-        fails = failure_diagnostics(s, sl)
-        ending = {0: None, 1: fails["asserts"][o.failed_assert].render() if o.outcome == 1 else None,
-                  2: fails["max_steps"].render(), 3: fails["step_error"].render()}[o.outcome]
-        mine = (res.passed, res.steps, res.asserts, res.failure.render() if res.failure else None)
-        theirs = (o.outcome == 0, o.steps, o.asserts, ending)
-        d = H.first_difference(it, H.Outcome(it.code, it.report, (tmp_path / "a.csv").read_text()))
-        if d is None and mine != theirs:
-            d = f"ending: interpreter {mine}, AVR {theirs}"
-        if d is not None:
-            (documented if quotients.n else bad).append((c, d))
-    assert not bad, "\n\n".join(f"=== case {c.index} (binary32, simavr): {d}\n{c.repro()}" for c, d in bad[:3])
-    print(f"\nsimavr: {len(loaded)} cases ({'; '.join(sizes)}); {dividing} divide into the subnormal range, "
-          f"{len(documented)} of them differ; {time.monotonic() - t0:.1f}s ({built:.1f}s building and simulating)")
+    r = A.compare(loaded, outcomes, str(tmp_path), monkeypatch)
+    assert not r.bad, "\n\n".join(f"=== case {c.index} (binary32, simavr): {d}\n{c.repro()}" for c, d in r.bad[:3])
+    print(f"\nsimavr: {len(loaded)} cases ({'; '.join(sizes)}); {r.dividing} divide into the subnormal range, "
+          f"{len(r.documented)} of them differ; {time.monotonic() - t0:.1f}s ({built:.1f}s building and simulating)")
 
 
 # ---- the float library itself ---------------------------------------------------------

@@ -30,8 +30,11 @@ def _bytes(data: bytes) -> str:
     return "{\n    " + ",\n    ".join(rows) + "\n}"
 
 
-def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str) -> str:
-    """The `<machine>.gen.cpp` that steps `m` through the VM."""
+def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str, avr: bool = False) -> str:
+    """The `<machine>.gen.cpp` that steps `m` through the VM. `avr`: for a
+    board without stdio (avr_sim.py's runner), where an image vm_verify
+    refuses sends `V` and the reason (1 byte) through the runner's byte sink
+    and stops the board (sleep, interrupts off) instead of printing."""
     name = c_ident(m.name)
     image = compile_machine(m, real)
     stored = stored_locals(m, real, scriptable)
@@ -41,9 +44,19 @@ def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str) -> str:
     copies += [(offs[v.index], f"prm + {enumerator('P_', v.name)}", v.type.size) for v in params]
     elems = ", ".join(f"{{{e.offset}, {TYPE_CODES[e.type.name]}}}" for e in m.sv.elements)
     ram = max(window_ram(m, real), 1)
-    c = ['#include <stdio.h>', '#include <stdlib.h>', f'#include "{name}.gen.h"', '#include "sv.gen.h"',
-         '#include "fsw_vm.h"', "", f"namespace {ns} {{", f"namespace {name} {{", "",
-         "fsw::Machine machine;"]
+    if avr:
+        c = ['#include <avr/interrupt.h>', '#include <avr/sleep.h>', '#include <string.h>']
+        refused = ["        const uint8_t v[2] = {'V', static_cast<uint8_t>(why)};",
+                   "        fsw_trace_write(v, 2);",
+                   "        cli();", "        sleep_enable();", "        sleep_cpu();"]
+    else:
+        c = ['#include <stdio.h>', '#include <stdlib.h>']
+        refused = [f"        printf(\"vm_verify refused the image of {name}: reason %d\\n\", static_cast<int>(why));",
+                   "        exit(9);"]
+    c += [f'#include "{name}.gen.h"', '#include "sv.gen.h"', '#include "fsw_vm.h"', ""]
+    if avr:
+        c += ["void fsw_trace_write(const uint8_t* data, uint16_t len);", ""]
+    c += [f"namespace {ns} {{", f"namespace {name} {{", "", "fsw::Machine machine;"]
     if stored:
         c.append("uint8_t loc[kLocSize];")
     if params:
@@ -69,10 +82,7 @@ def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str) -> str:
           "}", "",
           "void reset(uint32_t initial) {",
           "    const fsw::VmReason why = fsw::vm_verify(kImage, sizeof kImage, kLayout, sizeof ram);",
-          "    if (why != fsw::kVmOk) {",
-          f"        printf(\"vm_verify refused the image of {name}: reason %d\\n\", static_cast<int>(why));",
-          "        exit(9);",
-          "    }",
+          "    if (why != fsw::kVmOk) {", *refused, "    }",
           "    fsw::vm_reset(kImage, ram, machine, initial);",
           "    from_vm();",
           "}", "",

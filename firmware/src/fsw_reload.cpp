@@ -255,11 +255,15 @@ void reload_poll(ReloadStore& s) {
         if (!s.sync) return;
         // the status and seq bytes of each whole slot, as the store has them
         // (status first: a cut before the seq leaves the slots in their old
-        // order, so the machine that ran before keeps its place at boot)
+        // order, so the machine that ran before keeps its place at boot; and
+        // the slot activated longer ago first, so that a cut between the two
+        // never leaves it the only one marked to boot)
         s.sync = false;
         const ReloadConfig c = config(s);
+        const uint8_t first = s.slot[1].seq < s.slot[0].seq ? 2u : 1u;
         uint8_t r = 0;
-        for (uint8_t w = 1; w <= 2; ++w) {
+        for (uint8_t k = 0; k < 2; ++k) {
+            const uint8_t w = k == 0 ? first : static_cast<uint8_t>(3u - first);
             const ReloadSlot& sl = s.slot[w - 1u];
             if (sl.status == kSlotEmpty) continue;
             s.queue[3u * r] = sl.status;

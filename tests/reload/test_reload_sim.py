@@ -298,3 +298,35 @@ def test_a_power_cut_at_any_eeprom_write_boots_the_old_machine_or_the_new(stand,
     assert r.writes > len(new_image[0])  # the bytes, the header, its magic, the order
     assert r.bad == []
     assert r.old > 0 and r.new > 0 and r.old + r.new == r.cases
+
+
+@pytest.mark.parametrize("cut", [1, 2])
+def test_a_power_cut_while_both_slots_lose_their_boot_mark_never_boots_the_older_image(stand, new_image, cut):
+    """Slot 1 runs the newest image, slot 2 holds one activated before it;
+    the crew goes back to the generated machine and the power is cut after
+    the first or second EEPROM write of that: the board comes back running
+    slot 1's image (what ran before) or the generated machine, never slot
+    2's older one."""
+    r = Rig(*stand)
+    try:
+        for _ in range(3):  # slots 1, 2, then 1 again: slot 1 newest, slot 2 older
+            slot, _ = r.c.upload(*new_image, restart=True)
+            r.c.activate(slot)
+        inf = r.c.info()
+        assert inf.active == 1 and [s.status for s in inf.slots] == [2, 2] and inf.slots[0].seq > inf.slots[1].seq
+        from fswkit.autocode.protocol import OP_MACHINE_ACTIVATE
+        from fswkit.link import wire
+
+        r.b.eeprom_cut(cut)
+        # ACTIVATE 0 sent once, not again after the cut (a client would resend it)
+        r.t.send(wire.uplink(OP_MACHINE_ACTIVATE, r.c.cmd.numbers.take(), b"\x00"))
+        while r.b.eeprom_count()[1] == 0 and r.b.time < 600:
+            r.t.events(0.01)
+        assert r.b.eeprom_count()[1] == 1  # the cut happened
+        r.psi(740)
+        r.t.events(0.3)
+        inf = r.c.info()
+        assert inf.active in (1, 0), inf
+        assert inf.active == (1 if cut == 1 else 0)  # one status byte written, or both
+    finally:
+        r.close()

@@ -332,7 +332,10 @@ def main(argv=None) -> int:
     print(line(tuple("-" * x for x in w[:4]) + ("",)))
     for r in rows:
         print(line(r))
-    return 0 if ok else 1
+    # a missed target is a measured figure, not a failure: the rest of
+    # `make bench` runs on (as the other bench tools do)
+    print(f"host tools: {'every target met' if ok else 'a target MISSED (above)'}")
+    return 0
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ U8   phase              # set by the mission for nav: 0 pad, 1 boost, 2 coast, 3
 bool baroStuck          # the pressure has not moved by half a count for STUCK_TIME (or baroFault)
 bool baroFault          # the digital barometer part has failed (examples/hpr_digital); the analog one never sets it
 bool accelFault         # the digital accelerometer part has failed (examples/hpr_digital); likewise
+U8   baroHealth         # the digital barometer part's health code (1: ok, docs/sensor-table.md); the analog one never sets it
 U8   agree              # samples in a row the barometer agreed with the filter (within its gate), at most 255
 
 [Nav]                   # not streamed (a third stream would collide with the others at 115200 baud)

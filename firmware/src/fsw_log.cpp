@@ -61,16 +61,6 @@ LogConfig config(const Recorder& r) {
     return c;
 }
 
-// One byte of an FSW_FLASH table: a single load, no copy routine (the
-// encoder reads two per field and sample).
-inline uint8_t flash_u8(const uint8_t* p) {
-#if FSW_USE_PROGMEM
-    return pgm_read_byte(p);
-#else
-    return *p;
-#endif
-}
-
 uint8_t table_u8(const uint8_t* table, uint8_t i) { return flash_u8(table + i); }
 
 uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_cast<uint32_t>(slot) * c.record; }

@@ -83,9 +83,7 @@ bool state_allows(const ParamConfig& c, const ParamDef& d) {
     uint32_t st;
     memcpy(&st, c.sv + w.state_off, sizeof st);
     if (st == 0 || (st - 1u) / 8u >= w.n) return false;
-    uint8_t byte;
-    flash_read(&byte, c.pool + w.mask + (st - 1u) / 8u, 1);
-    return (byte >> ((st - 1u) % 8u)) & 1u;
+    return (flash_u8(c.pool + w.mask + (st - 1u) / 8u) >> ((st - 1u) % 8u)) & 1u;
 }
 
 void set_bytes(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {

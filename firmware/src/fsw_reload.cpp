@@ -70,10 +70,7 @@ bool allowed(const ReloadStore& s, const ReloadConfig& c) {
     const uint32_t byte = (st - 1u) / 8u;
     const uint8_t bit = static_cast<uint8_t>(1u << ((st - 1u) % 8u));
     if (s.active == kReloadBuiltIn) {
-        if (byte >= c.n_allow) return false;
-        uint8_t b;
-        flash_read(&b, c.allow + byte, 1);
-        return (b & bit) != 0;
+        return byte < c.n_allow && (flash_u8(c.allow + byte) & bit) != 0;
     }
     const ReloadSlot& sl = s.slot[s.active - 1u];
     return byte < sl.nmask && (c.image[sl.len + byte] & bit) != 0;

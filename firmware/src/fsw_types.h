@@ -101,6 +101,15 @@ inline void flash_read(void* dst, const void* src, size_t n) {
 #endif
 }
 
+// One byte of a constant table (marked FSW_FLASH): a single load, no copy routine.
+inline uint8_t flash_u8(const uint8_t* p) {
+#if FSW_USE_PROGMEM
+    return pgm_read_byte(p);
+#else
+    return *p;
+#endif
+}
+
 }  // namespace fsw
 
 #endif  // FSW_TYPES_H

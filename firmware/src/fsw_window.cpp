@@ -12,17 +12,13 @@ static inline I step_back(I i, I n) { return static_cast<I>(i == 0 ? n - 1u : i 
 #if FSW_REAL_IS_FLOAT
 // On binary32 R the tests below are made on the bits, with the same
 // results as the float comparisons and no float library call (on an 8-bit
-// MCU each is a routine): window_sample, the extreme deques' ordering (of
-// samples, never NaN or -0: the key orders them as the floats), and
-// roll_avg_mean's test of 1/n.
+// MCU each is a routine): the extreme deques' ordering (of samples, never
+// NaN or -0: the key orders them as the floats) and roll_avg_mean's test
+// of 1/n (window_sample, fsw_window.h, likewise).
 static inline uint32_t real_bits(Real x) {
     uint32_t b;
     memcpy(&b, &x, sizeof b);
     return b;
-}
-static inline Real sample_of(Real x) {
-    const uint32_t a = real_bits(x) & 0x7FFFFFFFUL;
-    return (a == 0 || a > 0x7F800000UL) ? Real(0) : x;  // +-0 or NaN: +0
 }
 static inline uint32_t order_key(Real x) {
     const uint32_t b = real_bits(x);
@@ -30,14 +26,13 @@ static inline uint32_t order_key(Real x) {
 }
 static inline bool nonzero(Real x) { return (real_bits(x) & 0x7FFFFFFFUL) != 0; }
 #else
-static inline Real sample_of(Real x) { return window_sample(x); }
 static inline Real order_key(Real x) { return x; }
 static inline bool nonzero(Real x) { return x != 0; }
 #endif
 
 template <typename I>
 void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
-    x = sample_of(x);
+    x = window_sample(x);
     if (w.count == n) {
         w.base = w.base - ring[w.head];  // the oldest sample leaves
     } else {
@@ -56,7 +51,7 @@ void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real 
 
 template <typename I>
 static void ext_push(RollExtS<I>& w, Real* vals, I* seqs, I n, Real x, bool is_max) {
-    x = sample_of(x);
+    x = window_sample(x);
     const I seq = w.next;
     // The front leaves once it is n samples old (at most one per push; ages
     // are below 2^bits of I, as n is, so the wrapping difference is exact).
@@ -112,7 +107,7 @@ static I upper_bound(const Real* s, I lo, I hi, Real x) {
 
 template <typename I>
 void roll_median_push(RollMedianS<I>& w, Real* ring, Real* sorted, typename same_t<I>::type n, Real x) {
-    x = sample_of(x);
+    x = window_sample(x);
     if (w.count < n) {  // filling: insert only
         ring[w.head] = x;
         w.head = step_fwd(w.head, n);

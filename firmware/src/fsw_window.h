@@ -19,8 +19,18 @@ struct conditional_t<false, T, F> {
 };
 
 // A sample as a window stores it: NaN -> +0 (spec), and -0 -> +0 so that
-// equal samples are identical bit patterns (no sign-of-zero ambiguity).
+// equal samples are identical bit patterns (no sign-of-zero ambiguity). On
+// binary32 R the test is made on the bits (no float routine on an 8-bit MCU).
+#if FSW_REAL_IS_FLOAT
+inline Real window_sample(Real x) {
+    uint32_t b;
+    memcpy(&b, &x, sizeof b);
+    b &= 0x7FFFFFFFUL;
+    return (b == 0 || b > 0x7F800000UL) ? Real(0) : x;  // +-0 or NaN: +0
+}
+#else
 inline Real window_sample(Real x) { return (x != x || x == 0) ? Real(0) : x; }
+#endif
 
 // ---- state structs: all-zero is "no samples yet", so they live in .bss ----
 // Templates on the index type I: uint8_t for windows of up to 255 samples

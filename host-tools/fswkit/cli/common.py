@@ -142,6 +142,27 @@ def open_link(args, layout, baud: int, say):
     return ground
 
 
+def talk_on_link(args, layout, baud: int, say, talk, refusals: tuple) -> int:
+    """`talk(ground)` over the target's link (`open_link`): its exit status.
+    A refusal (one of the exception classes `refusals`) or a port that goes
+    away is said through `say` (exit 1); the link is closed whatever happens."""
+    from fswkit.link.port import port_errors
+
+    ground = open_link(args, layout, baud, say)
+    if ground is None:
+        return EXIT_FAIL
+    try:
+        return talk(ground)
+    except refusals as e:
+        say(str(e))
+        return EXIT_FAIL
+    except port_errors() as e:
+        say(f"{args.port}: the port went away ({e})")
+        return EXIT_FAIL
+    finally:
+        ground.close()
+
+
 def real_of(args, command: str):
     """The evaluation type `--real` and `--board` name (a board's own; the two
     must agree; f64 when neither is given), or None after a message."""

@@ -38,17 +38,13 @@ def _talk(args, app, p) -> int:
     from fswkit.autocode.recorder import RecordError, decode
     from fswkit.autocode.schema import link_plan
     from fswkit.autocode.protocol import OP_LOG_ERASE
-    from fswkit.cli.common import open_link
+    from fswkit.cli.common import talk_on_link
     from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import from_app
     from fswkit.link.log import LogError
-    from fswkit.link.port import port_errors
     from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
 
-    ground = open_link(args, from_app(app), args.baud or app.baud, _say)
-    if ground is None:
-        return EXIT_FAIL
-    try:
+    def talk(ground) -> int:
         def command(op, a):
             return ground.command(op, a, tries=5, timeout=0.5)
 
@@ -117,11 +113,5 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
             print("erasing the record on the target")
         return EXIT_OK
-    except LinkTimeout as e:
-        _say(str(e))
-        return EXIT_FAIL
-    except port_errors() as e:
-        _say(f"{args.port}: the port went away ({e})")
-        return EXIT_FAIL
-    finally:
-        ground.close()
+
+    return talk_on_link(args, from_app(app), args.baud or app.baud, _say, talk, (LinkTimeout,))

@@ -129,17 +129,14 @@ def _describe(app, inf) -> list[str]:
 
 def _talk(args, app, built, which) -> int:
     from fswkit.autocode.schema import link_plan
-    from fswkit.cli.common import open_link
+    from fswkit.cli.common import talk_on_link
     from fswkit.link.layout import from_app
-    from fswkit.link.port import port_errors
     from fswkit.param.client import ParamError, PortTransport
     from fswkit.reload.client import MachineClient, MachineError
 
     baud = args.baud or app.baud
-    ground = open_link(args, from_app(app), baud, _say)
-    if ground is None:
-        return EXIT_FAIL
-    try:
+
+    def talk(ground) -> int:
         client = MachineClient(PortTransport(ground), link_plan(app).tx_cap, baud=baud)
         a = args.action
         if a == "upload":
@@ -160,11 +157,5 @@ def _talk(args, app, built, which) -> int:
         for line in _describe(app, inf):
             print(line)
         return EXIT_OK
-    except (MachineError, ParamError) as e:
-        _say(str(e))
-        return EXIT_FAIL
-    except port_errors() as e:
-        _say(f"{args.port}: the port went away ({e})")
-        return EXIT_FAIL
-    finally:
-        ground.close()
+
+    return talk_on_link(args, from_app(app), baud, _say, talk, (MachineError, ParamError))

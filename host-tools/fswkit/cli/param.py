@@ -101,15 +101,12 @@ def cmd_param(args) -> int:
 
 
 def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
-    from fswkit.cli.common import open_link
-    from fswkit.link.port import port_errors
+    from fswkit.cli.common import talk_on_link
     from fswkit.param.client import ParamClient, ParamError, PortTransport
 
     baud = args.baud or app.baud
-    ground = open_link(args, layout, baud, _say)
-    if ground is None:
-        return EXIT_FAIL
-    try:
+
+    def talk(ground) -> int:
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
         from fswkit.autocode.params import param_hash
 
@@ -121,14 +118,8 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
                      "built from other configs; build and flash it again")
                 return EXIT_FAIL
         return _action(args, client, params, by_name, wanted, file_values, params_text)
-    except ParamError as e:
-        _say(str(e))
-        return EXIT_FAIL
-    except port_errors() as e:
-        _say(f"{args.port}: the port went away ({e})")
-        return EXIT_FAIL
-    finally:
-        ground.close()
+
+    return talk_on_link(args, layout, baud, _say, talk, (ParamError,))
 
 
 def _action(args, client, params, by_name, wanted, file_values, params_text) -> int:

@@ -15,14 +15,6 @@ uint8_t* mode_byte(const ExecConfig& c, const Task& t, uint8_t i) {
     return t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
 }
 
-void mirror_stats(const ExecConfig& c, const Task& t, const TaskStats& s) {
-    if (t.overruns_off == kNoElement && t.worst_us_off == kNoElement) return;
-    const pal::IrqState saved = c.sv_lock ? pal::critical_enter() : 0;
-    if (t.overruns_off != kNoElement) store<uint16_t>(c.sv + t.overruns_off, s.overruns);
-    if (t.worst_us_off != kNoElement) store<uint32_t>(c.sv + t.worst_us_off, s.worst_us);
-    if (c.sv_lock) pal::critical_exit(saved);
-}
-
 }  // namespace
 
 ExecConfig executor_config(const Executor& ex) {
@@ -69,37 +61,51 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
 void executor_run_cycle(Executor& ex) {
     pal::watchdog_kick();
     const ExecConfig c = executor_config(ex);
+#if FSW_TASK_TIMING
+    // One clock read per task run: a run is timed from the previous run's
+    // end (the cycle's start for the first) to its own end, so it counts
+    // the executor's few instructions that find and start it too.
+    uint32_t mark = pal::micros32();
+#endif
     for (uint8_t i = 0; i < c.n_tasks; ++i) {
         TaskStats& s = c.stats[i];
         if (s.countdown != 0) {
             --s.countdown;
             continue;
         }
-        Task t;
-        read_task(c, i, t);
-        s.countdown = static_cast<uint16_t>(t.divider - 1u);
-        uint8_t* const mode_at = mode_byte(c, t, i);
+        // The row's fields one at a time, each as it is needed: a run reads
+        // 10 of its 17 bytes, a step of a disabled task 4.
+        const Task& row = c.tasks[i];
+        s.countdown = static_cast<uint16_t>(flash_get(row.divider) - 1u);
+        const ElemOff mode_off = flash_get(row.mode_off);
+        uint8_t* const mode_at = mode_off != kNoElement ? c.sv + mode_off : &s.mode;
         const uint8_t mode = *mode_at;
         if (mode == kModeDisabled) continue;
-#if FSW_TASK_TIMING
-        const uint32_t start = pal::micros32();
-#endif
         if (mode == kModeEnabled) {
-            const Result r = t.step(t.ctx);
+            const Result r = flash_get(row.step)(flash_get(row.ctx));
             if (r != kOk) {
                 *mode_at = kModeSafed;
                 s.last_fault = r;
                 if (s.faults != 0xFFu) ++s.faults;
             }
-        } else if (t.safe != 0) {
-            t.safe(t.ctx);
+        } else {
+            const TaskSafeFn safe = flash_get(row.safe);
+            if (safe != 0) safe(flash_get(row.ctx));
         }
 #if FSW_TASK_TIMING
-        const uint32_t took = pal::micros32() - start;
+        const uint32_t end = pal::micros32();
+        const uint32_t took = end - mark;
+        mark = end;
         if (took > s.worst_us) s.worst_us = took;
-        if (took > c.period_us * t.divider && s.overruns != 0xFFFFu) ++s.overruns;
+        if (took > c.period_us * flash_get(row.divider) && s.overruns != 0xFFFFu) ++s.overruns;
 #endif
-        mirror_stats(c, t, s);
+        const ElemOff overruns_off = flash_get(row.overruns_off), worst_us_off = flash_get(row.worst_us_off);
+        if (overruns_off != kNoElement || worst_us_off != kNoElement) {
+            const pal::IrqState saved = c.sv_lock ? pal::critical_enter() : 0;
+            if (overruns_off != kNoElement) store<uint16_t>(c.sv + overruns_off, s.overruns);
+            if (worst_us_off != kNoElement) store<uint32_t>(c.sv + worst_us_off, s.worst_us);
+            if (c.sv_lock) pal::critical_exit(saved);
+        }
     }
     if (++ex.cycles == 0) ++ex.cycles_high;
 }

@@ -110,6 +110,30 @@ inline uint8_t flash_u8(const uint8_t* p) {
 #endif
 }
 
+// One field of a constant table entry (marked FSW_FLASH) of 1, 2 or 4
+// bytes (an integer, an offset, a pointer): one or two word loads inline
+// where flash_read would call the copy routine for the whole entry.
+template <class T>
+inline T flash_get(const T& field) {
+#if FSW_USE_PROGMEM
+    static_assert(sizeof(T) == 1 || sizeof(T) == 2 || sizeof(T) == 4, "flash_get reads 1, 2 or 4 bytes");
+    T v;
+    if (sizeof(T) == 1) {
+        const uint8_t b = pgm_read_byte(&field);
+        memcpy(&v, &b, 1);
+    } else if (sizeof(T) == 2) {
+        const uint16_t w = pgm_read_word(&field);
+        memcpy(&v, &w, 2);
+    } else {
+        const uint32_t d = pgm_read_dword(&field);
+        memcpy(&v, &d, sizeof v);
+    }
+    return v;
+#else
+    return field;
+#endif
+}
+
 }  // namespace fsw
 
 #endif  // FSW_TYPES_H

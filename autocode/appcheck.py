@@ -27,8 +27,6 @@ from .diagnostics import APP, SM, Diagnostics, Source, read_source
 from .iotables import check_table
 from .lexer import ID, NUM, Tok
 from .logcheck import check_log
-from .pyrocheck import check_pyro
-from .reloadcheck import check_reload
 from .sensors import SensorState, check_sensor_table, sensor_name
 from .limits import U8_COUNT, hz
 from .model import TASK_KINDS, TASK_MODES, Task
@@ -126,8 +124,13 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
                 pyro_names, sensors)
     budget = _budget(f.budget, board, r)
     log = check_log(f.log, sv, tasks, machines, board, r, channels=channels, sensors=sensors)
-    pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks)
-    reload = check_reload(f.reload, tasks, machines, board, log, r)
+    pyro, reload = [], None
+    if f.pyro:  # the proofs' module is imported for an application that has pyro channels only
+        from .pyrocheck import check_pyro
+        pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks)
+    if f.reload:
+        from .reloadcheck import check_reload
+        reload = check_reload(f.reload, tasks, machines, board, log, r)
     return Parts(name, board, rate, baud, sv, machines, channels, time_source, time_unit, time_element, tasks,
                  streams, writable, reset_cause, budget, sv_file.file,
                  {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in machine_files}, log, pyro, sensors,

@@ -188,6 +188,11 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     values only (spec §4.4); None after reporting why not."""
     if type(n) is S.Num:  # the common case: a literal, which nothing can make wrong here
         return F64MODE.literal(n.text)
+    if type(n) is S.Name:  # the next: a local with a known value, read as the general case below reads it
+        i = res.names.get(n.name)
+        if i is not None and vars_[i].kind == M.LOCAL and i in consts:
+            res.used.add(i)
+            return F64MODE.read(vars_[i].type, consts[i])
     # Counted on `error_count`: `errors` builds a list, and one per window
     # made many windows with errors quadratic.
     reported = res.diags.error_count
@@ -646,8 +651,9 @@ def script_exprs(s: M.Script):
 
 # A decimal literal beyond binary32's range has an exponent or 39 digits or
 # more; a file without either has no literal to refuse (comments may give
-# a false alarm: the expressions are walked then).
-_MAY_OVERFLOW_F32 = re.compile(r"[0-9.][eE][+-]?[0-9]|[0-9]{39}")
+# a false alarm: the expressions are walked then). Both start with a digit
+# or a point (39 digits: a digit, then 38 more), so one scan looks for both.
+_MAY_OVERFLOW_F32 = re.compile(r"[0-9.](?:[eE][+-]?[0-9]|(?<=[0-9])[0-9]{38})")
 
 
 def check_literals(exprs, real, src: Source, diags: Diagnostics, lang: str, whose: str = "this run's") -> bool:

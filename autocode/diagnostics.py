@@ -124,8 +124,10 @@ class Source:
 
     @classmethod
     def from_text(cls, path: str, text: str) -> "Source":
-        lines = tuple(l[:-1] if l.endswith("\r") else l for l in text.split("\n"))
-        return cls(path, text, lines)
+        lines = text.split("\n")
+        if "\r" in text:  # a CR before a line's LF is no part of the line
+            lines = [l[:-1] if l.endswith("\r") else l for l in lines]
+        return cls(path, text, tuple(lines))
 
     def line(self, n: int) -> str:
         return self.lines[n - 1] if 1 <= n <= len(self.lines) else ""

@@ -23,15 +23,16 @@ class Tok(NamedTuple):
     col: int  # 1-based, tabs expanded
 
 
-# One token, with the blanks before it (a line's blanks are no token).
+# One token, with the blanks before it (a line's blanks are no token). No
+# two kinds start alike, so they are tried most common first.
 _BLANKS = r"[ \t\f\v\r]*"
 _TOKEN = re.compile(_BLANKS + r"""(?:
-    (?P<comment>\#.*)
-  | (?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)
-  | (?P<id>[A-Za-z_][A-Za-z0-9_]*)
-  | (?P<annot>@[A-Za-z_][A-Za-z0-9_]*)
-  | (?P<label>\.[A-Za-z_][A-Za-z0-9_]*)
+    (?P<id>[A-Za-z_][A-Za-z0-9_]*)
   | (?P<op>->|<=|>=|==|!=|[-+*/<>=!(){}:,\[\]])
+  | (?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)
+  | (?P<label>\.[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<annot>@[A-Za-z_][A-Za-z0-9_]*)
+  | (?P<comment>\#.*)
 )""", re.X)
 _SKIP_BLANKS = re.compile(_BLANKS)
 _NUMBER_TAIL = re.compile(r"[A-Za-z0-9_.]+")

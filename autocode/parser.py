@@ -75,7 +75,8 @@ def stream(lines: list[list[Tok]]) -> list[Tok]:
 # ---- expressions and statements ---------------------------------------------
 
 class Parser:
-    """Recursive descent over one token stream."""
+    """Recursive descent over one token stream. The current token is
+    self.toks[self.i]: the stream ends with EOF, which `next` never passes."""
 
     def __init__(self, toks: list[Tok], src: Source, diags: Diagnostics, lang: str):
         self.toks = toks
@@ -114,14 +115,16 @@ class Parser:
         return self.peek().kind in (NL, EOF)
 
     def end_of_statement(self, what: str) -> None:
-        t = self.peek()
+        t = self.toks[self.i]
         if t.kind in (NL, EOF) or (t.kind == OP and t.text == "}"):
             return
         raise ParseError(t, f"unexpected {show(t)} after {what}")
 
     def skip_newlines(self) -> None:
-        while self.peek().kind == NL:
-            self.i += 1
+        toks, i = self.toks, self.i
+        while toks[i].kind == NL:
+            i += 1
+        self.i = i
 
     def enter(self, t: Tok) -> None:
         self.nesting += 1
@@ -209,19 +212,11 @@ class Parser:
 
     def primary(self) -> S.Expr:
         t = self.toks[self.i]
-        if t.kind == NUM:
-            self.i += 1
-            if float(t.text) == math.inf:  # every literal must be a finite binary64 (401 digits is not)
-                raise ParseError(t, "number is outside the representable range")
-            return S.Num(t.line, t.col, t.text)
-        if t.kind == KW and t.text in ("true", "false"):
-            self.next()
-            return S.Bool(t.line, t.col, t.text == "true")
         if t.kind == ID:
-            self.next()
-            if self.at_op("("):
-                self.enter(self.peek())
-                self.next()
+            self.i += 1
+            if self.toks[self.i].text == "(":  # only an operator has this text
+                self.enter(self.toks[self.i])
+                self.i += 1
                 args = []
                 if not self.at_op(")"):
                     args.append(self.expression())
@@ -232,6 +227,14 @@ class Parser:
                 self.nesting -= 1
                 return S.Call(t.line, t.col, t.text, tuple(args))
             return S.Name(t.line, t.col, t.text)
+        if t.kind == NUM:
+            self.i += 1
+            if float(t.text) == math.inf:  # every literal must be a finite binary64 (401 digits is not)
+                raise ParseError(t, "number is outside the representable range")
+            return S.Num(t.line, t.col, t.text)
+        if t.kind == KW and t.text in ("true", "false"):
+            self.i += 1
+            return S.Bool(t.line, t.col, t.text == "true")
         if t.kind == OP and t.text == "(":
             self.next()
             self.enter(t)
@@ -249,7 +252,7 @@ class Parser:
         out: list[S.Stmt] = []
         while True:
             self.skip_newlines()
-            t = self.peek()
+            t = self.toks[self.i]
             if t.kind in (EOF, LABEL):
                 return tuple(out)
             if t.kind == OP and t.text == "}":
@@ -266,7 +269,7 @@ class Parser:
                 self.resync()
 
     def sm_statement(self) -> S.Stmt:
-        t = self.peek()
+        t = self.toks[self.i]
         if t.kind == OP and t.text == "->":
             self.next()
             target = self.peek()
@@ -277,9 +280,9 @@ class Parser:
             if not (nxt.kind in (NL, EOF) or (nxt.kind == OP and nxt.text == "}")):
                 raise ParseError(nxt, "nothing may follow a transition on its line")
             return S.Transition(t.line, t.col, target.text, target.col)
-        if t.kind == ID and self.peek(1).kind == OP and self.peek(1).text == "=":
-            self.next()
-            self.next()
+        # An ID is never the last token, and only an operator's text is `=`.
+        if t.kind == ID and self.toks[self.i + 1].text == "=":
+            self.i += 2
             if self.at_end():
                 raise ParseError(self.peek(), "expected an expression")
             return S.Assign(t.line, t.col, t.text, self.expression())
@@ -299,7 +302,7 @@ class Parser:
         return S.If(t.line, t.col, cond, body, orelse, braced, else_braced)
 
     def sm_guarded_body(self) -> tuple[tuple[S.Stmt, ...], bool]:
-        t = self.peek()
+        t = self.toks[self.i]
         if t.kind == OP and t.text == ":":
             self.next()
             if self.at_end():
@@ -325,7 +328,7 @@ class Parser:
         out: list[S.Stmt] = []
         while True:
             self.skip_newlines()
-            t = self.peek()
+            t = self.toks[self.i]
             if t.kind == OP and t.text == "}":
                 self.next()
                 return tuple(out)

@@ -7,6 +7,7 @@ Exact rational arithmetic throughout."""
 
 from __future__ import annotations
 
+import functools
 import math
 import struct
 from fractions import Fraction
@@ -52,6 +53,7 @@ def key32(v: float) -> int:
     return (~bits) & (2**32 - 1) if bits >> 31 else bits | (1 << 31)
 
 
+@functools.cache  # a machine tests a few constants again and again (-0.0 and 0.0 give the same answer)
 def greater(c: float, size: int):
     """How to test `round32(x) > c` for an element x of `size` bytes: True or
     False when no x / every x passes, else (key, inclusive): x passes when

@@ -4,6 +4,8 @@ carries."""
 
 from __future__ import annotations
 
+import math
+import re
 import struct
 
 from .. import model as M
@@ -40,7 +42,7 @@ def real_literal(x: float, real: Real) -> str:
     """The exact R value `x` as a C++ literal of type fsw::Real."""
     if x != x:
         raise ValueError("NaN has no literal")
-    if x in (float("inf"), float("-inf")):
+    if x in (math.inf, -math.inf):
         body = "__builtin_inff()" if real.bits == 32 else "__builtin_inf()"
         return f"(-{body})" if x < 0 else body
     if real.bits == 64:
@@ -78,16 +80,21 @@ def real_check(fname: str, real: Real) -> str:
             f"{c_string(f'{fname} was generated for binary{real.bits} R: build with FSW_REAL_IS_FLOAT={flag}')});\n")
 
 
+_NOT_PARENS = re.compile(r"[^()]+")
+
+
 def parens(cond: str) -> str:
     """`cond` as the parenthesised condition of an `if`, with no second pair
     around one that has its own (clang -Wall warns about `if ((a == b))`)."""
-    if cond.startswith("("):
+    if cond.startswith("(") and cond.endswith(")"):
+        # Own pair: its first `(` closes at its last character. The depth
+        # changes only at parentheses, so walk them alone.
+        shape = _NOT_PARENS.sub("", cond)
         depth = 0
-        for i, ch in enumerate(cond):
-            depth += ch == "("
-            depth -= ch == ")"
+        for i, ch in enumerate(shape):
+            depth += 1 if ch == "(" else -1
             if depth == 0:
-                if i == len(cond) - 1:
+                if i == len(shape) - 1:
                     return cond
                 break
     return f"({cond})"

@@ -17,6 +17,10 @@ from ..thresholds import tests
 from .common import real_literal
 
 
+# `a op b` is `b _FLIP[op] a`.
+_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+
+
 def _no_reads(i: int):
     raise NotConstant(None)
 
@@ -136,10 +140,9 @@ class ExprEmitter:
     def float_threshold(self, left: M.Expr, op: str, right: M.Expr):
         """binary32 R: `R(x) op c` for a float variable x and a literal c as
         integer threshold tests on x's stored bytes (autocode/thresholds.py)."""
-        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
         x, cv = left, self.known(right)
         if type(x) is not M.Ref or x.var in self.consts or cv is None:
-            x, cv, op = right, self.known(left), flip[op]
+            x, cv, op = right, self.known(left), _FLIP[op]
         if type(x) is not M.Ref or x.var in self.consts or cv is None:
             return None
         v = self.m.vars[x.var]
@@ -326,7 +329,7 @@ class ExprEmitter:
         x = self.known(e)
         if x is None:
             return None
-        if x != x or x in (float("inf"), float("-inf")) or x != int(x):
+        if x != x or x in (math.inf, -math.inf) or x != int(x):
             return None
         c = int(x)
         return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
@@ -334,13 +337,12 @@ class ExprEmitter:
     def int_compare(self, left: M.Expr, op: str, right: M.Expr):
         """`x op c` on the integer itself. Converting an integer to R is
         monotonic and exact near c, so `R(x) op c` equals `x op c`."""
-        flip = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
         a, c, x = self.int_operand(left), self.exact_int_const(right), left
         if a is None or c is None:
             a, c, x = self.int_operand(right), self.exact_int_const(left), right
             if a is None or c is None:
                 return None
-            op = flip[op]
+            op = _FLIP[op]
         text, t = a
         lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
         # Constant over the type's whole range (c outside it, or `x >= 0` on an

@@ -8,15 +8,19 @@ import shutil
 
 import pytest
 
-from conftest import EXAMPLES
+from conftest import EXAMPLES, ROOT
 
 SCRIPTS = sorted(p for p in EXAMPLES.rglob("*.ss"))
 needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
 
 
 @pytest.fixture(autouse=True)
-def _cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "fsw-cache"))
+def _cache(monkeypatch):
+    """`fsw test --native`'s builds kept in build/differential/fsw-cache,
+    not the user's ~/.cache: a build is keyed by the hash of all it reads
+    (the compiler, the runtime, the generated code, the flags), so a warm
+    run compiles only what changed (fswkit.run.native)."""
+    monkeypatch.setenv("FSW_CACHE_DIR", str(ROOT / "build" / "differential" / "fsw-cache"))
 
 
 @needs_cxx

@@ -10,8 +10,8 @@ pytestmark = MARKS
 
 
 @pytest.fixture(scope="module")
-def hpr_firmware(tmp_path_factory):
-    return build_hpr(tmp_path_factory)
+def hpr_firmware():
+    return build_hpr()
 
 
 @pytest.mark.parametrize("name", tapes("cats"))

@@ -55,10 +55,10 @@ def decoded(log: Path):
 
 
 @pytest.fixture(scope="module")
-def tank_link(tmp_path_factory) -> bytes:
+def tank_link() -> bytes:
     if shutil.which("g++") is None:
         pytest.skip("no host C++ compiler")
-    exe = build_native(TANK, tmp_path_factory.mktemp("tank"))
+    exe = build_native(TANK)
     return simulated_link(exe, 300, "a14=700")  # 3 s on the simulated clock
 
 

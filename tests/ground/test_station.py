@@ -29,8 +29,8 @@ FSW = os.path.join(os.path.dirname(sys.executable), "fsw")
 
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
-    return build_native(TANK, tmp_path_factory.mktemp("tank"))
+def exe():
+    return build_native(TANK)
 
 
 @pytest.fixture(autouse=True)
@@ -262,16 +262,16 @@ def test_the_station_comes_back_after_a_reset_and_a_cable_pull(station, board):
 def test_param_and_cmd_go_through_the_station_while_a_monitor_watches(tmp_path):
     """`fsw param` pipelines its own numbered commands: through the station
     it leases the uplink, and a monitor attached all along loses nothing."""
-    from conftest import ROOT, run_fsw
+    from conftest import ROOT
     from fswkit.ground.station import Station
     from fswkit.link.layout import from_app
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.target.build import load
 
+    from support.simfw import kept_native
+
     rig = ROOT / "tests" / "param" / "tuned"
-    r = run_fsw("build", str(rig), "--board", "native", "--out", str(tmp_path / "b"))
-    assert r.code == 0, r.err
-    b = Board(tmp_path / "b" / "tuned", str(tmp_path / "ttyRIG"), "--eeprom", str(tmp_path / "e.bin"))
+    b = Board(kept_native(rig) / "tuned", str(tmp_path / "ttyRIG"), "--eeprom", str(tmp_path / "e.bin"))
     try:
         st = Station(from_app(load(str(rig), Diagnostics())), str(rig), b.link, 115200)
         rec = Recorder(st)

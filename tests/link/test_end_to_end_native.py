@@ -26,8 +26,8 @@ RAW = 770  # 770 counts -> 815.4 psi: between 775 and 825, the vent valve opens
 
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
-    return build_native(TANK, tmp_path_factory.mktemp("tank"))
+def exe():
+    return build_native(TANK)
 
 
 @pytest.fixture

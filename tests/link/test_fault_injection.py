@@ -20,8 +20,8 @@ pytestmark = needs_cxx()
 
 
 @pytest.fixture(scope="module")
-def clean(tmp_path_factory):
-    exe = build_native(TANK, tmp_path_factory.mktemp("tank"))
+def clean():
+    exe = build_native(TANK)
     data = simulated_link(exe, 60000, "--uart", "115200", "a14=700")  # 10 simulated minutes
     return data
 

@@ -15,17 +15,15 @@ import pytest
 
 from conftest import run_fsw
 from support.linkfw import PtyTarget, needs_cxx
+from support.simfw import kept_native
 
 pytestmark = needs_cxx()
 RIG = Path(__file__).resolve().parent / "tuned"
 
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
-    out = tmp_path_factory.mktemp("tuned")
-    r = run_fsw("build", str(RIG), "--board", "native", "--out", str(out))
-    assert r.code == 0, r.err
-    return out / "tuned"
+def exe():
+    return kept_native(RIG) / "tuned"
 
 
 def param(port, *args):

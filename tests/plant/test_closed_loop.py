@@ -20,6 +20,7 @@ import pytest
 
 from conftest import EXAMPLES, ROOT
 from fswkit.plant.run import FILES, execute, prepare
+from support.simfw import kept_sim
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -29,19 +30,11 @@ SEEDS = (1, 2)  # make bench flies seeds 1-20
 HOLD_S = 6.0  # the pinned-sensor faults sit armed on the pad until then (plant.toml says 20 s)
 
 
-def _build(project: Path, out: Path):
-    from fswkit.sim.command import build
-
-    built = build(str(project), out=str(out))
-    assert not isinstance(built, int), f"{project} did not build"
-    return built
-
-
 @pytest.fixture(scope="module")
 def flights(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("flights")
-    rocket_elf, board = _build(ROCKET, tmp / "build-rocket")
-    tank_elf, _ = _build(TANK, tmp / "build-tank")
+    rocket_elf, board = kept_sim(ROCKET)  # built into build/sim-tests/, once for every test file
+    tank_elf, _ = kept_sim(TANK)
     short = tmp / "short-hold.toml"
     text = (ROCKET / "plant.toml").read_text()
     assert "hold_s     = 20" in text

@@ -252,11 +252,9 @@ def test_the_firmware_reads_the_parts_the_plant_feeds_and_sees_one_fail(tmp_path
     counts through the drivers), then the barometer stops answering at 3 s
     and the health frames say so."""
     from fswkit.plant.cosim import fly
-    from fswkit.sim.command import build
+    from support.simfw import kept_sim
 
-    built = build(str(DIGITAL), out=str(tmp_path / "build"))
-    assert not isinstance(built, int)
-    elf, board = built
+    elf, board = kept_sim(DIGITAL)  # built into build/sim-tests/, once for every test file
     p = digital(tmp_path, '[scenario]\npart_fail = "bmp280@0x76"\npart_fail_s = 3.0\n')
     _app, layout, sc = prepare(str(DIGITAL), "rocket", params=str(p))
     sc.max_s = 5.0  # on the pad: the motor lights at 5 s

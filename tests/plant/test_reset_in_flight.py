@@ -112,15 +112,12 @@ needs_board = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.
 
 
 @pytest.fixture(scope="module")
-def flights(tmp_path_factory):
+def flights():
     from fswkit.plant.cosim import fly
-    from fswkit.sim.command import build
+    from support.simfw import kept_sim
 
-    tmp = tmp_path_factory.mktemp("reset")
     project = ROCKET  # its igniters' continuity driven intact by its plant
-    built = build(str(project), out=str(tmp / "build"))
-    assert not isinstance(built, int), "examples/rocket did not build"
-    elf, board = built
+    elf, board = kept_sim(project)  # built into build/sim-tests/, once for every test file
 
     def flight(max_s, **attrs):
         _app, layout, sc = prepare(str(project), "rocket", seed=1)

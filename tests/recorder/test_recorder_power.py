@@ -12,23 +12,21 @@ from pathlib import Path
 
 import pytest
 
-from conftest import run_fsw
 from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.app import load_app
 from fswkit.autocode.recorder import RECORDER_SIZE, plan
 from fswkit.testing.recorder_cuts import power_cuts
+from support.simfw import kept_sim
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 RIG = Path(__file__).resolve().parent / "logged"
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("logged-uno")
-    r = run_fsw("build", str(RIG), "--out", str(out))
-    assert r.code == 0, r.err
+def built():
+    elf, _board = kept_sim(RIG)
     app = load_app(str(RIG / "logged.app"), Diagnostics())
-    return out / "logged.elf", plan(app)
+    return Path(elf), plan(app)
 
 
 def test_the_recorder_record_is_the_size_the_tools_count(built):

@@ -24,6 +24,7 @@ from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.autocode.recorder import RECORDER_SIZE, decode, plan
 from fswkit.testing.recorder_cuts import CutReport, _check_samples, power_cuts_nor, store_image, valid_records
 from support.linkfw import PtyTarget
+from support.simfw import OUT, kept_native, kept_sim
 
 RIG = Path(__file__).resolve().parent / "spi"
 LOGGED = Path(__file__).resolve().parent / "logged"
@@ -33,11 +34,9 @@ CHIP = "B2:1048576"  # the Uno's D10
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("spi-uno")
-    r = run_fsw("build", str(RIG), "--out", str(out))
-    assert r.code == 0, r.err
-    return out / "spi.elf", plan(load_app(str(RIG / "spi.app"), Diagnostics()))
+def built():
+    elf, _board = kept_sim(RIG)
+    return Path(elf), plan(load_app(str(RIG / "spi.app"), Diagnostics()))
 
 
 def flight(b, seconds: float = 1.5) -> None:
@@ -159,20 +158,24 @@ def test_power_cuts_lose_only_the_record_being_written(built):
 # ---- the native build: the chip in a file, dumped over the link ---------------------
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
+def exe():
     """The rig on a 64 KiB chip (512 slots: `fsw dump` reads every slot)."""
     if shutil.which("g++") is None:
         pytest.skip("no host C++ compiler")
-    src = tmp_path_factory.mktemp("spi-src")
-    for f in RIG.iterdir():
-        if f.is_file():
-            shutil.copy(f, src / f.name)
-    app = src / "spi.app"
-    app.write_text(app.read_text().replace("store   spi_nor 10 1 M", "store   spi_nor 10 64 K"))
-    out = tmp_path_factory.mktemp("spi-native")
-    r = run_fsw("build", str(src), "--board", "native", "--out", str(out))
-    assert r.code == 0, r.err
-    return src, out / "spi"
+    # a copy of the rig kept in build/sim-tests/ with its build (support.simfw.kept_native): a file is
+    # written only when its text changed, so a warm run's build finds everything up to date
+    src = OUT / "spi-64k"
+    src.mkdir(parents=True, exist_ok=True)
+    texts = {f.name: f.read_text() for f in RIG.iterdir() if f.is_file()}
+    texts["spi.app"] = texts["spi.app"].replace("store   spi_nor 10 1 M", "store   spi_nor 10 64 K")
+    assert "spi_nor 10 64 K" in texts["spi.app"]
+    for f in src.iterdir():
+        if f.is_file() and f.name not in texts:
+            f.unlink()
+    for name, text in texts.items():
+        if not (src / name).is_file() or (src / name).read_text() != text:
+            (src / name).write_text(text)
+    return src, kept_native(src) / "spi"
 
 
 def test_the_native_build_keeps_the_chip_in_a_file_and_dumps_it(exe, tmp_path):

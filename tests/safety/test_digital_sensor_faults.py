@@ -38,7 +38,7 @@ def flights(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("digital")
     cut = tmp / "cut.toml"  # the project's plant, flown to CUT_S only
     cut.write_text(f'extends = "{DIGITAL / "plant.toml"}"\n\n[scenario]\nmax_s = {CUT_S}\n')
-    flown = fly_all(DIGITAL, build_project(DIGITAL, tmp),
+    flown = fly_all(DIGITAL, build_project(DIGITAL),
                     {"nominal": {}, "nack": {"fault": f"baro-nack@{FAIL_S:g}", "params": str(cut)}})
     return {name: flight for name, (_app, flight) in flown.items()}
 
@@ -96,7 +96,7 @@ def test_the_mission_falls_back_to_its_backup_timers(flights):
 
 @pytest.mark.skipif(not (EXAMPLES.parent.parent / "shared" / "flights").is_dir(),
                     reason="../shared/flights is absent: no real flight to replay")
-def test_a_real_flight_through_the_parts(tmp_path_factory):
+def test_a_real_flight_through_the_parts():
     from support.hpr_tapes import build_hpr, replay_and_check
 
-    replay_and_check("ndrt2020_raven", build_hpr(tmp_path_factory, DIGITAL))
+    replay_and_check("ndrt2020_raven", build_hpr(DIGITAL))

@@ -52,7 +52,7 @@ def flights(tmp_path_factory):
     jobs = {name: {"reset": spec} for name, spec in RESETS.items()}
     jobs["pad-power"] = {"reset": ("Armed", 0.5, "power")}
     jobs["open-igniter"] = {"fault": "open-igniter", "params": str(short)}
-    return fly_all(ROCKET, build_project(ROCKET, tmp), jobs)
+    return fly_all(ROCKET, build_project(ROCKET), jobs)
 
 
 def _states(run) -> list[str]:

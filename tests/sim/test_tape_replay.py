@@ -227,14 +227,14 @@ def test_perturbed_replays_are_deterministic_per_seed(flights, tmp_path):
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.plant import tape_replay as tr
-    from fswkit.sim.command import build
     from fswkit.target.build import load
+    from support.simfw import kept_sim
 
     app = load(str(ROCKET), Diagnostics(), None)
     layout = from_app(app)
     cfg = tr.load_config(app, layout, str(flights / "tape.toml"))
     tape, truth = tr.load_tape(str(_write_tape(tmp_path, "short", end=9.0)), cfg)
-    elf, board = build(str(ROCKET), out=str(tmp_path / "build"))
+    elf, board = kept_sim(ROCKET)  # built into build/sim-tests/, once for every test file
     a = tr.robustness(tape, truth, cfg, elf, board, layout, 2, seed=3, workers=2)
     b = tr.robustness(tape, truth, cfg, elf, board, layout, 1, seed=3)  # run i is the seed's i-th child: N aside
     strip = [{k: v for k, v in r.numbers.items() if k != "speed"} for r in a]

@@ -16,13 +16,13 @@ needs_avr_sim = pytest.mark.skipif(shutil.which("avr-gcc") is None
                                    reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
 
-def build_project(project: Path, tmp: Path) -> tuple[str, str]:
-    """`project`'s firmware built into tmp/build: (its ELF, its board)."""
-    from fswkit.sim.command import build
+def build_project(project: Path) -> tuple[str, str]:
+    """`project`'s firmware built into build/sim-tests/ (kept between runs,
+    built once for every test file: support.simfw.kept_sim): (its ELF, its
+    board)."""
+    from support.simfw import kept_sim
 
-    built = build(str(project), out=str(tmp / "build"))
-    assert not isinstance(built, int), f"{project} did not build"
-    return built
+    return kept_sim(project)
 
 
 def fly(project: Path, built: tuple[str, str], fault: str | None = None, params: str | None = None,

@@ -43,23 +43,23 @@ def tapes(of: str) -> list[str]:
     return [t for t in TAPES if group(t) == of]
 
 
-def build_hpr(tmp_path_factory, project=HPR):
+def build_hpr(project=HPR):
     """(app, layout, tape config, elf, board) of examples/hpr, or of another
-    project that replays tapes (examples/hpr_digital), built once."""
+    project that replays tapes (examples/hpr_digital), its firmware kept
+    in build/sim-tests/ (support.simfw.kept_sim: built once for every test
+    file, and again only for what changed)."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.plant import tape_replay as tr
-    from fswkit.sim.command import build
     from fswkit.target.build import load
+    from support.simfw import kept_sim
 
     diags = Diagnostics()
     app = load(str(project), diags)
     assert app is not None, diags.render()
     layout = from_app(app)
     cfg = tr.load_config(app, layout, None)
-    built = build(str(project), out=str(tmp_path_factory.mktemp(project.name) / "firmware"))
-    assert not isinstance(built, int), f"examples/{project.name}'s firmware did not build"
-    elf, board = built
+    elf, board = kept_sim(project)  # built into build/sim-tests/, once for every test file
     return app, layout, cfg, elf, board
 
 

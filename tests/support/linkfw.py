@@ -11,15 +11,18 @@ import subprocess
 import tty
 from pathlib import Path
 
-from conftest import EXAMPLES, run_fsw
+from conftest import EXAMPLES
 
 TANK = EXAMPLES / "tank"
 
 
-def build_native(project: Path, out: Path) -> Path:
-    r = run_fsw("build", str(project), "--board", "native", "--out", str(out))
-    assert r.code == 0, r.err
-    return out / "tank"
+def build_native(project: Path) -> Path:
+    """The project built for the host into build/sim-tests/ (kept between
+    runs, built once for every test file: support.simfw.kept_native); its
+    executable."""
+    from support.simfw import kept_native
+
+    return kept_native(project) / project.name
 
 
 def tank_layout(project: Path = TANK):

@@ -1,11 +1,14 @@
-"""Firmware for the simulated-board tests, built into build/sim-tests/
-(kept between runs, so rebuilds are incremental), and the fixtures that
-build it once per session."""
+"""Firmware for the simulated-board tests, and the host builds of the link
+tests, built into build/sim-tests/ (kept between runs, so rebuilds are
+incremental, and shared by the test files that build the same project),
+and the fixtures that build it once per session."""
 
 from __future__ import annotations
 
+import hashlib
 import os
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -76,6 +79,38 @@ def project_elf(project: str, board: str) -> str:
     r = run_fsw("build", str(project), "--board", board, "--out", str(out))
     assert r.code == 0, r.err
     return str(out / f"{name}.elf")
+
+
+def kept_folder(project, board: str) -> Path:
+    """The folder in build/sim-tests/ that keeps `project`'s build for
+    `board` ("own": the board its configs name), named by the project's
+    folder and its real path (two projects of one name, two folders)."""
+    path = Path(project).resolve()
+    return OUT / f"{path.name}-{board}-{hashlib.sha1(str(path).encode()).hexdigest()[:8]}"
+
+
+def kept_native(project) -> Path:
+    """`fsw build PROJECT --board native` into build/sim-tests/ (kept
+    between runs: make rebuilds what changed, the firmware's sources, the
+    generated code or the flags; the build holds its folder, so test
+    files and xdist workers building the same project take turns and the
+    later finds it up to date); the build folder, which holds the
+    executable named after the application file."""
+    out = kept_folder(project, "native")
+    r = run_fsw("build", str(project), "--board", "native", "--out", str(out))
+    assert r.code == 0, r.err
+    return out
+
+
+def kept_sim(project):
+    """`project`'s firmware for its own board as `fsw sim` builds it
+    (fswkit.sim.command.build), into build/sim-tests/ as `kept_native`
+    keeps its builds; (its ELF, its board)."""
+    from fswkit.sim.command import build
+
+    built = build(str(project), out=str(kept_folder(project, "own")))
+    assert not isinstance(built, int), f"{project} did not build"
+    return built
 
 
 def sketch_elf(name: str, source: str, board: str = "uno") -> str:

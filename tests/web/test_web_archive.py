@@ -228,8 +228,8 @@ def test_the_archive_routes_cap_a_long_session_and_refuse_in_words(tmp_path):
 # ---- in the browser, on the tank firmware --------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
-    return build_native(TANK, tmp_path_factory.mktemp("tank"))
+def exe():
+    return build_native(TANK)
 
 
 @needs_cxx()

@@ -24,8 +24,8 @@ RAW = 770  # 815.86 psi: the vent valve opens
 
 
 @pytest.fixture(scope="module")
-def exe(tmp_path_factory):
-    return build_native(TANK, tmp_path_factory.mktemp("tank"))
+def exe():
+    return build_native(TANK)
 
 
 class Station:
@@ -111,7 +111,7 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             station.close()
 
 
-def test_the_page_shows_each_charges_status_from_the_health_frame(browser, tmp_path):
+def test_the_page_shows_each_charges_status_from_the_health_frame(browser):
     """The rocket built for the host, its key on, both igniters reading
     intact (2.5 V: count 512) and then the drogue's open: the page's link
     table says so in words (docs/safety.md, "Continuity")."""
@@ -119,10 +119,10 @@ def test_the_page_shows_each_charges_status_from_the_health_frame(browser, tmp_p
 
     from conftest import EXAMPLES
 
+    from support.simfw import kept_native
+
     rocket = EXAMPLES / "rocket"
-    r = run_fsw("build", str(rocket), "--board", "native", "--out", str(tmp_path / "rocket"))
-    assert r.code == 0, r.err
-    exe = tmp_path / "rocket" / "rocket"
+    exe = kept_native(rocket) / "rocket"
     for drogue, words in ((512, "armed, continuity, not fired"), (0, "armed, OPEN, not fired")):
         with PtyTarget(exe, "d2=1", f"a16={drogue}", "a17=512") as target:
             station = Station(target.port, rocket)
@@ -136,24 +136,31 @@ def test_the_page_shows_each_charges_status_from_the_health_frame(browser, tmp_p
                 station.close()
 
 
-def test_the_page_shows_each_sensor_parts_health(browser, tmp_path):
+def test_the_page_shows_each_sensor_parts_health(browser):
     """An application with a barometer and an accelerometer built for the
     host, where nobody answers on either bus: the link table names each
     part with its health in words (docs/sensor-table.md)."""
     from selenium.webdriver.common.by import By
 
-    project = tmp_path / "parts"
-    project.mkdir()
-    (project / "p.sv").write_text("[Data]\nU64 time\nU32 state\nF32 baroP\nF32 accelZ\nbool high\n")
-    (project / "p.sm").write_text("[state_vector]\nU64 time @alias G\nU32 state @alias S\nF32 baroP @read_only\n"
-                                  "bool high\n\n[Run]\n.step\n    high = baroP > 100000\n")
-    (project / "p.sns").write_text("bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:7 z=accelZ\n")
-    (project / "p.app").write_text("[application]\nboard native\nrate 100\n[configs]\nstate_vector p.sv\n"
-                                   "machine p.sm\nio p.sns\n[tasks]\nsense inputs rate=100\n"
-                                   "control machine p rate=100\ndown telemetry rate=50\n[telemetry]\nData rate=10\n")
-    r = run_fsw("build", str(project), "--board", "native", "--out", str(tmp_path / "build"))
-    assert r.code == 0, r.err
-    with PtyTarget(tmp_path / "build" / "p") as target:
+    from support.simfw import OUT, kept_native
+
+    # the project and its build kept in build/sim-tests/ (support.simfw.kept_native): a file is written
+    # only when its text changed, so a warm run's build finds everything up to date
+    project = OUT / "web-parts"
+    project.mkdir(parents=True, exist_ok=True)
+    texts = {
+        "p.sv": "[Data]\nU64 time\nU32 state\nF32 baroP\nF32 accelZ\nbool high\n",
+        "p.sm": "[state_vector]\nU64 time @alias G\nU32 state @alias S\nF32 baroP @read_only\n"
+                "bool high\n\n[Run]\n.step\n    high = baroP > 100000\n",
+        "p.sns": "bmp280 i2c:0x76 pressure=baroP\nadxl345 spi:7 z=accelZ\n",
+        "p.app": "[application]\nboard native\nrate 100\n[configs]\nstate_vector p.sv\n"
+                 "machine p.sm\nio p.sns\n[tasks]\nsense inputs rate=100\n"
+                 "control machine p rate=100\ndown telemetry rate=50\n[telemetry]\nData rate=10\n",
+    }
+    for name, text in texts.items():
+        if not (project / name).is_file() or (project / name).read_text() != text:
+            (project / name).write_text(text)
+    with PtyTarget(kept_native(project) / "p") as target:
         station = Station(target.port, project)
         try:
             browser.get(station.url)
@@ -218,7 +225,7 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
 
     import uvicorn
 
-    from conftest import ROOT, run_fsw
+    from conftest import ROOT
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.params import app_parameters
     from fswkit.autocode.schema import link_plan
@@ -228,11 +235,12 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
     from fswkit.web.app import create_app
     from fswkit.web.source import LiveSource
 
+    from support.simfw import kept_native
+
     rig = ROOT / "tests" / "param" / "tuned"
-    r = run_fsw("build", str(rig), "--board", "native", "--out", str(tmp_path / "b"))
-    assert r.code == 0, r.err
+    exe = kept_native(rig) / "tuned"
     app = load(str(rig), Diagnostics())
-    with PtyTarget(tmp_path / "b" / "tuned", "--eeprom", str(tmp_path / "e.bin")) as target:
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
         ground = Ground(from_app(app), str(rig), target.port, 115200)
         ground.start()
         source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)

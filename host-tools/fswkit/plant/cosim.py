@@ -82,13 +82,37 @@ _cpu_lock = threading.Lock()
 _cpu_users: dict[int, int] = {}  # CPU -> flights pinned to it now
 
 
+def _boards_pinned() -> dict[int, int]:
+    """CPU -> the simulated boards of every process on this machine that run
+    pinned to it (a flight's board runs on its flight's one CPU: `_one_cpu`)."""
+    out: dict[int, int] = {}
+    try:
+        pids = [p for p in os.listdir("/proc") if p.isdigit()]
+    except OSError:
+        return out
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/comm") as f:
+                if f.read().strip() != "simboard":
+                    continue
+            cpus = os.sched_getaffinity(int(pid))
+        except (OSError, ValueError):  # gone meanwhile, or not ours to ask
+            continue
+        if len(cpus) == 1:
+            cpu = next(iter(cpus))
+            out[cpu] = out.get(cpu, 0) + 1
+    return out
+
+
 @contextlib.contextmanager
 def _one_cpu():
     """Runs this thread, and the board it starts, on one CPU — the least used
-    by other flights of this process. Lock-step is a ping-pong: one of the
-    two processes works while the other waits, and a pipe round trip between
-    two processes on one CPU costs about 10 µs, across CPUs 60 to 100 µs
-    (about a quarter of a 1 kHz step's time)."""
+    by other flights of this process, and of those the one the fewest boards
+    of other processes are pinned to (processes that fly at once: pytest-xdist's
+    workers, two `fsw sim`s), not the first CPU for every process. Lock-step
+    is a ping-pong: one of the two processes works while the other waits, and
+    a pipe round trip between two processes on one CPU costs about 10 µs,
+    across CPUs 60 to 100 µs (about a quarter of a 1 kHz step's time)."""
     if not hasattr(os, "sched_setaffinity"):
         yield
         return
@@ -101,7 +125,8 @@ def _one_cpu():
         yield
         return
     with _cpu_lock:
-        cpu = min(sorted(before), key=lambda c: _cpu_users.get(c, 0))
+        pinned = _boards_pinned()
+        cpu = min(sorted(before), key=lambda c: (_cpu_users.get(c, 0), pinned.get(c, 0)))
         _cpu_users[cpu] = _cpu_users.get(cpu, 0) + 1
     try:
         try:
@@ -249,6 +274,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         # the parts the plant feeds, with the calibration each holds (read once)
         feeds = {s: PartFeed(s, where[s], b.part_calibration(where[s]))
                  for s in getattr(scenario, "parts", ()) if s in where}
+        # each part's feed by the part object itself (kept, so its id is never another's): a part is a
+        # frozen dataclass whose hash walks all its fields, twice a step otherwise
+        feed_of: dict[int, tuple] = {}
         last_raw: dict = {}  # harness id -> the raw counts set last
         fail_plan = list(getattr(scenario, "part_fail_plan", ()))
         last_mv = {name: _mv(v, vref) for name, v in analog.items()}
@@ -291,7 +319,10 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             set_parts = {}  # the parts' raw counts that changed
             if feeds:
                 for part, values in scenario.part_values.items():
-                    feed = feeds.get(part)
+                    known = feed_of.get(id(part))
+                    if known is None or known[0] is not part:
+                        known = feed_of[id(part)] = (part, feeds.get(part))
+                    feed = known[1]
                     if feed is None:
                         continue
                     raw = feed.raw(**values)

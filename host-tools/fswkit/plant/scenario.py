@@ -705,9 +705,10 @@ class RocketScenario:
     def inputs(self, t: float):
         pa = self.rocket.static_pressure() + self.baro_noise()
         g = self.rocket.specific_force() / G0 + self.accel_noise()
-        if self.baro_part is not None and self.baro_part in self.noisy_parts:
+        noisy = self.noisy_parts  # (empty but for a `noisy` part failure: no part hashed then)
+        if noisy and self.baro_part is not None and self.baro_part in noisy:
             pa += self.noisy_noise() * NOISY_PA
-        if self.accel_part is not None and self.accel_part in self.noisy_parts:
+        if noisy and self.accel_part is not None and self.accel_part in noisy:
             g += self.noisy_noise() * NOISY_G
         self.part_values = {}
         if self.baro_part is not None:

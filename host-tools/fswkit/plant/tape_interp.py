@@ -79,8 +79,23 @@ class _Gate:
 
 def _reading(sensor, counts: int) -> float:
     """The element's value for a count, as the firmware computes it (binary32)."""
+    return _readings(sensor, [counts])[0]
+
+
+def _readings(sensor, counts: list[int]) -> list[float]:
+    """_reading of each count: each distinct count's value worked out once
+    (exact rational arithmetic, and a tape's rows repeat a few hundred
+    counts)."""
     gain = analog_gain(sensor.scale, sensor.vref, sensor.bits, F32MODE)
-    return analog_value(counts, gain, F32MODE.literal(repr(float(sensor.offset))), F32MODE)
+    offset = F32MODE.literal(repr(float(sensor.offset)))
+    memo: dict[int, float] = {}
+    out = []
+    for k in counts:
+        v = memo.get(k)
+        if v is None:
+            v = memo[k] = analog_value(k, gain, offset, F32MODE)
+        out.append(v)
+    return out
 
 
 def analog_inputs(cfg, columns: dict) -> tuple[dict, dict]:
@@ -94,7 +109,7 @@ def analog_inputs(cfg, columns: dict) -> tuple[dict, dict]:
         if s is None:
             continue
         counts = counts_series(columns[col], s, cfg.missing, cfg.silent_volts)
-        series[s.element] = [_reading(s, k) for k in counts.tolist()]
+        series[s.element] = _readings(s, counts.tolist())
     constant = {ig.sensor.element: _reading(ig.sensor, ig.counts) for ig in getattr(cfg, "igniters", {}).values()}
     series.update(part_inputs(cfg, columns))
     return series, constant

@@ -254,6 +254,7 @@ class PartFeed:
     def __init__(self, sensor, where: int | str, calibration: bytes | None):
         from . import parts as P
 
+        self._P = P  # (`raw` runs every plant step: the module looked up once)
         self.sensor, self.where, self.part = sensor, where, sensor.part
         self.name = part_name(sensor)
         self.settings = dict(sensor.settings)
@@ -267,6 +268,12 @@ class PartFeed:
         # the raw temperature (BMP280 adc_T, MS5611 D2): the temperature changes at every plant step
         self._temp = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, True)
         self._p = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, self.part != "bmp280")
+        # the BMP280's compensations are pure functions of the raw counts (and t_fine): each raw count's
+        # value is worked out once (a flight's temperatures span a few hundred adc_T; its pressures, for
+        # one t_fine at a time, the few counts around the last answer)
+        self._t_of: dict[int, tuple[int, int]] = {}  # adc_T -> bmp280_compensate_T
+        self._p_of: dict[int, int] = {}  # adc_P -> bmp280_compensate_P64 at t_fine self._p_tf
+        self._p_tf: int | None = None
 
     @property
     def data_format(self) -> int:
@@ -275,17 +282,22 @@ class PartFeed:
 
     def raw(self, pressure: float | None = None, temperature: float | None = None,
             x: float = 0.0, y: float = 0.0, z: float = 0.0) -> dict[str, int]:
-        from . import parts as P
+        P = self._P
 
         if self.part in BAROMETERS:
             out = {}
             t_c = 15.0 if temperature is None else float(temperature)
             if self._t is None or self._t[0] != t_c:
                 if self.part == "bmp280":
-                    c = self.calib
-                    adc_T = self._temp(lambda a: P.bmp280_compensate_T(c, a)[0], t_c * 100.0,
-                                       lambda: P.bmp280_adc_T_for(c, t_c))
-                    self._t = (t_c, adc_T, P.bmp280_compensate_T(self.calib, adc_T)[1])
+                    c, t_of = self.calib, self._t_of
+
+                    def comp_t(a):
+                        r = t_of.get(a)
+                        if r is None:
+                            r = t_of[a] = P.bmp280_compensate_T(c, a)
+                        return r
+                    adc_T = self._temp(lambda a: comp_t(a)[0], t_c * 100.0, lambda: P.bmp280_adc_T_for(c, t_c))
+                    self._t = (t_c, adc_T, comp_t(adc_T)[1])
                 else:
                     c = self.calib
                     self._t = (t_c, self._temp(lambda d: P.ms5611_compensate(c, 0, d, True).TEMP, t_c * 100.0,
@@ -294,7 +306,16 @@ class PartFeed:
                 out["adc_T"] = self._t[1]
                 if pressure is not None:
                     c, tf = self.calib, self._t[2]
-                    out["adc_P"] = self._p(lambda a: P.bmp280_compensate_P64(c, a, tf), float(pressure) * 256.0,
+                    if tf != self._p_tf:
+                        self._p_tf, self._p_of = tf, {}
+                    p_of = self._p_of
+
+                    def comp_p(a):
+                        r = p_of.get(a)
+                        if r is None:
+                            r = p_of[a] = P.bmp280_compensate_P64(c, a, tf)
+                        return r
+                    out["adc_P"] = self._p(comp_p, float(pressure) * 256.0,
                                            lambda: P.bmp280_adc_P_for(c, float(pressure), tf))
             else:
                 out["D2"] = d2 = self._t[1]

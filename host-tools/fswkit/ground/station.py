@@ -199,6 +199,13 @@ class Station:
             except errors as e:
                 self._lost(e)
                 continue
+            except (TypeError, AttributeError):
+                # pyserial reading a port closed under it (its descriptor is
+                # None): stop() closes the port once its wait for this thread
+                # has run out. Stopping, that is the end; otherwise a defect.
+                if self._stop.is_set():
+                    break
+                raise
             if data:
                 self._received(data)
             elif self.archive is not None:

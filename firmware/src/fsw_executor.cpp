@@ -74,7 +74,7 @@ void executor_run_cycle(Executor& ex) {
             continue;
         }
         // The row's fields one at a time, each as it is needed: a run reads
-        // 10 of its 17 bytes, a step of a disabled task 4.
+        // 12 of its 17 bytes, the turn of a disabled task 4.
         const Task& row = c.tasks[i];
         s.countdown = static_cast<uint16_t>(flash_get(row.divider) - 1u);
         const ElemOff mode_off = flash_get(row.mode_off);

@@ -121,7 +121,7 @@ __attribute__((noinline)) bool sub_period_ended() {
 // The timer's count now, in us past the sub-period's start, and whether a
 // sub-period ended that the interrupt has not counted yet (interrupts off).
 // Always inlined: called, its flag would go through the stack and the call
-// would cost micros32() (twice per task step) half its 89 cycles.
+// would cost micros32() (once per task run) half its 89 cycles.
 inline __attribute__((always_inline)) uint16_t elapsed_us(bool& wrapped) {
     const uint16_t t = TCNT1;
     wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < g_ct.early;

@@ -188,11 +188,6 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
     values only (spec §4.4); None after reporting why not."""
     if type(n) is S.Num:  # the common case: a literal, which nothing can make wrong here
         return F64MODE.literal(n.text)
-    if type(n) is S.Name:  # the next: a local with a known value, read as the general case below reads it
-        i = res.names.get(n.name)
-        if i is not None and vars_[i].kind == M.LOCAL and i in consts:
-            res.used.add(i)
-            return F64MODE.read(vars_[i].type, consts[i])
     # Counted on `error_count`: `errors` builds a list, and one per window
     # made many windows with errors quadratic.
     reported = res.diags.error_count

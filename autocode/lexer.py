@@ -24,7 +24,7 @@ class Tok(NamedTuple):
 
 
 # One token, with the blanks before it (a line's blanks are no token). No
-# two kinds start alike, so they are tried most common first.
+# two kinds match at the same place, so they are tried most common first.
 _BLANKS = r"[ \t\f\v\r]*"
 _TOKEN = re.compile(_BLANKS + r"""(?:
     (?P<id>[A-Za-z_][A-Za-z0-9_]*)

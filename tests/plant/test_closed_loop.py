@@ -95,7 +95,9 @@ def test_nominal_flight_passes_every_check(flights, seed):
     # the link was clean, and the plant really ran at 1 kHz in lock-step
     s = fl.run.session
     assert s.stats.lost == 0 and s.deframer.stats.crc_errors == 0 and s.hello["schema_ok"]
-    assert fl.run.steps == fl.run.round_trips == round(fl.run.sim_s * 1000)
+    assert fl.run.steps == round(fl.run.sim_s * 1000)
+    # several steps to a write while nothing the board says can change them (test_speculative_steps.py)
+    assert fl.run.round_trips < fl.run.steps / 8
 
 
 def test_the_pins_the_firmware_drives_deploy_the_chutes(flights):

@@ -1,10 +1,11 @@
 """The lock-step loop: the firmware on the simulated board (fswkit.sim.board)
 and a plant scenario advance together at the scenario's rate. Each step is
-one `SimBoard.batch` — one command and one pipe round trip: the sensors'
-volts, the digital parts' raw counts and the switch levels that changed, a
-run to the step's last cycle, the
-pyro/valve pins' edges and the UART's bytes — then the plant integrates the
-same interval with the pins as they were, to the cycle. The UART's bytes go through the ground's decoder
+one `batch` line: the sensors' volts, the digital parts' raw counts and the
+switch levels that changed, a run to the step's last cycle, the pyro/valve
+pins' edges and the UART's bytes — then the plant integrates the same
+interval with the pins as they were, to the cycle. Up to SPECULATE steps go
+to the board in one write, worked out ahead (see SPECULATE), with the same
+flight as a step at a time. The UART's bytes go through the ground's decoder
 (fswkit.link.Session), as `fsw monitor` decodes them, and into a link log
 of the same format."""
 
@@ -24,6 +25,14 @@ from fswkit.sim.board import RESET_CAUSES, EdgeOverflow, SimBoard, SimError
 from fswkit.sim.sensors import PartFeed, board_parts, part_name
 
 RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
+
+# Plant steps one write to the board may carry. The plant works their inputs out ahead as if the
+# firmware's outputs stayed as they are; the board runs them in turn and stops after a step in which a
+# watched pin changed or the mission machine's state element did (`SimBoard.batches`), and the plant
+# is worked out again from the write's start as far as the board went. Only while telemetry shows the
+# state the firmware is in, no reset is due and the scenario can tell ahead when the run ends
+# (`would_end`): so a flight is the same, step for step, as one sent a step at a time.
+SPECULATE = 16
 
 
 class CosimError(Exception):
@@ -285,6 +294,39 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             b.watch(pin)
         k = 0
         t1 = 0.0
+        finished = False
+        spec, fw_state = _guard(b, scenario, layout), None
+
+        def changed_inputs(analog, digital):
+            """(set_analog, set_digital, set_parts): what of the inputs (`analog`, `digital` and the
+            scenario's parts' values) changed since last sent; last_mv, last_din and last_raw follow."""
+            set_parts = {}  # the parts' raw counts that changed
+            if feeds:
+                for part, values in scenario.part_values.items():
+                    known = feed_of.get(id(part))
+                    if known is None or known[0] is not part:
+                        known = feed_of[id(part)] = (part, feeds.get(part))
+                    feed = known[1]
+                    if feed is None:
+                        continue
+                    raw = feed.raw(**values)
+                    old = last_raw.get(feed.where, {})
+                    changed = {n: v for n, v in raw.items() if old.get(n) != v}
+                    if changed:
+                        last_raw[feed.where] = raw
+                        set_parts[feed.where] = changed
+            set_analog, set_digital = {}, {}  # the inputs that changed
+            for name, v in analog.items():
+                mv = _mv(v, vref)
+                if mv != last_mv[name]:
+                    last_mv[name] = mv
+                    set_analog[name] = v
+            for pin, level in digital.items():
+                if last_din.get(pin) != level:
+                    last_din[pin] = level
+                    set_digital[pin] = level
+            return set_analog, set_digital, set_parts
+
         # resets the scenario asks for: at a simulated second (`reset_at`: a study's brown-out), and
         # `reset_after_s` after telemetry first shows the mission machine in `reset_state`
         reset_at, at_cause, reset_state, state_cause, after_s = _reset_plan(scenario, telemetry)
@@ -314,59 +356,86 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     else:
                         b.part_fail(where[part], mode)
                     run.part_failures.append((t0, part_name(part), mode))
-            if k:
-                analog, digital = scenario.inputs(t0)
-            set_parts = {}  # the parts' raw counts that changed
-            if feeds:
-                for part, values in scenario.part_values.items():
-                    known = feed_of.get(id(part))
-                    if known is None or known[0] is not part:
-                        known = feed_of[id(part)] = (part, feeds.get(part))
-                    feed = known[1]
-                    if feed is None:
-                        continue
-                    raw = feed.raw(**values)
-                    old = last_raw.get(feed.where, {})
-                    changed = {n: v for n, v in raw.items() if old.get(n) != v}
-                    if changed:
-                        last_raw[feed.where] = raw
-                        set_parts[feed.where] = changed
-            set_analog, set_digital = {}, {}  # the inputs that changed
-            for name, v in analog.items():
-                mv = _mv(v, vref)
-                if mv != last_mv[name]:
-                    last_mv[name] = mv
-                    set_analog[name] = v
-            for pin, level in digital.items():
-                if last_din.get(pin) != level:
-                    last_din[pin] = level
-                    set_digital[pin] = level
-            k += 1
+            # How many steps this write carries: more than one only while nothing that the board's reply
+            # could change is due (see SPECULATE)
+            n = 1
+            if (spec is not None and reset_state is None and state_due is None and telemetry.reset_t is None
+                    and telemetry.last_state is not None and int(telemetry.last_state) == fw_state):
+                n = SPECULATE
+                for due in (reset_at, fail_plan[0][0] if fail_plan else None):
+                    if due is not None:
+                        n = next((i for i in range(1, n) if (k + i) / rate >= due), n)
+            saved = (scenario.save(), dict(last_mv), dict(last_din), dict(last_raw)) if n > 1 else None
+            state = run.transitions[-1][2] if run.transitions else None
+            steps, rows, first = [], [], (analog, digital)  # first: the inputs at 0 s, worked out before the loop
+            ahead = 0  # the steps the plant has been worked out for ahead of the board
+            for i in range(n):
+                kk = k + i
+                if kk:
+                    analog, digital = scenario.inputs(kk / rate)
+                steps.append(((kk + 1) * cycles,) + changed_inputs(analog, digital))
+                if i < n - 1:  # ahead of the board: the plant with the pins as they are
+                    scenario.advance(kk / rate, (kk + 1) / rate, ())
+                    rows.append(scenario.record() if (kk + 1) % record_every == 0 else None)
+                    ahead = i + 1
+                    if scenario.would_end((kk + 1) / rate, state):  # the run ends with this step
+                        n = i + 1
+                        break
             try:
-                step = b.batch(k * cycles, set_analog, set_digital, set_parts)
+                results = [b.batch(*steps[0])] if n == 1 else b.batches(steps)
             except EdgeOverflow:
                 raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to "
                                  "watch") from None
             run.round_trips += 1
-            if step.run.stop != "target":
-                raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {t0:.3f} s simulated")
-            t1 = k / rate
-            edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges] if step.edges else ()
-            for ev in scenario.advance(t0, t1, edges):
-                run.pin_events.append(ev)
-            if step.uart:
-                telemetry.feed(step.uart, t1)
-                if reset_state is not None:
-                    for tt, _sid, name in run.transitions[seen:]:
-                        if name == reset_state:  # the first time only
-                            state_due, reset_state = tt + after_s, None
-                            break
-                    seen = len(run.transitions)
-            if k % record_every == 0:
-                run.rows.append(scenario.record())
-            state = run.transitions[-1][2] if run.transitions else None
-            bar.update(t1, state=state or "-")
-            if scenario.done(t1, state):
+            ran = next((i for i, r in enumerate(results) if r is None), n)  # the steps the board ran
+            for i in range(ran):
+                step = results[i]
+                t0 = k / rate
+                if step.run.stop != "target":
+                    raise CosimError(f"{stop_words(step.run.stop, wall_limit)} at {t0:.3f} s simulated")
+                k += 1
+                t1 = k / rate
+                if spec is not None:
+                    fw_state = int.from_bytes(step.guard, "little")
+                edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges] if step.edges else ()
+                if i >= ahead:  # the last step sent: the plant was not worked out ahead for it
+                    for ev in scenario.advance(t0, t1, edges):
+                        run.pin_events.append(ev)
+                    row = scenario.record() if k % record_every == 0 else None
+                elif i == ran - 1 and (edges or ran < n):  # the board stopped early (an edge, a state change;
+                    # the plant has taken the next step's inputs): the plant again from the write's start, as
+                    # far as the board went, this step with its edges
+                    plant, last_mv, last_din, last_raw = (saved[0], dict(saved[1]), dict(saved[2]),
+                                                          dict(saved[3]))
+                    scenario.restore(plant)
+                    for j in range(ran):
+                        kk = k - ran + j
+                        analog, digital = scenario.inputs(kk / rate) if kk else first
+                        changed_inputs(analog, digital)
+                        for ev in scenario.advance(kk / rate, (kk + 1) / rate, edges if j == ran - 1 else ()):
+                            run.pin_events.append(ev)
+                    row = scenario.record() if k % record_every == 0 else None
+                else:
+                    row = rows[i]
+                if step.uart:
+                    telemetry.feed(step.uart, t1)
+                    if reset_state is not None:
+                        for tt, _sid, name in run.transitions[seen:]:
+                            if name == reset_state:  # the first time only
+                                state_due, reset_state = tt + after_s, None
+                                break
+                        seen = len(run.transitions)
+                if row is not None:
+                    run.rows.append(row)
+                state = run.transitions[-1][2] if run.transitions else None
+                bar.update(t1, state=state or "-")
+                if scenario.done(t1, state):
+                    if i != ran - 1:
+                        raise CosimError(f"internal error: the run ended at {t1:.3f} s simulated, inside steps the "
+                                         "board had already run ahead")
+                    finished = True
+                    break
+            if finished:
                 break
         run.steps = k
         run.sim_s = t1
@@ -395,6 +464,26 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         if log:
             log.close()
     return run
+
+
+def _guard(b: SimBoard, scenario, layout: Layout):
+    """Guards the state element's bytes on the board for speculative steps
+    (SPECULATE) and returns its (address, size); None when the scenario
+    cannot take them back (no save, restore and would_end) or the firmware
+    has no state vector to watch."""
+    if not all(hasattr(scenario, f) for f in ("save", "restore", "would_end")):
+        return None
+    el = next((e for e in layout.elements if e.name == scenario.state_element), None)
+    if el is None or el.size > 8:
+        return None
+    try:
+        addr, size = b.symbol("fsw_gen::sv")
+    except SimError:
+        return None
+    if el.offset + el.size > size:
+        return None
+    b.guard(addr + el.offset, el.size)
+    return addr + el.offset, el.size
 
 
 def _ram_seed(seed) -> int:

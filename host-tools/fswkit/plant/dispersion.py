@@ -280,7 +280,7 @@ def apply(sc, d: Draw) -> None:
         return
     inputs = sc.inputs
     vref = sc.vref
-    held: dict = {}  # part -> its values when a dropout started
+    held = sc.dropout_held  # part -> its values when a dropout started (the scenario's: saved with it)
 
     def dispersed_inputs(t: float):
         analog, digital = inputs(t)

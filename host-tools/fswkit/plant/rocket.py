@@ -87,6 +87,17 @@ class Rocket:
         self.apogee_h, self.apogee_t = 0.0, None
         self.wind = None  # t -> the air's vertical velocity, m/s up (gusts: dispersion studies); None: still air
 
+    def save(self) -> tuple:
+        """What `ignite`, `deploy` and `advance` change, for `restore` (a
+        co-simulation's speculative steps)."""
+        return (self.t, self.h, self.v, self.a, self.ignition, self.liftoff, self.touchdown, dict(self.deployed),
+                self.apogee_h, self.apogee_t)
+
+    def restore(self, saved: tuple) -> None:
+        (self.t, self.h, self.v, self.a, self.ignition, self.liftoff, self.touchdown, deployed,
+         self.apogee_h, self.apogee_t) = saved
+        self.deployed = dict(deployed)
+
     # -- inputs --
     def ignite(self, t: float) -> None:
         if self.ignition is None:

@@ -263,6 +263,12 @@ class Noise:
         self.buf: list[float] = []
         self.i = 0
 
+    def save(self) -> tuple:
+        return self.buf, self.i, self.rng.bit_generator.state  # buf is replaced, never changed in place
+
+    def restore(self, saved: tuple) -> None:
+        self.buf, self.i, self.rng.bit_generator.state = saved
+
     def __call__(self) -> float:
         if not self.sigma:
             return 0.0
@@ -622,6 +628,7 @@ class RocketScenario:
         self.ignition_s = None if fault in PAD_FAULTS else sc["ignition_s"]
         self.max_s = sc["hold_s"] if self.ignition_s is None else sc["max_s"]
         self.frozen_baro: float | None = None
+        self.dropout_held: dict = {}  # a dispersion's dropouts: part -> its values when the dropout started
         self.landed_seen: float | None = None
         self.t = 0.0
         self.baro_v = self.accel_v = 0.0
@@ -771,6 +778,28 @@ class RocketScenario:
                                 {"altitude": h0 + (r.h - h0) * f, "velocity": v0 + (r.v - v0) * f}))
         return out
 
+    # -- speculative steps (fswkit.plant.cosim): what inputs() and advance() change --
+    def save(self) -> tuple:
+        return (self.rocket.save(), tuple((q.high_since, q.fired_at) for q in self.pyros.values()),
+                dict(self.levels), dict(self.cont_v),
+                self.baro_noise.save(), self.accel_noise.save(), self.noisy_noise.save(), set(self.noisy_parts),
+                self.part_values, self.frozen_baro, self.landed_seen, self.t, self.baro_v, self.accel_v, self.arm,
+                dict(self.dropout_held))
+
+    def restore(self, saved: tuple) -> None:
+        (rocket, pyros, levels, cont_v, baro_n, accel_n, noisy_n, noisy_parts, self.part_values, self.frozen_baro,
+         self.landed_seen, self.t, self.baro_v, self.accel_v, self.arm, held) = saved
+        self.rocket.restore(rocket)
+        for q, (high_since, fired_at) in zip(self.pyros.values(), pyros):
+            q.high_since, q.fired_at = high_since, fired_at
+        self.levels, self.cont_v = dict(levels), dict(cont_v)
+        self.baro_noise.restore(baro_n)
+        self.accel_noise.restore(accel_n)
+        self.noisy_noise.restore(noisy_n)
+        self.noisy_parts = set(noisy_parts)
+        self.dropout_held.clear()
+        self.dropout_held.update(held)
+
     def record(self) -> tuple:
         r, t = self.rocket, self.t
         return (round(t, 6), r.h, r.v, r.a, r.specific_force() / G0, r.static_pressure(), r.mass(t), r.thrust(t),
@@ -779,14 +808,20 @@ class RocketScenario:
                 self.baro_v, self.accel_v) + tuple(self.cont_v.values())
 
     def done(self, t: float, state: str | None) -> bool:
+        if state == self.p["firmware"]["landed_state"] and self.landed_seen is None and self.ignition_s is not None:
+            self.landed_seen = t
+        return self.would_end(t, state)
+
+    def would_end(self, t: float, state: str | None) -> bool:
+        """done(t, state) without its side effect: whether the run ends at
+        `t` with telemetry showing `state`."""
         if t >= self.max_s:
             return True
         if self.ignition_s is None:
             return False
         if state == self.p["firmware"]["landed_state"]:
-            if self.landed_seen is None:
-                self.landed_seen = t
-            return t >= self.landed_seen + self.p["scenario"]["linger_s"]
+            seen = t if self.landed_seen is None else self.landed_seen
+            return t >= seen + self.p["scenario"]["linger_s"]
         td = self.rocket.touchdown
         return td is not None and t >= td + self.p["scenario"]["landed_timeout_s"]
 
@@ -861,16 +896,30 @@ class TankScenario:
         self.t = t1
         return out
 
+    # -- speculative steps (fswkit.plant.cosim): what inputs() and advance() change --
+    def save(self) -> tuple:
+        return self.tank.save(), self.noise.save(), self.valve, self.abort_seen, self.t, self.volts
+
+    def restore(self, saved: tuple) -> None:
+        tank, noise, self.valve, self.abort_seen, self.t, self.volts = saved
+        self.tank.restore(tank)
+        self.noise.restore(noise)
+
     def record(self) -> tuple:
         tk, t = self.tank, self.t
         return (round(t, 6), tk.gauge_psi, tk.pressure, tk.mass, tk.inflow * 1000, tk.outflow * 1000,
                 int(t >= self.p["scenario"]["failure_s"]), int(self.valve), tk.valve, self.volts)
 
     def done(self, t: float, state: str | None) -> bool:
+        if state == self.p["firmware"]["abort_state"] and self.abort_seen is None:
+            self.abort_seen = t
+        return self.would_end(t, state)
+
+    def would_end(self, t: float, state: str | None) -> bool:
+        """done(t, state) without its side effect."""
         if t >= self.max_s:
             return True
         if state == self.p["firmware"]["abort_state"]:
-            if self.abort_seen is None:
-                self.abort_seen = t
-            return t >= self.abort_seen + self.p["scenario"]["linger_s"]
+            seen = t if self.abort_seen is None else self.abort_seen
+            return t >= seen + self.p["scenario"]["linger_s"]
         return False

@@ -29,6 +29,13 @@ class Tank:
         self._critical = (2.0 / (g + 1.0)) ** (g / (g - 1.0))  # p_out/p_in at which the flow chokes
         self._choked = math.sqrt(g / self.rt) * (2.0 / (g + 1.0)) ** ((g + 1.0) / (2.0 * (g - 1.0)))
 
+    def save(self) -> tuple:
+        """What `advance` changes, for `restore` (a co-simulation's speculative steps)."""
+        return self.mass, self.t, self.valve, self.inflow, self.outflow
+
+    def restore(self, saved: tuple) -> None:
+        self.mass, self.t, self.valve, self.inflow, self.outflow = saved
+
     @property
     def pressure(self) -> float:
         """Pa, absolute."""

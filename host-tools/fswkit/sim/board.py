@@ -258,6 +258,7 @@ class Batch(NamedTuple):
     run: RunResult
     edges: list[Edge]
     uart: bytes
+    guard: bytes = b""  # the guarded RAM bytes after the run (`guard`), when any are
 
 
 @dataclass(frozen=True)
@@ -521,7 +522,33 @@ class SimBoard:
         the watched pins' edges and the UART's bytes since the last read
         (what `set_analog`s, `set_digital`s, `part_raw`s, `until`, `edges`
         and `uart_read` do in turn)."""
-        line = f"batch {int(until)}"
+        self._send(self._batch_line("batch", until, analog, digital, parts))
+        return self._batch_result(self._read())
+
+    def batches(self, steps: list[tuple]) -> list[Batch | None]:
+        """Several lock-steps in one write, their inputs worked out ahead:
+        `steps` is a list of `batch`'s arguments, (until, analog, digital,
+        parts). The first runs as `batch` does; each later one runs only if
+        no step before it in the list saw a watched pin's edge, a change of
+        the guarded RAM bytes (`guard`) or a stop short of its cycle, and is
+        None otherwise (the board did nothing for it). A co-simulation whose
+        plant reacts to the firmware's outputs works its plant out again
+        from the last step run."""
+        self._send("".join(self._batch_line("batch?" if i else "batch", *step) for i, step in enumerate(steps)))
+        lines = [self._read_line() for _ in steps]  # every response, so the channel stays in step
+        for line in lines:
+            if line.startswith("err"):
+                raise SimError(line[4:])
+        return [None if line == "skip" else self._batch_result(line) for line in lines]
+
+    def guard(self, addr: int, size: int) -> None:
+        """RAM bytes (data addresses, up to 8; size 0: none) whose change ends
+        a `batches` run after the step that changed them; each step's
+        `Batch.guard` holds their value after it."""
+        self.command(f"guard {int(addr)} {int(size)}")
+
+    def _batch_line(self, word: str, until: int, analog=None, digital=None, parts=None) -> str:
+        line = f"{word} {int(until)}"
         if analog:
             for p, v in analog.items():
                 line += f" {self.adc_channel(p)}={self._millivolts(v)}"
@@ -533,14 +560,19 @@ class SimBoard:
             for where, values in parts.items():
                 if values:
                     line += f" @{_part_id(where)}:" + ",".join(f"{k}={int(v)}" for k, v in values.items())
-        # `ok cycle=C time=S state=ST stop=R uart=HEX n=K overflow=F EDGE...`, read
+        return line + "\n"
+
+    def _batch_result(self, text: str) -> Batch:
+        # `ok cycle=C time=S state=ST stop=R uart=HEX n=K overflow=F EDGE... [guard=HEX]`, read
         # by position: one step of a co-simulation, kept cheap
-        self._send(line + "\n")
-        toks = self._read().split(" ")
+        toks = text.split(" ")
         self.cycle = int(toks[1][6:])
         run = RunResult(self.cycle, float(toks[2][5:]), toks[3][6:], toks[4][5:])
+        guard = b""
+        if toks[-1].startswith("guard="):
+            guard = bytes.fromhex(toks.pop()[6:])
         edges = self._edges(toks[7:]) if toks[6] != "n=0" or toks[7] != "overflow=0" else []
-        return Batch(run, edges, bytes.fromhex(toks[5][5:]))
+        return Batch(run, edges, bytes.fromhex(toks[5][5:]), guard)
 
     def reset(self, cause: str = "brownout") -> None:
         """Resets the MCU for `cause`, one of RESET_CAUSES: "brownout" (the

@@ -1721,14 +1721,41 @@ static int batch_part(char* word, int apply, part_t** bad_part) {
     return 0;
 }
 
+/* Speculative lock-steps (`batch?`): a co-simulation may send several steps
+   in one write, their inputs worked out ahead as if the firmware's outputs
+   stayed as they were. A `batch?` runs only while no step since the last
+   plain `batch` has seen a watched pin's edge or a change of the guarded
+   RAM bytes (`guard`); else it answers `skip` and changes nothing, so the
+   caller can work the plant out again from the last step run. */
+static int spec_stopped;
+static uint16_t guard_addr;
+static uint8_t guard_len;
+
+static int cmd_guard(int argc, char** argv) {
+    unsigned long long a, n;
+    if (argc != 3 || parse_u64(argv[1], &a) || parse_u64(argv[2], &n) || n > 8 || (n && (a < 0x20 || a + n - 1 > avr->ramend)))
+        return fail("usage: guard ADDR LEN (RAM bytes a `batch?` watches, LEN 0-8, 0: none)");
+    guard_addr = (uint16_t)a;
+    guard_len = (uint8_t)n;
+    fprintf(proto, "ok\n");
+    return 1;
+}
+
 /* One lock-step of a co-simulation: inputs set in the order given, a run to
    absolute cycle C, then the run's result, the UART's bytes and the edges:
    what `adc`..., `din`..., `part ID raw`..., `until C`, `uart`, `edges` do,
-   in one line. */
+   in one line; ` guard=HEX` at its end when RAM bytes are guarded. `batch?`
+   is the same step, run only as the comment above `spec_stopped` says. */
 static int cmd_batch(int argc, char** argv) {
-    static const char usage[] = "usage: batch CYCLE [CH=MV]... [PB=0|1]... [@ID:NAME=V[,NAME=V]...]... "
+    static const char usage[] = "usage: batch[?] CYCLE [CH=MV]... [PB=0|1]... [@ID:NAME=V[,NAME=V]...]... "
                                 "(ADC channel 0-15, port A-L bit 0-7, a part's I2C address or SPI chip-select pin)";
     unsigned long long target, v;
+    const int speculative = argv[0][5] == '?';
+    if (speculative && spec_stopped) {
+        fprintf(proto, "skip\n");
+        return 1;
+    }
+    spec_stopped = 0;
     if (argc < 2 || parse_u64(argv[1], &target)) return fail("%s", usage);
     for (int i = 2; i < argc; i++) { /* all checked before any is applied */
         if (argv[i][0] == '@') {
@@ -1773,10 +1800,18 @@ static int cmd_batch(int argc, char** argv) {
             drive_pin(avr, argv[i][0], (uint8_t)v, (uint32_t)value);
         }
     }
-    put_run(run_until(1, target, 0, 0));
+    uint8_t before[8];
+    memcpy(before, avr->data + guard_addr, guard_len);
+    const char* why = run_until(1, target, 0, 0);
+    put_run(why);
     fputs(" uart=", proto);
     put_uart();
+    if (strcmp(why, "target") || n_edges || edges_overflow || memcmp(before, avr->data + guard_addr, guard_len)) spec_stopped = 1;
     put_edges();
+    if (guard_len) {
+        fputs(" guard=", proto);
+        hex_out(avr->data + guard_addr, guard_len);
+    }
     fputc('\n', proto);
     return 1;
 }
@@ -2268,7 +2303,7 @@ static const struct {
     {"watch", cmd_watch}, {"edges", cmd_edges}, {"uart", cmd_uart},   {"send", cmd_send},
     {"peek", cmd_peek},   {"stop", cmd_stop},   {"reset", cmd_reset}, {"prof", cmd_prof},
     {"eeprom", cmd_eeprom}, {"flash", cmd_flash}, {"sched", cmd_sched}, {"part", cmd_part},
-    {"quit", cmd_quit},
+    {"batch?", cmd_batch}, {"guard", cmd_guard}, {"quit", cmd_quit},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 

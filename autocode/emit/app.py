@@ -325,10 +325,14 @@ def _app_cpp(app: Application) -> str:
                  + (" and writes\n// the next parameter, image or record byte to the EEPROM when it is ready."
                     if params or app.log is not None or app.reload is not None else "."))
         c.append("void poll() {")
+        busy = ([("fsw::link_busy(link)")] if has_link else []) + (["fsw::param_busy(params)"] if params else []) \
+            + (["fsw::reload_writing(reload)"] if app.reload is not None else []) \
+            + (["fsw::log_busy(rec)"] if app.log is not None else [])
+        c.append(f"    const bool background = {' || '.join(busy)};  // else the CPU sleeps on until the cycle")
         if resumes(app):
-            c.append("    if (fsw::executor_poll(ex)) fsw::resume_save(resume);  // the cycle's state, kept")
+            c.append("    if (fsw::executor_poll(ex, background)) fsw::resume_save(resume);  // the cycle's state, kept")
         else:
-            c.append("    (void)fsw::executor_poll(ex);")
+            c.append("    (void)fsw::executor_poll(ex, background);")
         if has_link:
             c.append("    fsw::link_poll(link);")
         if params:
@@ -340,8 +344,8 @@ def _app_cpp(app: Application) -> str:
         c.append("}")
     else:
         c.append("// Runs a cycle when one is due.")
-        c.append("void poll() { if (fsw::executor_poll(ex)) fsw::resume_save(resume); }" if resumes(app)
-                 else "void poll() { (void)fsw::executor_poll(ex); }")
+        c.append("void poll() { if (fsw::executor_poll(ex, false)) fsw::resume_save(resume); }" if resumes(app)
+                 else "void poll() { (void)fsw::executor_poll(ex, false); }")
     c.append("// Runs one cycle now (hosts: simulations and tests).")
     c.append("void run_cycle() { fsw::executor_run_cycle(ex);" + (" fsw::resume_save(resume);" if resumes(app) else "")
              + " }")

@@ -117,9 +117,9 @@ inline void count(uint16_t& n, uint8_t by) {
 }
 }  // namespace
 
-bool executor_poll(Executor& ex) {
+bool executor_poll(Executor& ex, bool background) {
     uint8_t skipped;
-    const uint8_t why = pal::cycle_wait(skipped);
+    const uint8_t why = pal::cycle_wait(skipped, background);
     if (why == pal::kCycleNotDue) return false;
     if (why != pal::kCycleOnTime) {
         count(ex.late, 1);
@@ -131,7 +131,7 @@ bool executor_poll(Executor& ex) {
     return true;
 }
 #else
-bool executor_poll(Executor& ex) {
+bool executor_poll(Executor& ex, bool) {
     // On 32 bits, wrap-safe: the due time is never more than a period ahead,
     // so the signed difference tells "not yet" from "late by so much" for
     // any lateness under 2^31 us (35.8 minutes; the watchdog resets an AVR

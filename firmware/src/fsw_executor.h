@@ -100,7 +100,9 @@ void executor_run_cycle(Executor& ex);
 // (missed cycles are skipped, not run in a burst); compared wrap-safe, the
 // due time never more than a period ahead, so a poll may come up to 2^31 us
 // (35.8 minutes) late.
-bool executor_poll(Executor& ex);
+// `background`: whether the main loop has work between cycles (the
+// sleeping executor then returns after any interrupt; pal::cycle_wait).
+bool executor_poll(Executor& ex, bool background = true);
 
 // The configuration the executor runs (a copy of its FSW_FLASH object).
 ExecConfig executor_config(const Executor& ex);

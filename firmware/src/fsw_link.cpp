@@ -451,6 +451,10 @@ Result link_uplink_task(void* p) {
     return kOk;
 }
 
+bool link_busy(const Link& l) {
+    return l.cfg != 0 && (l.tx_len != 0 || l.pending != 0 || l.snapshot_at != kNoSnapshot);
+}
+
 void link_poll(Link& l) {
     if (l.cfg == 0) return;
     pump(l);

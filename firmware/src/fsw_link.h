@@ -215,6 +215,9 @@ Result link_uplink_task(void* link);
 // health frames only here, never in a task's step) and feeds the transmit
 // buffer to the console as it drains.
 void link_poll(Link& link);
+// Whether link_poll has work: frames in the transmit buffer, control frames
+// or a snapshot waiting (the sleeping executor wakes the main loop for it).
+bool link_busy(const Link& link);
 // A parameter command (kOpParamGet..kOpParamInfo) on the store, and what its
 // acknowledgement carries after its 6 bytes (GET's values, INFO's state,
 // the id a refusal stopped at).

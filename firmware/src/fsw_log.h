@@ -149,6 +149,8 @@ Result log_task(void* recorder);
 // from loop() between cycles.
 void log_eeprom_poll(Recorder& r);
 void log_nor_poll(Recorder& r);
+// Whether the writer has bytes to put into the store (either store).
+bool log_busy(const Recorder& r);
 // The store's entry points, chosen where log_nor_cs is known: the generated
 // code, which defines it, calls these, so the compiler drops the other
 // store's calls before the link (LTO alone does not fold the constant away).

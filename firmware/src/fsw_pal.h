@@ -41,10 +41,14 @@ enum CycleWait : uint8_t {
 // Starts the timer that paces cycles of `period_us` (1..1000000, a divisor
 // of 1000000) and keeps the clock from then on; the first cycle is due at once.
 void cycle_timer_begin(uint32_t period_us);
-// Sleeps until the next cycle is due or another interrupt wakes the CPU.
+// Sleeps until the next cycle is due, or, when `background` (the main loop
+// has work between cycles: the link's transmit buffer, an EEPROM writer),
+// until any interrupt wakes the CPU (kCycleNotDue then). Without background
+// work the CPU sleeps on through the other interrupts (the UART's transmit,
+// the ADC's scan): each would otherwise run the main loop for nothing.
 // A cycle that is due returns with interrupts on, marked as running until
 // cycle_end(); `skipped` counts the cycles whose start passed unserved.
-uint8_t cycle_wait(uint8_t& skipped);
+uint8_t cycle_wait(uint8_t& skipped, bool background = true);
 // The cycle cycle_wait() started has ended.
 void cycle_end();
 #endif

@@ -347,6 +347,8 @@ uint8_t param_count(const ParamStore& s) { return config(s).n; }
 
 uint16_t param_crc(const ParamStore& s) { return live_crc(config(s), kCrcInit); }
 
+bool param_busy(const ParamStore& s) { return s.w_job != kIdle && s.cfg != 0; }
+
 void param_poll(ParamStore& s) {
     if (s.w_job == kIdle || s.cfg == 0 || !pal::eeprom_ready()) return;
     const ParamConfig c = config(s);

@@ -119,6 +119,8 @@ uint16_t param_crc(const ParamStore& s);
 // ready and a job is under way. Called from loop() between cycles (and on
 // the EEPROM-ready interrupt's wake-up).
 void param_poll(ParamStore& s);
+// Whether param_poll has a job under way.
+bool param_busy(const ParamStore& s);
 
 }  // namespace fsw
 

@@ -124,6 +124,7 @@ uint8_t reload_write(ReloadStore& s, uint16_t off, const uint8_t* data, uint8_t 
 uint8_t reload_commit(ReloadStore& s, uint8_t& reason);
 uint8_t reload_activate(ReloadStore& s, uint8_t which);
 // Whether the background writer has bytes to write.
+// (reload_poll's work: the main loop is woken for it between cycles.)
 bool reload_writing(const ReloadStore& s);
 
 // The background writer: writes the next EEPROM byte if the EEPROM is ready

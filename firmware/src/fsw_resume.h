@@ -58,7 +58,7 @@ struct Resume {
 bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause);
 // Copies the spans into the older bank, then its sequence number, then its
 // check: a reset part way through leaves that bank invalid and the other one
-// whole. About 30 cycles a byte on AVR.
+// whole. About 9 cycles a byte on AVR.
 FSW_NOINLINE void resume_save(Resume& r);
 // The newest whole bank: 0 or 1, or -1 when neither is (tests, the link).
 int8_t resume_newest(const ResumeConfig* cfg);

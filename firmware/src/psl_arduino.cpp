@@ -166,7 +166,7 @@ void cycle_timer_begin(uint32_t period_us) {
     critical_exit(saved);
 }
 
-uint8_t cycle_wait(uint8_t& skipped) {
+uint8_t cycle_wait(uint8_t& skipped, bool background) {
     for (uint8_t pass = 0;; ++pass) {
         cli();
         if (g_ct.due != 0) {  // a start passed (late), or the first cycle
@@ -189,7 +189,7 @@ uint8_t cycle_wait(uint8_t& skipped) {
             sei();
             return kCycleOnTime;
         }
-        if (pass != 0 || g_ct.spin) {
+        if ((pass != 0 && background) || g_ct.spin) {
             sei();
             return kCycleNotDue;
         }

@@ -12,6 +12,7 @@ target.
     tools/bench_firmware.py            # everything
     tools/bench_firmware.py rocket     # the rocket's footprint only
     tools/bench_firmware.py sensors    # the sensor drivers' flash and RAM only
+    tools/bench_firmware.py core       # the rocket without what came after its size target
 """
 
 from __future__ import annotations
@@ -271,6 +272,56 @@ def pyro_cost() -> tuple[tuple[int, int], tuple[int, int]]:
     return sizes[0], sizes[1]
 
 
+def without_later_features(folder: str) -> None:
+    """Turns the copy of examples/rocket in `folder` into the rocket as the
+    speed-and-scale target measured it (10,400 B, 2026-11-23), before the
+    flight recorder, the parameters and the pyro channels came: no [log]
+    (and no recorder task), no [pyro], the [parameters] as [local]
+    constants of the same values."""
+    app = os.path.join(folder, "rocket.app")
+    text = open(app).read()
+    text = text[:text.index("[pyro]")]
+    text = re.sub(r"(?m)^log\s+recorder\b.*\n", "", text)
+    text = re.sub(r"\n\[log\].*?(?=\n\[)", "\n", text, flags=re.S)
+    open(app, "w").write(text)
+    sm = os.path.join(folder, "mission.sm")
+    text = open(sm).read()
+    start = text.index("[parameters]")
+    end = text.index("\n[", start + 1)
+    consts = re.sub(r"@\w+\s+\S+", "", text[start + len("[parameters]"):end]).strip("\n")
+    text = text[:start] + text[end + 1:]
+    local_end = text.index("\n[", text.index("[local]") + 1)
+    open(sm, "w").write(text[:local_end] + "\n" + consts + "\n" + text[local_end:])
+
+
+def core_size() -> tuple[int, int]:
+    """(flash, RAM: .data + .bss + .noinit) of examples/rocket without what
+    came after the target was set (without_later_features)."""
+    import shutil
+    import tempfile
+
+    from fswkit.sim.command import build as build_for_sim
+
+    with tempfile.TemporaryDirectory(prefix="fsw-bench-core-") as tmp:
+        proj = os.path.join(tmp, "rocket")
+        shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
+        without_later_features(proj)
+        built = build_for_sim(proj, "uno", os.path.join(tmp, "out"))
+        if isinstance(built, int):
+            sys.exit("bench: building the rocket without its recorder, parameters and pyro channels failed")
+        flash, ram = elf_size(built[0])
+        return flash, ram + elf_noinit(built[0])
+
+
+def print_core_size() -> None:
+    flash, ram = core_size()
+    print()
+    print("the rocket as the 8 KB target measured it (10,400 B flash, 727 B static RAM, 2026-11-23): without the "
+          "flight recorder, the parameters and the pyro channels that came after")
+    print(f"  flash {flash:,} B (target <= {TARGET['flash']:,} B: {'ok' if flash <= TARGET['flash'] else 'MISSED'}), "
+          f"static RAM {ram:,} B (.data + .bss + .noinit; with the stack against the {TARGET['ram']} B target)")
+
+
 def print_pyro_cost() -> None:
     (f1, r1), (f0, r0) = pyro_cost()
     print()
@@ -347,6 +398,9 @@ def main() -> int:
     if sys.argv[1:] == ["pyro"]:
         print_pyro_cost()
         return 0
+    if sys.argv[1:] == ["core"]:
+        print_core_size()
+        return 0
     if sys.argv[1:] == ["sensors"]:
         print_sensor_costs()
         return 0
@@ -364,6 +418,7 @@ def main() -> int:
     for name, ref, target, got, ok in rows:
         print(f"{name:<55} {ref:>10} {target:>12} {got:>10}  {'ok' if ok else 'MISSED'}")
     print_rocket(rocket_footprint())
+    print_core_size()
     print_pyro_cost()
     print_sensor_costs()
     return 0

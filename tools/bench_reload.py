@@ -87,8 +87,8 @@ def main() -> int:
     print(f"  flash {tank.size.flash:,} -> {stand.size.flash:,} B (+{df:,}: the VM, its EEPROM verifier, the store "
           f"and its link commands)")
     print(f"  static RAM {tank.size.ram:,} -> {stand.size.ram:,} B (+{dr:,}: the image buffer of "
-          f"{stand_app.reload.size} B, {stand_app.reload.ram} B for an image's windows and locals, the layout "
-          f"table, the store)")
+          f"{stand_app.reload.size} B, {stand_app.reload.ram} B for an image's windows and locals, the "
+          f"layout's record (its element table is in flash), the store)")
     print(f"  targets (the VM alone, tools/bench_vm.py): flash <= 3,072 B, RAM <= 64 B beyond the state vector")
 
     d = Diagnostics()

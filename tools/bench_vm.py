@@ -25,6 +25,15 @@ from fswkit.autocode.numeric import F32MODE  # noqa: E402
 from fswkit.autocode.vmverify import TYPE_CODES  # noqa: E402
 
 
+def sv_bytes() -> int:
+    """Bytes of the tank's state vector."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.project import load_machine
+
+    m = load_machine(os.path.join(ROOT, "examples", "tank", "tank.sm"), Diagnostics())
+    return max(e.offset + e.type.size for e in m.sv.elements)
+
+
 def image_header(folder: str) -> int:
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.project import load_machine
@@ -34,7 +43,7 @@ def image_header(folder: str) -> int:
     elems = ", ".join(f"{{{e.offset}, {TYPE_CODES[e.type.name]}}}" for e in m.sv.elements)
     with open(os.path.join(folder, "tank_image.h"), "w") as f:
         f.write(f"uint8_t kImage[] = {{{', '.join(str(b) for b in im)}}};\n"
-                f"const fsw::VmElem kElems[] = {{{elems}}};\n"
+                f"const fsw::VmElem kElems[] FSW_FLASH = {{{elems}}};\n"
                 f"const uint16_t kElemCount = {len(m.sv.elements)};\n"
                 f"const uint16_t kRam = {window_ram(m, F32MODE, idx_bytes=2, align=1)};\n")
     return len(im)
@@ -81,10 +90,13 @@ def main() -> int:
         print(f"tank step, {what:9} ATmega2560: avg {avg:,} cycles, worst {worst:,} (state {state})")
     vm_flash = s[2][0] - s[0][0] - size
     vm_ram = s[2][1] - s[0][1] - size
+    sv = sv_bytes()
+    beyond, gen_ram = vm_ram - sv, s[1][1] - s[0][1]
     print(f"VM against its targets: flash {vm_flash:,} B without the image (target <= 3,072: "
-          f"{'met' if vm_flash <= 3072 else 'MISSED'}), RAM {vm_ram:,} B (the tank's 60 B of state vector and "
-          f"windows among them; target <= 64 beyond the state vector), tank step {avgs[1] / avgs[0]:.1f}x the "
-          f"generated code's (target <= 3x: {'met' if avgs[1] <= 3 * avgs[0] else 'MISSED'})")
+          f"{'met' if vm_flash <= 3072 else 'MISSED'}), RAM {vm_ram:,} B: {beyond:,} B beyond the tank's {sv} B state "
+          f"vector (target <= 64: {'met' if beyond <= 64 else 'MISSED'}; the generated tank's machine, locals and "
+          f"state vector take {gen_ram} B, the VM {vm_ram - gen_ram:,} B more), tank step {avgs[1] / avgs[0]:.1f}x "
+          f"the generated code's (target <= 3x: {'met' if avgs[1] <= 3 * avgs[0] else 'MISSED'})")
     return 0
 
 

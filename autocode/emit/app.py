@@ -749,7 +749,7 @@ def _reload(app: Application) -> list[str]:
     return ["// ---- machines replaced at run time (docs/reload.md) ----",
             f"// {name}:{rl.line}: machine {m.name}; two slots of {rl.size} B in the EEPROM from byte {base} "
             f"({eeprom_bytes(rl.size)} B); another machine may take over in " + ", ".join(rl.activate),
-            f"const fsw::VmElem kReloadElems[{len(app.sv.elements)}] = {{{elems}}};  // RAM: the VM reads it",
+            f"const fsw::VmElem kReloadElems[{len(app.sv.elements)}] FSW_FLASH = {{{elems}}};",
             f"const fsw::VmLayout kReloadLayout = {{kReloadElems, {len(app.sv.elements)}, kSchemaHash}};",
             f"const uint8_t kReloadAllow[{len(mask)}] FSW_FLASH = {{{', '.join(f'0x{b:02x}' for b in mask)}}};"
             f"  // {' '.join(rl.activate)}",

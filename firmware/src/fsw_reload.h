@@ -46,7 +46,7 @@ struct ReloadConfig {
     uint8_t* image;          // RAM: the running image and its mask (size bytes)
     uint8_t* ram;            // RAM: the running image's windows and locals (ram_size bytes, aligned for Real)
     uint8_t* sv;             // the state vector
-    const VmLayout* layout;  // the state vector's layout (RAM: the VM reads it directly)
+    const VmLayout* layout;  // the state vector's layout (RAM; its element table FSW_FLASH)
     Machine* machine;        // the generated machine's record: the VM steps the same one
     ReloadStepFn step;       // the generated machine's step()
     ReloadLeaveFn leave;     // its leave(): the current state's .exit

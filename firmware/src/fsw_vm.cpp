@@ -244,7 +244,7 @@ VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
             case kConst: case kLdt: pushes = 1; break;
             case kLde: case kSte: {
                 const uint16_t e = r16(im, a);
-                if (e >= layout.count || layout.elems[e].type != im[a + 2u]) return kVmBadElement;
+                if (e >= layout.count || flash_get(layout.elems[e].type) != im[a + 2u]) return kVmBadElement;
                 if (op == kLde) pushes = 1; else pops = 1;
                 break;
             }
@@ -301,7 +301,8 @@ VmReason verify(const Im& im, uint16_t len, const VmLayout& layout, uint32_t ram
     offsets(im, p);
     if (p.total != len) return kVmBadSize;
     const uint16_t g = r16(im, 14), s = r16(im, 16);
-    if (g >= layout.count || s >= layout.count || layout.elems[g].type != kU64 || layout.elems[s].type != kU32)
+    if (g >= layout.count || s >= layout.count || flash_get(layout.elems[g].type) != kU64 ||
+        flash_get(layout.elems[s].type) != kU32)
         return kVmBadElement;
     if (p.states == 0) return kVmBadState;
     for (uint16_t k = 0; k < p.locals; ++k) {
@@ -460,7 +461,7 @@ uint32_t run_block(const Run& r, uint16_t pc) {
                 continue;
             case kConst: memcpy(&st[sp++], a, sizeof(Real)); pc = static_cast<uint16_t>(pc + 1u + sizeof(Real)); continue;
             case kLde: {
-                const uint8_t* e = r.sv + r.layout->elems[u16(a)].off;
+                const uint8_t* e = r.sv + flash_get(r.layout->elems[u16(a)].off);
                 if (r.lock) {
                     SvGuard<true> g;
                     st[sp++] = read_elem(e, a[2]);
@@ -471,7 +472,7 @@ uint32_t run_block(const Run& r, uint16_t pc) {
                 continue;
             }
             case kSte: {
-                uint8_t* e = r.sv + r.layout->elems[u16(a)].off;
+                uint8_t* e = r.sv + flash_get(r.layout->elems[u16(a)].off);
                 --sp;
                 if (r.lock) {
                     SvGuard<true> g;
@@ -541,8 +542,8 @@ void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv,
 Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     Run r;
     run_init(r, image, layout, sv, ram, m);
-    uint8_t* g = sv + layout.elems[u16(image + 14)].off;
-    uint8_t* s = sv + layout.elems[u16(image + 16)].off;
+    uint8_t* g = sv + flash_get(layout.elems[u16(image + 14)].off);
+    uint8_t* s = sv + flash_get(layout.elems[u16(image + 16)].off);
     if (r.lock) {  // as a generated step() over a locked state vector
         uint64_t now;
         {

@@ -39,7 +39,7 @@ struct VmElem {
 
 // The layout of the running firmware's state vector, in element order.
 struct VmLayout {
-    const VmElem* elems;
+    const VmElem* elems;  // FSW_FLASH table (read a field at a time)
     uint16_t count;
     uint32_t schema;  // the state vector's schema hash
 };

@@ -62,7 +62,7 @@ def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str, avr: bool = Fal
     if params:
         c.append("uint8_t prm[kPrmSize];")
     c += ["", "namespace {", "", f"const uint8_t kImage[] = {_bytes(image)};",
-          f"const fsw::VmElem kElems[] = {{{elems}}};",
+          f"const fsw::VmElem kElems[] FSW_FLASH = {{{elems}}};",
           f"const fsw::VmLayout kLayout = {{kElems, {len(m.sv.elements)}, kSchemaHash}};",
           f"alignas(8) uint8_t ram[{ram}];", "",
           "void to_vm() {", "    uint8_t* l = fsw::vm_locals(kImage, ram);"]

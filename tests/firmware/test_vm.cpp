@@ -11,7 +11,7 @@ void tearDown(void) {}
 namespace {
 
 // The state vector the images are bound to: G, S, x (F32), n (I16).
-const VmElem kElems[] = {{0, kU64}, {8, kU32}, {12, kF32}, {16, kI16}};
+const VmElem kElems[] FSW_FLASH = {{0, kU64}, {8, kU32}, {12, kF32}, {16, kI16}};
 const VmLayout kLayout = {kElems, 4, 0x12345678UL};
 uint8_t sv[18];
 alignas(8) uint8_t ram[128];

@@ -90,6 +90,17 @@ def main() -> int:
         print(f"tank step, {what:9} ATmega2560: avg {avg:,} cycles, worst {worst:,} (state {state})")
     vm_flash = s[2][0] - s[0][0] - size
     vm_ram = s[2][1] - s[0][1] - size
+    # what the VM probe's RAM holds beyond the bare sketch's, by symbol
+    ram_syms = {}
+    for i in (0, 2):
+        text = B.sh(["avr-nm", "-S", "-C", build(*uno, i, False, gen)]).stdout
+        ram_syms[i] = {m.group(3): int(m.group(2), 16)
+                       for m in re.finditer(r"^([0-9a-f]+) ([0-9a-f]+) [bBdD] (.*)$", text, re.M)}
+    extra = {k.replace("(anonymous namespace)::", ""): v for k, v in ram_syms[2].items() if k not in ram_syms[0]}
+    print("  the VM probe's RAM beyond the bare sketch's, by symbol: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(extra.items(), key=lambda kv: -kv[1]))
+          + " (g_ct and g_scan: the platform layer's cycle timer and ADC scan, in every fswkit firmware; "
+          "machine: the machine's record, as generated code has; ram: the image's windows and locals)")
     sv = sv_bytes()
     beyond, gen_ram = vm_ram - sv, s[1][1] - s[0][1]
     print(f"VM against its targets: flash {vm_flash:,} B without the image (target <= 3,072: "

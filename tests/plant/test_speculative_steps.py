@@ -3,8 +3,9 @@ write, worked out ahead (fswkit.plant.cosim.SPECULATE): the flight must be
 the one sent a step at a time, step for step -- the truth rows, the pin
 events, the telemetry, the resets, the parts' failures, the recorder's
 EEPROM. Flown both ways here through what makes the board stop early or the
-plant go back: pyro edges, a brown-out in flight, sensor dropouts held by a
-digital part, a part that stops answering, the tank's valve."""
+plant go back: pyro edges, a brown-out in flight, a reset when telemetry
+shows a state, sensor dropouts held by a digital part, a part that stops
+answering, the tank's valve."""
 
 from __future__ import annotations
 
@@ -62,6 +63,21 @@ def test_a_brownout_in_flight_and_the_drogue(monkeypatch):
     same(one, many)
     assert [e.role for e in one.pin_events][:1] == ["drogue"] and len(one.resets) == 1
     assert one.pin_events[0].t < one.resets[0]
+
+
+def test_a_reset_when_telemetry_shows_a_state(monkeypatch):
+    elf, board = kept_sim(EXAMPLES / "rocket")
+    _app, layout, _sc = prepare(str(EXAMPLES / "rocket"), "rocket", seed=2)
+
+    def make():
+        sc = prepare(str(EXAMPLES / "rocket"), "rocket", seed=2)[2]
+        sc.reset_state, sc.reset_cause, sc.reset_after_s = "Coast", "watchdog", 0.05
+        sc.max_s = 9.0
+        return sc
+
+    one, many = both_ways(make, elf, board, layout, monkeypatch)
+    same(one, many)
+    assert [(e.cause, e.state, e.trigger) for e in one.reset_events] == [("watchdog", "Coast", "state")]
 
 
 def test_a_digital_barometers_dropout_and_its_failure(monkeypatch):

@@ -29,9 +29,11 @@ RECORD_HZ = 100  # truth rows per simulated second (the executor's rate)
 # Plant steps one write to the board may carry. The plant works their inputs out ahead as if the
 # firmware's outputs stayed as they are; the board runs them in turn and stops after a step in which a
 # watched pin changed or the mission machine's state element did (`SimBoard.batches`), and the plant
-# is worked out again from the write's start as far as the board went. Only while telemetry shows the
-# state the firmware is in, no reset is due and the scenario can tell ahead when the run ends
-# (`would_end`): so a flight is the same, step for step, as one sent a step at a time.
+# is worked out again from the write's start as far as the board went. While the board runs a full
+# write, the next is worked out and sent behind it, all `batch?`: the board skips it if the one before
+# stopped. Only while telemetry shows the state the firmware is in, never past a reset or a part
+# failure that is due, and up to the step where the scenario says the run ends (`would_end`): so a
+# flight is the same, step for step, as one sent a step at a time.
 SPECULATE = 16
 
 
@@ -121,28 +123,35 @@ def _one_cpu():
     workers, two `fsw sim`s), not the first CPU for every process. Lock-step
     is a ping-pong: one of the two processes works while the other waits, and
     a pipe round trip between two processes on one CPU costs about 10 µs,
-    across CPUs 60 to 100 µs (about a quarter of a 1 kHz step's time)."""
+    across CPUs 60 to 100 µs (about a quarter of a 1 kHz step's time).
+    Yields another CPU this thread may move to once the board has started
+    (`_split`), when no other flight of any process has one pinned: the
+    board then runs a write while this thread works out the next (SPECULATE),
+    and a write's round trip between two CPUs is shared by its 16 steps;
+    None otherwise."""
     if not hasattr(os, "sched_setaffinity"):
-        yield
+        yield None
         return
     try:
         before = os.sched_getaffinity(0)
     except OSError:
-        yield
+        yield None
         return
     if len(before) < 2:
-        yield
+        yield None
         return
     with _cpu_lock:
         pinned = _boards_pinned()
         cpu = min(sorted(before), key=lambda c: (_cpu_users.get(c, 0), pinned.get(c, 0)))
         _cpu_users[cpu] = _cpu_users.get(cpu, 0) + 1
+        alone = not pinned and sum(_cpu_users.values()) == 1
+        other = min(c for c in before if c != cpu) if alone else None
     try:
         try:
             os.sched_setaffinity(0, {cpu})
         except OSError:
-            pass
-        yield
+            other = None
+        yield other
     finally:
         with contextlib.suppress(OSError):
             os.sched_setaffinity(0, before)
@@ -157,8 +166,8 @@ def fly(scenario, elf: str, board, layout: Layout, log_path: str | None = None, 
     terminal, a bar shows the simulated time of the planned duration.
     `profile`: flash byte addresses of functions whose cycles the board
     counts from reset (SimBoard.profile; tools/bench_busy.py), in run.profile."""
-    with _one_cpu(), progress("flight", total=float(scenario.max_s), unit="s") as bar:
-        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile)
+    with _one_cpu() as other, progress("flight", total=float(scenario.max_s), unit="s") as bar:
+        return _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile, other)
 
 
 def stop_words(stop: str, wall_limit: float) -> str:
@@ -249,7 +258,7 @@ class Telemetry:
                     run.transitions.append((tt, int(st), self.state_names.get(int(st), str(st))))
 
 
-def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile=None) -> Run:
+def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, profile=None, other_cpu=None) -> Run:
     rate = scenario.rate
     f_cpu = int(board.f_cpu)
     if f_cpu % rate:
@@ -277,6 +286,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             log.close()
         raise CosimError(str(e)) from None
     wall0 = time.perf_counter()
+    if other_cpu is not None:  # the board has its CPU to itself (_one_cpu): this thread works on another
+        with contextlib.suppress(OSError):
+            os.sched_setaffinity(0, {other_cpu})
     try:
         if profile:
             b.profile(profile)
@@ -294,7 +306,6 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             b.watch(pin)
         k = 0
         t1 = 0.0
-        finished = False
         spec, fw_state = _guard(b, scenario, layout), None
 
         def changed_inputs(analog, digital):
@@ -327,14 +338,50 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     set_digital[pin] = level
             return set_analog, set_digital, set_parts
 
+        def compose(k0: int, chained: bool):
+            """The write that starts at step k0: its steps' `batch` arguments, the plant worked out
+            ahead for them (all of them when there are several: a chained write may follow), the
+            truth rows ahead, and what the plant was at its start. One step (nothing worked out
+            ahead) unless speculating is safe (SPECULATE); a chained write is None then."""
+            nonlocal analog, digital
+            n = 1
+            if (spec is not None and telemetry.reset_t is None and telemetry.last_state is not None
+                    and int(telemetry.last_state) == fw_state):
+                n = SPECULATE
+                for due in (reset_at, state_due, fail_plan[0][0] if fail_plan else None):
+                    if due is not None:
+                        n = next((i for i in range(0 if chained else 1, n) if (k0 + i) / rate >= due), n)
+            if chained and n <= 1:
+                return None
+            w = _Write(k0, n, first=(analog, digital))
+            if n > 1:
+                w.saved = (scenario.save(), dict(last_mv), dict(last_din), dict(last_raw))
+            state = run.transitions[-1][2] if run.transitions else None
+            for i in range(n):
+                kk = k0 + i
+                if kk:
+                    analog, digital = scenario.inputs(kk / rate)
+                w.steps.append(((kk + 1) * cycles,) + changed_inputs(analog, digital))
+                if n > 1:  # ahead of the board: the plant with the pins as they are
+                    scenario.advance(kk / rate, (kk + 1) / rate, ())
+                    w.rows.append(scenario.record() if (kk + 1) % record_every == 0 else None)
+                    w.ahead = i + 1
+                    if scenario.would_end((kk + 1) / rate, state):  # the run ends with this step
+                        w.n = n = i + 1
+                        w.ends = True
+                        break
+            return w
+
+        finished = False
         # resets the scenario asks for: at a simulated second (`reset_at`: a study's brown-out), and
         # `reset_after_s` after telemetry first shows the mission machine in `reset_state`
         reset_at, at_cause, reset_state, state_cause, after_s = _reset_plan(scenario, telemetry)
         state_due: float | None = None
         seen = 0  # transitions already looked at for reset_state
+        pending: list = []  # writes sent whose responses are not read yet: (write, responses or None)
         while True:
             t0 = k / rate
-            if reset_at is not None or state_due is not None:
+            if not pending and (reset_at is not None or state_due is not None):
                 for due, cause, trigger in ((reset_at, at_cause, "time"), (state_due, state_cause, "state")):
                     if due is None or t0 < due:
                         continue
@@ -348,7 +395,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     telemetry.restarted(t0)
                     last_mv = {name: -1 for name in last_mv}  # every input driven again
                     last_din = {}
-            while fail_plan and t0 >= fail_plan[0][0]:  # a part fails (its mode set before the step runs)
+            while not pending and fail_plan and t0 >= fail_plan[0][0]:  # a part fails (its mode set before the step runs)
                 _at, part, mode = fail_plan.pop(0)
                 if part in where:
                     if mode == "noisy":  # the plant's doing: the part itself works
@@ -356,38 +403,30 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     else:
                         b.part_fail(where[part], mode)
                     run.part_failures.append((t0, part_name(part), mode))
-            # How many steps this write carries: more than one only while nothing that the board's reply
-            # could change is due (see SPECULATE)
-            n = 1
-            if (spec is not None and reset_state is None and state_due is None and telemetry.reset_t is None
-                    and telemetry.last_state is not None and int(telemetry.last_state) == fw_state):
-                n = SPECULATE
-                for due in (reset_at, fail_plan[0][0] if fail_plan else None):
-                    if due is not None:
-                        n = next((i for i in range(1, n) if (k + i) / rate >= due), n)
-            saved = (scenario.save(), dict(last_mv), dict(last_din), dict(last_raw)) if n > 1 else None
-            state = run.transitions[-1][2] if run.transitions else None
-            steps, rows, first = [], [], (analog, digital)  # first: the inputs at 0 s, worked out before the loop
-            ahead = 0  # the steps the plant has been worked out for ahead of the board
-            for i in range(n):
-                kk = k + i
-                if kk:
-                    analog, digital = scenario.inputs(kk / rate)
-                steps.append(((kk + 1) * cycles,) + changed_inputs(analog, digital))
-                if i < n - 1:  # ahead of the board: the plant with the pins as they are
-                    scenario.advance(kk / rate, (kk + 1) / rate, ())
-                    rows.append(scenario.record() if (kk + 1) % record_every == 0 else None)
-                    ahead = i + 1
-                    if scenario.would_end((kk + 1) / rate, state):  # the run ends with this step
-                        n = i + 1
-                        break
-            try:
-                results = [b.batch(*steps[0])] if n == 1 else b.batches(steps)
-            except EdgeOverflow:
-                raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to "
-                                 "watch") from None
+            # a write, and while the board runs one, the next (chained): see SPECULATE
+            if not pending:
+                w = compose(k, False)
+                if w.n == 1:
+                    pending.append((w, [b.batch(*w.steps[0])]))
+                else:
+                    b.batches_send(w.steps)
+                    pending.append((w, None))
+            last = pending[-1][0]
+            if len(pending) == 1 and last.n == SPECULATE and last.ahead == last.n and not last.ends:
+                w2 = compose(last.k0 + last.n, True)
+                if w2 is not None:
+                    b.batches_send(w2.steps, chained=True)
+                    pending.append((w2, None))
+            w, results = pending.pop(0)
+            if results is None:
+                try:
+                    results = b.batches_read(w.n)
+                except EdgeOverflow:
+                    raise CosimError("the board recorded more pin edges than it keeps: a pin toggles too fast to "
+                                     "watch") from None
             run.round_trips += 1
-            ran = next((i for i, r in enumerate(results) if r is None), n)  # the steps the board ran
+            ran = next((i for i, r in enumerate(results) if r is None), w.n)  # the steps the board ran
+            stopped = ran < w.n  # the board stopped the run of steps: it runs no chained write
             for i in range(ran):
                 step = results[i]
                 t0 = k / rate
@@ -396,27 +435,31 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                 k += 1
                 t1 = k / rate
                 if spec is not None:
-                    fw_state = int.from_bytes(step.guard, "little")
+                    was, fw_state = fw_state, int.from_bytes(step.guard, "little")
+                    if fw_state != was:
+                        stopped = True  # a state change stops the run of steps
                 edges = [(e.cycle / f_cpu, e.pin, e.level) for e in step.edges] if step.edges else ()
-                if i >= ahead:  # the last step sent: the plant was not worked out ahead for it
+                if edges:
+                    stopped = True  # and so does an edge
+                if i >= w.ahead:  # a step sent alone: the plant was not worked out ahead for it
                     for ev in scenario.advance(t0, t1, edges):
                         run.pin_events.append(ev)
                     row = scenario.record() if k % record_every == 0 else None
-                elif i == ran - 1 and (edges or ran < n):  # the board stopped early (an edge, a state change;
-                    # the plant has taken the next step's inputs): the plant again from the write's start, as
-                    # far as the board went, this step with its edges
-                    plant, last_mv, last_din, last_raw = (saved[0], dict(saved[1]), dict(saved[2]),
-                                                          dict(saved[3]))
+                elif i == ran - 1 and stopped:  # the board stopped here (an edge, a state change; the plant
+                    # has gone on ahead): the plant again from the write's start, as far as the board went, this
+                    # step with its edges
+                    plant, last_mv, last_din, last_raw = (w.saved[0], dict(w.saved[1]), dict(w.saved[2]),
+                                                          dict(w.saved[3]))
                     scenario.restore(plant)
                     for j in range(ran):
                         kk = k - ran + j
-                        analog, digital = scenario.inputs(kk / rate) if kk else first
+                        analog, digital = scenario.inputs(kk / rate) if kk else w.first
                         changed_inputs(analog, digital)
                         for ev in scenario.advance(kk / rate, (kk + 1) / rate, edges if j == ran - 1 else ()):
                             run.pin_events.append(ev)
                     row = scenario.record() if k % record_every == 0 else None
                 else:
-                    row = rows[i]
+                    row = w.rows[i]
                 if step.uart:
                     telemetry.feed(step.uart, t1)
                     if reset_state is not None:
@@ -430,11 +473,17 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                 state = run.transitions[-1][2] if run.transitions else None
                 bar.update(t1, state=state or "-")
                 if scenario.done(t1, state):
-                    if i != ran - 1:
+                    if i != ran - 1 or (pending and not stopped):
                         raise CosimError(f"internal error: the run ended at {t1:.3f} s simulated, inside steps the "
                                          "board had already run ahead")
                     finished = True
                     break
+            if stopped or finished:  # a chained write the board skipped, step by step
+                for w2, _ in pending:
+                    run.round_trips += 1
+                    if any(r is not None for r in b.batches_read(w2.n)):
+                        raise CosimError("internal error: the board ran steps after their run had stopped")
+                pending = []
             if finished:
                 break
         run.steps = k
@@ -464,6 +513,20 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
         if log:
             log.close()
     return run
+
+
+@dataclass
+class _Write:
+    """Plant steps sent to the board in one write (fswkit.plant.cosim's loop)."""
+
+    k0: int  # its first step
+    n: int  # its steps
+    first: tuple  # the inputs the loop held at its start (those of step 0 for the first write)
+    steps: list = field(default_factory=list)  # each step's `batch` arguments
+    ahead: int = 0  # the steps the plant was worked out for ahead of the board
+    rows: list = field(default_factory=list)  # the truth rows ahead (None: no row at that step)
+    saved: tuple | None = None  # the plant and the inputs last sent, at its start
+    ends: bool = False  # the run ends with its last step (would_end): no write follows it
 
 
 def _guard(b: SimBoard, scenario, layout: Layout):

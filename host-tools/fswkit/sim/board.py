@@ -534,8 +534,20 @@ class SimBoard:
         None otherwise (the board did nothing for it). A co-simulation whose
         plant reacts to the firmware's outputs works its plant out again
         from the last step run."""
-        self._send("".join(self._batch_line("batch?" if i else "batch", *step) for i, step in enumerate(steps)))
-        lines = [self._read_line() for _ in steps]  # every response, so the channel stays in step
+        self.batches_send(steps)
+        return self.batches_read(len(steps))
+
+    def batches_send(self, steps: list[tuple], chained: bool = False) -> None:
+        """The first half of `batches`: sends the steps and returns at once
+        (the board works on them meanwhile). `chained`: every step is a
+        `batch?`, so none runs if the run of steps the write before began
+        has stopped. Read the responses with `batches_read`, in order."""
+        self._send("".join(self._batch_line("batch?" if i or chained else "batch", *step)
+                           for i, step in enumerate(steps)))
+
+    def batches_read(self, count: int) -> list[Batch | None]:
+        """The responses of `count` steps sent with `batches_send`."""
+        lines = [self._read_line() for _ in range(count)]  # every response, so the channel stays in step
         for line in lines:
             if line.startswith("err"):
                 raise SimError(line[4:])

@@ -124,11 +124,10 @@ def _one_cpu():
     is a ping-pong: one of the two processes works while the other waits, and
     a pipe round trip between two processes on one CPU costs about 10 µs,
     across CPUs 60 to 100 µs (about a quarter of a 1 kHz step's time).
-    Yields another CPU this thread may move to once the board has started
-    (`_split`), when no other flight of any process has one pinned: the
-    board then runs a write while this thread works out the next (SPECULATE),
-    and a write's round trip between two CPUs is shared by its 16 steps;
-    None otherwise."""
+    Yields another CPU this thread may move to once the board has started,
+    when no other flight of any process has one pinned: the board then runs
+    a write while this thread works out the next (SPECULATE), and a write's
+    round trip between two CPUs is shared by its 16 steps; None otherwise."""
     if not hasattr(os, "sched_setaffinity"):
         yield None
         return
@@ -286,9 +285,21 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             log.close()
         raise CosimError(str(e)) from None
     wall0 = time.perf_counter()
-    if other_cpu is not None:  # the board has its CPU to itself (_one_cpu): this thread works on another
+    # With another CPU free (_one_cpu), this thread moves there while writes are chained, so that the
+    # board runs one while the next is worked out; in a long stretch of steps sent one at a time, where a
+    # round trip between two CPUs costs several times one on a CPU, it goes back to the board's.
+    cpus = None
+    if other_cpu is not None:
         with contextlib.suppress(OSError):
-            os.sched_setaffinity(0, {other_cpu})
+            cpus = (os.sched_getaffinity(0), {other_cpu})
+
+    def place(on_other: bool) -> None:
+        nonlocal cpus
+        if cpus is not None and on_other != (cpus[1] == os.sched_getaffinity(0)):
+            try:
+                os.sched_setaffinity(0, cpus[1] if on_other else cpus[0])
+            except OSError:
+                cpus = None
     try:
         if profile:
             b.profile(profile)
@@ -373,6 +384,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             return w
 
         finished = False
+        alone = 1  # writes of one step in a row (place: this thread on the board's CPU from 32 on)
         # resets the scenario asks for: at a simulated second (`reset_at`: a study's brown-out), and
         # `reset_after_s` after telemetry first shows the mission machine in `reset_state`
         reset_at, at_cause, reset_state, state_cause, after_s = _reset_plan(scenario, telemetry)
@@ -407,6 +419,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             if not pending:
                 w = compose(k, False)
                 if w.n == 1:
+                    alone += 1
+                    if alone == 32:
+                        place(False)
                     pending.append((w, [b.batch(*w.steps[0])]))
                 else:
                     b.batches_send(w.steps)
@@ -415,6 +430,9 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
             if len(pending) == 1 and last.n == SPECULATE and last.ahead == last.n and not last.ends:
                 w2 = compose(last.k0 + last.n, True)
                 if w2 is not None:
+                    if alone:
+                        alone = 0
+                        place(True)
                     b.batches_send(w2.steps, chained=True)
                     pending.append((w2, None))
             w, results = pending.pop(0)

@@ -244,32 +244,40 @@ def rocket_footprint() -> dict:
             "parts": symbol_breakdown(elf, tuple(m.name for m in app.machines))}
 
 
+def variant_size(edit, what: str) -> tuple[int, int]:
+    """(flash, RAM: .data + .bss + .noinit) of a copy of examples/rocket
+    that `edit(folder)` changed (None: as it is), built as `fsw sim` builds
+    it; `what` names the variant in an error."""
+    import shutil
+    import tempfile
+
+    from fswkit.sim.command import build as build_for_sim
+
+    with tempfile.TemporaryDirectory(prefix="fsw-bench-variant-") as tmp:
+        proj = os.path.join(tmp, "rocket")
+        shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
+        if edit is not None:
+            edit(proj)
+        built = build_for_sim(proj, "uno", os.path.join(tmp, "out"))
+        if isinstance(built, int):
+            sys.exit(f"bench: building the rocket {what} failed")
+        flash, ram = elf_size(built[0])
+        return flash, ram + elf_noinit(built[0])
+
+
+def without_pyro(folder: str) -> None:
+    app = os.path.join(folder, "rocket.app")
+    text = open(app).read()
+    open(app, "w").write(text[:text.index("[pyro]")])
+
+
 def pyro_cost() -> tuple[tuple[int, int], tuple[int, int]]:
     """((flash, RAM) of the rocket, (flash, RAM) of the same rocket without
     its [pyro] section): what its two pyro channels cost with all that comes
     with them -- the gates, the continuity status, the health frame's
     status bytes, and keeping the flight across a reset (docs/safety.md).
     RAM is .data + .bss + .noinit."""
-    import shutil
-    import tempfile
-
-    from fswkit.sim.command import build as build_for_sim
-
-    sizes = []
-    with tempfile.TemporaryDirectory(prefix="fsw-bench-pyro-") as tmp:
-        for keep in (True, False):
-            proj = os.path.join(tmp, "with" if keep else "without", "rocket")
-            shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
-            if not keep:
-                app = os.path.join(proj, "rocket.app")
-                text = open(app).read()
-                open(app, "w").write(text[:text.index("[pyro]")])
-            built = build_for_sim(proj, "uno", os.path.join(tmp, "out-with" if keep else "out-without"))
-            if isinstance(built, int):
-                sys.exit("bench: building the rocket for the pyro cost failed")
-            flash, ram = elf_size(built[0])
-            sizes.append((flash, ram + elf_noinit(built[0])))
-    return sizes[0], sizes[1]
+    return variant_size(None, "for the pyro cost"), variant_size(without_pyro, "without its pyro channels")
 
 
 def without_later_features(folder: str) -> None:
@@ -278,9 +286,9 @@ def without_later_features(folder: str) -> None:
     flight recorder, the parameters and the pyro channels came: no [log]
     (and no recorder task), no [pyro], the [parameters] as [local]
     constants of the same values."""
+    without_pyro(folder)
     app = os.path.join(folder, "rocket.app")
     text = open(app).read()
-    text = text[:text.index("[pyro]")]
     text = re.sub(r"(?m)^log\s+recorder\b.*\n", "", text)
     text = re.sub(r"\n\[log\].*?(?=\n\[)", "\n", text, flags=re.S)
     open(app, "w").write(text)
@@ -297,20 +305,7 @@ def without_later_features(folder: str) -> None:
 def core_size() -> tuple[int, int]:
     """(flash, RAM: .data + .bss + .noinit) of examples/rocket without what
     came after the target was set (without_later_features)."""
-    import shutil
-    import tempfile
-
-    from fswkit.sim.command import build as build_for_sim
-
-    with tempfile.TemporaryDirectory(prefix="fsw-bench-core-") as tmp:
-        proj = os.path.join(tmp, "rocket")
-        shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
-        without_later_features(proj)
-        built = build_for_sim(proj, "uno", os.path.join(tmp, "out"))
-        if isinstance(built, int):
-            sys.exit("bench: building the rocket without its recorder, parameters and pyro channels failed")
-        flash, ram = elf_size(built[0])
-        return flash, ram + elf_noinit(built[0])
+    return variant_size(without_later_features, "without its recorder, parameters and pyro channels")
 
 
 def print_core_size() -> None:

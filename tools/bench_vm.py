@@ -25,16 +25,9 @@ from fswkit.autocode.numeric import F32MODE  # noqa: E402
 from fswkit.autocode.vmverify import TYPE_CODES  # noqa: E402
 
 
-def sv_bytes() -> int:
-    """Bytes of the tank's state vector."""
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.project import load_machine
-
-    m = load_machine(os.path.join(ROOT, "examples", "tank", "tank.sm"), Diagnostics())
-    return max(e.offset + e.type.size for e in m.sv.elements)
-
-
-def image_header(folder: str) -> int:
+def image_header(folder: str) -> tuple[int, int]:
+    """Writes the tank's image and layout for vm_probe.cpp; (the image's
+    bytes, the state vector's bytes)."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.project import load_machine
 
@@ -46,7 +39,7 @@ def image_header(folder: str) -> int:
                 f"const fsw::VmElem kElems[] FSW_FLASH = {{{elems}}};\n"
                 f"const uint16_t kElemCount = {len(m.sv.elements)};\n"
                 f"const uint16_t kRam = {window_ram(m, F32MODE, idx_bytes=2, align=1)};\n")
-    return len(im)
+    return len(im), max(e.offset + e.type.size for e in m.sv.elements)
 
 
 def build(mcu: str, variant: str, define: str, probe: int, timing: bool, gen: str) -> str:
@@ -73,9 +66,10 @@ def cycles(elf: str) -> tuple[int, int, int]:
 def main() -> int:
     gen = os.path.join(B.OUT, "vm-tank-f32")
     B.generate(F32MODE, gen)
-    size = image_header(gen)
+    size, sv = image_header(gen)
     uno = ("atmega328p", "standard", "ARDUINO_AVR_UNO")
-    s = [B.elf_size(build(*uno, p, False, gen)) for p in (0, 1, 2)]
+    elfs = [build(*uno, p, False, gen) for p in (0, 1, 2)]
+    s = [B.elf_size(elf) for elf in elfs]
     print(f"tank image: {size} bytes")
     print(f"Uno, empty sketch:          flash {s[0][0]:6,}  RAM {s[0][1]:5,}")
     print(f"Uno, generated tank:        flash {s[1][0]:6,}  RAM {s[1][1]:5,}  "
@@ -93,7 +87,7 @@ def main() -> int:
     # what the VM probe's RAM holds beyond the bare sketch's, by symbol
     ram_syms = {}
     for i in (0, 2):
-        text = B.sh(["avr-nm", "-S", "-C", build(*uno, i, False, gen)]).stdout
+        text = B.sh(["avr-nm", "-S", "-C", elfs[i]]).stdout
         ram_syms[i] = {m.group(3): int(m.group(2), 16)
                        for m in re.finditer(r"^([0-9a-f]+) ([0-9a-f]+) [bBdD] (.*)$", text, re.M)}
     extra = {k.replace("(anonymous namespace)::", ""): v for k, v in ram_syms[2].items() if k not in ram_syms[0]}
@@ -101,7 +95,6 @@ def main() -> int:
           + ", ".join(f"{k} {v}" for k, v in sorted(extra.items(), key=lambda kv: -kv[1]))
           + " (g_ct and g_scan: the platform layer's cycle timer and ADC scan, in every fswkit firmware; "
           "machine: the machine's record, as generated code has; ram: the image's windows and locals)")
-    sv = sv_bytes()
     beyond, gen_ram = vm_ram - sv, s[1][1] - s[0][1]
     print(f"VM against its targets: flash {vm_flash:,} B without the image (target <= 3,072: "
           f"{'met' if vm_flash <= 3072 else 'MISSED'}), RAM {vm_ram:,} B: {beyond:,} B beyond the tank's {sv} B state "

@@ -427,7 +427,7 @@ def _fly(scenario, elf, board, layout, log_path, wall_limit, log_meta, bar, prof
                     b.batches_send(w.steps)
                     pending.append((w, None))
             last = pending[-1][0]
-            if len(pending) == 1 and last.n == SPECULATE and last.ahead == last.n and not last.ends:
+            if len(pending) == 1 and last.n == SPECULATE and not last.ends:
                 w2 = compose(last.k0 + last.n, True)
                 if w2 is not None:
                     if alone:

@@ -51,10 +51,14 @@ docs-img: setup
 test: setup test-python test-firmware
 
 # pytest on every core (pytest-xdist), a test file's tests on one worker so
-# that a module's costly set-up (a wheel, a firmware build) runs once
-PYTEST_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# that a module's costly set-up (a wheel, a firmware build) runs once. One
+# worker more than the cores: the link and ground-station tests spend most of
+# their time waiting on a board paced to the wall clock, and the third worker
+# runs meanwhile. The files marked `costly` go out first, costliest first
+# (tests/conftest.py); xdist's own order (most tests first) is turned off.
+PYTEST_JOBS ?= $(shell echo $$(( $$(nproc 2>/dev/null || echo 2) + 1 )))
 test-python: setup
-	$(PY) -m pytest -n $(PYTEST_JOBS) --dist loadfile tests
+	$(PY) -m pytest -n $(PYTEST_JOBS) --dist loadfile --no-loadscope-reorder tests
 
 ## fuzz: the front end's mutation fuzzer (1,000,000 cases on both cores,
 ## about an hour; crashing inputs land in build/fuzz/), the uplink parser, the

@@ -54,3 +54,25 @@ def project_config(project_dir, tmp_path) -> dict[str, dict]:
                        capture_output=True, text=True, env=env, timeout=120)
     assert r.returncode == 0, r.stderr + r.stdout
     return {section: dict(options) for section, options in json.loads(r.stdout[r.stdout.index("["):])}
+
+
+# ---- the order files are handed out in (make test: pytest-xdist, --dist loadfile) ----
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "costly(seconds): a test file's measured cost (wall seconds on one core, its set-up "
+        "included): such files are handed to workers first, the costliest first")
+
+
+def pytest_collection_modifyitems(config, items):
+    """The costly files first, costliest first, then the rest in their order.
+    pytest-xdist hands whole files (--dist loadfile) to the worker that asks
+    next in this order (make test passes --no-loadscope-reorder, which would
+    put the files with the most tests first): a long file started last would
+    keep one core busy after the others are done."""
+    def cost(item) -> float:
+        mark = item.get_closest_marker("costly")
+        return float(mark.args[0]) if mark and mark.args else 0.0
+
+    order = {id(item): i for i, item in enumerate(items)}
+    items.sort(key=lambda item: (-cost(item), item.path.as_posix() if cost(item) else "", order[id(item)]))

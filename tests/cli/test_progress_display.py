@@ -22,6 +22,8 @@ import pytest
 
 from conftest import ROOT
 
+pytestmark = pytest.mark.costly(9)
+
 ERASE_LINE = b"\x1b[2K"
 
 SCRIPT = textwrap.dedent("""

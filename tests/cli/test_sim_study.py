@@ -22,6 +22,8 @@ import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
 
+pytestmark = pytest.mark.costly(12)
+
 ROCKET = EXAMPLES / "rocket"
 DISPERSION = ROCKET / "dispersion.toml"
 needs_sim = pytest.mark.skipif(shutil.which("avr-gcc") is None

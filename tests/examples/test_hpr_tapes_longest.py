@@ -1,4 +1,5 @@
-"""Real flights through examples/hpr, the longest tape: see tests/support/hpr_tapes.py."""
+"""Real flights through examples/hpr, the longest replay (lince, 406 s through the main): see
+tests/support/hpr_tapes.py."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import pytest
 
 from support.hpr_tapes import MARKS, build_hpr, replay_and_check, tapes
 
-pytestmark = MARKS
+pytestmark = MARKS + [pytest.mark.costly(20)]
 
 
 @pytest.fixture(scope="module")

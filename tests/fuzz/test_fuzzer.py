@@ -11,6 +11,8 @@ import pytest
 
 from fswkit.testing import fuzz
 
+pytestmark = pytest.mark.costly(12)
+
 CASES = int(os.environ.get("FSW_FUZZ_SMOKE", "1000"))
 
 

@@ -10,6 +10,8 @@ import pytest
 
 from conftest import ROOT
 
+pytestmark = pytest.mark.costly(15)
+
 
 @pytest.mark.skipif(shutil.which("clang++") is None, reason="clang is not installed (make setup installs it)")
 def test_uplink_fuzz_short_run():

@@ -22,8 +22,9 @@ from conftest import EXAMPLES, ROOT
 from fswkit.plant.run import FILES, execute, prepare
 from support.simfw import kept_sim
 
-pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
-                                reason="gcc-avr and libsimavr-dev are needed (make setup)")
+pytestmark = [pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
+                                 reason="gcc-avr and libsimavr-dev are needed (make setup)"),
+              pytest.mark.costly(12)]
 
 ROCKET, TANK = EXAMPLES / "rocket", EXAMPLES / "tank"
 SEEDS = (1, 2)  # make bench flies seeds 1-20

@@ -26,6 +26,8 @@ from fswkit.testing.recorder_cuts import CutReport, _check_samples, power_cuts_n
 from support.linkfw import PtyTarget
 from support.simfw import OUT, kept_native, kept_sim
 
+pytestmark = pytest.mark.costly(11)
+
 RIG = Path(__file__).resolve().parent / "spi"
 LOGGED = Path(__file__).resolve().parent / "logged"
 needs_sim = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),

@@ -23,7 +23,7 @@ import pytest
 
 from conftest import EXAMPLES, ROOT
 
-pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
+pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed"), pytest.mark.costly(9)]
 SIMAVR = os.path.exists("/usr/include/simavr/sim_avr.h")
 SOURCES = ("pyproject.toml", "README.md", "host-tools", "autocode", "firmware", "boards", "mk", "integrations")
 

@@ -28,6 +28,8 @@ from conftest import run_fsw
 from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
+pytestmark = pytest.mark.costly(10)
+
 RAW = 770  # 815.86 psi
 
 

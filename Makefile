@@ -83,7 +83,7 @@ fuzz: setup fuzz-uplink fuzz-vm
 FUZZ_RUNS ?= 10000000
 FUZZ_SECONDS ?= 0
 FUZZ_UPLINK := $(BUILD)/fuzz/uplink/fuzz_uplink
-FUZZ_UPLINK_SRCS := tests/fuzz/uplink/fuzz_uplink.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp,$(wildcard firmware/src/*.cpp))
+FUZZ_UPLINK_SRCS := tests/fuzz/uplink/fuzz_uplink.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp %/psl_arduino_eeprom.cpp,$(wildcard firmware/src/*.cpp))
 $(FUZZ_UPLINK): $(FUZZ_UPLINK_SRCS) $(wildcard firmware/src/*.h)
 	@mkdir -p $(@D)
 	clang++ -std=c++11 -g -O1 -fno-exceptions -fno-rtti -fsanitize=fuzzer,address,undefined \
@@ -105,7 +105,7 @@ fuzz-uplink: $(FUZZ_UPLINK)
 ## every example machine (fsw compile). FUZZ_RUNS, FUZZ_SECONDS
 ## as for fuzz-uplink
 FUZZ_VM := $(BUILD)/fuzz/vm/fuzz_vm
-FUZZ_VM_SRCS := tests/fuzz/vm/fuzz_vm.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp,$(wildcard firmware/src/*.cpp))
+FUZZ_VM_SRCS := tests/fuzz/vm/fuzz_vm.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp %/psl_arduino_eeprom.cpp,$(wildcard firmware/src/*.cpp))
 $(FUZZ_VM): $(FUZZ_VM_SRCS) $(wildcard firmware/src/*.h)
 	@mkdir -p $(@D)
 	clang++ -std=c++11 -g -O1 -fno-exceptions -fno-rtti -fsanitize=fuzzer,address,undefined \

@@ -753,8 +753,8 @@ def _reload(app: Application) -> list[str]:
             f"const fsw::VmLayout kReloadLayout = {{kReloadElems, {len(app.sv.elements)}, kSchemaHash}};",
             f"const uint8_t kReloadAllow[{len(mask)}] FSW_FLASH = {{{', '.join(f'0x{b:02x}' for b in mask)}}};"
             f"  // {' '.join(rl.activate)}",
-            f"alignas(8) uint8_t reload_image[{rl.size}];  // the running image and its state mask",
-            f"alignas(8) uint8_t reload_ram[{max(rl.ram, 1)}];  // its windows and locals",
+            f"uint8_t reload_image[{rl.size}];  // the running image and its state mask (read a byte at a time)",
+            f"alignas(fsw::kVmRamAlign) uint8_t reload_ram[{max(rl.ram, 1)}];  // its windows and locals",
             "const fsw::ReloadConfig kReloadConfig FSW_FLASH = {",
             f"    reload_image, reload_ram, sv, &kReloadLayout, &{ns}::machine, {ns}::step, {ns}::leave, {ns}::reset,",
             f"    kReloadAllow, {rl.size}, {rl.ram}, {base}, {len(mask)}}};",

@@ -114,7 +114,7 @@ void parts(const uint8_t* im, Parts& p) {
 
 // Storage of a window of n samples in the VM's RAM: the state struct and its
 // arrays, as the typed wrappers of fsw_window.h lay them, with WinIdx indices.
-const uint32_t kAlign = alignof(Real) > alignof(WinIdx) ? alignof(Real) : alignof(WinIdx);
+const uint32_t kAlign = kVmRamAlign;
 inline uint32_t up(uint32_t x) { return (x + kAlign - 1u) / kAlign * kAlign; }
 inline uint32_t ext_size(uint32_t n) {
     return up(sizeof(RollExtS<WinIdx>)) + up(n * sizeof(Real)) + up(n * sizeof(WinIdx));

@@ -44,9 +44,15 @@ struct VmLayout {
     uint32_t schema;  // the state vector's schema hash
 };
 
+// The alignment of the caller's RAM buffer (`alignas(fsw::kVmRamAlign)`):
+// that of Real and of the windows' indices, 1 on an AVR (which aligns
+// nothing: no padding in front of the buffer), 8 where R is binary64 on a
+// host. The image itself is read a byte at a time and needs none.
+static const uint8_t kVmRamAlign = alignof(Real) > alignof(WinIdx) ? alignof(Real) : alignof(WinIdx);
+
 // Bytes of RAM the image needs (windows, then locals): 0 for an image whose
 // header cannot be read. vm_verify checks it against the caller's buffer,
-// which must be aligned for Real (alignas(8) serves every board).
+// which must be aligned to kVmRamAlign.
 uint32_t vm_ram_size(const uint8_t* image, uint16_t len);
 
 // Checks every rule of docs/bytecode.md; kVmOk means vm_step may run it.

@@ -64,7 +64,7 @@ def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str, avr: bool = Fal
     c += ["", "namespace {", "", f"const uint8_t kImage[] = {_bytes(image)};",
           f"const fsw::VmElem kElems[] FSW_FLASH = {{{elems}}};",
           f"const fsw::VmLayout kLayout = {{kElems, {len(m.sv.elements)}, kSchemaHash}};",
-          f"alignas(8) uint8_t ram[{ram}];", "",
+          f"alignas(fsw::kVmRamAlign) uint8_t ram[{ram}];", "",
           "void to_vm() {", "    uint8_t* l = fsw::vm_locals(kImage, ram);"]
     c += [f"    memcpy(l + {o}, {p}, {n});" for o, p, n in copies]
     if not copies:

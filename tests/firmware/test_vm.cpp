@@ -14,7 +14,7 @@ namespace {
 const VmElem kElems[] FSW_FLASH = {{0, kU64}, {8, kU32}, {12, kF32}, {16, kI16}};
 const VmLayout kLayout = {kElems, 4, 0x12345678UL};
 uint8_t sv[18];
-alignas(8) uint8_t ram[128];
+alignas(kVmRamAlign) uint8_t ram[128];
 
 enum : uint8_t {
     END = 0x00, GOTO = 0x01, JMP = 0x02, JF = 0x03, AND = 0x04, OR = 0x05, CONST = 0x06, LDE = 0x07,

@@ -12,7 +12,7 @@
 #elif FSW_VM_PROBE == 2
 #include "tank_image.h"  // kImage, kElems, kElemCount (tools/bench_vm.py writes it)
 namespace {
-alignas(8) uint8_t ram[kRam];
+alignas(fsw::kVmRamAlign) uint8_t ram[kRam];
 fsw::Machine machine;
 const fsw::VmLayout kLayout = {kElems, kElemCount, fsw_gen::kSchemaHash};
 }  // namespace

@@ -1,0 +1,70 @@
+"""A sketch that runs the bytecode VM and checks an image kept in the
+EEPROM (vm_verify_eeprom) used to link the platform layer's whole
+psl_arduino.cpp through its EEPROM read: the cycle timer's TIMER1_COMPA and
+the ADC scan's interrupts, and their 30 B of state, in a sketch that has no
+executor. A sketch using Timer1 itself (the Servo library does) would have
+lost it. The EEPROM has a file of its own (psl_arduino_eeprom.cpp); this
+sketch links no interrupt of the platform layer but the EEPROM's, and no
+cycle-timer state."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+ARDUINO = Path("/usr/share/arduino/hardware/arduino/avr")
+AVR = ROOT / "build" / "firmware" / "avr"
+
+SKETCH = r"""
+#include <Arduino.h>
+#include "fswkit.h"
+
+namespace {
+const fsw::VmElem kElems[] FSW_FLASH = {{0, fsw::kU64}, {8, fsw::kU32}};
+const fsw::VmLayout kLayout = {kElems, 2, 0x12345678UL};
+uint8_t sv[12];
+alignas(fsw::kVmRamAlign) uint8_t ram[32];
+uint8_t image[64];
+fsw::Machine machine;
+}  // namespace
+
+void setup() {
+    pinMode(13, OUTPUT);
+    if (fsw::vm_verify_eeprom(0, sizeof image, kLayout, sizeof ram) == fsw::kVmOk &&
+        fsw::vm_step(image, kLayout, sv, ram, machine) == fsw::kOk)
+        digitalWrite(13, HIGH);
+}
+
+void loop() {}
+"""
+
+pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not ARDUINO.is_dir(),
+                                reason="gcc-avr and arduino-core-avr are needed (make setup)")
+
+
+def test_a_vm_sketch_links_no_cycle_timer_or_adc_interrupt(tmp_path):
+    r = subprocess.run(["make", "--no-print-directory", "-f", "mk/firmware.mk",
+                        str((AVR / "libfswkit.a").relative_to(ROOT)), str((AVR / "core.a").relative_to(ROOT))],
+                       cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    src, elf = tmp_path / "sketch.cpp", tmp_path / "sketch.elf"
+    src.write_text(SKETCH)
+    r = subprocess.run(["avr-g++", "-std=gnu++11", "-Os", "-ffunction-sections", "-fdata-sections",
+                        "-fno-exceptions", "-fno-rtti", "-fno-threadsafe-statics", "-mmcu=atmega328p",
+                        "-DF_CPU=16000000L", "-DARDUINO=10819", "-DARDUINO_AVR_UNO", "-DARDUINO_ARCH_AVR",
+                        f"-I{ARDUINO}/cores/arduino", f"-I{ARDUINO}/variants/standard",
+                        f"-I{ROOT / 'firmware' / 'src'}", "-Wall", "-Wextra", "-Werror",
+                        "-o", str(elf), str(src), str(AVR / "libfswkit.a"), str(AVR / "core.a"),
+                        "-Wl,--gc-sections"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    syms = subprocess.run(["avr-nm", "-C", str(elf)], capture_output=True, text=True, check=True).stdout
+    assert "fsw::vm_step" in syms and "fsw::pal::eeprom_read" in syms, syms  # the sketch is what it says
+    # ATmega328P vectors: 11 TIMER1_COMPA (the cycle timer), 21 ADC (the scan); 22 EE_READY is the EEPROM's own
+    vectors = {int(line.split("__vector_")[1]) for line in syms.splitlines()
+               if " T __vector_" in line and line.split("__vector_")[1].isdigit()}
+    assert not vectors & {11, 21}, sorted(vectors)
+    assert "g_ct" not in syms and "g_scan" not in syms, [x for x in syms.splitlines() if "g_ct" in x or "g_scan" in x]

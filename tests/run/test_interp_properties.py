@@ -118,8 +118,8 @@ def tree_script(script: M.Script, real):
             if sec.state is not None and sec.state != tm.state:
                 continue
             for grp in sec.inputs:
-                if truthy(ev(grp.guard)):
-                    for a in grp.inputs:
+                for a in grp.inputs:  # the guard just before each input: an earlier input may turn it false
+                    if truthy(ev(grp.guard)):
                         tm.assign(a.var, ev(a.expr))
             for grp in sec.checks:
                 if truthy(ev(grp.guard)):

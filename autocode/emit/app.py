@@ -15,6 +15,7 @@ from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan
 from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
+from .expr import float_key_test
 from .machine import emit_machine, stored_locals
 from .sv import emit_sv
 
@@ -166,7 +167,7 @@ def _resume(app: Application) -> list[str]:
     spans = [("sv", "kSvSize", "the state vector")]
     for m in app.machines:
         ns = c_ident(m.name)
-        spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::machine)", "sizeof(fsw::Machine)",
+        spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::machine)", "fsw::kMachineKept",
                       f"{m.name}: its state, entry time and last G"))
         if stored_locals(m, real):
             spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
@@ -425,8 +426,14 @@ def _pyro_lines(app: Application, t: Task) -> list[str]:
         fire = " || ".join(f"{ns}::machine.state == {ns}::S_{st}" for st in fires)
         if p.continuity is not None:
             el = p.continuity.element
-            sense = (f"(fsw::read_{el.type.name}(sv + E_{el.name}) >= "
-                     f"{real_literal(float(p.continuity_min), real)} ? fsw::kPyroContinuity : 0)")
+            # binary32 R: a float reading against its minimum as an integer
+            # test of the element's key (as the machines test literals: no
+            # float compare routine, each cycle, for each channel)
+            intact = (float_key_test(">=", float(p.continuity_min), el.type.size, f"sv + E_{el.name}")
+                      if real.bits == 32 and el.type.kind == "float" and not app.sv.lock else None)
+            if intact is None:
+                intact = f"fsw::read_{el.type.name}(sv + E_{el.name}) >= {real_literal(float(p.continuity_min), real)}"
+            sense = f"({intact} ? fsw::kPyroContinuity : 0)"
         else:
             sense = "fsw::kPyroNoSense"
         gate = f"fsw::pyro_gate(Pyro[{k}], sv[E_{p.element.name}] != 0, {arm}, {fire}, {runs}u, {sense})"

@@ -150,39 +150,7 @@ class ExprEmitter:
             return None
         if self.sv_lock and v.kind == M.ELEMENT:
             return None
-        negate = op == "!="
-        terms = tests("==" if negate else op, cv, v.type.size)
-        if terms is None:
-            return None
-        nan_result = compare(op, 0.0, cv)  # a NaN element reads as 0
-        bits = 64 if v.type.size == 8 else 32
-        if all(isinstance(t, bool) for _, t in terms):
-            # The same for every value (`x > 1e39` in binary32: never), so
-            # also for 0, which is what a NaN reads as: a constant.
-            value = all(t != neg for neg, t in terms) != negate
-            assert value == nan_result
-            return "true" if value else "false"
-        parts = []
-        for neg, t in terms:
-            if isinstance(t, bool):
-                test = "true" if t else "false"
-            else:
-                key, inclusive = t
-                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}{'UL' if bits == 32 else 'ULL'}"
-            parts.append(f"!({test})" if neg else f"({test})")
-        body = " && ".join(parts)
-        if negate:
-            body = f"!({body})"
-        # A NaN reads as +0, and the key of +0 passes the terms exactly when
-        # `0 op c` holds (nan_result): one key read covers both.
-        zero = 1 << (bits - 1)
-        at_zero = all((t if isinstance(t, bool) else (zero >= t[0] if t[1] else zero > t[0])) != neg
-                      for neg, t in terms)
-        assert (at_zero != negate) == nan_result, "threshold terms disagree with R at +0"
-        if len(parts) == 1 and not negate:
-            return parts[0].replace("k ", f"fsw::f{bits}_read_key({self.ptr(v)}) ", 1)
-        return (f"([&]() -> bool {{ const uint{bits}_t k = fsw::f{bits}_read_key({self.ptr(v)}); "
-                f"return {body}; }}())")
+        return float_key_test(op, cv, v.type.size, self.ptr(v))
 
     # -- integer fast paths, bit-identical to the R semantics ------------------
     def assign(self, var: int, e: M.Expr) -> str:
@@ -357,3 +325,42 @@ class ExprEmitter:
             # T saturated to 32 bits tests the same against such a c (fsw_machine.h).
             return f"(fsw::machine_T32({self.prefix}machine) {op} {c}UL)"
         return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"
+
+
+def float_key_test(op: str, cv: float, size: int, ptr: str):
+    """binary32 R: `R(x) op c` for the float element or local x of `size`
+    bytes at `ptr` and a literal c, as integer threshold tests on x's
+    stored bytes (autocode/thresholds.py), or None when not expressible."""
+    negate = op == "!="
+    terms = tests("==" if negate else op, cv, size)
+    if terms is None:
+        return None
+    nan_result = compare(op, 0.0, cv)  # a NaN element reads as 0
+    bits = 64 if size == 8 else 32
+    if all(isinstance(t, bool) for _, t in terms):
+        # The same for every value (`x > 1e39` in binary32: never), so
+        # also for 0, which is what a NaN reads as: a constant.
+        value = all(t != neg for neg, t in terms) != negate
+        assert value == nan_result
+        return "true" if value else "false"
+    parts = []
+    for neg, t in terms:
+        if isinstance(t, bool):
+            test = "true" if t else "false"
+        else:
+            key, inclusive = t
+            test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}{'UL' if bits == 32 else 'ULL'}"
+        parts.append(f"!({test})" if neg else f"({test})")
+    body = " && ".join(parts)
+    if negate:
+        body = f"!({body})"
+    # A NaN reads as +0, and the key of +0 passes the terms exactly when
+    # `0 op c` holds (nan_result): one key read covers both.
+    zero = 1 << (bits - 1)
+    at_zero = all((t if isinstance(t, bool) else (zero >= t[0] if t[1] else zero > t[0])) != neg
+                  for neg, t in terms)
+    assert (at_zero != negate) == nan_result, "threshold terms disagree with R at +0"
+    if len(parts) == 1 and not negate:
+        return parts[0].replace("k ", f"fsw::f{bits}_read_key({ptr}) ", 1)
+    return (f"([&]() -> bool {{ const uint{bits}_t k = fsw::f{bits}_read_key({ptr}); "
+            f"return {body}; }}())")

@@ -67,15 +67,17 @@ void executor_run_cycle(Executor& ex) {
     // the executor's few instructions that find and start it too.
     uint32_t mark = pal::micros32();
 #endif
-    for (uint8_t i = 0; i < c.n_tasks; ++i) {
-        TaskStats& s = c.stats[i];
+    const Task* rows = c.tasks;
+    TaskStats* const stats_end = c.stats + c.n_tasks;
+    for (TaskStats* sp = c.stats; sp != stats_end; ++sp, ++rows) {  // a row and its record a turn
+        TaskStats& s = *sp;
         if (s.countdown != 0) {
             --s.countdown;
             continue;
         }
         // The row's fields one at a time, each as it is needed: a run reads
         // 12 of its 17 bytes, the turn of a disabled task 4.
-        const Task& row = c.tasks[i];
+        const Task& row = *rows;
         s.countdown = static_cast<uint16_t>(flash_get(row.divider) - 1u);
         const ElemOff mode_off = flash_get(row.mode_off);
         uint8_t* const mode_at = mode_off != kNoElement ? c.sv + mode_off : &s.mode;
@@ -97,7 +99,9 @@ void executor_run_cycle(Executor& ex) {
         const uint32_t took = end - mark;
         mark = end;
         if (took > s.worst_us) s.worst_us = took;
-        if (took > c.period_us * flash_get(row.divider) && s.overruns != 0xFFFFu) ++s.overruns;
+        // A run within the base period is within the task's (divider >= 1):
+        // the product, a 32-bit multiplication, only for the longer ones.
+        if (took > c.period_us && took > c.period_us * flash_get(row.divider) && s.overruns != 0xFFFFu) ++s.overruns;
 #endif
         const ElemOff overruns_off = flash_get(row.overruns_off), worst_us_off = flash_get(row.worst_us_off);
         if (overruns_off != kNoElement || worst_us_off != kNoElement) {

@@ -36,10 +36,10 @@ void inc16(uint16_t& c) {
 void read_config(const Link& l, LinkConfig& c) { flash_read(&c, l.cfg, sizeof c); }
 
 // Copies state vector bytes, atomically when the `lock` option is on.
-void sv_move(const LinkConfig& c, void* dst, const void* src, uint16_t n) {
-    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+void sv_move(bool lock, void* dst, const void* src, uint16_t n) {
+    const pal::IrqState saved = lock ? pal::critical_enter() : 0;
     memcpy(dst, src, n);
-    if (c.lock) pal::critical_exit(saved);
+    if (lock) pal::critical_exit(saved);
 }
 
 // Hands as much of the transmit buffer to the console as it takes now.
@@ -112,14 +112,23 @@ void frame_end(Link& l, bool pump_now, const uint8_t* src = 0, uint16_t n = 0) {
 }
 
 // State vector bytes into the frame, atomically when the lock is on.
-void put_sv(const LinkConfig& c, uint16_t off, uint16_t n) {
-    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
-    put_bytes(c.sv + off, n);
-    if (c.lock) pal::critical_exit(saved);
+void put_sv(const uint8_t* sv, bool lock, uint16_t off, uint16_t n) {
+    const pal::IrqState saved = lock ? pal::critical_enter() : 0;
+    put_bytes(sv + off, n);
+    if (lock) pal::critical_exit(saved);
 }
 
+// What sampling reads of the configuration (the telemetry task reads these
+// fields out of flash one at a time, not the configuration whole).
+struct Sampling {
+    uint8_t* sv;
+    const Executor* ex;
+    LinkStreamState* states;
+    bool lock;
+};
+
 // Sends the open batch of stream i (and the current region when `with_now`).
-void send_batch(Link& l, const LinkConfig& c, const LinkStream& s, LinkStreamState& st, uint8_t i,
+void send_batch(Link& l, const Sampling& c, const LinkStream& s, LinkStreamState& st, uint8_t i,
                 bool with_now) {
     const uint8_t stored = st.count;
     st.count = 0;
@@ -136,12 +145,12 @@ void send_batch(Link& l, const LinkConfig& c, const LinkStream& s, LinkStreamSta
         frame_end(l, false, c.sv + s.off, s.size);  // the region copied in as it is framed
         return;
     }
-    if (with_now) put_sv(c, s.off, s.size);  // atomically, then framed
+    if (with_now) put_sv(c.sv, c.lock, s.off, s.size);  // atomically, then framed
     frame_end(l, false);
 }
 
-void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, uint32_t now32) {
-    LinkStreamState& st = c.stream_state[i];
+void take_sample(Link& l, const Sampling& c, const LinkStream& s, uint8_t i, uint32_t now32) {
+    LinkStreamState& st = c.states[i];
     const uint16_t skipped = c.ex->skipped;
     // Samples of a frame are evenly spaced: a batch the executor broke by
     // skipping cycles goes out as it is (a cycle that only started late
@@ -152,7 +161,7 @@ void take_sample(Link& l, const LinkConfig& c, const LinkStream& s, uint8_t i, u
         st.skipped0 = skipped;
     }
     if (static_cast<uint8_t>(st.count + 1u) < s.batch) {
-        sv_move(c, s.store + st.count * s.size, c.sv + s.off, s.size);
+        sv_move(c.lock, s.store + st.count * s.size, c.sv + s.off, s.size);
         ++st.count;
         return;
     }
@@ -209,7 +218,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         uint16_t n = static_cast<uint16_t>(c.sv_size - off);
         if (n > c.snapshot_chunk) n = c.snapshot_chunk;
         put_u16(off);
-        put_sv(c, off, n);
+        put_sv(c.sv, c.lock, off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= c.sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
     frame_end(l, true);
@@ -376,59 +385,71 @@ void link_begin(Link& l, const LinkConfig* cfg) {
 
 // The telemetry task's step: samples the streams due and sends the sample
 // frames; control frames wait for link_poll, right after the cycle. It reads
-// the configuration up to `lock` only (what sampling uses).
+// the fields it uses out of flash one at a time (no copy of the whole
+// configuration: the task runs every cycle, and 4 runs in 10 on the rocket
+// sample nothing), and the time once, when a stream is due.
 Result link_telemetry_task(void* p) {
     Link& l = *static_cast<Link*>(p);
-    LinkConfig c;
-    flash_read(&c, l.cfg, offsetof(LinkConfig, params));
+    const LinkConfig& f = *l.cfg;
     pump(l);
+    Sampling c;
     uint32_t now32 = 0;
-    bool have_now = false;
-    for (uint8_t i = 0; i < c.n_streams; ++i) {
-        LinkStreamState& st = c.stream_state[i];
+    bool have_c = false;
+    const uint8_t n_streams = flash_get(f.n_streams);
+    LinkStreamState* const states = flash_get(f.stream_state);
+    for (uint8_t i = 0; i < n_streams; ++i) {
+        LinkStreamState& st = states[i];
         if (st.countdown != 0) {
             --st.countdown;
             continue;
         }
-        if (!have_now) {  // the time, once a stream is due
-            now32 = static_cast<uint32_t>(c.now());
-            have_now = true;
+        if (!have_c) {
+            c.sv = flash_get(f.sv);
+            c.ex = flash_get(f.ex);
+            c.states = states;
+            c.lock = flash_get(f.lock);
+            now32 = static_cast<uint32_t>(flash_get(f.now)());
+            have_c = true;
         }
         LinkStream s;
-        flash_read(&s, &c.streams[i], sizeof s);
+        flash_read(&s, &flash_get(f.streams)[i], sizeof s);
         st.countdown = static_cast<uint16_t>(s.every - 1u);
         take_sample(l, c, s, i, now32);
     }
-    if (c.health_every != 0 && --l.health_countdown == 0) {
-        l.health_countdown = c.health_every;
+    const uint16_t health_every = flash_get(f.health_every);
+    if (health_every != 0 && --l.health_countdown == 0) {
+        l.health_countdown = health_every;
         l.pending |= kPendHealth;
-        if (c.hello_every != 0 && --l.hello_countdown == 0) {
-            l.hello_countdown = c.hello_every;
+        const uint8_t hello_every = flash_get(f.hello_every);
+        if (hello_every != 0 && --l.hello_countdown == 0) {
+            l.hello_countdown = hello_every;
             l.pending |= kPendHello;
         }
     }
     return kOk;
 }
 
-// Most runs have nothing to send and receive nothing: with no control
-// frame waiting, service would only hand the transmit buffer to the
-// console, so such a run does that, and copies the configuration out of
-// flash only when a frame has been received whole.
-Result link_uplink_task(void* p) {
-    Link& l = *static_cast<Link*>(p);
+namespace {
+
+// The uplink task's run past its first look: the control frames waiting
+// sent (service), then the bytes received, `b` first when the caller read
+// it already (else -1), into the frame being received; at a delimiter the
+// frame is handled and the link serviced. The configuration is copied out
+// of flash once, when first needed.
+FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
     LinkConfig c;
     bool have_c = false;
     if (l.pending != 0 || l.snapshot_at != kNoSnapshot) {
         read_config(l, c);
         have_c = true;
         service(l, c, false);
-    } else {
-        pump(l);
     }
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
-        if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
-        const int16_t b = pal::console_read();
-        if (b < 0) break;
+        if (k != 0 || b < 0) {  // (else b is the byte the caller read)
+            if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
+            b = pal::console_read();
+            if (b < 0) break;
+        }
         if (b == 0) {
             if (!have_c) {
                 read_config(l, c);
@@ -448,6 +469,25 @@ Result link_uplink_task(void* p) {
             l.rx_over = true;
         }
     }
+}
+
+}  // namespace
+
+// Most runs have nothing to send and receive nothing: with no control
+// frame waiting, service would only hand the transmit buffer to the
+// console, so such a run does that and looks for a received byte, and
+// nothing more (the rest of the run, with the configuration copied out of
+// flash when it needs it, is out of line: its frame on the stack is not
+// paid by these runs).
+Result link_uplink_task(void* p) {
+    Link& l = *static_cast<Link*>(p);
+    if (l.pending != 0 || l.snapshot_at != kNoSnapshot) {
+        uplink_run(l, -1);
+        return kOk;
+    }
+    pump(l);
+    const int16_t b = pal::console_read();
+    if (b >= 0) uplink_run(l, b);
     return kOk;
 }
 

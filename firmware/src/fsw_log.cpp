@@ -23,13 +23,6 @@
 
 namespace fsw {
 
-static_assert(offsetof(LogConfig, sv) == offsetof(LogHot, sv) && offsetof(LogConfig, divider) == offsetof(LogHot, divider) &&
-                  offsetof(LogConfig, state_off) == offsetof(LogHot, state_off) &&
-                  offsetof(LogConfig, runs_mod) == offsetof(LogHot, runs_mod) &&
-                  offsetof(LogConfig, n_states) == offsetof(LogHot, n_states) &&
-                  offsetof(LogConfig, trigger) == offsetof(LogHot, trigger),
-              "LogHot is LogConfig's first fields");
-
 namespace {
 
 // The writer's phases (Recorder::w_phase).
@@ -577,26 +570,12 @@ void log_resume(Recorder& r, uint8_t flight, uint8_t mode) {
     r.flags = kStartDue;
 }
 
-Result log_task(void* ctx) {
-    Recorder& r = *static_cast<Recorder*>(ctx);
-    // Most runs take no sample and find nothing to encode: they read only
-    // the first fields of the table (LogHot) and count the run.
-    LogHot h;
-    flash_read(&h, r.cfg, sizeof h);
-    uint32_t s32;
-    memcpy(&s32, h.sv + h.state_off, sizeof s32);
-    const uint8_t st = s32 < h.n_states ? static_cast<uint8_t>(s32) : 0u;
-    const uint8_t prev = r.state;
-    r.state = st;
-    const uint8_t div = table_u8(h.divider, st);
-    if (st != prev) r.countdown = static_cast<uint8_t>(div != 0 ? (div - r.runs % div) % div : 0u);  // in phase
-    const bool sample = div != 0 && r.countdown == 0;
-    if (div != 0) r.countdown = static_cast<uint8_t>((r.countdown == 0 ? div : r.countdown) - 1u);
-    if (++r.runs == h.runs_mod) r.runs = 0;
-    if (st == prev && !sample &&
-        (r.mode != kLogRecording || (r.r_len == 0 && !(r.flags & (kStartDue | kEnding)))))
-        return kOk;
+namespace {
 
+// The rest of a run that takes a sample, sees the state change or has
+// bytes to encode: out of line, with the whole table copied (its frame on
+// the stack, and the registers it saves, are not paid by the other runs).
+FSW_NOINLINE void log_run(Recorder& r, uint8_t st, uint8_t prev, uint8_t div, bool sample) {
     const LogConfig c = config(r);
     const uint32_t now = now_ms(c);
     if (r.mode == kLogIdle && st == c.trigger && prev != c.trigger) {
@@ -627,6 +606,30 @@ Result log_task(void* ctx) {
         if (r.mode == kLogIdle) trim(c, r, now);  // keep only what the trigger would commit
     }
     encode(c, r, now);
+}
+
+}  // namespace
+
+Result log_task(void* ctx) {
+    Recorder& r = *static_cast<Recorder*>(ctx);
+    // Most runs take no sample and find nothing to encode: they read only
+    // the first fields of the table, a field at a time, and count the run.
+    const LogConfig& h = *r.cfg;
+    const uint8_t* const sv = flash_get(h.sv);
+    uint32_t s32;
+    memcpy(&s32, sv + flash_get(h.state_off), sizeof s32);
+    const uint8_t st = s32 < flash_get(h.n_states) ? static_cast<uint8_t>(s32) : 0u;
+    const uint8_t prev = r.state;
+    r.state = st;
+    const uint8_t div = table_u8(flash_get(h.divider), st);
+    if (st != prev) r.countdown = static_cast<uint8_t>(div != 0 ? (div - r.runs % div) % div : 0u);  // in phase
+    const bool sample = div != 0 && r.countdown == 0;
+    if (div != 0) r.countdown = static_cast<uint8_t>((r.countdown == 0 ? div : r.countdown) - 1u);
+    if (++r.runs == flash_get(h.runs_mod)) r.runs = 0;
+    if (st == prev && !sample &&
+        (r.mode != kLogRecording || (r.r_len == 0 && !(r.flags & (kStartDue | kEnding)))))
+        return kOk;
+    log_run(r, st, prev, div, sample);
     return kOk;
 }
 

@@ -48,8 +48,9 @@ struct LogField {
 
 // The recorder's tables (FSW_FLASH).
 struct LogConfig {
-    // the fields every run of the task reads, first: log_task copies only
-    // these (LogHot) unless the run takes a sample or has work to do
+    // the fields every run of the task reads, first: log_task reads only
+    // these, a field at a time, unless the run takes a sample or has work
+    // to do (then it copies the whole table)
     const uint8_t* sv;          // the state vector
     const uint8_t* divider;     // per state id (0..n_states-1; id 0 unused): task runs between samples, 0: none
     uint16_t state_off;         // the machine's `S` element (U32)
@@ -79,16 +80,6 @@ struct LogConfig {
                                 // escape in the samples (else it closes the record)
     bool newest;                // full: overwrite the oldest records (else stop)
     bool time_us;               // `G` counts microseconds
-};
-
-// LogConfig's first fields, as they lie in it.
-struct LogHot {
-    const uint8_t* sv;
-    const uint8_t* divider;
-    uint16_t state_off;
-    uint16_t runs_mod;
-    uint8_t n_states;
-    uint8_t trigger;
 };
 
 

@@ -28,10 +28,13 @@ struct Check {
     }
 };
 
-// `n` bytes from `p` copied to `at` and into the check: the save's loop, 9
-// cycles a byte on AVR, four bytes a turn after the n % 4 first ones (the
-// same sums as Check::add, in assembly: the compiler's version took twice
-// as long, and the save runs every cycle).
+// The spans' bytes copied to `at` and into the check: the save's loop, 9
+// cycles a byte on AVR, four bytes a turn after each span's n % 4 first
+// ones (the same sums as Check::add, in assembly: the compiler's version
+// took twice as long, and the save runs every cycle). On AVR the walk of
+// the spans' table is in the assembly too: a span's address and size read
+// from flash in 4 instructions, 30 cycles a span where the compiler's
+// loop around the copy took about 45.
 #if defined(__AVR__)
 #define FSW_RESUME_BYTE              \
     "ld __tmp_reg__, Z+\n\t"         \
@@ -41,35 +44,54 @@ struct Check {
     "add %[b], %[a]\n\t"             \
     "adc %[b], __zero_reg__\n\t"
 #endif
-inline uint8_t* copy_checked(uint8_t* at, const uint8_t* p, uint16_t n, Check& k) {
-    if (n == 0) return at;
-#if defined(__AVR__)
-    uint8_t a = k.a, b = k.b;
-    uint8_t odd = static_cast<uint8_t>(n & 3u);
-    uint16_t quads = static_cast<uint16_t>(n >> 2);
+inline uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_spans, Check& k) {
+    if (n_spans == 0) return at;
+#if defined(__AVR__) && FSW_USE_PROGMEM  // the table in flash
+    uint8_t a = k.a, b = k.b, odd;
+    uint16_t quads, table;
     __asm__ __volatile__(
-        "tst %[odd]\n\t"
-        "breq 2f\n\t"
-        "1:\n\t" FSW_RESUME_BYTE
-        "dec %[odd]\n\t"
-        "brne 1b\n\t"
-        "2:\n\t"
+        "1:\n\t"
+        "lpm  r0, Z+\n\t"  // the span's address, in r1:r0 for a moment
+        "lpm  r1, Z+\n\t"
+        "lpm  %A[q], Z+\n\t"  // its size
+        "lpm  %B[q], Z+\n\t"
+        "movw %[table], r30\n\t"  // Z: the span's bytes, the table's place kept
+        "movw r30, r0\n\t"
+        "clr  r1\n\t"
+        "mov  %[odd], %A[q]\n\t"
+        "lsr  %B[q]\n\t"
+        "ror  %A[q]\n\t"
+        "lsr  %B[q]\n\t"
+        "ror  %A[q]\n\t"
+        "andi %[odd], 3\n\t"
+        "breq 3f\n\t"
+        "2:\n\t" FSW_RESUME_BYTE
+        "dec  %[odd]\n\t"
+        "brne 2b\n\t"
+        "3:\n\t"
         "sbiw %[q], 0\n\t"
-        "breq 4f\n\t"
-        "3:\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE
+        "breq 5f\n\t"
+        "4:\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE
         "sbiw %[q], 1\n\t"
-        "brne 3b\n\t"
-        "4:\n\t"
-        : [a] "+r"(a), [b] "+r"(b), [odd] "+r"(odd), [q] "+w"(quads), [p] "+z"(p), [at] "+x"(at)
+        "brne 4b\n\t"
+        "5:\n\t"
+        "movw r30, %[table]\n\t"
+        "dec  %[n]\n\t"
+        "brne 1b\n\t"
+        : [a] "+r"(a), [b] "+r"(b), [n] "+r"(n_spans), [odd] "=&d"(odd), [q] "=&w"(quads), [table] "=&r"(table),
+          [z] "+z"(spans), [at] "+x"(at)
         :
         : "memory");
     k.a = a;
     k.b = b;
 #else
-    for (; n != 0; --n) {
-        const uint8_t v = *p++;
-        *at++ = v;
-        k.add(v);
+    for (uint8_t i = 0; i < n_spans; ++i) {
+        const uint8_t* p = flash_get(spans[i].p);
+        for (uint16_t n = flash_get(spans[i].n); n != 0; --n) {
+            const uint8_t v = *p++;
+            *at++ = v;
+            k.add(v);
+        }
     }
 #endif
     return at;
@@ -109,6 +131,9 @@ bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause) {
     r.cfg = cfg;
     r.seq = 0;
     r.next = 0;
+    const Check seed = seeded(c);
+    r.seed_a = seed.a;
+    r.seed_b = seed.b;
     const int8_t b = (cause & kResetKeepsRam) != 0 && (cause & kResetFresh) == 0 ? newest(c) : -1;
     if (b < 0) {  // a fresh start: no bank from before it may ever be taken for one of this run's
         for (uint8_t k = 0; k < 2; ++k) {
@@ -136,14 +161,8 @@ void resume_save(Resume& r) {
     uint8_t* const bank = flash_get(f.banks) + (r.next != 0 ? size + 3u : 0u);
     bank[size + 1u] = static_cast<uint8_t>(~bank[size + 1u]);  // invalid while it is written
     uint8_t* at = bank;
-    Check k = {0, 0};  // seeded()'s sums, here inline and from flash: a call costs the save 2 us a cycle
-    const uint32_t schema = flash_get(f.schema);
-    uint8_t sch[4];
-    memcpy(sch, &schema, sizeof sch);
-    for (uint8_t i = 0; i < 4; ++i) k.add(sch[i]);
-    const ResumeSpan* const spans = flash_get(f.spans);
-    const uint8_t n_spans = flash_get(f.n_spans);
-    for (uint8_t i = 0; i < n_spans; ++i) at = copy_checked(at, flash_get(spans[i].p), flash_get(spans[i].n), k);
+    Check k = {r.seed_a, r.seed_b};  // seeded()'s sums, as resume_begin found them (4 us a save to work out)
+    at = copy_spans(at, flash_get(f.spans), flash_get(f.n_spans), k);
     r.seq = static_cast<uint8_t>(r.seq + 1u);
     *at = r.seq;
     k.add(r.seq);

@@ -47,6 +47,7 @@ struct Resume {
     const ResumeConfig* cfg;  // FSW_FLASH
     uint8_t seq;              // the newest bank's sequence number
     uint8_t next;             // 0 or 1: the bank the next save writes
+    uint8_t seed_a, seed_b;   // the check's two sums after the schema hash, worked out once at boot
 };
 
 // Boot: when `cause` is a brown-out or a watchdog reset (and neither a

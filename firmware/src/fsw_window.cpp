@@ -32,14 +32,19 @@ static inline bool nonzero(Real x) { return x != 0; }
 
 template <typename I>
 void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
-    x = window_sample(x);
+    // The sample goes into its slot first and is read back from there: the
+    // same operations in the same order, with fewer values to keep across
+    // the float routines' calls (on AVR no call of the register-saving
+    // routine around them).
+    Real* const slot = ring + w.head;
+    const Real oldest = *slot;
+    *slot = window_sample(x);
     if (w.count == n) {
-        w.base = w.base - ring[w.head];  // the oldest sample leaves
+        w.base = w.base - oldest;  // the oldest sample leaves
     } else {
         ++w.count;
     }
-    ring[w.head] = x;
-    w.fresh = w.fresh + x;
+    w.fresh = w.fresh + *slot;
     w.head = step_fwd(w.head, n);
     if (w.head == 0) {
         // A full lap: `fresh` is the in-order sum of exactly the samples in

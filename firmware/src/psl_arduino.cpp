@@ -96,6 +96,7 @@ struct CycleTimer {
     volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
     volatile uint8_t why;       // why the first of them was missed (CycleWait)
     volatile uint8_t running;   // a cycle's tasks are running
+    volatile uint8_t woke;      // a compare interrupt ran since cycle_wait() last looked
 };
 CycleTimer g_ct;
 
@@ -169,6 +170,7 @@ void cycle_timer_begin(uint32_t period_us) {
 uint8_t cycle_wait(uint8_t& skipped, bool background) {
     for (uint8_t pass = 0;; ++pass) {
         cli();
+        g_ct.woke = 0;  // what follows reads all the compare interrupts change
         if (g_ct.due != 0) {  // a start passed (late), or the first cycle
             skipped = static_cast<uint8_t>(g_ct.due - 1u);
             const uint8_t why = g_ct.why;
@@ -198,6 +200,19 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
         SMCR = _BV(SE);  // idle mode (SM2..0 = 0): timers, UART and ADC run on
         sei();
         sleep_cpu();
+        // Without background work only the timer's compare interrupts bring
+        // the loop anything (a cycle due, the last stretch): after another
+        // (the UART's transmit, about 18 a cycle on the demo flight; the
+        // ADC's) the CPU sleeps again at once, without the tests above
+        // (and, as above, no wake-up lost between the test and the sleep).
+        if (!background) {
+            for (;;) {
+                cli();
+                if (g_ct.woke != 0) break;
+                sei();
+                sleep_cpu();
+            }
+        }
         SMCR = 0;
     }
 }
@@ -421,13 +436,25 @@ uint8_t spi_transfer(uint8_t) { return 0xFF; }
 // was missed (the running cycle overran, or something else held the CPU).
 ISR(TIMER1_COMPA_vect) {
     using fsw::pal::g_ct;
+    g_ct.woke = 1;
     if (fsw::pal::sub_period_ended()) {
         if (g_ct.due == 0) g_ct.why = g_ct.running ? fsw::pal::kCycleLateOverrun : fsw::pal::kCycleLateOther;
         if (g_ct.due != 0xFFu) ++g_ct.due;
     }
 }
-// The CPU wakes to wait out the last stretch before a cycle (cycle_wait()).
-EMPTY_INTERRUPT(TIMER1_COMPB_vect);
+// The CPU wakes to wait out the last stretch before a cycle (cycle_wait()),
+// told so by `woke`. Naked: r24 is the only register it changes (ldi and
+// sts leave the status register alone), 12 bytes where the compiler's
+// handler saves r0, r1 and SREG around the store.
+ISR(TIMER1_COMPB_vect, ISR_NAKED) {
+    __asm__ __volatile__(
+        "push r24\n\t"
+        "ldi r24, 1\n\t"
+        "sts %[woke], r24\n\t"
+        "pop r24\n\t"
+        "reti\n\t" ::[woke] "i"(&fsw::pal::g_ct.woke)
+        : "memory");
+}
 #endif
 
 #endif  // FSW_PLATFORM_ARDUINO

@@ -61,15 +61,53 @@ ISR(FSW_UART_RX_VECT) {
 }
 
 // The data register is free: the next byte, and the interrupt off once the
-// ring is empty (console_write turns it back on).
-ISR(FSW_UART_UDRE_VECT) {
-    uint8_t t = g_tx_tail;
-    if (t != g_tx_head) {
-        UDR0 = g_tx[t];
-        t = static_cast<uint8_t>((t + 1u) & kTxMask);
-        g_tx_tail = t;
-    }
-    if (t == g_tx_head) UCSR0B = static_cast<uint8_t>(UCSR0B & ~_BV(UDRIE0));
+// ring is empty (console_write turns it back on). It runs once a byte sent
+// (about 18 times a cycle on the demo flight): naked, it saves only the
+// three registers and the status register it uses, 44 cycles a byte where
+// the compiler's handler took 59. In C:
+//     uint8_t t = g_tx_tail;
+//     if (t != g_tx_head) {
+//         UDR0 = g_tx[t];
+//         t = (t + 1) & kTxMask;
+//         g_tx_tail = t;
+//     }
+//     if (t == g_tx_head) UCSR0B &= ~_BV(UDRIE0);
+ISR(FSW_UART_UDRE_VECT, ISR_NAKED) {
+    __asm__ __volatile__(
+        "push r24\n\t"
+        "in   r24, __SREG__\n\t"
+        "push r24\n\t"
+        "push r30\n\t"
+        "push r31\n\t"
+        "lds  r30, %[tail]\n\t"
+        "lds  r24, %[head]\n\t"
+        "cp   r30, r24\n\t"
+        "breq 1f\n\t"
+        "ldi  r31, 0\n\t"  // Z = g_tx + t
+        "subi r30, lo8(-(%[ring]))\n\t"
+        "sbci r31, hi8(-(%[ring]))\n\t"
+        "ld   r24, Z+\n\t"
+        "sts  %[udr], r24\n\t"
+        "subi r30, lo8(%[ring])\n\t"  // t + 1 (the low byte is all the mask keeps)
+        "andi r30, %[mask]\n\t"
+        "sts  %[tail], r30\n\t"
+        "lds  r24, %[head]\n\t"
+        "cp   r30, r24\n\t"
+        "brne 2f\n\t"
+        "1:\n\t"
+        "lds  r24, %[ucsrb]\n\t"
+        "andi r24, %[no_udrie]\n\t"
+        "sts  %[ucsrb], r24\n\t"
+        "2:\n\t"
+        "pop  r31\n\t"
+        "pop  r30\n\t"
+        "pop  r24\n\t"
+        "out  __SREG__, r24\n\t"
+        "pop  r24\n\t"
+        "reti\n\t" ::[tail] "i"(&g_tx_tail),
+        [head] "i"(&g_tx_head), [ring] "i"(g_tx), [mask] "M"(kTxMask), [udr] "n"(_SFR_MEM_ADDR(UDR0)),
+        [ucsrb] "n"(_SFR_MEM_ADDR(UCSR0B)), [no_udrie] "M"(0xFF & ~_BV(UDRIE0))
+        : "memory");  // it reads the ring console_write fills
 }
 
 namespace fsw {

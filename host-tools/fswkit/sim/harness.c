@@ -221,10 +221,17 @@ static void prof_frame_close(void) {
     prof_frame_open = 0;
 }
 
-/* After each instruction while profiling: `c0` and `slept` are the cycle and
-   whether the core slept before it ran. */
-static void prof_step(avr_t* a, avr_cycle_count_t c0, int slept) {
-    if (slept) prof_sleep += a->cycle - c0;
+/* After each instruction while profiling: `c0`, `slept` and `pc0` are the
+   cycle, whether the core slept before it ran, and where it ran. simavr
+   sleeps in the step of the SLEEP instruction itself (to its next cycle
+   timer): of that step only the instruction's cycle is awake. */
+static void prof_step(avr_t* a, avr_cycle_count_t c0, int slept, avr_flashaddr_t pc0) {
+    if (slept) {
+        prof_sleep += a->cycle - c0;
+    } else if (a->cycle - c0 > 1 && pc0 + 1 <= a->flashend &&
+               (a->flash[pc0] | (a->flash[pc0 + 1] << 8)) == 0x9588 /* SLEEP */) {
+        prof_sleep += a->cycle - c0 - 1;
+    }
     const uint16_t sp = (uint16_t)(a->data[R_SPL] | (a->data[R_SPH] << 8));
     if (prof_active >= 0) {
         if (sp <= prof_sp) return;
@@ -1523,9 +1530,10 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
             }
             const avr_cycle_count_t c0 = a->cycle;
             const int slept = a->state == cpu_Sleeping;
+            const avr_flashaddr_t pc0 = a->pc;
             int st = avr_run(a);
             if (__builtin_expect(cut_now, 0)) power_cut(a);
-            if (prof_n) prof_step(a, c0, slept);
+            if (prof_n) prof_step(a, c0, slept, pc0);
             if (st == cpu_Done || st == cpu_Crashed) {
                 halted = 1;
                 why = st == cpu_Crashed ? "crashed" : "done";

@@ -67,9 +67,9 @@ def pytest_configure(config):
 def pytest_collection_modifyitems(config, items):
     """The costly files first, costliest first, then the rest in their order.
     pytest-xdist hands whole files (--dist loadfile) to the worker that asks
-    next in this order (make test passes --no-loadscope-reorder, which would
-    put the files with the most tests first): a long file started last would
-    keep one core busy after the others are done."""
+    next in this order (make test passes --no-loadscope-reorder: xdist would
+    otherwise put the files with the most tests first): a long file started
+    last would keep one core busy after the others are done."""
     def cost(item) -> float:
         mark = item.get_closest_marker("costly")
         return float(mark.args[0]) if mark and mark.args else 0.0

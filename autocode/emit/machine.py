@@ -27,6 +27,53 @@ def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
     return offsets, size, b"".join(value_bytes(v.type, values[v.index]) for v in vs)
 
 
+def _walk(node, found: list) -> None:
+    """Every Roll and Goto under a statement or expression, into `found`."""
+    if isinstance(node, (M.Roll, M.Goto)):
+        found.append(node)
+    if isinstance(node, (tuple, list)):
+        for x in node:
+            _walk(x, found)
+    elif isinstance(node, (M.Neg, M.Not, M.Arith, M.Cmp, M.ChainCmp, M.Logic, M.Roll, M.Assign, M.If)):
+        for f in node.__dataclass_fields__:
+            if f not in ("line", "col"):
+                _walk(getattr(node, f), found)
+
+
+def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
+    """For each window, the states (indices) whose step must sample it: those
+    from which a state that reads its value can still be reached. In any
+    other state no step can read it again (a state is left only by a
+    transition; a reset and a resume start the windows from empty), so its
+    samples there are never seen (spec 4.6 step 3 made unobservable).
+    None when some window's argument reads another window (then every state
+    samples every window, as the spec words it)."""
+    for w in m.windows:
+        inner: list = []
+        _walk(w.arg, inner)
+        if any(isinstance(x, M.Roll) for x in inner):
+            return None
+    reads: dict[int, set[int]] = {w.index: set() for w in m.windows}
+    succ: dict[int, set[int]] = {}
+    for st in m.states:
+        found: list = []
+        _walk((st.entry, st.step, st.exit), found)
+        succ[st.index] = {x.state for x in found if isinstance(x, M.Goto)}
+        for x in found:
+            if isinstance(x, M.Roll):
+                reads[x.window].add(st.index)
+    reach: dict[int, set[int]] = {}
+    for st in m.states:
+        seen, todo = {st.index}, [st.index]
+        while todo:
+            for t in succ[todo.pop()]:
+                if t not in seen:
+                    seen.add(t)
+                    todo.append(t)
+        reach[st.index] = seen
+    return {w.index: frozenset(i for i in reach if reach[i] & reads[w.index]) for w in m.windows}
+
+
 def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
     """The locals a machine keeps in memory (its `loc` array): those that
     change, and every one in a scriptable build; parameters are apart."""
@@ -139,16 +186,31 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # only windows of lower index (inner calls get theirs first), and equal
     # arguments read the same ones, so every window still sees its argument
     # after the windows it reads were pushed.
+    # A group is sampled only in the states where one of its windows may
+    # still be read (window_states); elsewhere its pushes are skipped.
     args: dict[str, list] = {}
     for w in m.windows:
         args.setdefault(ex.value(w.arg), []).append(w)
+    sampled = window_states(m)
+    every = frozenset(st.index for st in m.states)
     for k, (arg, ws) in enumerate(args.items()):
+        where = every if sampled is None else frozenset().union(*(sampled[w.index] for w in ws))
+        pad = "    "
+        if where != every:
+            names = ", ".join(m.states[i].name for i in sorted(where))
+            c.append(f"    switch (machine.state) {{  // sampled where still read: {names}")
+            for i in sorted(where):
+                c.append(f"    case S_{m.states[i].name}:")
+            c.append("    {")
+            pad = "        "
         if len(ws) == 1:
-            c.append(f"    w{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
-            continue
-        c.append(f"    const fsw::Real x{k} = {arg};")
-        for w in ws:
-            c.append(f"    w{w.index}.push(x{k});  // {src}:{w.line}")
+            c.append(f"{pad}w{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
+        else:
+            c.append(f"{pad}const fsw::Real x{k} = {arg};")
+            for w in ws:
+                c.append(f"{pad}w{w.index}.push(x{k});  // {src}:{w.line}")
+        if where != every:
+            c += ["        break;", "    }", "    default:", "        break;", "    }"]
     moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
     if moves:
         c.append(f"    {sid} next = 0;")

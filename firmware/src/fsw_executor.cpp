@@ -28,6 +28,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     flash_read(&c, cfg, sizeof c);
     if (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0))) return kErrConfig;
     ex.cfg = cfg;
+    uint8_t mirrors = 0;
     for (uint8_t i = 0; i < c.n_tasks; ++i) {
         Task t;
         read_task(c, i, t);
@@ -36,6 +37,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
                           t.worst_us_off != kNoElement)) {
             return kErrConfig;
         }
+        if (t.overruns_off != kNoElement || t.worst_us_off != kNoElement) mirrors = 1;
         TaskStats& s = c.stats[i];
         memset(&s, 0, sizeof s);
         s.countdown = t.phase;
@@ -52,6 +54,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     ex.late_overrun = 0;
     ex.late_other = 0;
     ex.skipped = 0;
+    ex.mirrors = mirrors;
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
@@ -60,16 +63,21 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
 
 void executor_run_cycle(Executor& ex) {
     pal::watchdog_kick();
-    const ExecConfig c = executor_config(ex);
+    // The configuration's fields read out of flash one at a time, only those
+    // a cycle uses (no copy routine for the whole of it: a cycle's 10 us).
+    const ExecConfig& f = *ex.cfg;
+    TaskStats* const stats = flash_get(f.stats);
+    uint8_t* const sv = flash_get(f.sv);
 #if FSW_TASK_TIMING
+    const uint32_t period_us = flash_get(f.period_us);
     // One clock read per task run: a run is timed from the previous run's
     // end (the cycle's start for the first) to its own end, so it counts
     // the executor's few instructions that find and start it too.
     uint32_t mark = pal::micros32();
 #endif
-    const Task* rows = c.tasks;
-    TaskStats* const stats_end = c.stats + c.n_tasks;
-    for (TaskStats* sp = c.stats; sp != stats_end; ++sp, ++rows) {  // a row and its record a turn
+    const Task* rows = flash_get(f.tasks);
+    TaskStats* const stats_end = stats + flash_get(f.n_tasks);
+    for (TaskStats* sp = stats; sp != stats_end; ++sp, ++rows) {  // a row and its record a turn
         TaskStats& s = *sp;
         if (s.countdown != 0) {
             --s.countdown;
@@ -80,7 +88,7 @@ void executor_run_cycle(Executor& ex) {
         const Task& row = *rows;
         s.countdown = static_cast<uint16_t>(flash_get(row.divider) - 1u);
         const ElemOff mode_off = flash_get(row.mode_off);
-        uint8_t* const mode_at = mode_off != kNoElement ? c.sv + mode_off : &s.mode;
+        uint8_t* const mode_at = mode_off != kNoElement ? sv + mode_off : &s.mode;
         const uint8_t mode = *mode_at;
         if (mode == kModeDisabled) continue;
         if (mode == kModeEnabled) {
@@ -101,14 +109,16 @@ void executor_run_cycle(Executor& ex) {
         if (took > s.worst_us) s.worst_us = took;
         // A run within the base period is within the task's (divider >= 1):
         // the product, a 32-bit multiplication, only for the longer ones.
-        if (took > c.period_us && took > c.period_us * flash_get(row.divider) && s.overruns != 0xFFFFu) ++s.overruns;
+        if (took > period_us && took > period_us * flash_get(row.divider) && s.overruns != 0xFFFFu) ++s.overruns;
 #endif
+        if (ex.mirrors == 0) continue;  // no row has an element to mirror into
         const ElemOff overruns_off = flash_get(row.overruns_off), worst_us_off = flash_get(row.worst_us_off);
         if (overruns_off != kNoElement || worst_us_off != kNoElement) {
-            const pal::IrqState saved = c.sv_lock ? pal::critical_enter() : 0;
-            if (overruns_off != kNoElement) store<uint16_t>(c.sv + overruns_off, s.overruns);
-            if (worst_us_off != kNoElement) store<uint32_t>(c.sv + worst_us_off, s.worst_us);
-            if (c.sv_lock) pal::critical_exit(saved);
+            const bool lock = flash_get(f.sv_lock);
+            const pal::IrqState saved = lock ? pal::critical_enter() : 0;
+            if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, s.overruns);
+            if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, s.worst_us);
+            if (lock) pal::critical_exit(saved);
         }
     }
     if (++ex.cycles == 0) ++ex.cycles_high;

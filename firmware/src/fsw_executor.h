@@ -70,6 +70,10 @@ struct Executor {
     uint16_t late_overrun;
     uint16_t late_other;
     uint16_t skipped;
+    // 1: some task mirrors its overruns or worst time into elements (set by
+    // executor_begin from the table: a cycle then looks at no row's offsets
+    // when none does).
+    uint8_t mirrors;
 };
 
 // Cycles run, all 64 bits: `[time] source cycle` keeps counting past the

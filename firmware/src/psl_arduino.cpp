@@ -297,6 +297,68 @@ bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uin
 }  // namespace fsw
 
 // A conversion ended: store its count, start the next or stop.
+#if !defined(MUX5) && FSW_USE_PROGMEM
+// Naked (4 times a cycle on the rocket): it saves only the four registers
+// and the status register it uses, where the compiler's handler also saved
+// r0, r1 and r18 and cleared r1; the C handler below, in assembly.
+ISR(ADC_vect, ISR_NAKED) {
+    __asm__ __volatile__(
+        "push r24\n\t"
+        "in   r24, __SREG__\n\t"
+        "push r24\n\t"
+        "push r25\n\t"
+        "push r30\n\t"
+        "push r31\n\t"
+        "lds  r24, %[adcl]\n\t"  // ADCL first: it latches ADCH
+        "lds  r25, %[adch]\n\t"
+        "lds  r30, %[raw]\n\t"
+        "lds  r31, %[raw]+1\n\t"
+        "st   Z+, r24\n\t"
+        "st   Z+, r25\n\t"
+        "lds  r24, %[left]\n\t"
+        "subi r24, 1\n\t"
+        "sts  %[left], r24\n\t"
+        "breq 1f\n\t"
+        "sts  %[raw], r30\n\t"  // the next count's place
+        "sts  %[raw]+1, r31\n\t"
+        "lds  r30, %[pin]\n\t"  // the next pin (no r1 = 0 assumed: ldi leaves the carry)
+        "lds  r31, %[pin]+1\n\t"
+        "lds  r24, %[stride]\n\t"
+        "add  r30, r24\n\t"
+        "ldi  r24, 0\n\t"
+        "adc  r31, r24\n\t"
+        "sts  %[pin], r30\n\t"
+        "sts  %[pin]+1, r31\n\t"
+        "lpm  r30, Z\n\t"  // adc_convert: the pin's channel, the reference, the start
+        "cpi  r30, %[a0]\n\t"
+        "brlo 2f\n\t"
+        "subi r30, %[a0]\n\t"
+        "2:\n\t"
+        "andi r30, 7\n\t"
+        "ori  r30, %[refs]\n\t"
+        "sts  %[admux], r30\n\t"
+        "lds  r24, %[adcsra]\n\t"
+        "ori  r24, %[start]\n\t"
+        "rjmp 3f\n\t"
+        "1:\n\t"
+        "lds  r24, %[adcsra]\n\t"  // the last: the interrupt off
+        "andi r24, %[stop]\n\t"
+        "3:\n\t"
+        "sts  %[adcsra], r24\n\t"
+        "pop  r31\n\t"
+        "pop  r30\n\t"
+        "pop  r25\n\t"
+        "pop  r24\n\t"
+        "out  __SREG__, r24\n\t"
+        "pop  r24\n\t"
+        "reti\n\t" ::[adcl] "n"(_SFR_MEM_ADDR(ADCL)),
+        [adch] "n"(_SFR_MEM_ADDR(ADCH)), [raw] "i"(&fsw::pal::g_scan.raw), [left] "i"(&fsw::pal::g_scan.left),
+        [pin] "i"(&fsw::pal::g_scan.pin), [stride] "i"(&fsw::pal::g_scan.stride), [a0] "M"(A0),
+        [refs] "M"(_BV(REFS0)), [admux] "n"(_SFR_MEM_ADDR(ADMUX)), [adcsra] "n"(_SFR_MEM_ADDR(ADCSRA)),
+        [start] "M"(_BV(ADIF) | _BV(ADIE) | _BV(ADSC)), [stop] "M"(0xFF & ~_BV(ADIE))
+        : "memory");
+}
+#else
 ISR(ADC_vect) {
     using fsw::pal::g_scan;
     const uint8_t lo = ADCL;  // ADCL first: it latches ADCH
@@ -313,6 +375,7 @@ ISR(ADC_vect) {
         ADCSRA = static_cast<uint8_t>(ADCSRA & ~_BV(ADIE));
     }
 }
+#endif
 
 namespace fsw {
 namespace pal {

@@ -30,6 +30,19 @@ static void test_analog_conversion_formula(void) {
     ASSERT_REAL_SAME(big * Real(0.5), analog_value(65535, Real(0.5), 0));
 }
 
+// Every count converts exactly, as the cast does (on AVR real_from_count
+// puts the float's bits together in assembly).
+static void test_every_count_converts_as_the_cast(void) {
+    for (uint32_t n = 0; n <= 0xFFFFu; ++n) {
+        volatile uint16_t count = static_cast<uint16_t>(n);  // no constant folding
+        const Real got = real_from_count(count);
+        const Real want = static_cast<Real>(static_cast<uint16_t>(count));
+        if (memcmp(&got, &want, sizeof got) != 0) {
+            TEST_ASSERT_EQUAL_UINT32(n, 0x10000UL);  // reports the first count that differs
+        }
+    }
+}
+
 #if FSW_REAL_IS_FLOAT
 // Bit patterns of analog_value for rocket.aio's two calibrations, as the
 // host computes them (fswkit.autocode.iotables.analog_value; the host test
@@ -278,6 +291,7 @@ static void test_resolved_pins_drive_and_read(void) {
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_analog_conversion_formula);
+    RUN_TEST(test_every_count_converts_as_the_cast);
     RUN_TEST(test_pwm_duty_from_volts);
 #if FSW_REAL_IS_FLOAT
     RUN_TEST(test_analog_conversion_matches_the_host_bit_for_bit);

@@ -551,6 +551,9 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
             out.append(f"    store_G_now(sv + E_{g});")
         else:
             out.append(f"    fsw::store<uint64_t>(sv + E_{g}, {_now(app)});")
+        if app.time_source != "cycle":  # a clock may not have ticked since the last run (docs/runtime.md)
+            out.append(f"    if (fsw::machine_same_tick({c_ident(m.name)}::machine, sv + E_{g})) return fsw::kOk;"
+                       "  // the same tick as its last step: the next run steps")
         if app.reload is not None and app.reload.machine == t.machine:
             out.append("    return fsw::reload_step(reload);  // the generated machine, or an uploaded image")
         else:

@@ -75,6 +75,15 @@ FSW_MUST_CHECK inline Result machine_begin(Machine& m, const uint8_t* g, uint8_t
 }
 #endif
 
+// Whether G at `g` is the G of the machine's last accepted step: a cycle
+// that started in the same tick of a coarse clock as the one before (the
+// cycle right after a late one can). A machine task then leaves the step
+// for its next run rather than run one the step refuses (kErrTime, which
+// safes the task); a G that went back is still the step's error.
+inline bool machine_same_tick(const Machine& m, const uint8_t* g) {
+    return m.started != 0 && memcmp(g, &m.last_g, sizeof m.last_g) == 0;  // bytes: no 64-bit compare inline
+}
+
 // T, the time spent in the current state (valid after machine_begin_step).
 inline uint64_t machine_T(const Machine& m) { return m.t; }
 

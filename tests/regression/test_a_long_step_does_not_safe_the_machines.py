@@ -1,0 +1,49 @@
+"""A long uplink step (a machine upload's commit checks the image in the
+EEPROM: 21 ms on an ATmega2560) made the next cycle start in the same
+millisecond as the late one: G (`[time] source clock, unit ms`) had not
+moved, both machine steps refused it (kErrTime) and the executor safed nav
+and mission, the rocket's flight logic, with the board otherwise running.
+The pending activation then never came. A machine task now leaves a step
+whose G is its last step's for its next run (fsw::machine_same_tick).
+
+The case as tools/bench_reload.py found it: examples/rocket on a simulated
+ATmega2560 at 9,600 baud, its mission machine uploaded and activated
+through a link that loses 20 % of the frames each way (seed 1)."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import shutil
+
+import pytest
+
+from conftest import EXAMPLES, ROOT
+
+pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
+                                 reason="gcc-avr and libsimavr-dev are needed (make setup)"),
+              pytest.mark.costly(12)]
+
+
+def _bench_reload():
+    spec = importlib.util.spec_from_file_location("bench_reload", ROOT / "tools" / "bench_reload.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_an_upload_over_a_lossy_9600_baud_link_activates_and_no_machine_is_safed(tmp_path, monkeypatch):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.cli.machine import image_for
+    from fswkit.reload.sim import timed_upload
+
+    R = _bench_reload()
+    monkeypatch.setattr(R, "OUT", str(tmp_path))
+    app, built = R.built(R.rocket_variant("rocket-9600", 9600))
+    d = Diagnostics()
+    got = image_for(app, str(EXAMPLES / "rocket" / "mission.sm"), d)
+    assert got is not None, d.render()
+    image, mask, _m = got
+    # before the fix: MachineError "still waiting after 30 s", nav and mission safed with a fault each
+    r = timed_upload(built.artifact, "mega2560", app, image, mask, loss=0.2, seed=1)
+    assert r.slot in (1, 2) and r.activate_s < 5.0, r

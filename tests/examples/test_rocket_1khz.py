@@ -6,20 +6,17 @@ cleanly and builds within the rocket's budget."""
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import shutil
 
 import pytest
 
 from conftest import ROOT
+from support.tools import tool
 
 
 def bench_busy():
-    spec = importlib.util.spec_from_file_location("bench_busy", ROOT / "tools" / "bench_busy.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return tool("bench_busy")
 
 
 def test_the_1khz_rocket_is_the_example_at_1khz(tmp_path, fsw):

@@ -6,23 +6,20 @@ matches the telemetry value for value."""
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 
 import pytest
 
-from conftest import ROOT, run_fsw
+from conftest import run_fsw
+from support.tools import tool
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
 
 def bench_recorder():
-    spec = importlib.util.spec_from_file_location("bench_recorder", ROOT / "tools" / "bench_recorder.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return tool("bench_recorder")
 
 
 def test_the_rocket_records_every_flight_element_at_100_hz_on_a_flash(tmp_path):

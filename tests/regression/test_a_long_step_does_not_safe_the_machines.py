@@ -12,13 +12,13 @@ through a link that loses 20 % of the frames each way (seed 1)."""
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 
 import pytest
 
-from conftest import EXAMPLES, ROOT
+from conftest import EXAMPLES
+from support.tools import tool
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
@@ -26,10 +26,7 @@ pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.
 
 
 def _bench_reload():
-    spec = importlib.util.spec_from_file_location("bench_reload", ROOT / "tools" / "bench_reload.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return tool("bench_reload")
 
 
 def test_an_upload_over_a_lossy_9600_baud_link_activates_and_no_machine_is_safed(tmp_path, monkeypatch):

@@ -608,14 +608,16 @@ def model_children(n: M.Expr):
 
 # ---- literals in the run's evaluation type -----------------------------------
 
-def _stmt_exprs(stmts):
+def stmt_exprs(stmts):
+    """Every expression of a statement list (conditions and assigned values),
+    nested ones included."""
     for st in stmts:
         if isinstance(st, M.Assign):
             yield st.expr
         elif isinstance(st, M.If):
             yield st.cond
-            yield from _stmt_exprs(st.then)
-            yield from _stmt_exprs(st.orelse)
+            yield from stmt_exprs(st.then)
+            yield from stmt_exprs(st.orelse)
 
 
 def machine_exprs(m: M.Machine):
@@ -625,7 +627,7 @@ def machine_exprs(m: M.Machine):
             yield v.init
     for st in m.states:
         for block in (st.entry, st.step, st.exit):
-            yield from _stmt_exprs(block)
+            yield from stmt_exprs(block)
 
 
 def script_exprs(s: M.Script):

@@ -9,6 +9,7 @@ logic; every algorithm lives in the hand-written runtime (firmware/src)."""
 from __future__ import annotations
 
 from .. import model as M
+from ..check import gotos, model_children, stmt_exprs
 from ..cnames import enumerator
 from ..evaluate import local_values
 from ..numeric import Real
@@ -27,17 +28,15 @@ def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
     return offsets, size, b"".join(value_bytes(v.type, values[v.index]) for v in vs)
 
 
-def _walk(node, found: list) -> None:
-    """Every Roll and Goto under a statement or expression, into `found`."""
-    if isinstance(node, (M.Roll, M.Goto)):
-        found.append(node)
-    if isinstance(node, (tuple, list)):
-        for x in node:
-            _walk(x, found)
-    elif isinstance(node, (M.Neg, M.Not, M.Arith, M.Cmp, M.ChainCmp, M.Logic, M.Roll, M.Assign, M.If)):
-        for f in node.__dataclass_fields__:
-            if f not in ("line", "col"):
-                _walk(getattr(node, f), found)
+def _rolls(e: M.Expr) -> list[M.Roll]:
+    """Every window read in an expression, nested ones included."""
+    out, todo = [], [e]
+    while todo:
+        n = todo.pop()
+        if isinstance(n, M.Roll):
+            out.append(n)
+        todo.extend(model_children(n))
+    return out
 
 
 def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
@@ -48,20 +47,17 @@ def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
     samples there are never seen (spec 4.6 step 3 made unobservable).
     None when some window's argument reads another window (then every state
     samples every window, as the spec words it)."""
-    for w in m.windows:
-        inner: list = []
-        _walk(w.arg, inner)
-        if any(isinstance(x, M.Roll) for x in inner):
-            return None
+    if any(_rolls(w.arg) for w in m.windows):
+        return None
     reads: dict[int, set[int]] = {w.index: set() for w in m.windows}
     succ: dict[int, set[int]] = {}
     for st in m.states:
-        found: list = []
-        _walk((st.entry, st.step, st.exit), found)
-        succ[st.index] = {x.state for x in found if isinstance(x, M.Goto)}
-        for x in found:
-            if isinstance(x, M.Roll):
-                reads[x.window].add(st.index)
+        blocks = (st.entry, st.step, st.exit)
+        succ[st.index] = {g.state for block in blocks for g in gotos(block)}
+        for block in blocks:
+            for e in stmt_exprs(block):
+                for r in _rolls(e):
+                    reads[r.window].add(st.index)
     reach: dict[int, set[int]] = {}
     for st in m.states:
         seen, todo = {st.index}, [st.index]

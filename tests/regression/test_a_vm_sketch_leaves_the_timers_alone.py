@@ -15,9 +15,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
 ARDUINO = Path("/usr/share/arduino/hardware/arduino/avr")
-AVR = ROOT / "build" / "firmware" / "avr"
 
 SKETCH = r"""
 #include <Arduino.h>
@@ -46,23 +44,13 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not ARDUINO.i
                                 reason="gcc-avr and arduino-core-avr are needed (make setup)")
 
 
-def test_a_vm_sketch_links_no_cycle_timer_or_adc_interrupt(tmp_path):
-    r = subprocess.run(["make", "--no-print-directory", "-f", "mk/firmware.mk",
-                        str((AVR / "libfswkit.a").relative_to(ROOT)), str((AVR / "core.a").relative_to(ROOT))],
-                       cwd=ROOT, capture_output=True, text=True)
-    assert r.returncode == 0, r.stdout + r.stderr
-    src, elf = tmp_path / "sketch.cpp", tmp_path / "sketch.elf"
-    src.write_text(SKETCH)
-    r = subprocess.run(["avr-g++", "-std=gnu++11", "-Os", "-ffunction-sections", "-fdata-sections",
-                        "-fno-exceptions", "-fno-rtti", "-fno-threadsafe-statics", "-mmcu=atmega328p",
-                        "-DF_CPU=16000000L", "-DARDUINO=10819", "-DARDUINO_AVR_UNO", "-DARDUINO_ARCH_AVR",
-                        f"-I{ARDUINO}/cores/arduino", f"-I{ARDUINO}/variants/standard",
-                        f"-I{ROOT / 'firmware' / 'src'}", "-Wall", "-Wextra", "-Werror",
-                        "-o", str(elf), str(src), str(AVR / "libfswkit.a"), str(AVR / "core.a"),
-                        "-Wl,--gc-sections"], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
-    syms = subprocess.run(["avr-nm", "-C", str(elf)], capture_output=True, text=True, check=True).stdout
-    assert "fsw::vm_step" in syms and "fsw::pal::eeprom_read" in syms, syms  # the sketch is what it says
+def test_a_vm_sketch_links_no_cycle_timer_or_adc_interrupt():
+    from support.simfw import sketch_elf
+
+    elf = sketch_elf("vm-eeprom-sketch", SKETCH)  # as fsw build links: the runtime's archive, LTO
+    syms = subprocess.run(["avr-nm", "-C", elf], capture_output=True, text=True, check=True).stdout
+    # the sketch is what it says: the VM's interpreter, its EEPROM verifier and the EEPROM read (LTO inlines the rest)
+    assert "::run_block(" in syms and "EepromImage" in syms and "fsw::pal::eeprom_read" in syms, syms
     # ATmega328P vectors: 11 TIMER1_COMPA (the cycle timer), 21 ADC (the scan); 22 EE_READY is the EEPROM's own
     vectors = {int(line.split("__vector_")[1]) for line in syms.splitlines()
                if " T __vector_" in line and line.split("__vector_")[1].isdigit()}

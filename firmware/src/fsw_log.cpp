@@ -681,12 +681,12 @@ void eeprom_next(const LogConfig& c, Recorder& r) {
 
 }  // namespace
 
+bool log_busy(const Recorder& r) { return log_writing(r); }
+
 // On an AVR a byte takes 3.4 ms: one is written per call, and the
 // EEPROM-ready interrupt wakes the loop for the next. A store that is ready
 // again at once (simavr's, the host's model) takes a few per call, so the
 // simulated writer is never slower than the silicon's.
-bool log_busy(const Recorder& r) { return log_writing(r); }
-
 void log_eeprom_poll(Recorder& r) {
     if (!log_writing(r) || !pal::eeprom_ready()) return;
     const LogConfig c = config(r);

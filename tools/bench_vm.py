@@ -23,6 +23,7 @@ import bench_firmware as B  # noqa: E402
 from fswkit.autocode.emit.bytecode import compile_machine, window_ram  # noqa: E402
 from fswkit.autocode.numeric import F32MODE  # noqa: E402
 from fswkit.autocode.vmverify import TYPE_CODES  # noqa: E402
+from fswkit.target.build import elf_symbols  # noqa: E402
 
 
 def image_header(folder: str) -> tuple[int, int]:
@@ -85,11 +86,8 @@ def main() -> int:
     vm_flash = s[2][0] - s[0][0] - size
     vm_ram = s[2][1] - s[0][1] - size
     # what the VM probe's RAM holds beyond the bare sketch's, by symbol
-    ram_syms = {}
-    for i in (0, 2):
-        text = B.sh(["avr-nm", "-S", "-C", elfs[i]]).stdout
-        ram_syms[i] = {m.group(3): int(m.group(2), 16)
-                       for m in re.finditer(r"^([0-9a-f]+) ([0-9a-f]+) [bBdD] (.*)$", text, re.M)}
+    ram_syms = {i: {name: size for _addr, size, kind, name in elf_symbols(elfs[i]) if kind in "bBdD"}
+                for i in (0, 2)}
     extra = {k.replace("(anonymous namespace)::", ""): v for k, v in ram_syms[2].items() if k not in ram_syms[0]}
     print("  the VM probe's RAM beyond the bare sketch's, by symbol: "
           + ", ".join(f"{k} {v}" for k, v in sorted(extra.items(), key=lambda kv: -kv[1]))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from . import model as M
 
 MAGIC = b"FSMB"
-VERSION = 1
+VERSION = 2
 HEADER = 28
 NONE = 0xFFFF  # a state without this block
 FLAG_LOCK = 1
@@ -25,6 +25,14 @@ NEG, ADD, SUB, MUL, DIV = 0x10, 0x11, 0x12, 0x13, 0x14
 LT, LE, GT, GE, EQ, NE, NOT, TRUTH = 0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E, 0x1F
 ARITH = {"+": ADD, "-": SUB, "*": MUL, "/": DIV}
 COMPARE = {"<": LT, "<=": LE, ">": GT, ">=": GE, "==": EQ, "!=": NE}
+# Typed tests and stores (version 2): the generated code's fast paths.
+JKEY, JINT, SETK, IADD, JCMP = 0x20, 0x21, 0x22, 0x23, 0x24
+REF_LOCAL = 0x8000  # a typed instruction's variable: element k, local REF_LOCAL + k
+REF_T = 0xFFFF  # or T (JINT only)
+TYPE_T = 0xFE
+JUMP_IF = 0x80  # JINT/JCMP: jump when the test holds (else when it fails)
+KEY_INCLUSIVE, KEY_JUMP_IF = 1, 2  # JKEY's flags
+CMP_CODES = {"<": 0, "<=": 1, ">": 2, ">=": 3, "==": 4, "!=": 5}
 
 WINDOW_FUNCS = {"avg": 0, "min": 1, "max": 2, "range": 3, "median": 4}
 # Element types as the runtime numbers them (fsw_types.h ElemType).
@@ -80,7 +88,28 @@ def operand_bytes(op: int, real: int) -> int | None:
         return 3
     if op == CONST:
         return real
+    if op in (JKEY, JINT, SETK, IADD):
+        return 2  # the ref; the rest is its type's
+    if op == JCMP:
+        return 3
     return None
+
+
+def _wrong_type(ref: int) -> int:
+    return BAD_LOCAL if REF_LOCAL <= ref != REF_T else BAD_ELEMENT
+
+
+def _ref_type(im: bytes, p: "Parts", layout: Layout, ref: int, lock: bool) -> tuple[int, int]:
+    """(reason, type code) of a typed instruction's variable (TYPE_T: T)."""
+    if ref == REF_T:
+        return OK, TYPE_T
+    if ref >= REF_LOCAL:
+        if ref - REF_LOCAL >= p.locals:
+            return BAD_LOCAL, 0
+        return OK, im[p.loc + 3 * (ref - REF_LOCAL)]
+    if ref >= len(layout.elems) or lock:
+        return BAD_ELEMENT, 0
+    return OK, layout.elems[ref][1]
 
 
 @dataclass
@@ -192,6 +221,69 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
             pend.append([target, depth - 1 if op == JF else depth])
             if op == JMP:
                 reachable = False
+        elif op in (JKEY, JINT, SETK, IADD):
+            ref = _u16(code, a)
+            lock = bool(im[6] & FLAG_LOCK)
+            why, t = _ref_type(im, p, layout, ref, lock)
+            if why != OK:
+                return why, deepest
+            b = a + 2
+            at = 0
+            if op == JKEY:
+                if t not in (TYPE_CODES["F32"], TYPE_CODES["F64"]):
+                    return _wrong_type(ref), deepest
+                at = 1 + TYPE_SIZES[t]
+                more = at + 2
+            elif op == JINT:
+                if t != TYPE_T and t > TYPE_CODES["U64"] and t != TYPE_CODES["bool"]:
+                    return _wrong_type(ref), deepest
+                at = 1 + (4 if t == TYPE_T else TYPE_SIZES[t])
+                more = at + 2
+            elif op == SETK:
+                if t == TYPE_T:
+                    return _wrong_type(ref), deepest
+                more = TYPE_SIZES[t]
+            else:
+                if t > TYPE_CODES["U64"]:
+                    return _wrong_type(ref), deepest
+                more = 6
+            if pc + more > p.code_size:
+                return BAD_OPCODE, deepest
+            pc += more
+            if op == SETK:
+                if t == TYPE_CODES["bool"] and code[b] > 1:
+                    return BAD_OPCODE, deepest
+            elif op == IADD:
+                src = _u16(code, b)
+                why, ts = _ref_type(im, p, layout, src, lock)
+                if why != OK:
+                    return why, deepest
+                if ts > TYPE_CODES["U64"]:
+                    return _wrong_type(src), deepest
+                k = struct.unpack_from("<i", code, b + 2)[0]
+                if real == 4 and not -16777215 <= k <= 16777215:
+                    return BAD_OPCODE, deepest
+            else:
+                if (code[b] & ~(KEY_INCLUSIVE | KEY_JUMP_IF)) if op == JKEY else (code[b] & ~JUMP_IF) > 5:
+                    return BAD_OPCODE, deepest
+                target = pc + _u16(code, b + at)
+                if target >= p.code_size:
+                    return BAD_JUMP, deepest
+                if len(pend) == pending:
+                    return TOO_NESTED, deepest
+                pend.append([target, depth])
+        elif op == JCMP:
+            if (code[a] & ~JUMP_IF) > 5:
+                return BAD_OPCODE, deepest
+            pops = 2
+            if depth < pops:
+                return BAD_STACK, deepest
+            target = pc + _u16(code, a + 1)
+            if target >= p.code_size:
+                return BAD_JUMP, deepest
+            if len(pend) == pending:
+                return TOO_NESTED, deepest
+            pend.append([target, depth - 2])
         elif op in (CONST, LDT):
             pushes = 1
         elif op in (LDE, STE):
@@ -283,3 +375,22 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
         if im[p.win + 4 * w] > 4 or im[p.win + 4 * w + 1] != 0 or n == 0:
             return BAD_WINDOW
     return _verify_code(im, p, layout, stack, pending)[0]
+
+
+def opcodes(im: bytes, layout: Layout) -> list[int]:
+    """The opcode of each instruction of a verified image, in code order
+    (what a listing or a test of the compiler's output walks)."""
+    p = parts(im)
+    code = im[p.code:p.code + p.code_size]
+    lock = bool(im[6] & FLAG_LOCK)
+    out, pc = [], 0
+    while pc < p.code_size:
+        op = code[pc]
+        n = operand_bytes(op, im[5])
+        if op in (JKEY, JINT, SETK, IADD):
+            t = _ref_type(im, p, layout, _u16(code, pc + 1), lock)[1]
+            size = 4 if t == TYPE_T else TYPE_SIZES[t]
+            n += {JKEY: 3 + size, JINT: 3 + size, SETK: size, IADD: 6}[op]
+        out.append(op)
+        pc += 1 + n
+    return out

@@ -2,21 +2,34 @@
 (firmware/src/fsw_vm.cpp): the same step as the C++ that emit/machine.py
 generates, evaluated in R over the same runtime helpers.
 
-The C++ emitter's fast paths (integer compares and adds, binary32 threshold
-tests, folded locals, x * 2^-k for x / 2^k) are bit-identical to plain R
-evaluation (the differential tests hold them to that), so the image
-carries the plain R form of every expression. Compilation is a pure
-function: the same machine gives the same bytes."""
+Conditions compile to tests that jump, and the C++ emitter's integer
+compares and adds, binary32 threshold tests and constant stores have typed
+instructions of their own (JINT, JKEY, IADD, SETK): each is bit-identical
+to plain R evaluation (the differential tests hold both to that), and saves
+the VM the conversions to and from R. A local the machine never
+writes (and that is no parameter) is a constant in the code, as in the
+C++; `scriptable` keeps every local a variable, for a state script that
+writes them (as the C++ emitter's own flag does). Compilation is a pure function: the same machine gives the same bytes."""
 
 from __future__ import annotations
 
+import math
 import struct
 
 from .. import model as M
-from ..evaluate import local_values
-from ..numeric import Real
+from ..check import assigned_vars
+from ..evaluate import NotConstant, compare, evaluate, local_values
+from ..numeric import Real, to_type
+from ..thresholds import tests
 from .. import vmverify as V
 from .common import value_bytes
+
+# `a op b` is `b _FLIP[op] a`.
+_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+
+
+def _no_reads(i: int):
+    raise NotConstant(None)
 
 
 class BytecodeError(Exception):
@@ -76,8 +89,10 @@ class _Code:
     """Code of one machine: bytes, with forward jumps patched once their
     target is known."""
 
-    def __init__(self, m: M.Machine, real: Real, elem_index: dict[str, int], loc_index: dict[int, int]):
+    def __init__(self, m: M.Machine, real: Real, elem_index: dict[str, int], loc_index: dict[int, int],
+                 consts: dict[int, float]):
         self.m, self.real = m, real
+        self.consts = consts  # locals read as constants: their R values
         self.b = bytearray()
         self.elem_index, self.loc_index = elem_index, loc_index
         self.fmt = "<f" if real.bits == 32 else "<d"
@@ -96,7 +111,7 @@ class _Code:
         self.b[after - 2:after] = struct.pack("<H", d)
 
     # -- expressions: each leaves one R on the stack -----------------------------
-    def top(self, e: M.Expr) -> None:
+    def top(self, e: M.Expr, emit: bool = True) -> None:
         """A whole expression (a statement's or a window's), refused where
         it needs more of the operand stack than the VM has."""
         need = stack_depth(e)
@@ -104,13 +119,17 @@ class _Code:
             raise BytecodeError(f"this expression needs an operand stack of {need} values; the VM has "
                                 f"{V.VM_STACK} (FSW_VM_STACK): split it over locals (not supported yet)",
                                 e.line, e.col)
-        self.value(e)
+        if emit:
+            self.value(e)
 
     def value(self, e: M.Expr) -> None:
         t = type(e)
         if t is M.Const:
             self.op(V.CONST)
             self.b += struct.pack(self.fmt, self.real.literal(e.text))
+        elif t is M.Ref and e.var in self.consts:
+            self.op(V.CONST)
+            self.b += struct.pack(self.fmt, self.consts[e.var])
         elif t is M.Ref:
             v = self.m.vars[e.var]
             if v.kind == M.TIME_IN_STATE:
@@ -153,6 +172,187 @@ class _Code:
         else:  # pragma: no cover - the model has no other expression
             raise BytecodeError(f"{t.__name__}: not supported yet", e.line, e.col)
 
+    # -- conditions: a tree of tests, compiled to jumps ---------------------------
+    # ("const", b) | ("key", ref, size, key, inclusive) | ("int", ref, cmp, c bytes)
+    # | ("cmp", op, left, right) | ("value", e) | ("not", n) | ("and"|"or", a, b)
+    def ref(self, i: int) -> int | None:
+        """A typed instruction's operand for variable `i`, or None (T, an
+        element of a locked state vector, an index past the encoding)."""
+        v = self.m.vars[i]
+        if v.kind == M.ELEMENT:
+            k = self.elem_index[v.name]
+            return k if k < V.REF_LOCAL and not self.m.sv.lock else None
+        if v.kind == M.LOCAL:
+            k = self.loc_index[v.index]
+            return V.REF_LOCAL + k if k < V.REF_T - V.REF_LOCAL else None
+        return None
+
+    def known(self, e: M.Expr):
+        """The R value of a literal or of a local read as a constant."""
+        if type(e) is M.Const:
+            return self.real.literal(e.text)
+        return self.consts.get(e.var) if type(e) is M.Ref else None
+
+    def exact_int_const(self, e: M.Expr):
+        """A literal integer of magnitude below 2^p (p = R's precision)."""
+        x = self.known(e)
+        if x is None or x != x or x in (math.inf, -math.inf) or x != int(x):
+            return None
+        c = int(x)
+        return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
+
+    def int_var(self, e: M.Expr):
+        """The integer or bool variable (or T) `e` reads, or None."""
+        if type(e) is not M.Ref:
+            return None
+        v = self.m.vars[e.var]
+        if v.kind == M.TIME_IN_STATE:
+            return v
+        if v.type.kind == "float" or e.var in self.consts or self.ref(e.var) is None:
+            return None
+        return v
+
+    def int_test(self, left: M.Expr, op: str, right: M.Expr):
+        """`x op c` on the integer itself, as the C++ emitter's int_compare:
+        a node, or None."""
+        v, c = self.int_var(left), self.exact_int_const(right)
+        if v is None or c is None:
+            v, c, op = self.int_var(right), self.exact_int_const(left), _FLIP[op]
+            if v is None or c is None:
+                return None
+        t = v.type
+        lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
+        points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
+        results = {compare(op, x, c) for x in points}
+        if len(results) == 1:
+            return ("const", results.pop())
+        if v.kind == M.TIME_IN_STATE:
+            if not 0 <= c < 0xFFFFFFFF:
+                return None
+            return ("int", V.REF_T, V.CMP_CODES[op], struct.pack("<I", c))
+        cb = bytes((c,)) if t.kind == "bool" else c.to_bytes(t.size, "little", signed=t.signed)
+        return ("int", self.ref(v.index), V.CMP_CODES[op], cb)
+
+    def key_test(self, left: M.Expr, op: str, right: M.Expr):
+        """binary32 R: `R(x) op c` for a float variable x as threshold tests
+        on x's stored bytes (autocode/thresholds.py), as the C++ emitter's
+        float_key_test: a node, or None."""
+        if self.real.bits != 32:
+            return None
+        x, cv = left, self.known(right)
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            x, cv, op = right, self.known(left), _FLIP[op]
+        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+            return None
+        v = self.m.vars[x.var]
+        if v.kind == M.TIME_IN_STATE or v.type.kind != "float" or self.ref(x.var) is None:
+            return None
+        negate = op == "!="
+        terms = tests("==" if negate else op, cv, v.type.size)
+        if terms is None:
+            return None
+        node = None
+        for neg, t in terms:
+            term = ("const", t) if isinstance(t, bool) else ("key", self.ref(x.var), v.type.size, *t)
+            term = ("not", term) if neg else term
+            node = term if node is None else ("and", node, term)
+        node = ("not", node) if negate else node
+        folded = _simplify(node)
+        # A NaN reads as +0 (its key is +0's): one key read covers both.
+        assert folded[0] != "const" or folded[1] == compare(op, 0.0, cv)
+        return folded
+
+    def tree(self, e: M.Expr):
+        t = type(e)
+        if t is M.Cmp:
+            node = self.int_test(e.left, e.op, e.right)
+            if node is None:
+                node = self.key_test(e.left, e.op, e.right)
+            return node if node is not None else ("cmp", e.op, e.left, e.right)
+        if t is M.ChainCmp:
+            node = None
+            for k, op in enumerate(e.ops):
+                pair = self.tree(M.Cmp(op, e.operands[k], e.operands[k + 1], e.line, e.col))
+                node = pair if node is None else ("and", node, pair)
+            return node
+        if t is M.Logic:
+            return (e.op, self.tree(e.left), self.tree(e.right))
+        if t is M.Not:
+            return ("not", self.tree(e.operand))
+        return ("value", e)
+
+    def jumps(self, n, sense: bool) -> list[int]:
+        """Code that jumps when `n` is `sense` and falls through otherwise:
+        the jumps to land (a simplified tree: no constant inside)."""
+        kind = n[0]
+        if kind == "not":
+            return self.jumps(n[1], not sense)
+        if kind in ("and", "or"):
+            if (kind == "and") != sense:  # a and b false / a or b true: either does
+                return self.jumps(n[1], sense) + self.jumps(n[2], sense)
+            skip = self.jumps(n[1], not sense)
+            out = self.jumps(n[2], sense)
+            for after in skip:
+                self.land(after)
+            return out
+        if kind == "key":
+            _, ref, size, key, inclusive = n
+            flags = (V.KEY_INCLUSIVE if inclusive else 0) | (V.KEY_JUMP_IF if sense else 0)
+            self.op(V.JKEY, *struct.pack("<HB", ref, flags))
+            self.b += key.to_bytes(size, "little")
+            return [self.jump_offset()]
+        if kind == "int":
+            _, ref, cmp, cb = n
+            self.op(V.JINT, *struct.pack("<HB", ref, cmp | (V.JUMP_IF if sense else 0)))
+            self.b += cb
+            return [self.jump_offset()]
+        if kind == "cmp":
+            _, op, left, right = n
+            self.top(M.Cmp(op, left, right, left.line, left.col), emit=False)
+            self.value(left)
+            self.value(right)
+            self.op(V.JCMP, V.CMP_CODES[op] | (V.JUMP_IF if sense else 0))
+            return [self.jump_offset()]
+        assert kind == "value", n
+        self.top(n[1])
+        if sense:
+            self.op(V.NOT)
+        return [self.jump(V.JF)]
+
+    def jump_offset(self) -> int:
+        self.b += bytes(2)
+        return len(self.b)
+
+    # -- stores with typed instructions ---------------------------------------------
+    def fast_assign(self, var: int, e: M.Expr) -> bool:
+        """`x = <literals>` (SETK) and `x = a + k` / `x = a - k` on integers
+        (IADD), as the C++ emitter's constant_store and int_add; False when
+        neither applies."""
+        target = self.m.vars[var]
+        ref = self.ref(var)
+        if ref is None:
+            return False
+        try:
+            x = evaluate(e, self.real, _no_reads)
+        except NotConstant:
+            x = None
+        if x is not None:
+            self.op(V.SETK, *struct.pack("<H", ref))
+            self.b += value_bytes(target.type, to_type(target.type, x))
+            return True
+        if type(e) is not M.Arith or e.op not in ("+", "-") or target.type.kind != "int":
+            return False
+        a, k = self.int_var(e.left), self.exact_int_const(e.right)
+        if e.op == "+" and (a is None or k is None):
+            a, k = self.int_var(e.right), self.exact_int_const(e.left)
+        if a is None or k is None or a.kind == M.TIME_IN_STATE or a.type.kind != "int":
+            return False
+        k = -k if e.op == "-" else k
+        if not -(1 << 31) <= k < (1 << 31) or (1 << (24 if self.real.bits == 32 else 53)) - 1 - abs(k) < 0:
+            return False
+        self.op(V.IADD, *struct.pack("<HHi", ref, self.ref(a.index), k))
+        return True
+
     def truth(self, e: M.Expr) -> None:
         """`e` as a truth value, 1 or 0 (what `and`/`or` leave)."""
         self.value(e)
@@ -166,6 +366,8 @@ class _Code:
         for st in stmts:
             t = type(st)
             if t is M.Assign:
+                if self.fast_assign(st.var, st.expr):
+                    continue
                 self.top(st.expr)
                 v = self.m.vars[st.var]
                 if v.kind == M.ELEMENT:
@@ -178,14 +380,20 @@ class _Code:
                 self.op(V.GOTO, st.state)
                 return True
             else:
-                self.top(st.cond)
-                to_else = self.jump(V.JF)
+                node = _simplify(self.tree(st.cond))
+                if node[0] == "const":  # the C++ compiler drops the branch never taken too
+                    if self.block(st.then if node[1] else st.orelse):
+                        return True
+                    continue
+                to_else = self.jumps(node, False)
                 then_ends = self.block(st.then)
                 if not st.orelse:
-                    self.land(to_else)
+                    for after in to_else:
+                        self.land(after)
                     continue
                 to_end = None if then_ends else self.jump(V.JMP)
-                self.land(to_else)
+                for after in to_else:
+                    self.land(after)
                 else_ends = self.block(st.orelse)
                 if to_end is not None:
                     self.land(to_end)
@@ -194,9 +402,28 @@ class _Code:
         return False
 
 
-def compile_machine(m: M.Machine, real: Real) -> bytes:
+def _simplify(n):
+    """A condition tree with its constants folded away (or one constant):
+    operands have no side effects, so `a and false` is false."""
+    kind = n[0]
+    if kind == "not":
+        x = _simplify(n[1])
+        return ("const", not x[1]) if x[0] == "const" else ("not", x)
+    if kind in ("and", "or"):
+        a, b = _simplify(n[1]), _simplify(n[2])
+        absorbing = kind == "or"  # the value that decides: true for or, false for and
+        for x, other in ((a, b), (b, a)):
+            if x[0] == "const":
+                return x if x[1] == absorbing else other
+        return (kind, a, b)
+    return n
+
+
+def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes:
     """The image of `m` for a runtime whose R is `real`. BytecodeError for
-    what the format cannot carry; the result passes vmverify.verify."""
+    what the format cannot carry; the result passes vmverify.verify.
+    `scriptable`: for a runner that may write the locals between steps (a
+    state script), so none is read as a constant."""
     if len(m.states) > 255:
         raise BytecodeError(f"{len(m.states)} states: an image holds at most 255 (not supported yet)",
                             m.states[255].line)
@@ -218,7 +445,12 @@ def compile_machine(m: M.Machine, real: Real) -> bytes:
     init = b"".join(value_bytes(v.type, values[v.index]) for v in locs)
     if len(init) > 0xFFFF or len(locs) > 0xFFFF:
         raise BytecodeError("more than 65535 bytes of locals: not supported yet")
-    code = _Code(m, real, elem_index, loc_index)
+    # Only the machine writes its locals on a board: one it never assigns
+    # keeps its initial value, as the C++ emitter folds it (ExprEmitter).
+    written = assigned_vars(m)
+    consts = {v.index: real.read(v.type, values[v.index]) for v in locs
+              if not scriptable and v.param is None and (v.read_only or v.index not in written)}
+    code = _Code(m, real, elem_index, loc_index, consts)
     offsets = []
     for st in m.states:
         row = []

@@ -15,7 +15,7 @@ namespace fsw {
 namespace {
 
 // ---- the format (docs/bytecode.md, "The image") --------------------------------
-const uint8_t kVersion = 1;
+const uint8_t kVersion = 2;
 const uint16_t kHeader = 28;
 const uint16_t kNone = 0xFFFFu;  // a state without this block
 const uint8_t kFlagLock = 1;
@@ -27,7 +27,32 @@ enum Op : uint8_t {
     kNeg = 0x10, kAdd = 0x11, kSub = 0x12, kMul = 0x13, kDiv = 0x14,
     kLt = 0x18, kLe = 0x19, kGt = 0x1A, kGe = 0x1B, kEq = 0x1C, kNe = 0x1D,
     kNot = 0x1E, kTruth = 0x1F,
+    // typed tests and stores (the generated code's fast paths; version 2)
+    kJKey = 0x20, kJInt = 0x21, kSetK = 0x22, kIAdd = 0x23, kJCmp = 0x24,
 };
+
+// A typed instruction's variable: an element's index (below kRefLocal), a
+// local's index plus kRefLocal, or kRefT (T, kJInt only).
+const uint16_t kRefLocal = 0x8000u;
+const uint16_t kRefT = 0xFFFFu;
+const uint8_t kTypeT = 0xFE;   // ref_type's type of T
+const uint8_t kJumpIf = 0x80;  // kJInt/kJCmp: jump when the test holds (else when it fails)
+const uint8_t kKeyInclusive = 1, kKeyJumpIf = 2;  // kJKey's flags
+
+// The comparisons' truth over the order of x and c: bit 0 when x < c, bit 1
+// when x == c, bit 2 when x > c, bit 3 when unordered (<, <=, >, >=, ==, !=
+// in kLt..kNe's order).
+const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered (order 2: a NaN)
+inline bool cmp_holds(uint8_t cmp, int8_t order) { return ((flash_get(kCmpMask[cmp & 7u]) >> (order + 1)) & 1u) != 0; }
+
+inline bool is_int(uint8_t t) { return t <= kU64; }
+
+// elem_size() of a type the verifier has checked, without a call on an AVR.
+// (Forced inline: -Os would call these few instructions.)
+#define FSW_VM_INLINE inline __attribute__((always_inline))
+FSW_VM_INLINE uint8_t size_of(uint8_t t) {
+    return static_cast<uint8_t>(t <= kU64 ? 1u << (t & 3u) : t == kF32 ? 4u : t == kF64 ? 8u : 1u);
+}
 
 // N is 16 bits in the image: every runtime holds a window of 65535 samples.
 static_assert(FSW_WINDOW_MAX_N >= 65535UL, "window sizes of the image");
@@ -96,20 +121,20 @@ struct Parts {
     const uint8_t* code;
 };
 
+// (A verified image's parts all lie within its at most 65535 bytes: 16-bit
+// sums, as offsets() has them in 32 bits for an image not yet checked.)
 void parts(const uint8_t* im, Parts& p) {
-    Offs o;
-    offsets(RamImage{im}, o);
-    p.states = o.states;
-    p.windows = o.windows;
-    p.locals = o.locals;
-    p.loc_size = o.loc_size;
-    p.prelude = o.prelude;
-    p.code_size = o.code_size;
-    p.st = im + o.st;
-    p.loc = im + o.loc;
-    p.win = im + o.win;
-    p.init = im + o.init;
-    p.code = im + o.code;
+    p.states = im[18];
+    p.windows = im[19];
+    p.locals = u16(im + 20);
+    p.loc_size = u16(im + 22);
+    p.prelude = u16(im + 24);
+    p.code_size = u16(im + 26);
+    p.st = im + kHeader;
+    p.loc = p.st + 6u * p.states;
+    p.win = p.loc + 3u * p.locals;
+    p.init = p.win + 4u * p.windows;
+    p.code = p.init + p.loc_size;
 }
 
 // Storage of a window of n samples in the VM's RAM: the state struct and its
@@ -151,6 +176,8 @@ uint8_t operand_bytes(uint8_t op, uint8_t real) {
         case kJmp: case kJf: case kAnd: case kOr: case kLdl: case kStl: return 2;
         case kLde: case kSte: return 3;
         case kConst: return real;
+        case kJKey: case kJInt: case kSetK: case kIAdd: return 2;  // the ref; the rest is the ref's type's
+        case kJCmp: return 3;
         default: return 0xFF;
     }
 }
@@ -167,10 +194,32 @@ void count_offsets(const Im& im, const Offs& p, uint16_t pc, uint16_t& moving, u
     }
 }
 
+const uint32_t kNoJump = 0xFFFFFFFFUL;  // an instruction that does not jump
+
 struct Pending {
     uint16_t target;
     uint8_t depth;
 };
+
+// The reason that refuses `ref` where its type does not fit the instruction.
+inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRefT ? kVmBadLocal : kVmBadElement; }
+
+// The type of a typed instruction's variable (kTypeT for T), or why not. An
+// image whose state vector is locked (kFlagLock) reads and writes elements
+// through the general instructions, which take the lock.
+template <class Im>
+VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t ref, bool lock, uint8_t& t) {
+    if (ref == kRefT) {
+        t = kTypeT;
+    } else if (ref >= kRefLocal) {
+        if (ref - kRefLocal >= p.locals) return kVmBadLocal;
+        t = im[p.loc + 3u * (ref - kRefLocal)];
+    } else {
+        if (ref >= layout.count || lock) return kVmBadElement;
+        t = flash_get(layout.elems[ref].type);
+    }
+    return kVmOk;
+}
 
 template <class Im>
 VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
@@ -219,7 +268,8 @@ VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
         if (n == 0xFF || static_cast<uint32_t>(pc) + 1u + n > p.code_size) return kVmBadOpcode;
         const uint32_t a = p.code + pc + 1u;  // the operands
         pc = static_cast<uint16_t>(pc + 1u + n);
-        uint8_t pops = 0, pushes = 0;
+        uint8_t pops = 0, pushes = 0, jump_depth = 0;
+        uint32_t jump_to = kNoJump;
         bool ends = false;
         switch (op) {
             case kEnd: ends = true; break;
@@ -231,14 +281,61 @@ VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
             case kJmp: case kJf: case kAnd: case kOr: {
                 pops = op == kJmp ? 0 : 1;
                 if (depth < pops) return kVmBadStack;
-                const uint32_t target = static_cast<uint32_t>(pc) + r16(im, a);
-                if (target >= p.code_size) return kVmBadJump;
-                if (np == FSW_VM_PENDING) return kVmTooNested;
+                jump_to = static_cast<uint32_t>(pc) + r16(im, a);
                 // and/or keep their left operand when they jump; jf drops it.
-                pend[np].target = static_cast<uint16_t>(target);
-                pend[np].depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
-                ++np;
+                jump_depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
                 if (op == kJmp) reachable = false;
+                break;
+            }
+            case kJKey: case kJInt: case kSetK: case kIAdd: {
+                const uint16_t ref = r16(im, a);
+                uint8_t t;
+                const VmReason why = ref_type(im, p, layout, ref, (im[6] & kFlagLock) != 0, t);
+                if (why != kVmOk) return why;
+                const uint32_t b = a + 2u;  // the operands after the ref
+                uint8_t more, at = 0;       // their bytes; where a jump's offset is
+                if (op == kJKey) {
+                    if (t != kF32 && t != kF64) return wrong_type(ref);
+                    at = static_cast<uint8_t>(1u + elem_size(t));
+                    more = static_cast<uint8_t>(at + 2u);
+                } else if (op == kJInt) {
+                    if (t != kTypeT && !is_int(t) && t != kBool) return wrong_type(ref);
+                    at = static_cast<uint8_t>(1u + (t == kTypeT ? 4u : elem_size(t)));
+                    more = static_cast<uint8_t>(at + 2u);
+                } else if (op == kSetK) {
+                    if (t == kTypeT) return wrong_type(ref);
+                    more = elem_size(t);
+                } else {
+                    if (!is_int(t)) return wrong_type(ref);
+                    more = 6;
+                }
+                if (static_cast<uint32_t>(pc) + more > p.code_size) return kVmBadOpcode;
+                pc = static_cast<uint16_t>(pc + more);
+                if (op == kSetK) {
+                    if (t == kBool && im[b] > 1u) return kVmBadOpcode;
+                } else if (op == kIAdd) {
+                    const uint16_t src = r16(im, b);
+                    uint8_t ts;
+                    const VmReason w = ref_type(im, p, layout, src, (im[6] & kFlagLock) != 0, ts);
+                    if (w != kVmOk) return w;
+                    if (!is_int(ts)) return wrong_type(src);
+                    // |k| below 2^p (p = R's precision): every integer near k is exact in R.
+                    const int32_t k = static_cast<int32_t>(r32(im, b + 2u));
+                    if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
+                } else {
+                    if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
+                        return kVmBadOpcode;
+                    jump_to = static_cast<uint32_t>(pc) + r16(im, b + at);
+                    jump_depth = depth;
+                }
+                break;
+            }
+            case kJCmp: {
+                if ((im[a] & ~kJumpIf) > 5u) return kVmBadOpcode;
+                pops = 2;
+                if (depth < pops) return kVmBadStack;
+                jump_to = static_cast<uint32_t>(pc) + r16(im, a + 1u);
+                jump_depth = static_cast<uint8_t>(depth - 2u);
                 break;
             }
             case kConst: case kLdt: pushes = 1; break;
@@ -264,6 +361,13 @@ VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
                 break;
             case kNeg: case kNot: case kTruth: pops = 1; pushes = 1; break;
             default: pops = 2; pushes = 1; break;  // arithmetic and comparisons
+        }
+        if (jump_to != kNoJump) {  // a forward jump: its target and the depth there
+            if (jump_to >= p.code_size) return kVmBadJump;
+            if (np == FSW_VM_PENDING) return kVmTooNested;
+            pend[np].target = static_cast<uint16_t>(jump_to);
+            pend[np].depth = jump_depth;
+            ++np;
         }
         if (depth < pops) return kVmBadStack;
         depth = static_cast<uint8_t>(depth - pops + pushes);
@@ -432,17 +536,192 @@ void window_push(const Run& r, uint8_t w, Real x) {
     }
 }
 
-// Runs the block at `pc`: the state id it goes to (0: none).
-uint32_t run_block(const Run& r, uint16_t pc) {
+// Where a typed instruction's variable (not T) is, and its type.
+FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
+    if (ref >= kRefLocal) {
+        const uint8_t* l = r.p.loc + 3u * (ref - kRefLocal);
+        t = l[0];
+        return r.loc + u16(l + 1);
+    }
+    const VmElem* e = r.layout->elems + ref;
+    t = flash_get(e->type);
+    return r.sv + flash_get(e->off);
+}
+
+// The order of the n-byte little-endian numbers at x and c, compared from
+// their top bytes down as unsigned ones after `flip` is xored into both top
+// bytes (0x80: as signed ones): -1, 0 or 1. Byte by byte: no 64-bit
+// arithmetic on an 8-bit MCU.
+FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
+    uint8_t i = static_cast<uint8_t>(n - 1u);
+    uint8_t a = static_cast<uint8_t>(x[i] ^ flip), b = static_cast<uint8_t>(c[i] ^ flip);
+    for (;;) {
+        if (a != b) return a < b ? -1 : 1;
+        if (i == 0) return 0;
+        --i;
+        a = x[i];
+        b = c[i];
+    }
+}
+
+// kJKey's test: whether the key of the float at `x` (n = 4 or 8 bytes; a
+// NaN reads as +0, fsw_f64.h) is greater than (inclusive: at least) the key
+// at `c`. The key flips every bit of a negative pattern and the sign bit
+// of any other: built a byte at a time, compared from the top.
+FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool inclusive) {
+    uint8_t i = static_cast<uint8_t>(n - 1u), neg = 0, k;
+    if (n == 8 ? f64_is_nan(x) : f32_is_nan(x)) {
+        x = nullptr;  // +0's key: 0x80, then zeros
+        k = 0x80;
+    } else {
+        neg = (x[i] & 0x80u) != 0 ? 0xFF : 0x00;
+        k = static_cast<uint8_t>(x[i] ^ (neg | 0x80u));  // a negative key flips the sign bit too
+    }
+    for (;;) {
+        if (k != c[i]) return k > c[i];
+        if (i == 0) return inclusive;
+        --i;
+        k = x == nullptr ? 0 : static_cast<uint8_t>(x[i] ^ neg);
+    }
+}
+
+// kJInt's order of the variable at `x` (type t, or T when x is null)
+// against the constant at `c`.
+FSW_VM_INLINE int8_t int_order(const Run& r, const uint8_t* x, uint8_t t, const uint8_t* c) {
+    if (x == nullptr) {
+        const uint32_t v = machine_T32(*r.m), cv = load<uint32_t>(c);
+        return v < cv ? -1 : v > cv ? 1 : 0;
+    }
+    if (t == kBool) return static_cast<int8_t>(static_cast<int8_t>(load_bool(x) ? 1 : 0) - static_cast<int8_t>(c[0]));
+    return le_order(x, c, size_of(t), t < kU8 ? 0x80 : 0x00);
+}
+
+template <bool Narrow>
+struct IntFast {
+    typedef int64_t T;
+};
+template <>
+struct IntFast<true> {
+    typedef int32_t T;
+};
+
+// The integers of kIAdd's fast path: |x| <= 2^p - 1 - |k| and x + k, with p
+// R's precision (24 or 53), fit this type with a byte to spare.
+typedef IntFast<sizeof(Real) == 4>::T Wide;
+
+// `d = x + k` for integers d and x (kIAdd): the integer sum clamped to d's
+// range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
+// the sum in R as the general instructions compute it. Bytes above Wide's
+// are only checked and filled (no 64-bit arithmetic on an AVR).
+void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
+    const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
+    const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
+    const uint8_t ns = size_of(ts), wb = sizeof(Wide);
+    const uint8_t fill = ts < kU8 && (x[ns - 1u] & 0x80u) != 0 ? 0xFF : 0x00;  // x's sign, in a byte
+    bool fast = true;
+    for (uint8_t i = wb - 1u; i < ns; ++i) fast = fast && x[i] == fill;  // past |x| < 2^(8 wb - 8)
+    Wide a = 0;
+    if (fast) {
+        uint8_t b[sizeof(Wide)];
+        for (uint8_t i = 0; i < wb; ++i) b[i] = i < ns && i < wb - 1u ? x[i] : fill;
+        memcpy(&a, b, sizeof a);  // little-endian, as the state vector
+        fast = a >= -limit && a <= limit;
+    }
+    if (!fast) {
+        write_elem(d, td, read_elem(x, ts) + static_cast<Real>(k));
+        return;
+    }
+    Wide v = a + k;
+    const uint8_t nd = size_of(td);
+    const bool sign = td < kU8;
+    if (!sign && v < 0) v = 0;
+    if (nd < wb) {  // d narrower than Wide: its range
+        const Wide hi = nd == 1 ? (sign ? 127 : 255) : nd == 2 ? (sign ? 32767 : static_cast<Wide>(65535L))
+                                                               : static_cast<Wide>(sign ? 2147483647LL : 4294967295LL);
+        if (v > hi) v = hi;
+        if (sign && v < -hi - 1) v = -hi - 1;
+    }
+    uint8_t b[sizeof(Wide)];
+    memcpy(b, &v, sizeof b);
+    const uint8_t vfill = v < 0 ? 0xFF : 0x00;
+    for (uint8_t i = 0; i < nd; ++i) d[i] = i < wb ? b[i] : vfill;
+}
+
+// The typed instructions, one function each (few live registers, so few
+// saved): each returns where the block goes on from the instruction at `pc`.
+FSW_NOINLINE uint16_t op_setk(const Run& r, uint16_t pc) {
+    const uint8_t* a = r.p.code + pc + 1;
+    uint8_t t;
+    uint8_t* x = ref_at(r, u16(a), t);
+    const uint8_t n = size_of(t);
+    memcpy(x, a + 2, n);
+    return static_cast<uint16_t>(pc + 3u + n);
+}
+
+FSW_NOINLINE uint16_t op_iadd(const Run& r, uint16_t pc) {
+    const uint8_t* a = r.p.code + pc + 1;
+    uint8_t td, ts;
+    uint8_t* d = ref_at(r, u16(a), td);
+    const uint8_t* x = ref_at(r, u16(a + 2), ts);
+    int_add(d, td, x, ts, static_cast<int32_t>(u32(a + 4)));
+    return static_cast<uint16_t>(pc + 9u);
+}
+
+FSW_NOINLINE uint16_t op_jkey(const Run& r, uint16_t pc) {
+    const uint8_t* a = r.p.code + pc + 1;
+    uint8_t t;
+    const uint8_t* x = ref_at(r, u16(a), t);
+    const uint8_t n = t == kF64 ? 8 : 4;
+    const uint8_t flags = a[2];
+    const bool holds = key_holds(x, n, a + 3, (flags & kKeyInclusive) != 0);
+    const uint8_t* o = a + 3 + n;  // the jump's offset
+    pc = static_cast<uint16_t>(pc + 6u + n);
+    return holds == ((flags & kKeyJumpIf) != 0) ? static_cast<uint16_t>(pc + u16(o)) : pc;
+}
+
+FSW_NOINLINE uint16_t op_jint(const Run& r, uint16_t pc) {
+    const uint8_t* a = r.p.code + pc + 1;
+    const uint16_t ref = u16(a);
+    uint8_t t = kTypeT;
+    const uint8_t* x = ref == kRefT ? nullptr : ref_at(r, ref, t);
+    const uint8_t n = t == kTypeT ? 4 : size_of(t);
+    const uint8_t flags = a[2];
+    const bool holds = cmp_holds(flags, int_order(r, x, t, a + 3));
+    const uint8_t* o = a + 3 + n;
+    pc = static_cast<uint16_t>(pc + 6u + n);
+    return holds == ((flags & kJumpIf) != 0) ? static_cast<uint16_t>(pc + u16(o)) : pc;
+}
+
+// One typed instruction (kJKey, kJInt, kSetK, kIAdd) at `pc`.
+uint16_t typed(const Run& r, uint16_t pc) {
+    switch (r.p.code[pc]) {
+        case kSetK: return op_setk(r, pc);
+        case kIAdd: return op_iadd(r, pc);
+        case kJKey: return op_jkey(r, pc);
+        default: return op_jint(r, pc);
+    }
+}
+
+
+// The order of two R values for kJCmp: -1, 0, 1, or 2 when unordered (a NaN).
+int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 : 2; }
+
+// Code that evaluates on the operand stack, from `pc` (at depth 0) to the
+// instruction after the one that empties the stack again: where the block
+// goes on. Apart from run_block, so that the stack's frame is only set up
+// for such code. (The compiler emits typed instructions only at depth 0, but
+// any verified image runs: they are handled here too.)
+FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
     Real st[FSW_VM_STACK];
     uint8_t sp = 0;
     const uint8_t* code = r.p.code;
-    for (;;) {
+    for (bool first = true;; first = false) {
+        if (!first && sp == 0) return pc;  // the stack is empty again
         const uint8_t op = code[pc];
         const uint8_t* a = code + pc + 1;
         switch (op) {
-            case kEnd: return 0;
-            case kGoto: return static_cast<uint32_t>(a[0]) + 1u;
+            case kEnd:
+            case kGoto: return pc;  // unreachable: a verified block ends at depth 0
             case kJmp: pc = static_cast<uint16_t>(pc + 3u + u16(a)); continue;
             case kJf:
                 --sp;
@@ -492,6 +771,14 @@ uint32_t run_block(const Run& r, uint16_t pc) {
                 pc = static_cast<uint16_t>(pc + 3u);
                 continue;
             }
+            case kJKey: case kJInt: case kSetK: case kIAdd: pc = typed(r, pc); continue;
+            case kJCmp: {
+                sp = static_cast<uint8_t>(sp - 2u);
+                const int8_t order = real_order(st[sp], st[sp + 1u]);
+                pc = static_cast<uint16_t>(pc + 4u);
+                if (cmp_holds(a[0], order) == ((a[0] & kJumpIf) != 0)) pc = static_cast<uint16_t>(pc + u16(a + 1));
+                continue;
+            }
             case kLdt: st[sp++] = machine_T_real(*r.m); break;
             case kRoll: st[sp++] = window_value(r, a[0]); pc = static_cast<uint16_t>(pc + 2u); continue;
             case kWpush: window_push(r, a[0], st[--sp]); pc = static_cast<uint16_t>(pc + 2u); continue;
@@ -522,6 +809,25 @@ uint32_t run_block(const Run& r, uint16_t pc) {
     }
 }
 
+// Runs the block at `pc`: the state id it goes to (0: none). Typed
+// instructions and jumps run here, stack code in run_stack.
+uint32_t run_block(const Run& r, uint16_t pc) {
+    const uint8_t* code = r.p.code;
+    for (;;) {
+        const uint8_t op = code[pc];
+        if (op == kEnd) return 0;
+        if (op == kGoto) return static_cast<uint32_t>(code[pc + 1u]) + 1u;
+        switch (op) {
+            case kJmp: pc = static_cast<uint16_t>(pc + 3u + u16(code + pc + 1u)); break;
+            case kJKey: pc = op_jkey(r, pc); break;
+            case kJInt: pc = op_jint(r, pc); break;
+            case kSetK: pc = op_setk(r, pc); break;
+            case kIAdd: pc = op_iadd(r, pc); break;
+            default: pc = run_stack(r, pc); break;
+        }
+    }
+}
+
 }  // namespace
 
 namespace {
@@ -532,7 +838,7 @@ void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv,
     r.layout = &layout;
     r.sv = sv;
     r.ram = ram;
-    r.loc = ram + windows_size(r.p);
+    r.loc = r.p.windows == 0 ? ram : ram + windows_size(r.p);
     r.m = &m;
     r.lock = (image[6] & kFlagLock) != 0;
 }
@@ -558,7 +864,7 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
     } else if (machine_begin(m, g, s) != kOk) {
         return kErrTime;
     }
-    if (run_block(r, r.p.prelude) != 0) return kErrConfig;  // unreachable for a verified image
+    if (r.p.code[r.p.prelude] != kEnd && run_block(r, r.p.prelude) != 0) return kErrConfig;  // unreachable when verified
     if (m.state == 0 || m.state > r.p.states) return kOk;
     const uint8_t* blocks = r.p.st + 6u * (m.state - 1u);
     const uint16_t entry = u16(blocks), step = u16(blocks + 2), exit = u16(blocks + 4);

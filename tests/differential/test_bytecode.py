@@ -129,6 +129,20 @@ def test_every_generated_image_verifies():
             assert V.verify(im, layout, 12 - REALS[mode].bits // 8) == V.BAD_REAL
 
 
+def test_cases_exercise_the_typed_instructions():
+    """The generated machines reach every typed instruction (JKEY only in
+    binary32, whose threshold tests they are), so the differential runs
+    above hold each of them to the interpreter."""
+    from collections import Counter
+
+    for mode, typed in (("f64", (V.JINT, V.SETK, V.IADD, V.JCMP)), ("f32", (V.JKEY, V.JINT, V.SETK, V.IADD, V.JCMP))):
+        seen = Counter()
+        for c in gp.cases(SEED, min(CASES, 200)):
+            s, _ = H.load(c)
+            seen.update(V.opcodes(compile_machine(s.machine, REALS[mode]), V.layout_of(s.machine.sv)))
+        assert all(seen[op] >= 20 for op in typed), (mode, {hex(op): seen[op] for op in typed})
+
+
 def test_compilation_is_reproducible():
     c = gp.case(SEED, 3)
     s1, _ = H.load(c)
@@ -225,10 +239,12 @@ def test_fsw_compile_bad_input(tmp_path, fsw):
     assert not (tmp_path / "x.fsm").exists()
 
 
-def test_stack_depth_is_what_the_verifier_finds():
+def test_stack_depth_bounds_what_the_verifier_finds():
     """The compiler's static depth of each expression (which it refuses past
-    the VM's stack) is the verifier's: for every generated machine, the
-    deepest expression is the image's header figure."""
+    the VM's stack) bounds the verifier's: for every generated machine the
+    image's header figure is at most the deepest expression's, and equal to
+    it where that expression is evaluated on the stack (typed tests and
+    stores use less, or none)."""
     from fswkit.autocode.emit.bytecode import stack_depth
     from fswkit.autocode import model as M
 
@@ -241,12 +257,16 @@ def test_stack_depth_is_what_the_verifier_finds():
                 yield from exprs(st.then)
                 yield from exprs(st.orelse)
 
+    equal = 0
     for c in gp.cases(SEED, min(CASES, 200)):
         s, _ = H.load(c)
         m = s.machine
         deepest = max([stack_depth(e) for st in m.states for b in (st.entry, st.step, st.exit) for e in exprs(b)]
                       + [stack_depth(w.arg) for w in m.windows] + [0])
-        assert compile_machine(m, REALS["f64"])[7] == deepest, c.repro()
+        got = compile_machine(m, REALS["f64"])[7]
+        assert got <= deepest, c.repro()
+        equal += got == deepest
+    assert equal > 100  # of 200: the bound is the figure for most machines
 
 
 def test_fsw_compile_refuses_an_expression_deeper_than_the_stack(tmp_path, fsw):

@@ -36,7 +36,7 @@ def vm_shim(m: M.Machine, real: Real, scriptable: bool, ns: str, avr: bool = Fal
     refuses sends `V` and the reason (1 byte) through the runner's byte sink
     and stops the board (sleep, interrupts off) instead of printing."""
     name = c_ident(m.name)
-    image = compile_machine(m, real)
+    image = compile_machine(m, real, scriptable)
     stored = stored_locals(m, real, scriptable)
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
     offs = local_offsets(m)

@@ -20,7 +20,10 @@ enum : uint8_t {
     END = 0x00, GOTO = 0x01, JMP = 0x02, JF = 0x03, AND = 0x04, OR = 0x05, CONST = 0x06, LDE = 0x07,
     STE = 0x08, LDL = 0x09, STL = 0x0A, LDT = 0x0B, ROLL = 0x0C, WPUSH = 0x0D, NEG = 0x10, ADD = 0x11,
     LT = 0x18, GT = 0x1A, NOT = 0x1E, TRUTH = 0x1F,
+    JKEY = 0x20, JINT = 0x21, SETK = 0x22, IADD = 0x23, JCMP = 0x24,
 };
+// A typed instruction's variable: element k, or local k + L0, or T.
+const uint8_t L0 = 0x80, TLO = 0xFF, THI = 0xFF;
 const uint16_t NO = 0xFFFFu;
 
 // The good image's code. Blocks, at code offsets:
@@ -55,7 +58,7 @@ void build(Image& im, const uint8_t* code, uint16_t n, const uint16_t offs[6], u
     memset(im.b, 0, sizeof im.b);
     uint8_t* h = im.b;
     h[0] = 'F'; h[1] = 'S'; h[2] = 'M'; h[3] = 'B';
-    h[4] = 1;
+    h[4] = 2;
     h[5] = sizeof(Real);
     h[6] = 0;
     h[7] = stack;
@@ -100,14 +103,18 @@ VmReason patched(uint16_t at, uint8_t v) {
 }
 
 // An image whose state A's .step is `code` (ending the code but for the prelude).
-VmReason with_step(const uint8_t* code, uint16_t n, uint8_t stack) {
+void step_image(Image& im, const uint8_t* code, uint16_t n, uint8_t stack) {
     uint8_t all[120];
     memcpy(all, code, n);
     const uint8_t prelude[] = {LDE, 2, 0, kF32, WPUSH, 0, END};
     memcpy(all + n, prelude, sizeof prelude);
     const uint16_t offs[6] = {NO, 0, NO, NO, NO, NO};
-    Image im;
     build(im, all, static_cast<uint16_t>(n + sizeof prelude), offs, n, stack);
+}
+
+VmReason with_step(const uint8_t* code, uint16_t n, uint8_t stack) {
+    Image im;
+    step_image(im, code, n, stack);
     return verify(im);
 }
 
@@ -127,7 +134,7 @@ void test_header_rules(void) {
     im.b[0] = 'X';
     TEST_ASSERT_EQUAL_UINT(kVmBadMagic, verify(im));
     good(im);
-    im.b[4] = 2;
+    im.b[4] = 1;  // the format before the typed instructions
     TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
     good(im);
     im.b[6] = 0x80;  // an unknown flag
@@ -299,6 +306,110 @@ void test_nesting_rule(void) {
     TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(code + 4, static_cast<uint16_t>(n - 4u), 1));
 }
 
+void test_typed_instruction_rules(void) {
+    // JKEY x > 1.5 (its key 0xBFC00000), jump past END to END
+    const uint8_t key[] = {JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END};
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(key, sizeof key, 1));
+    uint8_t c[sizeof key];
+    memcpy(c, key, sizeof c);
+    c[1] = 3;  // n: an I16, not a float
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof c, 1));
+    c[1] = 4;  // past the layout
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof c, 1));
+    c[1] = 0;
+    c[2] = L0;  // local 0: a U8
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, with_step(c, sizeof c, 1));
+    c[1] = 1;  // local 1: there is one local
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, with_step(c, sizeof c, 1));
+    memcpy(c, key, sizeof c);
+    c[3] = 4;  // an unknown flag
+    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, with_step(c, sizeof c, 1));
+    Image im;
+    step_image(im, key, sizeof key, 1);
+    im.b[6] = 1;  // a locked state vector: elements only through LDE/STE
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    // JINT T > 0x00000FA0 (4 bytes for T), jump past END
+    const uint8_t t[] = {JINT, TLO, THI, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END};
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(t, sizeof t, 1));
+    memcpy(c, t, sizeof t);
+    c[3] = 0x86;  // comparison 6: none
+    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, with_step(c, sizeof t, 1));
+    const uint8_t fx[] = {JINT, 2, 0, 0x02, 0, 0, 0, 0, 1, 0, END, END};  // x is no integer
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(fx, sizeof fx, 1));
+    const uint8_t far[] = {JINT, TLO, THI, 0x82, 0, 0, 0, 0, 9, 0, END, END};  // past the code
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, with_step(far, sizeof far, 1));
+    // SETK: a bool takes 0 or 1 only; T takes nothing
+    const uint8_t set[] = {SETK, 0, L0, 7, END};
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(set, sizeof set, 1));
+    const uint8_t sett[] = {SETK, TLO, THI, 0, 0, 0, 0, 0, 0, 0, 0, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(sett, sizeof sett, 1));
+    // IADD n = l + k: integers only, |k| below 2^24 in binary32
+    const uint8_t add[] = {IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END};  // k = -10
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(add, sizeof add, 1));
+    memcpy(c, add, sizeof add);
+    c[1] = 2;  // into x: a float
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof add, 1));
+    const uint8_t big[] = {IADD, 3, 0, 0, L0, 0x00, 0x00, 0x00, 0x01, END};  // k = 2^24
+    TEST_ASSERT_EQUAL_UINT(sizeof(Real) == 4 ? kVmBadOpcode : kVmOk, with_step(big, sizeof big, 1));
+    // JCMP pops two
+    const uint8_t cmp[] = {LDT, LDT, JCMP, 0x00, 1, 0, END, END};
+    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(cmp, sizeof cmp, 2));
+    const uint8_t one[] = {LDT, JCMP, 0x00, 1, 0, END, END};
+    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(one, sizeof one, 1));
+}
+
+void test_the_vm_steps_typed_instructions(void) {
+    const uint8_t code[] = {
+        SETK, 0, L0, 7,                           // 0: l = 7
+        IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF,   // 4: n = l - 10
+        JINT, 3, 0, 0x80, 0, 0, 4, 0,             // 13: n < 0: past the next
+        SETK, 0, L0, 99,                          // 21
+        JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 2, 0,  // 25: x > 1.5: past the goto
+        GOTO, 1,                                  // 35: to B
+        END,                                      // 37
+    };
+    Image im;
+    step_image(im, code, sizeof code, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    Machine m;
+    memset(sv, 0, sizeof sv);
+    vm_reset(im.b, ram, m, 1);
+    const uint8_t* loc = vm_locals(im.b, ram);
+    store<float>(sv + 12, 2.0f);
+    store<uint64_t>(sv, 10);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_UINT8(7, loc[0]);  // the SETK after the JINT skipped
+    TEST_ASSERT_EQUAL_INT16(-3, load<int16_t>(sv + 16));
+    TEST_ASSERT_EQUAL_UINT32(1, m.state);  // x > 1.5: no goto
+    store<float>(sv + 12, -2.0f);  // a negative key is below every positive one
+    store<uint64_t>(sv, 20);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_UINT32(2, m.state);
+    const float above[] = {1.5000001f, 3e38f};
+    const float below[] = {1.5f, -0.0f, -3e38f, 1e-45f};
+    for (int k = 0; k < 6; ++k) {
+        vm_reset(im.b, ram, m, 1);
+        store<float>(sv + 12, k < 2 ? above[k] : below[k - 2]);
+        store<uint64_t>(sv, static_cast<uint64_t>(30 + k));
+        TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+        TEST_ASSERT_EQUAL_UINT32(k < 2 ? 1 : 2, m.state);
+    }
+    vm_reset(im.b, ram, m, 1);
+    uint32_t nan = 0x7FC00001UL;  // a NaN reads as 0: not > 1.5
+    memcpy(sv + 12, &nan, 4);
+    store<uint64_t>(sv, 40);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_UINT32(2, m.state);
+    // IADD saturates at its target's range: n = l + 40000 is 32767
+    const uint8_t sat[] = {IADD, 3, 0, 0, L0, 0x40, 0x9C, 0x00, 0x00, END};
+    step_image(im, sat, sizeof sat, 1);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    vm_reset(im.b, ram, m, 1);
+    store<uint64_t>(sv, 50);
+    TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+    TEST_ASSERT_EQUAL_INT16(32767, load<int16_t>(sv + 16));  // 3 + 40000, saturated
+}
+
 void test_the_vm_steps_the_good_image(void) {
     Image im;
     good(im);
@@ -342,6 +453,8 @@ FSW_TEST_MAIN([] {
     RUN_TEST(test_opcode_and_end_rules);
     RUN_TEST(test_place_rules);
     RUN_TEST(test_nesting_rule);
+    RUN_TEST(test_typed_instruction_rules);
+    RUN_TEST(test_the_vm_steps_typed_instructions);
     RUN_TEST(test_the_vm_steps_the_good_image);
     (void)UNITY_END();
 })

@@ -374,7 +374,7 @@ def test_bad_images_are_refused_with_the_verifiers_reason():
     lib = S.Machine.from_sm(TANK)
     for bad, reason in ((b"", V.BAD_SIZE), (b"FSMB", V.BAD_SIZE), (b"x" * 300, V.BAD_MAGIC),
                         (image[:-1], V.BAD_SIZE), (image + b"\0", V.BAD_SIZE),
-                        (image[:4] + b"\x02" + image[5:], V.BAD_VERSION)):
+                        (image[:4] + bytes((V.VERSION + 1,)) + image[5:], V.BAD_VERSION)):
         e = _raises(S.ImageRefused, lib.load_image, bad, code=S.E_VERIFY)
         assert e.reason == reason and e.reason_text == V.REASONS[reason]
         assert f"reason {reason}" in e.message and e.name == "FSWSM_E_VERIFY"

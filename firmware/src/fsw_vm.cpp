@@ -47,12 +47,12 @@ inline bool cmp_holds(uint8_t cmp, int8_t order) { return ((flash_get(kCmpMask[c
 
 inline bool is_int(uint8_t t) { return t <= kU64; }
 
-// elem_size() of a type the verifier has checked, without a call on an AVR.
-// (Forced inline: -Os would call these few instructions.)
+// elem_size() of a type the verifier has checked, from a table in flash
+// (no call, no shift loop on an AVR). (Forced inline: -Os would call these
+// few instructions.)
 #define FSW_VM_INLINE inline __attribute__((always_inline))
-FSW_VM_INLINE uint8_t size_of(uint8_t t) {
-    return static_cast<uint8_t>(t <= kU64 ? 1u << (t & 3u) : t == kF32 ? 4u : t == kF64 ? 8u : 1u);
-}
+const uint8_t kSizes[kBool + 1] FSW_FLASH = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
+FSW_VM_INLINE uint8_t size_of(uint8_t t) { return flash_get(kSizes[t]); }
 
 // N is 16 bits in the image: every runtime holds a window of 65535 samples.
 static_assert(FSW_WINDOW_MAX_N >= 65535UL, "window sizes of the image");
@@ -553,14 +553,14 @@ FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
 // bytes (0x80: as signed ones): -1, 0 or 1. Byte by byte: no 64-bit
 // arithmetic on an 8-bit MCU.
 FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
-    uint8_t i = static_cast<uint8_t>(n - 1u);
-    uint8_t a = static_cast<uint8_t>(x[i] ^ flip), b = static_cast<uint8_t>(c[i] ^ flip);
+    x += n;
+    c += n;
+    uint8_t a = static_cast<uint8_t>(*--x ^ flip), b = static_cast<uint8_t>(*--c ^ flip);
     for (;;) {
         if (a != b) return a < b ? -1 : 1;
-        if (i == 0) return 0;
-        --i;
-        a = x[i];
-        b = c[i];
+        if (--n == 0) return 0;
+        a = *--x;
+        b = *--c;
     }
 }
 
@@ -569,19 +569,21 @@ FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uin
 // at `c`. The key flips every bit of a negative pattern and the sign bit
 // of any other: built a byte at a time, compared from the top.
 FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool inclusive) {
-    uint8_t i = static_cast<uint8_t>(n - 1u), neg = 0, k;
-    if (n == 8 ? f64_is_nan(x) : f32_is_nan(x)) {
-        x = nullptr;  // +0's key: 0x80, then zeros
-        k = 0x80;
-    } else {
-        neg = (x[i] & 0x80u) != 0 ? 0xFF : 0x00;
-        k = static_cast<uint8_t>(x[i] ^ (neg | 0x80u));  // a negative key flips the sign bit too
+    c += n;
+    if (n == 8 ? f64_is_nan(x) : f32_is_nan(x)) {  // +0's key: 0x80, then zeros
+        if (*--c != 0x80u) return 0x80u > *c;
+        while (--n != 0)
+            if (*--c != 0) return false;
+        return inclusive;
     }
+    x += n;
+    const uint8_t neg = (x[-1] & 0x80u) != 0 ? 0xFF : 0x00;
+    uint8_t k = static_cast<uint8_t>(*--x ^ (neg | 0x80u));  // a negative key flips the sign bit too
     for (;;) {
-        if (k != c[i]) return k > c[i];
-        if (i == 0) return inclusive;
-        --i;
-        k = x == nullptr ? 0 : static_cast<uint8_t>(x[i] ^ neg);
+        const uint8_t b = *--c;
+        if (k != b) return k > b;
+        if (--n == 0) return inclusive;
+        k = static_cast<uint8_t>(*--x ^ neg);
     }
 }
 

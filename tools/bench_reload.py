@@ -109,6 +109,9 @@ def main() -> int:
         link = f"{baud} baud" + (f", {loss:.0%} lost each way" if loss else ", clean")
         print(f"  {link:<28} {n:>6} {r.seconds:>8.2f}s {r.activate_s:>8.2f}s {r.sent:>9} {r.resent:>11} "
               f"{r.busy:>5}  {r.up_dropped} of {r.up_frames} / {r.down_dropped} of {r.down_frames}")
+    print(f"  the longest reload command the board handled (the commit: the image's CRC and the board's verifier "
+          f"reading the EEPROM): {max(r.longest_command for *_x, r in rows) / 16e3:.1f} ms of CPU at 16 MHz, "
+          f"in one uplink step")
 
     volts = {"A0": (740 + 125.0) / 250.0}  # 740 psi: the vent controller holds, a new one may take over
     got = image_for(stand_app, os.path.join(ROOT, "examples", "stand", "tank_700.sm"), d)

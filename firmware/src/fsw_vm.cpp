@@ -188,9 +188,17 @@ template <class Im>
 void count_offsets(const Im& im, const Offs& p, uint16_t pc, uint16_t& moving, uint16_t& still) {
     moving = 0;
     still = p.prelude == pc ? 1u : 0u;
+    // Byte by byte with 16-bit indices (the table lies in the first 1,558
+    // bytes): an offset whose low byte differs costs one read, which in an
+    // EEPROM is most of the cost (a board verifies a committed image there).
+    const uint8_t lo = static_cast<uint8_t>(pc), hi = static_cast<uint8_t>(pc >> 8);
+    uint16_t at = static_cast<uint16_t>(p.st);
     for (uint8_t s = 0; s < p.states; ++s) {
-        moving = static_cast<uint16_t>(moving + (r16(im, p.st + 6u * s) == pc) + (r16(im, p.st + 6u * s + 2u) == pc));
-        still = static_cast<uint16_t>(still + (r16(im, p.st + 6u * s + 4u) == pc));
+        for (uint8_t k = 0; k < 3; ++k, at = static_cast<uint16_t>(at + 2u)) {
+            if (im[at] != lo || im[at + 1u] != hi) continue;
+            if (k < 2) ++moving;
+            else ++still;
+        }
     }
 }
 

@@ -26,6 +26,7 @@ class Upload:
     down_frames: int
     down_dropped: int
     slot: int
+    longest_command: int = 0  # cycles of the longest uplink command the board handled (0: not measured)
 
 
 def _session(app, b, loss: float, seed: int):
@@ -48,19 +49,26 @@ def _session(app, b, loss: float, seed: int):
 def timed_upload(elf: str, board: str, app, image: bytes, mask: bytes, loss: float = 0.0, seed: int = 1,
                  baud: int | None = None, analog: dict | None = None) -> Upload:
     """Boots the firmware and uploads `image` (and activates it), through a
-    link that drops `loss` of the frames each way."""
+    link that drops `loss` of the frames each way; the board's profiler
+    times each reload command it handles (`fsw::link_reload_apply`)."""
     from fswkit.sim.board import SimBoard
+    from fswkit.target.build import elf_symbols
 
+    apply_at = [addr for addr, _size, kind, name in elf_symbols(elf)
+                if kind in "tT" and name.startswith("fsw::link_reload_apply(")]
     with SimBoard(elf, board, uart="control", sim_limit=1e6, analog=analog) as b:
+        if apply_at:
+            b.profile(apply_at[:1])
         c, t, up, down = _session(app, b, loss, seed)
         t0 = t.now()
         slot, _ = c.upload(image, mask)
         t1 = t.now()
         c.activate(slot, wait=30)
         t2 = t.now()
+        longest = b.profile_read().functions[0].worst if apply_at else 0
         return Upload(t1 - t0, t2 - t1, c.stats.sent, c.stats.resent, c.stats.busy,
                       up.frames if up else 0, up.dropped if up else 0, down.frames if down else 0,
-                      down.dropped if down else 0, slot)
+                      down.dropped if down else 0, slot, longest)
 
 
 @dataclass

@@ -844,7 +844,15 @@ namespace {
 
 void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     r.im = image;
-    parts(image, r.p);
+    // The parts a step reads (parts() has them all): the header read again
+    // each step costs less than RAM to keep it in.
+    r.p.states = image[18];
+    r.p.windows = image[19];
+    r.p.prelude = u16(image + 24);
+    r.p.st = image + kHeader;
+    r.p.loc = r.p.st + 6u * r.p.states;
+    r.p.win = r.p.loc + 3u * u16(image + 20);
+    r.p.code = r.p.win + 4u * r.p.windows + u16(image + 22);
     r.layout = &layout;
     r.sv = sv;
     r.ram = ram;

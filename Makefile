@@ -102,7 +102,8 @@ fuzz-uplink: $(FUZZ_UPLINK)
 ## (clang): no image the verifier accepts reads or writes outside the state
 ## vector, and the EEPROM verifier agrees with the RAM one (docs/reload.md).
 ## Seeds: tests/fuzz/vm/seeds/ compiled against the target's state vector, and
-## every example machine (fsw compile). FUZZ_RUNS, FUZZ_SECONDS
+## every example machine (fsw compile). The images of tests/fuzz/vm/regressions
+## (inputs that once failed) run first, once each. FUZZ_RUNS, FUZZ_SECONDS
 ## as for fuzz-uplink
 FUZZ_VM := $(BUILD)/fuzz/vm/fuzz_vm
 FUZZ_VM_SRCS := tests/fuzz/vm/fuzz_vm.cpp $(filter-out %/psl_arduino.cpp %/psl_arduino_console.cpp %/psl_arduino_eeprom.cpp,$(wildcard firmware/src/*.cpp))
@@ -118,6 +119,8 @@ fuzz-vm: $(FUZZ_VM) | $(STAMP)
 	@for sm in examples/*/*.sm; do \
 	  $(FSW) compile $$sm --real f64 -o $(BUILD)/fuzz/vm/corpus/$$(basename $$(dirname $$sm))-$$(basename $$sm .sm).fsm \
 	    >/dev/null 2>&1 || true; done
+	@$(FUZZ_VM) -runs=0 tests/fuzz/vm/regressions 2>$(BUILD)/fuzz/vm/regressions.txt || \
+	  { tail -30 $(BUILD)/fuzz/vm/regressions.txt; echo "vm fuzz: 0 passed, 1 failed (a past finding, tests/fuzz/vm/regressions)"; exit 1; }
 	@$(FUZZ_VM) -runs=$(FUZZ_RUNS) -max_total_time=$(FUZZ_SECONDS) -seed=1 -max_len=4096 -print_final_stats=1 \
 	    -artifact_prefix=$(BUILD)/fuzz/vm/ $(BUILD)/fuzz/vm/corpus 2>$(BUILD)/fuzz/vm/log.txt; st=$$?; \
 	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|vm_verify says" $(BUILD)/fuzz/vm/log.txt; \

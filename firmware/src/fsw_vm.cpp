@@ -602,7 +602,10 @@ FSW_VM_INLINE int8_t int_order(const Run& r, const uint8_t* x, uint8_t t, const 
         const uint32_t v = machine_T32(*r.m), cv = load<uint32_t>(c);
         return v < cv ? -1 : v > cv ? 1 : 0;
     }
-    if (t == kBool) return static_cast<int8_t>(static_cast<int8_t>(load_bool(x) ? 1 : 0) - static_cast<int8_t>(c[0]));
+    if (t == kBool) {  // 0 or 1 against any byte (the compiler writes 0 or 1)
+        const uint8_t v = load_bool(x) ? 1 : 0;
+        return v < c[0] ? -1 : v > c[0] ? 1 : 0;
+    }
     return le_order(x, c, size_of(t), t < kU8 ? 0x80 : 0x00);
 }
 

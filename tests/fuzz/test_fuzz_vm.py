@@ -1,7 +1,8 @@
 """A short run of the bytecode VM's libFuzzer target (ASan + UBSan,
 tests/fuzz/vm/fuzz_vm.cpp): no image the verifier accepts makes the VM read
 or write outside the state vector, and the loader's EEPROM verifier agrees
-with the RAM one (docs/reload.md); `make fuzz` runs 10,000,000 inputs."""
+with the RAM one (docs/reload.md); `make fuzz` runs 10,000,000 inputs.
+The inputs of tests/fuzz/vm/regressions (past findings) run first, once each."""
 
 from __future__ import annotations
 
@@ -22,4 +23,4 @@ def test_vm_fuzz_short_run():
     runs = int(r.stdout.split("stat::number_of_executed_units:")[1].split()[0])
     assert runs >= 5000, r.stdout
     seeds = sorted(p.name for p in (ROOT / "build" / "fuzz" / "vm" / "corpus").glob("seed-*.fsm"))
-    assert seeds == ["seed-counter.fsm", "seed-windows.fsm"]  # the seeds that pass the verifier as they are
+    assert seeds == ["seed-counter.fsm", "seed-typed.fsm", "seed-windows.fsm"]  # the seeds that pass the verifier

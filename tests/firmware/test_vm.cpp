@@ -306,56 +306,53 @@ void test_nesting_rule(void) {
     TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(code + 4, static_cast<uint16_t>(n - 4u), 1));
 }
 
-void test_typed_instruction_rules(void) {
+// A typed instruction's rule: the step's code (in flash, as the table is
+// long for an Uno) and the reason it gets.
+struct TypedCase {
+    uint8_t code[12];
+    uint8_t n, stack, reason;
+};
+const uint8_t kIfF32 = sizeof(Real) == 4 ? kVmBadOpcode : kVmOk;
+const TypedCase kTypedCases[] FSW_FLASH = {
     // JKEY x > 1.5 (its key 0xBFC00000), jump past END to END
-    const uint8_t key[] = {JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END};
-    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(key, sizeof key, 1));
-    uint8_t c[sizeof key];
-    memcpy(c, key, sizeof c);
-    c[1] = 3;  // n: an I16, not a float
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof c, 1));
-    c[1] = 4;  // past the layout
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof c, 1));
-    c[1] = 0;
-    c[2] = L0;  // local 0: a U8
-    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, with_step(c, sizeof c, 1));
-    c[1] = 1;  // local 1: there is one local
-    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, with_step(c, sizeof c, 1));
-    memcpy(c, key, sizeof c);
-    c[3] = 4;  // an unknown flag
-    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, with_step(c, sizeof c, 1));
-    Image im;
-    step_image(im, key, sizeof key, 1);
-    im.b[6] = 1;  // a locked state vector: elements only through LDE/STE
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    {{JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmOk},
+    {{JKEY, 3, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadElement},  // n: an I16
+    {{JKEY, 4, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadElement},  // past the layout
+    {{JKEY, 0, L0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadLocal},   // local 0: a U8
+    {{JKEY, 1, L0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadLocal},   // one local only
+    {{JKEY, 2, 0, 4, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadOpcode},   // an unknown flag
     // JINT T > 0x00000FA0 (4 bytes for T), jump past END
-    const uint8_t t[] = {JINT, TLO, THI, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END};
-    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(t, sizeof t, 1));
-    memcpy(c, t, sizeof t);
-    c[3] = 0x86;  // comparison 6: none
-    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, with_step(c, sizeof t, 1));
-    const uint8_t fx[] = {JINT, 2, 0, 0x02, 0, 0, 0, 0, 1, 0, END, END};  // x is no integer
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(fx, sizeof fx, 1));
-    const uint8_t far[] = {JINT, TLO, THI, 0x82, 0, 0, 0, 0, 9, 0, END, END};  // past the code
-    TEST_ASSERT_EQUAL_UINT(kVmBadJump, with_step(far, sizeof far, 1));
-    // SETK: a bool takes 0 or 1 only; T takes nothing
-    const uint8_t set[] = {SETK, 0, L0, 7, END};
-    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(set, sizeof set, 1));
-    const uint8_t sett[] = {SETK, TLO, THI, 0, 0, 0, 0, 0, 0, 0, 0, END};
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(sett, sizeof sett, 1));
+    {{JINT, TLO, THI, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 12, 1, kVmOk},
+    {{JINT, TLO, THI, 0x86, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 12, 1, kVmBadOpcode},  // comparison 6: none
+    {{JINT, 2, 0, 0x02, 0, 0, 0, 0, 1, 0, END, END}, 12, 1, kVmBadElement},          // x is no integer
+    {{JINT, TLO, THI, 0x82, 0, 0, 0, 0, 9, 0, END, END}, 12, 1, kVmBadJump},          // past the code
+    // SETK: T takes nothing
+    {{SETK, 0, L0, 7, END}, 5, 1, kVmOk},
+    {{SETK, TLO, THI, 0, 0, 0, 0, 0, 0, 0, 0, END}, 12, 1, kVmBadElement},
     // IADD n = l + k: integers only, |k| below 2^24 in binary32
-    const uint8_t add[] = {IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END};  // k = -10
-    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(add, sizeof add, 1));
-    memcpy(c, add, sizeof add);
-    c[1] = 2;  // into x: a float
-    TEST_ASSERT_EQUAL_UINT(kVmBadElement, with_step(c, sizeof add, 1));
-    const uint8_t big[] = {IADD, 3, 0, 0, L0, 0x00, 0x00, 0x00, 0x01, END};  // k = 2^24
-    TEST_ASSERT_EQUAL_UINT(sizeof(Real) == 4 ? kVmBadOpcode : kVmOk, with_step(big, sizeof big, 1));
+    {{IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END}, 10, 1, kVmOk},                 // k = -10
+    {{IADD, 2, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END}, 10, 1, kVmBadElement},         // into x: a float
+    {{IADD, 3, 0, 0, L0, 0x00, 0x00, 0x00, 0x01, END}, 10, 1, kIfF32},                // k = 2^24
     // JCMP pops two
-    const uint8_t cmp[] = {LDT, LDT, JCMP, 0x00, 1, 0, END, END};
-    TEST_ASSERT_EQUAL_UINT(kVmOk, with_step(cmp, sizeof cmp, 2));
-    const uint8_t one[] = {LDT, JCMP, 0x00, 1, 0, END, END};
-    TEST_ASSERT_EQUAL_UINT(kVmBadStack, with_step(one, sizeof one, 1));
+    {{LDT, LDT, JCMP, 0x00, 1, 0, END, END}, 8, 2, kVmOk},
+    {{LDT, JCMP, 0x00, 1, 0, END, END}, 7, 1, kVmBadStack},
+};
+
+void test_typed_instruction_rules(void) {
+    for (uint8_t k = 0; k < sizeof kTypedCases / sizeof kTypedCases[0]; ++k) {
+        TypedCase c;
+        flash_read(&c, &kTypedCases[k], sizeof c);
+        // 100 k + reason: a failure shows the case's index too
+        TEST_ASSERT_EQUAL_UINT(100u * k + c.reason, 100u * k + with_step(c.code, c.n, c.stack));
+    }
+    // a locked state vector: elements only through LDE/STE
+    TypedCase c;
+    flash_read(&c, &kTypedCases[0], sizeof c);
+    Image im;
+    step_image(im, c.code, c.n, c.stack);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    im.b[6] = 1;
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
 }
 
 void test_the_vm_steps_typed_instructions(void) {

@@ -472,6 +472,7 @@ struct Run {
     const uint8_t* im;
     Parts p;
     const VmLayout* layout;
+    const VmElem* elems;  // layout->elems
     uint8_t* sv;
     uint8_t* ram;
     uint8_t* loc;
@@ -551,7 +552,7 @@ FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
         t = l[0];
         return r.loc + u16(l + 1);
     }
-    const VmElem* e = r.layout->elems + ref;
+    const VmElem* e = r.elems + ref;
     t = flash_get(e->type);
     return r.sv + flash_get(e->off);
 }
@@ -661,60 +662,60 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
 }
 
 // The typed instructions, one function each (few live registers, so few
-// saved): each returns where the block goes on from the instruction at `pc`.
-FSW_NOINLINE uint16_t op_setk(const Run& r, uint16_t pc) {
-    const uint8_t* a = r.p.code + pc + 1;
+// saved): each takes its opcode's address and returns the next
+// instruction's (a jump's target when it jumps).
+FSW_NOINLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    uint8_t* x = ref_at(r, u16(a), t);
+    uint8_t* x = ref_at(r, u16(ip + 1), t);
     const uint8_t n = size_of(t);
-    memcpy(x, a + 2, n);
-    return static_cast<uint16_t>(pc + 3u + n);
+    memcpy(x, ip + 3, n);
+    return ip + 3 + n;
 }
 
-FSW_NOINLINE uint16_t op_iadd(const Run& r, uint16_t pc) {
-    const uint8_t* a = r.p.code + pc + 1;
+FSW_NOINLINE const uint8_t* op_iadd(const Run& r, const uint8_t* ip) {
     uint8_t td, ts;
-    uint8_t* d = ref_at(r, u16(a), td);
-    const uint8_t* x = ref_at(r, u16(a + 2), ts);
-    int_add(d, td, x, ts, static_cast<int32_t>(u32(a + 4)));
-    return static_cast<uint16_t>(pc + 9u);
+    uint8_t* d = ref_at(r, u16(ip + 1), td);
+    const uint8_t* x = ref_at(r, u16(ip + 3), ts);
+    int_add(d, td, x, ts, static_cast<int32_t>(u32(ip + 5)));
+    return ip + 9;
 }
 
-FSW_NOINLINE uint16_t op_jkey(const Run& r, uint16_t pc) {
-    const uint8_t* a = r.p.code + pc + 1;
+// The end of a test's instruction (its jump offset `o`, 2 bytes, last):
+// where to go on when the test `holds`, under the instruction's `jump_if`.
+FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if) {
+    return holds == jump_if ? o + 2 + u16(o) : o + 2;
+}
+
+FSW_NOINLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    const uint8_t* x = ref_at(r, u16(a), t);
+    const uint8_t* x = ref_at(r, u16(ip + 1), t);
     const uint8_t n = t == kF64 ? 8 : 4;
-    const uint8_t flags = a[2];
-    const bool holds = key_holds(x, n, a + 3, (flags & kKeyInclusive) != 0);
-    const uint8_t* o = a + 3 + n;  // the jump's offset
-    pc = static_cast<uint16_t>(pc + 6u + n);
-    return holds == ((flags & kKeyJumpIf) != 0) ? static_cast<uint16_t>(pc + u16(o)) : pc;
+    const uint8_t flags = ip[3];
+    const bool holds = key_holds(x, n, ip + 4, (flags & kKeyInclusive) != 0);
+    return test_end(ip + 4 + n, holds, (flags & kKeyJumpIf) != 0);
 }
 
-FSW_NOINLINE uint16_t op_jint(const Run& r, uint16_t pc) {
-    const uint8_t* a = r.p.code + pc + 1;
-    const uint16_t ref = u16(a);
+FSW_NOINLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
+    const uint16_t ref = u16(ip + 1);
     uint8_t t = kTypeT;
     const uint8_t* x = ref == kRefT ? nullptr : ref_at(r, ref, t);
     const uint8_t n = t == kTypeT ? 4 : size_of(t);
-    const uint8_t flags = a[2];
-    const bool holds = cmp_holds(flags, int_order(r, x, t, a + 3));
-    const uint8_t* o = a + 3 + n;
-    pc = static_cast<uint16_t>(pc + 6u + n);
-    return holds == ((flags & kJumpIf) != 0) ? static_cast<uint16_t>(pc + u16(o)) : pc;
+    const uint8_t flags = ip[3];
+    const bool holds = cmp_holds(flags, int_order(r, x, t, ip + 4));
+    return test_end(ip + 4 + n, holds, (flags & kJumpIf) != 0);
 }
 
 // One typed instruction (kJKey, kJInt, kSetK, kIAdd) at `pc`.
 uint16_t typed(const Run& r, uint16_t pc) {
-    switch (r.p.code[pc]) {
-        case kSetK: return op_setk(r, pc);
-        case kIAdd: return op_iadd(r, pc);
-        case kJKey: return op_jkey(r, pc);
-        default: return op_jint(r, pc);
+    const uint8_t* ip = r.p.code + pc;
+    switch (*ip) {
+        case kSetK: ip = op_setk(r, ip); break;
+        case kIAdd: ip = op_iadd(r, ip); break;
+        case kJKey: ip = op_jkey(r, ip); break;
+        default: ip = op_jint(r, ip); break;
     }
+    return static_cast<uint16_t>(ip - r.p.code);
 }
-
 
 // The order of two R values for kJCmp: -1, 0, 1, or 2 when unordered (a NaN).
 int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 : 2; }
@@ -825,18 +826,17 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
 // Runs the block at `pc`: the state id it goes to (0: none). Typed
 // instructions and jumps run here, stack code in run_stack.
 uint32_t run_block(const Run& r, uint16_t pc) {
-    const uint8_t* code = r.p.code;
+    const uint8_t* ip = r.p.code + pc;
     for (;;) {
-        const uint8_t op = code[pc];
-        if (op == kEnd) return 0;
-        if (op == kGoto) return static_cast<uint32_t>(code[pc + 1u]) + 1u;
-        switch (op) {
-            case kJmp: pc = static_cast<uint16_t>(pc + 3u + u16(code + pc + 1u)); break;
-            case kJKey: pc = op_jkey(r, pc); break;
-            case kJInt: pc = op_jint(r, pc); break;
-            case kSetK: pc = op_setk(r, pc); break;
-            case kIAdd: pc = op_iadd(r, pc); break;
-            default: pc = run_stack(r, pc); break;
+        switch (*ip) {
+            case kEnd: return 0;
+            case kGoto: return static_cast<uint32_t>(ip[1]) + 1u;
+            case kJmp: ip += 3 + u16(ip + 1); break;
+            case kJKey: ip = op_jkey(r, ip); break;
+            case kJInt: ip = op_jint(r, ip); break;
+            case kSetK: ip = op_setk(r, ip); break;
+            case kIAdd: ip = op_iadd(r, ip); break;
+            default: ip = r.p.code + run_stack(r, static_cast<uint16_t>(ip - r.p.code)); break;
         }
     }
 }
@@ -857,6 +857,7 @@ void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv,
     r.p.win = r.p.loc + 3u * u16(image + 20);
     r.p.code = r.p.win + 4u * r.p.windows + u16(image + 22);
     r.layout = &layout;
+    r.elems = layout.elems;
     r.sv = sv;
     r.ram = ram;
     r.loc = r.p.windows == 0 ? ram : ram + windows_size(r.p);

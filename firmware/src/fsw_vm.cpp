@@ -627,26 +627,37 @@ typedef IntFast<sizeof(Real) == 4>::T Wide;
 // range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
 // the sum in R as the general instructions compute it. Bytes above Wide's
 // are only checked and filled (no 64-bit arithmetic on an AVR).
+// x (of type ts) as a Wide when it is one, else false.
+FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
+    const uint8_t ns = size_of(ts), wb = sizeof(Wide);
+    const bool sign = ts < kU8;
+    if (ns > wb) {  // the bytes past Wide's must be its sign's
+        const uint8_t fill = sign && (x[ns - 1u] & 0x80u) != 0 ? 0xFF : 0x00;
+        for (const uint8_t* p = x + wb; p != x + ns; ++p)
+            if (*p != fill) return false;
+        a = load<Wide>(x);
+        return (a < 0) == (fill != 0);
+    }
+    if (ns == wb) {
+        a = load<Wide>(x);
+        return sign || a >= 0;  // an unsigned value past Wide's range is not one
+    }
+    if (ns == 4) a = sign ? static_cast<Wide>(load<int32_t>(x)) : static_cast<Wide>(load<uint32_t>(x));
+    else if (ns == 2) a = sign ? static_cast<Wide>(load<int16_t>(x)) : static_cast<Wide>(load<uint16_t>(x));
+    else a = sign ? static_cast<Wide>(static_cast<int8_t>(x[0])) : static_cast<Wide>(x[0]);
+    return true;
+}
+
 void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
     const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
     const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
-    const uint8_t ns = size_of(ts), wb = sizeof(Wide);
-    const uint8_t fill = ts < kU8 && (x[ns - 1u] & 0x80u) != 0 ? 0xFF : 0x00;  // x's sign, in a byte
-    bool fast = true;
-    for (uint8_t i = wb - 1u; i < ns; ++i) fast = fast && x[i] == fill;  // past |x| < 2^(8 wb - 8)
-    Wide a = 0;
-    if (fast) {
-        uint8_t b[sizeof(Wide)];
-        for (uint8_t i = 0; i < wb; ++i) b[i] = i < ns && i < wb - 1u ? x[i] : fill;
-        memcpy(&a, b, sizeof a);  // little-endian, as the state vector
-        fast = a >= -limit && a <= limit;
-    }
-    if (!fast) {
+    Wide a;
+    if (!as_wide(x, ts, a) || a < -limit || a > limit) {
         write_elem(d, td, read_elem(x, ts) + static_cast<Real>(k));
         return;
     }
     Wide v = a + k;
-    const uint8_t nd = size_of(td);
+    const uint8_t nd = size_of(td), wb = sizeof(Wide);
     const bool sign = td < kU8;
     if (!sign && v < 0) v = 0;
     if (nd < wb) {  // d narrower than Wide: its range
@@ -654,11 +665,12 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
                                                                : static_cast<Wide>(sign ? 2147483647LL : 4294967295LL);
         if (v > hi) v = hi;
         if (sign && v < -hi - 1) v = -hi - 1;
+        memcpy(d, &v, nd);  // its low bytes, little-endian
+        return;
     }
-    uint8_t b[sizeof(Wide)];
-    memcpy(b, &v, sizeof b);
-    const uint8_t vfill = v < 0 ? 0xFF : 0x00;
-    for (uint8_t i = 0; i < nd; ++i) d[i] = i < wb ? b[i] : vfill;
+    memcpy(d, &v, wb);
+    const uint8_t fill = v < 0 ? 0xFF : 0x00;  // (only a signed d is negative here)
+    for (uint8_t i = wb; i < nd; ++i) d[i] = fill;
 }
 
 // The typed instructions, one function each (few live registers, so few

@@ -22,7 +22,7 @@ import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
 
-pytestmark = pytest.mark.costly(12)
+pytestmark = pytest.mark.costly(8)
 
 ROCKET = EXAMPLES / "rocket"
 DISPERSION = ROCKET / "dispersion.toml"

@@ -6,7 +6,7 @@ import pytest
 
 from support.hpr_tapes import MARKS, build_hpr, replay_and_check, tapes
 
-pytestmark = MARKS + [pytest.mark.costly(19)]
+pytestmark = MARKS + [pytest.mark.costly(8)]
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import pytest
 
 from support.hpr_tapes import MARKS, build_hpr, replay_and_check, tapes
 
-pytestmark = MARKS + [pytest.mark.costly(20)]
+pytestmark = MARKS + [pytest.mark.costly(7)]
 
 
 @pytest.fixture(scope="module")

@@ -24,7 +24,7 @@ from support.simfw import kept_sim
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
-              pytest.mark.costly(12)]
+              pytest.mark.costly(9)]
 
 ROCKET, TANK = EXAMPLES / "rocket", EXAMPLES / "tank"
 SEEDS = (1, 2)  # make bench flies seeds 1-20

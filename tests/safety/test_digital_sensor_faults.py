@@ -26,7 +26,7 @@ import pytest
 from conftest import EXAMPLES
 from support.closed_loop import build_project, fly_all, needs_avr_sim
 
-pytestmark = [needs_avr_sim, pytest.mark.costly(33)]
+pytestmark = [needs_avr_sim, pytest.mark.costly(17)]
 
 DIGITAL = EXAMPLES / "hpr_digital"
 FAIL_S = 15.0

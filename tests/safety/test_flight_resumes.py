@@ -23,7 +23,7 @@ import pytest
 from conftest import EXAMPLES
 from support.closed_loop import build_project, fly_all, needs_avr_sim
 
-pytestmark = [needs_avr_sim, pytest.mark.costly(15)]
+pytestmark = [needs_avr_sim, pytest.mark.costly(11)]
 
 ROCKET = EXAMPLES / "rocket"
 SEQUENCE = ["Safe", "Armed", "Boost", "Coast", "Apogee", "Drogue", "Main", "Descent", "Landed"]

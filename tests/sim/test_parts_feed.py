@@ -81,6 +81,25 @@ def test_barometer_counts_are_the_datasheet_inverse():
         assert abs(P.ms5611_compensate(m, raw["D1"], raw["D2"]).P - pa) <= 0.5
 
 
+def test_a_temperature_met_again_reads_the_count_a_full_search_gives():
+    """PartFeed keeps the raw temperature it found by the half-count of the
+    target (a compensated temperature is a whole number of 0.01 degC): a
+    temperature wandering back and forth across a few counts, through their
+    halves and onto them exactly, reads what parts.py's full search gives
+    each time, on both barometers."""
+    rng = random.Random(7)
+    temps = [20.0 + 0.0001 * i + rng.gauss(0, 0.006) for i in range(300)]
+    temps += [20.0 + k * 0.005 for k in range(-6, 7)] * 2  # the half-counts and the counts themselves
+    c = P.BMP280_EXAMPLE[0]
+    feed = PartFeed(BMP, 0x76, P.bmp280_calib_bytes(c))
+    for t_c in temps:
+        assert feed.raw(pressure=101325.0, temperature=t_c)["adc_T"] == P.bmp280_adc_T_for(c, t_c), t_c
+    m = P.MS5611_EXAMPLE[0]
+    feed = PartFeed(MS, 0x77, b"".join(w.to_bytes(2, "big") for w in P.ms5611_prom_words(m)))
+    for t_c in temps:
+        assert feed.raw(pressure=100000.0, temperature=t_c)["D2"] == P.ms5611_D2_for(m, t_c), t_c
+
+
 def test_accelerometer_counts_at_the_parts_range():
     """ADXL345 in full resolution: 256 counts a g at every range, stopping at
     the range's 13 bits (+-16 g); MPU-6050 at +-8 g: 4096 a g; an axis not

@@ -294,6 +294,16 @@ def test_simulated_time_limit_stops_a_spinning_firmware(spin_uno):
         assert b.go(realtime=False).stop == "sim-limit"
 
 
+def test_simulated_time_limit_stops_a_sleeping_firmware_at_the_limit(tank_uno):
+    # the tank's executor sleeps between its cycles: the core wakes at the limit (a cycle timer, as at a
+    # step's target), not at its next event after it
+    for run in (lambda b: b.step(10 ** 12), lambda b: b.go(realtime=False)):
+        with SimBoard(tank_uno, "uno", sim_limit=0.05) as b:
+            r = run(b)
+            assert r.stop == "sim-limit"
+            assert r.cycle == pytest.approx(800000, abs=4), r
+
+
 def test_wall_clock_limit_stops_a_spinning_firmware(spin_uno):
     t0 = time.monotonic()
     with SimBoard(spin_uno, "uno", wall_limit=0.5) as b:

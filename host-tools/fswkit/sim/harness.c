@@ -46,6 +46,7 @@
 #include <simavr/avr_eeprom.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_spi.h>
+#include <simavr/avr_timer.h>
 #include <simavr/avr_twi.h>
 #include <simavr/avr_uart.h>
 #include <simavr/avr_watchdog.h>
@@ -329,6 +330,31 @@ static void uart_bit_times(void) {
     if (uart0) avr_register_io_write(avr, uart0->ubrrl.reg, on_ubrr_write, NULL);
 }
 
+/* simavr 1.6's ATmega328P and ATmega2560 leave the phase-correct PWM modes of
+   their timers out of the mode table (the 8-bit timers' mode 1, the 16-bit
+   timers' modes 1-3): an absent mode has a TOP of 0, so the timer
+   overflows, and matches both compare units, every prescaler period. The
+   Arduino core's init() leaves Timer1 and Timer2 (and the Mega's Timer3-5)
+   in mode 1 at clk/64: they overflowed every 64 CPU cycles, three
+   interrupt flags raised each time, two fifths of the simulator's time on a
+   flight that never uses them. The absent modes get the entries simavr
+   gives these modes on its ATmega164-1284 and ATmega32U4 cores (8, 9 and
+   10-bit, one TOP + 1 period: an overflow every 256 x 64 cycles at
+   clk/64, where the part's dual slope takes 510 x 64). A mode the library
+   defines is left as it is. */
+static void timer_pwm_modes(void) {
+    static const avr_timer_wgm_t pc8 = AVR_TIMER_WGM_FCPWM8(), pc9 = AVR_TIMER_WGM_FCPWM9(),
+                                 pc10 = AVR_TIMER_WGM_FCPWM10();
+    for (avr_io_t* io = avr->io_port; io; io = io->next) {
+        if (!io->kind || strcmp(io->kind, "timer") != 0) continue;
+        avr_timer_t* t = (avr_timer_t*)io;
+        const int wide = t->r_tcnth != 0; /* a 16-bit timer: modes 1-3 are 8, 9 and 10-bit */
+        if (t->wgm_op[1].kind == avr_timer_wgm_none) t->wgm_op[1] = pc8;
+        if (wide && t->wgm_op[2].kind == avr_timer_wgm_none) t->wgm_op[2] = pc9;
+        if (wide && t->wgm_op[3].kind == avr_timer_wgm_none) t->wgm_op[3] = pc10;
+    }
+}
+
 /* Hands waiting host bytes to the AVR's UART while its FIFO has room. */
 static void uart_feed(void) {
     while (!uart_xoff && bytes_pending(&uart_in)) avr_raise_irq(uart_in_irq, uart_in.buf[uart_in.head++]);
@@ -355,7 +381,7 @@ static avr_cycle_count_t on_target(struct avr_t* a, avr_cycle_count_t when, void
     (void)a;
     (void)when;
     (void)param;
-    return 0; /* exists only so that a sleeping core wakes at the target cycle */
+    return 0; /* exists only so that a sleeping core wakes at the target cycle (or the limit) */
 }
 
 static void on_sigint(int sig) {
@@ -1514,12 +1540,14 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
     if (wall_limit > 0 && wall_now() - wall_start >= wall_limit) return "wall-limit";
     if (cycle_limit && avr->cycle >= cycle_limit) return "sim-limit";
     if (has_target && avr->cycle >= target) return "target";
-    if (has_target) avr_cycle_timer_register(avr, target - avr->cycle, on_target, NULL);
     const avr_cycle_count_t c0 = avr->cycle;
     const double w0 = wall_now();
     /* one comparison per instruction: the earlier of the target and the limit */
     avr_cycle_count_t stop_at = has_target ? target : ~(avr_cycle_count_t)0;
     if (cycle_limit && cycle_limit < stop_at) stop_at = cycle_limit;
+    /* a sleeping core wakes there (it sleeps to its next cycle timer), not at the next event after it */
+    const int wake = stop_at != ~(avr_cycle_count_t)0;
+    if (wake) avr_cycle_timer_register(avr, stop_at - avr->cycle, on_target, NULL);
     const char* why = NULL;
     while (!why) {
         avr_t* const a = avr; /* a local: the compiler need not reload it after each instruction */
@@ -1557,7 +1585,7 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
             if (ahead > 0.002) sleep_s(ahead);
         }
     }
-    if (has_target) avr_cycle_timer_cancel(avr, on_target, NULL);
+    if (wake) avr_cycle_timer_cancel(avr, on_target, NULL);
     uart_service();
     return why;
 }
@@ -2619,6 +2647,7 @@ int main(int argc, char** argv) {
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), on_uart_xoff, NULL);
     uart_in_irq = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
     uart_bit_times();
+    timer_pwm_modes();
     if (uart_mode == UART_PTY && pty_open() != 0) return 2;
     if (uart_mode == UART_STDIO) fcntl(1, F_SETFL, fcntl(1, F_GETFL) | O_NONBLOCK);
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 __all__ = [
     "Bmp280Calib", "bmp280_parse_calib", "bmp280_parse_raw", "bmp280_raw_bytes", "bmp280_calib_bytes",
-    "bmp280_compensate_T", "bmp280_compensate_P64", "bmp280_compensate_P32",
+    "bmp280_compensate_T", "bmp280_compensate_P64", "bmp280_P64_terms", "bmp280_P64_of", "bmp280_compensate_P32",
     "bmp280_adc_T_for", "bmp280_adc_P_for",
     "Ms5611Calib", "Ms5611Result", "ms5611_crc4", "ms5611_prom_words", "ms5611_parse_prom", "ms5611_compensate",
     "ms5611_D2_for", "ms5611_D1_for",
@@ -114,12 +114,25 @@ def bmp280_compensate_T(c: Bmp280Calib, adc_T: int) -> tuple[int, int]:
 
 def bmp280_compensate_P64(c: Bmp280Calib, adc_P: int, t_fine: int) -> int:
     """Pa in unsigned Q24.8: datasheet 3.11.3 bmp280_compensate_P_int64."""
+    return bmp280_P64_of(c, adc_P, bmp280_P64_terms(c, t_fine))
+
+
+def bmp280_P64_terms(c: Bmp280Calib, t_fine: int) -> tuple[int, int]:
+    """(var1, var2) of bmp280_compensate_P_int64 before adc_P enters: they
+    depend on t_fine alone, so a search over adc_P works them out once."""
     var1 = t_fine - 128000
     var2 = _s64(_s64(var1 * var1) * c.dig_P6)
     var2 = _s64(var2 + _s64(_s64(var1 * c.dig_P5) << 17))
     var2 = _s64(var2 + _s64(c.dig_P4 << 35))
     var1 = _s64((_s64(_s64(var1 * var1) * c.dig_P3) >> 8) + _s64(_s64(var1 * c.dig_P2) << 12))
     var1 = _s64(_s64((1 << 47) + var1) * c.dig_P1) >> 33
+    return var1, var2
+
+
+def bmp280_P64_of(c: Bmp280Calib, adc_P: int, terms: tuple[int, int]) -> int:
+    """bmp280_compensate_P_int64 from adc_P on, with `terms` =
+    bmp280_P64_terms(c, t_fine)."""
+    var1, var2 = terms
     if var1 == 0:
         return 0
     p = 1048576 - adc_P
@@ -182,7 +195,8 @@ def bmp280_adc_P_for(c: Bmp280Calib, pascal: float, t_fine: int, formula: int = 
     `pascal`, by the 64-bit (Q24.8) or the 32-bit (whole Pa) formula; the
     pressure falls as adc_P rises."""
     if formula == 64:
-        return _nearest_search(lambda a: bmp280_compensate_P64(c, a, t_fine), pascal * 256.0, 0, 0xFFFFF, False)
+        terms = bmp280_P64_terms(c, t_fine)
+        return _nearest_search(lambda a: bmp280_P64_of(c, a, terms), pascal * 256.0, 0, 0xFFFFF, False)
     return _nearest_search(lambda a: bmp280_compensate_P32(c, a, t_fine), pascal, 0, 0xFFFFF, False)
 
 

@@ -214,14 +214,34 @@ def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bo
 class _Inverse:
     """A monotonic integer function's nearest inverse, remembering its last
     answers: a plant step's value is near the last one, so the answer is a
-    few steps from a secant guess (the same answer as a full search)."""
+    few steps from a secant guess (the same answer as a full search).
 
-    def __init__(self, lo: int, hi: int, increasing: bool):
+    `whole`: f is always the same function and its values are whole
+    numbers. The answer then depends on the target only through
+    ceil(2 x target) (floor when f falls): the first x whose f(x) reaches
+    the target is the first that reaches its ceiling (floor), and the
+    nearer of it and its predecessor is decided by 2 x target against the
+    whole number f(x - 1) + f(x). Answers are kept by that number: a
+    temperature, whose counts step in plateaus a whole 0.01 degC wide, moves
+    across one in several plant steps, and the walk is done once for it."""
+
+    def __init__(self, lo: int, hi: int, increasing: bool, whole: bool = False):
         self.lo, self.hi, self.increasing = lo, hi, increasing
         self.last: tuple[float, int] | None = None
         self.slope: float | None = None  # counts per unit of target
+        self.known: dict[int, int] | None = {} if whole else None  # ceil(2 x target) (floor) -> the answer
 
     def __call__(self, f, target: float, full) -> int:
+        known = self.known
+        if known is not None and math.isfinite(target):
+            key = math.ceil(2.0 * target) if self.increasing else math.floor(2.0 * target)
+            x = known.get(key)
+            if x is None:
+                x = known[key] = self._search(f, target, full)
+            return x
+        return self._search(f, target, full)
+
+    def _search(self, f, target: float, full) -> int:
         x = None
         if self.last is not None and self.slope is not None:
             t0, x0 = self.last
@@ -266,7 +286,8 @@ class PartFeed:
             self.calib = P.Ms5611Calib(*words[1:7])
         self._t: tuple[float, int, int] | None = None  # (°C, raw temperature, t_fine / D2)
         # the raw temperature (BMP280 adc_T, MS5611 D2): the temperature changes at every plant step
-        self._temp = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, True)
+        # (its compensation, BMP280 T or MS5611 TEMP, is in whole 0.01 degC: `whole`)
+        self._temp = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, True, whole=True)
         self._p = _Inverse(0, 0xFFFFF if self.part == "bmp280" else 0xFFFFFF, self.part != "bmp280")
         # the BMP280's compensations are pure functions of the raw counts (and t_fine): each raw count's
         # value is worked out once (a flight's temperatures span a few hundred adc_T; its pressures, for
@@ -274,6 +295,7 @@ class PartFeed:
         self._t_of: dict[int, tuple[int, int]] = {}  # adc_T -> bmp280_compensate_T
         self._p_of: dict[int, int] = {}  # adc_P -> bmp280_compensate_P64 at t_fine self._p_tf
         self._p_tf: int | None = None
+        self._p_terms: tuple[int, int] = (0, 0)  # parts.bmp280_P64_terms at self._p_tf
 
     @property
     def data_format(self) -> int:
@@ -306,14 +328,14 @@ class PartFeed:
                 out["adc_T"] = self._t[1]
                 if pressure is not None:
                     c, tf = self.calib, self._t[2]
-                    if tf != self._p_tf:
-                        self._p_tf, self._p_of = tf, {}
-                    p_of = self._p_of
+                    if tf != self._p_tf:  # (and t_fine's part of the formula, worked out once for it)
+                        self._p_tf, self._p_of, self._p_terms = tf, {}, P.bmp280_P64_terms(c, tf)
+                    p_of, terms = self._p_of, self._p_terms
 
                     def comp_p(a):
                         r = p_of.get(a)
                         if r is None:
-                            r = p_of[a] = P.bmp280_compensate_P64(c, a, tf)
+                            r = p_of[a] = P.bmp280_P64_of(c, a, terms)
                         return r
                     out["adc_P"] = self._p(comp_p, float(pressure) * 256.0,
                                            lambda: P.bmp280_adc_P_for(c, float(pressure), tf))

@@ -23,9 +23,7 @@ from ..numeric import Real, to_type
 from ..thresholds import tests
 from .. import vmverify as V
 from .common import value_bytes
-
-# `a op b` is `b _FLIP[op] a`.
-_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
+from .fastpaths import folded_compare, orient
 
 
 def _no_reads(i: int):
@@ -215,17 +213,15 @@ class _Code:
     def int_test(self, left: M.Expr, op: str, right: M.Expr):
         """`x op c` on the integer itself, as the C++ emitter's int_compare:
         a node, or None."""
-        v, c = self.int_var(left), self.exact_int_const(right)
-        if v is None or c is None:
-            v, c, op = self.int_var(right), self.exact_int_const(left), _FLIP[op]
-            if v is None or c is None:
-                return None
+        got = orient(left, op, right, self.int_var, self.exact_int_const)
+        if got is None:
+            return None
+        _, v, c, op = got
         t = v.type
         lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
-        points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
-        results = {compare(op, x, c) for x in points}
-        if len(results) == 1:
-            return ("const", results.pop())
+        folded = folded_compare(op, c, lo, hi)
+        if folded is not None:
+            return ("const", folded)
         if v.kind == M.TIME_IN_STATE:
             if not 0 <= c < 0xFFFFFFFF:
                 return None
@@ -239,11 +235,11 @@ class _Code:
         float_key_test: a node, or None."""
         if self.real.bits != 32:
             return None
-        x, cv = left, self.known(right)
-        if type(x) is not M.Ref or x.var in self.consts or cv is None:
-            x, cv, op = right, self.known(left), _FLIP[op]
-        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+        got = orient(left, op, right, lambda e: e if type(e) is M.Ref and e.var not in self.consts else None,
+                     self.known)
+        if got is None:
             return None
+        x, _, cv, op = got
         v = self.m.vars[x.var]
         if v.kind == M.TIME_IN_STATE or v.type.kind != "float" or self.ref(x.var) is None:
             return None

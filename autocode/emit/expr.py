@@ -15,10 +15,9 @@ from ..evaluate import NotConstant, compare, evaluate, local_values
 from ..numeric import Real, to_type
 from ..thresholds import tests
 from .common import real_literal
+from .fastpaths import folded_compare, orient
 
 
-# `a op b` is `b _FLIP[op] a`.
-_FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
 
 
 def _no_reads(i: int):
@@ -140,17 +139,20 @@ class ExprEmitter:
     def float_threshold(self, left: M.Expr, op: str, right: M.Expr):
         """binary32 R: `R(x) op c` for a float variable x and a literal c as
         integer threshold tests on x's stored bytes (autocode/thresholds.py)."""
-        x, cv = left, self.known(right)
-        if type(x) is not M.Ref or x.var in self.consts or cv is None:
-            x, cv, op = right, self.known(left), _FLIP[op]
-        if type(x) is not M.Ref or x.var in self.consts or cv is None:
+        got = orient(left, op, right, self.threshold_var, self.known)
+        if got is None:
             return None
+        x, _, cv, op = got
         v = self.m.vars[x.var]
         if v.kind == M.TIME_IN_STATE or v.type.kind != "float":
             return None
         if self.sv_lock and v.kind == M.ELEMENT:
             return None
         return float_key_test(op, cv, v.type.size, self.ptr(v))
+
+    def threshold_var(self, e: M.Expr):
+        """`e` when it reads a variable that is no folded constant."""
+        return e if type(e) is M.Ref and e.var not in self.consts else None
 
     # -- integer fast paths, bit-identical to the R semantics ------------------
     def assign(self, var: int, e: M.Expr) -> str:
@@ -305,20 +307,14 @@ class ExprEmitter:
     def int_compare(self, left: M.Expr, op: str, right: M.Expr):
         """`x op c` on the integer itself. Converting an integer to R is
         monotonic and exact near c, so `R(x) op c` equals `x op c`."""
-        a, c, x = self.int_operand(left), self.exact_int_const(right), left
-        if a is None or c is None:
-            a, c, x = self.int_operand(right), self.exact_int_const(left), right
-            if a is None or c is None:
-                return None
-            op = _FLIP[op]
-        text, t = a
+        got = orient(left, op, right, self.int_operand, self.exact_int_const)
+        if got is None:
+            return None
+        x, (text, t), c, op = got
         lo, hi = (0, 1) if t.kind == "bool" else (t.lo, t.hi)
-        # Constant over the type's whole range (c outside it, or `x >= 0` on an
-        # unsigned type): fold it, as compilers would warn about the test.
-        points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
-        results = {compare(op, x, c) for x in points}
-        if len(results) == 1:
-            return "true" if results.pop() else "false"
+        folded = folded_compare(op, c, lo, hi)
+        if folded is not None:
+            return "true" if folded else "false"
         if t.kind == "bool":
             return f"(static_cast<int>({text}) {op} {c})"
         if self.m.vars[x.var].kind == M.TIME_IN_STATE and 0 <= c < 0xFFFFFFFF:

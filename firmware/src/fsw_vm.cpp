@@ -623,11 +623,8 @@ struct IntFast<true> {
 // R's precision (24 or 53), fit this type with a byte to spare.
 typedef IntFast<sizeof(Real) == 4>::T Wide;
 
-// `d = x + k` for integers d and x (kIAdd): the integer sum clamped to d's
-// range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
-// the sum in R as the general instructions compute it. Bytes above Wide's
-// are only checked and filled (no 64-bit arithmetic on an AVR).
-// x (of type ts) as a Wide when it is one, else false.
+// x (of type ts) as a Wide when it is one, else false. Bytes above Wide's
+// are only checked (no 64-bit arithmetic on an AVR).
 FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
     const uint8_t ns = size_of(ts), wb = sizeof(Wide);
     const bool sign = ts < kU8;
@@ -648,6 +645,10 @@ FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
     return true;
 }
 
+// `d = x + k` for integers d and x (kIAdd): the integer sum clamped to d's
+// range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
+// the sum in R as the general instructions compute it. Bytes of d above
+// Wide's are filled with the sum's sign.
 void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
     const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
     const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));

@@ -89,10 +89,11 @@ def main() -> int:
     ram_syms = {i: {name: size for _addr, size, kind, name in elf_symbols(elfs[i]) if kind in "bBdD"}
                 for i in (0, 2)}
     extra = {k.replace("(anonymous namespace)::", ""): v for k, v in ram_syms[2].items() if k not in ram_syms[0]}
+    legend = {"machine": "the machine's record, as generated code has", "ram": "the image's windows and locals",
+              "kLayout": "the state vector's layout the image is checked against"}
     print("  the VM probe's RAM beyond the bare sketch's, by symbol: "
           + ", ".join(f"{k} {v}" for k, v in sorted(extra.items(), key=lambda kv: -kv[1]))
-          + " (machine: the machine's record, as generated code has; ram: the image's windows and locals; "
-          "kLayout: the state vector's layout the image is checked against)")
+          + " (" + "; ".join(f"{k}: {what}" for k, what in legend.items() if any(k in name for name in extra)) + ")")
     beyond, gen_ram = vm_ram - sv, s[1][1] - s[0][1]
     print(f"VM against its targets: flash {vm_flash:,} B without the image (target <= 3,072: "
           f"{'met' if vm_flash <= 3072 else 'MISSED'}), RAM {vm_ram:,} B: {beyond:,} B beyond the tank's {sv} B state "

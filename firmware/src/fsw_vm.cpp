@@ -121,20 +121,27 @@ struct Parts {
     const uint8_t* code;
 };
 
-// (A verified image's parts all lie within its at most 65535 bytes: 16-bit
-// sums, as offsets() has them in 32 bits for an image not yet checked.)
-void parts(const uint8_t* im, Parts& p) {
+// The parts a step reads: the header read again each step costs less than
+// the RAM to keep it in. (A verified image's parts all lie within its at
+// most 65535 bytes: 16-bit sums, as offsets() has them in 32 bits for an
+// image not yet checked.)
+inline void step_parts(const uint8_t* im, Parts& p) {
     p.states = im[18];
     p.windows = im[19];
-    p.locals = u16(im + 20);
-    p.loc_size = u16(im + 22);
     p.prelude = u16(im + 24);
-    p.code_size = u16(im + 26);
     p.st = im + kHeader;
     p.loc = p.st + 6u * p.states;
-    p.win = p.loc + 3u * p.locals;
-    p.init = p.win + 4u * p.windows;
-    p.code = p.init + p.loc_size;
+    p.win = p.loc + 3u * u16(im + 20);
+    p.code = p.win + 4u * p.windows + u16(im + 22);
+}
+
+// All of them.
+void parts(const uint8_t* im, Parts& p) {
+    step_parts(im, p);
+    p.locals = u16(im + 20);
+    p.loc_size = u16(im + 22);
+    p.code_size = u16(im + 26);
+    p.init = p.code - p.loc_size;
 }
 
 // Storage of a window of n samples in the VM's RAM: the state struct and its
@@ -471,8 +478,7 @@ namespace {
 struct Run {
     const uint8_t* im;
     Parts p;
-    const VmLayout* layout;
-    const VmElem* elems;  // layout->elems
+    const VmElem* elems;  // the layout's element table (FSW_FLASH)
     uint8_t* sv;
     uint8_t* ram;
     uint8_t* loc;
@@ -767,7 +773,7 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 continue;
             case kConst: memcpy(&st[sp++], a, sizeof(Real)); pc = static_cast<uint16_t>(pc + 1u + sizeof(Real)); continue;
             case kLde: {
-                const uint8_t* e = r.sv + flash_get(r.layout->elems[u16(a)].off);
+                const uint8_t* e = r.sv + flash_get(r.elems[u16(a)].off);
                 if (r.lock) {
                     SvGuard<true> g;
                     st[sp++] = read_elem(e, a[2]);
@@ -778,7 +784,7 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 continue;
             }
             case kSte: {
-                uint8_t* e = r.sv + flash_get(r.layout->elems[u16(a)].off);
+                uint8_t* e = r.sv + flash_get(r.elems[u16(a)].off);
                 --sp;
                 if (r.lock) {
                     SvGuard<true> g;
@@ -860,16 +866,7 @@ namespace {
 
 void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     r.im = image;
-    // The parts a step reads (parts() has them all): the header read again
-    // each step costs less than RAM to keep it in.
-    r.p.states = image[18];
-    r.p.windows = image[19];
-    r.p.prelude = u16(image + 24);
-    r.p.st = image + kHeader;
-    r.p.loc = r.p.st + 6u * r.p.states;
-    r.p.win = r.p.loc + 3u * u16(image + 20);
-    r.p.code = r.p.win + 4u * r.p.windows + u16(image + 22);
-    r.layout = &layout;
+    step_parts(image, r.p);
     r.elems = layout.elems;
     r.sv = sv;
     r.ram = ram;

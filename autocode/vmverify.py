@@ -95,6 +95,16 @@ def operand_bytes(op: int, real: int) -> int | None:
     return None
 
 
+def _typed_operands(op: int, t: int) -> int:
+    """Bytes of a typed instruction's operands after its variable of type `t`
+    (TYPE_T: T): a test's flags or comparison, its constant and its jump
+    offset; SETK's value; IADD's source and constant."""
+    if op == IADD:
+        return 6
+    size = 4 if t == TYPE_T else TYPE_SIZES[t]
+    return size if op == SETK else 1 + size + 2
+
+
 def _wrong_type(ref: int) -> int:
     return BAD_LOCAL if REF_LOCAL <= ref != REF_T else BAD_ELEMENT
 
@@ -228,25 +238,18 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
             if why != OK:
                 return why, deepest
             b = a + 2
-            at = 0
             if op == JKEY:
-                if t not in (TYPE_CODES["F32"], TYPE_CODES["F64"]):
-                    return _wrong_type(ref), deepest
-                at = 1 + TYPE_SIZES[t]
-                more = at + 2
+                fits = t in (TYPE_CODES["F32"], TYPE_CODES["F64"])
             elif op == JINT:
-                if t != TYPE_T and t > TYPE_CODES["U64"] and t != TYPE_CODES["bool"]:
-                    return _wrong_type(ref), deepest
-                at = 1 + (4 if t == TYPE_T else TYPE_SIZES[t])
-                more = at + 2
+                fits = t == TYPE_T or t <= TYPE_CODES["U64"] or t == TYPE_CODES["bool"]
             elif op == SETK:
-                if t == TYPE_T:
-                    return _wrong_type(ref), deepest
-                more = TYPE_SIZES[t]
+                fits = t != TYPE_T
             else:
-                if t > TYPE_CODES["U64"]:
-                    return _wrong_type(ref), deepest
-                more = 6
+                fits = t <= TYPE_CODES["U64"]
+            if not fits:
+                return _wrong_type(ref), deepest
+            more = _typed_operands(op, t)
+            at = more - 2  # a test's jump offset, last
             if pc + more > p.code_size:
                 return BAD_OPCODE, deepest
             pc += more
@@ -388,9 +391,7 @@ def opcodes(im: bytes, layout: Layout) -> list[int]:
         op = code[pc]
         n = operand_bytes(op, im[5])
         if op in (JKEY, JINT, SETK, IADD):
-            t = _ref_type(im, p, layout, _u16(code, pc + 1), lock)[1]
-            size = 4 if t == TYPE_T else TYPE_SIZES[t]
-            n += {JKEY: 3 + size, JINT: 3 + size, SETK: size, IADD: 6}[op]
+            n += _typed_operands(op, _ref_type(im, p, layout, _u16(code, pc + 1), lock)[1])
         out.append(op)
         pc += 1 + n
     return out

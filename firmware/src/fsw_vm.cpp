@@ -216,6 +216,15 @@ struct Pending {
     uint8_t depth;
 };
 
+// Bytes of a typed instruction's operands after its variable of type `t`
+// (kTypeT: T): a test's flags or comparison, its constant and its jump
+// offset; kSetK's value; kIAdd's source and constant.
+inline uint8_t typed_operands(uint8_t op, uint8_t t) {
+    if (op == kIAdd) return 6;
+    const uint8_t size = t == kTypeT ? 4u : elem_size(t);
+    return op == kSetK ? size : static_cast<uint8_t>(1u + size + 2u);
+}
+
 // The reason that refuses `ref` where its type does not fit the instruction.
 inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRefT ? kVmBadLocal : kVmBadElement; }
 
@@ -307,23 +316,14 @@ VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
                 uint8_t t;
                 const VmReason why = ref_type(im, p, layout, ref, (im[6] & kFlagLock) != 0, t);
                 if (why != kVmOk) return why;
+                const bool fits = op == kJKey ? t == kF32 || t == kF64
+                                  : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
+                                  : op == kSetK ? t != kTypeT
+                                                : is_int(t);
+                if (!fits) return wrong_type(ref);
                 const uint32_t b = a + 2u;  // the operands after the ref
-                uint8_t more, at = 0;       // their bytes; where a jump's offset is
-                if (op == kJKey) {
-                    if (t != kF32 && t != kF64) return wrong_type(ref);
-                    at = static_cast<uint8_t>(1u + elem_size(t));
-                    more = static_cast<uint8_t>(at + 2u);
-                } else if (op == kJInt) {
-                    if (t != kTypeT && !is_int(t) && t != kBool) return wrong_type(ref);
-                    at = static_cast<uint8_t>(1u + (t == kTypeT ? 4u : elem_size(t)));
-                    more = static_cast<uint8_t>(at + 2u);
-                } else if (op == kSetK) {
-                    if (t == kTypeT) return wrong_type(ref);
-                    more = elem_size(t);
-                } else {
-                    if (!is_int(t)) return wrong_type(ref);
-                    more = 6;
-                }
+                const uint8_t more = typed_operands(op, t);
+                const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
                 if (static_cast<uint32_t>(pc) + more > p.code_size) return kVmBadOpcode;
                 pc = static_cast<uint16_t>(pc + more);
                 if (op == kSetK) {
@@ -807,9 +807,8 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kJKey: case kJInt: case kSetK: case kIAdd: pc = typed(r, pc); continue;
             case kJCmp: {
                 sp = static_cast<uint8_t>(sp - 2u);
-                const int8_t order = real_order(st[sp], st[sp + 1u]);
-                pc = static_cast<uint16_t>(pc + 4u);
-                if (cmp_holds(a[0], order) == ((a[0] & kJumpIf) != 0)) pc = static_cast<uint16_t>(pc + u16(a + 1));
+                const bool holds = cmp_holds(a[0], real_order(st[sp], st[sp + 1u]));
+                pc = static_cast<uint16_t>(test_end(a + 1, holds, (a[0] & kJumpIf) != 0) - code);
                 continue;
             }
             case kLdt: st[sp++] = machine_T_real(*r.m); break;

@@ -9,25 +9,20 @@ to plain R evaluation (the differential tests hold both to that), and saves
 the VM the conversions to and from R. A local the machine never
 writes (and that is no parameter) is a constant in the code, as in the
 C++; `scriptable` keeps every local a variable, for a state script that
-writes them (as the C++ emitter's own flag does). Compilation is a pure function: the same machine gives the same bytes."""
+writes them (as the C++ emitter's own flag does). Compilation is a pure
+function: the same machine gives the same bytes."""
 
 from __future__ import annotations
 
-import math
 import struct
 
 from .. import model as M
-from ..check import assigned_vars
 from ..evaluate import NotConstant, compare, evaluate, local_values
 from ..numeric import Real, to_type
 from ..thresholds import tests
 from .. import vmverify as V
 from .common import value_bytes
-from .fastpaths import folded_compare, orient
-
-
-def _no_reads(i: int):
-    raise NotConstant(None)
+from .fastpaths import exact_int, folded_compare, folded_locals, known, no_reads, orient
 
 
 class BytecodeError(Exception):
@@ -109,16 +104,20 @@ class _Code:
         self.b[after - 2:after] = struct.pack("<H", d)
 
     # -- expressions: each leaves one R on the stack -----------------------------
-    def top(self, e: M.Expr, emit: bool = True) -> None:
-        """A whole expression (a statement's or a window's), refused where
-        it needs more of the operand stack than the VM has."""
+    def top(self, e: M.Expr) -> None:
+        """A whole expression (a statement's or a window's)."""
+        self.check_depth(e)
+        self.value(e)
+
+    @staticmethod
+    def check_depth(e: M.Expr) -> None:
+        """Refuses an expression that needs more of the operand stack than
+        the VM has."""
         need = stack_depth(e)
         if need > V.VM_STACK:
             raise BytecodeError(f"this expression needs an operand stack of {need} values; the VM has "
                                 f"{V.VM_STACK} (FSW_VM_STACK): split it over locals (not supported yet)",
                                 e.line, e.col)
-        if emit:
-            self.value(e)
 
     def value(self, e: M.Expr) -> None:
         t = type(e)
@@ -187,17 +186,11 @@ class _Code:
 
     def known(self, e: M.Expr):
         """The R value of a literal or of a local read as a constant."""
-        if type(e) is M.Const:
-            return self.real.literal(e.text)
-        return self.consts.get(e.var) if type(e) is M.Ref else None
+        return known(e, self.real, self.consts)
 
     def exact_int_const(self, e: M.Expr):
-        """A literal integer of magnitude below 2^p (p = R's precision)."""
-        x = self.known(e)
-        if x is None or x != x or x in (math.inf, -math.inf) or x != int(x):
-            return None
-        c = int(x)
-        return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
+        """A known integer of magnitude below 2^p (p = R's precision)."""
+        return exact_int(self.known(e), self.real)
 
     def int_var(self, e: M.Expr):
         """The integer or bool variable (or T) `e` reads, or None."""
@@ -304,7 +297,7 @@ class _Code:
             return [self.jump_offset()]
         if kind == "cmp":
             _, op, left, right = n
-            self.top(M.Cmp(op, left, right, left.line, left.col), emit=False)
+            self.check_depth(M.Cmp(op, left, right, left.line, left.col))
             self.value(left)
             self.value(right)
             self.op(V.JCMP, V.CMP_CODES[op] | (V.JUMP_IF if sense else 0))
@@ -329,7 +322,7 @@ class _Code:
         if ref is None:
             return False
         try:
-            x = evaluate(e, self.real, _no_reads)
+            x = evaluate(e, self.real, no_reads)
         except NotConstant:
             x = None
         if x is not None:
@@ -441,12 +434,7 @@ def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes
     init = b"".join(value_bytes(v.type, values[v.index]) for v in locs)
     if len(init) > 0xFFFF or len(locs) > 0xFFFF:
         raise BytecodeError("more than 65535 bytes of locals: not supported yet")
-    # Only the machine writes its locals on a board: one it never assigns
-    # keeps its initial value, as the C++ emitter folds it (ExprEmitter).
-    written = assigned_vars(m)
-    consts = {v.index: real.read(v.type, values[v.index]) for v in locs
-              if not scriptable and v.param is None and (v.read_only or v.index not in written)}
-    code = _Code(m, real, elem_index, loc_index, consts)
+    code = _Code(m, real, elem_index, loc_index, folded_locals(m, real, scriptable))
     offsets = []
     for st in m.states:
         row = []

@@ -9,19 +9,14 @@ import math
 import struct
 
 from .. import model as M
-from ..check import assigned_vars
 from ..cnames import enumerator
-from ..evaluate import NotConstant, compare, evaluate, local_values
+from ..evaluate import NotConstant, compare, evaluate
 from ..numeric import Real, to_type
 from ..thresholds import tests
 from .common import real_literal
-from .fastpaths import folded_compare, orient
+from .fastpaths import exact_int, folded_compare, folded_locals, known, no_reads, orient
 
 
-
-
-def _no_reads(i: int):
-    raise NotConstant(None)
 
 
 class ExprEmitter:
@@ -35,15 +30,7 @@ class ExprEmitter:
         self.scriptable = scriptable
         self.prefix = prefix  # qualifies the machine's names from outside (scripts)
         self.windows = windows
-        self.consts: dict[int, float] = {}
-        values = local_values(m, real)
-        # In firmware only the machine writes its locals: one it never
-        # assigns keeps its initial value, exactly like a @read_only one.
-        # (A state script may write any local, so scripts keep them all.)
-        written = assigned_vars(m)
-        for v in m.vars:
-            if v.kind == M.LOCAL and not scriptable and v.param is None and (v.read_only or v.index not in written):
-                self.consts[v.index] = real.read(v.type, values[v.index])
+        self.consts = folded_locals(m, real, scriptable)
         self.sv_lock = m.sv.lock
 
     def ptr(self, v: M.Var) -> str:
@@ -185,7 +172,7 @@ class ExprEmitter:
         if self.sv_lock and self.m.vars[var].kind == M.ELEMENT:
             return None
         try:
-            x = evaluate(e, self.real, _no_reads)
+            x = evaluate(e, self.real, no_reads)
         except NotConstant:
             return None
         t = self.m.vars[var].type
@@ -287,22 +274,12 @@ class ExprEmitter:
 
     def known(self, e: M.Expr):
         """The R value of a literal or of a local folded to a constant."""
-        if type(e) is M.Const:
-            return self.real.literal(e.text)
-        if type(e) is M.Ref and e.var in self.consts:
-            return self.consts[e.var]
-        return None
+        return known(e, self.real, self.consts)
 
     def exact_int_const(self, e: M.Expr):
         """The value of a known operand that is an integer of magnitude below
         2^p (p = 24 or 53), so that every integer near it is exact in R."""
-        x = self.known(e)
-        if x is None:
-            return None
-        if x != x or x in (math.inf, -math.inf) or x != int(x):
-            return None
-        c = int(x)
-        return c if abs(c) < (1 << (24 if self.real.bits == 32 else 53)) else None
+        return exact_int(self.known(e), self.real)
 
     def int_compare(self, left: M.Expr, op: str, right: M.Expr):
         """`x op c` on the integer itself. Converting an integer to R is

@@ -1,12 +1,18 @@
-"""The fast paths' shared decisions: which side of a comparison is the
-variable and which the constant, and when an integer comparison is the same
-over its variable's whole range. The C++ emitter (expr.py) and the bytecode
-compiler (bytecode.py) decide them here, so that an image takes a fast path
-exactly where generated code does."""
+"""The fast paths' shared decisions: which locals read as constants, which
+operands are known values and exact integers, which side of a comparison is
+the variable and which the constant, and when an integer comparison is the
+same over its variable's whole range. The C++ emitter (expr.py) and the
+bytecode compiler (bytecode.py) decide them here, so that an image takes a
+fast path exactly where generated code does."""
 
 from __future__ import annotations
 
-from ..evaluate import compare
+import math
+
+from .. import model as M
+from ..check import assigned_vars
+from ..evaluate import NotConstant, compare, local_values
+from ..numeric import Real
 
 # `a op b` is `b FLIP[op] a`.
 FLIP = {"<": ">", "<=": ">=", ">": "<", ">=": "<=", "==": "==", "!=": "!="}
@@ -33,3 +39,38 @@ def folded_compare(op: str, c: int, lo: int, hi: int):
     points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)
     results = {compare(op, x, c) for x in points}
     return results.pop() if len(results) == 1 else None
+
+
+def no_reads(i: int):
+    """`evaluate`'s read of a variable for an expression of literals only."""
+    raise NotConstant(None)
+
+
+def folded_locals(m: M.Machine, real: Real, scriptable: bool) -> dict[int, float]:
+    """The locals read as constants, with their R values. In firmware only
+    the machine writes its locals: one it never assigns keeps its initial
+    value, exactly like a @read_only one; a parameter is the ground's to
+    write. (A state script may write any local: `scriptable` keeps them all.)"""
+    if scriptable:
+        return {}
+    values = local_values(m, real)
+    written = assigned_vars(m)
+    return {v.index: real.read(v.type, values[v.index]) for v in m.vars
+            if v.kind == M.LOCAL and v.param is None and (v.read_only or v.index not in written)}
+
+
+def known(e: M.Expr, real: Real, consts: dict[int, float]):
+    """The R value of a literal or of a local read as a constant, or None."""
+    if type(e) is M.Const:
+        return real.literal(e.text)
+    return consts.get(e.var) if type(e) is M.Ref else None
+
+
+def exact_int(x, real: Real):
+    """The known value `x` as an integer when it is one of magnitude below
+    2^p (p = R's precision: 24 or 53), so that every integer near it is
+    exact in R; else None."""
+    if x is None or x != x or x in (math.inf, -math.inf) or x != int(x):
+        return None
+    c = int(x)
+    return c if abs(c) < (1 << (24 if real.bits == 32 else 53)) else None

@@ -22,7 +22,8 @@ from ..numeric import Real, to_type
 from ..thresholds import tests
 from .. import vmverify as V
 from .common import value_bytes
-from .fastpaths import exact_int, folded_compare, folded_locals, known, no_reads, orient
+from .fastpaths import (add_operands, exact_int, exact_sum_limit, folded_compare, folded_locals, known, no_reads,
+                        orient)
 
 
 class BytecodeError(Exception):
@@ -331,13 +332,11 @@ class _Code:
             return True
         if type(e) is not M.Arith or e.op not in ("+", "-") or target.type.kind != "int":
             return False
-        a, k = self.int_var(e.left), self.exact_int_const(e.right)
-        if e.op == "+" and (a is None or k is None):
-            a, k = self.int_var(e.right), self.exact_int_const(e.left)
-        if a is None or k is None or a.kind == M.TIME_IN_STATE or a.type.kind != "int":
+        got = add_operands(e, self.int_var, self.exact_int_const)
+        if got is None or got[0].kind == M.TIME_IN_STATE or got[0].type.kind != "int":
             return False
-        k = -k if e.op == "-" else k
-        if not -(1 << 31) <= k < (1 << 31) or (1 << (24 if self.real.bits == 32 else 53)) - 1 - abs(k) < 0:
+        a, k = got
+        if not -(1 << 31) <= k < (1 << 31) or exact_sum_limit(k, self.real) < 0:
             return False
         self.op(V.IADD, *struct.pack("<HHi", ref, self.ref(a.index), k))
         return True

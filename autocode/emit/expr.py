@@ -14,7 +14,8 @@ from ..evaluate import NotConstant, compare, evaluate
 from ..numeric import Real, to_type
 from ..thresholds import tests
 from .common import real_literal
-from .fastpaths import exact_int, folded_compare, folded_locals, known, no_reads, orient
+from .fastpaths import (add_operands, exact_int, exact_sum_limit, folded_compare, folded_locals, known, no_reads,
+                        orient)
 
 
 
@@ -198,15 +199,11 @@ class ExprEmitter:
             return None
         if self.sv_lock and target.kind == M.ELEMENT:
             return None
-        a, k = self.int_operand(e.left), self.exact_int_const(e.right)
-        if e.op == "+" and (a is None or k is None):
-            a, k = self.int_operand(e.right), self.exact_int_const(e.left)
-        if a is None or k is None or a[1].kind != "int":
+        got = add_operands(e, self.int_operand, self.exact_int_const)
+        if got is None or got[0][1].kind != "int":
             return None
-        if e.op == "-":
-            k = -k
-        text, ta = a
-        limit = (1 << (24 if self.real.bits == 32 else 53)) - 1 - abs(k)
+        (text, ta), k = got
+        limit = exact_sum_limit(k, self.real)
         if limit < 0:
             return None
         # |a| <= limit: a, a + k and the result are all exact in R, so the

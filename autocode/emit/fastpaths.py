@@ -74,3 +74,20 @@ def exact_int(x, real: Real):
         return None
     c = int(x)
     return c if abs(c) < (1 << (24 if real.bits == 32 else 53)) else None
+
+
+def add_operands(e: M.Expr, as_var, as_const):
+    """`x + k`, `k + x` or `x - k` read from `e` (an Arith + or -): (as_var(x),
+    k with the sign it adds), or None."""
+    a, k = as_var(e.left), as_const(e.right)
+    if e.op == "+" and (a is None or k is None):
+        a, k = as_var(e.right), as_const(e.left)
+    if a is None or k is None:
+        return None
+    return a, -k if e.op == "-" else k
+
+
+def exact_sum_limit(k: int, real: Real) -> int:
+    """The largest |x| for which x, x + k and the sum are all exact in R
+    (negative: none is)."""
+    return (1 << (24 if real.bits == 32 else 53)) - 1 - abs(k)

@@ -51,6 +51,13 @@ DEPS     := -MMD -MP
 LDFLAGS  := -mmcu=$(MCU) -Os $(SIZE_OPT) -g -flto -fuse-linker-plugin -Wl,--gc-sections -Wl,--relax
 NATIVE_FLAGS := -std=gnu++11 -O2 -ffp-contract=off -fno-exceptions -fno-rtti $(WARN)
 
+# LIBS: a folder holding this very configuration's core.a and libfswkit.a,
+# built before (`fsw build` passes its cache's, fswkit.target.libcache, with
+# their hash in LIBS_KEY): the firmware links them instead of those built in
+# OUT. NATIVE_RT: the same for a native build, a folder of the runtime's
+# objects (NATIVE_RT_KEY).
+ARCHIVES := $(if $(LIBS),$(LIBS)/libfswkit.a $(LIBS)/core.a,$(OUT)/libfswkit.a $(OUT)/core.a)
+
 CORE_OBJS := $(patsubst $(CORE_DIR)/%,$(OUT)/core/%.o,$(CORE_SRCS))
 RT_OBJS   := $(patsubst $(RUNTIME)/%.cpp,$(OUT)/rt/%.o,$(RT_SRCS))
 GEN_OBJS  := $(patsubst $(GEN)/%.cpp,$(OUT)/gen/%.o,$(GEN_SRCS))
@@ -77,7 +84,7 @@ AVR_CONFIG := mcu=$(MCU) f_cpu=$(F_CPU) variant=$(VARIANT) board=$(BOARD_DEFINE)
     cflags=$(CFLAGS) cxxflags=$(CXXFLAGS) warn=$(WARN) ldflags=$(LDFLAGS) \
     cc=$(call tool_id,$(AVR_CC)) cxx=$(call tool_id,$(AVR_CXX)) ar=$(call tool_id,$(AVR_AR)) \
     objcopy=$(call tool_id,$(AVR_OBJCOPY)) libc=$(call file_id,$(AVR_CC) -mmcu=$(MCU) -print-file-name=libc.a) \
-    sources=$(notdir $(CORE_SRCS) $(RT_SRCS) $(GEN_SRCS))
+    sources=$(notdir $(CORE_SRCS) $(RT_SRCS) $(GEN_SRCS)) libs=$(LIBS) $(LIBS_KEY)
 ifneq ($(file <$(AVR_STAMP)),$(AVR_CONFIG))
 $(shell mkdir -p $(OUT))
 $(file >$(AVR_STAMP),$(AVR_CONFIG))
@@ -85,7 +92,7 @@ endif
 endif
 ifneq ($(filter native $(OUT)/$(NAME),$(GOALS)),)
 NATIVE_CONFIG := runtime=$(realpath $(RUNTIME)) gen=$(realpath $(GEN)) flags=$(NATIVE_FLAGS) \
-    cxx=$(call tool_id,$(HOST_CXX)) sources=$(notdir $(NATIVE_SRCS) $(GEN_SRCS))
+    cxx=$(call tool_id,$(HOST_CXX)) sources=$(notdir $(NATIVE_SRCS) $(GEN_SRCS)) rt=$(NATIVE_RT) $(NATIVE_RT_KEY)
 ifneq ($(file <$(NATIVE_STAMP)),$(NATIVE_CONFIG))
 $(shell mkdir -p $(OUT))
 $(file >$(NATIVE_STAMP),$(NATIVE_CONFIG))
@@ -118,20 +125,27 @@ $(OUT)/gen/%.o: $(GEN)/%.cpp $(CONFIG)
 	@mkdir -p $(@D)
 	$(AVR_CXX) $(CXXFLAGS) $(WARN) $(DEPS) -I$(RUNTIME) -I$(GEN) -c $< -o $@
 
-$(OUT)/$(NAME).elf: $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a $(CONFIG)
-	$(AVR_CC) $(LDFLAGS) -o $@ $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a -lm
+$(OUT)/$(NAME).elf: $(GEN_OBJS) $(ARCHIVES) $(CONFIG)
+	$(AVR_CC) $(LDFLAGS) -o $@ $(GEN_OBJS) $(ARCHIVES) -lm
 $(OUT)/$(NAME).hex: $(OUT)/$(NAME).elf
 	$(AVR_OBJCOPY) -O ihex -R .eeprom $< $@
 
 # The same link, kept although it does not fit the MCU's memory, for a
 # report of what uses it (`fsw build` asks for it when the link overflows).
-$(OUT)/$(NAME).overflow.elf: $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a $(CONFIG)
-	$(AVR_CC) $(LDFLAGS) -Wl,--noinhibit-exec -o $@ $(GEN_OBJS) $(OUT)/libfswkit.a $(OUT)/core.a -lm
+$(OUT)/$(NAME).overflow.elf: $(GEN_OBJS) $(ARCHIVES) $(CONFIG)
+	$(AVR_CC) $(LDFLAGS) -Wl,--noinhibit-exec -o $@ $(GEN_OBJS) $(ARCHIVES) -lm
 
 -include $(CORE_OBJS:.o=.d) $(RT_OBJS:.o=.d) $(GEN_OBJS:.o=.d)
 
 # ---- host executable ----------------------------------------------------------
 native: $(OUT)/$(NAME)
+ifneq ($(NATIVE_RT),)
+NATIVE_RT_OBJS := $(sort $(wildcard $(NATIVE_RT)/*.o))
+$(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_RT_OBJS) $(wildcard $(GEN)/*.h) $(RT_HDRS) $(NATIVE_STAMP) $(THIS_MK)
+	@mkdir -p $(@D)
+	$(HOST_CXX) $(NATIVE_FLAGS) -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_RT_OBJS) -pthread
+else
 $(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_SRCS) $(wildcard $(GEN)/*.h) $(RT_HDRS) $(NATIVE_STAMP) $(THIS_MK)
 	@mkdir -p $(@D)
 	$(HOST_CXX) $(NATIVE_FLAGS) -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_SRCS) -pthread
+endif

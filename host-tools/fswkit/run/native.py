@@ -42,10 +42,16 @@ class NativeError(Exception):
     """The host compiler is missing or failed."""
 
 
-def cache_dir() -> str:
-    base = os.environ.get("FSW_CACHE_DIR") or os.path.join(
+def cache_root() -> str:
+    """The kit's cache: $FSW_CACHE_DIR, else fswkit in the user's cache
+    folder. `native` holds these runners and the runtime's objects,
+    `avr` the boards' archives (fswkit.target.libcache)."""
+    return os.environ.get("FSW_CACHE_DIR") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "fswkit")
-    return os.path.join(base, "native")
+
+
+def cache_dir() -> str:
+    return os.path.join(cache_root(), "native")
 
 
 def runtime_sources() -> list[str]:

@@ -279,10 +279,13 @@ def firmware_name(app: Application) -> str:
     return re.sub(r"[^A-Za-z0-9_.+-]", "_", os.path.splitext(os.path.basename(app.path))[0])
 
 
-def make_args(app: Application, out: str, jobs: int = 2) -> tuple[str, list[str]]:
+def make_args(app: Application, out: str, jobs: int = 2, cached: bool = False) -> tuple[str, list[str]]:
     """(artifact, command) of mk/build.mk for the application. The command
     runs in `out` and names the build's own files relative to it, so a
-    folder whose path Make cannot take (a space, `:`) builds all the same."""
+    folder whose path Make cannot take (a space, `:`) builds all the same.
+    `cached`: linked against the Arduino core and the runtime compiled
+    once for every build of the board (fswkit.target.libcache), made
+    ready now; the caller holds the folder."""
     b = app.board
     name = firmware_name(app)
     args = ["make", "--no-print-directory", f"-j{jobs}", "-f", BUILD_MK, "GEN=gen", "OUT=.", f"NAME={name}",
@@ -295,13 +298,22 @@ def make_args(app: Application, out: str, jobs: int = 2) -> tuple[str, list[str]
         if not os.path.isfile(os.path.join(ARDUINO, "cores", "arduino", "Arduino.h")):
             raise BuildError(f"the Arduino core is not installed ({ARDUINO}, Debian package arduino-core-avr): "
                              "run `make setup` (or tools/bootstrap.sh)")
-        args += ["avr", f"MCU={b.mcu}", f"F_CPU={b.f_cpu}", f"VARIANT={ard.get('variant', 'standard')}",
-                 f"BOARD_DEFINE={ard.get('board_define', 'ARDUINO_AVR_UNO')}"]
+        board = {"MCU": b.mcu, "F_CPU": b.f_cpu, "VARIANT": ard.get("variant", "standard"),
+                 "BOARD_DEFINE": ard.get("board_define", "ARDUINO_AVR_UNO")}
+        args += ["avr"] + [f"{k}={v}" for k, v in board.items()]
+        if cached:
+            from fswkit.target.libcache import make_vars
+
+            args += make_vars(out, dict(board, ARDUINO=ARDUINO), jobs)
         artifact = os.path.join(out, name + ".elf")
     else:
         if shutil.which("g++") is None or shutil.which("make") is None:
             raise BuildError("`g++` and `make` are needed for native builds: run `make setup`")
         args += ["native"]
+        if cached:
+            from fswkit.target.libcache import make_vars
+
+            args += make_vars(out, None, jobs)
         artifact = os.path.join(out, name)
     return artifact, args
 
@@ -309,8 +321,8 @@ def make_args(app: Application, out: str, jobs: int = 2) -> tuple[str, list[str]
 def make(app: Application, out: str, jobs: int = 2) -> tuple[str, subprocess.CompletedProcess]:
     """Runs mk/build.mk for the application, holding its folder; returns
     (artifact, process). The compiler's whole output goes to `out/build.log`."""
-    artifact, args = make_args(app, out, jobs)
     with build_lock(out):
+        artifact, args = make_args(app, out, jobs, cached=True)
         proc = _run_make(args, out)
         with open(log_path(out), "w") as f:
             f.write(" ".join(args) + "\n" + proc.stdout + proc.stderr)
@@ -397,11 +409,12 @@ def explain_failure(app: Application, out: str, proc: subprocess.CompletedProces
 def overflow_report(app: Application, out: str) -> str | None:
     """Links the firmware although it does not fit (`NAME.overflow.elf`,
     removed after) and says what uses the memory; None when that fails."""
-    artifact, args = make_args(app, out)
-    elf = artifact[:-4] + ".overflow.elf"
-    args = [a for a in args if a != "avr"] + [os.path.basename(elf)]
+    elf = None
     try:
         with build_lock(out):
+            artifact, args = make_args(app, out, cached=True)
+            elf = artifact[:-4] + ".overflow.elf"
+            args = [a for a in args if a != "avr"] + [os.path.basename(elf)]
             r = subprocess.run(args, capture_output=True, text=True, cwd=out)
             if r.returncode != 0 or not os.path.exists(elf):
                 return None
@@ -410,7 +423,7 @@ def overflow_report(app: Application, out: str) -> str | None:
     except BuildError:
         return None
     finally:
-        if os.path.exists(elf):
+        if elf is not None and os.path.exists(elf):
             os.remove(elf)
 
 

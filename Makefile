@@ -110,7 +110,8 @@ fuzz-uplink: $(FUZZ_UPLINK)
 
 ## fuzz-vm: the bytecode verifier and VM under libFuzzer with ASan + UBSan
 ## (clang): no image the verifier accepts reads or writes outside the state
-## vector, and the EEPROM verifier agrees with the RAM one (docs/reload.md).
+## vector, and the EEPROM verifier agrees with the RAM one, in one call and
+## in slices, each slice within its reads (docs/reload.md).
 ## Seeds: tests/fuzz/vm/seeds/ compiled against the target's state vector, and
 ## every example machine (fsw compile). The images of tests/fuzz/vm/regressions
 ## (inputs that once failed) run first, once each. FUZZ_RUNS, FUZZ_SECONDS
@@ -133,7 +134,7 @@ fuzz-vm: $(FUZZ_VM) | $(STAMP)
 	  { tail -30 $(BUILD)/fuzz/vm/regressions.txt; echo "vm fuzz: 0 passed, 1 failed (a past finding, tests/fuzz/vm/regressions)"; exit 1; }
 	@$(FUZZ_VM) -runs=$(FUZZ_RUNS) -max_total_time=$(FUZZ_SECONDS) -seed=1 -max_len=4096 -print_final_stats=1 \
 	    -artifact_prefix=$(BUILD)/fuzz/vm/ $(BUILD)/fuzz/vm/corpus 2>$(BUILD)/fuzz/vm/log.txt; st=$$?; \
-	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|vm_verify says" $(BUILD)/fuzz/vm/log.txt; \
+	  grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|vm_verify says|vm_check_eeprom:" $(BUILD)/fuzz/vm/log.txt; \
 	  if [ $$st -eq 0 ]; then echo "vm fuzz: 1 passed, 0 failed"; else tail -30 $(BUILD)/fuzz/vm/log.txt; \
 	  echo "vm fuzz: 0 passed, 1 failed"; fi; exit $$st
 

@@ -238,7 +238,8 @@
 #  define FSW_VM_STACK 12
 #endif
 // Forward jumps the verifier tracks at once (nesting of if/and/or); more is
-// refused (kVmTooNested). Each costs 4 bytes of the verifier's C stack.
+// refused (kVmTooNested). Each costs 3 bytes of RAM on an AVR (4 on a host):
+// in the reload store's check (fsw_reload.h), on the stack of vm_verify.
 #ifndef FSW_VM_PENDING
 #  define FSW_VM_PENDING 16
 #endif
@@ -253,6 +254,15 @@
 #endif
 #if FSW_RELOAD_QUEUE < 10 || FSW_RELOAD_QUEUE > 200
 #  error "fswkit: FSW_RELOAD_QUEUE must be 10..200"
+#endif
+// A slice of an image's check (fsw_reload.h: its CRC, then the verifier, a
+// slice at each machine-task step): the EEPROM bytes it reads. 48: a slice
+// takes at most 0.4 ms of a 16 MHz AVR (tools/bench_reload.py).
+#ifndef FSW_RELOAD_SLICE
+#  define FSW_RELOAD_SLICE 48
+#endif
+#if FSW_RELOAD_SLICE < 16 || FSW_RELOAD_SLICE > 2048
+#  error "fswkit: FSW_RELOAD_SLICE must be 16..2048"
 #endif
 
 // Elements and regions are little-endian in memory (spec 2); typed access

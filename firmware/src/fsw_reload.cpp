@@ -46,7 +46,8 @@ bool read_slot(const ReloadConfig& c, uint8_t which, ReloadSlot& out) {
     return true;
 }
 
-// The image in slot `which` checked where it lies (CRC again, then the verifier).
+// The image in slot `which` checked where it lies (CRC again, then the
+// verifier), in one call: at boot.
 uint8_t check_slot(const ReloadConfig& c, const ReloadSlot& sl, uint8_t which) {
     const uint16_t a = static_cast<uint16_t>(slot_addr(c, which) + kReloadHeader);
     if (payload_crc(a, static_cast<uint16_t>(sl.len + sl.nmask)) != sl.crc) return kReloadCrcFails;
@@ -55,10 +56,15 @@ uint8_t check_slot(const ReloadConfig& c, const ReloadSlot& sl, uint8_t which) {
 
 // Copies slot `which` (checked) into the running image's buffer and starts
 // it from its first state.
-void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
+FSW_NOINLINE void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
     const ReloadSlot& sl = s.slot[which - 1u];
+    // (the bounds in registers: a store to the image could alias the store's
+    // record, which the loop would read again each byte: 66 AVR cycles a
+    // byte, about 30 so)
     const uint16_t a = static_cast<uint16_t>(slot_addr(c, which) + kReloadHeader);
-    for (uint16_t i = 0; i < sl.len + sl.nmask; ++i) c.image[i] = pal::eeprom_read(static_cast<uint16_t>(a + i));
+    const uint16_t n = static_cast<uint16_t>(sl.len + sl.nmask);
+    uint8_t* const im = c.image;
+    for (uint16_t i = 0; i < n; ++i) im[i] = pal::eeprom_read(static_cast<uint16_t>(a + i));
     vm_reset(c.image, c.ram, *c.machine, 1);
     s.active = which;
 }
@@ -92,14 +98,7 @@ void activate_now(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
         s.sync = true;
         return;
     }
-    ReloadSlot& sl = s.slot[which - 1u];
-    const uint8_t r = check_slot(c, sl, which);
-    if (r != kVmOk) {  // the running machine goes on untouched
-        s.refused = which;
-        s.reason = r;
-        if (r == kReloadCrcFails) sl.status = kSlotEmpty;  // the bytes changed in the EEPROM
-        return;
-    }
+    ReloadSlot& sl = s.slot[which - 1u];  // checked (check_slice): its CRC and the verifier passed
     leave(s, c);
     run_slot(s, c, which);
     const ReloadSlot& o = s.slot[2u - which];
@@ -120,6 +119,59 @@ void start_writer(ReloadStore& s) {
     s.w_i = 0;
 }
 
+// Whether the check that runs is the open upload's (a COMMIT's).
+bool checking_upload(const ReloadStore& s) { return s.ck_slot != 0 && s.ck_slot == s.up_slot; }
+
+// Starts the check of slot `which`: the open upload's bytes, or a committed
+// image an activation waits for.
+void check_start(ReloadStore& s, uint8_t which) {
+    s.ck_slot = which;
+    s.ck_at = 0;
+    s.ck_crc = kCrcInit;
+    vm_check_begin(s.vm);
+}
+
+// A slice of the check that runs: FSW_RELOAD_SLICE bytes of the CRC, or as
+// many EEPROM reads of the verifier (and the unit of work it is in); when
+// the check is over, its verdict goes to the COMMIT that asks next, or to
+// the pending activation. (Out of line, as run_slot: tools/bench_reload.py
+// times each call.)
+FSW_NOINLINE void check_slice(ReloadStore& s, const ReloadConfig& c) {
+    const uint8_t w = s.ck_slot;
+    const bool upload = w == s.up_slot;
+    ReloadSlot& sl = s.slot[w - 1u];
+    const uint16_t len = upload ? s.up_len : sl.len;
+    const uint16_t total = static_cast<uint16_t>(len + (upload ? s.up_nmask : sl.nmask));
+    const uint16_t a = static_cast<uint16_t>(slot_addr(c, w) + kReloadHeader);
+    uint8_t r;
+    if (s.ck_at < total) {
+        const uint16_t end =
+            total - s.ck_at > FSW_RELOAD_SLICE ? static_cast<uint16_t>(s.ck_at + FSW_RELOAD_SLICE) : total;
+        uint16_t crc = s.ck_crc;
+        for (uint16_t i = s.ck_at; i < end; ++i)
+            crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(a + i)));
+        s.ck_crc = crc;
+        s.ck_at = end;
+        if (end < total || crc == (upload ? s.up_crc : sl.crc)) return;  // (the verifier from the next slice)
+        r = kReloadCrcFails;
+    } else {
+        r = vm_check_eeprom(s.vm, a, len, *c.layout, c.ram_size, FSW_RELOAD_SLICE);
+        if (r == kVmMore) return;
+    }
+    s.ck_slot = 0;
+    if (upload) {
+        s.ck_result = r == kVmOk ? kReloadOk : r == kReloadCrcFails ? kReloadMismatch : kReloadBadImage;
+        s.ck_reason = r == kReloadCrcFails ? static_cast<uint8_t>(kVmOk) : r;
+    } else if (r == kVmOk) {
+        s.ready = w;
+    } else {  // refused: the running machine goes on untouched
+        s.pending = kReloadNone;
+        s.refused = w;
+        s.reason = r;
+        if (r == kReloadCrcFails) sl.status = kSlotEmpty;  // the bytes changed in the EEPROM
+    }
+}
+
 }  // namespace
 
 void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
@@ -127,6 +179,7 @@ void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
     s.cfg = cfg;
     s.pending = kReloadNone;
     s.w_seg = kNoSeg;
+    s.ck_result = kReloadNone;
     const ReloadConfig c = config(s);
     for (uint8_t w = 1; w <= 2; ++w) read_slot(c, w, s.slot[w - 1u]);
     for (uint8_t tries = 0; tries < 2; ++tries) {  // the newest activated image first
@@ -150,11 +203,20 @@ void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
 
 Result reload_step(ReloadStore& s) {
     const ReloadConfig c = config(s);
-    // (with the writer idle: the checks read the EEPROM, and a read waits for a byte being written)
-    if (s.pending != kReloadNone && s.w_seg == kNoSeg && allowed(s, c)) {
-        const uint8_t which = s.pending;
-        s.pending = kReloadNone;
-        activate_now(s, c, which);
+    // (with the writer idle and the EEPROM ready: the check and the copy read
+    // the EEPROM, and a read waits for a byte being written)
+    if (s.w_seg == kNoSeg && pal::eeprom_ready()) {
+        if (s.ck_slot == 0 && s.pending != kReloadNone && s.pending != kReloadBuiltIn && s.ready != s.pending)
+            check_start(s, s.pending);
+        if (s.ck_slot != 0) {
+            check_slice(s, c);  // a slice a step: the switch at a later one
+        } else if (s.pending != kReloadNone && (s.pending == kReloadBuiltIn || s.ready == s.pending) &&
+                   allowed(s, c)) {
+            const uint8_t which = s.pending;
+            s.pending = kReloadNone;
+            s.ready = 0;
+            activate_now(s, c, which);
+        }
     }
     if (s.active == kReloadBuiltIn) return c.step();
     return vm_step(c.image, *c.layout, c.sv, c.ram, *c.machine);
@@ -166,7 +228,7 @@ uint8_t reload_upload_begin(ReloadStore& s, uint16_t len, uint8_t nmask, uint16_
     const ReloadConfig c = config(s);
     if (static_cast<uint32_t>(len) + nmask > c.size) return kReloadTooBig;
     if (len == 0) return kReloadBadLength;
-    if (reload_writing(s)) return kReloadBusy;
+    if (reload_writing(s) || checking_upload(s)) return kReloadBusy;
     // never the slot that runs: an empty one, else the older
     uint8_t to;
     if (s.active != kReloadBuiltIn) {
@@ -178,6 +240,7 @@ uint8_t reload_upload_begin(ReloadStore& s, uint16_t len, uint8_t nmask, uint16_
     }
     if (s.pending == to) return kReloadWrongState;
     memset(&s.slot[to - 1u], 0, sizeof s.slot[0]);  // kSlotEmpty from the first byte written
+    s.ck_result = kReloadNone;  // the last upload's, not asked for
     s.up_slot = to;
     s.up_len = len;
     s.up_nmask = nmask;
@@ -194,8 +257,9 @@ uint8_t reload_write(ReloadStore& s, uint16_t off, const uint8_t* data, uint8_t 
     if (s.up_slot == 0) return kReloadNoLoad;
     if (n == 0 || n > FSW_RELOAD_QUEUE) return kReloadBadLength;
     if (static_cast<uint32_t>(off) + n > static_cast<uint32_t>(s.up_len) + s.up_nmask) return kReloadOutOfRange;
-    if (reload_writing(s)) return kReloadBusy;
+    if (reload_writing(s) || checking_upload(s)) return kReloadBusy;
     const ReloadConfig c = config(s);
+    s.ck_result = kReloadNone;  // a check of the bytes before: void
     memcpy(s.queue, data, n);
     queue_run(s, 0, static_cast<uint16_t>(slot_addr(c, s.up_slot) + kReloadHeader + off), n);
     queue_run(s, 1, 0, 0);
@@ -210,13 +274,19 @@ uint8_t reload_commit(ReloadStore& s, uint8_t& reason) {
     if (reload_writing(s)) return kReloadBusy;
     const uint16_t total = static_cast<uint16_t>(s.up_len + s.up_nmask);
     if (s.up_next < total) return kReloadNoLoad;
+    if (s.ck_result == kReloadNone) {  // the check: started, running, or after an activation's
+        if (s.ck_slot == 0) check_start(s, s.up_slot);
+        return kReloadBusy;
+    }
+    const uint8_t st = s.ck_result;
+    s.ck_result = kReloadNone;
+    if (st == kReloadMismatch) return kReloadMismatch;  // the upload stays open: WRITEs may mend it
     const ReloadConfig c = config(s);
     const uint8_t to = s.up_slot;
     const uint16_t a = slot_addr(c, to);
-    if (payload_crc(static_cast<uint16_t>(a + kReloadHeader), total) != s.up_crc) return kReloadMismatch;
     s.up_slot = 0;  // whatever follows, the upload is over
-    reason = vm_verify_eeprom(static_cast<uint16_t>(a + kReloadHeader), s.up_len, *c.layout, c.ram_size);
-    if (reason != kVmOk) {
+    if (st != kReloadOk) {
+        reason = s.ck_reason;
         s.refused = to;
         s.reason = reason;
         return kReloadBadImage;
@@ -242,7 +312,12 @@ uint8_t reload_activate(ReloadStore& s, uint8_t which) {
     if (which > 2) return kReloadOutOfRange;
     if (which != kReloadBuiltIn && s.slot[which - 1u].status == kSlotEmpty) return kReloadNoImage;
     if (which != kReloadBuiltIn && s.up_slot == which) return kReloadNoImage;
-    s.pending = which == s.active ? kReloadNone : which;
+    const uint8_t p = which == s.active ? kReloadNone : which;
+    if (p != s.pending) {
+        if (s.ck_slot != 0 && !checking_upload(s)) s.ck_slot = 0;  // the check for the one asked before: void
+        s.ready = 0;
+        s.pending = p;
+    }
     return kReloadOk;
 }
 

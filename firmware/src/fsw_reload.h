@@ -3,10 +3,12 @@
 // bytecode image (fsw_vm.h) that the ground uploaded over the link into one
 // of two EEPROM slots. An upload never touches the slot whose image runs; an
 // image is checked (CRC and the verifier, read in the EEPROM) when it is
-// committed and again before it runs; the switch happens at the machine
-// task's step, in a state the configuration allows: the old machine's
-// `.exit`, then the new one's first step (`.entry`, `.step`). The board
-// boots the newest activated valid image, else the other, else the
+// committed and again before it runs, each check in slices of
+// FSW_RELOAD_SLICE EEPROM reads, a slice at each of the machine task's
+// steps (a COMMIT answers BUSY until its check is over); the switch happens
+// at the machine task's step, in a state the configuration allows: the old
+// machine's `.exit`, then the new one's first step (`.entry`, `.step`). The
+// board boots the newest activated valid image, else the other, else the
 // generated machine. EEPROM bytes are written in the background, one
 // whenever the EEPROM is ready: nothing here waits for it.
 #ifndef FSW_RELOAD_H
@@ -93,6 +95,15 @@ struct ReloadStore {
     uint8_t w_i;              // bytes of it written
     bool sync;                // the slots' status and seq bytes are to be brought up to date
     uint8_t queue[FSW_RELOAD_QUEUE];
+    // the check of a slot (its CRC, then the verifier), a slice a machine step:
+    // the open upload's (COMMIT), or the pending activation's
+    uint8_t ck_slot;          // the slot being checked (0: none)
+    uint8_t ck_result;        // the upload's check, over: kReloadOk, kReloadMismatch, kReloadBadImage (kReloadNone: none)
+    uint8_t ck_reason;        // ... and the verifier's VmReason
+    uint8_t ready;            // the slot of the pending activation whose check passed (0: none)
+    uint16_t ck_at;           // bytes of the slot's CRC read so far (all of them: the verifier runs)
+    uint16_t ck_crc;
+    VmCheck vm;               // the verifier's state between slices
 };
 
 // Ack statuses of the reload commands (continuing LinkStatus).
@@ -100,7 +111,7 @@ enum ReloadStatus : uint8_t {
     kReloadOk = 0,
     kReloadBadLength = 3,
     kReloadOutOfRange = 9,   // WRITE past the open upload's end
-    kReloadBusy = 11,        // the writer is busy: try again
+    kReloadBusy = 11,        // the writer is busy, or a check runs: try again
     kReloadNoLoad = 12,      // WRITE or COMMIT without BEGIN, or COMMIT before every byte was written
     kReloadMismatch = 13,    // the bytes in the slot do not have BEGIN's CRC
     kReloadTooBig = 14,      // BEGIN: the image and its mask do not fit a slot
@@ -114,13 +125,18 @@ enum ReloadStatus : uint8_t {
 // generated machine), from its first state. Blocking EEPROM reads only.
 void reload_begin(ReloadStore& s, const ReloadConfig* cfg);
 
-// The machine task's step: an activation waiting for an allowed state takes
-// place first, then the running machine steps.
+// The machine task's step: a slice of the check that runs (at most
+// FSW_RELOAD_SLICE EEPROM reads and the unit of work it ends in), else an
+// activation whose check passed takes place if the machine is in an
+// allowed state; then the running machine steps.
 Result reload_step(ReloadStore& s);
 
 // The commands (the link calls them, with the arguments as received).
 uint8_t reload_upload_begin(ReloadStore& s, uint16_t len, uint8_t nmask, uint16_t crc);
 uint8_t reload_write(ReloadStore& s, uint16_t off, const uint8_t* data, uint8_t n);
+// COMMIT: the first of a whole upload starts its check and answers BUSY, as
+// do those while it runs; the next one answers its result (and, when it
+// passed, queues the slot's header).
 uint8_t reload_commit(ReloadStore& s, uint8_t& reason);
 uint8_t reload_activate(ReloadStore& s, uint8_t which);
 // Whether the background writer has bytes to write.

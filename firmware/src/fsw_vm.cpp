@@ -64,16 +64,6 @@ inline uint32_t u32(const uint8_t* p) {
     return static_cast<uint32_t>(u16(p)) | (static_cast<uint32_t>(u16(p + 2)) << 16);
 }
 
-// The verifier reads an image through a reader: in RAM (vm_verify), or in
-// the EEPROM a loader keeps it in (vm_verify_eeprom), byte by byte.
-struct RamImage {
-    const uint8_t* im;
-    uint8_t operator[](uint32_t i) const { return im[i]; }
-};
-struct EepromImage {
-    uint16_t base;
-    uint8_t operator[](uint32_t i) const { return pal::eeprom_read(static_cast<uint16_t>(base + i)); }
-};
 template <class Im>
 inline uint16_t r16(const Im& im, uint32_t i) { return static_cast<uint16_t>(im[i] | (im[i + 1u] << 8)); }
 template <class Im>
@@ -189,32 +179,7 @@ uint8_t operand_bytes(uint8_t op, uint8_t real) {
     }
 }
 
-// How many of the image's declared block offsets equal `pc` (exit and prelude
-// blocks counted apart: they may not transition).
-template <class Im>
-void count_offsets(const Im& im, const Offs& p, uint16_t pc, uint16_t& moving, uint16_t& still) {
-    moving = 0;
-    still = p.prelude == pc ? 1u : 0u;
-    // Byte by byte with 16-bit indices (the table lies in the first 1,558
-    // bytes): an offset whose low byte differs costs one read, which in an
-    // EEPROM is most of the cost (a board verifies a committed image there).
-    const uint8_t lo = static_cast<uint8_t>(pc), hi = static_cast<uint8_t>(pc >> 8);
-    uint16_t at = static_cast<uint16_t>(p.st);
-    for (uint8_t s = 0; s < p.states; ++s) {
-        for (uint8_t k = 0; k < 3; ++k, at = static_cast<uint16_t>(at + 2u)) {
-            if (im[at] != lo || im[at + 1u] != hi) continue;
-            if (k < 2) ++moving;
-            else ++still;
-        }
-    }
-}
-
 const uint32_t kNoJump = 0xFFFFFFFFUL;  // an instruction that does not jump
-
-struct Pending {
-    uint16_t target;
-    uint8_t depth;
-};
 
 // Bytes of a typed instruction's operands after its variable of type `t`
 // (kTypeT: T): a test's flags or comparison, its constant and its jump
@@ -245,178 +210,28 @@ VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t 
     return kVmOk;
 }
 
+// ---- the verifier: one pass over the image, resumable -------------------------
+// The pass goes through phases; its state between two calls is a VmCheck.
+// A unit of work (a local, a window, a block offset, the block offsets of
+// a state compared to pc, an instruction) is never cut: a call stops
+// between two of them once its reader has read `budget` bytes.
+enum CheckPhase : uint8_t { kChHeader = 0, kChLocals, kChWindows, kChOffsets, kChCode };
+// VmCheck::flags in the code
+const uint8_t kReachable = 1;  // the next instruction can be reached
+const uint8_t kAtStart = 2;    // a block starts at pc
+const uint8_t kMayMove = 4;    // the block may transition (an entry or step block)
+const uint8_t kPrelude = 8;    // the block is the prelude
+const uint8_t kScanned = 16;   // moving and still are pc's
+
+// The header's fields, and where the parts lie.
 template <class Im>
-VmReason verify_code(const Im& im, const Offs& p, const VmLayout& layout) {
-    const uint8_t real = im[5];
-    uint16_t declared = p.prelude != kNone ? 1u : 0u;
-    for (uint16_t k = 0; k < 3u * p.states; ++k) {
-        const uint16_t off = r16(im, p.st + 2u * k);
-        if (off == kNone) continue;
-        if (off >= p.code_size) return kVmBadState;
-        ++declared;
-    }
-    if (p.prelude == kNone || p.prelude >= p.code_size) return kVmBadEnd;
-    Pending pend[FSW_VM_PENDING];
-    uint8_t np = 0, depth = 0, deepest = 0, pushed = 0;
-    bool reachable = true, at_start = true, may_move = false, prelude = false;
-    uint16_t matched = 0, pc = 0;
-    while (pc < p.code_size) {
-        if (at_start) {  // a block starts here: what may it do?
-            uint16_t moving, still;
-            count_offsets(im, p, pc, moving, still);
-            if (moving != 0 && still != 0) return kVmBadPlace;
-            matched = static_cast<uint16_t>(matched + moving + still);
-            may_move = moving != 0;
-            prelude = p.prelude == pc;
-            pushed = 0;
-            at_start = false;
-            reachable = true;
-        }
-        for (uint8_t k = 0; k < np;) {  // jumps landing here
-            if (pend[k].target < pc) return kVmBadJump;  // into an instruction
-            if (pend[k].target == pc) {
-                uint16_t moving, still;
-                count_offsets(im, p, pc, moving, still);
-                if (moving != 0 || still != 0) return kVmBadJump;  // into another block
-                if (reachable && depth != pend[k].depth) return kVmBadStack;
-                depth = pend[k].depth;
-                reachable = true;
-                pend[k] = pend[--np];
-            } else {
-                ++k;
-            }
-        }
-        if (!reachable) return kVmBadEnd;
-        const uint8_t op = im[p.code + pc];
-        const uint8_t n = operand_bytes(op, real);
-        if (n == 0xFF || static_cast<uint32_t>(pc) + 1u + n > p.code_size) return kVmBadOpcode;
-        const uint32_t a = p.code + pc + 1u;  // the operands
-        pc = static_cast<uint16_t>(pc + 1u + n);
-        uint8_t pops = 0, pushes = 0, jump_depth = 0;
-        uint32_t jump_to = kNoJump;
-        bool ends = false;
-        switch (op) {
-            case kEnd: ends = true; break;
-            case kGoto:
-                if (!may_move) return kVmBadPlace;
-                if (im[a] >= p.states) return kVmBadState;
-                ends = true;
-                break;
-            case kJmp: case kJf: case kAnd: case kOr: {
-                pops = op == kJmp ? 0 : 1;
-                if (depth < pops) return kVmBadStack;
-                jump_to = static_cast<uint32_t>(pc) + r16(im, a);
-                // and/or keep their left operand when they jump; jf drops it.
-                jump_depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
-                if (op == kJmp) reachable = false;
-                break;
-            }
-            case kJKey: case kJInt: case kSetK: case kIAdd: {
-                const uint16_t ref = r16(im, a);
-                uint8_t t;
-                const VmReason why = ref_type(im, p, layout, ref, (im[6] & kFlagLock) != 0, t);
-                if (why != kVmOk) return why;
-                const bool fits = op == kJKey ? t == kF32 || t == kF64
-                                  : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
-                                  : op == kSetK ? t != kTypeT
-                                                : is_int(t);
-                if (!fits) return wrong_type(ref);
-                const uint32_t b = a + 2u;  // the operands after the ref
-                const uint8_t more = typed_operands(op, t);
-                const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
-                if (static_cast<uint32_t>(pc) + more > p.code_size) return kVmBadOpcode;
-                pc = static_cast<uint16_t>(pc + more);
-                if (op == kSetK) {
-                    if (t == kBool && im[b] > 1u) return kVmBadOpcode;
-                } else if (op == kIAdd) {
-                    const uint16_t src = r16(im, b);
-                    uint8_t ts;
-                    const VmReason w = ref_type(im, p, layout, src, (im[6] & kFlagLock) != 0, ts);
-                    if (w != kVmOk) return w;
-                    if (!is_int(ts)) return wrong_type(src);
-                    // |k| below 2^p (p = R's precision): every integer near k is exact in R.
-                    const int32_t k = static_cast<int32_t>(r32(im, b + 2u));
-                    if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
-                } else {
-                    if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
-                        return kVmBadOpcode;
-                    jump_to = static_cast<uint32_t>(pc) + r16(im, b + at);
-                    jump_depth = depth;
-                }
-                break;
-            }
-            case kJCmp: {
-                if ((im[a] & ~kJumpIf) > 5u) return kVmBadOpcode;
-                pops = 2;
-                if (depth < pops) return kVmBadStack;
-                jump_to = static_cast<uint32_t>(pc) + r16(im, a + 1u);
-                jump_depth = static_cast<uint8_t>(depth - 2u);
-                break;
-            }
-            case kConst: case kLdt: pushes = 1; break;
-            case kLde: case kSte: {
-                const uint16_t e = r16(im, a);
-                if (e >= layout.count || flash_get(layout.elems[e].type) != im[a + 2u]) return kVmBadElement;
-                if (op == kLde) pushes = 1; else pops = 1;
-                break;
-            }
-            case kLdl: case kStl:
-                if (r16(im, a) >= p.locals) return kVmBadLocal;
-                if (op == kLdl) pushes = 1; else pops = 1;
-                break;
-            case kRoll:
-                if (im[a] >= p.windows || (prelude && im[a] >= pushed)) return kVmBadWindow;
-                pushes = 1;
-                break;
-            case kWpush:
-                if (!prelude) return kVmBadPlace;
-                if (im[a] != pushed) return kVmBadWindow;
-                ++pushed;
-                pops = 1;
-                break;
-            case kNeg: case kNot: case kTruth: pops = 1; pushes = 1; break;
-            default: pops = 2; pushes = 1; break;  // arithmetic and comparisons
-        }
-        if (jump_to != kNoJump) {  // a forward jump: its target and the depth there
-            if (jump_to >= p.code_size) return kVmBadJump;
-            if (np == FSW_VM_PENDING) return kVmTooNested;
-            pend[np].target = static_cast<uint16_t>(jump_to);
-            pend[np].depth = jump_depth;
-            ++np;
-        }
-        if (depth < pops) return kVmBadStack;
-        depth = static_cast<uint8_t>(depth - pops + pushes);
-        if (depth > deepest) deepest = depth;
-        if (deepest > FSW_VM_STACK) return kVmBadStack;
-        if (ends) {
-            if (depth != 0) return kVmBadStack;
-            reachable = false;
-            if (np == 0) {  // the block is over
-                if (prelude && pushed != p.windows) return kVmBadWindow;
-                at_start = true;
-            }
-        }
-    }
-    if (np != 0) return kVmBadJump;
-    if (!at_start) return kVmBadEnd;
-    if (matched != declared) return kVmBadEnd;
-    if (deepest != im[7]) return kVmBadStack;
-    return kVmOk;
-}
-
-}  // namespace
-
-namespace {
-
-template <class Im>
-VmReason verify(const Im& im, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
+VmReason check_header(const Im& im, uint16_t len, const VmLayout& layout, Offs& p) {
     if (len < kHeader) return kVmBadSize;
     if (im[0] != 'F' || im[1] != 'S' || im[2] != 'M' || im[3] != 'B') return kVmBadMagic;
     if (im[4] != kVersion) return kVmBadVersion;
     if (im[5] != sizeof(Real)) return kVmBadReal;
     if ((im[6] & ~kFlagLock) != 0) return kVmBadVersion;
     if (r32(im, 8) != layout.schema || r16(im, 12) != layout.count) return kVmBadSchema;
-    Offs p;
     offsets(im, p);
     if (p.total != len) return kVmBadSize;
     const uint16_t g = r16(im, 14), s = r16(im, 16);
@@ -424,20 +239,270 @@ VmReason verify(const Im& im, uint16_t len, const VmLayout& layout, uint32_t ram
         flash_get(layout.elems[s].type) != kU32)
         return kVmBadElement;
     if (p.states == 0) return kVmBadState;
-    for (uint16_t k = 0; k < p.locals; ++k) {
-        const uint8_t t = im[p.loc + 3u * k];
-        const uint16_t off = r16(im, p.loc + 3u * k + 1u);
-        if (elem_size(t) == 0 || static_cast<uint32_t>(off) + elem_size(t) > p.loc_size) return kVmBadLocal;
-    }
-    for (uint8_t w = 0; w < p.windows; ++w) {
-        const uint16_t n = r16(im, p.win + 4u * w + 2u);
-        if (im[p.win + 4u * w] > kMedian || im[p.win + 4u * w + 1u] != 0 || n == 0) return kVmBadWindow;
-    }
-    const VmReason r = verify_code(im, p, layout);
-    if (r != kVmOk) return r;
-    if (windows_size(im, p) + p.loc_size > ram_len) return kVmNoRam;
     return kVmOk;
 }
+
+// One instruction of the code (after the block offsets equal to pc were
+// counted, when a block starts there or a jump lands there): kVmMore, or
+// the pass's verdict once the code is over.
+template <class Im>
+uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayout& layout) {
+    uint8_t& depth = c.depth;
+    uint16_t pc = c.pc;
+    if (pc >= p.code_size) {  // the end
+        if (c.np != 0) return kVmBadJump;
+        if ((c.flags & kAtStart) == 0) return kVmBadEnd;
+        if (c.matched != c.declared) return kVmBadEnd;
+        if (c.deepest != im[7]) return kVmBadStack;
+        return kVmOk;
+    }
+    if ((c.flags & kAtStart) != 0) {  // a block starts here: what may it do?
+        if (c.moving != 0 && c.still != 0) return kVmBadPlace;
+        c.matched = static_cast<uint16_t>(c.matched + c.moving + c.still);
+        c.flags = static_cast<uint8_t>(kReachable | (c.moving != 0 ? kMayMove : 0) | (p.prelude == pc ? kPrelude : 0));
+        c.pushed = 0;
+    }
+    for (uint8_t k = 0; k < c.np;) {  // jumps landing here
+        VmPending& j = c.pend[k];
+        if (j.target < pc) return kVmBadJump;  // into an instruction
+        if (j.target == pc) {
+            if (c.moving != 0 || c.still != 0) return kVmBadJump;  // into another block
+            if ((c.flags & kReachable) != 0 && depth != j.depth) return kVmBadStack;
+            depth = j.depth;
+            c.flags |= kReachable;
+            j = c.pend[--c.np];
+        } else {
+            ++k;
+        }
+    }
+    if ((c.flags & kReachable) == 0) return kVmBadEnd;
+    const uint8_t real = im[5];
+    const uint8_t op = im[p.code + pc];
+    const uint8_t n = operand_bytes(op, real);
+    if (n == 0xFF || static_cast<uint32_t>(pc) + 1u + n > p.code_size) return kVmBadOpcode;
+    const uint32_t a = p.code + pc + 1u;  // the operands
+    pc = static_cast<uint16_t>(pc + 1u + n);
+    uint8_t pops = 0, pushes = 0, jump_depth = 0;
+    uint32_t jump_to = kNoJump;
+    bool ends = false;
+    const bool prelude = (c.flags & kPrelude) != 0;
+    switch (op) {
+        case kEnd: ends = true; break;
+        case kGoto:
+            if ((c.flags & kMayMove) == 0) return kVmBadPlace;
+            if (im[a] >= p.states) return kVmBadState;
+            ends = true;
+            break;
+        case kJmp: case kJf: case kAnd: case kOr: {
+            pops = op == kJmp ? 0 : 1;
+            if (depth < pops) return kVmBadStack;
+            jump_to = static_cast<uint32_t>(pc) + r16(im, a);
+            // and/or keep their left operand when they jump; jf drops it.
+            jump_depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
+            if (op == kJmp) c.flags &= static_cast<uint8_t>(~kReachable);
+            break;
+        }
+        case kJKey: case kJInt: case kSetK: case kIAdd: {
+            const uint16_t ref = r16(im, a);
+            uint8_t t;
+            const VmReason why = ref_type(im, p, layout, ref, (im[6] & kFlagLock) != 0, t);
+            if (why != kVmOk) return why;
+            const bool fits = op == kJKey ? t == kF32 || t == kF64
+                              : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
+                              : op == kSetK ? t != kTypeT
+                                            : is_int(t);
+            if (!fits) return wrong_type(ref);
+            const uint32_t b = a + 2u;  // the operands after the ref
+            const uint8_t more = typed_operands(op, t);
+            const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
+            if (static_cast<uint32_t>(pc) + more > p.code_size) return kVmBadOpcode;
+            pc = static_cast<uint16_t>(pc + more);
+            if (op == kSetK) {
+                if (t == kBool && im[b] > 1u) return kVmBadOpcode;
+            } else if (op == kIAdd) {
+                const uint16_t src = r16(im, b);
+                uint8_t ts;
+                const VmReason w = ref_type(im, p, layout, src, (im[6] & kFlagLock) != 0, ts);
+                if (w != kVmOk) return w;
+                if (!is_int(ts)) return wrong_type(src);
+                // |k| below 2^p (p = R's precision): every integer near k is exact in R.
+                const int32_t k = static_cast<int32_t>(r32(im, b + 2u));
+                if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
+            } else {
+                if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
+                    return kVmBadOpcode;
+                jump_to = static_cast<uint32_t>(pc) + r16(im, b + at);
+                jump_depth = depth;
+            }
+            break;
+        }
+        case kJCmp: {
+            if ((im[a] & ~kJumpIf) > 5u) return kVmBadOpcode;
+            pops = 2;
+            if (depth < pops) return kVmBadStack;
+            jump_to = static_cast<uint32_t>(pc) + r16(im, a + 1u);
+            jump_depth = static_cast<uint8_t>(depth - 2u);
+            break;
+        }
+        case kConst: case kLdt: pushes = 1; break;
+        case kLde: case kSte: {
+            const uint16_t e = r16(im, a);
+            if (e >= layout.count || flash_get(layout.elems[e].type) != im[a + 2u]) return kVmBadElement;
+            if (op == kLde) pushes = 1; else pops = 1;
+            break;
+        }
+        case kLdl: case kStl:
+            if (r16(im, a) >= p.locals) return kVmBadLocal;
+            if (op == kLdl) pushes = 1; else pops = 1;
+            break;
+        case kRoll:
+            if (im[a] >= p.windows || (prelude && im[a] >= c.pushed)) return kVmBadWindow;
+            pushes = 1;
+            break;
+        case kWpush:
+            if (!prelude) return kVmBadPlace;
+            if (im[a] != c.pushed) return kVmBadWindow;
+            ++c.pushed;
+            pops = 1;
+            break;
+        case kNeg: case kNot: case kTruth: pops = 1; pushes = 1; break;
+        default: pops = 2; pushes = 1; break;  // arithmetic and comparisons
+    }
+    if (jump_to != kNoJump) {  // a forward jump: its target and the depth there
+        if (jump_to >= p.code_size) return kVmBadJump;
+        if (c.np == FSW_VM_PENDING) return kVmTooNested;
+        c.pend[c.np].target = static_cast<uint16_t>(jump_to);
+        c.pend[c.np].depth = jump_depth;
+        ++c.np;
+    }
+    if (depth < pops) return kVmBadStack;
+    depth = static_cast<uint8_t>(depth - pops + pushes);
+    if (depth > c.deepest) c.deepest = depth;
+    if (c.deepest > FSW_VM_STACK) return kVmBadStack;
+    c.flags &= static_cast<uint8_t>(~(kAtStart | kScanned));
+    if (ends) {
+        if (depth != 0) return kVmBadStack;
+        c.flags &= static_cast<uint8_t>(~kReachable);
+        if (c.np == 0) {  // the block is over
+            if (prelude && c.pushed != p.windows) return kVmBadWindow;
+            c.flags |= kAtStart;
+        }
+    }
+    c.pc = pc;
+    c.i = 0;
+    return kVmMore;
+}
+
+// The pass from where `c` left it, a unit of work at least, until its
+// reader has read `budget` bytes (a RamImage counts none: to the end):
+// kVmMore, or the verdict.
+template <class Im>
+uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, uint32_t ram_len, uint16_t budget) {
+    Offs p;
+    if (c.phase == kChHeader) {
+        const VmReason r = check_header(im, len, layout, p);
+        if (r != kVmOk) return r;
+        c.phase = kChLocals;
+    } else {
+        offsets(im, p);  // read again: 10 bytes a call, rather than 34 of RAM kept
+    }
+    for (bool first = true;; first = false) {
+        if (!first && im.reads() >= budget) return kVmMore;  // (a unit a call at least: the check moves on)
+        if (c.phase == kChLocals) {
+            if (c.i < p.locals) {
+                const uint32_t at = p.loc + 3u * c.i;
+                const uint8_t t = im[at];
+                const uint16_t off = r16(im, at + 1u);
+                if (elem_size(t) == 0 || static_cast<uint32_t>(off) + elem_size(t) > p.loc_size) return kVmBadLocal;
+                ++c.i;
+                continue;
+            }
+            c.phase = kChWindows;
+            c.i = 0;
+        } else if (c.phase == kChWindows) {
+            if (c.i < p.windows) {
+                const uint32_t at = p.win + 4u * c.i;
+                const uint8_t func = im[at];
+                const uint16_t n = r16(im, at + 2u);
+                if (func > kMedian || im[at + 1u] != 0 || n == 0) return kVmBadWindow;
+                c.ram += window_size(func, n);
+                ++c.i;
+                continue;
+            }
+            c.phase = kChOffsets;
+            c.i = 0;
+            c.declared = p.prelude != kNone ? 1u : 0u;
+        } else if (c.phase == kChOffsets) {
+            if (c.i < 3u * p.states) {
+                const uint16_t off = r16(im, p.st + 2u * c.i);
+                ++c.i;
+                if (off == kNone) continue;
+                if (off >= p.code_size) return kVmBadState;
+                ++c.declared;
+                continue;
+            }
+            if (p.prelude == kNone || p.prelude >= p.code_size) return kVmBadEnd;
+            c.phase = kChCode;
+            c.i = 0;
+            c.flags = kReachable | kAtStart;
+        } else {
+            const uint16_t pc = c.pc;
+            if ((c.flags & kScanned) == 0 && pc < p.code_size) {
+                // The block offsets equal to pc, needed where a block starts
+                // or a jump lands: a state's three a unit (exit blocks and
+                // the prelude counted apart: they may not transition). Byte
+                // by byte: an offset whose low byte differs costs one read,
+                // which in an EEPROM is most of the cost.
+                bool lands = (c.flags & kAtStart) != 0;
+                for (uint8_t k = 0; k < c.np && !lands; ++k) lands = c.pend[k].target == pc;
+                if (lands) {
+                    if (c.i == 0) {
+                        c.moving = 0;
+                        c.still = p.prelude == pc ? 1u : 0u;
+                    }
+                    if (c.i < p.states) {
+                        const uint8_t lo = static_cast<uint8_t>(pc), hi = static_cast<uint8_t>(pc >> 8);
+                        uint16_t at = static_cast<uint16_t>(p.st + 6u * c.i);
+                        for (uint8_t k = 0; k < 3; ++k, at = static_cast<uint16_t>(at + 2u)) {
+                            if (im[at] != lo || im[at + 1u] != hi) continue;
+                            if (k < 2) ++c.moving;
+                            else ++c.still;
+                        }
+                        ++c.i;
+                        continue;
+                    }
+                } else {
+                    c.moving = 0;
+                    c.still = 0;
+                }
+                c.flags |= kScanned;
+            }
+            const uint8_t r = check_instruction(im, c, p, layout);
+            if (r == kVmMore) continue;
+            if (r != kVmOk) return r;
+            if (c.ram + p.loc_size > ram_len) return kVmNoRam;
+            return kVmOk;
+        }
+    }
+}
+
+// The verifier reads an image through a reader: in RAM (vm_verify), or in
+// the EEPROM a loader keeps it in (vm_verify_eeprom, vm_check_eeprom), byte
+// by byte, counting its reads.
+struct RamImage {
+    const uint8_t* im;
+    uint8_t operator[](uint32_t i) const { return im[i]; }
+    uint16_t reads() const { return 0; }
+};
+struct EepromImage {
+    uint16_t base;
+    mutable uint16_t n;
+    uint8_t operator[](uint32_t i) const {
+        ++n;
+        return pal::eeprom_read(static_cast<uint16_t>(base + i));
+    }
+    uint16_t reads() const { return n; }
+};
 
 }  // namespace
 
@@ -449,12 +514,27 @@ uint32_t vm_ram_size(const uint8_t* image, uint16_t len) {
     return windows_size(RamImage{image}, o) + o.loc_size;
 }
 
+void vm_check_begin(VmCheck& c) { memset(&c, 0, sizeof c); }
+
 VmReason vm_verify(const uint8_t* im, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
-    return verify(RamImage{im}, len, layout, ram_len);
+    VmCheck c;
+    vm_check_begin(c);
+    return static_cast<VmReason>(check(RamImage{im}, c, len, layout, ram_len, 1));  // reads none: to the end
+}
+
+uint8_t vm_check_eeprom(VmCheck& c, uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len,
+                        uint16_t budget) {
+    return check(EepromImage{addr, 0}, c, len, layout, ram_len, budget);
 }
 
 VmReason vm_verify_eeprom(uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len) {
-    return verify(EepromImage{addr}, len, layout, ram_len);
+    VmCheck c;
+    vm_check_begin(c);
+    uint8_t r;
+    do {
+        r = vm_check_eeprom(c, addr, len, layout, ram_len, 0xFFFFu);
+    } while (r == kVmMore);
+    return static_cast<VmReason>(r);
 }
 
 uint8_t* vm_locals(const uint8_t* image, uint8_t* ram) {

@@ -59,9 +59,45 @@ uint32_t vm_ram_size(const uint8_t* image, uint16_t len);
 FSW_MUST_CHECK VmReason vm_verify(const uint8_t* image, uint16_t len, const VmLayout& layout, uint32_t ram_len);
 
 // The same rules for an image kept in the EEPROM at `addr` (a loader's slot,
-// fsw_reload.h), read there byte by byte: an image is checked before it is
-// copied over the one that runs.
+// fsw_reload.h), read there byte by byte, in one call (a board's boot).
 FSW_MUST_CHECK VmReason vm_verify_eeprom(uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len);
+
+// A forward jump the verifier has seen and not yet reached: its target and
+// the stack's depth there.
+struct VmPending {
+    uint16_t target;
+    uint8_t depth;
+};
+
+// The verifier's state between the calls of a check in slices (RAM): what
+// its one pass over the image has seen so far.
+struct VmCheck {
+    uint32_t ram;            // the windows' bytes, summed so far
+    uint16_t i;              // the phase's index: a local, a window, a block offset, a state scanned
+    uint16_t pc;             // the next instruction
+    uint16_t declared;       // the image's block offsets, the prelude's included
+    uint16_t matched;        // ... those found where a block starts
+    uint16_t moving, still;  // the block offsets equal to pc (moving: entry and step)
+    uint8_t phase, np, depth, deepest, pushed, flags;
+    VmPending pend[FSW_VM_PENDING];
+};
+
+// vm_check_eeprom's answer while the check is not over (never a VmReason).
+static const uint8_t kVmMore = 0xFF;
+
+// The rules of vm_verify_eeprom over many calls, so that no call holds the
+// CPU for long (a board checks an uploaded image between its machine's
+// steps, fsw_reload.h): vm_check_begin, then vm_check_eeprom with the same
+// arguments until it answers something else than kVmMore (the answer
+// vm_verify_eeprom gives). A call does one unit of work at least (a local,
+// a window, a block offset, a state's three compared with an instruction's
+// address, an instruction: 14 reads at most) and stops before the next
+// once it has read `budget` EEPROM bytes, the header's included (27 the
+// first call, 10 the next ones): at most `budget` + 13 reads a call, or
+// the header's and a unit's when `budget` is below the header's.
+void vm_check_begin(VmCheck& c);
+FSW_MUST_CHECK uint8_t vm_check_eeprom(VmCheck& c, uint16_t addr, uint16_t len, const VmLayout& layout, uint32_t ram_len,
+                                       uint16_t budget);
 
 // The image's locals inside `ram` (packed little-endian, in declaration order).
 uint8_t* vm_locals(const uint8_t* image, uint8_t* ram);

@@ -54,6 +54,7 @@ const uint16_t kEepromSize = 1024;
 uint8_t g_eeprom[kEepromSize];
 bool g_eeprom_init;
 uint32_t g_eeprom_writes;
+uint32_t g_eeprom_reads;
 uint32_t g_eeprom_freeze = 0xFFFFFFFFu;
 FILE* g_eeprom_file;
 // The SPI NOR flash model (psl_native.h). Its bytes are kept inverted, so
@@ -201,6 +202,7 @@ uint8_t* sim_eeprom() {
     return g_eeprom;
 }
 uint32_t sim_eeprom_writes() { return g_eeprom_writes; }
+uint32_t sim_eeprom_reads() { return g_eeprom_reads; }
 void sim_eeprom_freeze_after(uint32_t writes) { g_eeprom_freeze = g_eeprom_writes + writes; }
 bool sim_eeprom_file(const char* path) {
     eeprom_init();
@@ -308,6 +310,7 @@ void begin() { clear_modes(); }
 uint16_t eeprom_size() { return kEepromSize; }
 uint8_t eeprom_read(uint16_t addr) {
     eeprom_init();
+    ++g_eeprom_reads;
     return addr < kEepromSize ? g_eeprom[addr] : 0xFF;
 }
 bool eeprom_ready() { return true; }

@@ -46,12 +46,14 @@ bool watchdog_armed();
 void sim_set_reset_cause(uint8_t cause);
 
 // The EEPROM model (1,024 bytes, kept across sim_reset()): erased to 0xFF;
-// its bytes; writes so far; a power cut after `writes` more writes (later
-// writes are lost); a file it is loaded from and written through to (false
-// when it cannot be opened or written).
+// its bytes; writes so far, reads so far (pal::eeprom_read's calls: what a
+// check in slices counts, fsw_vm.h); a power cut after `writes` more writes
+// (later writes are lost); a file it is loaded from and written through to
+// (false when it cannot be opened or written).
 void sim_eeprom_erase();
 uint8_t* sim_eeprom();
 uint32_t sim_eeprom_writes();
+uint32_t sim_eeprom_reads();
 void sim_eeprom_freeze_after(uint32_t writes);
 bool sim_eeprom_file(const char* path);
 

@@ -2,6 +2,9 @@
 // an image that breaks each of its rules, with that rule's reason code, and
 // the VM steps a verified image as a generated machine steps.
 #include "test_support.h"
+#if !defined(__AVR__)
+#include "psl_native.h"
+#endif
 
 using namespace fsw;
 
@@ -407,6 +410,62 @@ void test_the_vm_steps_typed_instructions(void) {
     TEST_ASSERT_EQUAL_INT16(32767, load<int16_t>(sv + 16));  // 3 + 40000, saturated
 }
 
+#if !defined(__AVR__)
+// The same rules in slices (vm_check_eeprom: what a board runs a slice of
+// at each machine step for a commit or an activation, fsw_reload.h), over
+// the image in the EEPROM: vm_verify's answer for every budget, each call
+// within the reads fsw_vm.h promises, over many calls for a small budget.
+// (Natively: the host's EEPROM model counts the reads; and an Uno's test_vm
+// has no flash left for the EEPROM verifier.)
+uint8_t sliced(const Image& im, uint16_t budget, uint32_t& calls) {
+    memcpy(native::sim_eeprom() + 100, im.b, im.len);
+    VmCheck c;
+    vm_check_begin(c);
+    uint8_t r = kVmMore;
+    for (calls = 0; r == kVmMore; ++calls) {
+        const uint32_t before = native::sim_eeprom_reads();
+        r = vm_check_eeprom(c, 100, im.len, kLayout, sizeof ram, budget);
+        const uint32_t reads = native::sim_eeprom_reads() - before, header = calls == 0 ? 27u : 10u;
+        TEST_ASSERT_TRUE(reads <= (budget > header ? budget + 13u : header + 14u));
+        TEST_ASSERT_TRUE(calls < 1000);
+    }
+    return r;
+}
+
+void test_the_check_in_slices_gives_vm_verify_s_answer(void) {
+    native::sim_eeprom_erase();
+    const uint16_t budgets[] = {1, 16, 48, 0xFFFF};
+    Image cases[5];
+    good(cases[0]);
+    good(cases[1]);
+    cases[1].b[0] = 'X';                   // kVmBadMagic
+    good(cases[2]);
+    cases[2].b[cases[2].code + 10] = 200;  // the JF past the code: kVmBadJump
+    good(cases[3]);
+    cases[3].b[cases[3].code + 24] = 0xEE;  // an unknown opcode
+    good(cases[4]);
+    put16(cases[4].b + 28 + 8, 26);        // B's .step moved into A's .exit: B's goto, kVmBadPlace
+    for (const Image& im : cases) {
+        const VmReason want = verify(im);
+        for (uint16_t budget : budgets) {
+            uint32_t calls;
+            TEST_ASSERT_EQUAL_UINT(want, sliced(im, budget, calls));
+            TEST_ASSERT_EQUAL_UINT(want, vm_verify_eeprom(100, im.len, kLayout, sizeof ram));
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(cases[0]));
+    TEST_ASSERT_EQUAL_UINT(kVmBadMagic, verify(cases[1]));
+    TEST_ASSERT_EQUAL_UINT(kVmBadJump, verify(cases[2]));
+    TEST_ASSERT_EQUAL_UINT(kVmBadOpcode, verify(cases[3]));
+    TEST_ASSERT_EQUAL_UINT(kVmBadPlace, verify(cases[4]));
+    uint32_t calls;
+    TEST_ASSERT_EQUAL_UINT(kVmOk, sliced(cases[0], 16, calls));
+    TEST_ASSERT_TRUE(calls >= 8);  // the good image's ~150 reads, 16 a call or so
+    TEST_ASSERT_EQUAL_UINT(kVmOk, sliced(cases[0], 0xFFFF, calls));
+    TEST_ASSERT_EQUAL_UINT(1, calls);
+}
+#endif
+
 void test_the_vm_steps_the_good_image(void) {
     Image im;
     good(im);
@@ -453,5 +512,8 @@ FSW_TEST_MAIN([] {
     RUN_TEST(test_typed_instruction_rules);
     RUN_TEST(test_the_vm_steps_typed_instructions);
     RUN_TEST(test_the_vm_steps_the_good_image);
+#if !defined(__AVR__)
+    RUN_TEST(test_the_check_in_slices_gives_vm_verify_s_answer);
+#endif
     (void)UNITY_END();
 })

@@ -194,6 +194,125 @@ def test_an_image_the_verifier_refuses_never_runs(rig, new_image):
     assert rig.valve_at(740) is False
 
 
+def _raw(rig, op: int, args: bytes = b"") -> dict:
+    """One command and its ack, BUSY included (not tried again)."""
+    return rig.c.cmd.run([(op, args)], busy_retry=False)[0]
+
+
+def _written(rig, data: bytes, crc: int, nmask: int = 1) -> None:
+    """BEGIN and every WRITE of `data`, and the EEPROM written: COMMIT next."""
+    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_WRITE
+    from fswkit.reload.client import CHUNK
+
+    ack = rig.c._one(OP_MACHINE_BEGIN, struct.pack("<HBH", len(data) - nmask, nmask, crc))
+    assert ack["status"] == 0, ack
+    for off in range(0, len(data), CHUNK):
+        ack = rig.c._one(OP_MACHINE_WRITE, struct.pack("<H", off) + data[off:off + CHUNK])
+        assert ack["status"] == 0, ack
+        rig.t.events(CHUNK * 0.0035)
+    while rig.c.info().writing:
+        rig.t.events(0.02)
+
+
+def _commit_until_answered(rig) -> tuple[dict, int]:
+    """COMMIT sent again every 20 ms while the board answers BUSY: the
+    answer, and how many BUSYs came before it."""
+    from fswkit.autocode.protocol import OP_MACHINE_COMMIT
+
+    busy = 0
+    while True:
+        ack = _raw(rig, OP_MACHINE_COMMIT)
+        if ack["status_name"] != "BUSY":
+            return ack, busy
+        busy += 1
+        assert busy < 200, "the check never ended"
+        rig.t.events(0.02)
+
+
+def test_a_commit_is_busy_while_the_board_checks_the_image_then_answers_its_result(rig, new_image):
+    """The check (the CRC, then the verifier) runs a slice at each of the
+    machine task's steps: the first COMMIT of a whole upload starts it and
+    answers BUSY, as do the COMMITs while it runs, and a BEGIN or a WRITE
+    meanwhile; the next COMMIT answers OK. Sent again after that (its ack
+    lost), COMMIT answers NO_LOAD, as before the checks ran in slices, and
+    the slot says the image is stored."""
+    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_COMMIT, OP_MACHINE_WRITE, crc16
+
+    image, mask = new_image
+    data = image + mask
+    _written(rig, data, crc16(data), len(mask))
+    assert _raw(rig, OP_MACHINE_COMMIT)["status_name"] == "BUSY"  # the check starts
+    begin = struct.pack("<HBH", len(image), len(mask), crc16(data))
+    assert _raw(rig, OP_MACHINE_BEGIN, begin)["status_name"] == "BUSY"
+    assert _raw(rig, OP_MACHINE_WRITE, struct.pack("<H", 0) + data[:8])["status_name"] == "BUSY"
+    ack, busy = _commit_until_answered(rig)
+    assert ack["status_name"] == "OK" and busy >= 1, (ack, busy)  # still running after the BEGIN and the WRITE
+    while rig.c.info().writing:  # the header
+        rig.t.events(0.02)
+    assert _raw(rig, OP_MACHINE_COMMIT)["status_name"] == "NO_LOAD"
+    inf = rig.c.info()
+    assert inf.up_slot == 0 and inf.slots[0].status == 1 and inf.slots[0].crc == crc16(data)
+    assert inf.slots[0].length == len(image) and inf.refused == 0
+    rig.c.activate(1)
+    assert rig.valve_at(740) is True
+
+
+def test_a_mismatch_leaves_the_upload_open_and_a_write_mends_it(rig, new_image):
+    """A COMMIT sent again after MISMATCH checks the bytes again (BUSY, then
+    MISMATCH): the answer is not lost. The byte written again, the next
+    COMMIT answers OK."""
+    from fswkit.autocode.protocol import OP_MACHINE_WRITE, crc16
+
+    image, mask = new_image
+    good = image + mask
+    bad = bytearray(good)
+    bad[60] ^= 0x10
+    _written(rig, bytes(bad), crc16(good), len(mask))
+    ack, busy = _commit_until_answered(rig)
+    assert ack["status_name"] == "MISMATCH" and busy >= 1, (ack, busy)
+    ack, busy = _commit_until_answered(rig)  # sent again: its ack lost
+    assert ack["status_name"] == "MISMATCH" and busy >= 1, (ack, busy)
+    assert rig.c.info().up_slot == 1
+    assert rig.c._one(OP_MACHINE_WRITE, struct.pack("<H", 56) + good[56:64])["status"] == 0
+    while rig.c.info().writing:
+        rig.t.events(0.02)
+    ack, _ = _commit_until_answered(rig)
+    assert ack["status_name"] == "OK", ack
+
+
+def test_a_commit_waits_for_the_machine_task_and_the_ground_says_why(rig, new_image):
+    """The checks run at the machine task's steps: with that task disabled
+    (MODE), COMMIT answers BUSY until the ground gives up, and it says why;
+    the task enabled again, the upload commits."""
+    from fswkit.autocode.protocol import OP_MODE
+    from fswkit.reload.client import MachineClient, MachineError
+
+    control = 2  # stand.app's tasks: uplink, sense, control, act, downlink
+    assert rig.c._one(OP_MODE, bytes((control, 0)))["status"] == 0
+    short = MachineClient(rig.t, rig.c.cmd.tx_cap, timeout=0.3, deadline=2.0)
+    with pytest.raises(MachineError, match="BUSY .* times .*machine's task; is that task disabled or safed"):
+        short.upload(*new_image)
+    assert rig.c._one(OP_MODE, bytes((control, 2)))["status"] == 0
+    slot, resumed = rig.c.upload(*new_image)  # the same bytes: only the COMMIT goes again
+    assert slot == 1 and resumed
+    assert rig.c.info().slots[0].status == 1
+
+
+def test_a_byte_changed_in_the_eeprom_after_the_commit_is_refused_at_the_activation(rig, new_image):
+    """The activation checks the slot again (in slices, as soon as ACTIVATE
+    arrives): its CRC no longer holds, the generated machine runs on."""
+    from fswkit.reload.client import MachineError
+
+    slot, _ = rig.c.upload(*new_image)
+    at = 9 + 40  # slot 1's image (the stand's slots start the EEPROM), byte 40
+    rig.b.eeprom_write(at, bytes((rig.b.eeprom_read(at, 1)[0] ^ 0x01,)))
+    with pytest.raises(MachineError, match="no longer have the CRC"):
+        rig.c.activate(slot)
+    inf = rig.c.info()
+    assert inf.active == 0 and inf.pending == 0xFF and inf.refused == 1 and inf.reason == 0x80
+    assert rig.valve_at(740) is False and rig.valve_at(790) is True
+
+
 def test_an_interrupted_upload_resumes(rig, new_image):
     class Cut(Exception):
         pass

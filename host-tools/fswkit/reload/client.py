@@ -1,7 +1,8 @@
 """The ground's machine client (docs/reload.md): uploads a bytecode image
 into the target's free slot, chunked and resumable over a lossy link, and
 verified twice on the target (the CRC BEGIN announced, then the board's own
-verifier at COMMIT); lists the slots; activates a slot or the generated
+verifier at COMMIT, both run in slices at its machine task's steps: COMMIT
+answers BUSY until they are over); lists the slots; activates a slot or the generated
 machine and waits until the target has switched, at the next step of its
 machine in a state the application allows.
 
@@ -145,7 +146,15 @@ class MachineClient:
             if self.on_progress is not None:
                 self.on_progress(off, len(data))
             self._wait(len(chunk) * EEPROM_BYTE_S)  # the target writes it before it takes the next
-        ack = self._one(OP_MACHINE_COMMIT)
+        busy = self.stats.busy
+        try:
+            ack = self._one(OP_MACHINE_COMMIT)
+        except ParamError as e:
+            if self.stats.busy - busy < 10:
+                raise
+            raise MachineError(f"COMMIT: the target answered BUSY {self.stats.busy - busy} times ({e}): it checks "
+                               "the image at the steps of the machine's task; is that task disabled or safed?") \
+                from None
         if ack["status"] == NO_LOAD:  # an earlier copy was applied and its ack lost: the slot says
             after = self.info()
             s = after.slots[slot - 1]

@@ -27,6 +27,12 @@ class Upload:
     down_dropped: int
     slot: int
     longest_command: int = 0  # cycles of the longest uplink command the board handled (0: not measured)
+    longest_slice: int = 0  # cycles of the longest slice of a check (the CRC's or the verifier's)
+    slices: int = 0  # slices the checks took (the commit's and the activation's)
+    copy: int = 0  # cycles of the switch's copy: the image from the EEPROM into RAM, and its reset
+    late: int = -1  # cycles the executor counted late from BEGIN to the switch (-1: no health frame)
+    worst_us: dict = field(default_factory=dict)  # task -> its longest step since boot (health frame)
+    overruns: dict = field(default_factory=dict)  # task -> its overruns from BEGIN to the switch
 
 
 def _session(app, b, loss: float, seed: int):
@@ -46,29 +52,63 @@ def _session(app, b, loss: float, seed: int):
     return MachineClient(t, link_plan(app).tx_cap, baud=app.baud, timeout=0.3, deadline=600), t, up, down
 
 
+# What timed_upload times on the board (when the build has them out of
+# line): each reload command the link hands the store, each slice of a
+# check, the switch's copy of the image into RAM.
+_TIMED = ("fsw::link_reload_apply(", "fsw::(anonymous namespace)::check_slice(",
+          "fsw::(anonymous namespace)::run_slot(")
+
+
 def timed_upload(elf: str, board: str, app, image: bytes, mask: bytes, loss: float = 0.0, seed: int = 1,
                  baud: int | None = None, analog: dict | None = None) -> Upload:
     """Boots the firmware and uploads `image` (and activates it), through a
     link that drops `loss` of the frames each way; the board's profiler
-    times each reload command it handles (`fsw::link_reload_apply`)."""
+    times each reload command it handles, each slice of the checks and the
+    switch's copy (_TIMED), and the health frames before and after give the late
+    cycles, the overruns and each task's longest step."""
     from fswkit.sim.board import SimBoard
     from fswkit.target.build import elf_symbols
 
-    apply_at = [addr for addr, _size, kind, name in elf_symbols(elf)
-                if kind in "tT" and name.startswith("fsw::link_reload_apply(")]
+    syms = [(addr, name) for addr, _size, kind, name in elf_symbols(elf) if kind in "tT"]
+    timed = [next((a for a, n in syms if n.startswith(prefix)), None) for prefix in _TIMED]
     with SimBoard(elf, board, uart="control", sim_limit=1e6, analog=analog) as b:
-        if apply_at:
-            b.profile(apply_at[:1])
+        if any(a is not None for a in timed):
+            b.profile([a for a in timed if a is not None])
         c, t, up, down = _session(app, b, loss, seed)
+        h0 = _health(t)
         t0 = t.now()
         slot, _ = c.upload(image, mask)
         t1 = t.now()
         c.activate(slot, wait=30)
         t2 = t.now()
-        longest = b.profile_read().functions[0].worst if apply_at else 0
+        fns = {f.entry: f for f in b.profile_read().functions} if any(a is not None for a in timed) else {}
+        command, check, copy = (fns.get(a) for a in timed)
+        h1 = _health(t)
+        late, worst, over = -1, {}, {}
+        if h0 is not None and h1 is not None:
+            late = h1["late"] - h0["late"]
+            worst = {x["name"]: x["worst_us"] for x in h1["tasks"]}
+            over = {x["name"]: x["overruns"] - y["overruns"] for x, y in zip(h1["tasks"], h0["tasks"])}
         return Upload(t1 - t0, t2 - t1, c.stats.sent, c.stats.resent, c.stats.busy,
                       up.frames if up else 0, up.dropped if up else 0, down.frames if down else 0,
-                      down.dropped if down else 0, slot, longest)
+                      down.dropped if down else 0, slot, longest_command=command.worst if command else 0,
+                      longest_slice=check.worst if check else 0, slices=check.calls if check else 0,
+                      copy=copy.worst if copy else 0, late=late, worst_us=worst, overruns=over)
+
+
+def _health(t, budget: float = 3.0) -> dict | None:
+    """The next health frame the board sends (sent after this call), or None
+    if none came within `budget` simulated seconds (a lossy link may drop
+    them)."""
+    last = t.session.health
+    seen = last["cycles"] if last is not None else -1
+    end = t.now() + budget
+    while t.now() < end:
+        t.events(0.05)
+        h = t.session.health
+        if h is not None and h["cycles"] > seen:
+            return dict(h)
+    return None
 
 
 @dataclass

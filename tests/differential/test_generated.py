@@ -192,7 +192,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
         counts["folded local"] += sum(1 for v in m.vars if v.kind == M.LOCAL and f"L_{v.name} =" not in
                                       "".join(files.values()))
         counts["window"] += len(m.windows) + len(script.windows)
-        # windows skipped in the states that can no longer read them (emit.machine.window_states)
+        # windows skipped in the states that can no longer read them (emit.machine.window_needs)
         counts["window sampled in some states"] += "sampled where still read" in "".join(files.values())
         counts["lock"] += m.sv.lock
     assert all(n >= 20 for n in counts.values()), counts

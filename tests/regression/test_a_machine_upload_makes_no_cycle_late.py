@@ -3,8 +3,8 @@ and the board's verifier reading the EEPROM byte by byte, 11.1 ms of CPU
 for the rocket's 646-byte mission machine on a 16 MHz ATmega2560, longer
 than the 10 ms cycle; the activation checked it again inside the machine
 task's step. A test stand at 100 Hz mid-sequence took a late cycle from a
-ground command. The checks now run in slices between cycles (docs/reload.md,
-"Checked in slices").
+ground command. The checks now run in slices, one at each of the machine
+task's steps (docs/reload.md, "Checked in slices").
 
 examples/rocket (100 Hz) with [reload] of its mission machine on a
 simulated ATmega2560 (tools/bench_reload.py's variant), and examples/stand

@@ -106,11 +106,12 @@ def test_the_key_follows_the_runtime_and_the_makefile(cache, tmp_path, monkeypat
     runtime = tmp_path / "runtime"
     shutil.copytree(libcache.RUNTIME, runtime)
     monkeypatch.setattr(libcache, "RUNTIME", str(runtime))
-    assert libcache.avr_key(*args) == key  # the same files elsewhere
+    moved = libcache.avr_key(*args)
+    assert moved != key  # the same files elsewhere: the archives' debug information names them there
     with open(runtime / "fsw_config.h", "a") as f:
         f.write("\n// edited\n")
     edited = libcache.avr_key(*args)
-    assert edited != key
+    assert edited not in (key, moved)
     mk = tmp_path / "build.mk"
     mk.write_text(Path(libcache.BUILD_MK).read_text() + "\n# edited\n")
     monkeypatch.setattr(libcache, "BUILD_MK", str(mk))

@@ -8,8 +8,9 @@ Uno, 0.5 s instead of 2.6 natively).
 They are kept in the user's cache beside `fsw test --native`'s runners
 (~/.cache/fswkit, or $FSW_CACHE_DIR), keyed by the hash of everything that
 goes into them: mk/build.mk (the flags), the board's MCU, clock, variant
-and define, the compilers' and the C library's identity, and the contents
-of the runtime's and the Arduino core's sources and headers. An entry is
+and define, the compilers' and the C library's identity, the runtime's
+folder (the archives' debug information names their sources), and the
+contents of the runtime's and the Arduino core's sources and headers. An entry is
 built in a private temporary folder (fswkit.run.native's) and moved into
 place whole, so concurrent builds never see each other's half-written
 files. A build folder keeps its own links (or copies) of the entry it uses
@@ -77,7 +78,8 @@ def avr_key(mcu: str, f_cpu: int, variant: str, define: str, arduino: str) -> st
     from fswkit.run.native import compiler_identity
 
     h = hashlib.sha256(b"fswkit avr archives 1\0")
-    h.update(f"{mcu} {f_cpu} {variant} {define} {os.path.realpath(arduino)}\0".encode())
+    # (the folders too: the archives' debug information names their sources)
+    h.update(f"{mcu} {f_cpu} {variant} {define} {os.path.realpath(arduino)} {os.path.realpath(RUNTIME)}\0".encode())
     for tool in ("avr-gcc", "avr-g++", "avr-gcc-ar"):
         h.update(compiler_identity(tool).encode() + b"\0")
     h.update(_libc_identity("avr-gcc", mcu).encode() + b"\0")

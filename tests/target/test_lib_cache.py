@@ -18,9 +18,10 @@ import pytest
 
 from conftest import EXAMPLES
 
-pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None
-                                or not os.path.isdir("/usr/share/arduino/hardware/arduino/avr/cores/arduino"),
-                                reason="gcc-avr or the Arduino core not installed (make setup)")
+pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None
+                                 or not os.path.isdir("/usr/share/arduino/hardware/arduino/avr/cores/arduino"),
+                                 reason="gcc-avr or the Arduino core not installed (make setup)"),
+              pytest.mark.costly(12)]
 
 TANK, ROCKET = EXAMPLES / "tank", EXAMPLES / "rocket"
 
@@ -36,26 +37,50 @@ def _compiles(log: Path) -> list[str]:
             if " -c " in line and ("firmware/src/" in line or "cores/arduino/" in line)]
 
 
+@pytest.fixture(scope="module")
+def first(tmp_path_factory):
+    """A cache of this file's own, and the Uno's entry the first build into
+    it compiled (the tank's): (the cache, the tank's build folder)."""
+    from conftest import run_fsw
+
+    root = tmp_path_factory.mktemp("libcache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("FSW_CACHE_DIR", str(root / "cache"))
+        mp.delenv("FSW_NO_LIB_CACHE", raising=False)
+        r = run_fsw("build", str(TANK), "--out", str(root / "tank"))
+    assert r.code == 0, r.err
+    return root / "cache", root / "tank"
+
+
 @pytest.fixture
-def cache(tmp_path, monkeypatch):
+def cache(first, monkeypatch):
+    """The module's cache, for the test's builds."""
+    monkeypatch.setenv("FSW_CACHE_DIR", str(first[0]))
+    monkeypatch.delenv("FSW_NO_LIB_CACHE", raising=False)
+    return first[0]
+
+
+@pytest.fixture
+def empty_cache(tmp_path, monkeypatch):
     folder = tmp_path / "cache"
     monkeypatch.setenv("FSW_CACHE_DIR", str(folder))
     monkeypatch.delenv("FSW_NO_LIB_CACHE", raising=False)
     return folder
 
 
-def test_a_second_project_links_the_archives_the_first_compiled(fsw, cache, tmp_path, monkeypatch):
-    assert fsw("build", str(TANK), "--out", str(tmp_path / "tank")).code == 0
+def test_a_second_project_links_the_archives_the_first_compiled(fsw, first, cache, tmp_path, monkeypatch):
     entries = _entries(cache)
-    assert len(entries) == 1 and {p.name for p in entries[0].iterdir()} == {"core.a", "libfswkit.a", "build.log"}
-    assert _compiles(entries[0] / "build.log"), "the entry's log shows its compile"
+    entry = cache / "avr" / (first[1] / "fsw-libs" / ".key").read_text()  # the Uno's, the tank compiled
+    assert _compiles(first[1] / "build.log") == [] and entry in entries
+    assert {p.name for p in entry.iterdir()} == {"core.a", "libfswkit.a", "build.log"}
+    assert _compiles(entry / "build.log"), "the entry's log shows its compile"
     r = fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket"))
     assert r.code == 0, r.err
     log = tmp_path / "rocket" / "build.log"
     assert _compiles(log) == [], "the runtime or the core compiled again"
     assert "fsw-libs/libfswkit.a fsw-libs/core.a" in log.read_text()
-    assert (tmp_path / "rocket" / "fsw-libs" / "build.log").read_text() == (entries[0] / "build.log").read_text()
-    assert len(_entries(cache)) == 1
+    assert (tmp_path / "rocket" / "fsw-libs" / "build.log").read_text() == (entry / "build.log").read_text()
+    assert _entries(cache) == entries
     # the same firmware as a build that compiles everything in its folder
     monkeypatch.setenv("FSW_NO_LIB_CACHE", "1")
     assert fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket-alone")).code == 0
@@ -66,9 +91,11 @@ def test_a_second_project_links_the_archives_the_first_compiled(fsw, cache, tmp_
 def test_another_board_is_another_entry(fsw, cache, tmp_path):
     out = tmp_path / "out"
     assert fsw("build", str(TANK), "--out", str(out)).code == 0
+    uno = (out / "fsw-libs" / ".key").read_text()
     r = fsw("build", str(TANK), "--board", "mega2560", "--out", str(out))
     assert r.code == 0, r.err
-    assert len(_entries(cache)) == 2
+    mega = (out / "fsw-libs" / ".key").read_text()
+    assert mega != uno and {uno, mega} <= {p.name for p in _entries(cache)}
     # the Mega's archives, not the Uno's: e_flags' architecture 6 (ATmega2560), not 5
     for name in ("tank.elf", "fsw-libs/core.a"):
         data = (out / name).read_bytes()
@@ -134,7 +161,9 @@ def test_a_cache_that_cannot_be_written_leaves_the_build_as_it_was(fsw, tmp_path
 
 
 @pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
-def test_a_native_build_links_the_runtimes_objects(fsw, cache, tmp_path, monkeypatch):
+def test_a_native_build_links_the_runtimes_objects(fsw, tmp_path, monkeypatch):
+    # the user's cache (the runtime's objects `fsw test --native` keeps, as likely there already)
+    monkeypatch.delenv("FSW_NO_LIB_CACHE", raising=False)
     out = tmp_path / "native"
     r = fsw("build", str(TANK), "--board", "native", "--out", str(out))
     assert r.code == 0, r.err
@@ -151,7 +180,8 @@ def test_a_native_build_links_the_runtimes_objects(fsw, cache, tmp_path, monkeyp
     assert runs[0].returncode == 0 and runs[0].stdout and runs[0].stdout == runs[1].stdout, runs
 
 
-def test_concurrent_first_builds_share_one_entry(cache, tmp_path):
+def test_concurrent_first_builds_share_one_entry(empty_cache, tmp_path):
+    cache = empty_cache
     fsw_exe = os.path.join(os.path.dirname(sys.executable), "fsw")
     env = dict(os.environ, FSW_CACHE_DIR=str(cache))
     env.pop("FSW_NO_LIB_CACHE", None)

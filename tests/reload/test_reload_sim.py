@@ -127,8 +127,9 @@ def test_the_valve_follows_the_uploaded_threshold_without_a_reset(rig, new_image
     assert rig.valve_at(740) is False and rig.valve_at(790) is True
 
 
-def _begin_and_write(rig, data: bytes, crc: int, nmask: int = 1):
-    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_COMMIT, OP_MACHINE_WRITE
+def _send(rig, data: bytes, crc: int, nmask: int = 1) -> None:
+    """BEGIN and every WRITE of `data` (the image, then its `nmask` mask bytes)."""
+    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_WRITE
     from fswkit.reload.client import CHUNK
 
     ack = rig.c._one(OP_MACHINE_BEGIN, struct.pack("<HBH", len(data) - nmask, nmask, crc))
@@ -137,6 +138,13 @@ def _begin_and_write(rig, data: bytes, crc: int, nmask: int = 1):
         ack = rig.c._one(OP_MACHINE_WRITE, struct.pack("<H", off) + data[off:off + CHUNK])
         assert ack["status"] == 0, ack
         rig.t.events(CHUNK * 0.0035)
+
+
+def _begin_and_write(rig, data: bytes, crc: int, nmask: int = 1):
+    """_send, then COMMIT at once: its acknowledgement."""
+    from fswkit.autocode.protocol import OP_MACHINE_COMMIT
+
+    _send(rig, data, crc, nmask)
     return rig.c._one(OP_MACHINE_COMMIT)
 
 
@@ -200,16 +208,8 @@ def _raw(rig, op: int, args: bytes = b"") -> dict:
 
 
 def _written(rig, data: bytes, crc: int, nmask: int = 1) -> None:
-    """BEGIN and every WRITE of `data`, and the EEPROM written: COMMIT next."""
-    from fswkit.autocode.protocol import OP_MACHINE_BEGIN, OP_MACHINE_WRITE
-    from fswkit.reload.client import CHUNK
-
-    ack = rig.c._one(OP_MACHINE_BEGIN, struct.pack("<HBH", len(data) - nmask, nmask, crc))
-    assert ack["status"] == 0, ack
-    for off in range(0, len(data), CHUNK):
-        ack = rig.c._one(OP_MACHINE_WRITE, struct.pack("<H", off) + data[off:off + CHUNK])
-        assert ack["status"] == 0, ack
-        rig.t.events(CHUNK * 0.0035)
+    """_send, and the EEPROM written: COMMIT next."""
+    _send(rig, data, crc, nmask)
     while rig.c.info().writing:
         rig.t.events(0.02)
 

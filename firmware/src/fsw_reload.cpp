@@ -210,6 +210,7 @@ Result reload_step(ReloadStore& s) {
             check_start(s, s.pending);
         if (s.ck_slot != 0) {
             check_slice(s, c);  // a slice a step: the switch at a later one
+            s.sliced = true;
         } else if (s.pending != kReloadNone && (s.pending == kReloadBuiltIn || s.ready == s.pending) &&
                    allowed(s, c)) {
             const uint8_t which = s.pending;
@@ -274,14 +275,19 @@ uint8_t reload_commit(ReloadStore& s, uint8_t& reason) {
     if (reload_writing(s)) return kReloadBusy;
     const uint16_t total = static_cast<uint16_t>(s.up_len + s.up_nmask);
     if (s.up_next < total) return kReloadNoLoad;
+    const ReloadConfig c = config(s);
     if (s.ck_result == kReloadNone) {  // the check: started, running, or after an activation's
-        if (s.ck_slot == 0) check_start(s, s.up_slot);
+        if (s.ck_slot == 0) {
+            check_start(s, s.up_slot);
+        } else if (!s.sliced && pal::eeprom_ready()) {  // no machine step carried it on since the last COMMIT
+            check_slice(s, c);
+        }
+        s.sliced = false;
         return kReloadBusy;
     }
     const uint8_t st = s.ck_result;
     s.ck_result = kReloadNone;
     if (st == kReloadMismatch) return kReloadMismatch;  // the upload stays open: WRITEs may mend it
-    const ReloadConfig c = config(s);
     const uint8_t to = s.up_slot;
     const uint16_t a = slot_addr(c, to);
     s.up_slot = 0;  // whatever follows, the upload is over

@@ -95,9 +95,11 @@ struct ReloadStore {
     uint8_t w_i;              // bytes of it written
     bool sync;                // the slots' status and seq bytes are to be brought up to date
     uint8_t queue[FSW_RELOAD_QUEUE];
-    // the check of a slot (its CRC, then the verifier), a slice a machine step:
-    // the open upload's (COMMIT), or the pending activation's
+    // the check of a slot (its CRC, then the verifier), a slice a machine step
+    // (and one a COMMIT when no step ran one since the last COMMIT): the open
+    // upload's (COMMIT), or the pending activation's
     uint8_t ck_slot;          // the slot being checked (0: none)
+    bool sliced;              // a machine step ran a slice since the last COMMIT
     uint8_t ck_result;        // the upload's check, over: kReloadOk, kReloadMismatch, kReloadBadImage (kReloadNone: none)
     uint8_t ck_reason;        // ... and the verifier's VmReason
     uint8_t ready;            // the slot of the pending activation whose check passed (0: none)
@@ -136,7 +138,10 @@ uint8_t reload_upload_begin(ReloadStore& s, uint16_t len, uint8_t nmask, uint16_
 uint8_t reload_write(ReloadStore& s, uint16_t off, const uint8_t* data, uint8_t n);
 // COMMIT: the first of a whole upload starts its check and answers BUSY, as
 // do those while it runs; the next one answers its result (and, when it
-// passed, queues the slot's header).
+// passed, queues the slot's header). A COMMIT runs a slice of the check
+// itself when no machine step did since the COMMIT before: the ground's
+// COMMITs carry the check on while the machine's task is disabled or safed
+// (or steps more slowly than the ground asks).
 uint8_t reload_commit(ReloadStore& s, uint8_t& reason);
 uint8_t reload_activate(ReloadStore& s, uint8_t which);
 // Whether the background writer has bytes to write.

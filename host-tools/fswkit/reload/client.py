@@ -1,8 +1,9 @@
 """The ground's machine client (docs/reload.md): uploads a bytecode image
 into the target's free slot, chunked and resumable over a lossy link, and
 verified twice on the target (the CRC BEGIN announced, then the board's own
-verifier at COMMIT, both run in slices at its machine task's steps: COMMIT
-answers BUSY until they are over); lists the slots; activates a slot or the generated
+verifier at COMMIT, both run in slices at its machine task's steps and at
+the COMMITs: COMMIT answers BUSY until they are over); lists the slots;
+activates a slot or the generated
 machine and waits until the target has switched, at the next step of its
 machine in a state the application allows.
 
@@ -152,8 +153,9 @@ class MachineClient:
         except ParamError as e:
             if self.stats.busy - busy < 10:
                 raise
-            raise MachineError(f"COMMIT: the target answered BUSY {self.stats.busy - busy} times ({e}): it checks "
-                               "the image at the steps of the machine's task; is that task disabled or safed?") \
+            raise MachineError(f"COMMIT: the target answered BUSY {self.stats.busy - busy} times ({e}): it was "
+                               "still checking the image (a slice at each step of the machine's task and at each "
+                               "COMMIT); `fsw machine list` shows the upload, and `upload` again commits it") \
                 from None
         if ack["status"] == NO_LOAD:  # an earlier copy was applied and its ack lost: the slot says
             after = self.info()

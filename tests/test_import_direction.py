@@ -74,51 +74,16 @@ def graph() -> dict[str, set[str]]:
 
 
 def cycles(g: dict[str, set[str]]) -> list[list[str]]:
-    """The strongly connected components of more than one module (Tarjan's
-    algorithm, iterative): each is a set of modules that import each
-    other, through some chain. Sorted, each sorted."""
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    on_stack: set[str] = set()
-    stack: list[str] = []
-    found: list[list[str]] = []
-    counter = 0
-    for root in sorted(g):
-        if root in index:
-            continue
-        work = [(root, iter(sorted(g.get(root, ()))))]
-        index[root] = low[root] = counter
-        counter += 1
-        stack.append(root)
-        on_stack.add(root)
-        while work:
-            node, children = work[-1]
-            child = next(children, None)
-            if child is not None:
-                if child not in index:
-                    index[child] = low[child] = counter
-                    counter += 1
-                    stack.append(child)
-                    on_stack.add(child)
-                    work.append((child, iter(sorted(g.get(child, ())))))
-                elif child in on_stack:
-                    low[node] = min(low[node], index[child])
-                continue
-            work.pop()
-            if work:
-                parent = work[-1][0]
-                low[parent] = min(low[parent], low[node])
-            if low[node] == index[node]:
-                component = []
-                while True:
-                    m = stack.pop()
-                    on_stack.discard(m)
-                    component.append(m)
-                    if m == node:
-                        break
-                if len(component) > 1:
-                    found.append(sorted(component))
-    return sorted(found)
+    """The strongly connected components of more than one module
+    (networkx's, as the code generator's window analysis uses): each is a
+    set of modules that import each other, through some chain. Sorted,
+    each sorted."""
+    import networkx as nx
+
+    dg = nx.DiGraph()
+    dg.add_nodes_from(g)
+    dg.add_edges_from((a, b) for a, bs in g.items() for b in bs)
+    return sorted(sorted(c) for c in nx.strongly_connected_components(dg) if len(c) > 1)
 
 
 def describe(component: list[str], g: dict[str, set[str]]) -> str:

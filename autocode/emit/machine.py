@@ -54,6 +54,8 @@ def window_needs(m: M.Machine) -> tuple[dict[int, int], dict[int, int]] | None:
     each state and a set of states for each window took 2.7 s."""
     if any(_rolls(w.arg) for w in m.windows):
         return None
+    if not m.windows:  # nothing to sample (and no graph to build)
+        return {st.index: 0 for st in m.states}, {}
     bit = {w.index: 1 << k for k, w in enumerate(m.windows)}
     reads: dict[int, int] = {}  # state -> the windows its blocks read
     succ: dict[int, list[int]] = {}

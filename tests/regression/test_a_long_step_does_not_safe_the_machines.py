@@ -17,30 +17,17 @@ import shutil
 
 import pytest
 
-from conftest import EXAMPLES
-from support.tools import tool
+from support.tools import rocket_with_reload
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
               pytest.mark.costly(12)]
 
 
-def _bench_reload():
-    return tool("bench_reload")
-
-
-def test_an_upload_over_a_lossy_9600_baud_link_activates_and_no_machine_is_safed(tmp_path, monkeypatch):
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.cli.machine import image_for
+def test_an_upload_over_a_lossy_9600_baud_link_activates_and_no_machine_is_safed(tmp_path):
     from fswkit.reload.sim import timed_upload
 
-    R = _bench_reload()
-    monkeypatch.setattr(R, "OUT", str(tmp_path))
-    app, built = R.built(R.rocket_variant("rocket-9600", 9600))
-    d = Diagnostics()
-    got = image_for(app, str(EXAMPLES / "rocket" / "mission.sm"), d)
-    assert got is not None, d.render()
-    image, mask, _m = got
+    app, built, image, mask = rocket_with_reload(str(tmp_path), 9600)
     # before the fix: MachineError "still waiting after 30 s", nav and mission safed with a fault each
     r = timed_upload(built.artifact, "mega2560", app, image, mask, loss=0.2, seed=1)
     assert r.slot in (1, 2) and r.activate_s < 5.0, r

@@ -19,7 +19,7 @@ import shutil
 import pytest
 
 from conftest import EXAMPLES
-from support.tools import tool
+from support.tools import rocket_with_reload
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
@@ -43,18 +43,10 @@ def _check(r, machine_task: str):
     assert 0 < r.longest_slice < SLICE_CYCLES and r.slices > 2, r
 
 
-def test_the_rocket_mission_machine_uploaded_and_activated_at_100_hz_on_a_mega2560(tmp_path, monkeypatch):
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.cli.machine import image_for
+def test_the_rocket_mission_machine_uploaded_and_activated_at_100_hz_on_a_mega2560(tmp_path):
     from fswkit.reload.sim import timed_upload
 
-    R = tool("bench_reload")
-    monkeypatch.setattr(R, "OUT", str(tmp_path))
-    app, built = R.built(R.rocket_variant("rocket-115200", 115200))
-    d = Diagnostics()
-    got = image_for(app, str(EXAMPLES / "rocket" / "mission.sm"), d)
-    assert got is not None, d.render()
-    image, mask, _m = got
+    app, built, image, mask = rocket_with_reload(str(tmp_path), 115200)
     assert len(image) + len(mask) == 646
     # before: 2 late cycles, an overrun each for the uplink task (the commit's
     # step: 11.4 ms) and the mission's (the activation's: 14.2 ms)

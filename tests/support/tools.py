@@ -15,3 +15,21 @@ def tool(name: str):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
+
+
+def rocket_with_reload(out: str, baud: int):
+    """examples/rocket with [reload] of its mission machine, as
+    tools/bench_reload.py builds it for a simulated ATmega2560 at `baud`
+    into `out`, and the mission machine's image: (the application, the
+    build, the image, its state mask)."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.cli.machine import image_for
+
+    R = tool("bench_reload")
+    R.OUT = out
+    app, built = R.built(R.rocket_variant(f"rocket-{baud}", baud))
+    d = Diagnostics()
+    got = image_for(app, str(TOOLS.parent / "examples" / "rocket" / "mission.sm"), d)
+    assert got is not None, d.render()
+    image, mask, _m = got
+    return app, built, image, mask

@@ -71,16 +71,6 @@ def window_needs(m: M.Machine) -> tuple[dict[int, int], dict[int, int]] | None:
     return still_read(succ, reads), bit
 
 
-def window_states(m: M.Machine) -> dict[int, frozenset[int]] | None:
-    """window_needs by window: the states whose step samples it (None: all
-    of them sample every window)."""
-    needs = window_needs(m)
-    if needs is None:
-        return None
-    need, bit = needs
-    return {w: frozenset(s for s, mask in need.items() if mask & b) for w, b in bit.items()}
-
-
 def still_read(succ: dict[int, list[int]], reads: dict[int, int]) -> dict[int, int]:
     """For each node of the graph `succ` (node -> its successors), the
     union of `reads` (node -> a bit set) over the nodes reachable from it,

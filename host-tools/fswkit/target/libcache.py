@@ -42,9 +42,8 @@ _MAKE_SAFE = re.compile(r"^[A-Za-z0-9_./+-]+$")  # a path make takes as a prereq
 _libc: dict[tuple, str] = {}
 
 
-def _tree_hash(h, folder: str, names=None) -> None:
-    """Every file of `folder` (not its subfolders; `names` only, when
-    given), by name and content."""
+def _tree_hash(h, folder: str) -> None:
+    """Every file of `folder` (not its subfolders), by name and content."""
     try:
         listed = sorted(os.listdir(folder))
     except OSError:
@@ -52,7 +51,7 @@ def _tree_hash(h, folder: str, names=None) -> None:
         return
     for name in listed:
         path = os.path.join(folder, name)
-        if (names is not None and name not in names) or not os.path.isfile(path):
+        if not os.path.isfile(path):
             continue
         with open(path, "rb") as f:
             h.update(name.encode() + b"\0" + f.read() + b"\0")
@@ -91,8 +90,8 @@ def avr_key(mcu: str, f_cpu: int, variant: str, define: str, arduino: str) -> st
     return h.hexdigest()[:20]
 
 
-def _entry_ready(entry: str, names) -> bool:
-    return all(os.path.isfile(os.path.join(entry, n)) for n in names)
+def _entry_ready(entry: str) -> bool:
+    return all(os.path.isfile(os.path.join(entry, n)) for n in ARCHIVES)
 
 
 UNUSED_S = 30 * 24 * 3600.0  # an entry no build used for this long is removed (another runtime, board, tools)
@@ -123,7 +122,7 @@ def avr_archives(mcu: str, f_cpu: int, variant: str, define: str, arduino: str, 
         key = avr_key(mcu, f_cpu, variant, define, arduino)
         cache = os.path.join(cache_root(), "avr")
         entry = os.path.join(cache, key)
-        if _entry_ready(entry, ARCHIVES):
+        if _entry_ready(entry):
             with contextlib.suppress(OSError):
                 os.utime(entry)  # used: kept by _prune
             return entry, key
@@ -133,7 +132,7 @@ def avr_archives(mcu: str, f_cpu: int, variant: str, define: str, arduino: str, 
         fd = os.open(entry + ".lock", os.O_RDWR | os.O_CREAT, 0o644)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)
-            if _entry_ready(entry, ARCHIVES):
+            if _entry_ready(entry):
                 return entry, key
             return _compile_entry(cache, entry, key, mcu, f_cpu, variant, define, arduino, jobs)
         finally:
@@ -169,10 +168,10 @@ def _compile_entry(cache: str, entry: str, key: str, mcu: str, f_cpu: int, varia
             os.replace(tmp, entry)
         except OSError:  # another build compiled the same entry first
             pass
-    return (entry, key) if _entry_ready(entry, ARCHIVES) else None
+    return (entry, key) if _entry_ready(entry) else None
 
 
-def native_objects(jobs: int) -> tuple[str, str] | None:
+def native_objects() -> tuple[str, str] | None:
     """(the cache folder of the runtime's objects for a native build, its
     key): `fsw test --native`'s, compiled with the same compiler and
     flags (binary64, as a native build evaluates); None when the cache
@@ -229,7 +228,7 @@ def make_vars(out: str, avr: dict | None, jobs: int) -> list[str]:
     if avr is not None:
         got = avr_archives(avr["MCU"], avr["F_CPU"], avr["VARIANT"], avr["BOARD_DEFINE"], avr["ARDUINO"], jobs)
     else:
-        got = native_objects(jobs)
+        got = native_objects()
     if got is None:
         return []
     folder = link_into(out, *got)

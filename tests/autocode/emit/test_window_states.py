@@ -1,4 +1,4 @@
-"""Which states sample a window (autocode/emit/machine.py window_needs and window_states,
+"""Which states sample a window (autocode/emit/machine.py window_needs,
 docs/codegen.md): those from which a state that reads it can still be
 reached. Worked out per strongly connected component of the transition
 graph, in linear time (`still_read`): the same sets as a reachability
@@ -12,7 +12,7 @@ import random
 import time
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit.machine import still_read, window_states
+from fswkit.autocode.emit.machine import still_read, window_needs
 from fswkit.autocode.project import load_machine
 
 
@@ -49,6 +49,15 @@ def test_a_long_chain_needs_no_recursion():
     reads = {i: 0 for i in range(n)}
     reads[n - 1] = 1
     assert set(still_read(succ, reads).values()) == {1}
+
+
+def window_states(m) -> dict[int, frozenset[int]] | None:
+    """window_needs by window: the states whose step samples it."""
+    needs = window_needs(m)
+    if needs is None:
+        return None
+    need, bit = needs
+    return {w: frozenset(s for s, mask in need.items() if mask & b) for w, b in bit.items()}
 
 
 def _ring(tmp_path, states: int):

@@ -113,7 +113,16 @@ def fly_run(setup: Setup, index: int) -> RunResult:
 _setup: Setup | None = None  # the workers' copy (inherited at fork)
 
 
+TERM_GRACE_S = 10  # a worker told to stop is gone by then, however its SystemExit fares
+
+
 def _on_term(signum, _frame):
+    # The pool stops its workers with one SIGTERM and waits for them without
+    # a limit. Where Python only prints an exception (an at-fork hook, a
+    # __del__) the SystemExit is lost, so the alarm's default action ends
+    # the worker anyway; its board sees its pipe close and stops.
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.alarm(TERM_GRACE_S)
     raise SystemExit(128 + signum)  # unwinds: the run's board is closed on the way out
 
 

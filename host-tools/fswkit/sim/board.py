@@ -24,7 +24,6 @@ import io
 import os
 import re
 import shutil
-import signal
 import struct
 import subprocess
 import tempfile
@@ -409,7 +408,7 @@ class SimBoard:
         self._err = tempfile.TemporaryFile()
         try:
             self._proc = subprocess.Popen(args + [elf], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                          stderr=self._err, bufsize=0, preexec_fn=_ignore_sigint)
+                                          stderr=self._err, bufsize=0, process_group=0)
         except OSError as e:
             self._err.close()
             raise SimError(f"cannot start the simulated board: {e.strerror or e}") from None
@@ -1009,7 +1008,3 @@ def _part_id(where: int | str) -> str:
     raise ValueError(f"a part is at an I2C address (0x76) or an SPI chip-select pin (\"B1\"), not {where!r}")
 
 
-def _ignore_sigint() -> None:
-    """The harness of a SimBoard ignores the terminal's Ctrl-C: its Python
-    owner decides (`go` asks it to stop)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)

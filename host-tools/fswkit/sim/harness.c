@@ -2662,7 +2662,8 @@ int main(int argc, char** argv) {
     sa.sa_handler = on_sigint;
     struct sigaction old;
     /* SIGINT ends a run (no SA_RESTART: a blocked poll returns), unless the
-       caller made the board ignore it, as fswkit.sim.board.SimBoard does: there
+       caller made the board ignore it. fswkit.sim.board.SimBoard starts the
+       board in a process group of its own, out of the terminal's Ctrl-C: there
        the board's owner decides, and stops a `go` with a `stop` command. */
     if (sigaction(SIGINT, NULL, &old) == 0 && old.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
     wall_start = wall_now();

@@ -4,7 +4,7 @@ project links the archives (native: the runtime's objects) the first one's
 build compiled into the cache, and its firmware is byte for byte the one a
 build compiling everything itself makes; another runtime, board or
 makefile is another entry and relinks the firmware; a cache that cannot be
-written leaves the build as it was."""
+written leaves the build as it was; FSW_NO_LIB_CACHE=1 leaves it alone."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from conftest import EXAMPLES
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None
                                  or not os.path.isdir("/usr/share/arduino/hardware/arduino/avr/cores/arduino"),
                                  reason="gcc-avr or the Arduino core not installed (make setup)"),
-              pytest.mark.costly(12)]
+              pytest.mark.costly(10)]
 
 TANK, ROCKET = EXAMPLES / "tank", EXAMPLES / "rocket"
 
@@ -39,17 +39,19 @@ def _compiles(log: Path) -> list[str]:
 
 @pytest.fixture(scope="module")
 def first(tmp_path_factory):
-    """A cache of this file's own, and the Uno's entry the first build into
-    it compiled (the tank's): (the cache, the tank's build folder)."""
-    from conftest import run_fsw
-
+    """A cache of this file's own, filled by two first builds at once (the
+    tank's and the rocket's, two `fsw build` processes) into it while empty:
+    (the cache, the tank's build folder, the rocket's)."""
     root = tmp_path_factory.mktemp("libcache")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("FSW_CACHE_DIR", str(root / "cache"))
-        mp.delenv("FSW_NO_LIB_CACHE", raising=False)
-        r = run_fsw("build", str(TANK), "--out", str(root / "tank"))
-    assert r.code == 0, r.err
-    return root / "cache", root / "tank"
+    fsw_exe = os.path.join(os.path.dirname(sys.executable), "fsw")
+    env = dict(os.environ, FSW_CACHE_DIR=str(root / "cache"))
+    env.pop("FSW_NO_LIB_CACHE", None)
+    procs = [subprocess.Popen([fsw_exe, "build", str(p), "--out", str(root / p.name)], env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for p in (TANK, ROCKET)]
+    for p in procs:
+        out, err = p.communicate(timeout=600)
+        assert p.returncode == 0, out + err
+    return root / "cache", root / "tank", root / "rocket"
 
 
 @pytest.fixture
@@ -60,32 +62,31 @@ def cache(first, monkeypatch):
     return first[0]
 
 
-@pytest.fixture
-def empty_cache(tmp_path, monkeypatch):
-    folder = tmp_path / "cache"
-    monkeypatch.setenv("FSW_CACHE_DIR", str(folder))
-    monkeypatch.delenv("FSW_NO_LIB_CACHE", raising=False)
-    return folder
-
-
-def test_a_second_project_links_the_archives_the_first_compiled(fsw, first, cache, tmp_path, monkeypatch):
-    entries = _entries(cache)
-    entry = cache / "avr" / (first[1] / "fsw-libs" / ".key").read_text()  # the Uno's, the tank compiled
-    assert _compiles(first[1] / "build.log") == [] and entry in entries
+def test_concurrent_first_builds_share_one_entry(first):
+    """Both first builds link the one entry for the Uno, which one of them
+    compiled (its log shows the compile) while the other waited for it:
+    neither build's own log compiles the runtime or the core."""
+    cache, tank, rocket = first
+    key = (tank / "fsw-libs" / ".key").read_text()
+    assert [p.name for p in _entries(cache)] == [key]
+    assert (rocket / "fsw-libs" / ".key").read_text() == key
+    entry = cache / "avr" / key
     assert {p.name for p in entry.iterdir()} == {"core.a", "libfswkit.a", "build.log"}
     assert _compiles(entry / "build.log"), "the entry's log shows its compile"
+    for folder in (tank, rocket):
+        log = (folder / "build.log").read_text()
+        assert _compiles(folder / "build.log") == [], f"{folder.name}: the runtime or the core compiled again"
+        assert "fsw-libs/libfswkit.a fsw-libs/core.a" in log
+        assert (folder / "fsw-libs" / "build.log").read_text() == (entry / "build.log").read_text()
+
+
+def test_a_later_build_links_the_archives(fsw, first, cache, tmp_path):
+    entries = _entries(cache)
     r = fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket"))
     assert r.code == 0, r.err
-    log = tmp_path / "rocket" / "build.log"
-    assert _compiles(log) == [], "the runtime or the core compiled again"
-    assert "fsw-libs/libfswkit.a fsw-libs/core.a" in log.read_text()
-    assert (tmp_path / "rocket" / "fsw-libs" / "build.log").read_text() == (entry / "build.log").read_text()
+    assert _compiles(tmp_path / "rocket" / "build.log") == [], "the runtime or the core compiled again"
     assert _entries(cache) == entries
-    # the same firmware as a build that compiles everything in its folder
-    monkeypatch.setenv("FSW_NO_LIB_CACHE", "1")
-    assert fsw("build", str(ROCKET), "--out", str(tmp_path / "rocket-alone")).code == 0
-    assert _compiles(tmp_path / "rocket-alone" / "build.log")
-    assert (tmp_path / "rocket" / "rocket.hex").read_bytes() == (tmp_path / "rocket-alone" / "rocket.hex").read_bytes()
+    assert (tmp_path / "rocket" / "rocket.hex").read_bytes() == (first[2] / "rocket.hex").read_bytes()
 
 
 def test_another_board_is_another_entry(fsw, cache, tmp_path):
@@ -146,18 +147,39 @@ def test_the_key_follows_the_runtime_and_the_makefile(cache, tmp_path, monkeypat
     assert libcache.avr_key("atmega2560", 16000000, "mega", "ARDUINO_AVR_MEGA2560", args[-1]) != key
 
 
-def test_a_cache_that_cannot_be_written_leaves_the_build_as_it_was(fsw, tmp_path, monkeypatch):
+def _blocked(tmp_path, monkeypatch) -> None:
+    """A cache folder that cannot be made: a file is in its place."""
     blocked = tmp_path / "not-a-folder"
     blocked.write_text("")
     monkeypatch.setenv("FSW_CACHE_DIR", str(blocked))
     monkeypatch.delenv("FSW_NO_LIB_CACHE", raising=False)
-    for board in ("uno", "native"):
-        out = tmp_path / board
-        r = fsw("build", str(TANK), "--board", board, "--out", str(out))
-        assert r.code == 0, r.err
-        assert not (out / "fsw-libs").exists()
-        assert "LIBS=" not in (out / "build.log").read_text().splitlines()[0]
-        assert "NATIVE_RT=" not in (out / "build.log").read_text().splitlines()[0]
+
+
+def test_a_cache_that_cannot_be_written_leaves_the_build_as_it_was(fsw, first, tmp_path, monkeypatch):
+    """The build compiles the core and the runtime in its own folder, and
+    its firmware is byte for byte the one linked from the cache's archives."""
+    _blocked(tmp_path, monkeypatch)
+    out = tmp_path / "uno"
+    r = fsw("build", str(TANK), "--out", str(out))
+    assert r.code == 0, r.err
+    assert not (out / "fsw-libs").exists()
+    assert "LIBS=" not in (out / "build.log").read_text().splitlines()[0]
+    assert _compiles(out / "build.log")
+    assert (out / "tank.hex").read_bytes() == (first[1] / "tank.hex").read_bytes()
+
+
+def test_no_lib_cache_builds_without_the_cache(monkeypatch, tmp_path):
+    """FSW_NO_LIB_CACHE=1: no make variables for the cache, and the cache
+    is not even looked at (its folder stays unmade)."""
+    from fswkit.target import libcache
+
+    monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("FSW_NO_LIB_CACHE", "1")
+    avr = {"MCU": "atmega328p", "F_CPU": 16000000, "VARIANT": "standard", "BOARD_DEFINE": "ARDUINO_AVR_UNO",
+           "ARDUINO": "/usr/share/arduino/hardware/arduino/avr"}
+    assert libcache.make_vars(str(tmp_path / "out"), avr, 1) == []
+    assert libcache.make_vars(str(tmp_path / "out"), None, 1) == []
+    assert not (tmp_path / "cache").exists()
 
 
 @pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
@@ -170,28 +192,17 @@ def test_a_native_build_links_the_runtimes_objects(fsw, tmp_path, monkeypatch):
     log = (out / "build.log").read_text()
     assert "NATIVE_RT=fsw-libs" in log and "fsw-libs/fsw_machine.o" in log
     assert not any(" -c " in line or "firmware/src/fsw_machine.cpp" in line for line in log.splitlines()[1:])
-    monkeypatch.setenv("FSW_NO_LIB_CACHE", "1")
+    # with a cache it cannot write, the build compiles the runtime itself
+    _blocked(tmp_path, monkeypatch)
     alone = tmp_path / "alone"
     assert fsw("build", str(TANK), "--board", "native", "--out", str(alone)).code == 0
-    assert "firmware/src/fsw_machine.cpp" in (alone / "build.log").read_text()
+    assert not (alone / "fsw-libs").exists()
+    log = (alone / "build.log").read_text()
+    assert "NATIVE_RT=" not in log.splitlines()[0] and "firmware/src/fsw_machine.cpp" in log
     # both run the tank the same: 500 cycles, the state vector in hex
     runs = [subprocess.run([str(folder / "tank"), "500"], capture_output=True, text=True, timeout=60)
             for folder in (out, alone)]
     assert runs[0].returncode == 0 and runs[0].stdout and runs[0].stdout == runs[1].stdout, runs
-
-
-def test_concurrent_first_builds_share_one_entry(empty_cache, tmp_path):
-    cache = empty_cache
-    fsw_exe = os.path.join(os.path.dirname(sys.executable), "fsw")
-    env = dict(os.environ, FSW_CACHE_DIR=str(cache))
-    env.pop("FSW_NO_LIB_CACHE", None)
-    procs = [subprocess.Popen([fsw_exe, "build", str(p), "--out", str(tmp_path / p.name)], env=env,
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for p in (TANK, ROCKET)]
-    for p in procs:
-        out, err = p.communicate(timeout=600)
-        assert p.returncode == 0, out + err
-    assert [p.name for p in _entries(cache)] == [(tmp_path / "tank" / "fsw-libs" / ".key").read_text()]
-    assert (tmp_path / "rocket" / "fsw-libs" / ".key").read_text() == (tmp_path / "tank" / "fsw-libs" / ".key").read_text()
 
 
 def test_entries_no_build_used_for_30_days_are_removed(tmp_path):

@@ -19,6 +19,7 @@ import time
 import pytest
 
 from conftest import EXAMPLES
+from support.caches import seeded
 
 SCRIPT = str(EXAMPLES / "tank" / "tank.ss")
 needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
@@ -73,7 +74,7 @@ def test_an_interrupted_compile_leaves_no_temporary_folder(tmp_path, sig, kind):
 def test_a_failed_compile_leaves_no_temporary_folder(fsw, tmp_path, monkeypatch):
     from fswkit.run import native
 
-    monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("FSW_CACHE_DIR", seeded(tmp_path))
     real = native.script_files
 
     def script_files(*a):  # generated code the compiler refuses
@@ -93,7 +94,7 @@ def test_a_failed_compile_leaves_no_temporary_folder(fsw, tmp_path, monkeypatch)
 
 @needs_cxx
 def test_the_folders_of_dead_compiles_are_swept_and_live_ones_kept(fsw, tmp_path, monkeypatch):
-    monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv("FSW_CACHE_DIR", seeded(tmp_path))
     gone = subprocess.Popen(["true"])
     gone.wait()
     live = subprocess.Popen(["sleep", "60"])

@@ -171,7 +171,14 @@ def test_yanked_cable_keeps_the_log(exe, tmp_path):
 
     with PtyTarget(exe, f"a14={RAW}") as t:
         time.sleep(0.3)
-        threading.Timer(0.8, t.stop).start()  # the board goes away mid-run
+
+        def yank():  # the board goes away mid-run: 0.8 s after the monitor knew it and named its log
+            deadline = time.monotonic() + 3.0  # (however long a loaded machine takes to get there)
+            while not log.exists() and time.monotonic() < deadline:
+                time.sleep(0.01)
+            time.sleep(0.8)
+            t.stop()
+        threading.Thread(target=yank, daemon=True).start()
         r = run_fsw("monitor", str(TANK), "--port", t.port, "--headless", "--duration", "5", "--log", str(log))
     assert r.code == 1 and "the port went away" in r.err and "Traceback" not in r.err
     printed = [ln for ln in r.out.splitlines() if " sample " in ln]

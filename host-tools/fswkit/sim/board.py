@@ -1006,5 +1006,3 @@ def _part_id(where: int | str) -> str:
     if isinstance(where, str) and re.fullmatch(r"[A-L][0-7]", where):
         return where
     raise ValueError(f"a part is at an I2C address (0x76) or an SPI chip-select pin (\"B1\"), not {where!r}")
-
-

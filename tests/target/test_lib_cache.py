@@ -41,7 +41,8 @@ def _compiles(log: Path) -> list[str]:
 def first(tmp_path_factory):
     """A cache of this file's own, filled by two first builds at once (the
     tank's and the rocket's, two `fsw build` processes) into it while empty:
-    (the cache, the tank's build folder, the rocket's)."""
+    (the cache, the tank's build folder, the rocket's, the cache's entries
+    right after them: later tests add others)."""
     root = tmp_path_factory.mktemp("libcache")
     fsw_exe = os.path.join(os.path.dirname(sys.executable), "fsw")
     env = dict(os.environ, FSW_CACHE_DIR=str(root / "cache"))
@@ -51,7 +52,7 @@ def first(tmp_path_factory):
     for p in procs:
         out, err = p.communicate(timeout=600)
         assert p.returncode == 0, out + err
-    return root / "cache", root / "tank", root / "rocket"
+    return root / "cache", root / "tank", root / "rocket", _entries(root / "cache")
 
 
 @pytest.fixture
@@ -66,9 +67,9 @@ def test_concurrent_first_builds_share_one_entry(first):
     """Both first builds link the one entry for the Uno, which one of them
     compiled (its log shows the compile) while the other waited for it:
     neither build's own log compiles the runtime or the core."""
-    cache, tank, rocket = first
+    cache, tank, rocket, entries = first
     key = (tank / "fsw-libs" / ".key").read_text()
-    assert [p.name for p in _entries(cache)] == [key]
+    assert [p.name for p in entries] == [key]
     assert (rocket / "fsw-libs" / ".key").read_text() == key
     entry = cache / "avr" / key
     assert {p.name for p in entry.iterdir()} == {"core.a", "libfswkit.a", "build.log"}

@@ -1,5 +1,5 @@
-"""Ctrl-C during a dispersion study hung `fsw sim --runs` for good, once in
-a few hundred runs: the pool ends its workers with one SIGTERM and waits
+"""Ctrl-C during a dispersion study hung `fsw sim --runs` for good, rarely
+(once in CI): the pool ends its workers with one SIGTERM and waits
 for them without a time limit, and a worker's SIGTERM handler raises
 SystemExit. A SIGTERM that lands where Python only prints an exception
 ("Exception ignored in: ...": an at-fork hook, a __del__) left the worker

@@ -301,20 +301,18 @@ def make_args(app: Application, out: str, jobs: int = 2, cached: bool = False) -
         board = {"MCU": b.mcu, "F_CPU": b.f_cpu, "VARIANT": ard.get("variant", "standard"),
                  "BOARD_DEFINE": ard.get("board_define", "ARDUINO_AVR_UNO")}
         args += ["avr"] + [f"{k}={v}" for k, v in board.items()]
-        if cached:
-            from fswkit.target.libcache import make_vars
-
-            args += make_vars(out, dict(board, ARDUINO=ARDUINO), jobs)
+        avr = dict(board, ARDUINO=ARDUINO)
         artifact = os.path.join(out, name + ".elf")
     else:
         if shutil.which("g++") is None or shutil.which("make") is None:
             raise BuildError("`g++` and `make` are needed for native builds: run `make setup`")
         args += ["native"]
-        if cached:
-            from fswkit.target.libcache import make_vars
-
-            args += make_vars(out, None, jobs)
+        avr = None
         artifact = os.path.join(out, name)
+    if cached:
+        from fswkit.target.libcache import make_vars
+
+        args += make_vars(out, avr, jobs)
     return artifact, args
 
 

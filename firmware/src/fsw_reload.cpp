@@ -20,11 +20,13 @@ uint16_t slot_addr(const ReloadConfig& c, uint8_t which) {  // which: 1 or 2
     return static_cast<uint16_t>(c.eeprom_base + (which - 1u) * (kReloadHeader + c.size));
 }
 
-uint16_t payload_crc(uint16_t addr, uint16_t n) {
-    uint16_t crc = kCrcInit;
+// The CRC `crc` carried on over `n` EEPROM bytes from `addr`.
+uint16_t eeprom_crc(uint16_t crc, uint16_t addr, uint16_t n) {
     for (uint16_t i = 0; i < n; ++i) crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(addr + i)));
     return crc;
 }
+
+uint16_t payload_crc(uint16_t addr, uint16_t n) { return eeprom_crc(kCrcInit, addr, n); }
 
 // Reads slot `which`'s header and checks its payload's CRC: false when the
 // slot holds nothing whole.
@@ -147,9 +149,8 @@ FSW_NOINLINE void check_slice(ReloadStore& s, const ReloadConfig& c) {
     if (s.ck_at < total) {
         const uint16_t end =
             total - s.ck_at > FSW_RELOAD_SLICE ? static_cast<uint16_t>(s.ck_at + FSW_RELOAD_SLICE) : total;
-        uint16_t crc = s.ck_crc;
-        for (uint16_t i = s.ck_at; i < end; ++i)
-            crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(a + i)));
+        const uint16_t crc =
+            eeprom_crc(s.ck_crc, static_cast<uint16_t>(a + s.ck_at), static_cast<uint16_t>(end - s.ck_at));
         s.ck_crc = crc;
         s.ck_at = end;
         if (end < total || crc == (upload ? s.up_crc : sl.crc)) return;  // (the verifier from the next slice)

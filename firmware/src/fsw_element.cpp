@@ -50,6 +50,95 @@ void write_F32(uint8_t* p, Real r) {
 }
 #endif
 
+void elem_widen(const uint8_t* p, uint8_t type, uint8_t* b) {
+    const uint8_t n = elem_size(type);
+    const uint8_t fill = type < kU8 && (p[n - 1u] & 0x80u) != 0 ? 0xFF : 0x00;
+    for (uint8_t i = 0; i < 8; ++i) b[i] = i < n ? p[i] : fill;
+}
+
+#if FSW_REAL_IS_FLOAT
+// Where R is binary32, every integer type goes through one path on the
+// bits (the typed conversions of fsw_convert.h, exactly): a read widens the
+// value to 64 bits and rounds its magnitude once, a write builds the
+// truncated magnitude from the float's fields and clamps by its exponent.
+// A third of the code the eleven typed cases inlined (the bytecode VM's
+// flash, tools/bench_vm.py), and no float arithmetic routine.
+
+namespace {
+
+// Two's complement negation of the 8 bytes at b, a byte at a time (no
+// 64-bit arithmetic inlined on an 8-bit MCU).
+FSW_NOINLINE void negate8(uint8_t* b) {
+    uint8_t carry = 1;
+    for (uint8_t i = 0; i < 8; ++i) {
+        const uint8_t x = static_cast<uint8_t>(static_cast<uint8_t>(~b[i]) + carry);
+        if (x != 0) carry = 0;
+        b[i] = x;
+    }
+}
+
+}  // namespace
+
+Real read_elem(const uint8_t* p, uint8_t type) {
+    if (type <= kU64) {
+        uint8_t b[8];
+        elem_widen(p, type, b);
+        const bool neg = type < kU8 && (b[7] & 0x80u) != 0;
+        if (neg) negate8(b);
+        uint64_t v;
+        memcpy(&v, b, sizeof v);
+        const Real r = real_from_U64(v);
+        return neg ? -r : r;
+    }
+    switch (type) {
+        case kF32: return read_F32(p);
+        case kF64: return read_F64(p);
+        case kBool: return read_bool(p);
+        default: return 0;
+    }
+}
+
+void write_elem(uint8_t* p, uint8_t type, Real r) {
+    if (type > kU64) {
+        switch (type) {
+            case kF32: write_F32(p, r); break;
+            case kF64: write_F64(p, r); break;
+            case kBool: write_bool(p, r); break;
+            default: break;
+        }
+        return;
+    }
+    uint32_t u;
+    memcpy(&u, &r, sizeof u);
+    const uint8_t n = elem_size(type);
+    const bool sign = type < kU8;
+    const bool neg = (u >> 31) != 0;
+    const uint8_t e = static_cast<uint8_t>(u >> 23);
+    uint8_t b[12] = {0};  // (4 spare: the shifted copy below) NaN, below 1 in magnitude, a negative into an unsigned type: 0
+    if ((u & 0x7FFFFFFFUL) <= 0x7F800000UL && e >= 127 && (sign || !neg)) {
+        // |r| = 1.f x 2^s: saturated at 2^bits (2^(bits-1) signed), which a
+        // saturating assignment clamps to, else truncated toward zero.
+        const uint8_t bits = static_cast<uint8_t>(8u * n - (sign ? 1u : 0u));
+        const uint8_t s = static_cast<uint8_t>(e - 127u);
+        if (s >= bits) {  // the type's max (min when negative), which needs no negation
+            memset(b, neg ? 0x00 : 0xFF, n);
+            if (sign) b[n - 1u] = neg ? 0x80 : 0x7F;
+        } else {
+            uint32_t m = (u & 0x7FFFFFUL) | 0x800000UL;  // 24 bits
+            uint8_t at = 0;
+            if (s <= 23) {
+                m >>= 23u - s;
+            } else {  // shifted left by s - 23 (1..40): by bytes, then bits
+                at = static_cast<uint8_t>((s - 23u) / 8u);
+                m <<= (s - 23u) % 8u;
+            }
+            memcpy(b + at, &m, 4);
+            if (neg) negate8(b);
+        }
+    }
+    memcpy(p, b, n);  // the low bytes (little-endian)
+}
+#else
 Real read_elem(const uint8_t* p, uint8_t type) {
     switch (type) {
         case kI8: return read_I8(p);
@@ -83,5 +172,6 @@ void write_elem(uint8_t* p, uint8_t type, Real r) {
         default: break;
     }
 }
+#endif
 
 }  // namespace fsw

@@ -74,6 +74,9 @@ inline void write_bool(uint8_t* p, Real r) { store_bool(p, bool_from_real(r)); }
 
 // Run-time dispatch on an ElemType (for tables: I/O channels, uplink).
 // Generated step code calls the typed functions above instead.
+// The integer element at p (type <= kU64) widened to 8 little-endian bytes
+// at b: sign-extended for a signed type, zero-extended for an unsigned one.
+void elem_widen(const uint8_t* p, uint8_t type, uint8_t* b);
 Real read_elem(const uint8_t* p, uint8_t type);
 void write_elem(uint8_t* p, uint8_t type, Real r);
 

@@ -65,22 +65,23 @@ inline uint32_t u32(const uint8_t* p) {
 }
 
 template <class Im>
-inline uint16_t r16(const Im& im, uint32_t i) { return static_cast<uint16_t>(im[i] | (im[i + 1u] << 8)); }
+inline uint16_t r16(const Im& im, uint16_t i) { return static_cast<uint16_t>(im[i] | (im[i + 1u] << 8)); }
 template <class Im>
-inline uint32_t r32(const Im& im, uint32_t i) {
-    return static_cast<uint32_t>(r16(im, i)) | (static_cast<uint32_t>(r16(im, i + 2u)) << 16);
+inline uint32_t r32(const Im& im, uint16_t i) {
+    return static_cast<uint32_t>(r16(im, i)) | (static_cast<uint32_t>(r16(im, static_cast<uint16_t>(i + 2u))) << 16);
 }
 
-// Where the parts of an image start, as offsets into it (valid once the
-// header was checked).
+// Where the parts of an image start, as offsets into it: 16 bits, valid
+// once the header was checked (the image's `total` bytes, which the header
+// check compares with its length, at most 65535: every part lies within).
+// The index arithmetic of the pass stays 16-bit, which on an 8-bit MCU is
+// half the code of 32-bit sums.
 struct Offs {
     uint8_t states, windows;
     uint16_t locals, loc_size, prelude, code_size;
-    uint32_t st;     // states: entry, step, exit code offsets (u16 each)
-    uint32_t loc;    // locals: type (u8), offset (u16)
-    uint32_t win;    // windows: function (u8), 0 (u8), N (u16)
-    uint32_t init;   // the locals' initial bytes
-    uint32_t code;
+    uint16_t loc;    // locals: type (u8), offset (u16); the states' entry, step, exit offsets are at kHeader
+    uint16_t win;    // windows: function (u8), 0 (u8), N (u16)
+    uint16_t code;   // the locals' initial bytes end here
     uint32_t total;  // bytes the header says the image has
 };
 
@@ -92,12 +93,12 @@ void offsets(const Im& im, Offs& o) {
     o.loc_size = r16(im, 22);
     o.prelude = r16(im, 24);
     o.code_size = r16(im, 26);
-    o.st = kHeader;
-    o.loc = o.st + 6u * o.states;
-    o.win = o.loc + 3u * o.locals;
-    o.init = o.win + 4u * o.windows;
-    o.code = o.init + o.loc_size;
-    o.total = o.code + o.code_size;
+    const uint32_t loc = kHeader + 6u * o.states, win = loc + 3u * static_cast<uint32_t>(o.locals),
+                   code = win + 4u * o.windows + o.loc_size;
+    o.loc = static_cast<uint16_t>(loc);
+    o.win = static_cast<uint16_t>(win);
+    o.code = static_cast<uint16_t>(code);
+    o.total = code + o.code_size;
 }
 
 // The same, as pointers into an image in RAM (the step's view).
@@ -154,7 +155,10 @@ uint32_t window_size(uint8_t func, uint32_t n) {
 template <class Im>
 uint32_t windows_size(const Im& im, const Offs& o) {
     uint32_t size = 0;
-    for (uint8_t w = 0; w < o.windows; ++w) size += window_size(im[o.win + 4u * w], r16(im, o.win + 4u * w + 2u));
+    for (uint8_t w = 0; w < o.windows; ++w) {
+        const uint16_t at = static_cast<uint16_t>(o.win + 4u * w);
+        size += window_size(im[at], r16(im, static_cast<uint16_t>(at + 2u)));
+    }
     return size;
 }
 uint32_t windows_size(const Parts& p) {
@@ -179,8 +183,6 @@ uint8_t operand_bytes(uint8_t op, uint8_t real) {
     }
 }
 
-const uint32_t kNoJump = 0xFFFFFFFFUL;  // an instruction that does not jump
-
 // Bytes of a typed instruction's operands after its variable of type `t`
 // (kTypeT: T): a test's flags or comparison, its constant and its jump
 // offset; kSetK's value; kIAdd's source and constant.
@@ -202,7 +204,7 @@ VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t 
         t = kTypeT;
     } else if (ref >= kRefLocal) {
         if (ref - kRefLocal >= p.locals) return kVmBadLocal;
-        t = im[p.loc + 3u * (ref - kRefLocal)];
+        t = im[static_cast<uint16_t>(p.loc + 3u * (ref - kRefLocal))];
     } else {
         if (ref >= layout.count || lock) return kVmBadElement;
         t = flash_get(layout.elems[ref].type);
@@ -279,11 +281,11 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
     const uint8_t real = im[5];
     const uint8_t op = im[p.code + pc];
     const uint8_t n = operand_bytes(op, real);
-    if (n == 0xFF || static_cast<uint32_t>(pc) + 1u + n > p.code_size) return kVmBadOpcode;
-    const uint32_t a = p.code + pc + 1u;  // the operands
+    if (n == 0xFF || n >= p.code_size - pc) return kVmBadOpcode;  // (pc < code_size)
+    const uint16_t a = static_cast<uint16_t>(p.code + pc + 1u);  // the operands
     pc = static_cast<uint16_t>(pc + 1u + n);
     uint8_t pops = 0, pushes = 0, jump_depth = 0;
-    uint32_t jump_to = kNoJump;
+    uint16_t jump_at = 0;  // a jump's offset operand (0: the instruction does not jump)
     bool ends = false;
     const bool prelude = (c.flags & kPrelude) != 0;
     switch (op) {
@@ -296,7 +298,7 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
         case kJmp: case kJf: case kAnd: case kOr: {
             pops = op == kJmp ? 0 : 1;
             if (depth < pops) return kVmBadStack;
-            jump_to = static_cast<uint32_t>(pc) + r16(im, a);
+            jump_at = a;
             // and/or keep their left operand when they jump; jf drops it.
             jump_depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
             if (op == kJmp) c.flags &= static_cast<uint8_t>(~kReachable);
@@ -312,10 +314,10 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
                               : op == kSetK ? t != kTypeT
                                             : is_int(t);
             if (!fits) return wrong_type(ref);
-            const uint32_t b = a + 2u;  // the operands after the ref
+            const uint16_t b = static_cast<uint16_t>(a + 2u);  // the operands after the ref
             const uint8_t more = typed_operands(op, t);
             const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
-            if (static_cast<uint32_t>(pc) + more > p.code_size) return kVmBadOpcode;
+            if (more > p.code_size - pc) return kVmBadOpcode;  // (pc <= code_size)
             pc = static_cast<uint16_t>(pc + more);
             if (op == kSetK) {
                 if (t == kBool && im[b] > 1u) return kVmBadOpcode;
@@ -326,12 +328,12 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
                 if (w != kVmOk) return w;
                 if (!is_int(ts)) return wrong_type(src);
                 // |k| below 2^p (p = R's precision): every integer near k is exact in R.
-                const int32_t k = static_cast<int32_t>(r32(im, b + 2u));
+                const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + 2u)));
                 if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
             } else {
                 if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
                     return kVmBadOpcode;
-                jump_to = static_cast<uint32_t>(pc) + r16(im, b + at);
+                jump_at = static_cast<uint16_t>(b + at);
                 jump_depth = depth;
             }
             break;
@@ -340,14 +342,14 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if ((im[a] & ~kJumpIf) > 5u) return kVmBadOpcode;
             pops = 2;
             if (depth < pops) return kVmBadStack;
-            jump_to = static_cast<uint32_t>(pc) + r16(im, a + 1u);
+            jump_at = static_cast<uint16_t>(a + 1u);
             jump_depth = static_cast<uint8_t>(depth - 2u);
             break;
         }
         case kConst: case kLdt: pushes = 1; break;
         case kLde: case kSte: {
             const uint16_t e = r16(im, a);
-            if (e >= layout.count || flash_get(layout.elems[e].type) != im[a + 2u]) return kVmBadElement;
+            if (e >= layout.count || flash_get(layout.elems[e].type) != im[static_cast<uint16_t>(a + 2u)]) return kVmBadElement;
             if (op == kLde) pushes = 1; else pops = 1;
             break;
         }
@@ -368,10 +370,11 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
         case kNeg: case kNot: case kTruth: pops = 1; pushes = 1; break;
         default: pops = 2; pushes = 1; break;  // arithmetic and comparisons
     }
-    if (jump_to != kNoJump) {  // a forward jump: its target and the depth there
-        if (jump_to >= p.code_size) return kVmBadJump;
+    if (jump_at != 0) {  // a forward jump: its target and the depth there
+        const uint16_t off = r16(im, jump_at);
+        if (off >= p.code_size - pc) return kVmBadJump;  // (pc <= code_size)
         if (c.np == FSW_VM_PENDING) return kVmTooNested;
-        c.pend[c.np].target = static_cast<uint16_t>(jump_to);
+        c.pend[c.np].target = static_cast<uint16_t>(pc + off);
         c.pend[c.np].depth = jump_depth;
         ++c.np;
     }
@@ -410,10 +413,10 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
         if (!first && im.reads() >= budget) return kVmMore;  // (a unit a call at least: the check moves on)
         if (c.phase == kChLocals) {
             if (c.i < p.locals) {
-                const uint32_t at = p.loc + 3u * c.i;
+                const uint16_t at = static_cast<uint16_t>(p.loc + 3u * c.i);
                 const uint8_t t = im[at];
                 const uint16_t off = r16(im, at + 1u);
-                if (elem_size(t) == 0 || static_cast<uint32_t>(off) + elem_size(t) > p.loc_size) return kVmBadLocal;
+                if (elem_size(t) == 0 || off > p.loc_size || elem_size(t) > p.loc_size - off) return kVmBadLocal;
                 ++c.i;
                 continue;
             }
@@ -421,7 +424,7 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
             c.i = 0;
         } else if (c.phase == kChWindows) {
             if (c.i < p.windows) {
-                const uint32_t at = p.win + 4u * c.i;
+                const uint16_t at = static_cast<uint16_t>(p.win + 4u * c.i);
                 const uint8_t func = im[at];
                 const uint16_t n = r16(im, at + 2u);
                 if (func > kMedian || im[at + 1u] != 0 || n == 0) return kVmBadWindow;
@@ -434,7 +437,7 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
             c.declared = p.prelude != kNone ? 1u : 0u;
         } else if (c.phase == kChOffsets) {
             if (c.i < 3u * p.states) {
-                const uint16_t off = r16(im, p.st + 2u * c.i);
+                const uint16_t off = r16(im, static_cast<uint16_t>(kHeader + 2u * c.i));
                 ++c.i;
                 if (off == kNone) continue;
                 if (off >= p.code_size) return kVmBadState;
@@ -462,7 +465,7 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
                     }
                     if (c.i < p.states) {
                         const uint8_t lo = static_cast<uint8_t>(pc), hi = static_cast<uint8_t>(pc >> 8);
-                        uint16_t at = static_cast<uint16_t>(p.st + 6u * c.i);
+                        uint16_t at = static_cast<uint16_t>(kHeader + 6u * c.i);
                         for (uint8_t k = 0; k < 3; ++k, at = static_cast<uint16_t>(at + 2u)) {
                             if (im[at] != lo || im[at + 1u] != hi) continue;
                             if (k < 2) ++c.moving;
@@ -491,13 +494,13 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
 // by byte, counting its reads.
 struct RamImage {
     const uint8_t* im;
-    uint8_t operator[](uint32_t i) const { return im[i]; }
+    uint8_t operator[](uint16_t i) const { return im[i]; }
     uint16_t reads() const { return 0; }
 };
 struct EepromImage {
     uint16_t base;
     mutable uint16_t n;
-    uint8_t operator[](uint32_t i) const {
+    uint8_t operator[](uint16_t i) const {
         ++n;
         return pal::eeprom_read(static_cast<uint16_t>(base + i));
     }
@@ -709,6 +712,10 @@ struct IntFast<true> {
 // R's precision (24 or 53), fit this type with a byte to spare.
 typedef IntFast<sizeof(Real) == 4>::T Wide;
 
+// The largest value of each integer type narrower than 8 bytes, in a
+// Wide (kIAdd's clamp; unused for the 8-byte types).
+const uint32_t kIntMax[8] FSW_FLASH = {127UL, 32767UL, 2147483647UL, 0, 255UL, 65535UL, 4294967295UL, 0};
+
 // x (of type ts) as a Wide when it is one, else false. Bytes above Wide's
 // are only checked (no 64-bit arithmetic on an AVR).
 FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
@@ -738,26 +745,27 @@ FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
 void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
     const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
     const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
-    Wide a;
-    if (!as_wide(x, ts, a) || a < -limit || a > limit) {
+    Wide v;
+    if (!as_wide(x, ts, v) || v < -limit || v > limit) {
         write_elem(d, td, read_elem(x, ts) + static_cast<Real>(k));
         return;
     }
-    Wide v = a + k;
-    const uint8_t nd = size_of(td), wb = sizeof(Wide);
+    v += k;
+    const uint8_t nd = size_of(td);
     const bool sign = td < kU8;
     if (!sign && v < 0) v = 0;
-    if (nd < wb) {  // d narrower than Wide: its range
-        const Wide hi = nd == 1 ? (sign ? 127 : 255) : nd == 2 ? (sign ? 32767 : static_cast<Wide>(65535L))
-                                                               : static_cast<Wide>(sign ? 2147483647LL : 4294967295LL);
+    if (nd < sizeof(Wide)) {  // d narrower than Wide: its range
+        const Wide hi = static_cast<Wide>(flash_get(kIntMax[td]));
         if (v > hi) v = hi;
         if (sign && v < -hi - 1) v = -hi - 1;
+    }
+    if (nd <= sizeof(Wide)) {
         memcpy(d, &v, nd);  // its low bytes, little-endian
         return;
     }
-    memcpy(d, &v, wb);
+    memcpy(d, &v, sizeof v);
     const uint8_t fill = v < 0 ? 0xFF : 0x00;  // (only a signed d is negative here)
-    for (uint8_t i = wb; i < nd; ++i) d[i] = fill;
+    for (uint8_t i = sizeof(Wide); i < nd; ++i) d[i] = fill;
 }
 
 // The typed instructions, one function each (few live registers, so few

@@ -1,5 +1,7 @@
 // Scenario: element <-> Real conversions (spec 4.5) at their boundaries:
 // saturation, truncation toward zero, NaN, +-inf, U64/I64 bounds, rounding.
+#include <stdio.h>
+
 #include "test_support.h"
 
 using namespace fsw;
@@ -239,6 +241,109 @@ static void test_element_pointer_access_round_trips_every_type(void) {
     ASSERT_REAL_SAME(Real(0), read_elem(buf, 99));
 }
 
+// The run-time access (read_elem/write_elem: I/O tables, the bytecode VM)
+// and the typed one (generated code) give the same bytes and values for
+// every integer type: at every power of two around each type's limits, on
+// both sides of them, at +-0, +-inf and NaN, and over random patterns
+// (fewer on an AVR, where the suite runs simulated).
+static void write_typed(uint8_t* p, uint8_t t, Real r) {
+    switch (t) {
+        case kI8: write_I8(p, r); break;
+        case kI16: write_I16(p, r); break;
+        case kI32: write_I32(p, r); break;
+        case kI64: write_I64(p, r); break;
+        case kU8: write_U8(p, r); break;
+        case kU16: write_U16(p, r); break;
+        case kU32: write_U32(p, r); break;
+        default: write_U64(p, r); break;
+    }
+}
+static Real read_typed(const uint8_t* p, uint8_t t) {
+    switch (t) {
+        case kI8: return read_I8(p);
+        case kI16: return read_I16(p);
+        case kI32: return read_I32(p);
+        case kI64: return read_I64(p);
+        case kU8: return read_U8(p);
+        case kU16: return read_U16(p);
+        case kU32: return read_U32(p);
+        default: return read_U64(p);
+    }
+}
+static void check_write(Real r) {
+    for (uint8_t t = kI8; t <= kU64; ++t) {
+        uint8_t a[10], b[10];
+        memset(a, 0x5A, sizeof a);
+        memset(b, 0x5A, sizeof b);
+        write_elem(a + 1, t, r);
+        write_typed(b + 1, t, r);
+        if (memcmp(a, b, sizeof a) != 0) {
+            char msg[80];
+            snprintf(msg, sizeof msg, "write_elem type %u of %.9g differs from the typed write", static_cast<unsigned>(t),
+                     static_cast<double>(r));
+            TEST_FAIL_MESSAGE(msg);
+        }
+    }
+}
+static void check_read(const uint8_t* bytes) {
+    for (uint8_t t = kI8; t <= kU64; ++t) {
+        if (!fsw_test_same(read_typed(bytes, t), read_elem(bytes, t))) {
+            char msg[80];
+            snprintf(msg, sizeof msg, "read_elem type %u of %02x..%02x differs from the typed read", static_cast<unsigned>(t),
+                     static_cast<unsigned>(bytes[0]),
+                     static_cast<unsigned>(bytes[elem_size(t) - 1u]));
+            TEST_FAIL_MESSAGE(msg);
+        }
+    }
+}
+
+static void test_run_time_element_access_matches_the_typed_conversions(void) {
+    check_write(0);
+    check_write(-static_cast<Real>(0));
+    check_write(kInf);
+    check_write(-kInf);
+    check_write(nan_real());
+    Real p = 1;
+    for (uint8_t k = 0; k <= 66; ++k, p = p * 2) {  // 2^k, and just above and below it, either sign
+        const Real around[] = {p, p * Real(1.5), p * Real(0.75), p * Real(0.99999994), p * Real(1.0000001)};
+        for (size_t i = 0; i < sizeof around / sizeof around[0]; ++i) {
+            check_write(around[i]);
+            check_write(-around[i]);
+            check_write(around[i] - 1);
+            check_write(1 - around[i]);
+        }
+    }
+    uint8_t edge[8];
+    for (uint8_t fill = 0; fill < 2; ++fill)
+        for (uint8_t top = 0; top < 8; ++top) {  // 0x00../0xFF.. with one byte 0x7F, 0x80 or 0x81
+            for (uint8_t v = 0x7F; v != 0x82; ++v) {
+                memset(edge, fill ? 0xFF : 0x00, sizeof edge);
+                edge[top] = v;
+                check_read(edge);
+            }
+        }
+    uint32_t x = 0x9E3779B9UL;
+#if defined(__AVR__)
+    const uint16_t n = 300;
+#else
+    const uint16_t n = 60000;
+#endif
+    for (uint16_t i = 0; i < n; ++i) {
+        uint8_t bytes[8];
+        for (uint8_t k = 0; k < 8; ++k) {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            bytes[k] = static_cast<uint8_t>(x >> 11);
+        }
+        check_read(bytes);
+        Real r;
+        memcpy(&r, bytes + (sizeof(Real) == 4 ? 4 : 0), sizeof r);  // any pattern: NaNs, subnormals, huge
+        check_write(r);
+        check_write(static_cast<Real>(static_cast<int32_t>(x)) * Real(1e-3) * static_cast<Real>(1u << (i % 32u)));
+    }
+}
+
 static void test_typed_writes_saturate_through_pointers(void) {
     uint8_t b[8];
     write_U8(b, 256);
@@ -347,6 +452,7 @@ static void run(void) {
     RUN_TEST(test_division_by_zero_follows_ieee);
     RUN_TEST(test_element_pointer_access_round_trips_every_type);
     RUN_TEST(test_typed_writes_saturate_through_pointers);
+    RUN_TEST(test_run_time_element_access_matches_the_typed_conversions);
     RUN_TEST(test_round_to_f32_precision_matches_binary32);
 #if !defined(__AVR__)
     RUN_TEST(test_64_bit_reads_match_single_rounding_reference);

@@ -52,7 +52,7 @@ element mainSense   hold
 element resetCause  hold   # held: a reset in flight shows as a change
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 24576            # measured high-water mark to the RAM
+flash 25600            # measured high-water mark to the RAM
 ram   1792
 
 [pyro]                 # the charges (docs/safety.md): fsw check proves each fires only armed, in its states

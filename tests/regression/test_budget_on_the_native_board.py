@@ -18,7 +18,7 @@ def test_a_budgeted_project_loads_for_the_native_board():
     app = load_app(str(EXAMPLES / "rocket" / "rocket.app"), diags, board_override="native")
     assert diags.error_count == 0, diags
     assert app is not None and app.board.name == "native"
-    assert (app.flash_budget, app.ram_budget) == (24576, 1792)
+    assert (app.flash_budget, app.ram_budget) == (25600, 1792)
 
 
 def test_a_budget_over_an_avr_board_is_still_refused(tmp_path):
@@ -26,8 +26,8 @@ def test_a_budget_over_an_avr_board_is_still_refused(tmp_path):
     shutil.copytree(EXAMPLES / "rocket", project, ignore=shutil.ignore_patterns("build"))
     app_file = project / "rocket.app"
     text = app_file.read_text()
-    app_file.write_text(text.replace("flash 24576", "flash 40000"))
-    line = next(i for i, row in enumerate(text.splitlines(), 1) if row.startswith("flash 24576"))
+    app_file.write_text(text.replace("flash 25600", "flash 40000"))
+    line = next(i for i, row in enumerate(text.splitlines(), 1) if row.startswith("flash 25600"))
     diags = Diagnostics()
     assert load_app(str(app_file), diags) is None
     assert [(d.line, d.message) for d in diags.errors] == [

@@ -107,8 +107,9 @@ class ExprEmitter:
                 return fast
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
         if t is M.ChainCmp:
-            if all(type(o) in (M.Const, M.Ref) for o in e.operands):
-                # Literals and variables read the same twice: test pair by pair.
+            if all(type(o) in (M.Const, M.Ref) or self.known(o) is not None for o in e.operands):
+                # Literals, variables and constant expressions (`-GATE`) read
+                # the same twice: test pair by pair, each on its fast path.
                 pairs = [self.cond(M.Cmp(op, e.operands[k], e.operands[k + 1], e.line, e.col))
                          for k, op in enumerate(e.ops)]
                 return "(" + " && ".join(pairs) + ")"

@@ -60,7 +60,11 @@ def folded_locals(m: M.Machine, real: Real, scriptable: bool) -> dict[int, float
 
 
 def known(e: M.Expr, real: Real, consts: dict[int, float]):
-    """The R value of a literal or of a local read as a constant, or None."""
+    """The R value of a literal, of a local read as a constant, or of the
+    negation of either (`-5`, `-GATE`: negating is exact in R), or None."""
+    if type(e) is M.Neg:
+        v = known(e.operand, real, consts)
+        return None if v is None else -v
     if type(e) is M.Const:
         return real.literal(e.text)
     return consts.get(e.var) if type(e) is M.Ref else None

@@ -155,7 +155,8 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     counts = dict.fromkeys(("int_compare", "int_compare folded", "int_add", "int_add slow path",
                             "constant_store", "constant_store NaN/inf/-0", "float_threshold F32",
                             "float_threshold F64", "chain split", "chain lambda", "folded local",
-                            "window", "window sampled in some states", "lock"), 0)
+                            "window", "window sampled in some states", "lock", "negated constant",
+                            "chain split, negated constant"), 0)
     E = expr.ExprEmitter
 
     def counting(name, key):
@@ -171,18 +172,26 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     def bump(k, n=1):
         counts[k] += n
 
-    counting("int_compare", lambda self, a, r: bump("int_compare folded" if r in ("true", "false") else "int_compare"))
+    def negated(args) -> bool:  # `x < -5`, `-GATE < x`: a constant behind a minus sign, folded
+        return any(type(o) is M.Neg for o in args)
+
+    counting("int_compare", lambda self, a, r: (bump("int_compare folded" if r in ("true", "false") else "int_compare"),
+                                                negated(a) and bump("negated constant")))
     counting("int_add", lambda self, a, r: (bump("int_add"), "round_to_f32_precision" in r and bump("int_add slow path")))
     counting("constant_store", lambda self, a, r: (bump("constant_store"),
                                                    re.search(r"// (inf|-inf|-0\.0)$", r) and bump("constant_store NaN/inf/-0")))
-    counting("float_threshold", lambda self, a, r: bump("float_threshold F32" if "f32_read_key" in r else
-                                                        "float_threshold F64" if "f64_read_key" in r else "int_compare folded"))
+    counting("float_threshold", lambda self, a, r: (bump("float_threshold F32" if "f32_read_key" in r else
+                                                         "float_threshold F64" if "f64_read_key" in r else
+                                                         "int_compare folded"),
+                                                    negated(a) and bump("negated constant")))
     orig_cond = E.cond
 
     def cond(self, e):
         r = orig_cond(self, e)
         if type(e) is M.ChainCmp:
             bump("chain lambda" if r.startswith("([&]") else "chain split")
+            if not r.startswith("([&]") and any(type(o) is M.Neg for o in e.operands):
+                bump("chain split, negated constant")
         return r
     monkeypatch.setattr(E, "cond", cond)
     for c in gp.cases(SEED, min(CASES, 1000)):

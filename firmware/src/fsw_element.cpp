@@ -50,6 +50,40 @@ void write_F32(uint8_t* p, Real r) {
 }
 #endif
 
+Real read_elem_typed(const uint8_t* p, uint8_t type) {
+    switch (type) {
+        case kI8: return read_I8(p);
+        case kI16: return read_I16(p);
+        case kI32: return read_I32(p);
+        case kI64: return read_I64(p);
+        case kU8: return read_U8(p);
+        case kU16: return read_U16(p);
+        case kU32: return read_U32(p);
+        case kU64: return read_U64(p);
+        case kF32: return read_F32(p);
+        case kF64: return read_F64(p);
+        case kBool: return read_bool(p);
+        default: return 0;
+    }
+}
+
+void write_elem_typed(uint8_t* p, uint8_t type, Real r) {
+    switch (type) {
+        case kI8: write_I8(p, r); break;
+        case kI16: write_I16(p, r); break;
+        case kI32: write_I32(p, r); break;
+        case kI64: write_I64(p, r); break;
+        case kU8: write_U8(p, r); break;
+        case kU16: write_U16(p, r); break;
+        case kU32: write_U32(p, r); break;
+        case kU64: write_U64(p, r); break;
+        case kF32: write_F32(p, r); break;
+        case kF64: write_F64(p, r); break;
+        case kBool: write_bool(p, r); break;
+        default: break;
+    }
+}
+
 void elem_widen(const uint8_t* p, uint8_t type, uint8_t* b) {
     const uint8_t n = elem_size(type);
     const uint8_t fill = type < kU8 && (p[n - 1u] & 0x80u) != 0 ? 0xFF : 0x00;
@@ -139,39 +173,8 @@ void write_elem(uint8_t* p, uint8_t type, Real r) {
     memcpy(p, b, n);  // the low bytes (little-endian)
 }
 #else
-Real read_elem(const uint8_t* p, uint8_t type) {
-    switch (type) {
-        case kI8: return read_I8(p);
-        case kI16: return read_I16(p);
-        case kI32: return read_I32(p);
-        case kI64: return read_I64(p);
-        case kU8: return read_U8(p);
-        case kU16: return read_U16(p);
-        case kU32: return read_U32(p);
-        case kU64: return read_U64(p);
-        case kF32: return read_F32(p);
-        case kF64: return read_F64(p);
-        case kBool: return read_bool(p);
-        default: return 0;
-    }
-}
-
-void write_elem(uint8_t* p, uint8_t type, Real r) {
-    switch (type) {
-        case kI8: write_I8(p, r); break;
-        case kI16: write_I16(p, r); break;
-        case kI32: write_I32(p, r); break;
-        case kI64: write_I64(p, r); break;
-        case kU8: write_U8(p, r); break;
-        case kU16: write_U16(p, r); break;
-        case kU32: write_U32(p, r); break;
-        case kU64: write_U64(p, r); break;
-        case kF32: write_F32(p, r); break;
-        case kF64: write_F64(p, r); break;
-        case kBool: write_bool(p, r); break;
-        default: break;
-    }
-}
+Real read_elem(const uint8_t* p, uint8_t type) { return read_elem_typed(p, type); }
+void write_elem(uint8_t* p, uint8_t type, Real r) { write_elem_typed(p, type, r); }
 #endif
 
 }  // namespace fsw

@@ -77,6 +77,11 @@ inline void write_bool(uint8_t* p, Real r) { store_bool(p, bool_from_real(r)); }
 // The integer element at p (type <= kU64) widened to 8 little-endian bytes
 // at b: sign-extended for a signed type, zero-extended for an unsigned one.
 void elem_widen(const uint8_t* p, uint8_t type, uint8_t* b);
+// The same by a switch over the typed conversions above: what read_elem
+// and write_elem are where R is binary64, and the reference their binary32
+// path is held to (tests/firmware/test_convert.cpp).
+Real read_elem_typed(const uint8_t* p, uint8_t type);
+void write_elem_typed(uint8_t* p, uint8_t type, Real r);
 Real read_elem(const uint8_t* p, uint8_t type);
 void write_elem(uint8_t* p, uint8_t type, Real r);
 

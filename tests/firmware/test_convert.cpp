@@ -246,37 +246,13 @@ static void test_element_pointer_access_round_trips_every_type(void) {
 // every integer type: at every power of two around each type's limits, on
 // both sides of them, at +-0, +-inf and NaN, and over random patterns
 // (fewer on an AVR, where the suite runs simulated).
-static void write_typed(uint8_t* p, uint8_t t, Real r) {
-    switch (t) {
-        case kI8: write_I8(p, r); break;
-        case kI16: write_I16(p, r); break;
-        case kI32: write_I32(p, r); break;
-        case kI64: write_I64(p, r); break;
-        case kU8: write_U8(p, r); break;
-        case kU16: write_U16(p, r); break;
-        case kU32: write_U32(p, r); break;
-        default: write_U64(p, r); break;
-    }
-}
-static Real read_typed(const uint8_t* p, uint8_t t) {
-    switch (t) {
-        case kI8: return read_I8(p);
-        case kI16: return read_I16(p);
-        case kI32: return read_I32(p);
-        case kI64: return read_I64(p);
-        case kU8: return read_U8(p);
-        case kU16: return read_U16(p);
-        case kU32: return read_U32(p);
-        default: return read_U64(p);
-    }
-}
 static void check_write(Real r) {
     for (uint8_t t = kI8; t <= kU64; ++t) {
         uint8_t a[10], b[10];
         memset(a, 0x5A, sizeof a);
         memset(b, 0x5A, sizeof b);
         write_elem(a + 1, t, r);
-        write_typed(b + 1, t, r);
+        write_elem_typed(b + 1, t, r);
         if (memcmp(a, b, sizeof a) != 0) {
             char msg[80];
             snprintf(msg, sizeof msg, "write_elem type %u of %.9g differs from the typed write", static_cast<unsigned>(t),
@@ -287,7 +263,7 @@ static void check_write(Real r) {
 }
 static void check_read(const uint8_t* bytes) {
     for (uint8_t t = kI8; t <= kU64; ++t) {
-        if (!fsw_test_same(read_typed(bytes, t), read_elem(bytes, t))) {
+        if (!fsw_test_same(read_elem_typed(bytes, t), read_elem(bytes, t))) {
             char msg[80];
             snprintf(msg, sizeof msg, "read_elem type %u of %02x..%02x differs from the typed read", static_cast<unsigned>(t),
                      static_cast<unsigned>(bytes[0]),

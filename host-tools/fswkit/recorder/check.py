@@ -81,6 +81,11 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
         return lines, [check_cls("the recorder kept the flight", False, "no flight in the record")], None
     s = flight.samples
     used = len(flight.records) + (flight.start is not None)
+    if not s:  # begun, but the run ended before its first sample was stored (a flight cut short)
+        lines.append(f"  flight {flight.number}: no sample stored yet ({used} record{'s' if used != 1 else ''} begun)")
+        return lines, [check_cls("the recorder stored the flight's samples", False,
+                                 f"flight {flight.number} holds no sample: the run ended before the first was "
+                                 "written")], (p, flight)
     span = (s[-1][0] - s[0][0]) / 1000 if s else 0.0
     per_record = len(s) / max(1, len(flight.records))
     capacity = (p.slots - 1) * per_record * span / max(1, len(s) - 1) if len(s) > 1 else 0.0

@@ -73,12 +73,18 @@ def is_direct(path: str) -> bool:
     return not stat.S_ISREG(st.st_mode)
 
 
-def check(path: str, inputs=(), *, force: bool = False, what: str = "output") -> None:
-    """Refuses an output path before any work is done: OutputError."""
+def not_an_input(path: str, inputs=(), what: str = "output") -> None:
+    """Refuses an output path that names one of the command's input files:
+    OutputError."""
     for i in inputs:
         if i is not None and os.path.exists(path) and same_file(path, i):
             raise OutputError(f"{path}: the {what} would overwrite an input of this command: "
                               "choose another name")
+
+
+def check(path: str, inputs=(), *, force: bool = False, what: str = "output") -> None:
+    """Refuses an output path before any work is done: OutputError."""
+    not_an_input(path, inputs, what)
     if os.path.isdir(path):
         raise OutputError(f"cannot write {path}: it is a folder (name a file for the {what})")
     if is_direct(path):

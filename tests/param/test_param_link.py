@@ -217,3 +217,12 @@ def test_fsw_sim_params_takes_a_parameter_file_too(tmp_path):
     assert r.code == 2 and "`MAIN_ALT` = 5 is outside its range 30..3000 m" in r.err, r.err
     r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(f), "--fw-params", str(f))
     assert r.code == 2 and "give one" in r.err
+    # a plant file whose tables all come from the file it extends is still a plant file: it was read as
+    # the firmware's parameters ("unknown parameter 'extends'"), and a study refused it for a --fw-params
+    p = tmp_path / "faster.toml"
+    p.write_text(f'extends = "{EXAMPLES / "rocket" / "plant.toml"}"\nrate_hz = 3000\n')
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(p),
+                "--out", str(tmp_path / "flight"))
+    assert r.code == 2 and "rate_hz" in r.err and "parameter" not in r.err, r.err
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(p), "--runs", "2")
+    assert r.code == 2 and "rate_hz" in r.err and "--fw-params" not in r.err, r.err

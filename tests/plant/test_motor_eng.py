@@ -63,6 +63,12 @@ def test_a_good_file_with_comments_and_two_motors():
     ("X10 29 124 4-7 0.05 0.10 M\n; no points\n", 1, 1, "motor X10 has no thrust points"),
     ("; nothing but comments\n\n", 1, 1, "no motor in this file"),
     ("X10 29 124 4-7 0.05 0.10 M\n0.1 nan\n1 0\n", 2, 5, "expected the thrust in newtons"),
+    # the limits of a plant file's thrust_curve hold for a motor file's too
+    ("X10 29 124 4-7 0.05 0.10 M\n0.1 1e300\n1 0\n", 2, 5, "1e300 N: a thrust curve's points are at most 1e+06 N"),
+    ("X10 29 124 4-7 0.05 0.10 M\n0.1 1e9\n0.2 0\n", 2, 5, "at most 1e+06 N"),
+    ("X10 29 124 4-7 0.05 0.10 M\n0.1 1\n700 0\n", 3, 1, "700 s: a thrust curve lasts at most 600 s"),
+    ("X10 29 124 4-7 2000 3000 M\n0.1 1\n1 0\n", 1, 16, "2000 kg: the motor's propellant mass is at most 1000 kg"),
+    ("X10 29 124 4-7 0.05 0.10 M\n0.1 1_0\n1 0\n", 2, 5, "`1_0`: expected the thrust in newtons"),
 ])
 def test_each_kind_of_bad_file_is_located(text, line, col, message):
     with pytest.raises(EngError) as e:
@@ -136,3 +142,42 @@ def test_a_bad_motor_file_named_by_plant_toml_is_located_in_both(tmp_path: Path)
     msg = str(e.value)
     assert f"{p}:" in msg and "[motor] file: the motor file" in msg
     assert "bad.eng:3:3: the thrust curve of X10 must end at zero thrust" in msg
+
+
+def test_a_motor_file_inherited_through_extends_is_the_one_its_file_names(tmp_path: Path):
+    """A `file` that a base plant file gives is relative to that file, not to
+    the one extending it: a motors folder beside the extending file (here
+    holding another motor under the same name) is not looked at."""
+    base = _plant(tmp_path, '[motor]\nfile = "motors/G80T.eng"\n')
+    sub = tmp_path / "sub"
+    (sub / "motors").mkdir(parents=True)
+    (sub / "motors" / "G80T.eng").write_text((MOTORS / "H128W.eng").read_text())  # the wrong motor, same name
+    variant = sub / "variant.toml"
+    variant.write_text(f'extends = "../{base.name}"\n\n[scenario]\nmax_s = 60\n')
+    sc = prepare(str(ROCKET), "rocket", params=str(variant), seed=1)[2]
+    assert sc.nominal_impulse == pytest.approx(118.6, abs=0.1)  # the G80T, not the H128W
+    assert sc.propellant_kg == 0.0625
+
+
+def test_a_motor_file_replaces_an_inherited_thrust_curve_and_its_propellant(tmp_path: Path):
+    """The example's plant writes a thrust curve and its propellant mass; a
+    file extending it that names a motor file flies that motor, with the
+    file's propellant mass (the curve's is dropped with the curve), or with
+    the one it writes itself."""
+    (tmp_path / "motors").mkdir()
+    (tmp_path / "motors" / "G80T.eng").write_text((MOTORS / "G80T.eng").read_text())
+    variant = tmp_path / "variant.toml"
+    variant.write_text(f'extends = "{ROCKET / "plant.toml"}"\n\n[motor]\nfile = "motors/G80T.eng"\n')
+    sc = prepare(str(ROCKET), "rocket", params=str(variant), seed=1)[2]
+    assert sc.nominal_impulse == pytest.approx(118.6, abs=0.1)
+    assert sc.propellant_kg == 0.0625  # the file's, not the example's 0.08
+    variant.write_text(f'extends = "{ROCKET / "plant.toml"}"\n\n[motor]\nfile = "motors/G80T.eng"\n'
+                       "propellant_kg = 0.07\n")
+    assert prepare(str(ROCKET), "rocket", params=str(variant), seed=1)[2].propellant_kg == 0.07
+    # and the other way: a propellant mass alone keeps the base's motor file
+    (tmp_path / "b").mkdir()
+    _plant(tmp_path / "b", '[motor]\nfile = "motors/G80T.eng"\n')
+    over = tmp_path / "b" / "over.toml"
+    over.write_text('extends = "plant.toml"\n\n[motor]\npropellant_kg = 0.05\n')
+    sc = prepare(str(ROCKET), "rocket", params=str(over), seed=1)[2]
+    assert sc.nominal_impulse == pytest.approx(118.6, abs=0.1) and sc.propellant_kg == 0.05

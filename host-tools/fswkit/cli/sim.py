@@ -15,7 +15,7 @@ from fswkit.cli.common import EXIT_CONFIG, flown, folder_and_firmware
 def _firmware_param_file(path: str) -> bool:
     """Whether `--params FILE` names a file of the firmware's parameters
     (top-level `NAME = value` lines only) rather than a plant's or a tape's
-    configuration (which are tables)."""
+    configuration (tables, or an `extends` of another such file)."""
     import tomllib
 
     try:
@@ -23,7 +23,8 @@ def _firmware_param_file(path: str) -> bool:
             doc = tomllib.load(f)
     except (OSError, ValueError):  # TOMLDecodeError, a bad encoding, an integer too long for int()
         return False  # the plant's or the tape's reader says what is wrong with it
-    return bool(doc) and not any(isinstance(v, dict) for v in doc.values())
+    # a plant's or a tape's file may hold no table of its own when it `extends` another
+    return bool(doc) and "extends" not in doc and not any(isinstance(v, dict) for v in doc.values())
 
 
 def cmd_sim(args) -> int:
@@ -156,7 +157,8 @@ def board_run(args) -> int:
 
 def plant_run(args) -> int:
     """`fsw sim PROJECT --plant rocket|tank`: build, fly, write the files, print the checks."""
-    from fswkit.plant.run import SetupError, execute, prepare
+    from fswkit.outputs import OutputError
+    from fswkit.plant.run import SetupError, execute, prepare, refuse_inputs
     from fswkit.sim.command import build, is_elf, say
     from fswkit.target.build import default_out
 
@@ -185,6 +187,10 @@ def plant_run(args) -> int:
     out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
     try:
         os.makedirs(out, exist_ok=True)
+        refuse_inputs(out, [args.params, args.fw_params])
+    except OutputError as e:
+        say(str(e))
+        return 2
     except OSError as e:
         say(f"cannot create the output folder {out}: {e.strerror or e}")
         return 2
@@ -205,6 +211,7 @@ def tape_run(args) -> int:
     from fswkit.link.layout import LayoutError, from_app
     from fswkit.outputs import OutputError, write_text
     from fswkit.plant import tape_replay as tr
+    from fswkit.plant.run import refuse_inputs
     from fswkit.sim.command import is_elf, say
     from fswkit.target.build import BuildError, default_out, load
     from fswkit.autocode.diagnostics import Diagnostics
@@ -251,6 +258,12 @@ def tape_run(args) -> int:
         return 2
     name = os.path.splitext(os.path.basename(args.tape))[0]
     out = args.out or os.path.join(default_out(app), f"tape-{name}")
+    try:
+        if os.path.isdir(out):
+            refuse_inputs(out, [args.tape, args.params, args.fw_params], extra=("perturb.csv", "perturb.txt"))
+    except OutputError as e:
+        say(str(e))
+        return 2
     built = folder_and_firmware(args.project, args.board, out)
     if isinstance(built, int):
         return built

@@ -80,7 +80,7 @@ def study_run(args) -> int:
     try:
         os.makedirs(out, exist_ok=True)
         for name in STUDY_FILES:
-            check(os.path.join(out, name), [params, args.dispersion], what="the study's " + name)
+            check(os.path.join(out, name), [params, args.dispersion], what="study's " + name)
     except OutputError as e:
         say(str(e))
         return 2
@@ -132,13 +132,20 @@ def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
     from fswkit.cli.common import flown, folder_and_firmware
     from fswkit.plant import study
     from fswkit.plant.dispersion import draw
-    from fswkit.plant.run import execute
+    from fswkit.outputs import OutputError
+    from fswkit.plant.run import execute, refuse_inputs
     from fswkit.sim.command import say
 
     d = draw(disp, seed, args.run)
     setup = study.Setup(app, layout, params, "", None, disp, seed)
     sc = study.scenario_for(setup, d)
     out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
+    try:
+        if os.path.isdir(out):
+            refuse_inputs(out, [params, args.dispersion])
+    except OutputError as e:
+        say(str(e))
+        return 2
     built = folder_and_firmware(args.project, args.board, out)
     if isinstance(built, int):
         return built

@@ -59,7 +59,17 @@ class EngMotor:
         return self.points[-1][0]
 
 
+# The limits of a thrust curve, whether written in a plant file
+# (`thrust_curve`) or read from a motor file, and of a motor's masses
+# (`propellant_kg`): beyond any motor the plant flies.
+CURVE_MAX_S = 600.0
+CURVE_MAX_N = 1e6
+MAX_MASS_KG = 1000.0
+
+
 def _number(tok: str) -> float | None:
+    if "_" in tok:  # Python reads 1_0 as 10; a motor file's numbers are plain
+        return None
     try:
         x = float(tok)
     except ValueError:
@@ -134,6 +144,10 @@ def parse(text: str, path: str) -> list[EngMotor]:
                 if x is None or x <= lo:
                     err(n, cols[idx], f"`{toks[idx]}`: expected the motor's {what}, a positive number")
                     cur["bad"] = True
+                elif k in ("prop", "total") and x > MAX_MASS_KG:
+                    err(n, cols[idx], f"{toks[idx]} kg: the motor's {what.split(' in ')[0]} is at most "
+                        f"{MAX_MASS_KG:g} kg")
+                    cur["bad"] = True
                 vals[k] = x
             if not cur["bad"]:
                 if vals["prop"] > vals["total"]:
@@ -164,6 +178,14 @@ def parse(text: str, path: str) -> list[EngMotor]:
             continue
         if f < 0:
             err(n, cols[1], f"{toks[1]} N: thrust is never negative")
+            cur["bad"] = True
+            continue
+        if t > CURVE_MAX_S:
+            err(n, cols[0], f"{toks[0]} s: a thrust curve lasts at most {CURVE_MAX_S:g} s")
+            cur["bad"] = True
+            continue
+        if f > CURVE_MAX_N:
+            err(n, cols[1], f"{toks[1]} N: a thrust curve's points are at most {CURVE_MAX_N:g} N")
             cur["bad"] = True
             continue
         pts = cur["points"]

@@ -62,6 +62,9 @@ class Table:
     # groups of keys that are alternatives of each other: a file that extends
     # another and sets a key of one group drops the base's keys of the others
     alternatives: tuple[tuple[str, ...], ...] = ()
+    # (key, the key it belongs to): dropped with it by an alternative, unless
+    # the extending file sets it too (a thrust curve's propellant mass)
+    follows: tuple[tuple[str, str], ...] = ()
 
 
 class Line(int):
@@ -319,6 +322,10 @@ def resolve(path: str, schema: Schema | None = None, _chain: tuple[str, ...] = (
                                 if k not in tval:
                                     merged.pop(k, None)
                                     loc.pop((tname, k), None)
+            for k, leader in (table.follows if table else ()):
+                if leader in out[tname] and leader not in merged and k not in tval:
+                    merged.pop(k, None)
+                    loc.pop((tname, k), None)
             merged.update(tval)
             out[tname] = merged
         else:
@@ -339,6 +346,13 @@ def load(path: str, schema: Schema) -> tuple[dict, dict]:
     if errors:
         raise ParamsError(errors)
     return values, where
+
+
+def key_file(path: str, where: dict, table: str, key: str) -> str:
+    """The file that gave `table`.`key`: `path`, or the base it was
+    inherited from through `extends` (a path in its value is relative to
+    that file)."""
+    return getattr(where.get((table, key)), "path", path)
 
 
 def error_at(path: str, where: dict, table: str, key: str, msg: str) -> str:

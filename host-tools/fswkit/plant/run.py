@@ -163,6 +163,17 @@ def execute(sc, elf: str, board, layout, out: str | None, *, quiet: bool = False
     return flight
 
 
+def refuse_inputs(out: str, inputs, extra=()) -> None:
+    """Before any work: an OutputError when a file a flight or a replay
+    writes into `out` (FILES, and `extra` names) is one of the command's
+    `inputs` (its plant or tape file, its dispersion, its parameters):
+    the set of files replaces what is there, and an input is never lost."""
+    from fswkit.outputs import not_an_input
+
+    for name in list(FILES.values()) + list(extra):
+        not_an_input(os.path.join(out, name), inputs, what=f"flight's {name}")
+
+
 def _execute(sc, elf, board, layout, folder: str | None) -> Flight:
     files = {k: os.path.join(folder, v) for k, v in FILES.items()} if folder is not None else {}
     meta = {"source": f"fsw sim --plant {sc.kind}", "clock": "simulated", "seed": sc.seed, "fault": sc.fault}

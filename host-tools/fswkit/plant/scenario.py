@@ -26,6 +26,7 @@ from fswkit.sim.sensors import ACCELEROMETERS, AXES, BAROMETERS, find_part
 from . import atmosphere
 from .atmosphere import G0
 from .cosim import PinEvent
+from .motor import CURVE_MAX_N, CURVE_MAX_S, MAX_MASS_KG
 from .params import Field as F
 from .params import ParamsError, Table, error_at
 from .params import load as load_params
@@ -123,13 +124,13 @@ ROCKET_SCHEMA = {
     "motor": Table("the motor: a thrust curve written here, or a RASP motor file", {
         "file": F("str", "a RASP .eng motor file (relative to this file): its first motor's thrust curve, and its "
                   "propellant mass unless propellant_kg says otherwise", required=False),
-        "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0, hi=1000,
-                           required=False),
-        "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated", x_hi=600,
-                          hi=1e6, required=False),
+        "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0,
+                           hi=MAX_MASS_KG, required=False),
+        "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated",
+                          x_hi=CURVE_MAX_S, hi=CURVE_MAX_N, required=False),
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
-    }),
+    }, alternatives=(("file",), ("thrust_curve",)), follows=(("propellant_kg", "thrust_curve"),)),
     "drogue": _chute("the drogue parachute"),
     "main": _chute("the main parachute"),
     "atmosphere": Table("the standard atmosphere", {
@@ -525,7 +526,9 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
             bind.err("motor", "", "propellant_kg: missing (a thrust_curve written here needs its propellant mass)")
             return fallback
         return mot["thrust_curve"], mot["propellant_kg"]
-    path = os.path.join(os.path.dirname(bind.path), mot["file"])
+    from .params import key_file
+
+    path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
     try:
         eng = load_eng(path)[0]
     except EngError as e:

@@ -95,7 +95,7 @@ void elem_widen(const uint8_t* p, uint8_t type, uint8_t* b) {
 // bits (the typed conversions of fsw_convert.h, exactly): a read widens the
 // value to 64 bits and rounds its magnitude once, a write builds the
 // truncated magnitude from the float's fields and clamps by its exponent.
-// A third of the code the eleven typed cases inlined (the bytecode VM's
+// Less than half the code the eleven typed cases inlined (the bytecode VM's
 // flash, tools/bench_vm.py), and no float arithmetic routine.
 
 namespace {

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "fsw_element.h"
 #include "fsw_machine.h"
@@ -74,6 +75,7 @@ struct fswsm {
     char** aliases;     // count entries (NULL: no alias)
     char** state_names; // n_state_names entries, state id k + 1
     uint32_t n_state_names;
+    uint8_t layout_real;  // the layout file's `real` (32, 64), 0 when it said none or came by fswsm_set_layout
     // the image
     uint8_t* image;
     uint32_t image_len;
@@ -243,6 +245,28 @@ int install_layout(fswsm* h, const uint16_t* offsets, const uint8_t* types, uint
         elems[k].off = offsets[k];
         elems[k].type = types[k];
     }
+    // no two elements share a byte: in offset order, each ends where the next may start
+    uint32_t* order = static_cast<uint32_t*>(malloc(sizeof(uint32_t) * (count ? count : 1)));
+    if (order == 0) {
+        free(elems);
+        return fail(h, FSWSM_E_NOMEM, "out of memory for a layout of %u elements", count);
+    }
+    for (uint32_t k = 0; k < count; ++k) order[k] = (static_cast<uint32_t>(offsets[k]) << 16) | k;
+    qsort(order, count, sizeof(uint32_t), [](const void* a, const void* b) -> int {
+        const uint32_t x = *static_cast<const uint32_t*>(a), y = *static_cast<const uint32_t*>(b);
+        return x < y ? -1 : x > y ? 1 : 0;
+    });
+    for (uint32_t k = 1; k < count; ++k) {
+        const uint32_t a = order[k - 1u] & 0xFFFFu, b = order[k] & 0xFFFFu;
+        if (static_cast<uint32_t>(offsets[a]) + fsw::elem_size(types[a]) > offsets[b]) {
+            free(order);
+            free(elems);
+            return fail(h, FSWSM_E_LAYOUT, "elements %u (offset %u, %u bytes) and %u (offset %u) overlap", a < b ? a : b,
+                        offsets[a < b ? a : b], fsw::elem_size(types[a < b ? a : b]), a < b ? b : a,
+                        offsets[a < b ? b : a]);
+        }
+    }
+    free(order);
     drop_layout(h);
     h->elems = elems;
     h->count = count;
@@ -252,6 +276,7 @@ int install_layout(fswsm* h, const uint16_t* offsets, const uint8_t* types, uint
     h->aliases = aliases;
     h->state_names = state_names;
     h->n_state_names = n_states;
+    h->layout_real = 0;  // a layout file's parse sets it after
     h->has_layout = true;
     return ok(h);
 }
@@ -302,6 +327,7 @@ struct Parsed {
     char** aliases;
     char** states;
     uint64_t count, n_states, schema, size;
+    uint8_t real;  // the `real` line's bits, 0 without one
     bool has_count, has_states, has_schema, has_size, has_version;
     uint32_t seen, seen_states;
 };
@@ -342,6 +368,7 @@ int parse_line(fswsm* h, Parsed& p, char* line, unsigned ln, const char* where) 
     if (strcmp(key, "real") == 0) {  // the image's R, for the reader: the image's header is what counts
         if (n != 2 || (strcmp(t[1], "32") != 0 && strcmp(t[1], "64") != 0))
             return fail(h, FSWSM_E_LAYOUT, "%s:%u: `real` takes 32 or 64", where, ln);
+        p.real = static_cast<uint8_t>(t[1][0] == '3' ? 32 : 64);  // held to the image's once it comes
         return 0;
     }
     if (strcmp(key, "schema") == 0 || strcmp(key, "size") == 0) {
@@ -365,6 +392,7 @@ int parse_line(fswsm* h, Parsed& p, char* line, unsigned ln, const char* where) 
             return fail(h, FSWSM_E_LAYOUT, "%s:%u: `%s` takes a count (at most %u)", where, ln, key,
                         elems ? 65535u : 255u);
         if (elems ? p.has_count : p.has_states) return fail(h, FSWSM_E_LAYOUT, "%s:%u: a second `%s`", where, ln, key);
+        if (!elems && v == 0) return fail(h, FSWSM_E_LAYOUT, "%s:%u: `states 0`: a machine has a state at least", where, ln);
         const size_t k = v ? static_cast<size_t>(v) : 1u;
         if (elems) {
             p.count = v;
@@ -401,10 +429,17 @@ int parse_line(fswsm* h, Parsed& p, char* line, unsigned ln, const char* where) 
             return fail(h, FSWSM_E_LAYOUT, "%s:%u: size %s is not a %s's %u", where, ln, t[5], t[3],
                         fsw::elem_size(static_cast<uint8_t>(type)));
         if (n == 7 && !name_ok(t[6])) return fail(h, FSWSM_E_LAYOUT, "%s:%u: `%s` is not a name", where, ln, t[6]);
-        for (uint32_t k = 0; k < p.seen; ++k)
-            if (strcmp(p.names[k], t[2]) == 0 || (n == 7 && p.aliases[k] && strcmp(p.aliases[k], t[6]) == 0))
-                return fail(h, FSWSM_E_LAYOUT, "%s:%u: a second element named `%s`", where, ln,
-                            strcmp(p.names[k], t[2]) == 0 ? t[2] : t[6]);
+        if (n == 7 && ((strcmp(t[6], "G") == 0 && type != fsw::kU64) || (strcmp(t[6], "S") == 0 && type != fsw::kU32)))
+            return fail(h, FSWSM_E_LAYOUT, "%s:%u: `%s` aliased %s is a %s: %s is a %s", where, ln, t[2], t[6], t[3],
+                        t[6], t[6][0] == 'G' ? "U64" : "U32");
+        for (uint32_t k = 0; k < p.seen; ++k) {  // a name or an alias names one element, whichever it meets
+            const char* clash = strcmp(p.names[k], t[2]) == 0 || (p.aliases[k] && strcmp(p.aliases[k], t[2]) == 0)
+                                    ? t[2]
+                                : n == 7 && (strcmp(p.names[k], t[6]) == 0 || (p.aliases[k] && strcmp(p.aliases[k], t[6]) == 0))
+                                    ? t[6]
+                                    : 0;
+            if (clash != 0) return fail(h, FSWSM_E_LAYOUT, "%s:%u: a second element named `%s`", where, ln, clash);
+        }
         p.offsets[p.seen] = static_cast<uint16_t>(off);
         p.types[p.seen] = static_cast<uint8_t>(type);
         p.names[p.seen] = dup(t[2], strlen(t[2]));
@@ -469,7 +504,10 @@ int parse_layout(fswsm* h, const char* text, const char* where) {
         r = install_layout(h, p.offsets, p.types, static_cast<uint32_t>(p.count), static_cast<uint32_t>(p.schema),
                            static_cast<uint32_t>(p.size), p.names, p.aliases, p.states,
                            static_cast<uint32_t>(p.n_states));
-        if (r == 0) p.names = p.aliases = p.states = 0;  // the handle's now
+        if (r == 0) {
+            p.names = p.aliases = p.states = 0;  // the handle's now
+            h->layout_real = p.real;
+        }
         else prefix(h, where);
     }
     free_parsed(p);
@@ -478,6 +516,11 @@ int parse_layout(fswsm* h, const char* text, const char* where) {
 
 // A whole file in memory (NUL-terminated), or NULL with the error written.
 char* read_file(fswsm* h, const char* path, size_t& len, int& code) {
+    struct stat st;
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) {  // a FIFO or a device would block, or never end
+        code = fail(h, FSWSM_E_FILE, "cannot read %s: not a regular file", path);
+        return 0;
+    }
     FILE* f = fopen(path, "rb");
     if (f == 0) {
         code = fail(h, FSWSM_E_FILE, "cannot read %s: %s", path, strerror(errno));
@@ -731,6 +774,12 @@ int fswsm_load_image(fswsm* h, const uint8_t* image, uint32_t len) {
                         image[5] * 8u);
         return fail(h, FSWSM_E_REAL, "the image's R is %u bytes: neither binary32 (4) nor binary64 (8)", image[5]);
     }
+    if (h->layout_real != 0 && h->layout_real != sizeof(fsw::Real) * 8u) {
+        h->reason = 0;
+        return fail(h, FSWSM_E_REAL, "the layout is of binary%u images, and this library is libfswsm%u (binary%u): "
+                    "a layout of another compile of the machine", h->layout_real,
+                    static_cast<unsigned>(sizeof(fsw::Real)) * 8u, static_cast<unsigned>(sizeof(fsw::Real)) * 8u);
+    }
     const uint32_t ram_size = len >= kHeader ? fsw::vm_ram_size(image, static_cast<uint16_t>(len)) : 0;
     uint8_t* copy = static_cast<uint8_t*>(malloc(len ? len : 1));
     uint8_t* ram = static_cast<uint8_t*>(malloc(ram_size ? ram_size : 1));  // malloc: aligned for any Real
@@ -758,6 +807,33 @@ int fswsm_load_image(fswsm* h, const uint8_t* image, uint32_t len) {
         return fail(h, why == fsw::kVmBadReal ? FSWSM_E_REAL : FSWSM_E_VERIFY,
                     "the verifier refused the image: reason %d, %s: %s", static_cast<int>(why),
                     why < kReasonCount ? kReasonNames[why] : "?", why < kReasonCount ? kReasons[why] : "?");
+    }
+    // what the layout's names say of the image: its states, and the elements it calls G and S
+    const char* mismatch = 0;
+    unsigned said = 0, is = 0;
+    if (h->n_state_names != 0 && h->n_state_names != copy[18]) {
+        mismatch = "states";
+        said = h->n_state_names;
+        is = copy[18];
+    }
+    for (uint32_t k = 0; mismatch == 0 && h->aliases != 0 && k < h->count; ++k) {
+        if (h->aliases[k] == 0 || (strcmp(h->aliases[k], "G") != 0 && strcmp(h->aliases[k], "S") != 0)) continue;
+        const unsigned at = h->aliases[k][0] == 'G' ? 14u : 16u;
+        const unsigned index = static_cast<unsigned>(copy[at] | (copy[at + 1u] << 8));
+        if (index != k) {
+            mismatch = h->aliases[k];
+            said = k;
+            is = index;
+        }
+    }
+    if (mismatch != 0) {
+        free(copy);
+        free(ram);
+        if (strcmp(mismatch, "states") == 0)
+            return fail(h, FSWSM_E_LAYOUT, "the layout names %u states and the image has %u: a layout of another "
+                        "machine", said, is);
+        return fail(h, FSWSM_E_LAYOUT, "the layout calls element %u %s, and the image's %s is element %u: a "
+                    "layout of another state vector", said, mismatch, mismatch, is);
     }
     drop_image(h);
     h->image = copy;

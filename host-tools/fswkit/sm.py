@@ -342,7 +342,11 @@ class Machine:
         `real` picks the library; by default the image's own (its byte 5),
         so only an explicit `real` can meet WrongReal."""
         if real is None:
+            import stat
+
             try:
+                if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block: the library refuses it
+                    raise OSError
                 with open(path, "rb") as f:
                     head = f.read(6)
             except OSError:  # the library says so, as FileUnreadable
@@ -393,6 +397,14 @@ class Machine:
         """`elems`: (offset, type code) per element in layout order, as
         fswkit.autocode.vmverify.layout_of gives them."""
         n = len(elems)
+        # the C types would wrap a number too large for them without a word
+        for k, (off, t) in enumerate(elems):
+            if not (isinstance(off, int) and 0 <= off <= 0xFFFF and isinstance(t, int) and 0 <= t <= 0xFF):
+                raise LayoutError(E_LAYOUT, "FSWSM_E_LAYOUT", f"element {k}: offset {off!r} and type code {t!r}: an "
+                                  "offset is 0..65535 and a type code 0..255")
+        for what, v in (("schema", schema), ("sv_size", sv_size)):
+            if not (isinstance(v, int) and 0 <= v <= 0xFFFFFFFF):
+                raise LayoutError(E_LAYOUT, "FSWSM_E_LAYOUT", f"{what} {v!r}: a number of 32 bits (0..4294967295)")
         offs = (ctypes.c_uint16 * max(n, 1))(*[o for o, _ in elems])
         types = (ctypes.c_uint8 * max(n, 1))(*[t for _, t in elems])
         self._check(self._lib.fswsm_set_layout(self._h, offs, types, n, schema, sv_size))
@@ -433,6 +445,8 @@ class Machine:
             return name
         k = self._index.get(name)
         if k is None:
+            if "\0" in str(name):  # C would read the name up to it, and find another element
+                raise NameNotFound(E_NAME, "FSWSM_E_NAME", f"no element named {name!r}: a name holds no NUL")
             n = ctypes.c_uint32()
             self._check(self._lib.fswsm_element_index(self._h, str(name).encode(), ctypes.byref(n)))
             k = self._index[name] = n.value
@@ -478,9 +492,13 @@ class Machine:
     def reset(self, state=1) -> None:
         """Back to before the first step, in `state` (a name or an id, 1..)."""
         if isinstance(state, str):
+            if "\0" in state:  # C would read the name up to it
+                raise StateError(E_STATE, "FSWSM_E_STATE", f"no state named {state!r}: a name holds no NUL")
             n = ctypes.c_uint32()
             self._check(self._lib.fswsm_state_id(self._h, state.encode(), ctypes.byref(n)))
             state = n.value
+        if not (isinstance(state, int) and 0 <= state <= 0xFFFFFFFF):  # the C type would wrap it
+            raise StateError(E_STATE, "FSWSM_E_STATE", f"state {state!r}: a state id is a name or a number 1..255")
         self._check(self._lib.fswsm_reset(self._h, state))
 
     def step(self, g: int | None = None) -> None:

@@ -271,6 +271,20 @@ def test_fsw_compile_writes_the_layout(tank_files, tmp_path, fsw):
     assert r.code == 2 and "the image's own path" in r.err
     r = fsw("compile", str(TANK), "-o", str(tmp_path / "a.fsm"), "--layout", str(TANK))
     assert r.code == 1 and "would overwrite an input" in r.err and TANK.read_text().startswith("[state_vector]")
+    # the image's path spelt another way (a relative path, a link) is the image's own path: it was written
+    # with the layout's text over the image, exit 0
+    import os
+
+    (tmp_path / "link.fsm").symlink_to(tmp_path / "b.fsm")
+    for out, lay in ((str(tmp_path / "b.fsm"), os.path.relpath(tmp_path / "b.fsm")),
+                     (str(tmp_path / "b.fsm"), str(tmp_path / "link.fsm"))):
+        r = fsw("compile", str(TANK), "-o", out, "--layout", lay)
+        assert r.code == 2 and "the image's own path" in r.err, r.err
+    # a layout that cannot be written leaves the image's path as it was (docs/cli.md)
+    keep = tmp_path / "keep.fsm"
+    keep.write_bytes(b"OLD")
+    r = fsw("compile", str(TANK), "-o", str(keep), "--layout", "/dev/full")
+    assert r.code == 1 and "cannot write /dev/full" in r.err and keep.read_bytes() == b"OLD", r.err
 
 
 C_STAND = r"""
@@ -536,6 +550,16 @@ BAD_LAYOUTS = [
     ("fswsm-layout 1\nschema 0x1\nsize 8\nelements 0\nbogus 1\n", ":5: unknown line `bogus`"),
     ("fswsm-layout 1\nsize 8\n", "no `schema`"),
     ("fswsm-layout 1\nschema 0x1 2 3 4 5 6 7 8 9\n", ":2: too many fields"),
+    # a name and another element's alias: the C lookup and Python's found different elements
+    ("fswsm-layout 1\nschema 0x1\nsize 9\nelements 2\nelement 0 t U64 0 8 G\nelement 1 v U8 8 1 t\n",
+     ":6: a second element named `t`"),
+    ("fswsm-layout 1\nschema 0x1\nsize 9\nelements 2\nelement 0 t U64 0 8 v\nelement 1 v U8 8 1\n",
+     ":6: a second element named `v`"),
+    ("fswsm-layout 1\nschema 0x1\nsize 16\nelements 2\nelement 0 t U64 0 8 G\nelement 1 v U64 4 8\n",
+     "elements 0 (offset 0, 8 bytes) and 1 (offset 4) overlap"),
+    ("fswsm-layout 1\nschema 0x1\nsize 16\nelements 1\nelement 0 t F64 0 8 G\n", ":5: `t` aliased G is a F64: G is a U64"),
+    ("fswsm-layout 1\nschema 0x1\nsize 8\nelements 1\nelement 0 s U8 0 1 S\n", ":5: `s` aliased S is a U8: S is a U32"),
+    ("fswsm-layout 1\nschema 0x1\nsize 8\nelements 0\nstates 0\n", ":5: `states 0`"),
 ]
 
 
@@ -565,6 +589,68 @@ def test_unreadable_files_and_bad_set_layout_are_refused(tmp_path):
             words="element 1 (F64 at offset 8) ends past the state vector's 15 bytes")
     with pytest.raises(S.ConfigError, match="tank_typo.sm:18:9"):
         S.Machine.from_sm(EXAMPLES / "tank" / "tank_typo.sm")
+    # numbers the C types would have wrapped without a word
+    _raises(S.LayoutError, lib.set_layout, ((0, 7 + 256),), 0, 8, code=S.E_LAYOUT, words="a type code 0..255")
+    _raises(S.LayoutError, lib.set_layout, ((0x10000, 4),), 0, 8, code=S.E_LAYOUT, words="an offset is 0..65535")
+    _raises(S.LayoutError, lib.set_layout, ((0, 7),), 2**32, 8, code=S.E_LAYOUT, words="schema 4294967296")
+    _raises(S.LayoutError, lib.set_layout, ((0, 7),), 0, 2**32 + 8, code=S.E_LAYOUT, words="sv_size 4294967304")
+    # a FIFO (or a device) as a layout or an image: it waited for a writer for good
+    import os
+
+    os.mkfifo(tmp_path / "fifo")
+    _raises(S.FileUnreadable, lib.load_layout_file, tmp_path / "fifo", code=S.E_FILE, words="not a regular file")
+    _raises(S.FileUnreadable, S.Machine.from_image, tmp_path / "fifo", tmp_path / "tank.layout", code=S.E_FILE,
+            words="not a regular file")
+
+
+def test_a_layout_that_is_not_the_images_is_refused(tank_files, tmp_path):
+    """The layout's state names and its G and S aliases are the image's:
+    a layout of another machine or another state vector that passed the
+    verifier named states the image has not and wrote G into another
+    element."""
+    image, layout = tank_files["f64"]
+    text = layout.read_text()
+    bad = tmp_path / "bad.layout"
+    five = text.replace("states 3", "states 5") + "state 4 D\nstate 5 E\n"
+    bad.write_text(five)
+    _raises(S.LayoutError, S.Machine.from_image, image, bad, code=S.E_LAYOUT,
+            words="the layout names 5 states and the image has 3")
+    # G on another U64 of the same offsets and types: a layout of another state vector with the same schema
+    assert "element 0 time U64 0 8 G" in text and "element 1 state U32 8 4 S" in text
+    sv = tmp_path / "two.sv"
+    sv.write_text("[Sv]\nU64 time\nU32 state\nU64 other\n")
+    sm = tmp_path / "two.sm"
+    sm.write_text("[state_vector]\nU64 time @alias G\nU32 state @alias S\nU64 other\n\n[A]\n.step\n    other = T\n")
+    from fswkit.testing.runner import run_fsw
+
+    r = run_fsw("compile", str(sm), "-o", str(tmp_path / "two.fsm"), "--layout", str(tmp_path / "two.layout"))
+    assert r.code == 0, r.err
+    two = (tmp_path / "two.layout").read_text()
+    moved = two.replace("element 0 time U64 0 8 G", "element 0 time U64 0 8").replace(
+        "element 2 other U64 12 8", "element 2 other U64 12 8 G")
+    assert moved != two
+    bad.write_text(moved)
+    _raises(S.LayoutError, S.Machine.from_image, tmp_path / "two.fsm", bad, code=S.E_LAYOUT,
+            words="the layout calls element 2 G, and the image's G is element 0")
+    assert S.Machine.from_image(tmp_path / "two.fsm", tmp_path / "two.layout").names == ["time", "state", "other"]
+
+
+def test_a_layout_of_the_other_evaluation_type_is_refused(tank_files):
+    """An f64 image with the layout `fsw compile --real f32` wrote (its
+    `real 32` line): the layout of another compile of the machine."""
+    image, layout32 = tank_files["f64"][0], tank_files["f32"][1]
+    e = _raises(S.WrongReal, S.Machine.from_image, image, layout32, code=S.E_REAL,
+                words="the layout is of binary32 images, and this library is libfswsm64")
+    assert e.reason == 0
+
+
+def test_names_with_a_nul_and_state_ids_past_32_bits_are_refused(tank_files):
+    m = S.Machine.from_image(*tank_files["f64"])
+    _raises(S.NameNotFound, m.__getitem__, "tankPressure\0junk", code=S.E_NAME, words="a name holds no NUL")
+    _raises(S.StateError, m.reset, "Idle\0zzz", code=S.E_STATE, words="a name holds no NUL")
+    _raises(S.StateError, m.reset, 2**32 + 3, code=S.E_STATE, words="state 4294967299")
+    m.reset("Idle")
+    assert m.state == "Idle"
 
 
 # ---- 4. several machines at once -----------------------------------------------------------------

@@ -41,7 +41,9 @@ def cmd_compile(args) -> int:
                          f"(reason {reason}: {V.REASONS[reason]})\n")
         return EXIT_INTERNAL
     layout = getattr(args, "layout", None)
-    if layout is not None and (layout == "-" or layout == args.output):
+    from fswkit.outputs import same_file
+
+    if layout is not None and (layout == "-" or (args.output != "-" and same_file(layout, args.output))):
         sys.stderr.write(f"fsw compile: --layout {layout}: " + ("the image goes to standard output; the layout "
                          "needs a file" if layout == "-" else "the image's own path: name another file") + "\n")
         return EXIT_CONFIG
@@ -49,16 +51,23 @@ def cmd_compile(args) -> int:
         if layout is not None:  # checked before anything is written
             from fswkit.outputs import check
             check(layout, (args.machine, m.sv.path))
-        if args.output == "-":
-            sys.stdout.buffer.write(image)
-            sys.stdout.buffer.flush()
-        else:
-            with output(args.output, (args.machine, m.sv.path), binary=True) as out:
-                out.write(image)
-        if layout is not None:
+        def write_layout() -> None:
             from fswkit.sm import layout_text
             with output(layout, (args.machine, m.sv.path), newline="\n", what="layout") as out:
                 out.write(layout_text(m, real.bits, None if args.output == "-" else args.output))
+
+        if args.output == "-":
+            sys.stdout.buffer.write(image)
+            sys.stdout.buffer.flush()
+            if layout is not None:
+                write_layout()
+        else:
+            # the layout is written inside the image's block: a layout that cannot be written (a full
+            # disk, /dev/full) leaves the image's path as it was
+            with output(args.output, (args.machine, m.sv.path), binary=True) as out:
+                out.write(image)
+                if layout is not None:
+                    write_layout()
     except OutputError as e:
         sys.stderr.write(f"fsw compile: {e}\n")
         return EXIT_FAIL

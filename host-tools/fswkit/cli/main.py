@@ -50,6 +50,15 @@ def _nonneg_float(text: str) -> float:
     return value
 
 
+def _seconds(text: str) -> float:
+    """A finite number of seconds, 0 or more (a NaN or an infinity would
+    make a wait that never ends)."""
+    value = _nonneg_float(text)
+    if value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds, found {text}")
+    return value
+
+
 def _positive_int(text: str) -> int:
     try:
         value = int(text)
@@ -296,7 +305,7 @@ def parser() -> argparse.ArgumentParser:
     mc.add_argument("--activate", action="store_true", help="upload: activate the image once it is committed")
     mc.add_argument("--restart", action="store_true", help="upload: start over instead of resuming an interrupted "
                     "upload of the same image")
-    mc.add_argument("--wait", type=float, default=10.0, metavar="S", help="activate, revert: seconds to wait for "
+    mc.add_argument("--wait", type=_seconds, default=10.0, metavar="S", help="activate, revert: seconds to wait for "
                     "the machine to reach a state that allows the switch (default 10)")
     mc.add_argument("--ignore-schema", action="store_true", help="talk to the target even when the schema differs")
     mc.set_defaults(func=_command("machine", "cmd_machine"))

@@ -1,8 +1,8 @@
 # Navigation: a barometer reading that is not a pressure moves nothing.
-# A single reading's spike (a glitch on the line) is outvoted by its
-# neighbours in the median of three, and a reading outside the sensor's
-# span (an open line reads 0 V: 76,875 Pa) is not taken at all, however
-# long it lasts. Either one would otherwise pass through the average into
+# A single reading's spike (a glitch on the line: more than GATE from the
+# last reading taken) is not taken, the last good reading standing in, and
+# a reading outside the sensor's span (an open line reads 0 V: 76,875 Pa)
+# is not taken at all, however long it lasts. Either one would otherwise pass through the average into
 # the altitude and could call apogee early (docs/sim.md, the study).
 
 [options]

@@ -257,13 +257,13 @@ int install_layout(fswsm* h, const uint16_t* offsets, const uint8_t* types, uint
         return x < y ? -1 : x > y ? 1 : 0;
     });
     for (uint32_t k = 1; k < count; ++k) {
-        const uint32_t a = order[k - 1u] & 0xFFFFu, b = order[k] & 0xFFFFu;
+        const uint32_t a = order[k - 1u] & 0xFFFFu, b = order[k] & 0xFFFFu;  // a's offset first
         if (static_cast<uint32_t>(offsets[a]) + fsw::elem_size(types[a]) > offsets[b]) {
+            const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;  // named in layout order
             free(order);
             free(elems);
-            return fail(h, FSWSM_E_LAYOUT, "elements %u (offset %u, %u bytes) and %u (offset %u) overlap", a < b ? a : b,
-                        offsets[a < b ? a : b], fsw::elem_size(types[a < b ? a : b]), a < b ? b : a,
-                        offsets[a < b ? b : a]);
+            return fail(h, FSWSM_E_LAYOUT, "elements %u (offset %u, %u bytes) and %u (offset %u) overlap", lo,
+                        offsets[lo], fsw::elem_size(types[lo]), hi, offsets[hi]);
         }
     }
     free(order);
@@ -809,31 +809,24 @@ int fswsm_load_image(fswsm* h, const uint8_t* image, uint32_t len) {
                     why < kReasonCount ? kReasonNames[why] : "?", why < kReasonCount ? kReasons[why] : "?");
     }
     // what the layout's names say of the image: its states, and the elements it calls G and S
-    const char* mismatch = 0;
-    unsigned said = 0, is = 0;
     if (h->n_state_names != 0 && h->n_state_names != copy[18]) {
-        mismatch = "states";
-        said = h->n_state_names;
-        is = copy[18];
-    }
-    for (uint32_t k = 0; mismatch == 0 && h->aliases != 0 && k < h->count; ++k) {
-        if (h->aliases[k] == 0 || (strcmp(h->aliases[k], "G") != 0 && strcmp(h->aliases[k], "S") != 0)) continue;
-        const unsigned at = h->aliases[k][0] == 'G' ? 14u : 16u;
-        const unsigned index = static_cast<unsigned>(copy[at] | (copy[at + 1u] << 8));
-        if (index != k) {
-            mismatch = h->aliases[k];
-            said = k;
-            is = index;
-        }
-    }
-    if (mismatch != 0) {
+        const unsigned states = copy[18];
         free(copy);
         free(ram);
-        if (strcmp(mismatch, "states") == 0)
-            return fail(h, FSWSM_E_LAYOUT, "the layout names %u states and the image has %u: a layout of another "
-                        "machine", said, is);
-        return fail(h, FSWSM_E_LAYOUT, "the layout calls element %u %s, and the image's %s is element %u: a "
-                    "layout of another state vector", said, mismatch, mismatch, is);
+        return fail(h, FSWSM_E_LAYOUT, "the layout names %u states and the image has %u: a layout of another "
+                    "machine", h->n_state_names, states);
+    }
+    for (uint32_t k = 0; h->aliases != 0 && k < h->count; ++k) {
+        const char* alias = h->aliases[k];
+        if (alias == 0 || (strcmp(alias, "G") != 0 && strcmp(alias, "S") != 0)) continue;
+        const unsigned at = alias[0] == 'G' ? 14u : 16u;  // the header's G and S element indices
+        const unsigned index = static_cast<unsigned>(copy[at] | (copy[at + 1u] << 8));
+        if (index != k) {
+            free(copy);
+            free(ram);
+            return fail(h, FSWSM_E_LAYOUT, "the layout calls element %u %s, and the image's %s is element %u: a "
+                        "layout of another state vector", k, alias, alias, index);
+        }
     }
     drop_image(h);
     h->image = copy;

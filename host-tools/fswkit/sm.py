@@ -256,6 +256,15 @@ def library(real: str = "f64") -> ctypes.CDLL:
 
 # ---- the layout file (`fsw compile --layout`) -------------------------------------------------
 
+def _c_name(name, exc, code: int, code_name: str, what: str) -> bytes:
+    """A name for the C API: C reads a string up to its first NUL, so a name
+    holding one would find the element or state named by what precedes it."""
+    text = str(name)
+    if "\0" in text:
+        raise exc(code, code_name, f"no {what} named {text!r}: a name holds no NUL")
+    return text.encode()
+
+
 def layout_text(m, real_bits: int, image: str | None = None) -> str:
     """The layout file of machine `m` (fswkit.autocode.model.Machine) and
     its image compiled for binary`real_bits`: what libfswsm needs besides
@@ -445,10 +454,9 @@ class Machine:
             return name
         k = self._index.get(name)
         if k is None:
-            if "\0" in str(name):  # C would read the name up to it, and find another element
-                raise NameNotFound(E_NAME, "FSWSM_E_NAME", f"no element named {name!r}: a name holds no NUL")
+            c_name = _c_name(name, NameNotFound, E_NAME, "FSWSM_E_NAME", "element")
             n = ctypes.c_uint32()
-            self._check(self._lib.fswsm_element_index(self._h, str(name).encode(), ctypes.byref(n)))
+            self._check(self._lib.fswsm_element_index(self._h, c_name, ctypes.byref(n)))
             k = self._index[name] = n.value
         return k
 
@@ -492,10 +500,9 @@ class Machine:
     def reset(self, state=1) -> None:
         """Back to before the first step, in `state` (a name or an id, 1..)."""
         if isinstance(state, str):
-            if "\0" in state:  # C would read the name up to it
-                raise StateError(E_STATE, "FSWSM_E_STATE", f"no state named {state!r}: a name holds no NUL")
+            c_name = _c_name(state, StateError, E_STATE, "FSWSM_E_STATE", "state")
             n = ctypes.c_uint32()
-            self._check(self._lib.fswsm_state_id(self._h, state.encode(), ctypes.byref(n)))
+            self._check(self._lib.fswsm_state_id(self._h, c_name, ctypes.byref(n)))
             state = n.value
         if not (isinstance(state, int) and 0 <= state <= 0xFFFFFFFF):  # the C type would wrap it
             raise StateError(E_STATE, "FSWSM_E_STATE", f"state {state!r}: a state id is a name or a number 1..255")

@@ -13,7 +13,7 @@ def cmd_compile(args) -> int:
     from fswkit.autocode import vmverify as V
     from fswkit.autocode.emit.bytecode import BytecodeError, compile_machine
     from fswkit.autocode.project import load_machine
-    from fswkit.outputs import OutputError, output
+    from fswkit.outputs import OutputError, check, output, same_file
 
     real = real_of(args, "compile")
     if real is None:
@@ -41,16 +41,14 @@ def cmd_compile(args) -> int:
                          f"(reason {reason}: {V.REASONS[reason]})\n")
         return EXIT_INTERNAL
     layout = getattr(args, "layout", None)
-    from fswkit.outputs import same_file
-
     if layout is not None and (layout == "-" or (args.output != "-" and same_file(layout, args.output))):
         sys.stderr.write(f"fsw compile: --layout {layout}: " + ("the image goes to standard output; the layout "
                          "needs a file" if layout == "-" else "the image's own path: name another file") + "\n")
         return EXIT_CONFIG
     try:
         if layout is not None:  # checked before anything is written
-            from fswkit.outputs import check
             check(layout, (args.machine, m.sv.path))
+
         def write_layout() -> None:
             from fswkit.sm import layout_text
             with output(layout, (args.machine, m.sv.path), newline="\n", what="layout") as out:

@@ -259,8 +259,7 @@ def tape_run(args) -> int:
     name = os.path.splitext(os.path.basename(args.tape))[0]
     out = args.out or os.path.join(default_out(app), f"tape-{name}")
     try:
-        if os.path.isdir(out):
-            refuse_inputs(out, [args.tape, args.params, args.fw_params], extra=("perturb.csv", "perturb.txt"))
+        refuse_inputs(out, [args.tape, args.params, args.fw_params], extra=("perturb.csv", "perturb.txt"))
     except OutputError as e:
         say(str(e))
         return 2

@@ -141,8 +141,7 @@ def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
     sc = study.scenario_for(setup, d)
     out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
     try:
-        if os.path.isdir(out):
-            refuse_inputs(out, [params, args.dispersion])
+        refuse_inputs(out, [params, args.dispersion])
     except OutputError as e:
         say(str(e))
         return 2

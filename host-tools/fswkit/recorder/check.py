@@ -86,7 +86,7 @@ def recorder_report(app, run, check_cls, *, launch_s: float | None, landed_s: fl
         return lines, [check_cls("the recorder stored the flight's samples", False,
                                  f"flight {flight.number} holds no sample: the run ended before the first was "
                                  "written")], (p, flight)
-    span = (s[-1][0] - s[0][0]) / 1000 if s else 0.0
+    span = (s[-1][0] - s[0][0]) / 1000
     per_record = len(s) / max(1, len(flight.records))
     capacity = (p.slots - 1) * per_record * span / max(1, len(s) - 1) if len(s) > 1 else 0.0
     lines.append(f"  flight {flight.number}: {len(s)} samples in {used} records ({used * p.record} B), "

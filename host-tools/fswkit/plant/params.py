@@ -89,23 +89,41 @@ _STRINGS = re.compile(r"\"(\\.|[^\"\\])*\"|'[^']*'")
 
 def locate(text: str) -> dict[tuple[str, str], int]:
     """(table, key) -> line of `key =` in that table, and (table, "") -> the
-    line of the table's header. Keys before any header are in table ""."""
+    line of the table's header. Keys before any header are in table "". A
+    dotted key (`vehicle.mass_sd = 0.1`) is located as the key it sets and
+    each table it names on the way; an array of tables (`[[name]]`) as the
+    key `name` of the table it is in."""
     where: dict[tuple[str, str], int] = {("", ""): 1}
     table = ""
-    header = re.compile(r"\s*\[\s*([A-Za-z0-9_.\-\" ]+?)\s*\]\s*(#.*)?$")
-    key = re.compile(r"\s*([A-Za-z0-9_\-]+|\"[^\"]*\")\s*=")
+    part = r"(?:[A-Za-z0-9_\-]+|\"[^\"]*\")"
+    header = re.compile(r"\s*(\[\[?)\s*(" + part + r"(?:\s*\.\s*" + part + r")*)\s*\]\]?\s*(#.*)?$")
+    key = re.compile(r"\s*(" + part + r"(?:\s*\.\s*" + part + r")*)\s*=")
     depth = 0  # brackets still open in a multi-line value
+
+    def parts(dotted: str) -> list[str]:
+        return [p.strip('"') for p in re.findall(part, dotted)]
+
     for n, line in enumerate(text.splitlines(), 1):
         code = _STRINGS.sub('""', line).split("#", 1)[0]
         if depth == 0:
             m = header.match(line)
-            if m and not line.lstrip().startswith("[["):
-                table = m.group(1).replace('"', "").replace(" ", "")
-                where.setdefault((table, ""), n)
+            if m:
+                names = parts(m.group(2))
+                if m.group(1) == "[[":  # an array of tables: located as the key that holds it
+                    where.setdefault((".".join(names[:-1]), names[-1]), n)
+                    table = "[[" + ".".join(names)  # its keys are no table's the schema knows
+                else:
+                    table = ".".join(names)
+                    where.setdefault((table, ""), n)
                 continue
             m = key.match(line)
             if m:
-                where.setdefault((table, m.group(1).strip('"')), n)
+                names = parts(m.group(1))
+                for i, name in enumerate(names):
+                    at = ".".join([table] * bool(table) + names[:i])
+                    where.setdefault((at, name), n)
+                    if i:
+                        where.setdefault((at, ""), n)
                 code = code.split("=", 1)[1]
             else:
                 continue
@@ -221,7 +239,9 @@ def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, lis
                 err(1, f"missing table [{tname}] ({table.doc})")
             got = {}
         elif tname and not isinstance(got, dict):
-            err(where.get(("", tname), 1), f"`{tname}` must be a table [{tname}]")
+            many = isinstance(got, list) and got and all(isinstance(x, dict) for x in got)
+            err(where.get(("", tname), 1), f"`{tname}` must be a table [{tname}]"
+                + (f", not an array of tables [[{tname}]]" if many else ""))
             got = {}
         vals = {}
         for key, f in table.fields.items():
@@ -236,7 +256,7 @@ def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, lis
                 err(where.get((tname, key), tline), e)
             vals[key] = v
         for key in got:
-            if tname == "" and key in schema and isinstance(got[key], dict):
+            if tname == "" and key in schema:  # a table's name: its own check reports a value that is not one
                 continue
             if key not in table.fields:
                 label = f"[{tname}] " if tname else ""

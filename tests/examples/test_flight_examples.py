@@ -12,6 +12,7 @@ from conftest import EXAMPLES
 # example -> the scripts it must have
 EXPECTED = {
     "rocket": {"mission_flight.ss", "mission_backup.ss", "mission_pad.ss", "mission_continuity.ss", "nav.ss",
+               "mission_high.ss", "mission_frozen.ss",
                "nav_spikes.ss"},
     "hpr": {"nav.ss", "mission_flight.ss", "mission_pad.ss", "mission_lockout.ss", "mission_backup.ss",
             "mission_stuck.ss", "mission_ballistic.ss", "nav_fault.ss"},

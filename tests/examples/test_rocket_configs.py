@@ -14,12 +14,12 @@ def test_coverage_names_what_one_script_misses(fsw):
     r = fsw("test", "--coverage", str(ROCKET / "mission_flight.ss"))
     assert r.code == 1
     assert "coverage of mission.sm: 9/10 states, 9/16 transitions" in r.out
-    assert "mission.sm:127: state Abort never entered" in r.out
+    assert "mission.sm:138: state Abort never entered" in r.out
     assert "transition Safe -> Abort never taken" in r.out
     assert "transition Coast -> Apogee never taken" in r.out  # the backup timer's
-    assert "mission.sm:105:23: transition Drogue -> Main never taken" in r.out  # and the main's
+    assert "mission.sm:116:41: transition Drogue -> Main never taken" in r.out  # and the main's
     # one report, unchanged, for one script
-    assert r.out.startswith("state script ran for 4348 steps\n")
+    assert r.out.startswith("state script ran for 4349 steps\n")
 
 
 def test_several_scripts_fail_together(fsw, tmp_path):

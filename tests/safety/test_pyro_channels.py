@@ -26,13 +26,13 @@ pyro channel drogue (rocket.app:60)
   machine:     mission; armed states Armed; fire states Apogee
   unarmed:     Safe, Abort (reached without an armed state: none sets it true)
   arming transitions (each requires armSwitch):
-    Safe -> Armed  mission.sm:65
+    Safe -> Armed  mission.sm:74
   states that can fire it:
-    Apogee  .entry  mission.sm:93  drogue = true
+    Apogee  .entry  mission.sm:102  drogue = true
       arming path: Safe -> Armed -> Boost -> Coast -> Apogee
   transitions that can fire it:
-    Coast -> Apogee  mission.sm:88  (enters Apogee)
-    Coast -> Apogee  mission.sm:89  (enters Apogee)
+    Coast -> Apogee  mission.sm:97  (enters Apogee)
+    Coast -> Apogee  mission.sm:98  (enters Apogee)
 
 pyro channel main (rocket.app:61)
   output:      pin 6 (rocket.dio:5), pulse 1 s
@@ -41,13 +41,13 @@ pyro channel main (rocket.app:61)
   machine:     mission; armed states Armed; fire states Main
   unarmed:     Safe, Abort (reached without an armed state: none sets it true)
   arming transitions (each requires armSwitch):
-    Safe -> Armed  mission.sm:65
+    Safe -> Armed  mission.sm:74
   states that can fire it:
-    Main  .entry  mission.sm:109  main = true
+    Main  .entry  mission.sm:120  main = true
       arming path: Safe -> Armed -> Boost -> Coast -> Apogee -> Drogue -> Main
   transitions that can fire it:
-    Drogue -> Main  mission.sm:104  (enters Main)
-    Drogue -> Main  mission.sm:105  (enters Main)
+    Drogue -> Main  mission.sm:115  (enters Main)
+    Drogue -> Main  mission.sm:116  (enters Main)
 """
 
 

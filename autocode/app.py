@@ -41,15 +41,17 @@ from .model import TASK_KINDS, TASK_MODES, Application, Channel, Stream, Task
 __all__ = ["TASK_KINDS", "TASK_MODES", "Application", "Channel", "Stream", "Task", "application", "load_app"]
 
 
-def load_app(path: str, diags: Diagnostics, board_override: str | None = None) -> Application | None:
+def load_app(path: str, diags: Diagnostics, board_override: str | None = None,
+             instead: dict[str, str] | None = None) -> Application | None:
     """The checked application with its state vector, machines and tables;
-    None with every error in `diags`."""
+    None with every error in `diags`. `instead`: {machine name: a file to
+    read that machine from} (appcheck.check_app)."""
     src = read_source(path, diags, APP)
     if src is None:
         return None
     before = diags.error_count
     tree = parse_app(src, diags)
-    parts = check_app(tree, diags, board_override, load_board)
+    parts = check_app(tree, diags, board_override, load_board, instead)
     if parts is None or not complete(parts, src, diags, before):
         return None
     app = application(path, parts)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 
 from . import model as M
@@ -80,10 +80,13 @@ class Report:
         self.diags.error(self.src, APP, line, col, msg)
 
 
-def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_board) -> Parts | None:
+def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_board,
+              instead: dict[str, str] | None = None) -> Parts | None:
     """The parts of the application in `f`; None when it has no state vector
     to check the rest against. `load_board(name)` gives a board or raises
-    BoardError."""
+    BoardError. `instead`: {machine name: a file to read that machine from}
+    (the application with an uploaded machine in place of its generated
+    one, `fsw machine upload`)."""
     r = Report(f.src, diags)
     settings = _settings(f.application, r)
     name = settings["name"].text if "name" in settings else os.path.splitext(os.path.basename(f.src.path))[0]
@@ -101,7 +104,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     if sv_src is None:
         return None
     sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
-    machines, machine_srcs = _machines(machine_files, sv, board, r)
+    machines, machine_srcs = _machines(machine_files, sv, board, r, instead or {})
     _parameters(machines, machine_files, board, r)
     channels, sensors = _channels(io_files, sv, board, r) if board is not None else ([], [])
 
@@ -267,18 +270,23 @@ def _configs(rows: tuple[ConfigFile, ...], r: Report):
     return sv_file, machine_files, io_files
 
 
-def _machines(files: list[ConfigFile], sv: M.StateVector, board: Board | None, r: Report):
+def _machines(files: list[ConfigFile], sv: M.StateVector, board: Board | None, r: Report,
+              instead: dict[str, str]):
     """(the machines, {machine name: its source}) of the `machine` files
-    that read, check and have names the generated code can take."""
+    that read, check and have names the generated code can take; a machine
+    named in `instead` is read from that file, under its own name."""
     machines: list[M.Machine] = []
     srcs: dict[str, Source] = {}  # where a machine's writes are reported
     for c in files:
-        msrc = read_source(c.path, r.diags, APP)
+        name = os.path.splitext(os.path.basename(c.path))[0]
+        msrc = read_source(instead.get(name, c.path), r.diags, APP)
         if msrc is None:
             continue
         m = check_sm(parse_sm(msrc, r.diags), msrc, sv, r.diags)
         if m is None:
             continue
+        if name in instead:
+            m = replace(m, name=name)
         if board is not None:  # an error, and the machine still known to the rest of the file
             check_literals(machine_exprs(m), REALS[board.real], msrc, r.diags, SM, f"the {board.name}'s")
         problem = _machine_name_problem(m, c, machines)

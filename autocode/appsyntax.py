@@ -32,6 +32,14 @@ class Problem:
 # ---- the application config (.app) ----------------------------------------------
 
 SECTIONS = ("application", "configs", "time", "tasks", "telemetry", "uplink", "budget", "log", "pyro", "reload")
+# Sections whose presence turns a feature on, and what they need: written
+# empty, they would otherwise read as absent, and the feature silently off.
+NEEDS_ROWS = {
+    "log": "`store`, `machine`, `trigger` and an `element` (docs/recorder.md); remove the section for an "
+           "application without a flight recorder",
+    "reload": "`machine NAME`, the machine the ground may replace (docs/reload.md); remove the section for an "
+              "application without one",
+}
 
 
 @dataclass(frozen=True)
@@ -136,6 +144,9 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
             diags.error(src, APP, header.line, header.col + 1, f"duplicate section `[{header.name}]`")
         else:
             body[header.name] = rows
+            if not rows and header.name in NEEDS_ROWS:  # else it would read as no section at all
+                diags.error(src, APP, header.line, header.col + 1,
+                            f"[{header.name}] is empty: it needs {NEEDS_ROWS[header.name]}")
     folder = os.path.dirname(src.path)
     rows = lambda name, row: tuple(row(toks) for toks in body.get(name, ()))  # noqa: E731
     return AppFile(

@@ -34,12 +34,16 @@ void volatile wchar_t while xor xor_eq typeof
 """.split())
 
 # Names the generated code and the runtime use in or around namespace
-# `fsw_gen`, and names the C library or the compilers define as macros in
-# lowercase (`stdin`, avr-libc's `sinf`, GNU mode's `linux`): a machine
-# namespace of that name would hide or be replaced by them.
+# `fsw_gen` (the optional sections' too: [reload], [log], parameters, the
+# resume after a reset, sensor tables), and names the C library or the
+# compilers define as macros in lowercase (`stdin`, avr-libc's `sinf`, GNU
+# mode's `linux`): a machine namespace of that name would hide or be
+# replaced by them.
 TAKEN = frozenset("""
 fsw fsw_gen std sv app ex stats link begin poll run_cycle setup loop main run_script
 script_main script_avr fswkit arduino
+reload reload_image reload_ram params param_staged rec resume time_base millis64 pulses samples
+log_fifo log_last log_nor_cs log_ring sensor_health
 memcpy memset memcmp memmove strcmp strlen strtoul sscanf printf fprintf sprintf snprintf
 fopen fclose fwrite fread fflush usleep clock_gettime timespec time errno assert offsetof
 trace_row put64 print_value as_signed as_unsigned var_bytes write_trace fsw_trace_write
@@ -51,8 +55,9 @@ con prn aux nul
 """.split())
 
 # Patterns of generated or library names: `*_t` types, the generated
-# `task_*` and `link_*` names, windows `w0`/`sw0`, Windows device files.
-TAKEN_PATTERN = re.compile(r".*_t|task_.*|link_.*|s?w[0-9]+|s[0-9]+_(entry|step|exit)|(com|lpt)[0-9]")
+# `task_*` and `link_*` names, windows `w0`/`sw0`, sensor parts `sensor0`,
+# Windows device files.
+TAKEN_PATTERN = re.compile(r".*_t|task_.*|link_.*|s?w[0-9]+|s[0-9]+_(entry|step|exit)|sensor[0-9]+|(com|lpt)[0-9]")
 
 # Macros of the headers generated code sees (glibc's stdio.h and unistd.h,
 # avr-libc) that a prefixed enumerator could spell.

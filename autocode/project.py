@@ -14,13 +14,16 @@ from .parser import parse_sm, parse_ss, parse_sv
 def find_beside(path: str, ext: str) -> str | None:
     """The `ext` file that belongs with `path`: same stem; else the one whose
     stem is the longest prefix of this stem (`tank_770.ss` → `tank.sm`);
-    else the only one in the folder."""
+    else the only one in the folder; for a state vector, else the one the
+    folder's only application config names (a machine to upload beside its
+    project, docs/reload.md)."""
     folder = os.path.dirname(path)
     stem = os.path.splitext(os.path.basename(path))[0]
     try:
-        names = sorted(n for n in os.listdir(folder or ".") if n.endswith(ext))
+        listing = sorted(os.listdir(folder or "."))
     except OSError:
         return None
+    names = [n for n in listing if n.endswith(ext)]
     stems = [n[: -len(ext)] for n in names]
     if stem in stems:
         return os.path.join(folder, stem + ext)
@@ -29,7 +32,23 @@ def find_beside(path: str, ext: str) -> str | None:
         return os.path.join(folder, max(prefixes, key=len) + ext)
     if len(names) == 1:
         return os.path.join(folder, names[0])
+    apps = [n for n in listing if n.endswith(".app")]
+    if ext == ".sv" and not names and len(apps) == 1:
+        return _app_state_vector(os.path.join(folder, apps[0]))
     return None
+
+
+def _app_state_vector(app: str) -> str | None:
+    """The `state_vector` an application config's [configs] names (the
+    config read only that far: its own errors are `fsw check`'s of it)."""
+    from .appsyntax import parse_app
+    from .diagnostics import APP
+
+    src = read_source(app, Diagnostics(), APP)
+    if src is None:
+        return None
+    rows = [c for c in parse_app(src, Diagnostics()).configs if c.kind.text == "state_vector" and c.file is not None]
+    return rows[0].path if len(rows) == 1 else None
 
 
 def load_sv(path: str, diags: Diagnostics) -> M.StateVector | None:

@@ -25,6 +25,7 @@ SIZE_RANGE = (32, 4096)
 RAM_RANGE = (0, 4096)
 DEFAULT_SIZE = 256
 DEFAULT_RAM = 64
+IMAGE_STATES = 255  # an image's states are counted in a byte (autocode/emit/bytecode.py)
 
 
 def eeprom_bytes(size: int) -> int:
@@ -55,11 +56,18 @@ def check_reload(rows: tuple[Setting, ...], tasks: list[M.Task], machines: list[
     else:
         s = once["machine"]
         names = [m.name for m in machines]
-        if len(s.values) != 1 or s.values[0].text not in names:
+        if len(s.values) > 1:
+            r.err(s.values[1], "`machine` takes one value: the reloadable machine is one")
+        elif not s.values or s.values[0].text not in names:
             r.err(s.values[0] if s.values else s.key,
                   f"`machine` takes the name of a machine from [configs] ({', '.join(names) or 'none'})")
         else:  # a task runs it: every machine has one (appcheck)
             machine = names.index(s.values[0].text)
+            n = len(machines[machine].states)
+            if n > IMAGE_STATES:
+                r.err(s.values[0], f"machine `{names[machine]}` has {n} states: an uploaded machine keeps them at "
+                                   f"their numbers and an image holds at most {IMAGE_STATES}, so no machine could "
+                                   "ever replace it")
     size = _number(once.get("size"), DEFAULT_SIZE, SIZE_RANGE, "the bytes of a slot (an image and its state mask)", r)
     ram = _number(once.get("ram"), DEFAULT_RAM, RAM_RANGE, "the bytes for an image's windows and locals", r)
     activate: tuple[str, ...] = ()
@@ -87,6 +95,10 @@ def check_reload(rows: tuple[Setting, ...], tasks: list[M.Task], machines: list[
     if board is not None and r.diags.error_count == before:
         at = once["size"].values[0] if "size" in once and once["size"].values else first
         _eeprom_room(machines, board, log, size, at, r)
+        if board.is_avr and board.ram and size + ram > board.ram:  # static buffers: the build could never fit
+            at = next((once[k].values[0] for k in ("ram", "size") if k in once and once[k].values), first)
+            r.err(at, f"the image's copy (size {size:,} B) and its windows and locals (ram {ram:,} B) take "
+                      f"{size + ram:,} B: more than the {board.name}'s RAM ({board.ram:,} B); lower `ram` or `size`")
     if r.diags.error_count != before or machine is None:
         return None
     return M.Reload(machine, size, ram, activate, first.line)
@@ -94,6 +106,10 @@ def check_reload(rows: tuple[Setting, ...], tasks: list[M.Task], machines: list[
 
 def _number(s: Setting | None, default: int, span: tuple[int, int], what: str, r) -> int:
     if s is None:
+        return default
+    signed = len(s.values) == 2 and s.values[0].text in ("-", "+") and s.values[1].kind == NUM  # out of range
+    if len(s.values) > 1 and not signed:
+        r.err(s.values[1], f"`{s.key.text}` takes one value")
         return default
     t = s.values[0] if s.values else s.key
     if len(s.values) != 1 or t.kind != NUM or not t.text.isdigit() or not span[0] <= int(t.text) <= span[1]:

@@ -3,9 +3,9 @@
 # between two hot fires without reflashing the Uno (docs/reload.md):
 #
 #     fsw compile tank_700.sm --sv ../tank/tank.sv -o tank_700.fsm
-#     fsw machine examples/stand upload tank_700.sm --activate
-#     fsw machine examples/stand list
-#     fsw machine examples/stand revert
+#     fsw machine . upload tank_700.sm --activate --port /dev/ttyACM0
+#     fsw machine . list --port /dev/ttyACM0
+#     fsw machine . revert --port /dev/ttyACM0
 
 [application]
 board uno

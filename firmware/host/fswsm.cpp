@@ -487,7 +487,7 @@ int parse_layout(fswsm* h, const char* text, const char* where) {
     }
     free(buf);
     if (r == 0) {
-        const char* missing = !p.has_version ? "the `fswsm-layout 1` line"
+        const char* missing = !p.has_version ? "`fswsm-layout 1` line (an empty file, or not a layout)"
                               : !p.has_schema ? "`schema`"
                               : !p.has_size   ? "`size`"
                               : !p.has_count  ? "`elements`"

@@ -282,9 +282,9 @@ def test_fsw_compile_writes_the_layout(tank_files, tmp_path, fsw):
         assert r.code == 2 and "the image's own path" in r.err, r.err
     # a layout that cannot be written leaves the image's path as it was (docs/cli.md)
     keep = tmp_path / "keep.fsm"
-    keep.write_bytes(b"OLD")
+    keep.write_bytes(b"FSMB OLD")  # an image of before (another file is not replaced unasked at all)
     r = fsw("compile", str(TANK), "-o", str(keep), "--layout", "/dev/full")
-    assert r.code == 1 and "cannot write /dev/full" in r.err and keep.read_bytes() == b"OLD", r.err
+    assert r.code == 1 and "cannot write /dev/full" in r.err and keep.read_bytes() == b"FSMB OLD", r.err
 
 
 C_STAND = r"""
@@ -533,7 +533,7 @@ def test_calls_out_of_order_and_null_arguments_are_refused():
 
 
 BAD_LAYOUTS = [
-    ("", "no the `fswsm-layout 1` line"),
+    ("", "no `fswsm-layout 1` line (an empty file, or not a layout)"),
     ("elements 1\n", "not a layout file"),
     ("fswsm-layout 2\n", "layout format 2"),
     ("fswsm-layout 1\nschema 0x1\nsize 8\nelements 1\nelement 0 time U64 1 8\n", "ends past the state vector"),

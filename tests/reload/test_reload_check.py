@@ -39,6 +39,32 @@ def test_activate_without_states_is_refused(tmp_path):
     assert _errors(_rig(tmp_path, "machine rig\nactivate\n")) == [(36, "`activate` takes states of machine `rig`")]
 
 
+def test_a_signed_number_is_one_value_out_of_range(tmp_path):
+    """`size -5` is a number out of range, not two values."""
+    msg = "`size` takes the bytes of a slot (an image and its state mask): a whole number from 32 to 4096"
+    assert _errors(_rig(tmp_path, "machine rig\nsize -5\n")) == [(36, msg)]
+    assert _errors(_rig(tmp_path, "machine rig\nsize +128\n")) == [(36, msg)]
+
+
+def test_a_machine_no_image_could_replace_is_refused(tmp_path):
+    """An uploaded machine keeps the generated machine's states at their
+    numbers; an image holds at most 255 states: a machine of 256 could never
+    be replaced, and the section is refused (255 is the boundary)."""
+    head = (GOLDEN / "rig.sm").read_text()
+    for n, ok in ((255, True), (256, False)):
+        app = _rig(tmp_path, "machine rig\n")
+        (tmp_path / "rig.sm").write_text(head + "".join(f"\n[X{i}]\n" for i in range(n - _states(head))))
+        errs = _errors(app)
+        assert (errs == []) is ok, errs
+    assert errs == [(35, "machine `rig` has 256 states: an uploaded machine keeps them at their numbers and an image "
+                         "holds at most 255, so no machine could ever replace it")]
+
+
+def _states(sm_text: str) -> int:
+    return sum(1 for line in sm_text.splitlines() if re.fullmatch(r"\[[A-Za-z_]\w*\]", line.strip())
+               and line.strip() not in ("[state_vector]", "[local]", "[parameters]"))
+
+
 def test_a_board_without_eeprom_is_told_so(tmp_path):
     errs = _errors(_rig(tmp_path, "machine rig\n"), lambda name: dataclasses.replace(load_board(name), eeprom=0))
     assert errs == [(35, "the uno has no EEPROM to keep uploaded machines in")]

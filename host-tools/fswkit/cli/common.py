@@ -156,6 +156,8 @@ def talk_on_link(args, layout, baud: int, say, talk, refusals: tuple) -> int:
     except refusals as e:
         say(str(e))
         return EXIT_FAIL
+    except BrokenPipeError:  # standard output's reader went away (`| head`): main's to take, not the port's
+        raise
     except port_errors() as e:
         say(f"{args.port}: the port went away ({e})")
         return EXIT_FAIL

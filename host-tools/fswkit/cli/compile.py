@@ -8,9 +8,39 @@ import sys
 from fswkit.autocode.diagnostics import SM, Diagnostics, Source
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags, real_of
 
+LAYOUT_HEAD = "fswsm-layout "  # the first line of a layout file that is not a comment (fswkit.sm.layout_text)
+
+
+def _not_ours(path: str, what: str) -> str | None:
+    """Why `path` may not be replaced by an image (`what` "image") or a
+    layout ("layout") unasked: a file that holds something else, which a
+    user wrote (a config, notes), is never overwritten without --force.
+    None for a path that does not exist, is empty, is no regular file (a
+    device) or holds what this command writes."""
+    import os
+    import stat
+
+    from fswkit.autocode.vmverify import MAGIC
+
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return None
+        with open(path, "rb") as f:
+            head = f.read(4096)
+    except OSError:
+        return None  # nothing there to lose (or unreadable: the write says why)
+    if not head:
+        return None
+    if what == "image":
+        return None if head.startswith(MAGIC) else "a bytecode image"
+    lines = (line.strip() for line in head.decode("utf-8", "replace").splitlines())
+    first = next((line for line in lines if line and not line.startswith("#")), "")
+    return None if first.startswith(LAYOUT_HEAD) else "a layout"
+
 
 def cmd_compile(args) -> int:
     from fswkit.autocode import vmverify as V
+    from fswkit.autocode.check import check_literals, machine_exprs
     from fswkit.autocode.emit.bytecode import BytecodeError, compile_machine
     from fswkit.autocode.project import load_machine
     from fswkit.outputs import OutputError, check, output, same_file
@@ -18,21 +48,26 @@ def cmd_compile(args) -> int:
     real = real_of(args, "compile")
     if real is None:
         return EXIT_CONFIG
+
+    def source() -> Source:
+        try:
+            with open(args.machine, encoding="utf-8", errors="surrogateescape") as f:
+                return Source.from_text(args.machine, f.read())
+        except OSError:
+            return Source.from_text(args.machine, "")
+
     diags = Diagnostics()
     m = load_machine(args.machine, diags, args.sv)
+    if m is not None:  # a number binary32 cannot hold would be compiled as an infinity
+        check_literals(machine_exprs(m), real, source(), diags, SM, "the image's")
     print_diags(diags)
-    if m is None:
+    if m is None or diags.error_count:
         return EXIT_CONFIG
     try:
         image = compile_machine(m, real)
     except BytecodeError as e:
-        try:
-            with open(args.machine, encoding="utf-8", errors="surrogateescape") as f:
-                src = Source.from_text(args.machine, f.read())
-        except OSError:
-            src = Source.from_text(args.machine, "")
         d = Diagnostics()
-        d.error(src, SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        d.error(source(), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
         print_diags(d)
         return EXIT_CONFIG
     reason = V.verify(image, V.layout_of(m.sv), real.bits // 8)
@@ -46,8 +81,14 @@ def cmd_compile(args) -> int:
                          "needs a file" if layout == "-" else "the image's own path: name another file") + "\n")
         return EXIT_CONFIG
     try:
-        if layout is not None:  # checked before anything is written
-            check(layout, (args.machine, m.sv.path))
+        for path in (args.output, layout):  # checked before anything is written
+            if path not in (None, "-"):
+                check(path, (args.machine, m.sv.path))
+        for path, what in ((args.output, "image"), (layout, "layout")):
+            kind = None if path in (None, "-") or args.force else _not_ours(path, what)
+            if kind is not None:
+                raise OutputError(f"{path}: the file exists and is not {kind}: it is not replaced unless asked "
+                                  "(--force)")
 
         def write_layout() -> None:
             from fswkit.sm import layout_text

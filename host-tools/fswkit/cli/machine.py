@@ -10,6 +10,9 @@ from fswkit.autocode.diagnostics import Diagnostics
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app, print_diags
 
 
+WAIT = 10.0  # seconds `activate`, `revert` and `upload --activate` wait for the switch (--wait)
+
+
 def _say(msg: str) -> None:
     sys.stderr.write(f"fsw machine: {msg}\n")
 
@@ -27,16 +30,21 @@ def image_for(app, path: str, diags: Diagnostics):
     m = load_machine(path, diags, app.sv.path)
     if m is None:
         return None
+
+    def source() -> Source:
+        try:
+            with open(path, encoding="utf-8", errors="surrogateescape") as f:
+                return Source.from_text(path, f.read())
+        except OSError:
+            return Source.from_text(path, "")
+
+    if not _in_application(app, m, path, source, diags):
+        return None
     real = real_of(app)
     try:
         image = compile_machine(m, real)
     except BytecodeError as e:
-        try:
-            with open(path, encoding="utf-8", errors="surrogateescape") as f:
-                src = Source.from_text(path, f.read())
-        except OSError:
-            src = Source.from_text(path, "")
-        diags.error(src, SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        diags.error(source(), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
         return None
     reason = V.verify(image, V.layout_of(app.sv), real.bits // 8)
     if reason != V.OK:
@@ -63,7 +71,58 @@ def image_for(app, path: str, diags: Diagnostics):
     return bytes(image), bytes(mask), m
 
 
+def _in_application(app, m, path: str, source, diags: Diagnostics) -> bool:
+    """Whether machine `m` (read from `path`) may take the place of the
+    generated machine that [reload] names; the reasons in `diags`, located.
+    The firmware's tables (the pyro gates' fire states, the recorder's
+    states, the activation's states) and the ground's state names hold the
+    generated machine's state numbers, so the uploaded machine keeps them,
+    and may add states after them; and the application with it in place
+    passes `fsw check` (one writer per element, the pyro proof, ...)."""
+    from fswkit.autocode.app import load_app
+    from fswkit.autocode.diagnostics import SM
+
+    gen = app.machines[app.reload.machine]
+    why = ("the firmware and the ground know a state by its number (the pyro gates, the recorder, the telemetry's "
+           "state names): keep the generated machine's states in their order, and add new ones after them")
+    for old, new in zip(gen.states, m.states):
+        if old.name != new.name:
+            diags.error(source(), SM, new.line, 2, f"state {new.id} is `{new.name}` here but `{old.name}` in the "
+                                                   f"generated machine `{gen.name}`: {why}")
+            return False
+    if len(m.states) < len(gen.states):
+        missing = ", ".join(st.name for st in gen.states[len(m.states):])
+        diags.error(source(), SM, m.states[-1].line if m.states else 1, 1,
+                    f"machine `{m.name}` has {len(m.states)} states: the generated machine `{gen.name}` has "
+                    f"{len(gen.states)} ({missing} missing): {why}")
+        return False
+    whole = Diagnostics()
+    if load_app(app.path, whole, instead={gen.name: path}) is not None:
+        return True
+    diags.extend(Diagnostics([d for d in whole.items if d.severity == "error"]))  # its warnings are said already
+    return False
+
+
+def _misplaced(args) -> str | None:
+    """What is wrong with an option given to an action it means nothing to
+    (ignored, it would leave the user believing it did something)."""
+    a = args.action
+    if args.activate and a != "upload":
+        return "--activate goes with `upload`"
+    if args.restart and a != "upload":
+        return "--restart goes with `upload`"
+    if args.wait is not None and not (a in ("activate", "revert") or a == "upload" and args.activate):
+        return "--wait goes with `activate`, `revert` and `upload --activate`"
+    return None
+
+
 def cmd_machine(args) -> int:
+    wrong = _misplaced(args)
+    if wrong is not None:
+        _say(wrong)
+        return EXIT_CONFIG
+    if args.wait is None:
+        args.wait = WAIT
     app = load_app(args.project, None, "machine")
     if app is None:
         return EXIT_CONFIG

@@ -146,6 +146,8 @@ def parser() -> argparse.ArgumentParser:
     cp.add_argument("-o", "--output", required=True, metavar="FILE.fsm", help="the image to write (- for standard output)")
     cp.add_argument("--layout", metavar="FILE", help="also write the state vector's layout and the state names, as "
                     "libfswsm reads them (docs/bytecode.md)")
+    cp.add_argument("--force", action="store_true", help="replace an -o or --layout file that holds something else "
+                    "than an image (a layout): never done unasked")
     cp.set_defaults(func=_command("compile", "cmd_compile"))
 
     gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
@@ -305,8 +307,8 @@ def parser() -> argparse.ArgumentParser:
     mc.add_argument("--activate", action="store_true", help="upload: activate the image once it is committed")
     mc.add_argument("--restart", action="store_true", help="upload: start over instead of resuming an interrupted "
                     "upload of the same image")
-    mc.add_argument("--wait", type=_seconds, default=10.0, metavar="S", help="activate, revert: seconds to wait for "
-                    "the machine to reach a state that allows the switch (default 10)")
+    mc.add_argument("--wait", type=_seconds, metavar="S", help="activate, revert, upload --activate: seconds to wait "
+                    "for the machine to reach a state that allows the switch (default 10)")
     mc.add_argument("--ignore-schema", action="store_true", help="talk to the target even when the schema differs")
     mc.set_defaults(func=_command("machine", "cmd_machine"))
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+import stat
 import tempfile
 import termios
 
@@ -155,6 +156,16 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
     except ImportError:
         raise PortError("pyserial is not installed: run `make setup` (or pip install pyserial)") from None
     exclusive = command is not None and not is_url(name)
+    if not is_url(name) and os.name == "posix":  # pyserial's words for these are an ioctl's or doubled
+        try:
+            mode = os.stat(name).st_mode
+        except FileNotFoundError:
+            raise PortError(f"cannot open {name}: no such device") from None
+        except OSError as e:
+            raise PortError(f"cannot open {name}: {e.strerror or e}") from None
+        if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+            kind = "a folder" if stat.S_ISDIR(mode) else "a regular file"
+            raise PortError(f"cannot open {name}: it is {kind}, not a serial port")
     if exclusive:
         rec = holder(name)
         if rec is not None and rec["pid"] != os.getpid():

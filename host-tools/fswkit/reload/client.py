@@ -102,6 +102,13 @@ class MachineClient:
         if len(data) < RELOAD_INFO.size + 2 * RELOAD_SLOT.size:
             raise MachineError("the target's MACHINE_INFO answer is too short: its firmware has no [reload] section")
         v = RELOAD_INFO.unpack_from(data)
+        # slot numbers index the slots: one past them (a target of another
+        # version, a corrupted answer) is said, never used
+        for field, value, allowed in (("active", v[0], (0, 1, 2)), ("pending", v[1], (0, 1, 2, NONE)),
+                                      ("refused", v[2], (0, 1, 2)), ("upload slot", v[7], (0, 1, 2))):
+            if value not in allowed:
+                raise MachineError(f"the target's MACHINE_INFO answer names {field} {value}: not a slot (1, 2) or "
+                                   "the generated machine (0); is its firmware of another kit version?")
         slots = tuple(Slot(i + 1, *RELOAD_SLOT.unpack_from(data, RELOAD_INFO.size + i * RELOAD_SLOT.size))
                       for i in range(2))
         s0, s1 = slots
@@ -205,10 +212,11 @@ class MachineClient:
                                    "the machine that runs is unchanged")
             if inf.pending == NONE and inf.active != which:
                 raise MachineError(f"the target did not switch to {which}: it runs {inf.active}")
-            if self.t.now() > end:
-                raise MachineError(f"still waiting after {wait:g} s: the running machine is not in a state in "
-                                   "which another may take over ([reload] activate); the activation stays "
-                                   "pending and happens when it is")
+            if self.t.now() > end:  # INFO does not say which of the two it waits for
+                raise MachineError(f"not switched after {wait:g} s: the target checks the image first (a slice "
+                                   "at each step of the machine's task), then switches when the running machine is "
+                                   "in a state in which another may take over ([reload] activate); the activation "
+                                   "stays pending and happens then")
             self._wait(0.05)
 
     def revert(self, wait: float = 5.0) -> tuple[int, Info]:

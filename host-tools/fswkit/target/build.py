@@ -432,7 +432,10 @@ CLONE = re.compile(r" \[clone [^\]]*\]|\.(?:lto_priv|constprop|isra|part)\.\d+")
 
 
 def elf_symbols(elf: str) -> list[tuple[int, int, str, str]]:
-    """(address, size, nm type, demangled name) of an ELF's sized symbols."""
+    """(address, size, nm type, demangled name) of an ELF's sized symbols.
+    A name LTO gave a suffix (`_ZN7fsw_gen12_GLOBAL__N_13recE.lto_priv.45`)
+    is left mangled by `avr-nm -C`: without the suffix, avr-c++filt
+    demangles it (fsw_gen::(anonymous namespace)::rec)."""
     r = subprocess.run(["avr-nm", "-S", "-C", elf], capture_output=True, text=True)
     if r.returncode != 0:
         raise BuildError(f"avr-nm failed: {r.stderr.strip()}")
@@ -444,6 +447,13 @@ def elf_symbols(elf: str) -> list[tuple[int, int, str, str]]:
                 out.append((int(parts[0], 16), int(parts[1], 16), parts[2], CLONE.sub("", parts[3])))
             except ValueError:
                 continue
+    mangled = sorted({name for *_, name in out if name.startswith("_Z")})
+    if mangled:
+        f = subprocess.run(["avr-c++filt"], input="\n".join(mangled) + "\n", capture_output=True, text=True)
+        plain = f.stdout.splitlines()
+        if f.returncode == 0 and len(plain) == len(mangled):
+            names = dict(zip(mangled, plain))
+            out = [(a, n, k, names.get(name, name)) for a, n, k, name in out]
     return out
 
 
@@ -503,6 +513,9 @@ def memory_users(app: Application, elf: str) -> dict[str, list[Use]]:
                 return f"m:{c_ident(mach.name)}", f"machine {mach.name}, {basename(mach.path)}: its states' code"
             if t is not None:
                 return f"t:{t.name}", f"task {t.name} ({t.kind}), {a}:{t.line}"
+        if rest.startswith(("reload", "kReload")) and app.reload is not None:
+            return "reload", f"the machine replaced at run time: its image, windows and locals, and store, " \
+                             f"{a}:{app.reload.line} [reload]"
         store = re.fullmatch(r"link_store_(\d+)", rest)
         if store and int(store.group(1)) < len(app.telemetry):
             s = app.telemetry[int(store.group(1))]

@@ -59,9 +59,10 @@ REASONS = {
     14: "goto outside .entry/.step, or a window push outside the prelude",
     15: "more pending forward jumps than the verifier tracks",
     16: "the RAM buffer is smaller than the image needs",
+    17: "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
 }
 (OK, BAD_MAGIC, BAD_VERSION, BAD_REAL, BAD_SCHEMA, BAD_SIZE, BAD_ELEMENT, BAD_LOCAL, BAD_STATE,
- BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM) = range(17)
+ BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM, BAD_MASK) = range(18)
 
 
 @dataclass(frozen=True)

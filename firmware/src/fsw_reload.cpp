@@ -48,12 +48,30 @@ bool read_slot(const ReloadConfig& c, uint8_t which, ReloadSlot& out) {
     return true;
 }
 
+// The state mask after an image the verifier passed (at `a`, `len` bytes,
+// its state count at byte 18): a bit for each of the image's states, and
+// at least one set. A mask the ground did not make so would leave a
+// machine that no state lets go (not even back to the generated one), and
+// EEPROM keeps it across a reflash.
+FSW_NOINLINE uint8_t mask_check(uint16_t a, uint16_t len, uint8_t nmask) {
+    uint8_t left = pal::eeprom_read(static_cast<uint16_t>(a + 18u));  // states not yet looked at
+    if (nmask != static_cast<uint8_t>((left + 7u) / 8u)) return kVmBadMask;
+    uint8_t any = 0;
+    for (a = static_cast<uint16_t>(a + len); left != 0; ++a) {  // bits past the last state do not count
+        const uint8_t n = left < 8u ? left : 8u;
+        any = static_cast<uint8_t>(any | (pal::eeprom_read(a) & static_cast<uint8_t>(0xFFu >> (8u - n))));
+        left = static_cast<uint8_t>(left - n);
+    }
+    return any != 0 ? static_cast<uint8_t>(kVmOk) : static_cast<uint8_t>(kVmBadMask);
+}
+
 // The image in slot `which` checked where it lies (CRC again, then the
-// verifier), in one call: at boot.
+// verifier and the mask), in one call: at boot.
 uint8_t check_slot(const ReloadConfig& c, const ReloadSlot& sl, uint8_t which) {
     const uint16_t a = static_cast<uint16_t>(slot_addr(c, which) + kReloadHeader);
     if (payload_crc(a, static_cast<uint16_t>(sl.len + sl.nmask)) != sl.crc) return kReloadCrcFails;
-    return vm_verify_eeprom(a, sl.len, *c.layout, c.ram_size);
+    const uint8_t r = vm_verify_eeprom(a, sl.len, *c.layout, c.ram_size);
+    return r != kVmOk ? r : mask_check(a, sl.len, sl.nmask);
 }
 
 // Copies slot `which` (checked) into the running image's buffer and starts
@@ -158,6 +176,7 @@ FSW_NOINLINE void check_slice(ReloadStore& s, const ReloadConfig& c) {
     } else {
         r = vm_check_eeprom(s.vm, a, len, *c.layout, c.ram_size, FSW_RELOAD_SLICE);
         if (r == kVmMore) return;
+        if (r == kVmOk) r = mask_check(a, len, upload ? s.up_nmask : sl.nmask);
     }
     s.ck_slot = 0;
     if (upload) {

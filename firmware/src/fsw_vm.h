@@ -29,6 +29,7 @@ enum VmReason : uint8_t {
     kVmBadPlace = 14,    // goto outside .entry/.step, a window push outside the prelude
     kVmTooNested = 15,   // more pending forward jumps than FSW_VM_PENDING
     kVmNoRam = 16,       // the caller's buffer is smaller than the image needs
+    kVmBadMask = 17,     // (a reload slot) the state mask after the image: not a bit per state, or no state set
 };
 
 // An element of the state vector the image is bound to: offset and type.

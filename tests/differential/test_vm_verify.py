@@ -121,7 +121,7 @@ def test_host_and_runtime_verifiers_agree(tmp_path, mode):
         assert got[0] == V.OK and got[1] == V.BAD_REAL
     # Every reason but the RAM check (the host verifier leaves RAM to the board)
     # and nesting (which needs more pending jumps than these machines hold).
-    missing = set(range(17)) - set(seen) - {V.NO_RAM, V.TOO_NESTED}
+    missing = set(range(17)) - set(seen) - {V.NO_RAM, V.TOO_NESTED}  # 17, the mask, is no image's: the board's
     assert not missing, f"no corruption reached reasons {sorted(missing)}: {seen}"
 
 

@@ -456,3 +456,40 @@ def test_a_power_cut_while_both_slots_lose_their_boot_mark_never_boots_the_older
         assert inf.active == (1 if cut == 1 else 0)  # one status byte written, or both
     finally:
         r.close()
+
+
+@pytest.mark.parametrize("mask_of", [
+    lambda mask: b"",                          # no mask at all
+    lambda mask: bytes(len(mask)),             # no state lets the machine go
+    lambda mask: mask + b"\xff",               # a byte more than the image's states
+], ids=["none", "empty", "long"])
+def test_a_state_mask_that_would_hold_the_machine_for_good_is_refused(rig, new_image, mask_of):
+    """The board checks the mask the ground sends, as it checks the image:
+    one a ground of its own made wrong (none, no state set, a byte too many)
+    would leave a machine no state lets go, not even back to the generated
+    one, and the EEPROM would keep it across a reflash. BAD_IMAGE with
+    reason 17; the generated machine keeps running."""
+    from fswkit.autocode.protocol import crc16
+    from fswkit.autocode.vmverify import BAD_MASK, REASONS
+
+    image, mask = new_image
+    bad = mask_of(mask)
+    data = image + bad
+    _written(rig, data, crc16(data), len(bad))
+    ack, _ = _commit_until_answered(rig)
+    assert ack["status_name"] == "BAD_IMAGE" and ack["data"][:1] == bytes((BAD_MASK,)), ack
+    assert "mask" in REASONS[BAD_MASK]
+    inf = rig.c.info()
+    assert inf.refused in (1, 2) and inf.reason == BAD_MASK and inf.active == 0
+    assert rig.valve_at(740) is False and rig.valve_at(790) is True
+
+
+def test_the_ground_s_own_mask_passes_the_board_s_check(rig, new_image):
+    from fswkit.autocode.protocol import crc16
+
+    image, mask = new_image
+    assert any(mask) and len(mask) == (image[18] + 7) // 8
+    data = image + mask
+    _written(rig, data, crc16(data), len(mask))
+    ack, _ = _commit_until_answered(rig)
+    assert ack["status_name"] == "OK", ack

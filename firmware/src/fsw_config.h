@@ -115,6 +115,16 @@
 #if FSW_WAKE_EARLY_US < 4 || FSW_WAKE_EARLY_US > 1000
 #  error "fswkit: FSW_WAKE_EARLY_US must be 4..1000"
 #endif
+// How long before a cycle the sleeping executor stops starting background
+// work (loop()'s service of the link and of the EEPROM writers, docs/runtime.md):
+// longer than such a pass takes, so that none holds the CPU past a cycle's
+// start (it would start late, counted as `late_other`).
+#ifndef FSW_BACKGROUND_GUARD_US
+#  define FSW_BACKGROUND_GUARD_US 256
+#endif
+#if FSW_BACKGROUND_GUARD_US < 0 || FSW_BACKGROUND_GUARD_US > 16000
+#  error "fswkit: FSW_BACKGROUND_GUARD_US must be 0..16000"
+#endif
 
 // Per-task step timing (worst case, overruns): costs two clock reads per task.
 #ifndef FSW_TASK_TIMING

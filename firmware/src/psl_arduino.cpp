@@ -90,6 +90,7 @@ struct CycleTimer {
     uint16_t sub_ms;
     uint16_t sub_frac;
     uint16_t early;     // OCR1B: the count where the CPU wakes to spin
+    uint16_t quiet;     // the count after which the last sub-period starts no background work
     uint8_t sub;        // sub-periods ended in this cycle
     uint8_t last;       // n - 1
     uint8_t spin;       // period too short to sleep in: spin from mid-period
@@ -150,6 +151,8 @@ void cycle_timer_begin(uint32_t period_us) {
     g_ct.sub_frac = static_cast<uint16_t>(sub_us % 1000u);
     g_ct.spin = top < 4u * early_ticks;
     g_ct.early = g_ct.spin ? static_cast<uint16_t>(top / 2u + 1u) : static_cast<uint16_t>(top - early_ticks);
+    const uint16_t guard_ticks = FSW_BACKGROUND_GUARD_US * FSW_T1_TICKS_PER_US;
+    g_ct.quiet = g_ct.early > guard_ticks ? static_cast<uint16_t>(g_ct.early - guard_ticks) : 0u;
     g_ct.sub = 0;
     g_ct.last = static_cast<uint8_t>(n - 1u);
     g_ct.due = 1;  // the first cycle: at once, on time
@@ -191,7 +194,10 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             sei();
             return kCycleOnTime;
         }
-        if ((pass != 0 && background) || g_ct.spin) {
+        // Background work (the link's service, the EEPROM writers) between
+        // cycles, but none started in the last FSW_BACKGROUND_GUARD_US before
+        // one: a pass that began there could hold the CPU past its start.
+        if (g_ct.spin || (pass != 0 && background && !(g_ct.sub == g_ct.last && TCNT1 >= g_ct.quiet))) {
             sei();
             return kCycleNotDue;
         }

@@ -126,7 +126,8 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs,
                 pyro_names, sensors)
     budget = _budget(f.budget, board, r)
-    log = check_log(f.log, sv, tasks, machines, board, r, channels=channels, sensors=sensors)
+    log = check_log(f.log, sv, tasks, machines, board, r, channels=channels, sensors=sensors,
+                    written="log" in f.sections)
     pyro, reload = [], None
     if f.pyro:  # the proofs' module is imported for an application that has pyro channels only
         from .pyrocheck import check_pyro

@@ -125,6 +125,7 @@ class AppFile:
     log: tuple[Setting, ...] = ()
     pyro: tuple[PyroRow, ...] = ()
     reload: tuple[Setting, ...] = ()
+    sections: frozenset = frozenset()  # the known sections written, empty or not
 
 
 def parse_app(src: Source, diags: Diagnostics) -> AppFile:
@@ -161,6 +162,7 @@ def parse_app(src: Source, diags: Diagnostics) -> AppFile:
         log=rows("log", _setting),
         pyro=rows("pyro", _pyro_row),
         reload=rows("reload", _setting),
+        sections=frozenset(body),
     )
 
 

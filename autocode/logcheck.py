@@ -45,15 +45,16 @@ MAX_SLOTS = 65535  # record indexes are u16
 
 
 def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine],
-              board, r, channels: list[M.Channel] | None = None, sensors=()) -> M.Log | None:
+              board, r, channels: list[M.Channel] | None = None, sensors=(), written: bool = False) -> M.Log | None:
     """The checked `[log]` section, None when it is absent or has errors
     (reported through `r`, appcheck's Report). `channels`: the I/O channels,
     whose pins an SPI flash's chip select must not take; `sensors`: the
     sensor tables' parts, whose chip selects and I2C pins it must not take
-    either."""
+    either. `written`: the section's header is there (empty: the parser
+    said so, once)."""
     rec_task = next((t for t in tasks if t.kind == "recorder"), None)
     if not rows:
-        if rec_task is not None:
+        if rec_task is not None and not written:
             r.at(rec_task.line, 1, f"task `{rec_task.name}` is a `recorder` but the application has no [log] section")
         return None
     first = rows[0].key

@@ -1,0 +1,35 @@
+# log empty section with a recorder task: one error, at the section (not also "no [log] section" at the task)
+[application]
+board uno
+rate 100
+reset_cause resetCause
+
+[configs]
+state_vector rig.sv
+machine rig.sm
+io rig.aio
+io rig.dio
+
+[time]
+source clock
+unit us
+
+[tasks]
+uplink uplink rate=100
+sense inputs rate=100
+control machine rig rate=50 mode=controlMode overruns=controlOverruns worst_us=controlWorst
+log recorder rate=100
+act outputs rate=100
+down telemetry rate=100
+
+[telemetry]
+Sensors rate=10
+
+[uplink]
+heater
+
+[budget]
+flash 30000
+ram 2000
+
+[log]

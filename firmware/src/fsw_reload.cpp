@@ -16,6 +16,12 @@ ReloadConfig config(const ReloadStore& s) {
     return c;
 }
 
+// Whether activation order `a` is after `b`: serial-number arithmetic, so
+// that the order wraps after 65,535 activations and the newest is still
+// the newest (the two slots' orders are never 32,768 apart: each
+// activation takes the other's plus one).
+bool later(uint16_t a, uint16_t b) { return static_cast<int16_t>(static_cast<uint16_t>(a - b)) > 0; }
+
 uint16_t slot_addr(const ReloadConfig& c, uint8_t which) {  // which: 1 or 2
     return static_cast<uint16_t>(c.eeprom_base + (which - 1u) * (kReloadHeader + c.size));
 }
@@ -122,8 +128,8 @@ void activate_now(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
     leave(s, c);
     run_slot(s, c, which);
     const ReloadSlot& o = s.slot[2u - which];
-    const uint16_t other = o.status != kSlotEmpty ? o.seq : 0u;
-    sl.seq = static_cast<uint16_t>((sl.seq > other ? sl.seq : other) + 1u);
+    const uint16_t other = o.status != kSlotEmpty ? o.seq : sl.seq;
+    sl.seq = static_cast<uint16_t>((later(sl.seq, other) ? sl.seq : other) + 1u);
     sl.status = kSlotBoot;
     s.sync = true;
 }
@@ -206,7 +212,7 @@ void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
         uint8_t best = 0;
         for (uint8_t w = 1; w <= 2; ++w) {
             const ReloadSlot& sl = s.slot[w - 1u];
-            if (sl.status == kSlotBoot && (best == 0 || sl.seq > s.slot[best - 1u].seq)) best = w;
+            if (sl.status == kSlotBoot && (best == 0 || later(sl.seq, s.slot[best - 1u].seq))) best = w;
         }
         if (best == 0) return;  // the generated machine
         const uint8_t r = check_slot(c, s.slot[best - 1u], best);
@@ -358,7 +364,7 @@ void reload_poll(ReloadStore& s) {
         // never leaves it the only one marked to boot)
         s.sync = false;
         const ReloadConfig c = config(s);
-        const uint8_t first = s.slot[1].seq < s.slot[0].seq ? 2u : 1u;
+        const uint8_t first = later(s.slot[0].seq, s.slot[1].seq) ? 2u : 1u;  // the older first
         uint8_t r = 0;
         for (uint8_t k = 0; k < 2; ++k) {
             const uint8_t w = k == 0 ? first : static_cast<uint8_t>(3u - first);

@@ -493,3 +493,30 @@ def test_the_ground_s_own_mask_passes_the_board_s_check(rig, new_image):
     _written(rig, data, crc16(data), len(mask))
     ack, _ = _commit_until_answered(rig)
     assert ack["status_name"] == "OK", ack
+
+
+def test_the_activation_order_wraps_and_the_newest_still_boots(rig, new_image):
+    """The activation order is 16 bits: after 65,535 activations the newest
+    slot's is 0 and the older one's 65,535. The board boots the newest by
+    serial-number arithmetic (it booted the older one: 65,535 > 0)."""
+    slot, _ = rig.c.upload(*new_image)
+    rig.c.activate(slot)
+    other, _ = rig.c.upload(*new_image)  # the same image into the other slot, then the newest
+    rig.c.activate(other)
+    inf = rig.c.info()
+    assert {slot, other} == {1, 2} and inf.active == other
+    assert inf.slots[other - 1].seq == inf.slots[slot - 1].seq + 1
+    while rig.c.info().writing:
+        rig.t.events(0.02)
+    # the two orders as 65,535 activations later: the older 0xFFFF, the newest 0 (slot headers from
+    # EEPROM byte 0, examples/stand's slots of 384 B and a 9-byte header: order u16 at bytes 2..3)
+    for n, seq in ((slot, 0xFFFF), (other, 0x0000)):
+        rig.b.eeprom_write((n - 1) * (9 + 384) + 2, struct.pack("<H", seq))
+    rig.b.reset("power")
+    rig.t.events(0.5)
+    inf = rig.c.info()
+    assert inf.active == other, inf
+    assert (inf.slots[slot - 1].seq, inf.slots[other - 1].seq) == (0xFFFF, 0), inf
+    rig.c.activate(slot)  # and the next activation comes after both
+    inf = rig.c.info()
+    assert inf.active == slot and inf.slots[slot - 1].seq == 1, inf

@@ -114,13 +114,17 @@ const char* const kReasons[] = {
     "goto outside .entry/.step, or a window push outside the prelude",
     "more pending forward jumps than the verifier tracks",
     "the RAM buffer is smaller than the image needs",
+    "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
 };
 const char* const kReasonNames[] = {
     "kVmOk", "kVmBadMagic", "kVmBadVersion", "kVmBadReal", "kVmBadSchema", "kVmBadSize", "kVmBadElement",
     "kVmBadLocal", "kVmBadState", "kVmBadWindow", "kVmBadJump", "kVmBadStack", "kVmBadOpcode", "kVmBadEnd",
-    "kVmBadPlace", "kVmTooNested", "kVmNoRam",
+    "kVmBadPlace", "kVmTooNested", "kVmNoRam", "kVmBadMask",
 };
 const int kReasonCount = static_cast<int>(sizeof kReasons / sizeof kReasons[0]);
+static_assert(sizeof kReasonNames / sizeof kReasonNames[0] == sizeof kReasons / sizeof kReasons[0],
+              "a name for every reason's words");
+static_assert(sizeof kReasons / sizeof kReasons[0] == fsw::kVmBadMask + 1, "the words of every VmReason");
 
 struct CodeText {
     int code;

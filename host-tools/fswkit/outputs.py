@@ -307,3 +307,25 @@ def stopped_by_signals():
     finally:
         for sig, handler in saved.items():
             signal.signal(sig, handler)
+
+
+def only_its_own(path: str | None, command: str, force: bool = False, head: int = 512) -> None:
+    """Refuses (OutputError) to replace a regular, non-empty file at `path`
+    whose first `head` bytes do not name `fsw COMMAND`, as the command's
+    own output does in its first lines (`fsw graph`, `fsw skeleton`): a
+    file the user wrote there, a state script beside its machine, is not
+    this command's to replace unless asked (`force`). Standard output,
+    devices, FIFOs and paths with nothing there pass."""
+    mark = f"`fsw {command}"
+    if path is None or path == "-" or force or is_direct(path):
+        return
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return
+        with open(path, "rb") as f:
+            start = f.read(head)
+    except OSError:
+        return  # nothing there to lose (or unreadable: the write says why)
+    if start and mark.encode() not in start:
+        raise OutputError(f"{path} exists and is not an earlier output of `fsw {command}` (a file you wrote?): "
+                          "it is replaced only when asked (--force)")

@@ -52,10 +52,18 @@ def port_or_only(port: str | None, command: str) -> str | None:
     return device
 
 
-def write_output(text: str, out: str | None, command: str, inputs=()) -> int:
-    from fswkit.outputs import OutputError, write_text
+def write_output(text: str, out: str | None, command: str, inputs=(), own: bool = False, force: bool = False) -> int:
+    """`text` to `out` (standard output for None or "-"). `own`: the text
+    names `fsw COMMAND` in its first lines, and a file there that does not
+    (one the user wrote) is replaced only with `force`."""
+    from fswkit.outputs import OutputError, check, only_its_own, write_text
 
     try:
+        if own:
+            assert f"`fsw {command}" in text[:512], "the output names its command"
+            if out not in (None, "-"):
+                check(out, inputs)  # an input, a recording, a folder: said as such first
+            only_its_own(out, command, force)
         write_text(out, text, inputs)
     except OutputError as e:
         sys.stderr.write(f"fsw {command}: {e}\n")

@@ -265,7 +265,7 @@ def cmd_graph(args) -> int:
     if m is None:
         return EXIT_CONFIG
     return write_output(to_mermaid(m) if args.format == "mermaid" else to_dot(m), args.output, "graph",
-                  (args.machine, m.sv.path))  # the state vector's as found beside the machine too
+                        (args.machine, m.sv.path), own=True, force=args.force)  # the .sv as found beside it too
 
 
 def cmd_skeleton(args) -> int:
@@ -274,7 +274,8 @@ def cmd_skeleton(args) -> int:
     m = _machine_or_exit(args)
     if m is None:
         return EXIT_CONFIG
-    return write_output(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, m.sv.path))
+    return write_output(skeleton(m, delta_t=args.delta_t), args.output, "skeleton", (args.machine, m.sv.path),
+                        own=True, force=args.force)
 
 
 # ---- fsw gen ---------------------------------------------------------------------------

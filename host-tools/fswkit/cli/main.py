@@ -135,6 +135,8 @@ def parser() -> argparse.ArgumentParser:
     g.add_argument("--format", choices=("dot", "mermaid"), default="dot")
     g.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     g.add_argument("-o", "--output", help="write here instead of standard output")
+    g.add_argument("--force", action="store_true", help="replace an -o file that is not an earlier graph "
+                   "(a file you wrote): never done unasked")
     g.set_defaults(func=_command("front", "cmd_graph"))
 
     cp = sub.add_parser("compile", help="a machine as a bytecode image for the runtime's VM (docs/bytecode.md)")
@@ -233,6 +235,8 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     s.add_argument("--delta-t", type=_delta_t, default=10, help="time step of the script (default 10)")
     s.add_argument("-o", "--output", help="write here instead of standard output")
+    s.add_argument("--force", action="store_true", help="replace an -o file that is not an earlier skeleton "
+                   "(a state script you wrote): never done unasked")
     s.set_defaults(func=_command("front", "cmd_skeleton"))
 
     m = sub.add_parser("monitor", help="decode a target's telemetry live (docs/telemetry.md)")

@@ -484,17 +484,6 @@ def test_a_state_mask_that_would_hold_the_machine_for_good_is_refused(rig, new_i
     assert rig.valve_at(740) is False and rig.valve_at(790) is True
 
 
-def test_the_ground_s_own_mask_passes_the_board_s_check(rig, new_image):
-    from fswkit.autocode.protocol import crc16
-
-    image, mask = new_image
-    assert any(mask) and len(mask) == (image[18] + 7) // 8
-    data = image + mask
-    _written(rig, data, crc16(data), len(mask))
-    ack, _ = _commit_until_answered(rig)
-    assert ack["status_name"] == "OK", ack
-
-
 def test_the_activation_order_wraps_and_the_newest_still_boots(rig, new_image):
     """The activation order is 16 bits: after 65,535 activations the newest
     slot's is 0 and the older one's 65,535. The board boots the newest by

@@ -154,8 +154,10 @@ def _u16(im: bytes, at: int) -> int:
     return im[at] | (im[at + 1] << 8)
 
 
-def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) -> tuple[int, int]:
-    """(reason, deepest stack) of the code pass."""
+def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int,
+                 nested: list | None = None) -> tuple[int, int]:
+    """(reason, deepest stack) of the code pass. `nested`: gets the code
+    offset of the jump that made too many pending (TOO_NESTED)."""
     real = im[5]
     offsets = [_u16(im, p.st + 2 * k) for k in range(3 * p.states)]
     declared = 1 if p.prelude != NONE else 0
@@ -228,6 +230,8 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
             if target >= p.code_size:
                 return BAD_JUMP, deepest
             if len(pend) == pending:
+                if nested is not None:
+                    nested.append(a - 1)
                 return TOO_NESTED, deepest
             pend.append([target, depth - 1 if op == JF else depth])
             if op == JMP:
@@ -274,6 +278,8 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
                 if target >= p.code_size:
                     return BAD_JUMP, deepest
                 if len(pend) == pending:
+                    if nested is not None:
+                        nested.append(a - 1)
                     return TOO_NESTED, deepest
                 pend.append([target, depth])
         elif op == JCMP:
@@ -286,6 +292,8 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
             if target >= p.code_size:
                 return BAD_JUMP, deepest
             if len(pend) == pending:
+                if nested is not None:
+                    nested.append(a - 1)
                 return TOO_NESTED, deepest
             pend.append([target, depth - 2])
         elif op in (CONST, LDT):
@@ -335,6 +343,15 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int) 
     if deepest != im[7]:
         return BAD_STACK, deepest
     return OK, deepest
+
+
+def too_nested_at(im: bytes, layout: Layout, pending: int = VM_PENDING) -> int | None:
+    """The code offset of the jump that has more than `pending` forward
+    jumps pending at once (TOO_NESTED), or None: where the compiler says a
+    machine's conditions nest too deep."""
+    at: list = []
+    _verify_code(im, parts(im), layout, 255, pending, at)
+    return at[0] if at else None
 
 
 def code_depth(im: bytes, layout: Layout, stack: int = 255) -> tuple[int, int]:

@@ -88,6 +88,7 @@ class _Code:
         self.m, self.real = m, real
         self.consts = consts  # locals read as constants: their R values
         self.b = bytearray()
+        self.starts: list[tuple[int, int, int]] = []  # (code offset, line, col) of each statement, in order
         self.elem_index, self.loc_index = elem_index, loc_index
         self.fmt = "<f" if real.bits == 32 else "<d"
 
@@ -352,6 +353,7 @@ class _Code:
         """The statements; True when every path ends in a goto (what follows
         is never reached, and is not emitted, as in the C++)."""
         for st in stmts:
+            self.starts.append((len(self.b), st.line, st.col))
             t = type(st)
             if t is M.Assign:
                 if self.fast_assign(st.var, st.expr):
@@ -451,8 +453,11 @@ def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes
         code.top(w.arg)
         code.op(V.WPUSH, w.index)
     code.op(V.END)
-    if len(code.b) > 0xFFFF:
-        raise BytecodeError(f"{len(code.b)} bytes of code: an image holds at most 65535 (not supported yet)")
+    if len(code.b) > 0xFFFF:  # located at the first statement past the limit (the windows' prelude: the last)
+        past = [(ln, c) for at, ln, c in code.starts if at > 0xFFFF] or [(ln, c) for _at, ln, c in code.starts[-1:]]
+        line, col = past[0] if past else (0, 0)
+        raise BytecodeError(f"{len(code.b)} bytes of code: an image holds at most 65535 (not supported yet)",
+                            line, col)
     from ..schema import schema_hash
     g, s = m.vars[m.g], m.vars[m.s]
     head = bytearray(V.MAGIC + bytes((V.VERSION, real.bits // 8, V.FLAG_LOCK if m.sv.lock else 0, 0)))
@@ -471,6 +476,9 @@ def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes
     assert deepest <= V.VM_STACK, "stack_depth() bounds every expression"
     image[7] = deepest
     if V.verify(bytes(image), layout, real.bits // 8) == V.TOO_NESTED:
+        off = V.too_nested_at(bytes(image), layout)  # the jump too many: in the last statement begun before it
+        before = [(ln, c) for at, ln, c in code.starts if off is not None and at <= off]
+        line, col = before[-1] if before else (0, 0)
         raise BytecodeError(f"conditions nested deeper than the verifier tracks ({V.VM_PENDING} forward jumps "
-                            f"pending at once, FSW_VM_PENDING): not supported yet")
+                            f"pending at once, FSW_VM_PENDING): not supported yet", line, col)
     return bytes(image)

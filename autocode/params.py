@@ -9,6 +9,7 @@ defaults, the ground (`fsw param`), `fsw sim --params` and the tests."""
 from __future__ import annotations
 
 import hashlib
+import math
 import struct
 from dataclasses import dataclass
 
@@ -141,7 +142,7 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
         return None, f"`{p.name}` is {t.name}: give a number, not {str(value).lower()}"
     if t.is_int:
         if isinstance(value, float):
-            if value != value or value != int(value):
+            if not math.isfinite(value) or value != int(value):  # int() of an infinity overflows
                 return None, f"`{p.name}` is {t.name}: give a whole number, not {value:g}"
             value = int(value)
         if not isinstance(value, int):

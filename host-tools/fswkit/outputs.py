@@ -1,8 +1,9 @@
 """Where a command's output goes: standard output, or a file that appears
 whole or not at all. Every command that writes a file goes through `output`:
 the path is checked before any work (not one of the command's inputs, not a
-link log, which is a recording and never overwritten, a folder that
-exists), the text goes to a temporary file beside it that replaces the path
+recording — a link log, replaced only by a new link log when asked, or an
+archive, never —, not a file there when the command asks first, a folder
+that exists), the text goes to a temporary file beside it that replaces the path
 only once everything is written, and a failed write — a full disk, a closed
 pipe, /dev/full — is an OutputError naming the file, never a traceback or a
 half-written file where the old one was."""
@@ -82,17 +83,25 @@ def not_an_input(path: str, inputs=(), what: str = "output") -> None:
                               "choose another name")
 
 
-def check(path: str, inputs=(), *, force: bool = False, what: str = "output") -> None:
-    """Refuses an output path before any work is done: OutputError."""
+def check(path: str, inputs=(), *, force: bool = False, log: bool = False, ask: bool = False,
+          what: str = "output") -> None:
+    """Refuses an output path before any work is done: OutputError. A
+    recording there is refused, but for a link log that a new one replaces
+    with `force` (`log`: the output is itself a link log, `fsw monitor
+    --log`, `fsw dump`); an archive never is. `ask`: any other file there
+    is refused too, unless `force` (the user's `--force`)."""
     not_an_input(path, inputs, what)
     if os.path.isdir(path):
         raise OutputError(f"cannot write {path}: it is a folder (name a file for the {what})")
     if is_direct(path):
         return
-    kind = recording(path) if os.path.lexists(path) and not force else None
-    if kind is not None:
-        raise OutputError(f"{path}: {kind} (a recording) is there: it is never overwritten; "
-                          "choose another name, or move it away first")
+    if os.path.lexists(path):
+        kind = recording(path)
+        if kind is not None and not (log and kind == "a link log"):
+            raise OutputError(f"{path}: {kind} (a recording) is there: it is never overwritten; "
+                              "choose another name, or move it away first")
+        if (ask or kind is not None) and not force:
+            raise OutputError(f"{path} exists: it is replaced only when asked (--force)")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise OutputError(f"cannot write {path}: no such folder {folder}")
@@ -153,7 +162,7 @@ def stdout() -> Stream:
 
 @contextlib.contextmanager
 def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | None = None,
-           force: bool = False, what: str = "output"):
+           force: bool = False, ask: bool = False, what: str = "output"):
     """A stream for the command's output: standard output for None or "-",
     else a temporary file beside `path` that replaces it when the block
     ends without an exception (and is removed when it raises)."""
@@ -162,7 +171,7 @@ def output(path: str | None, inputs=(), *, binary: bool = False, newline: str | 
         yield out
         out.flush()
         return
-    check(path, inputs, force=force, what=what)
+    check(path, inputs, force=force, ask=ask, what=what)
     if is_direct(path):
         try:
             f = open(path, "wb" if binary else "w", **({} if binary else {"newline": newline}))

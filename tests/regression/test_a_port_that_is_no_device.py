@@ -18,7 +18,7 @@ STAND = EXAMPLES / "stand"
 @pytest.mark.parametrize("port, words", [
     (str(STAND / "stand.app"), "it is a regular file, not a serial port"),
     (str(STAND), "it is a folder, not a serial port"),
-    ("/dev/ttyNOPE", "no such device"),
+    ("/dev/ttyNOPE", "no such port"),
 ])
 @pytest.mark.parametrize("argv", [("machine", str(STAND), "list"), ("monitor", str(STAND), "--headless")])
 def test_a_port_that_is_no_device_is_said_so(fsw, port, words, argv):

@@ -90,7 +90,7 @@ def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
     csv = tmp_path / "x.csv"
     csv.write_text("the previous export\n")
     file_size_limit()
-    r = run_fsw("log2csv", str(log), "-o", str(csv))
+    r = run_fsw("log2csv", str(log), "-o", str(csv), "--force")
     assert r.code == 1 and "File too large" in r.err and "Traceback" not in r.err, r.err
     assert csv.read_text() == "the previous export\n"
     _no_parts(tmp_path)
@@ -173,7 +173,7 @@ def test_an_output_stopped_by_a_signal_leaves_the_old_file(tmp_path, monkeypatch
 
     monkeypatch.setattr(fswkit.ground.logs, "log2csv", log2csv)
     before = signal.getsignal(sig)
-    r = run_fsw("log2csv", str(log), "-o", str(csv))
+    r = run_fsw("log2csv", str(log), "-o", str(csv), "--force")
     assert r.code == 128 + sig, r.err
     assert signal.getsignal(sig) == before
     assert csv.read_text() == "the previous export\n"

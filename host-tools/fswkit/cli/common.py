@@ -36,6 +36,12 @@ def load_app(project: str, board: str | None, command: str):
     return app
 
 
+def config_paths(app) -> list[str]:
+    """The files of a project's configs: inputs of every command on it,
+    which no output of the command may replace."""
+    return [app.path, app.sv.path] + [m.path for m in app.machines] + [c.path for c in app.channels]
+
+
 def port_or_only(port: str | None, command: str) -> str | None:
     """The port named, else the only candidate (said on standard error);
     None after a message when there is none or several."""

@@ -38,10 +38,11 @@ def _talk(args, app, p) -> int:
     from fswkit.autocode.recorder import RecordError, decode
     from fswkit.autocode.schema import link_plan
     from fswkit.autocode.protocol import OP_LOG_ERASE
-    from fswkit.cli.common import talk_on_link
+    from fswkit.cli.common import config_paths, talk_on_link
     from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import from_app
     from fswkit.link.log import LogError
+    from fswkit.outputs import OutputError, check
     from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
 
     def talk(ground) -> int:
@@ -76,9 +77,21 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
         elif not args.all and flights:
             chosen = flights[-1:]  # the newest
-        os.makedirs(args.output, exist_ok=True)
+        try:  # its own words: an OSError here would be taken for the port going away
+            os.makedirs(args.output, exist_ok=True)
+        except OSError as e:
+            _say(f"cannot create the folder {args.output}: {e.strerror or e}")
+            return EXIT_FAIL
+        paths = {f.number: os.path.join(args.output, f"flight-{f.number}.log") for f in chosen}
+        try:  # every file before the first is written: a flight log replaces only a flight log, with --force
+            for path in paths.values():
+                check(path, config_paths(app) + [args.port], force=args.force, log=True, ask=True,
+                      what="flight log")
+        except OutputError as e:
+            _say(str(e))
+            return EXIT_FAIL
         for f in chosen:
-            path = os.path.join(args.output, f"flight-{f.number}.log")
+            path = paths[f.number]
             try:
                 n = write_flight(path, app, p, f, force=args.force)
             except LogError as e:
@@ -100,8 +113,12 @@ def _talk(args, app, p) -> int:
                 if not sys.stdin.isatty():
                     _say("--erase asks for a confirmation: add --yes when no one is at the terminal")
                     return EXIT_FAIL
-                answer = input(f"erase every record on the target ({len(flights)} flight(s), dumped above)? "
-                               "type `erase`: ")
+                try:
+                    answer = input(f"erase every record on the target ({len(flights)} flight(s), dumped above)? "
+                                   "type `erase`: ")
+                except EOFError:  # Ctrl-D: no answer is no
+                    answer = ""
+                    print()
                 if answer.strip() != "erase":
                     print("not erased")
                     return EXIT_OK

@@ -9,7 +9,7 @@ import sys
 from functools import partial
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, port_or_only, print_diags
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, config_paths, port_or_only, print_diags
 
 
 def _link_layout(project: str, command: str, configs: list | None = None):
@@ -29,7 +29,7 @@ def _link_layout(project: str, command: str, configs: list | None = None):
     if app is None:
         return None
     if configs is not None:
-        configs += [app.path, app.sv.path] + [m.path for m in app.machines] + [c.path for c in app.channels]
+        configs += config_paths(app)
     return from_app(app), app.baud
 
 
@@ -64,6 +64,10 @@ def cmd_monitor(args) -> int:
 
     from fswkit.outputs import OutputError, check
 
+    if args.log == "-":  # `-` is standard output elsewhere; here that carries the view, and a log is binary
+        sys.stderr.write("fsw monitor: --log -: a link log is written to a file, never to standard output: "
+                         "name a file\n")
+        return EXIT_CONFIG
     configs: list[str] = []
     link = _link_layout(args.project, "monitor", configs)
     if link is None:
@@ -72,9 +76,9 @@ def cmd_monitor(args) -> int:
     port = port_or_only(args.port, "monitor")
     if port is None:
         return EXIT_FAIL
-    if args.log is not None:  # --force replaces an old recording, never a config or the port itself
+    if args.log is not None:  # --force replaces an old log, never a config, the port itself or an archive
         try:
-            check(args.log, configs + [port], force=True, what="log")
+            check(args.log, configs + [port], force=True, log=True, what="log")
         except OutputError as e:
             sys.stderr.write(f"fsw monitor: {e}\n")
             return EXIT_FAIL
@@ -100,7 +104,7 @@ def cmd_log2csv(args) -> int:
     from fswkit.outputs import output
 
     def run() -> int:
-        with output(args.output, [args.log], newline="", what="CSV") as f:
+        with output(args.output, [args.log], newline="", force=args.force, ask=True, what="CSV") as f:
             return log2csv(args.log, f, args.ignore_schema, args.session)
 
     return _ground("log2csv", run)
@@ -116,7 +120,8 @@ def cmd_replay(args) -> int:
 def cmd_plot(args) -> int:
     from fswkit.ground.logs import plot
 
-    return _ground("plot", plot, args.log, args.element, args.output, args.ignore_schema, args.session)
+    return _ground("plot", partial(plot, force=args.force), args.log, args.element, args.output, args.ignore_schema,
+                   args.session)
 
 
 def cmd_archive_list(args) -> int:

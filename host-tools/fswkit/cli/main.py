@@ -94,6 +94,14 @@ def _nonneg_int(text: str) -> int:
     return value
 
 
+def _tcp_port(text: str) -> int:
+    """A TCP port to listen on: 0 (any free one) to 65535."""
+    value = _nonneg_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"expected a TCP port from 0 to 65535, found {text}")
+    return value
+
+
 # ---- the parser -------------------------------------------------------------------
 
 def parser() -> argparse.ArgumentParser:
@@ -274,11 +282,12 @@ def parser() -> argparse.ArgumentParser:
         wb.add_argument("project", metavar="PROJECT", help="the project the firmware was built from")
         wb.add_argument("--port", help="serial device or pyserial URL (default: the only serial port found)")
         wb.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
-        wb.add_argument("--archive", metavar="FILE.sqlite",
-                        help="the SQLite archive the session is added to (default PROJECT/ground-archive.sqlite)")
-        wb.add_argument("--no-archive", action="store_true", help="archive nothing")
+        kept = wb.add_mutually_exclusive_group()
+        kept.add_argument("--archive", metavar="FILE.sqlite",
+                          help="the SQLite archive the session is added to (default PROJECT/ground-archive.sqlite)")
+        kept.add_argument("--no-archive", action="store_true", help="archive nothing")
         wb.add_argument("--no-web", action="store_true", help="serve the local clients only, no web page")
-        wb.add_argument("--http-port", type=int, default=8000, metavar="N",
+        wb.add_argument("--http-port", type=_tcp_port, default=8000, metavar="N",
                         help="the web server's TCP port on localhost (default 8000; 0: any free one)")
         wb.add_argument("--host", default="127.0.0.1",
                         help="the address to serve on (default 127.0.0.1: this machine only)")
@@ -322,7 +331,8 @@ def parser() -> argparse.ArgumentParser:
     du.add_argument("--port", required=True, help="serial device or pyserial URL")
     du.add_argument("--baud", type=_baud, help="link speed (default: the application's `baud`)")
     du.add_argument("-o", "--output", required=True, metavar="DIR", help="the folder for flight-N.log files")
-    du.add_argument("--flight", type=int, metavar="N", help="this flight (default: the newest)")
+    du.add_argument("--flight", type=_int_upto(255, "a flight number"), metavar="N",
+                    help="this flight, 1 to 255 (default: the newest)")
     du.add_argument("--all", action="store_true", help="every flight in the record")
     du.add_argument("--force", action="store_true", help="replace existing flight-N.log files")
     du.add_argument("--erase", action="store_true", help="after the dump, erase the record (asks first; only in the "
@@ -334,6 +344,7 @@ def parser() -> argparse.ArgumentParser:
     lc = sub.add_parser("log2csv", help="a link log as CSV: one row per sample")
     lc.add_argument("log", metavar="LOG")
     lc.add_argument("-o", "--output", metavar="FILE", help="write here instead of standard output")
+    lc.add_argument("--force", action="store_true", help="replace FILE if it exists")
     lc.add_argument("--ignore-schema", action="store_true")
     lc.add_argument("--session", type=_positive_int, metavar="N", help=_SESSION_HELP)
     lc.set_defaults(func=_command("ground", "cmd_log2csv"))
@@ -353,6 +364,7 @@ def parser() -> argparse.ArgumentParser:
     pl.add_argument("log", metavar="LOG")
     pl.add_argument("-e", "--element", nargs="+", required=True, metavar="ELEMENT")
     pl.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    pl.add_argument("--force", action="store_true", help="replace OUT if it exists")
     pl.add_argument("--ignore-schema", action="store_true")
     pl.add_argument("--session", type=_positive_int, metavar="N", help=_SESSION_HELP)
     pl.set_defaults(func=_command("ground", "cmd_plot"))
@@ -367,9 +379,9 @@ def parser() -> argparse.ArgumentParser:
     ae = asub.add_parser("export", help="a session's samples as CSV or Parquet, one row per sample")
     ae.add_argument("archive", metavar="FILE")
     ae.add_argument("--session", type=_positive_int, metavar="N", help="this session (default: the newest)")
-    ae.add_argument("--from", dest="t_from", type=_nonneg_float, metavar="SECONDS",
+    ae.add_argument("--from", dest="t_from", type=_seconds, metavar="SECONDS",
                     help="rows from SECONDS after the session began (host clock)")
-    ae.add_argument("--to", dest="t_to", type=_nonneg_float, metavar="SECONDS",
+    ae.add_argument("--to", dest="t_to", type=_seconds, metavar="SECONDS",
                     help="rows up to SECONDS after the session began")
     ae.add_argument("-o", "--output", required=True, metavar="OUT.csv|OUT.parquet",
                     help="the file to write; its extension says the format")

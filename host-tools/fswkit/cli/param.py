@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, config_paths, load_app
 
 
 def _say(msg: str) -> None:
@@ -88,13 +88,13 @@ def cmd_param(args) -> int:
 
         from fswkit.outputs import OutputError, check
 
-        if os.path.lexists(args.output) and not args.force:
-            _say(f"{args.output} exists: a parameter file is never overwritten without --force")
-            return EXIT_FAIL
-        try:
-            check(args.output, [app.path], force=args.force, what="parameter file")
+        try:  # not a config, not the port, not a folder, never a recording, --force or not
+            check(args.output, config_paths(app) + [args.port], force=args.force, what="parameter file")
         except OutputError as e:
             _say(str(e))
+            return EXIT_FAIL
+        if os.path.lexists(args.output) and not args.force:
+            _say(f"{args.output} exists: a parameter file is never overwritten without --force")
             return EXIT_FAIL
     return _talk(args, app, params, by_name, wanted, file_values, from_app(app), link_plan(app).tx_cap,
                  params_text)

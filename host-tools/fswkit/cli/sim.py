@@ -18,9 +18,10 @@ def _firmware_param_file(path: str) -> bool:
     configuration (tables, or an `extends` of another such file)."""
     import tomllib
 
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
+    from fswkit.autocode.diagnostics import read_input
+
+    try:  # a FIFO or a device is not read (the reader below says so)
+        doc = tomllib.loads(read_input(path).decode("utf-8"))
     except (OSError, ValueError):  # TOMLDecodeError, a bad encoding, an integer too long for int()
         return False  # the plant's or the tape's reader says what is wrong with it
     # a plant's or a tape's file may hold no table of its own when it `extends` another

@@ -36,12 +36,8 @@ def archive_path(args) -> str | None:
 
 
 def cmd_ground(args) -> int:
-    from fswkit.cli.ground import _link_baud, _link_layout
-    from fswkit.ground.archive import Archive, ArchiveError
-    from fswkit.ground.station import Station
-    from fswkit.link.port import PortError
-    from fswkit.web.app import AssetsMissing, create_app, serve, uplot_dir
-    from fswkit.web.source import LiveSource
+    from fswkit.cli.ground import _link_layout
+    from fswkit.web.app import AssetsMissing, listen, uplot_dir
 
     name = args.command
     link = _link_layout(args.project, name)
@@ -51,13 +47,34 @@ def cmd_ground(args) -> int:
     port_name = port_or_only(args.port, name)
     if port_name is None:
         return EXIT_FAIL
-    web = not args.no_web
-    if web:
+    sock = None
+    if not args.no_web:
         try:
             uplot_dir()
+            sock = listen(args.host, args.http_port)  # before the port and the archive are touched
         except AssetsMissing as e:
             sys.stderr.write(f"fsw {name}: {e}\n")
             return EXIT_FAIL
+        except OSError as e:
+            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
+            return EXIT_FAIL
+    try:
+        return _station(args, name, layout, app_baud, port_name, sock)
+    finally:
+        if sock is not None:
+            sock.close()
+
+
+def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> int:
+    """The station on `port_name` until the user ends it, serving the web
+    page on `sock` (None: no web page)."""
+    from fswkit.cli.ground import _link_baud
+    from fswkit.ground.archive import Archive, ArchiveError
+    from fswkit.ground.station import Station
+    from fswkit.link.port import PortError
+    from fswkit.web.app import create_app, serve
+    from fswkit.web.source import LiveSource
+
     baud = _link_baud(args.baud, app_baud, name)
     path = archive_path(args)
     try:
@@ -69,15 +86,15 @@ def cmd_ground(args) -> int:
     station.notes(lambda text, up: sys.stderr.write(f"fsw {name}: {port_name}: {text}\n"))
     try:
         station.start()
-    except PortError as e:
+    except (PortError, ArchiveError) as e:  # ArchiveError: the session could not begin (a lock, a full disk)
         sys.stderr.write(f"fsw {name}: {e}\n")
         if archive is not None:
-            archive.close()
+            archive.abandon()
         return EXIT_FAIL
     said = f"the ground station of {args.project} on {port_name} at {baud} baud" + (
         f", archiving into {path}" if path else "")
     try:
-        if not web:
+        if sock is None:
             sys.stderr.write(f"fsw {name}: {said}; `fsw monitor`, `fsw cmd`, `fsw param` and `fsw dump` on "
                              f"{port_name} go through it (Ctrl-C ends it)\n")
             stop = threading.Event()
@@ -96,7 +113,7 @@ def cmd_ground(args) -> int:
             sys.stderr.write(f"fsw {name}: {said}: open {url} (Ctrl-C ends it)\n")
 
         try:
-            serve(app, host=args.host, port=args.http_port, on_ready=ready)
+            serve(app, host=args.host, port=args.http_port, on_ready=ready, sock=sock)
         except OSError as e:
             sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
             return EXIT_FAIL

@@ -365,6 +365,17 @@ class Archive:
                 self._con = None
                 con.close()
 
+    def abandon(self) -> None:
+        """Closes the file at once, the open batch dropped and the session
+        left not ended: after a write failed (a lock another program holds, a
+        full disk), when no further write could be waited for."""
+        with self._lock:
+            con, self._con = self._con, None
+            if con is not None:
+                with contextlib.suppress(sqlite3.Error):
+                    con.rollback()
+                con.close()
+
     def __enter__(self):
         return self
 
@@ -395,7 +406,7 @@ class ArchiveReader:
     """One session of an archive, read as fswkit.link.log.LogReader reads a
     log: `layout`, `header`, `path`, `records()`. `session` None: the
     newest. `truncated`: the session was never ended (the station was
-    killed, or is still writing it)."""
+    killed, or is still writing it); `incomplete` says so in words."""
 
     def __init__(self, path: str, session: int | None = None):
         from fswkit.link.layout import LayoutError, from_dict
@@ -422,10 +433,15 @@ class ArchiveReader:
         self.header = {"session": s["id"], "project": s["project"], "port": s["port"], "baud": s["baud"],
                        "started": s["started"], "ended": s["ended"]}
         self.truncated = s["ended"] is None
+        self.incomplete = (f"session {self.session} was never ended (the station was killed, or still runs): "
+                           "what it committed is read") if self.truncated else None
         try:
             self.layout = from_dict(json.loads(s["layout"]))
         except (ValueError, LayoutError) as e:
             raise ArchiveError(f"{path}: session {self.session}: not a valid layout: {e}") from None
+        except RecursionError:
+            raise ArchiveError(f"{path}: session {self.session}: not a valid layout: JSON nested too deeply "
+                               "to read") from None
 
     def records(self):
         """(direction, host time in seconds, bytes) in the order they were archived."""

@@ -33,7 +33,7 @@ def _log_session(path: str, ignore_schema: bool, session: int | None = None):
             reader = ArchiveReader(path, session)
         except ArchiveError as e:
             raise GroundError(str(e)) from None
-    elif session is not None:
+    elif session is not None and outputs.recording(path) == "a link log":  # else: said as the file it is
         raise GroundError(f"{path}: --session {session}: this is a link log, one recording; --session "
                           "chooses a session of a ground station's archive")
     else:
@@ -52,12 +52,18 @@ def _log_session(path: str, ignore_schema: bool, session: int | None = None):
     return reader, decoder, events()
 
 
+def said_incomplete(command: str, reader) -> None:
+    """Says, once a recording is read, that it ended before its end (a log
+    cut short or damaged, a session never ended), as its reader words it."""
+    if reader.incomplete:
+        sys.stderr.write(f"fsw {command}: {reader.path}: {reader.incomplete}\n")
+
+
 def log2csv(path: str, out, ignore_schema: bool, session: int | None = None) -> int:
     reader, session, events = _log_session(path, ignore_schema, session)
     columns, rows = table(reader.layout, events)
     n, boots = write_csv(out, reader.layout, columns, rows)
-    if reader.truncated:
-        sys.stderr.write(f"fsw log2csv: {path}: the last record is cut short (the recording stopped mid-write)\n")
+    said_incomplete("log2csv", reader)
     restarts = f" from {boots} boots of the target (column `{BOOT}`)" if boots > 1 else ""
     sys.stderr.write(f"fsw log2csv: {n} rows{restarts}; " + summary(session) + "\n")
     return 0
@@ -228,6 +234,7 @@ def replay(path: str, headless: bool, speed: float, ignore_schema: bool, session
                     time.sleep(min(wait, 3600.0))
             view.event(ev)
             view.update(ev.host_time)
+    said_incomplete("replay", reader)
     sys.stderr.write(summary(session) + "\n")
     return 0
 
@@ -252,9 +259,11 @@ def image_format(out: str) -> str:
     return ext
 
 
-def plot(path: str, elements: list[str], out: str, ignore_schema: bool, session: int | None = None) -> int:
+def plot(path: str, elements: list[str], out: str, ignore_schema: bool, session: int | None = None, *,
+         force: bool = False) -> int:
     fmt = image_format(out)
-    outputs.check(out, [path], what="plot")
+    outputs.check(out, [path], force=force, ask=True, what="plot")
+    elements = list(dict.fromkeys(elements))  # one panel each: `-e x x` drew (and took the time of) two
     reader, session, events = _log_session(path, ignore_schema, session)
     lay = reader.layout
     missing = [e for e in elements if lay.element(e) is None]
@@ -262,8 +271,9 @@ def plot(path: str, elements: list[str], out: str, ignore_schema: bool, session:
         raise GroundError(f"unknown element(s) {', '.join(missing)}: the log's elements are "
                           + ", ".join(e.name for e in lay.elements))
     data = plot_data(lay, events, elements)
+    said_incomplete("plot", reader)
     fig, unlabelled = figure(lay, data, elements, f"{lay.name}: {path}")
-    with outputs.output(out, [path], binary=True, what="plot") as f:
+    with outputs.output(out, [path], binary=True, force=force, ask=True, what="plot") as f:
         try:
             fig.savefig(f.raw, format=fmt)
         except OSError as e:
@@ -511,9 +521,7 @@ def export(path: str, out: str, *, session: int | None, t_from: float | None, t_
             "no such file" if not os.path.exists(path) else "not an fswkit archive (`fsw log2csv` reads a link log)")
         raise ArchiveError(f"{path}: {why}")
     what = _EXPORT_FORMATS[ext]
-    outputs.check(out, [path], force=force, what=what)
-    if not force and os.path.lexists(out) and not outputs.is_direct(out):
-        raise ArchiveError(f"{out} exists: it is replaced only when asked (--force)")
+    outputs.check(out, [path], force=force, ask=True, what=what)
     if ext == ".parquet":
         try:
             import pyarrow  # noqa: F401  (checked before the work)
@@ -531,14 +539,15 @@ def export(path: str, out: str, *, session: int | None, t_from: float | None, t_
 
     n = 0
     if ext == ".csv":
-        with outputs.output(out, [path], newline="", force=True, what=what) as f:
+        with outputs.output(out, [path], newline="", force=force, ask=True, what=what) as f:
             n = write_csv(f, reader.layout, columns, chosen)[0]
+        said_incomplete("archive export", reader)
         return n, reader.session
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     types = _arrow_types(reader.layout, columns)
-    with outputs.output(out, [path], binary=True, force=True, what=what) as f:
+    with outputs.output(out, [path], binary=True, force=force, ask=True, what=what) as f:
         writer = None
         batch: list = []
 
@@ -563,4 +572,5 @@ def export(path: str, out: str, *, session: int | None, t_from: float | None, t_
             raise ArchiveError(f"cannot write {out}: {e.strerror or e}") from None
         except (pa.ArrowInvalid, pa.ArrowTypeError, OverflowError) as e:
             raise ArchiveError(f"{path}: a value does not fit its Parquet column: {e}") from None
+    said_incomplete("archive export", reader)
     return n, reader.session

@@ -45,6 +45,8 @@ from fswkit.link.log import RX, TX
 from fswkit.link.port import PortError, open_port, port_errors, port_key, runtime_dir
 from fswkit.link.session import Event, Session, reset_words
 
+from .archive import ArchiveError
+
 PROTOCOL = 1
 REOPEN_S = 0.25  # how often a port that went away is tried again
 CLIENT_BACKLOG = 200_000  # messages queued for a client that does not read before it is dropped
@@ -106,11 +108,16 @@ class Station:
         """Opens the port (PortBusy / PortError when it cannot) and starts
         serving."""
         self.port = open_port(self.port_name, self.baud, command="fsw ground", socket=self.socket_path)
+        if self.archive is not None:
+            try:
+                self.archive.begin(layout=self.layout, project=self.project, port=self.port_name, baud=self.baud,
+                                   started=time.time())
+            except ArchiveError:  # refused as an archive is, the port given up
+                self.port.close()
+                self.port = None
+                raise
         self.up = True
         self._say("port open")
-        if self.archive is not None:
-            self.archive.begin(layout=self.layout, project=self.project, port=self.port_name, baud=self.baud,
-                               started=time.time())
         if self.socket_path is not None:
             self._listen_socket()
         self._spawn(self._read_loop, "fsw-ground-reader")
@@ -137,8 +144,7 @@ class Station:
         if self.port is not None:
             self.port.close()
             self.port = None
-        if self.archive is not None:
-            self.archive.close()
+        self._archive("close")
 
     def __enter__(self):
         self.start()
@@ -167,10 +173,27 @@ class Station:
         status, ok, words, host_time."""
         self._command_listeners.append(fn)
 
+    def _archive(self, what: str, *args, **kw) -> None:
+        """The archive's `what` (rx, event, tick, ...). An archive that cannot
+        be written (a lock another program holds longer than SQLite waits, a
+        full disk) stops archiving, said once: the link goes on without it,
+        the archive keeps what was committed."""
+        archive = self.archive
+        if archive is None:
+            return
+        try:
+            getattr(archive, what)(*args, **kw)
+        except ArchiveError as e:
+            if self.archive is not archive:  # another thread said it
+                return
+            self.archive = None
+            archive.abandon()
+            self._say(f"archiving stopped: {e}; the link goes on without it (the archive keeps what was "
+                      "committed before)")
+
     def _say(self, text: str) -> None:
         self.note = text
-        if self.archive is not None:
-            self.archive.note(time.time(), text)
+        self._archive("note", time.time(), text)
         for fn in list(self._note_listeners):
             fn(text, self.up)
         self._broadcast({"t": "note", "text": text, "up": self.up})
@@ -208,8 +231,8 @@ class Station:
                 raise
             if data:
                 self._received(data)
-            elif self.archive is not None:
-                self.archive.tick()
+            else:
+                self._archive("tick")
 
     def _lost(self, e: Exception) -> None:
         port, self.port = self.port, None
@@ -220,8 +243,7 @@ class Station:
         self._say(f"the port went away ({e}); waiting for it to come back")
 
     def _reopen(self) -> None:
-        if self.archive is not None:
-            self.archive.tick()  # the note that the port went away, and the last bytes, committed
+        self._archive("tick")  # the note that the port went away, and the last bytes, committed
         if self._stop.wait(REOPEN_S):
             return
         try:
@@ -248,8 +270,7 @@ class Station:
     def _received(self, data: bytes) -> None:
         t_ns = time.time_ns()
         host = t_ns / 1e9
-        if self.archive is not None:
-            self.archive.rx(t_ns, data)
+        self._archive("rx", t_ns, data)
         # clients get whole frames: the chunk up to its last delimiter; decoded
         # and sent under the clients' lock, so a client's welcome (the station's
         # numbering as of then) is never ahead of the first chunk it gets
@@ -272,12 +293,10 @@ class Station:
                     w["event"].set()
             elif ev.kind == "hello":
                 self._on_hello(ev)
-            if self.archive is not None:
-                self.archive.event(ev)
+            self._archive("event", ev)
         for fn in list(self._listeners):
             fn(evs)
-        if self.archive is not None:
-            self.archive.tick()
+        self._archive("tick")
 
     def _on_hello(self, ev: Event) -> None:
         i = ev.info
@@ -295,8 +314,7 @@ class Station:
         if port is None:
             raise OSError("the port is not open (it went away)")
         with self._write_lock:
-            if self.archive is not None:
-                self.archive.tx(time.time_ns(), data)
+            self._archive("tx", time.time_ns(), data)
             port.write(data)
             port.flush()
 
@@ -320,10 +338,9 @@ class Station:
             entry = {"t": "command", "who": who, "text": text, "status": None if ack is None else ack["status"],
                      "ok": ack is not None and ack["status"] == 0,
                      "words": "no acknowledgement" if ack is None else ack["reason"], "host_time": time.time()}
-            if self.archive is not None:
-                self.archive.command(who=who, text=text, op=op, args=args, sent=sent,
-                                     cmd_seq=None if ack is None else ack["cmd_seq"], status=entry["status"],
-                                     words=entry["words"], acked=None if ack is None else entry["host_time"])
+            self._archive("command", who=who, text=text, op=op, args=args, sent=sent,
+                          cmd_seq=None if ack is None else ack["cmd_seq"], status=entry["status"],
+                          words=entry["words"], acked=None if ack is None else entry["host_time"])
             for fn in list(self._command_listeners):
                 fn(entry)
 
@@ -398,6 +415,16 @@ class Station:
             return [c.who for c in self._clients]
 
 
+def _message(raw: bytes) -> dict | None:
+    """A client's line as the JSON object it must be, or None (not JSON,
+    another JSON value, or nested too deeply to read)."""
+    try:
+        msg = json.loads(raw)
+    except (ValueError, RecursionError):
+        return None
+    return msg if isinstance(msg, dict) else None
+
+
 class _Client:
     """One local client: a thread reading its requests, one writing its
     messages in order."""
@@ -457,7 +484,7 @@ class _Client:
     def _reader(self) -> None:
         f = self.conn.makefile("rb")
         try:
-            first = json.loads(f.readline() or b"{}")
+            first = _message(f.readline() or b"{}") or {}
             self.who = str(first.get("who") or self.who)[:120]
             # registered and welcomed under the clients' lock: no chunk can come
             # before the welcome, nor be missed after it
@@ -466,10 +493,9 @@ class _Client:
                 self.st._clients.add(self)
             threading.Thread(target=self._writer, name="fsw-ground-client-out", daemon=True).start()
             for raw in f:
-                try:
-                    msg = json.loads(raw)
-                except ValueError:
-                    self._send({"t": "error", "text": "not a JSON line"})
+                msg = _message(raw)
+                if msg is None:
+                    self._send({"t": "error", "text": "not a JSON object on one line"})
                     continue
                 self._request(msg)
         except (OSError, ValueError):
@@ -488,7 +514,7 @@ class _Client:
                 ack = self.st.command(self.who, op, args, int(msg.get("tries", 3)), float(msg.get("timeout", 0.5)),
                                       str(msg.get("text", ""))[:200])
                 self._send({"t": "ack", "id": ident, "info": jsonable(ack)})
-            except (KeyError, ValueError, TypeError) as e:
+            except (KeyError, ValueError, TypeError, OverflowError) as e:  # OverflowError: int() of an infinity
                 self._send({"t": "ack", "id": ident, "error": f"malformed command: {e}"})
             except (LinkTimeout, OSError) as e:
                 self._send({"t": "ack", "id": ident, "error": str(e)})

@@ -6,7 +6,7 @@ yanked cable loses nothing already received; the file is fsync'ed on close.
     magic     8 bytes  b"FSWLOG1\\n"
     header    u32 length + that many bytes of JSON: {"format": 1, "layout": {...}, ...}
     records   dir u8 (0 from the target, 1 to the target), host time u64 (ns since
-              the Unix epoch), length u32, the bytes
+              the Unix epoch), length u32 (never 0), the bytes
 """
 
 from __future__ import annotations
@@ -107,7 +107,8 @@ class LogWriter:
 
 class LogReader:
     """A log's layout and records. A record cut short (the recorder died
-    mid-write) ends the log: `truncated` says so."""
+    mid-write) or one no recorder writes (a damaged file) ends the log:
+    `truncated` says so, and `incomplete` in words, once read."""
 
     def __init__(self, path: str):
         try:
@@ -122,6 +123,8 @@ class LogReader:
             self.header = json.loads(data[start:start + n].decode())
         except ValueError as e:  # JSONDecodeError and UnicodeDecodeError alike
             raise LogError(f"{path}: not a valid log: its header is not JSON ({e})") from None
+        except RecursionError:
+            raise LogError(f"{path}: not a valid log: its header is JSON nested too deeply to read") from None
         if not isinstance(self.header, dict) or "layout" not in self.header:
             raise LogError(f"{path}: not a valid log: its header has no `layout` object")
         if self.header.get("format") != 1:
@@ -135,19 +138,26 @@ class LogReader:
         self._at = start + n
         self.path = path
         self.truncated = False
+        self.incomplete: str | None = None
+
+    def _ends(self, at: int, why: str) -> None:
+        self.truncated = True
+        self.incomplete = why.format(at=at, left=len(self._data) - at)
 
     def records(self):
         """(direction, host time in seconds, bytes) in recording order."""
         data, at = self._data, self._at
         size = _REC.size
         while at < len(data):
-            if at + size > len(data):
-                self.truncated = True
+            # a record's head cut short is a record that runs past the end
+            d, t, n = _REC.unpack_from(data, at) if at + size <= len(data) else (RX, 0, len(data))
+            if d not in (RX, TX) or n == 0:  # a recorder writes no empty record: a tail of NULs is damage
+                self._ends(at, "the record at byte {at:,} is not one a recorder writes: the file is damaged; "
+                               "its last {left:,} bytes are not decoded")
                 return
-            d, t, n = _REC.unpack_from(data, at)
-            at += size
-            if at + n > len(data) or d not in (RX, TX):
-                self.truncated = True
+            if at + size + n > len(data):
+                self._ends(at, "the record at byte {at:,} is cut short ({left:,} bytes not decoded): the "
+                               "recording stopped mid-write, or the file is damaged")
                 return
-            yield d, t / 1e9, data[at:at + n]
-            at += n
+            yield d, t / 1e9, data[at + size:at + size + n]
+            at += size + n

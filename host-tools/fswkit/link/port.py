@@ -147,6 +147,24 @@ def _held_serial():
     return Held
 
 
+def not_a_port(name: str) -> str | None:
+    """Why a device path cannot be a serial port, in words (None: it may
+    be one — a device, a pty, a FIFO — or is a pyserial URL)."""
+    if is_url(name):
+        return None
+    try:
+        mode = os.stat(name).st_mode
+    except FileNotFoundError:
+        return "no such port (`fsw ports` lists the serial ports connected)"
+    except OSError:
+        return None  # pyserial says why
+    if stat.S_ISDIR(mode):
+        return "it is a folder, not a serial port"
+    if stat.S_ISREG(mode):
+        return "it is a regular file, not a serial port"
+    return None
+
+
 def open_port(name: str, baud: int, *, command: str | None = None, socket: str | None = None):
     """The port `name` at `baud`. With `command` (the fswkit command opening
     it), a device is held exclusively and a holder record written, both
@@ -155,17 +173,10 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
         import serial
     except ImportError:
         raise PortError("pyserial is not installed: run `make setup` (or pip install pyserial)") from None
+    why = not_a_port(name)
+    if why is not None:
+        raise PortError(f"cannot open {name}: {why}")
     exclusive = command is not None and not is_url(name)
-    if not is_url(name) and os.name == "posix":  # pyserial's words for these are an ioctl's or doubled
-        try:
-            mode = os.stat(name).st_mode
-        except FileNotFoundError:
-            raise PortError(f"cannot open {name}: no such device") from None
-        except OSError as e:
-            raise PortError(f"cannot open {name}: {e.strerror or e}") from None
-        if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
-            kind = "a folder" if stat.S_ISDIR(mode) else "a regular file"
-            raise PortError(f"cannot open {name}: it is {kind}, not a serial port")
     if exclusive:
         rec = holder(name)
         if rec is not None and rec["pid"] != os.getpid():

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 import tomllib
 
+from fswkit.autocode.diagnostics import read_input
 from fswkit.autocode.params import AppParam, check_value
 
 
@@ -32,9 +33,8 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
     """{name: checked value} of a parameter file; ParamFileError (located)
     for a file that is not TOML, a table, an unknown name, a value of the
     wrong type or out of range."""
-    try:
-        with open(path, "rb") as f:
-            data = f.read()
+    try:  # a FIFO, a device or a huge file is refused without reading it
+        data = read_input(path)
     except OSError as e:
         raise ParamFileError(f"{path}: cannot read: {e.strerror or e}") from None
     try:

@@ -11,6 +11,7 @@ import contextlib
 import json
 import os
 import shutil
+import socket
 import tempfile
 
 from starlette.applications import Starlette
@@ -146,7 +147,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
     async def command(request: Request) -> Response:
         try:
             body = await request.json()
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested deeper than the reader recurses
             return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
         if not isinstance(body, dict) or not all(isinstance(body.get(k), str) for k in ("kind", "target", "value")):
             return JSONResponse({"ok": False, "words": "expected {kind, target, value} as strings"}, status_code=400)
@@ -164,7 +165,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
             return JSONResponse(await source.params_now())
         try:
             body = await request.json()
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested deeper than the reader recurses
             return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
         if not isinstance(body, dict) or not isinstance(body.get("values"), dict):
             return JSONResponse({"ok": False, "words": "expected {values: {NAME: VALUE}}"}, status_code=400)
@@ -224,8 +225,24 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
     return app
 
 
-def serve(app: Starlette, host: str = "127.0.0.1", port: int = 8000, on_ready=None) -> None:
-    """Runs uvicorn in this thread until Ctrl-C; `on_ready(url)` once it listens."""
+def listen(host: str, port: int) -> socket.socket:
+    """The web server's socket, listening on host:port before anything
+    else starts: an OSError with the system's reason when it cannot (the
+    port taken, a host that does not resolve or is not this machine's),
+    where uvicorn would log it and exit the process."""
+    family = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0][0]
+    return socket.create_server((host, port), family=family)
+
+
+def url(host: str, port: int) -> str:
+    """The page's address on host:port (an IPv6 address in brackets)."""
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+
+
+def serve(app: Starlette, host: str = "127.0.0.1", port: int = 8000, on_ready=None,
+          sock: socket.socket | None = None) -> None:
+    """Runs uvicorn in this thread until Ctrl-C; `on_ready(url)` once it
+    listens, on `sock` (from `listen`) when given."""
     import uvicorn
 
     config = uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="on", ws="websockets-sansio",
@@ -233,12 +250,12 @@ def serve(app: Starlette, host: str = "127.0.0.1", port: int = 8000, on_ready=No
     server = uvicorn.Server(config)
 
     async def main():
-        task = asyncio.create_task(server.serve())
+        task = asyncio.create_task(server.serve(sockets=[sock] if sock is not None else None))
         while not server.started and not task.done():
             await asyncio.sleep(0.02)
         if server.started and on_ready is not None:
             bound = server.servers[0].sockets[0].getsockname()[1] if server.servers else port
-            on_ready(f"http://{host}:{bound}/")
+            on_ready(url(host, bound))
         await task
 
     asyncio.run(main())

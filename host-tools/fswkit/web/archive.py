@@ -219,6 +219,9 @@ class Session:
             self.layout = from_dict(json.loads(text))
         except (ValueError, LayoutError) as e:
             raise BrowseError(422, f"session {self.id} of {path}: not a valid layout: {e}") from None
+        except RecursionError:
+            raise BrowseError(422, f"session {self.id} of {path}: not a valid layout: JSON nested too deeply "
+                                   "to read") from None
         self.live = self.id == live
         end = self.ended if self.ended is not None else (time.time() if self.live else (last or self.started))
         self.span = max(0.0, end - self.started)

@@ -318,10 +318,12 @@ def stopped_by_signals():
             signal.signal(sig, handler)
 
 
-def only_its_own(path: str | None, command: str, force: bool = False, head: int = 512) -> None:
+def only_its_own(path: str | None, command: str, force: bool = False, head: int = 512,
+                 starts: bytes | None = None, what: str = "output") -> None:
     """Refuses (OutputError) to replace a regular, non-empty file at `path`
     whose first `head` bytes do not name `fsw COMMAND`, as the command's
-    own output does in its first lines (`fsw graph`, `fsw skeleton`): a
+    own output does in its first lines (`fsw graph`, `fsw skeleton`), or
+    that does not begin with `starts` when given (a trace's header): a
     file the user wrote there, a state script beside its machine, is not
     this command's to replace unless asked (`force`). Standard output,
     devices, FIFOs and paths with nothing there pass."""
@@ -335,6 +337,6 @@ def only_its_own(path: str | None, command: str, force: bool = False, head: int 
             start = f.read(head)
     except OSError:
         return  # nothing there to lose (or unreadable: the write says why)
-    if start and mark.encode() not in start:
-        raise OutputError(f"{path} exists and is not an earlier output of `fsw {command}` (a file you wrote?): "
+    if start and not (start.startswith(starts) if starts is not None else mark.encode() in start):
+        raise OutputError(f"{path} exists and is not an earlier {what} of `fsw {command}` (a file you wrote?): "
                           "it is replaced only when asked (--force)")

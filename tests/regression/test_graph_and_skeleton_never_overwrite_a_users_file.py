@@ -50,3 +50,21 @@ def test_its_own_output_and_an_empty_file_are_replaced(tank, command, args):
     if command == "graph":
         other = ("--format", "dot") if args else ("--format", "mermaid")
         assert run_fsw(command, str(tank / "tank.sm"), *other, "-o", str(out)).code == 0
+
+
+def test_a_trace_replaces_only_an_earlier_trace(tank):
+    """`fsw test --trace FILE` wrote its CSV over any file: a trace replaces
+    an earlier trace (its header begins `step,`) or an empty file only."""
+    notes = tank / "notes.csv"
+    notes.write_text("date,what\n2026-12-06,hot fire\n")
+    r = run_fsw("test", str(tank / "tank.ss"), "--trace", str(notes))
+    assert r.code == 1 and "--force" in r.err, r.err
+    assert notes.read_text() == "date,what\n2026-12-06,hot fire\n"
+    trace = tank / "trace.csv"
+    assert run_fsw("test", str(tank / "tank.ss"), "--trace", str(trace)).code == 0
+    first = trace.read_text()
+    assert first.startswith("step,")
+    assert run_fsw("test", str(tank / "tank.ss"), "--trace", str(trace)).code == 0
+    assert trace.read_text() == first
+    assert run_fsw("test", str(tank / "tank.ss"), "--trace", str(notes), "--force").code == 0
+    assert notes.read_text() == first

@@ -181,9 +181,10 @@ def _test_one(path: str, args, real):
 
     trace = None
     if args.trace:  # written beside its path and renamed into place once whole
-        from fswkit.outputs import OutputError, Replacement, check
+        from fswkit.outputs import OutputError, Replacement, check, only_its_own
         try:
             check(args.trace, [path, script.machine.path, script.machine.sv.path], what="trace")
+            only_its_own(args.trace, "test", args.force, starts=b"step,", what="trace")  # its header's start
             trace = Replacement(args.trace)
         except OutputError as e:
             sys.stderr.write(f"fsw test: {e}\n")

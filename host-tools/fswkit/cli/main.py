@@ -131,6 +131,8 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument("--native", action="store_true",
                    help="run the generated C++ compiled for this host instead of the interpreter")
     t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
+    t.add_argument("--force", action="store_true", help="replace a --trace file that is not an earlier trace "
+                   "(a file you wrote): never done unasked")
     t.add_argument("--coverage", action="store_true",
                    help="report the states and transitions the scripts never reached, and fail if any")
     t.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",

@@ -40,17 +40,25 @@ def same_file(a: str, b: str) -> bool:
         return os.path.realpath(a) == os.path.realpath(b)
 
 
-def recording(path: str) -> str | None:
-    """What recording `path` is: "a link log" (`fsw monitor --log`, `fsw sim
-    --plant`), "a ground station archive" (`fsw ground`: SQLite with the
-    archive's application id), or None. Only a regular file is read (a
-    FIFO or a device is never opened: that would wait for a writer)."""
+def file_head(path: str, n: int) -> bytes | None:
+    """The first `n` bytes of the regular file at `path`; None for no file,
+    one that cannot be read, or one that is not regular (a FIFO or a device
+    is never opened: that would wait for a writer)."""
     try:
         if not stat.S_ISREG(os.stat(path).st_mode):
             return None
         with open(path, "rb") as f:
-            head = f.read(100)
+            return f.read(n)
     except OSError:
+        return None
+
+
+def recording(path: str) -> str | None:
+    """What recording `path` is: "a link log" (`fsw monitor --log`, `fsw sim
+    --plant`), "a ground station archive" (`fsw ground`: SQLite with the
+    archive's application id), or None."""
+    head = file_head(path, 100)
+    if head is None:
         return None
     if head.startswith(RECORDING_MAGIC):
         return "a link log"
@@ -330,13 +338,7 @@ def only_its_own(path: str | None, command: str, force: bool = False, head: int 
     mark = f"`fsw {command}"
     if path is None or path == "-" or force or is_direct(path):
         return
-    try:
-        if not stat.S_ISREG(os.stat(path).st_mode):
-            return
-        with open(path, "rb") as f:
-            start = f.read(head)
-    except OSError:
-        return  # nothing there to lose (or unreadable: the write says why)
+    start = file_head(path, head)  # None: nothing there to lose (or unreadable: the write says why)
     if start and not (start.startswith(starts) if starts is not None else mark.encode() in start):
         raise OutputError(f"{path} exists and is not an earlier {what} of `fsw {command}` (a file you wrote?): "
                           "it is replaced only when asked (--force)")

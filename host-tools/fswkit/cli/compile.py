@@ -17,19 +17,11 @@ def _not_ours(path: str, what: str) -> str | None:
     user wrote (a config, notes), is never overwritten without --force.
     None for a path that does not exist, is empty, is no regular file (a
     device) or holds what this command writes."""
-    import os
-    import stat
-
     from fswkit.autocode.vmverify import MAGIC
+    from fswkit.outputs import file_head
 
-    try:
-        if not stat.S_ISREG(os.stat(path).st_mode):
-            return None
-        with open(path, "rb") as f:
-            head = f.read(4096)
-    except OSError:
-        return None  # nothing there to lose (or unreadable: the write says why)
-    if not head:
+    head = file_head(path, 4096)
+    if not head:  # nothing there to lose (or unreadable: the write says why)
         return None
     if what == "image":
         return None if head.startswith(MAGIC) else "a bytecode image"

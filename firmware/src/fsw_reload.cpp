@@ -127,9 +127,8 @@ void activate_now(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
     ReloadSlot& sl = s.slot[which - 1u];  // checked (check_slice): its CRC and the verifier passed
     leave(s, c);
     run_slot(s, c, which);
-    const ReloadSlot& o = s.slot[2u - which];
-    const uint16_t other = o.status != kSlotEmpty ? o.seq : sl.seq;
-    sl.seq = static_cast<uint16_t>((later(sl.seq, other) ? sl.seq : other) + 1u);
+    const ReloadSlot& o = s.slot[2u - which];  // the order after the other slot's (this one's own may be stale)
+    sl.seq = static_cast<uint16_t>((o.status != kSlotEmpty ? o.seq : sl.seq) + 1u);
     sl.status = kSlotBoot;
     s.sync = true;
 }

@@ -509,3 +509,25 @@ def test_the_activation_order_wraps_and_the_newest_still_boots(rig, new_image):
     rig.c.activate(slot)  # and the next activation comes after both
     inf = rig.c.info()
     assert inf.active == slot and inf.slots[slot - 1].seq == 1, inf
+
+
+def test_an_image_activated_against_any_order_of_the_other_slot_boots(rig, new_image):
+    """The new order is the other slot's plus one, whatever this slot's own
+    (a commit sets it 0): taking the later of the two by serial-number
+    arithmetic gave 1 against 32,769, which is not after it."""
+    slot, _ = rig.c.upload(*new_image)
+    rig.c.activate(slot)
+    while rig.c.info().writing:
+        rig.t.events(0.02)
+    rig.b.eeprom_write((slot - 1) * (9 + 384) + 2, struct.pack("<H", 32769))
+    rig.b.reset("power")
+    rig.t.events(0.5)
+    assert rig.c.info().active == slot
+    other, _ = rig.c.upload(*new_image)  # committed: its order 0
+    rig.c.activate(other)
+    while rig.c.info().writing:
+        rig.t.events(0.02)
+    assert rig.c.info().slots[other - 1].seq == 32770
+    rig.b.reset("power")
+    rig.t.events(0.5)
+    assert rig.c.info().active == other

@@ -326,7 +326,7 @@ def stopped_by_signals():
             signal.signal(sig, handler)
 
 
-def only_its_own(path: str | None, command: str, force: bool = False, head: int = 512,
+def only_its_own(path: str | None, command: str, force: bool = False, head: int = 8192,
                  starts: bytes | None = None, what: str = "output") -> None:
     """Refuses (OutputError) to replace a regular, non-empty file at `path`
     whose first `head` bytes do not name `fsw COMMAND`, as the command's

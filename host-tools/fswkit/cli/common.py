@@ -66,7 +66,7 @@ def write_output(text: str, out: str | None, command: str, inputs=(), own: bool 
 
     try:
         if own:
-            assert f"`fsw {command}" in text[:512], "the output names its command"
+            assert f"`fsw {command}" in text[:8192], "the output names its command (in its first lines)"
             if out not in (None, "-"):
                 check(out, inputs)  # an input, a recording, a folder: said as such first
             only_its_own(out, command, force)

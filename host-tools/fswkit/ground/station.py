@@ -41,7 +41,6 @@ from contextlib import contextmanager
 from fswkit.link import wire
 from fswkit.link.client import LinkTimeout, Numbers, exchange
 from fswkit.link.layout import Layout
-from fswkit.link.log import RX, TX
 from fswkit.link.port import PortError, open_port, port_errors, port_key, runtime_dir
 from fswkit.link.session import Event, Session, reset_words
 

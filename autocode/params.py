@@ -132,8 +132,13 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
         try:
             value = int(text, 0) if t.is_int else float(text)
         except ValueError:
-            kind = "a whole number" if t.is_int else "a number"
-            return None, f"`{p.name}` is {t.name}: `{value}` is not {kind}"
+            try:  # `1e3` or `3000.0` for a whole number, as a parameter file's TOML takes them
+                value = float(text) if t.is_int else None
+            except ValueError:
+                value = None
+            if value is None:
+                kind = "a whole number" if t.is_int else "a number"
+                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}"
     if t.is_bool:
         if isinstance(value, bool):
             return value, None

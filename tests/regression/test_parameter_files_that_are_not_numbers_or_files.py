@@ -84,3 +84,19 @@ def test_sim_params_that_are_a_device_or_a_fifo(tmp_path):
     for path, kind in (("/dev/zero", "a device"), (str(fifo), "a FIFO")):
         r = fsw_child("sim", tank, "--plant", "tank", "--params", path)
         assert r.returncode == 2 and f"not a regular file ({kind})" in r.stderr, r.stderr
+
+
+def test_the_command_line_takes_a_whole_number_as_a_file_does():
+    """`fsw param set HOLD_MS=1e3` was refused (`is not a whole number`)
+    where a file's `HOLD_MS = 1e3` was taken: both take a number that is
+    whole, and both refuse one that is not, or is beyond the float range."""
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.params import app_parameters
+    from fswkit.target.build import load as load_app
+
+    p = {q.name: q for q in app_parameters(load_app(str(RIG), Diagnostics()))}["HOLD_MS"]
+    for text, file_value in (("1e3", 1e3), ("250.0", 250.0), (" 0x20 ", 32)):
+        assert check_value(p, text) == check_value(p, file_value) and check_value(p, text)[1] is None, text
+    for text in ("1.5", "1e400", "inf", "nan", "ten", ""):
+        value, why = check_value(p, text)
+        assert value is None and "HOLD_MS" in why, (text, why)

@@ -36,6 +36,19 @@ def load_app(project: str, board: str | None, command: str):
     return app
 
 
+def source_or_empty(path: str):
+    """A machine's text for a diagnostic after the fact (as
+    fswkit.autocode.project.source_of reads it); an empty one when the file
+    can no longer be read: the diagnostic still names the file and line."""
+    from fswkit.autocode.diagnostics import Source
+    from fswkit.autocode.project import source_of
+
+    try:
+        return source_of(path)
+    except OSError:
+        return Source.from_text(path, "")
+
+
 def config_paths(app) -> list[str]:
     """The files of a project's configs: inputs of every command on it,
     which no output of the command may replace."""

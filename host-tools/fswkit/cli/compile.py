@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import sys
 
-from fswkit.autocode.diagnostics import SM, Diagnostics, Source
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags, real_of
+from fswkit.autocode.diagnostics import SM, Diagnostics
+from fswkit.cli.common import (EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK, plural, print_diags, real_of,
+                               source_or_empty)
 
 LAYOUT_HEAD = "fswsm-layout "  # the first line of a layout file that is not a comment (fswkit.sm.layout_text)
 
@@ -41,17 +42,10 @@ def cmd_compile(args) -> int:
     if real is None:
         return EXIT_CONFIG
 
-    def source() -> Source:
-        try:
-            with open(args.machine, encoding="utf-8", errors="surrogateescape") as f:
-                return Source.from_text(args.machine, f.read())
-        except OSError:
-            return Source.from_text(args.machine, "")
-
     diags = Diagnostics()
     m = load_machine(args.machine, diags, args.sv)
     if m is not None:  # a number binary32 cannot hold would be compiled as an infinity
-        check_literals(machine_exprs(m), real, source(), diags, SM, "the image's")
+        check_literals(machine_exprs(m), real, source_or_empty(args.machine), diags, SM, "the image's")
     print_diags(diags)
     if m is None or diags.error_count:
         return EXIT_CONFIG
@@ -59,7 +53,7 @@ def cmd_compile(args) -> int:
         image = compile_machine(m, real)
     except BytecodeError as e:
         d = Diagnostics()
-        d.error(source(), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        d.error(source_or_empty(args.machine), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
         print_diags(d)
         return EXIT_CONFIG
     reason = V.verify(image, V.layout_of(m.sv), real.bits // 8)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app, print_diags
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, load_app, print_diags, source_or_empty
 
 
 WAIT = 10.0  # seconds `activate`, `revert` and `upload --activate` wait for the switch (--wait)
@@ -22,7 +22,7 @@ def image_for(app, path: str, diags: Diagnostics):
     against the application's state vector for its board's evaluation type;
     None with the reasons in `diags` or said."""
     from fswkit.autocode import vmverify as V
-    from fswkit.autocode.diagnostics import SM, Source
+    from fswkit.autocode.diagnostics import SM
     from fswkit.autocode.emit.app import real_of
     from fswkit.autocode.emit.bytecode import BytecodeError, compile_machine
     from fswkit.autocode.project import load_machine
@@ -31,20 +31,13 @@ def image_for(app, path: str, diags: Diagnostics):
     if m is None:
         return None
 
-    def source() -> Source:
-        try:
-            with open(path, encoding="utf-8", errors="surrogateescape") as f:
-                return Source.from_text(path, f.read())
-        except OSError:
-            return Source.from_text(path, "")
-
-    if not _in_application(app, m, path, source, diags):
+    if not _in_application(app, m, path, diags):
         return None
     real = real_of(app)
     try:
         image = compile_machine(m, real)
     except BytecodeError as e:
-        diags.error(source(), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
+        diags.error(source_or_empty(path), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
         return None
     reason = V.verify(image, V.layout_of(app.sv), real.bits // 8)
     if reason != V.OK:
@@ -71,7 +64,7 @@ def image_for(app, path: str, diags: Diagnostics):
     return bytes(image), bytes(mask), m
 
 
-def _in_application(app, m, path: str, source, diags: Diagnostics) -> bool:
+def _in_application(app, m, path: str, diags: Diagnostics) -> bool:
     """Whether machine `m` (read from `path`) may take the place of the
     generated machine that [reload] names; the reasons in `diags`, located.
     The firmware's tables (the pyro gates' fire states, the recorder's
@@ -87,12 +80,13 @@ def _in_application(app, m, path: str, source, diags: Diagnostics) -> bool:
            "state names): keep the generated machine's states in their order, and add new ones after them")
     for old, new in zip(gen.states, m.states):
         if old.name != new.name:
-            diags.error(source(), SM, new.line, 2, f"state {new.id} is `{new.name}` here but `{old.name}` in the "
-                                                   f"generated machine `{gen.name}`: {why}")
+            diags.error(source_or_empty(path), SM, new.line, 2,
+                        f"state {new.id} is `{new.name}` here but `{old.name}` in the generated machine `{gen.name}`: "
+                        f"{why}")
             return False
     if len(m.states) < len(gen.states):
         missing = ", ".join(st.name for st in gen.states[len(m.states):])
-        diags.error(source(), SM, m.states[-1].line if m.states else 1, 1,
+        diags.error(source_or_empty(path), SM, m.states[-1].line if m.states else 1, 1,
                     f"machine `{m.name}` has {len(m.states)} states: the generated machine `{gen.name}` has "
                     f"{len(gen.states)} ({missing} missing): {why}")
         return False

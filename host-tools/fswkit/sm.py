@@ -351,13 +351,10 @@ class Machine:
         `real` picks the library; by default the image's own (its byte 5),
         so only an explicit `real` can meet WrongReal."""
         if real is None:
-            import stat
+            from fswkit.autocode.diagnostics import read_head
 
-            try:
-                if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block: the library refuses it
-                    raise OSError
-                with open(path, "rb") as f:
-                    head = f.read(6)
+            try:  # read_head refuses a FIFO without waiting on it: the library refuses it too
+                head = read_head(path, 6)
             except OSError:  # the library says so, as FileUnreadable
                 head = b""
             real = "f32" if len(head) == 6 and head[5] == 4 else "f64"

@@ -60,9 +60,54 @@ REASONS = {
     15: "more pending forward jumps than the verifier tracks",
     16: "the RAM buffer is smaller than the image needs",
     17: "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
+    18: "a window function or value type (F32, F64) the board's VM was built without",
 }
 (OK, BAD_MAGIC, BAD_VERSION, BAD_REAL, BAD_SCHEMA, BAD_SIZE, BAD_ELEMENT, BAD_LOCAL, BAD_STATE,
- BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM, BAD_MASK) = range(18)
+ BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM, BAD_MASK,
+ NO_FEATURE) = range(19)
+
+
+# What a VM runs beyond what every image may use (fsw_vm.h VmFeature): a
+# window function (bit 1 << its WINDOW_FUNCS code), values of a type other
+# than U32, U64 and bool, a locked state vector. A board's VM has those of
+# its application (features_of); libfswsm's has every one.
+FEAT_F32, FEAT_F64, FEAT_LOCK = 0x20, 0x40, 0x80
+FEAT_WINDOWS = 0x1F
+ALL_FEATURES = 0x3FFF
+# the bit of each type's values (0: always taken)
+TYPE_FEATURES = {"I8": 0x100, "I16": 0x200, "I32": 0x400, "I64": 0x800, "U8": 0x1000, "U16": 0x2000,
+                 "U32": 0, "U64": 0, "F32": FEAT_F32, "F64": FEAT_F64, "bool": 0}
+
+
+def takes(type_code: int, features: int) -> bool:
+    """Whether a VM of `features` takes values of this type (fsw_vm.cpp takes())."""
+    if type_code >= len(TYPE_SIZES):
+        return True  # (an unknown type is refused by its own rule)
+    bit = TYPE_FEATURES[list(TYPE_CODES)[type_code]]
+    return bit == 0 or bool(features & bit)
+
+
+def features_of(sv: M.StateVector, m: M.Machine) -> int:
+    """The features of the VM built into an application whose state vector
+    is `sv` and whose replaceable machine is `m`: the types of the vector's
+    elements and of the machine's locals, the machine's window functions,
+    the vector's lock option (autocode/emit/app.py writes them as
+    fsw::vm_features)."""
+    types = {e.type.name for e in sv.elements} | {v.type.name for v in m.vars if v.kind == M.LOCAL}
+    f = FEAT_LOCK if sv.lock else 0
+    for t in types:
+        f |= TYPE_FEATURES[t]
+    for w in m.windows:
+        f |= 1 << WINDOW_FUNCS[w.func]
+    return f
+
+
+def feature_names(features: int) -> list[str]:
+    """What `features` holds, in the words of a machine: `roll_avg`...,
+    the types beyond U32, U64 and bool, lock."""
+    names = [f"roll_{name}" for name, code in WINDOW_FUNCS.items() if features & (1 << code)]
+    names += [t for t, bit in TYPE_FEATURES.items() if bit and features & bit]
+    return names + (["lock"] if features & FEAT_LOCK else [])
 
 
 @dataclass(frozen=True)
@@ -361,10 +406,11 @@ def code_depth(im: bytes, layout: Layout, stack: int = 255) -> tuple[int, int]:
     return _verify_code(im, parts(im), layout, stack, VM_PENDING)
 
 
-def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pending: int = VM_PENDING) -> int:
+def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pending: int = VM_PENDING,
+           features: int = ALL_FEATURES) -> int:
     """vm_verify on the host: the reason code (0: the image may run).
     `real_bytes` is the runtime's sizeof(Real); RAM is not checked here
-    (the board's buffer is the board's)."""
+    (the board's buffer is the board's); `features` are the VM's (fsw::vm_features)."""
     if len(im) > 0xFFFF or len(im) < HEADER:
         return BAD_SIZE
     if im[:4] != MAGIC:
@@ -378,6 +424,10 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
     schema, count = struct.unpack_from("<IH", im, 8)
     if schema != layout.schema or count != len(layout.elems):
         return BAD_SCHEMA
+    if im[6] & FLAG_LOCK and not features & FEAT_LOCK:
+        return NO_FEATURE
+    if any(not takes(t, features) for _off, t in layout.elems):
+        return NO_FEATURE
     p = parts(im)
     if p.total != len(im):
         return BAD_SIZE
@@ -391,10 +441,14 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
         off = _u16(im, p.loc + 3 * k + 1)
         if t >= len(TYPE_SIZES) or off + TYPE_SIZES[t] > p.loc_size:
             return BAD_LOCAL
+        if not takes(t, features):
+            return NO_FEATURE
     for w in range(p.windows):
         n = _u16(im, p.win + 4 * w + 2)
         if im[p.win + 4 * w] > 4 or im[p.win + 4 * w + 1] != 0 or n == 0:
             return BAD_WINDOW
+        if not features & (1 << im[p.win + 4 * w]):
+            return NO_FEATURE
     return _verify_code(im, p, layout, stack, pending)[0]
 
 

@@ -22,13 +22,15 @@ sys.path.insert(0, HERE)
 import bench_firmware as B  # noqa: E402
 from fswkit.autocode.emit.bytecode import compile_machine, window_ram  # noqa: E402
 from fswkit.autocode.numeric import F32MODE  # noqa: E402
-from fswkit.autocode.vmverify import TYPE_CODES  # noqa: E402
+from fswkit.autocode.vmverify import TYPE_CODES, feature_names, features_of  # noqa: E402
 from fswkit.target.build import elf_symbols  # noqa: E402
 
 
-def image_header(folder: str) -> tuple[int, int]:
-    """Writes the tank's image and layout for vm_probe.cpp; (the image's
-    bytes, the state vector's bytes)."""
+def image_header(folder: str) -> tuple[int, int, int]:
+    """Writes the tank's image and layout for vm_probe.cpp, and the VM's
+    features as a board with the tank's layout and machine has them
+    (examples/stand's); (the image's bytes, the state vector's bytes, the
+    features)."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.project import load_machine
 
@@ -39,8 +41,9 @@ def image_header(folder: str) -> tuple[int, int]:
         f.write(f"uint8_t kImage[] = {{{', '.join(str(b) for b in im)}}};\n"
                 f"const fsw::VmElem kElems[] FSW_FLASH = {{{elems}}};\n"
                 f"const uint16_t kElemCount = {len(m.sv.elements)};\n"
-                f"const uint16_t kRam = {window_ram(m, F32MODE, idx_bytes=2, align=1)};\n")
-    return len(im), max(e.offset + e.type.size for e in m.sv.elements)
+                f"const uint16_t kRam = {window_ram(m, F32MODE, idx_bytes=2, align=1)};\n"
+                f"extern const uint16_t fsw::vm_features = {features_of(m.sv, m)};\n")
+    return len(im), max(e.offset + e.type.size for e in m.sv.elements), features_of(m.sv, m)
 
 
 def build(mcu: str, variant: str, define: str, probe: int, timing: bool, gen: str) -> str:
@@ -67,11 +70,11 @@ def cycles(elf: str) -> tuple[int, int, int]:
 def main() -> int:
     gen = os.path.join(B.OUT, "vm-tank-f32")
     B.generate(F32MODE, gen)
-    size, sv = image_header(gen)
+    size, sv, feats = image_header(gen)
     uno = ("atmega328p", "standard", "ARDUINO_AVR_UNO")
     elfs = [build(*uno, p, False, gen) for p in (0, 1, 2)]
     s = [B.elf_size(elf) for elf in elfs]
-    print(f"tank image: {size} bytes")
+    print(f"tank image: {size} bytes; the VM's features: {', '.join(feature_names(feats)) or 'none'}")
     print(f"Uno, empty sketch:          flash {s[0][0]:6,}  RAM {s[0][1]:5,}")
     print(f"Uno, generated tank:        flash {s[1][0]:6,}  RAM {s[1][1]:5,}  "
           f"(+{s[1][0] - s[0][0]:,} / +{s[1][1] - s[0][1]:,})")

@@ -744,6 +744,7 @@ def _reload(app: Application) -> list[str]:
     and its windows and locals, and the slots' place in the EEPROM."""
     from ..params import HEADER as PHEADER
     from ..reloadcheck import eeprom_bytes
+    from ..vmverify import feature_names, features_of
 
     rl = app.reload
     m = app.machines[rl.machine]
@@ -756,7 +757,14 @@ def _reload(app: Application) -> list[str]:
         if st.name in rl.activate:
             mask[(st.id - 1) // 8] |= 1 << ((st.id - 1) % 8)
     elems = ", ".join(f"{{E_{e.name}, {ELEM_CODE[e.type.name]}}}" for e in app.sv.elements)
+    feats = features_of(app.sv, m)
+    have = ", ".join(feature_names(feats) + ["U32, U64 and bool"])
     return ["// ---- machines replaced at run time (docs/reload.md) ----",
+            "}  // namespace", "}  // namespace fsw_gen", "namespace fsw {",
+            f"// The VM's features (fsw_vm.h): {have}; LTO drops the code of the others, and an image",
+            "// that needs one of them is refused (kVmNoFeature)",
+            f"extern const uint16_t vm_features = 0x{feats:04x};",
+            "}  // namespace fsw", "namespace fsw_gen {", "namespace {",
             f"// {name}:{rl.line}: machine {m.name}; two slots of {rl.size} B in the EEPROM from byte {base} "
             f"({eeprom_bytes(rl.size)} B); another machine may take over in " + ", ".join(rl.activate),
             f"const fsw::VmElem kReloadElems[{len(app.sv.elements)}] FSW_FLASH = {{{elems}}};",

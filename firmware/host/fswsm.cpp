@@ -29,6 +29,9 @@
 // as a task and an interrupt are on a board. (This lock is the library's
 // only process-wide object; it holds no machine's state.)
 namespace fsw {
+// libfswsm runs every image of its evaluation type: a VM with every feature.
+extern const uint16_t vm_features = kVmAllFeatures;
+
 namespace pal {
 namespace {
 void* g_owner;
@@ -115,16 +118,17 @@ const char* const kReasons[] = {
     "more pending forward jumps than the verifier tracks",
     "the RAM buffer is smaller than the image needs",
     "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
+    "a window function or value type (F32, F64) the board's VM was built without",
 };
 const char* const kReasonNames[] = {
     "kVmOk", "kVmBadMagic", "kVmBadVersion", "kVmBadReal", "kVmBadSchema", "kVmBadSize", "kVmBadElement",
     "kVmBadLocal", "kVmBadState", "kVmBadWindow", "kVmBadJump", "kVmBadStack", "kVmBadOpcode", "kVmBadEnd",
-    "kVmBadPlace", "kVmTooNested", "kVmNoRam", "kVmBadMask",
+    "kVmBadPlace", "kVmTooNested", "kVmNoRam", "kVmBadMask", "kVmNoFeature",
 };
 const int kReasonCount = static_cast<int>(sizeof kReasons / sizeof kReasons[0]);
 static_assert(sizeof kReasonNames / sizeof kReasonNames[0] == sizeof kReasons / sizeof kReasons[0],
               "a name for every reason's words");
-static_assert(sizeof kReasons / sizeof kReasons[0] == fsw::kVmBadMask + 1, "the words of every VmReason");
+static_assert(sizeof kReasons / sizeof kReasons[0] == fsw::kVmNoFeature + 1, "the words of every VmReason");
 
 struct CodeText {
     int code;

@@ -113,17 +113,19 @@ FSW_NOINLINE void negate8(uint8_t* b) {
 
 }  // namespace
 
+Real read_int_elem(const uint8_t* p, uint8_t type) {
+    uint8_t b[8];
+    elem_widen(p, type, b);
+    const bool neg = type < kU8 && (b[7] & 0x80u) != 0;
+    if (neg) negate8(b);
+    uint64_t v;
+    memcpy(&v, b, sizeof v);
+    const Real r = real_from_U64(v);
+    return neg ? -r : r;
+}
+
 Real read_elem(const uint8_t* p, uint8_t type) {
-    if (type <= kU64) {
-        uint8_t b[8];
-        elem_widen(p, type, b);
-        const bool neg = type < kU8 && (b[7] & 0x80u) != 0;
-        if (neg) negate8(b);
-        uint64_t v;
-        memcpy(&v, b, sizeof v);
-        const Real r = real_from_U64(v);
-        return neg ? -r : r;
-    }
+    if (type <= kU64) return read_int_elem(p, type);
     switch (type) {
         case kF32: return read_F32(p);
         case kF64: return read_F64(p);
@@ -133,15 +135,17 @@ Real read_elem(const uint8_t* p, uint8_t type) {
 }
 
 void write_elem(uint8_t* p, uint8_t type, Real r) {
-    if (type > kU64) {
-        switch (type) {
-            case kF32: write_F32(p, r); break;
-            case kF64: write_F64(p, r); break;
-            case kBool: write_bool(p, r); break;
-            default: break;
-        }
-        return;
+    switch (type) {
+        case kF32: write_F32(p, r); break;
+        case kF64: write_F64(p, r); break;
+        case kBool: write_bool(p, r); break;
+        default:
+            if (type <= kU64) write_int_elem(p, type, r);
+            break;
     }
+}
+
+void write_int_elem(uint8_t* p, uint8_t type, Real r) {
     uint32_t u;
     memcpy(&u, &r, sizeof u);
     const uint8_t n = elem_size(type);

@@ -84,6 +84,13 @@ Real read_elem_typed(const uint8_t* p, uint8_t type);
 void write_elem_typed(uint8_t* p, uint8_t type, Real r);
 Real read_elem(const uint8_t* p, uint8_t type);
 void write_elem(uint8_t* p, uint8_t type, Real r);
+#if FSW_REAL_IS_FLOAT
+// Their path for the integer types (type <= kU64), for a caller that
+// takes the other types itself (the bytecode VM, which leaves out the
+// float types its board has no element or local of: fsw_vm.h).
+Real read_int_elem(const uint8_t* p, uint8_t type);
+void write_int_elem(uint8_t* p, uint8_t type, Real r);
+#endif
 
 }  // namespace fsw
 

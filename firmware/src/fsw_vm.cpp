@@ -59,6 +59,58 @@ static_assert(FSW_WINDOW_MAX_N >= 65535UL, "window sizes of the image");
 
 enum WinFunc : uint8_t { kAvg = 0, kMin = 1, kMax = 2, kRange = 3, kMedian = 4 };
 
+// Whether the VM was built with feature `f` (vm_features: a constant the
+// application defines, so each test folds and the code of a feature the
+// board does not have is dropped).
+FSW_VM_INLINE bool has(uint16_t f) { return (vm_features & f) != 0; }
+// Whether it takes values of type t (kVmNoFeature otherwise): U32, U64 and
+// bool always (every layout has G and S), the others as built.
+inline bool takes(uint8_t t) {
+    switch (t) {
+        case kI8: return has(kVmFeatI8);
+        case kI16: return has(kVmFeatI16);
+        case kI32: return has(kVmFeatI32);
+        case kI64: return has(kVmFeatI64);
+        case kU8: return has(kVmFeatU8);
+        case kU16: return has(kVmFeatU16);
+        case kF32: return has(kVmFeatF32);
+        case kF64: return has(kVmFeatF64);
+        default: return true;
+    }
+}
+// Whether an integer of type t (a verified one) is signed: never where the
+// VM takes no signed type.
+FSW_VM_INLINE bool is_signed(uint8_t t) { return has(kVmFeatSigned) && t < kU8; }
+// An element or local of a verified type read as R, and R written to one:
+// read_elem and write_elem without the float types the VM was built
+// without (their conversions, software binary64 on an AVR, go with them).
+Real vm_read(const uint8_t* p, uint8_t t) {
+#if FSW_REAL_IS_FLOAT
+    if (t <= kU64) return read_int_elem(p, t);
+    if (t == kF32 && has(kVmFeatF32)) return read_F32(p);
+    if (t == kF64 && has(kVmFeatF64)) return read_F64(p);
+    return read_bool(p);
+#else
+    return read_elem(p, t);
+#endif
+}
+void vm_write(uint8_t* p, uint8_t t, Real r) {
+#if FSW_REAL_IS_FLOAT
+    if (t <= kU64) write_int_elem(p, t, r);
+    else if (t == kF32 && has(kVmFeatF32)) write_F32(p, r);
+    else if (t == kF64 && has(kVmFeatF64)) write_F64(p, r);
+    else write_bool(p, r);
+#else
+    write_elem(p, t, r);
+#endif
+}
+
+// The bytes of a float variable of type t (kJKey's, verified F32 or F64):
+// a constant where the VM takes only one of them.
+FSW_VM_INLINE uint8_t float_bytes(uint8_t t) {
+    return !has(kVmFeatF32) ? 8 : !has(kVmFeatF64) ? 4 : t == kF64 ? 8 : 4;
+}
+
 inline uint16_t u16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
 inline uint32_t u32(const uint8_t* p) {
     return static_cast<uint32_t>(u16(p)) | (static_cast<uint32_t>(u16(p + 2)) << 16);
@@ -142,19 +194,20 @@ inline uint32_t up(uint32_t x) { return (x + kAlign - 1u) / kAlign * kAlign; }
 inline uint32_t ext_size(uint32_t n) {
     return up(sizeof(RollExtS<WinIdx>)) + up(n * sizeof(Real)) + up(n * sizeof(WinIdx));
 }
+// 0 for a function the VM was built without (an image that has one is
+// refused before its windows are summed).
 uint32_t window_size(uint8_t func, uint32_t n) {
-    switch (func) {
-        case kAvg: return up(sizeof(RollAvgS<WinIdx>)) + up(n * sizeof(Real));
-        case kMin:
-        case kMax: return ext_size(n);
-        case kRange: return 2u * ext_size(n);
-        default: return up(sizeof(RollMedianS<WinIdx>)) + 2u * up(n * sizeof(Real));
-    }
+    if (func == kAvg && has(kVmFeatAvg)) return up(sizeof(RollAvgS<WinIdx>)) + up(n * sizeof(Real));
+    if ((func == kMin && has(kVmFeatMin)) || (func == kMax && has(kVmFeatMax))) return ext_size(n);
+    if (func == kRange && has(kVmFeatRange)) return 2u * ext_size(n);
+    if (func == kMedian && has(kVmFeatMedian)) return up(sizeof(RollMedianS<WinIdx>)) + 2u * up(n * sizeof(Real));
+    return 0;
 }
 
 template <class Im>
 uint32_t windows_size(const Im& im, const Offs& o) {
     uint32_t size = 0;
+    if (!has(kVmFeatWindows)) return size;
     for (uint8_t w = 0; w < o.windows; ++w) {
         const uint16_t at = static_cast<uint16_t>(o.win + 4u * w);
         size += window_size(im[at], r16(im, static_cast<uint16_t>(at + 2u)));
@@ -163,6 +216,7 @@ uint32_t windows_size(const Im& im, const Offs& o) {
 }
 uint32_t windows_size(const Parts& p) {
     uint32_t size = 0;
+    if (!has(kVmFeatWindows)) return size;  // (a verified image has none)
     for (uint8_t w = 0; w < p.windows; ++w) size += window_size(p.win[4u * w], u16(p.win + 4u * w + 2u));
     return size;
 }
@@ -188,7 +242,7 @@ uint8_t operand_bytes(uint8_t op, uint8_t real) {
 // offset; kSetK's value; kIAdd's source and constant.
 inline uint8_t typed_operands(uint8_t op, uint8_t t) {
     if (op == kIAdd) return 6;
-    const uint8_t size = t == kTypeT ? 4u : elem_size(t);
+    const uint8_t size = t == kTypeT ? 4u : op == kJKey ? float_bytes(t) : elem_size(t);
     return op == kSetK ? size : static_cast<uint8_t>(1u + size + 2u);
 }
 
@@ -234,6 +288,12 @@ VmReason check_header(const Im& im, uint16_t len, const VmLayout& layout, Offs& 
     if (im[5] != sizeof(Real)) return kVmBadReal;
     if ((im[6] & ~kFlagLock) != 0) return kVmBadVersion;
     if (r32(im, 8) != layout.schema || r16(im, 12) != layout.count) return kVmBadSchema;
+    if ((im[6] & kFlagLock) != 0 && !has(kVmFeatLock)) return kVmNoFeature;  // (the schema holds the option)
+    // Every type of the layout (a generated layout's always are: the VM's
+    // code relies on it where it reads an element's type from the layout).
+    if ((vm_features & kVmFeatTypes) != kVmFeatTypes)
+        for (uint16_t e = 0; e < layout.count; ++e)
+            if (!takes(flash_get(layout.elems[e].type))) return kVmNoFeature;
     offsets(im, p);
     if (p.total != len) return kVmBadSize;
     const uint16_t g = r16(im, 14), s = r16(im, 16);
@@ -417,6 +477,7 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
                 const uint8_t t = im[at];
                 const uint16_t off = r16(im, at + 1u);
                 if (elem_size(t) == 0 || off > p.loc_size || elem_size(t) > p.loc_size - off) return kVmBadLocal;
+                if (!takes(t)) return kVmNoFeature;
                 ++c.i;
                 continue;
             }
@@ -428,6 +489,7 @@ uint8_t check(const Im& im, VmCheck& c, uint16_t len, const VmLayout& layout, ui
                 const uint8_t func = im[at];
                 const uint16_t n = r16(im, at + 2u);
                 if (func > kMedian || im[at + 1u] != 0 || n == 0) return kVmBadWindow;
+                if (!has(static_cast<uint16_t>(1u << func))) return kVmNoFeature;
                 c.ram += window_size(func, n);
                 ++c.i;
                 continue;
@@ -590,47 +652,44 @@ void ext_push(uint8_t* at, uint16_t n, bool max, Real x) {
     else roll_min_push<WinIdx>(s, vals, seqs, n, x);
 }
 
+// A window's value and push, each function's code only where the VM was
+// built with it (a verified image has no other).
 Real window_value(const Run& r, uint8_t w) {
     uint8_t func;
     uint16_t n;
     uint8_t* at = window_at(r, w, func, n);
-    switch (func) {
-        case kAvg: {
-            // A power-of-two N multiplies by 1/N once full, as RollAvgN does.
-            const Real inv = (n & (n - 1u)) == 0 ? Real(1) / Real(n) : Real(0);
-            return roll_avg_mean<WinIdx>(*reinterpret_cast<RollAvgS<WinIdx>*>(at), n, inv);
-        }
-        case kMin:
-        case kMax: return ext_value(at);
-        case kRange: return ext_value(at) - ext_value(at + ext_size(n));
-        default:
-            return roll_median_value<WinIdx>(*reinterpret_cast<RollMedianS<WinIdx>*>(at),
-                                             reinterpret_cast<Real*>(at + up(sizeof(RollMedianS<WinIdx>)) +
-                                                                     up(n * static_cast<uint32_t>(sizeof(Real)))));
+    if (func == kAvg && has(kVmFeatAvg)) {
+        // A power-of-two N multiplies by 1/N once full, as RollAvgN does.
+        const Real inv = (n & (n - 1u)) == 0 ? Real(1) / Real(n) : Real(0);
+        return roll_avg_mean<WinIdx>(*reinterpret_cast<RollAvgS<WinIdx>*>(at), n, inv);
     }
+    if ((func == kMin && has(kVmFeatMin)) || (func == kMax && has(kVmFeatMax))) return ext_value(at);
+    if (func == kRange && has(kVmFeatRange)) return ext_value(at) - ext_value(at + ext_size(n));
+    if (func == kMedian && has(kVmFeatMedian))
+        return roll_median_value<WinIdx>(*reinterpret_cast<RollMedianS<WinIdx>*>(at),
+                                         reinterpret_cast<Real*>(at + up(sizeof(RollMedianS<WinIdx>)) +
+                                                                 up(n * static_cast<uint32_t>(sizeof(Real)))));
+    return 0;
 }
 
 void window_push(const Run& r, uint8_t w, Real x) {
     uint8_t func;
     uint16_t n;
     uint8_t* at = window_at(r, w, func, n);
-    switch (func) {
-        case kAvg:
-            roll_avg_push<WinIdx>(*reinterpret_cast<RollAvgS<WinIdx>*>(at),
-                                  reinterpret_cast<Real*>(at + up(sizeof(RollAvgS<WinIdx>))), n, x);
-            break;
-        case kMin: ext_push(at, n, false, x); break;
-        case kMax: ext_push(at, n, true, x); break;
-        case kRange:  // RollRangeN: the max part, then the min part
-            ext_push(at, n, true, x);
-            ext_push(at + ext_size(n), n, false, x);
-            break;
-        default: {
-            Real* ring = reinterpret_cast<Real*>(at + up(sizeof(RollMedianS<WinIdx>)));
-            roll_median_push<WinIdx>(*reinterpret_cast<RollMedianS<WinIdx>*>(at), ring,
-                                     ring + up(n * static_cast<uint32_t>(sizeof(Real))) / sizeof(Real), n, x);
-            break;
-        }
+    if (func == kAvg && has(kVmFeatAvg)) {
+        roll_avg_push<WinIdx>(*reinterpret_cast<RollAvgS<WinIdx>*>(at),
+                              reinterpret_cast<Real*>(at + up(sizeof(RollAvgS<WinIdx>))), n, x);
+    } else if (func == kMin && has(kVmFeatMin)) {
+        ext_push(at, n, false, x);
+    } else if (func == kMax && has(kVmFeatMax)) {
+        ext_push(at, n, true, x);
+    } else if (func == kRange && has(kVmFeatRange)) {  // RollRangeN: the max part, then the min part
+        ext_push(at, n, true, x);
+        ext_push(at + ext_size(n), n, false, x);
+    } else if (func == kMedian && has(kVmFeatMedian)) {
+        Real* ring = reinterpret_cast<Real*>(at + up(sizeof(RollMedianS<WinIdx>)));
+        roll_median_push<WinIdx>(*reinterpret_cast<RollMedianS<WinIdx>*>(at), ring,
+                                 ring + up(n * static_cast<uint32_t>(sizeof(Real))) / sizeof(Real), n, x);
     }
 }
 
@@ -662,13 +721,25 @@ FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uin
     }
 }
 
+// Whether the n-byte float at x (4 or 8) is a NaN: fsw_f64.h's f64_is_nan
+// and f32_is_nan, inline (a call would make kJKey's function save
+// registers around it on every test, for a case that is rare).
+FSW_VM_INLINE bool is_nan(const uint8_t* x, uint8_t n) {
+    if (n == 8) {
+        if ((x[7] & 0x7Fu) != 0x7Fu || (x[6] & 0xF0u) != 0xF0u) return false;
+        return ((x[6] & 0x0Fu) | x[5] | x[4] | x[3] | x[2] | x[1] | x[0]) != 0;
+    }
+    if ((x[3] & 0x7Fu) != 0x7Fu || (x[2] & 0x80u) == 0) return false;
+    return ((x[2] & 0x7Fu) | x[1] | x[0]) != 0;
+}
+
 // kJKey's test: whether the key of the float at `x` (n = 4 or 8 bytes; a
 // NaN reads as +0, fsw_f64.h) is greater than (inclusive: at least) the key
 // at `c`. The key flips every bit of a negative pattern and the sign bit
 // of any other: built a byte at a time, compared from the top.
 FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool inclusive) {
     c += n;
-    if (n == 8 ? f64_is_nan(x) : f32_is_nan(x)) {  // +0's key: 0x80, then zeros
+    if (is_nan(x, n)) {  // +0's key: 0x80, then zeros
         if (*--c != 0x80u) return 0x80u > *c;
         while (--n != 0)
             if (*--c != 0) return false;
@@ -685,18 +756,14 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
     }
 }
 
-// kJInt's order of the variable at `x` (type t, or T when x is null)
+// kJInt's order of the variable at `x` (type t; T: op_jint_t)
 // against the constant at `c`.
-FSW_VM_INLINE int8_t int_order(const Run& r, const uint8_t* x, uint8_t t, const uint8_t* c) {
-    if (x == nullptr) {
-        const uint32_t v = machine_T32(*r.m), cv = load<uint32_t>(c);
-        return v < cv ? -1 : v > cv ? 1 : 0;
-    }
+FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, const uint8_t* c) {
     if (t == kBool) {  // 0 or 1 against any byte (the compiler writes 0 or 1)
         const uint8_t v = load_bool(x) ? 1 : 0;
         return v < c[0] ? -1 : v > c[0] ? 1 : 0;
     }
-    return le_order(x, c, size_of(t), t < kU8 ? 0x80 : 0x00);
+    return le_order(x, c, size_of(t), is_signed(t) ? 0x80 : 0x00);
 }
 
 template <bool Narrow>
@@ -720,7 +787,7 @@ const uint32_t kIntMax[8] FSW_FLASH = {127UL, 32767UL, 2147483647UL, 0, 255UL, 6
 // are only checked (no 64-bit arithmetic on an AVR).
 FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
     const uint8_t ns = size_of(ts), wb = sizeof(Wide);
-    const bool sign = ts < kU8;
+    const bool sign = is_signed(ts);
     if (ns > wb) {  // the bytes past Wide's must be its sign's
         const uint8_t fill = sign && (x[ns - 1u] & 0x80u) != 0 ? 0xFF : 0x00;
         for (const uint8_t* p = x + wb; p != x + ns; ++p)
@@ -747,14 +814,15 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
     const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
     Wide v;
     if (!as_wide(x, ts, v) || v < -limit || v > limit) {
-        write_elem(d, td, read_elem(x, ts) + static_cast<Real>(k));
+        vm_write(d, td, vm_read(x, ts) + static_cast<Real>(k));
         return;
     }
     v += k;
     const uint8_t nd = size_of(td);
-    const bool sign = td < kU8;
+    const bool sign = is_signed(td);
     if (!sign && v < 0) v = 0;
-    if (nd < sizeof(Wide)) {  // d narrower than Wide: its range
+    // d narrower than Wide (where the VM takes such a type): its range
+    if (nd < sizeof(Wide) && (sizeof(Wide) > 4 || has(kVmFeatI8 | kVmFeatI16 | kVmFeatU8 | kVmFeatU16))) {
         const Wide hi = static_cast<Wide>(flash_get(kIntMax[td]));
         if (v > hi) v = hi;
         if (sign && v < -hi - 1) v = -hi - 1;
@@ -775,7 +843,7 @@ FSW_NOINLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
     uint8_t t;
     uint8_t* x = ref_at(r, u16(ip + 1), t);
     const uint8_t n = size_of(t);
-    memcpy(x, ip + 3, n);
+    for (uint8_t i = 0; i < n; ++i) x[i] = ip[3 + i];  // (no call: a leaf saves fewer registers)
     return ip + 3 + n;
 }
 
@@ -796,20 +864,28 @@ FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if
 FSW_NOINLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
     uint8_t t;
     const uint8_t* x = ref_at(r, u16(ip + 1), t);
-    const uint8_t n = t == kF64 ? 8 : 4;
+    const uint8_t n = float_bytes(t);
     const uint8_t flags = ip[3];
     const bool holds = key_holds(x, n, ip + 4, (flags & kKeyInclusive) != 0);
     return test_end(ip + 4 + n, holds, (flags & kKeyJumpIf) != 0);
 }
 
+// kJInt of T: a function of its own, which calls machine_T32, so that the
+// test of a variable calls nothing and saves few registers.
+FSW_NOINLINE const uint8_t* op_jint_t(const Run& r, const uint8_t* ip) {
+    const uint32_t v = machine_T32(*r.m), c = u32(ip + 4);
+    const bool holds = cmp_holds(ip[3], v < c ? -1 : v > c ? 1 : 0);
+    return test_end(ip + 8, holds, (ip[3] & kJumpIf) != 0);
+}
+
 FSW_NOINLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
     const uint16_t ref = u16(ip + 1);
-    uint8_t t = kTypeT;
-    const uint8_t* x = ref == kRefT ? nullptr : ref_at(r, ref, t);
-    const uint8_t n = t == kTypeT ? 4 : size_of(t);
+    if (ref == kRefT) return op_jint_t(r, ip);
+    uint8_t t;
+    const uint8_t* x = ref_at(r, ref, t);
     const uint8_t flags = ip[3];
-    const bool holds = cmp_holds(flags, int_order(r, x, t, ip + 4));
-    return test_end(ip + 4 + n, holds, (flags & kJumpIf) != 0);
+    const bool holds = cmp_holds(flags, int_order(x, t, ip + 4));
+    return test_end(ip + 4 + size_of(t), holds, (flags & kJumpIf) != 0);
 }
 
 // One typed instruction (kJKey, kJInt, kSetK, kIAdd) at `pc`.
@@ -864,9 +940,9 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 const uint8_t* e = r.sv + flash_get(r.elems[u16(a)].off);
                 if (r.lock) {
                     SvGuard<true> g;
-                    st[sp++] = read_elem(e, a[2]);
+                    st[sp++] = vm_read(e, a[2]);
                 } else {
-                    st[sp++] = read_elem(e, a[2]);
+                    st[sp++] = vm_read(e, a[2]);
                 }
                 pc = static_cast<uint16_t>(pc + 4u);
                 continue;
@@ -876,9 +952,9 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 --sp;
                 if (r.lock) {
                     SvGuard<true> g;
-                    write_elem(e, a[2], st[sp]);
+                    vm_write(e, a[2], st[sp]);
                 } else {
-                    write_elem(e, a[2], st[sp]);
+                    vm_write(e, a[2], st[sp]);
                 }
                 pc = static_cast<uint16_t>(pc + 4u);
                 continue;
@@ -887,8 +963,8 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kStl: {
                 const uint8_t* l = r.p.loc + 3u * u16(a);
                 uint8_t* at = r.loc + u16(l + 1);
-                if (op == kLdl) st[sp++] = read_elem(at, l[0]);
-                else write_elem(at, l[0], st[--sp]);
+                if (op == kLdl) st[sp++] = vm_read(at, l[0]);
+                else vm_write(at, l[0], st[--sp]);
                 pc = static_cast<uint16_t>(pc + 3u);
                 continue;
             }
@@ -900,8 +976,15 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 continue;
             }
             case kLdt: st[sp++] = machine_T_real(*r.m); break;
-            case kRoll: st[sp++] = window_value(r, a[0]); pc = static_cast<uint16_t>(pc + 2u); continue;
-            case kWpush: window_push(r, a[0], st[--sp]); pc = static_cast<uint16_t>(pc + 2u); continue;
+            case kRoll:
+                st[sp++] = has(kVmFeatWindows) ? window_value(r, a[0]) : Real(0);  // (none in a verified image without)
+                pc = static_cast<uint16_t>(pc + 2u);
+                continue;
+            case kWpush:
+                --sp;
+                if (has(kVmFeatWindows)) window_push(r, a[0], st[sp]);
+                pc = static_cast<uint16_t>(pc + 2u);
+                continue;
             case kNeg: st[sp - 1u] = -st[sp - 1u]; break;
             case kNot: st[sp - 1u] = real_from_truth(!truthy(st[sp - 1u])); break;
             case kTruth: st[sp - 1u] = real_from_truth(truthy(st[sp - 1u])); break;
@@ -959,7 +1042,7 @@ void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv,
     r.ram = ram;
     r.loc = r.p.windows == 0 ? ram : ram + windows_size(r.p);
     r.m = &m;
-    r.lock = (image[6] & kFlagLock) != 0;
+    r.lock = has(kVmFeatLock) && (image[6] & kFlagLock) != 0;  // (a verified image is locked only where built so)
 }
 
 }  // namespace

@@ -30,7 +30,35 @@ enum VmReason : uint8_t {
     kVmTooNested = 15,   // more pending forward jumps than FSW_VM_PENDING
     kVmNoRam = 16,       // the caller's buffer is smaller than the image needs
     kVmBadMask = 17,     // (a reload slot) the state mask after the image: not a bit per state, or no state set
+    kVmNoFeature = 18,   // a window function, value type or lock the VM was built without (vm_features)
 };
+
+// What a VM runs beyond what every image may use (U32, U64 and bool values,
+// every instruction): a window function (bit 1 << function: 0 avg, 1 min,
+// 2 max, 3 range, 4 median), values of another type (elements and locals),
+// a locked state vector. An image that needs one the VM lacks is refused
+// (kVmNoFeature).
+enum VmFeature : uint16_t {
+    kVmFeatAvg = 1, kVmFeatMin = 2, kVmFeatMax = 4, kVmFeatRange = 8, kVmFeatMedian = 16,
+    kVmFeatF32 = 32, kVmFeatF64 = 64, kVmFeatLock = 128,
+    kVmFeatI8 = 0x100, kVmFeatI16 = 0x200, kVmFeatI32 = 0x400, kVmFeatI64 = 0x800,
+    kVmFeatU8 = 0x1000, kVmFeatU16 = 0x2000,
+};
+static const uint16_t kVmFeatWindows = 0x1F;  // any window function
+static const uint16_t kVmFeatSigned = 0xF00;  // any signed integer type
+static const uint16_t kVmFeatTypes = 0x3F60;  // every type
+static const uint16_t kVmAllFeatures = 0x3FFF;
+
+// The features of this program's VM. An application with a replaceable
+// machine defines it in its generated code from its layout: the types of
+// its state vector and of the machine's locals, the machine's window
+// functions, the vector's lock option (docs/bytecode.md, "A board's VM"), a
+// constant that LTO folds into the VM, dropping the code of the others. A
+// program that links the VM defines it (kVmAllFeatures: every image runs);
+// the native PSL has a weak kVmAllFeatures for host programs (libfswsm, the
+// tests). Never weak on an AVR: avr-gcc 5.4 folds a weak constant's own
+// value even where a strong one overrides it.
+extern const uint16_t vm_features;
 
 // An element of the state vector the image is bound to: offset and type.
 struct VmElem {

@@ -12,12 +12,15 @@
 #include "fsw_clock.h"
 #include "fsw_log.h"
 #include "fsw_pal.h"
+#include "fsw_vm.h"
 #include "psl_native.h"
 
 namespace fsw {
 
 // The recorder's store where no generated code names it (fsw_log.h).
 extern const uint8_t log_nor_cs __attribute__((weak)) = kLogEeprom;
+// The VM's features where no generated code names them (fsw_vm.h): all.
+extern const uint16_t vm_features __attribute__((weak)) = kVmAllFeatures;
 
 namespace {
 

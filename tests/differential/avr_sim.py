@@ -169,7 +169,10 @@ def build_elf(workdir: str, items: list[tuple[int, M.Script]], pool: ThreadPoolE
             lines += [f'#include "c{k}/sv.gen.cpp"', f'#include "c{k}/{machine}"', f'#include "c{k}/script_avr.cpp"']
         tus.append(pool.submit(_cached_object, "\n".join(lines) + "\n", f"tu{start}.cpp", workdir, [workdir],
                                tkey.digest()))
-    main = pool.submit(_cached_object, _main_cpp([k for k, _ in items]), "main.cpp", workdir, [], b"")
+    main_cpp = _main_cpp([k for k, _ in items])
+    if machine_cpp is not None:  # a VM with every feature (fsw_vm.h)
+        main_cpp += '#include "fsw_vm.h"\nextern const uint16_t fsw::vm_features = fsw::kVmAllFeatures;\n'
+    main = pool.submit(_cached_object, main_cpp, "main.cpp", workdir, [], key if machine_cpp else b"")
     objs = [f.result() for f in tus] + [main.result()]
     lib = os.path.join(workdir, "libfsw.a")
     if os.path.exists(lib):

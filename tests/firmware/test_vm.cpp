@@ -8,6 +8,10 @@
 
 using namespace fsw;
 
+// This program's VM: every feature but roll_median and F64 values, as on a
+// board whose application has neither (test_feature_rules).
+extern const uint16_t fsw::vm_features = kVmAllFeatures & ~(kVmFeatMedian | kVmFeatF64);
+
 void setUp(void) {}
 void tearDown(void) {}
 
@@ -179,6 +183,54 @@ void test_local_rules(void) {
     good(im);
     im.b[28 + 12] = 11;  // no such type
     TEST_ASSERT_EQUAL_UINT(kVmBadLocal, verify(im));
+}
+
+// The good image with its U8 local declared `type` (4 or 8 bytes, zero).
+void wide_local(Image& im, uint8_t type, uint8_t bytes) {
+    good(im);
+    im.b[28 + 12] = type;
+    put16(im.b + 22, bytes);
+    const uint8_t more = static_cast<uint8_t>(bytes - 1u);
+    memmove(im.b + im.code + more, im.b + im.code, im.len - im.code);
+    memset(im.b + im.code - 1, 0, bytes);
+    im.code = static_cast<uint16_t>(im.code + more);
+    im.len = static_cast<uint16_t>(im.len + more);
+}
+
+#if !defined(__AVR__)
+// The layout above with x an F64: a type this VM was built without.
+const VmElem kF64Elems[] FSW_FLASH = {{0, kU64}, {8, kU32}, {12, kF64}, {20, kI16}};
+#endif
+
+void test_feature_rules(void) {
+    // A window function and a value type this VM was built without.
+    Image im;
+    good(im);
+    im.b[28 + 15] = 4;  // roll_median
+    TEST_ASSERT_EQUAL_UINT(kVmNoFeature, verify(im));
+    wide_local(im, kF64, 8);
+    TEST_ASSERT_EQUAL_UINT(kVmNoFeature, verify(im));
+#if !defined(__AVR__)  // (the rest on a host: the suite fills the ATmega328P's flash)
+    // ... and those it was built with: the same images otherwise.
+    good(im);
+    im.b[28 + 15] = 2;  // roll_max
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    wide_local(im, kF32, 4);
+    TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+    // A rule of the window or the local itself comes first.
+    good(im);
+    im.b[28 + 15] = 4;
+    put16(im.b + 28 + 17, 0);  // N = 0
+    TEST_ASSERT_EQUAL_UINT(kVmBadWindow, verify(im));
+    wide_local(im, kF64, 8);
+    put16(im.b + 22, 7);  // and the local past the locals' bytes
+    TEST_ASSERT_EQUAL_UINT(kVmBadLocal, vm_verify(im.b, static_cast<uint16_t>(im.len - 1u), kLayout, sizeof ram));
+    // A layout with such a type: no image runs on it, refused before its
+    // code is read (a generated layout's types are always the VM's).
+    const VmLayout f64 = {kF64Elems, 4, 0x12345678UL};
+    good(im);
+    TEST_ASSERT_EQUAL_UINT(kVmNoFeature, vm_verify(im.b, im.len, f64, sizeof ram));
+#endif
 }
 
 void test_state_rules(void) {
@@ -502,6 +554,7 @@ FSW_TEST_MAIN([] {
     RUN_TEST(test_header_rules);
     RUN_TEST(test_element_rules);
     RUN_TEST(test_local_rules);
+    RUN_TEST(test_feature_rules);
     RUN_TEST(test_state_rules);
     RUN_TEST(test_window_rules);
     RUN_TEST(test_jump_rules);

@@ -525,7 +525,7 @@ def test_calls_out_of_order_and_null_arguments_are_refused():
     for code in [S.OK, S.STEP_TIME, S.STEP_CONFIG] + list(range(-1, -17, -1)):
         assert c.fswsm_error_name(code).startswith(b"FSWSM_") and c.fswsm_error_text(code) != b"unknown code"
         assert code in S._ERRORS or code == S.OK
-    assert c.fswsm_error_name(-99) == b"unknown" and c.fswsm_reason_text(18) == b"unknown reason"
+    assert c.fswsm_error_name(-99) == b"unknown" and c.fswsm_reason_text(19) == b"unknown reason"
     for reason, words in V.REASONS.items():
         assert c.fswsm_reason_text(reason).decode() == words
     assert [c.fswsm_type_name(t).decode() for t in range(11)] == list(V.TYPE_CODES)

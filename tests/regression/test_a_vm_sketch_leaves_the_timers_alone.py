@@ -29,6 +29,7 @@ alignas(fsw::kVmRamAlign) uint8_t ram[32];
 uint8_t image[64];
 fsw::Machine machine;
 }  // namespace
+extern const uint16_t fsw::vm_features = fsw::kVmAllFeatures;
 
 void setup() {
     pinMode(13, OUTPUT);

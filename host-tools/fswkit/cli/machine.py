@@ -33,13 +33,16 @@ def image_for(app, path: str, diags: Diagnostics):
 
     if not _in_application(app, m, path, diags):
         return None
+    features = V.features_of(app.sv, app.machines[app.reload.machine])
+    if not _board_runs(app, m, features, path, diags):
+        return None
     real = real_of(app)
     try:
         image = compile_machine(m, real)
     except BytecodeError as e:
         diags.error(source_or_empty(path), SM, max(e.line, 1), max(e.col, 1), f"cannot compile to bytecode: {e}")
         return None
-    reason = V.verify(image, V.layout_of(app.sv), real.bits // 8)
+    reason = V.verify(image, V.layout_of(app.sv), real.bits // 8, features=features)
     if reason != V.OK:
         _say(f"internal error: the image of {path} fails the verifier ({V.REASONS[reason]})")
         return None
@@ -62,6 +65,34 @@ def image_for(app, path: str, diags: Diagnostics):
              f"({', '.join(allow)}): once running it could never be replaced again; add one of them")
         return None
     return bytes(image), bytes(mask), m
+
+
+def _board_runs(app, m, features: int, path: str, diags: Diagnostics) -> bool:
+    """Whether the board's VM has what machine `m` (read from `path`)
+    needs: the firmware was built with a VM that has only the window
+    functions of the generated machine and the value types of it and its
+    state vector (vmverify.features_of, docs/bytecode.md); each local and
+    window it lacks is an error in `diags`, located."""
+    from fswkit.autocode import model as M
+    from fswkit.autocode import vmverify as V
+    from fswkit.autocode.diagnostics import SM
+
+    gen = app.machines[app.reload.machine].name
+    why = (f"the firmware's VM was built without it (its VM has what the machine `{gen}` and the state vector use: "
+           f"{', '.join(V.feature_names(features & ~V.FEAT_LOCK))}, and U32, U64 and bool); "
+           f"{{fix}}, or add it to `{gen}` and build and flash the firmware again")
+    ok = True
+    for v in m.vars:
+        if v.kind == M.LOCAL and not V.takes(V.TYPE_CODES[v.type.name], features):
+            diags.error(source_or_empty(path), SM, v.line, 1, f"local `{v.name}` is {v.type.name}: "
+                        + why.format(fix="declare it with a type the board takes"))
+            ok = False
+    for w in m.windows:
+        if not features & (1 << V.WINDOW_FUNCS[w.func]):
+            diags.error(source_or_empty(path), SM, w.line, w.col, f"roll_{w.func}: "
+                        + why.format(fix="use a window function the board has"))
+            ok = False
+    return ok
 
 
 def _in_application(app, m, path: str, diags: Diagnostics) -> bool:

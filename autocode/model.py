@@ -393,6 +393,7 @@ class Reload:
     ram: int  # bytes for an image's windows and locals
     activate: tuple[str, ...]  # state names in which another machine may take over
     line: int  # the section's first row
+    vm: tuple[str, ...] = ()  # the VM's features beyond the machine's and the state vector's (vmverify), or ("all",)
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,8 @@ bytecode image (`fsw machine upload`), without reflashing.
     ram      64                   # bytes for an image's windows and locals (0..4096)
     activate TankVentControl Idle # the states in which another machine may take over
                                   # (default: the machine's first state)
+    vm       roll_median F32      # what an upload may use beyond what the machine and the
+                                  # state vector use (default: nothing more; `all`: everything)
 
 The two slots live in the EEPROM after the parameters' banks and before
 the flight recorder's records. Every problem is reported where it is
@@ -19,7 +21,7 @@ from . import model as M
 from .appsyntax import Setting
 from .lexer import NUM
 
-KEYS = ("machine", "size", "ram", "activate")
+KEYS = ("machine", "size", "ram", "activate", "vm")
 SLOT_HEADER = 9  # firmware/src/fsw_reload.h kReloadHeader
 SIZE_RANGE = (32, 4096)
 RAM_RANGE = (0, 4096)
@@ -89,6 +91,7 @@ def check_reload(rows: tuple[Setting, ...], tasks: list[M.Task], machines: list[
                 else:
                     seen.append(t.text)
             activate = tuple(seen)
+    vm = _vm(once.get("vm"), r)
     if not any(t.kind == "uplink" for t in tasks):
         r.err(first, "[reload] takes its images over the link: add an `uplink` task to [tasks] "
                      "(e.g. `uplink uplink rate=100`)")
@@ -101,7 +104,31 @@ def check_reload(rows: tuple[Setting, ...], tasks: list[M.Task], machines: list[
                       f"{size + ram:,} B: more than the {board.name}'s RAM ({board.ram:,} B); lower `ram` or `size`")
     if r.diags.error_count != before or machine is None:
         return None
-    return M.Reload(machine, size, ram, activate, first.line)
+    return M.Reload(machine, size, ram, activate, first.line, vm)
+
+
+def _vm(s: Setting | None, r) -> tuple[str, ...]:
+    """`vm`'s features, each known and named once; `all` alone."""
+    from .vmverify import FEATURE_BITS
+
+    if s is None:
+        return ()
+    if not s.values:
+        r.err(s.key, "`vm` takes the VM's features beyond the machine's and the state vector's: `all`, or some of "
+                     + ", ".join(FEATURE_BITS))
+        return ()
+    seen: list[str] = []
+    for t in s.values:
+        if t.text != "all" and t.text not in FEATURE_BITS:
+            r.err(t, f"unknown VM feature `{t.text}`: expected `all` or some of " + ", ".join(FEATURE_BITS))
+        elif t.text in seen:
+            r.err(t, f"`{t.text}` named twice")
+        else:
+            seen.append(t.text)
+    beside = [t for t in s.values if t.text != "all"]
+    if "all" in seen and beside:
+        r.err(beside[0], "`all` is every feature: name nothing beside it")
+    return tuple(seen)
 
 
 def _number(s: Setting | None, default: int, span: tuple[int, int], what: str, r) -> int:

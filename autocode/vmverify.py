@@ -102,6 +102,24 @@ def features_of(sv: M.StateVector, m: M.Machine) -> int:
     return f
 
 
+# Every feature by the name `[reload] vm` takes (feature_names' words).
+FEATURE_BITS = {**{f"roll_{name}": 1 << code for name, code in WINDOW_FUNCS.items()},
+                **{t: bit for t, bit in TYPE_FEATURES.items() if bit}}
+
+
+def board_features(app) -> int:
+    """The features of an application's VM: those of its state vector and
+    replaceable machine (features_of) and those its `[reload] vm` names
+    (`all`: every one, as libfswsm's VM)."""
+    rl = app.reload
+    if "all" in rl.vm:
+        return ALL_FEATURES
+    f = features_of(app.sv, app.machines[rl.machine])
+    for name in rl.vm:
+        f |= FEATURE_BITS[name]
+    return f
+
+
 def feature_names(features: int) -> list[str]:
     """What `features` holds, in the words of a machine: `roll_avg`...,
     the types beyond U32, U64 and bool, lock."""

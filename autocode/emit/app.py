@@ -744,7 +744,7 @@ def _reload(app: Application) -> list[str]:
     and its windows and locals, and the slots' place in the EEPROM."""
     from ..params import HEADER as PHEADER
     from ..reloadcheck import eeprom_bytes
-    from ..vmverify import feature_names, features_of
+    from ..vmverify import board_features, feature_names
 
     rl = app.reload
     m = app.machines[rl.machine]
@@ -757,7 +757,7 @@ def _reload(app: Application) -> list[str]:
         if st.name in rl.activate:
             mask[(st.id - 1) // 8] |= 1 << ((st.id - 1) % 8)
     elems = ", ".join(f"{{E_{e.name}, {ELEM_CODE[e.type.name]}}}" for e in app.sv.elements)
-    feats = features_of(app.sv, m)
+    feats = board_features(app)
     have = ", ".join(feature_names(feats) + ["U32, U64 and bool"])
     return ["// ---- machines replaced at run time (docs/reload.md) ----",
             "}  // namespace", "}  // namespace fsw_gen", "namespace fsw {",

@@ -78,3 +78,55 @@ def test_the_host_verifier_refuses_the_image_as_the_board_would(tmp_path):
         assert V.verify(im, lay, 4, features=feats) == want
         assert V.verify(im, lay, 4) == V.OK  # libfswsm's VM has every feature
     assert V.NO_FEATURE == 18 and "built without" in V.REASONS[V.NO_FEATURE]
+
+
+def _stand_with(tmp_path, vm_row: str):
+    """examples/stand copied with `vm_row` added to its [reload]."""
+    import shutil
+
+    out = tmp_path / "stand"
+    for name in ("stand", "tank"):  # the stand reads the tank's configs beside it
+        shutil.copytree(EXAMPLES / name, tmp_path / name, ignore=shutil.ignore_patterns("build"))
+    app = (out / "stand.app").read_text()
+    assert "\nactivate TankVentControl Idle" in app
+    (out / "stand.app").write_text(app.replace("\nactivate TankVentControl Idle",
+                                               f"\n{vm_row}\nactivate TankVentControl Idle"))
+    return out
+
+
+def test_reload_vm_builds_the_board_with_more(fsw, tmp_path):
+    """`vm roll_median F32 I16` in [reload]: the board's VM has them too, so
+    the wider machine uploads (it fails only at the port); `vm all`: every
+    feature, the VM libfswsm has."""
+    from fswkit.autocode import vmverify as V
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.emit.app import emit_app
+    from fswkit.target.build import load
+
+    stand = _stand_with(tmp_path, "vm       roll_median F32 I16   # what an upload may use beyond the machine's")
+    app_text = (stand / "stand.app").read_text()
+    (stand / "stand.app").write_text(app_text.replace("\nram      64 ", "\nram      96 "))  # the median's samples
+    app = load(str(stand), Diagnostics())
+    f = V.board_features(app)
+    assert V.feature_names(f) == ["roll_median", "I16", "U16", "F32", "F64"], V.feature_names(f)
+    assert f"extern const uint16_t vm_features = 0x{f:04x};" in "\n".join(emit_app(app).values())
+    sm = tmp_path / "tank_median.sm"
+    sm.write_text(WIDER)
+    r = fsw("machine", str(stand), "upload", str(sm), "--port", str(tmp_path / "none"))
+    assert r.code != 0 and "built without" not in r.err and "no such port" in r.err, r.err
+
+    every = load(str(_stand_with(tmp_path / "all", "vm all")), Diagnostics())
+    assert V.board_features(every) == V.ALL_FEATURES
+
+
+def test_reload_vm_refuses_what_it_does_not_know(fsw, tmp_path):
+    for row, col, said in (("vm roll_mean", 4, "unknown VM feature `roll_mean`"),
+                           ("vm all F32", 8, "`all` is every feature: name nothing beside it"),
+                           ("vm F32 F32", 8, "`F32` named twice"),
+                           ("vm", 1, "`vm` takes the VM's features beyond the machine's")):
+        stand = _stand_with(tmp_path / str(col) / row.replace(" ", "_"), row)
+        r = fsw("check", str(stand))
+        lines = (stand / "stand.app").read_text().splitlines()
+        n = lines.index(row) + 1
+        assert r.code != 0 and "Traceback" not in r.err, r.err
+        assert f"stand.app:{n}:{col}:" in r.err and said in r.err, (row, r.err)

@@ -33,7 +33,7 @@ def image_for(app, path: str, diags: Diagnostics):
 
     if not _in_application(app, m, path, diags):
         return None
-    features = V.features_of(app.sv, app.machines[app.reload.machine])
+    features = V.board_features(app)
     if not _board_runs(app, m, features, path, diags):
         return None
     real = real_of(app)
@@ -70,17 +70,19 @@ def image_for(app, path: str, diags: Diagnostics):
 def _board_runs(app, m, features: int, path: str, diags: Diagnostics) -> bool:
     """Whether the board's VM has what machine `m` (read from `path`)
     needs: the firmware was built with a VM that has only the window
-    functions of the generated machine and the value types of it and its
-    state vector (vmverify.features_of, docs/bytecode.md); each local and
-    window it lacks is an error in `diags`, located."""
+    functions of the generated machine, the value types of it and its
+    state vector, and what `[reload] vm` names (vmverify.board_features,
+    docs/bytecode.md); each local and window it lacks is an error in
+    `diags`, located."""
     from fswkit.autocode import model as M
     from fswkit.autocode import vmverify as V
     from fswkit.autocode.diagnostics import SM
 
     gen = app.machines[app.reload.machine].name
-    why = (f"the firmware's VM was built without it (its VM has what the machine `{gen}` and the state vector use: "
-           f"{', '.join(V.feature_names(features & ~V.FEAT_LOCK))}, and U32, U64 and bool); "
-           f"{{fix}}, or add it to `{gen}` and build and flash the firmware again")
+    extra = " and [reload] `vm` names" if app.reload.vm else ""
+    why = (f"the firmware's VM was built without it (its VM has what the machine `{gen}` and the state vector use"
+           f"{extra}: {', '.join(V.feature_names(features & ~V.FEAT_LOCK))}, and U32, U64 and bool); "
+           f"{{fix}}, or name it in [reload] `vm` (or add it to `{gen}`) and build and flash the firmware again")
     ok = True
     for v in m.vars:
         if v.kind == M.LOCAL and not V.takes(V.TYPE_CODES[v.type.name], features):

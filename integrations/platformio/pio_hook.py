@@ -110,10 +110,18 @@ def needs_decimal_dig(cxx):
     return r.returncode == 0 and "#define DECIMAL_DIG " not in r.stdout
 
 
+# Linked as mk/build.mk links (`fsw build`): with -flto the program is
+# compiled again at the link, and without these in one section, so
+# --gc-sections cannot drop what became dead only there (a board's VM, whose
+# unused features fold away at the link: docs/bytecode.md).
+AVR_LINKFLAGS = ["-ffunction-sections", "-fdata-sections"]
+
+
 def configure_toolchain(env):
     platform = env.PioPlatform()
     if platform.name != "atmelavr":
         return
+    env.Append(LINKFLAGS=AVR_LINKFLAGS)
     tool_dir = platform.get_package_dir("toolchain-atmelavr")
     if not tool_dir:
         return

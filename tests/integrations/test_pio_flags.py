@@ -7,7 +7,8 @@ machine reaches, so the comparison is made from what can be read here:
   reads platformio.ini (board_build.*, build_flags, build_unflags), on top of
   the flags the atmelavr platform's Arduino builder always passes
   (PIO_ARDUINO below, copied from platform-atmelavr 5.2.0,
-  builder/frameworks/arduino.py). The board settings are written out in
+  builder/frameworks/arduino.py) and the link flags the kit's hook adds
+  (pio_hook.py's AVR_LINKFLAGS). The board settings are written out in
   platformio.ini, so they do not depend on the platform's board manifests.
 - `fsw build`'s side: the commands mk/build.mk runs for the same board, as
   the build service calls it (`make -n` of target.build.make_args).
@@ -53,7 +54,20 @@ PIO_ARDUINO = {
 # decide the code.
 CODE_FLAGS = {"-ffunction-sections", "-fdata-sections", "-flto", "-mcall-prologues", "-fno-exceptions",
               "-fno-threadsafe-statics"}
-LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues"}
+LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues",
+              "-ffunction-sections", "-fdata-sections"}  # (at the link: LTO's own compilation, mk/build.mk)
+
+
+def hook_linkflags() -> list[str]:
+    """What integrations/platformio/pio_hook.py appends to an atmelavr
+    build's LINKFLAGS (its AVR_LINKFLAGS), read from the hook's text."""
+    import ast
+
+    tree = ast.parse((ROOT / "integrations" / "platformio" / "pio_hook.py").read_text())
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["AVR_LINKFLAGS"]:
+            return list(ast.literal_eval(node.value))
+    return []
 IGNORED_DEFINES = {"DECIMAL_DIG"}
 
 BOARD_ENVS = {"uno": "uno", "nanoatmega328": "nano", "megaatmega2560": "mega2560"}
@@ -81,6 +95,7 @@ def pio_flags(env: dict) -> dict:
         return [f.replace("$BOARD_MCU", mcu).replace("$BOARD_F_CPU", f_cpu) for f in fs]
 
     cc, c, cxx, link = (sub(PIO_ARDUINO[k]) for k in ("CCFLAGS", "CFLAGS", "CXXFLAGS", "LINKFLAGS"))
+    link += hook_linkflags()
     defines = ["-D" + d for d in sub(PIO_ARDUINO["CPPDEFINES"])] + _split(env.get("board_build.extra_flags", ""))
     for f in _split(env.get("build_flags", [])):
         if f.startswith("-D"):
@@ -199,8 +214,9 @@ def test_a_mismatch_is_reported(tmp_path):
     assert "cxx define F_CPU: PlatformIO 8000000L, fsw build 16000000L" in diffs
     assert "cxx -O: PlatformIO ['-O2', '-Os'], fsw build ['-Os']" in diffs
     assert "c define EXTRA: only in PlatformIO" in diffs
-    assert "link flags: PlatformIO ['-Wl,--gc-sections', '-flto', '-fuse-linker-plugin'], fsw build " \
-           "['-Wl,--gc-sections', '-Wl,--relax', '-flto', '-fuse-linker-plugin', '-mcall-prologues']" in diffs
+    assert "link flags: PlatformIO ['-Wl,--gc-sections', '-fdata-sections', '-ffunction-sections', '-flto', " \
+           "'-fuse-linker-plugin'], fsw build ['-Wl,--gc-sections', '-Wl,--relax', '-fdata-sections', " \
+           "'-ffunction-sections', '-flto', '-fuse-linker-plugin', '-mcall-prologues']" in diffs
 
 
 @needs_pio

@@ -16,6 +16,8 @@ import pytest
 from conftest import EXAMPLES, ROOT
 
 HOOK = ROOT / "integrations" / "platformio" / "pio_hook.py"
+# what the hook adds to every atmelavr build: the link's sections, as mk/build.mk links
+SECTIONS = {"LINKFLAGS": ["-ffunction-sections", "-fdata-sections"]}
 TANK = EXAMPLES / "tank"
 
 
@@ -186,10 +188,10 @@ def test_decimal_dig_is_defined_only_where_the_toolchain_lacks_it(tmp_path):
     has = _toolchain(tmp_path / "b", "#!/bin/sh\ncat >/dev/null\necho '#define DECIMAL_DIG 17'\n")
     env = uno_env(tmp_path, "examples/tank", platform=FakePlatform("atmelavr", {"toolchain-atmelavr": lacks}))
     run_hook(env)
-    assert env.appended == [{"CPPDEFINES": [("DECIMAL_DIG", "__DECIMAL_DIG__")]}]
+    assert env.appended == [SECTIONS, {"CPPDEFINES": [("DECIMAL_DIG", "__DECIMAL_DIG__")]}]
     env = uno_env(tmp_path, "examples/tank", platform=FakePlatform("atmelavr", {"toolchain-atmelavr": has}))
     run_hook(env)
-    assert env.appended == []
+    assert env.appended == [SECTIONS]  # no define
 
 
 @pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
@@ -205,7 +207,7 @@ def test_debian_avr_gcc_needs_decimal_dig(tmp_path):
         pytest.skip(f"avr-gcc {version} is not Debian's 5.4")
     env = uno_env(tmp_path, "examples/tank", platform=FakePlatform("atmelavr", {"toolchain-atmelavr": str(tool)}))
     run_hook(env)
-    assert env.appended == [{"CPPDEFINES": [("DECIMAL_DIG", "__DECIMAL_DIG__")]}]
+    assert env.appended == [SECTIONS, {"CPPDEFINES": [("DECIMAL_DIG", "__DECIMAL_DIG__")]}]
 
 
 def test_hook_finds_the_kits_checkout_without_file(tmp_path):

@@ -36,7 +36,8 @@ def test_sketch_folder_holds_the_generated_code_an_ino_and_the_fqbn(fsw, tmp_pat
     yaml = (sketch / "sketch.yaml").read_text()
     assert yaml.endswith("default_fqbn: arduino:avr:uno\n")
     # fsw build's flags, named for the command line (the folder cannot carry them)
-    assert "#   --build-property compiler.c.elf.extra_flags=-Wl,--relax\n" in yaml
+    assert "#   --build-property 'compiler.c.elf.extra_flags=-Wl,--relax -ffunction-sections -fdata-sections'\n" \
+        in yaml
     assert "#   --build-property compiler.cpp.extra_flags=-mcall-prologues\n" in yaml
     ref = tmp_path / "ref"
     assert fsw("gen", str(TANK), "--out", str(ref)).code == 0

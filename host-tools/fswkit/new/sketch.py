@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import re
+import shlex
 
 from fswkit.autocode.app import Application
 from fswkit.autocode.cnames import comment
@@ -22,8 +23,10 @@ SKETCH_NAME = re.compile(r"[0-9A-Za-z_][0-9A-Za-z_.-]{0,62}\Z")
 # compiles to `fsw build`'s firmware (integrations/arduino-cli/README.md).
 # A sketch folder cannot carry them (sketch.yaml has no place for flags):
 # sketch.yaml names them in a comment.
+# (The link's -ffunction-sections -fdata-sections: LTO compiles the program
+# again there, and a board's VM drops its unused features only then.)
 BUILD_PROPERTIES = {"compiler.c.extra_flags": "-mcall-prologues", "compiler.cpp.extra_flags": "-mcall-prologues",
-                    "compiler.c.elf.extra_flags": "-Wl,--relax"}
+                    "compiler.c.elf.extra_flags": "-Wl,--relax -ffunction-sections -fdata-sections"}
 
 
 class SketchError(Exception):
@@ -57,7 +60,7 @@ def sketch_files(app: Application, generated: dict[str, str], name: str) -> dict
     ino += [f'#include "{h}"' for h in headers]
     files = dict(generated)
     files[name + ".ino"] = "\n".join(ino) + "\n"
-    props = "".join(f"#   --build-property {k}={v}\n" for k, v in BUILD_PROPERTIES.items())
+    props = "".join(f"#   --build-property {shlex.quote(f'{k}={v}')}\n" for k, v in BUILD_PROPERTIES.items())
     files["sketch.yaml"] = (f"# arduino-cli: `arduino-cli compile` in this folder builds for the {app.board.name}.\n"
                             "# With fsw build's flags (its firmware; integrations/arduino-cli/README.md of fswkit):\n"
                             + props + f"default_fqbn: {fqbn}\n")

@@ -288,7 +288,7 @@ def test_fsw_tape_import(tmp_path):
     assert t.sources[0].startswith("log.csv (imported with `fsw tape import cats`")
     before = open(out).read()
     r = run_fsw("tape", "import", "cats", src, "-o", out)
-    assert r.code == 1 and "the file exists: it is not replaced unless asked (--force)" in r.err
+    assert r.code == 1 and "tape.csv exists: it is replaced only when asked (--force)" in r.err
     assert open(out).read() == before
     r = run_fsw("tape", "import", "cats", src, "-o", out, "--force")
     assert r.code == 0 and read_tape(out).pressure[2] == pytest.approx(isa_p(1.0), abs=0.05)
@@ -308,5 +308,5 @@ def test_fsw_tape_import(tmp_path):
     r = run_fsw("tape", "show", "")
     assert r.code == 2 and "an empty string names nothing" in r.err
     r = run_fsw("tape", "import", "cats", src, "-o", str(tmp_path / "n.csv"), "--pad-alt", "nan")
-    assert r.code == 1 and "--pad-alt nan: expected a pad elevation" in r.err
+    assert r.code == 2 and "--pad-alt: expected a pad elevation from -500 to 9,000 m ASL, found nan" in r.err
     assert not (tmp_path / "n.csv").exists()

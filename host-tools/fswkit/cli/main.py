@@ -94,6 +94,18 @@ def _nonneg_int(text: str) -> int:
     return value
 
 
+def _pad_alt(text: str) -> float:
+    """A pad's elevation in m ASL: from -500 (the Dead Sea's shore is -430)
+    to 9,000 (the pressure a tape is made from stays in the ISA troposphere)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of metres, found {text!r}")
+    if not -500.0 <= value <= 9_000.0:
+        raise argparse.ArgumentTypeError(f"expected a pad elevation from -500 to 9,000 m ASL, found {text}")
+    return value
+
+
 def _tcp_port(text: str) -> int:
     """A TCP port to listen on: 0 (any free one) to 65535."""
     value = _nonneg_int(text)
@@ -401,7 +413,7 @@ def parser() -> argparse.ArgumentParser:
     ti.add_argument("log", metavar="LOG")
     ti.add_argument("-o", "--output", required=True, metavar="TAPE.csv", help="the tape to write (- for "
                     "standard output)")
-    ti.add_argument("--pad-alt", type=float, metavar="M", help="pad elevation in m ASL, for pressure made "
+    ti.add_argument("--pad-alt", type=_pad_alt, metavar="M", help="pad elevation in m ASL, for pressure made "
                     "from a log's altitude (default 0)")
     ti.add_argument("--force", action="store_true", help="replace TAPE.csv if it exists")
     ti.set_defaults(func=_command("tape", "cmd_import"))

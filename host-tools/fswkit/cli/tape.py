@@ -26,11 +26,9 @@ def cmd_import(args) -> int:
         if value == "":  # as main.py refuses an empty option of the other commands
             sys.stderr.write(f"fsw tape import: {option}: an empty string names nothing: give a path\n")
             return EXIT_CONFIG
-    try:  # the output is refused before any work (an input, a folder, a missing folder)
-        check(args.output, (args.log,), force=args.force, what="tape")
-        if args.output != "-" and not args.force and os.path.lexists(args.output) \
-                and os.path.isfile(args.output):
-            raise OutputError(f"{args.output}: the file exists: it is not replaced unless asked (--force)")
+    try:  # the output is refused before any work (an input, a folder, a missing folder, a file there)
+        if args.output != "-":
+            check(args.output, (args.log,), force=args.force, ask=True, what="tape")
         tape = convert(args.format, args.log, args.pad_alt)
         write_tape(args.output, replace(tape, path=args.output), force=args.force, inputs=(args.log,))
     except (TapeError, OutputError) as e:
@@ -38,7 +36,28 @@ def cmd_import(args) -> int:
     if args.output != "-":
         sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} rows, {tape.start:.2f} to "
                          f"{tape.end:.2f} s, columns {', '.join(tape.columns_available()) or 'none'}\n")
+    if args.pad_alt is not None and not any("ISA standard atmosphere with the pad at" in d for d in tape.derived):
+        # the pad altitude only sets pressure made from an altitude: given and unused is said, not ignored
+        why = "the log has pressure of its own" if "pressure_pa" in tape.columns_available() \
+            else "the log has no altitude to make pressure from"
+        sys.stderr.write(f"fsw tape import: --pad-alt is not used: {why}\n")
+    late = _dropped_late(tape)
+    if late:  # a clock that restarted mid-log loses what follows: said here, not only in the header
+        sys.stderr.write(f"fsw tape import: {late:,} rows of the log dropped: their time is not after the "
+                         "previous row's (the tape's header counts them)\n")
     return EXIT_OK
+
+
+def _dropped_late(tape) -> int:
+    """The rows a converter dropped for a time not after the previous row's,
+    as its `# derived: rows dropped: N with a time ...` header line counts them."""
+    import re
+
+    for d in tape.derived:
+        m = re.match(r"rows dropped: (\d+) with a time not after", d)
+        if m:
+            return int(m.group(1))
+    return 0
 
 
 def show_text(tape, truth=None, truth_error: str | None = None) -> str:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import re
+import shlex
 import shutil
 import tempfile
 
@@ -349,5 +350,5 @@ def main(args) -> int:
     print(f"fsw new: {name} for the {board.name} in {target}/")
     for fname in sorted(texts):
         print(f"  {fname}")
-    print(f"next: cd {target} && fsw check . && fsw test {name}.ss && fsw build .")
+    print(f"next: cd {shlex.quote(target)} && fsw check . && fsw test {name}.ss && fsw build .")  # pasted as is
     return 0

@@ -71,11 +71,14 @@ def _ours(path: str) -> bool:
     """Whether a sketch's file may be written at `path`: nothing is there, or a
     file an export wrote (its first line names fswkit, or arduino-cli for
     sketch.yaml)."""
-    try:
-        with open(path, "rb") as f:
-            first = f.readline(400)
+    from fswkit.autocode.diagnostics import InputError, read_head
+
+    try:  # a FIFO or a device is not opened for long, and is no export's file
+        first = read_head(path, 400).split(b"\n", 1)[0]
     except FileNotFoundError:
         return True
+    except InputError:
+        return False
     except OSError:
         return not os.path.lexists(path)
     return b"fswkit" in first or first.startswith(b"# arduino-cli:")

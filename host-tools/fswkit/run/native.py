@@ -16,6 +16,7 @@ import shutil
 import signal
 import struct
 import subprocess
+import tempfile
 import threading
 import time
 
@@ -237,17 +238,22 @@ def run(script: M.Script, real: Real, source_line, trace_path: str | None = None
     exe = compile_script(script, real, source_line)
     raw = None
     args = [exe]
-    if trace_path:
-        raw = trace_path + ".raw"
+    if trace_path:  # the runner's binary rows: a temporary file of their own, removed however the run ends
+        from fswkit.outputs import is_direct
+
+        folder = None if is_direct(trace_path) else os.path.dirname(os.path.abspath(trace_path))  # not in /dev
+        fd, raw = tempfile.mkstemp(prefix=".fsw-trace.", suffix=".raw", dir=folder)
+        os.close(fd)
         args.append(raw)
-    r = subprocess.run(args, capture_output=True, text=True)
-    if r.returncode not in (0, 1):
-        raise NativeError(f"the native runner failed (status {r.returncode}): {r.stderr.strip()}")
-    if raw:
-        try:
+    try:
+        r = subprocess.run(args, capture_output=True, text=True)
+        if r.returncode not in (0, 1):
+            raise NativeError(f"the native runner failed (status {r.returncode}): {r.stderr.strip()}")
+        if raw:
             _raw_to_csv(script.machine, raw, trace_path)
-        finally:
-            if os.path.exists(raw):
+    finally:
+        if raw:
+            with contextlib.suppress(OSError):
                 os.remove(raw)
     return r.returncode, r.stdout
 

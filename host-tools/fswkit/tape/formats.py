@@ -54,7 +54,7 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, read_file
+from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -103,14 +103,13 @@ class Log:
             if s == "" or s.lower() == "nan":
                 if required:
                     err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`) is empty: "
-                                                    "every row needs it")
+                                                    "every row needs it" if s == "" else
+                                                    f"{what} (`{self.raw_names[col]}`): `{s}` is not a finite number")
                 out[i] = math.nan
                 continue
-            try:
-                v = float(s)
-            except ValueError:
+            v = number(s)
+            if v is None:
                 v = math.nan
-            if not math.isfinite(v):
                 err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`): `{s[:40]}` is not "
                                                 "a finite number")
             out[i] = v
@@ -133,7 +132,7 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
     `wanted(normalised names)` holds. TapeError (located) otherwise."""
     data = read_file(path, MAX_LOG)
     err = _Errors(path)
-    text = _text(data, err)
+    text = _text(data, err, "log")
     err.raise_if_any()
     lines = text.split("\n")
     header = None
@@ -174,6 +173,16 @@ def _increasing(t: np.ndarray) -> np.ndarray:
     return keep
 
 
+def _from_liftoff(t: np.ndarray, t_lift: float) -> tuple[np.ndarray, np.ndarray]:
+    """The times counted from liftoff, and a mask of the rows kept: two log
+    times closer than binary64 tells apart at the shifted magnitude (0 and
+    1e-320, liftoff at 1 s) become one time, and the later row is dropped
+    as a row whose time is not after the previous one."""
+    shifted = t - t_lift
+    kept = _increasing(shifted)
+    return shifted[kept], kept
+
+
 def _pressure_pa(p: np.ndarray, log: Log, col: int) -> tuple[np.ndarray, str]:
     """A pressure column in Pa, its unit told from its magnitude: Pa (median
     10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise."""
@@ -183,12 +192,32 @@ def _pressure_pa(p: np.ndarray, log: Log, col: int) -> tuple[np.ndarray, str]:
                          f"`{log.raw_names[col]}` holds no value"])
     med = float(np.median(have))
     if 10_000 <= med <= 120_000:
-        return p, "Pa"
+        return _positive(p, log, col, "Pa"), "Pa"
     if 100 <= med <= 1_200:
-        return p * 100.0, "hPa (mbar)"
+        with np.errstate(over="ignore"):  # a cell beyond binary64 once scaled: refused below, located
+            return _positive(p * 100.0, log, col, "hPa"), "hPa (mbar)"
     raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: cannot tell the unit of "
                      f"`{log.raw_names[col]}`: its median {med:g} is neither Pa (10,000 to 120,000) nor "
                      "hPa/mbar (100 to 1,200)"])
+
+
+def _positive(p: np.ndarray, log: Log, col: int, unit: str) -> np.ndarray:
+    """`p` (Pa, one value per row of the log) when every value is a finite
+    pressure above 0; otherwise TapeError at each cell that is not: a glitch
+    row of a sensor (0, negative) is the log's cell to locate, not a tape
+    the writer refuses later without a line."""
+    bad = np.flatnonzero(~np.isnan(p) & ~((p > 0) & np.isfinite(p)))
+    if bad.size == 0:
+        return p
+    err = log.err()
+    name = log.raw_names[col]
+    for i in bad.tolist():
+        ln, cells = log.rows[i]
+        cell = cells[col].strip()[:40]
+        why = "is not above 0 Pa" if not p[i] > 0 else f"read as {unit} is beyond the largest number once in Pa"
+        err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{cell}` {why}")
+    err.raise_if_any()
+    return p
 
 
 def _liftoff_accel(t: np.ndarray, a: np.ndarray) -> float | None:
@@ -482,9 +511,11 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         derived.append("merged onto the accel clock while it lasts, holding the last altitude sample "
                        "(sample-and-hold; empty before the first altitude sample); after the accel data end, "
                        "rows follow the altitude clock")
-    derived += _dropped(late[0])
+    t, kept = _from_liftoff(t, t_lift)
+    p, accel = p[kept], accel[kept]
+    derived += _dropped(late[0] + int((~kept).sum()))
     flight = f"recorder Featherweight Raven (FIP export); pad elevation {_pad_text(pad_alt)}"
-    return Tape(path, t - t_lift, p, accel, (_source(path, "raven"),), flight, tuple(derived))
+    return Tape(path, t, p, accel, (_source(path, "raven"),), flight, tuple(derived))
 
 
 # ---- Eggtimer ---------------------------------------------------------------------
@@ -558,15 +589,17 @@ def rrc3(path: str, pad_alt: float | None = None) -> Tape:
     t_lift = _liftoff_baro(t, h)
     if t_lift is None:
         raise TapeError([f"{log.path}: no liftoff found: the altitude is never 10 m above the pad for 0.5 s"])
+    t, kept = _from_liftoff(t, t_lift)
+    p = p[kept]
     derived = ["liftoff defined here by the BARO rule: the last sample within 1 m of the pad (median pressure "
                "altitude of the log's first second before the rise) before the altitude is 10 m above it for "
                "0.5 s: RRC3 time "
                f"{t_lift:g} s; time_s = RRC3 time - {t_lift:g}", how,
-               "accel_g empty: an RRC3 logs no acceleration"] + _dropped(int((~keep).sum()))
+               "accel_g empty: an RRC3 logs no acceleration"] + _dropped(int((~keep).sum()) + int((~kept).sum()))
     flight = "recorder Missile Works RRC3 (mDACS export)"
     if ip is None:
         flight += f"; pad elevation {_pad_text(pad_alt)}"
-    return Tape(path, t - t_lift, p, np.full(t.size, math.nan), (_source(path, "rrc3"),), flight, tuple(derived))
+    return Tape(path, t, p, np.full(t.size, math.nan), (_source(path, "rrc3"),), flight, tuple(derived))
 
 
 @dataclass(frozen=True)

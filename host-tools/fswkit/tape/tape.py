@@ -31,7 +31,6 @@ every other key optional, unknown keys kept in `extra`.
 from __future__ import annotations
 
 import math
-import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -158,7 +157,8 @@ class Tape:
         t = self.time[mask]
         if t.size < 2:
             return 0.0
-        return float(1.0 / np.median(np.diff(t)))
+        with np.errstate(over="ignore", divide="ignore"):  # times at binary64's ends: inf Hz, not a warning
+            return float(1.0 / np.median(np.diff(t)))
 
     def altitude_agl(self, pad_pa: float | None = None) -> np.ndarray:
         """ISA pressure altitude above the pad, m (NaN where no pressure):
@@ -181,12 +181,19 @@ class Tape:
 
 # ---- reading ------------------------------------------------------------------------
 
-def _text(data: bytes, err: _Errors) -> str | None:
+_EMPTY = {"tape": "a tape starts with the line `# fswkit sensor tape v1` (docs/tapes.md)",
+          "log": "a recorder's log holds a column line and rows (docs/tapes.md, Converters)",
+          "truth": "a truth file holds at least `name = \"...\"`"}
+_UTF8 = {"tape": "a tape is UTF-8 text (docs/tapes.md)", "log": "the log is read as UTF-8 text (docs/tapes.md)",
+         "truth": "a truth file is UTF-8 text"}
+
+
+def _text(data: bytes, err: _Errors, what: str = "tape") -> str | None:
     """The file's text: UTF-8 (a byte order mark dropped), no NUL bytes;
-    a located error at the first bad byte otherwise."""
+    a located error at the first bad byte otherwise. `what` the file is
+    ("tape", "log", "truth") words the message."""
     if not data:
-        err.at(None, None, "empty file: a tape starts with the line `# fswkit sensor tape v1` "
-                           "(docs/tapes.md)")
+        err.at(None, None, f"empty file: {_EMPTY[what]}")
         return None
     bad = data.find(b"\0")
     try:
@@ -196,9 +203,23 @@ def _text(data: bytes, err: _Errors) -> str | None:
     if bad >= 0:
         line = data.count(b"\n", 0, bad) + 1
         col = bad - (data.rfind(b"\n", 0, bad) + 1) + 1
-        err.at(line, col, "not a text file (binary data here): a tape is UTF-8 text (docs/tapes.md)")
+        err.at(line, col, f"not a text file (binary data here): {_UTF8[what]}")
         return None
     return text
+
+
+def number(text: str) -> float | None:
+    """The number a stripped cell writes as CSV writes one (ASCII digits, a
+    point, an exponent), None if it writes none: float() takes more
+    (`1_000`, digits of any script, `infinity`), and NaN and infinities are
+    no finite number. Checked after float() (the usual cell is a number)."""
+    try:
+        v = float(text)
+    except ValueError:
+        return None
+    if not math.isfinite(v) or "_" in text or not text.isascii():
+        return None
+    return v
 
 
 def _cell_value(cell: str) -> float | None:
@@ -206,11 +227,7 @@ def _cell_value(cell: str) -> float | None:
     s = cell.strip()
     if not s:
         return math.nan
-    try:
-        v = float(s)
-    except ValueError:
-        return None
-    return v if math.isfinite(v) else None
+    return number(s)
 
 
 def parse_tape(data: bytes | str, path: str) -> Tape:
@@ -335,7 +352,11 @@ def _num(v: float, digits: int) -> str:
 
 def format_tape(tape: Tape, *, time_digits: int = 5, pressure_digits: int = 1, accel_digits: int = 4) -> str:
     """The tape as the text of a v1 file (header, column line, rows). Numbers
-    are written with at most the given decimals, trailing zeros dropped."""
+    are written with at most the given decimals, trailing zeros dropped; but
+    what the file must keep apart is written exactly (Python's shortest
+    round-trip text) where those decimals would merge or zero it: every time
+    of a tape whose rows lie closer than the time's precision, and a
+    pressure above 0 that would round to 0. So what is written reads back."""
     out = [MAGIC]
     out += [f"# source: {s}" for s in tape.sources]
     if tape.flight:
@@ -344,9 +365,21 @@ def format_tape(tape: Tape, *, time_digits: int = 5, pressure_digits: int = 1, a
     out += [f"# note: {n}" for n in tape.notes]
     out += [f"# {c}" for c in tape.comments]
     out.append(COLUMN_LINE)
-    for t, p, a in zip(tape.time.tolist(), tape.pressure.tolist(), tape.accel.tolist()):
-        out.append(f"{_num(t, time_digits)},{_num(p, pressure_digits)},{_num(a, accel_digits)}")
+    times = [_num(t, time_digits) for t in tape.time.tolist()]
+    back = [float(c) if c else math.nan for c in times]
+    if any(b <= a for a, b in zip(back, back[1:])):  # rows closer than the precision: written exactly
+        times = [_exact(t) for t in tape.time.tolist()]
+    for t, p, a in zip(times, tape.pressure.tolist(), tape.accel.tolist()):
+        pressure = _num(p, pressure_digits)
+        if pressure and float(pressure) <= 0:  # a pressure above 0 that rounds to 0 (0.01 Pa): exactly
+            pressure = _exact(p)
+        out.append(f"{t},{pressure},{_num(a, accel_digits)}")
     return "\n".join(out) + "\n"
+
+
+def _exact(v: float) -> str:
+    """The shortest text that reads back as `v` exactly ("" for NaN)."""
+    return "" if math.isnan(v) else repr(float(v))
 
 
 def check_tape(tape: Tape) -> None:
@@ -379,14 +412,11 @@ def write_tape(path: str, tape: Tape, *, force: bool = False, inputs=()) -> None
     """Writes `tape` to `path` ("-": standard output) through fswkit.outputs:
     whole or not at all. An existing file is replaced only with `force`
     (OutputError otherwise), never one of `inputs`."""
-    from fswkit.outputs import OutputError, is_direct, output
+    from fswkit.outputs import output
 
     check_tape(tape)
-    if path not in ("-",) and not force and os.path.lexists(path) and not is_direct(path) \
-            and not os.path.isdir(path):
-        raise OutputError(f"{path}: the file exists: it is not replaced unless asked (--force)")
     text = format_tape(tape)
-    with output(path, inputs, force=force, what="tape") as f:
+    with output(path, inputs, force=force, ask=True, what="tape") as f:
         f.write(text)
 
 
@@ -451,7 +481,7 @@ def read_truth(path: str) -> Truth:
     """Reads a `.truth.toml`; TapeError with a located message when it cannot."""
     data = read_file(path, MAX_INPUT)
     err = _Errors(path)
-    text = _text(data, err) if data else ""
+    text = _text(data, err, "truth") if data else ""
     err.raise_if_any()
     try:
         doc = tomllib.loads(text)

@@ -11,12 +11,15 @@ else the compiler refuses is an internal error to report."""
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import os
 import re
 import shutil
+import stat
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from dataclasses import dataclass
@@ -47,7 +50,13 @@ def find_app(project: str) -> str:
             raise BuildError(f"{project}: not an application config (.app)")
         return project
     if not os.path.isdir(project):
-        raise BuildError(f"{project}: no such file or folder")
+        try:
+            mode = os.stat(project).st_mode
+        except OSError:
+            raise BuildError(f"{project}: no such file or folder") from None
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) \
+            else "a socket" if stat.S_ISSOCK(mode) else "not a file or folder"
+        raise BuildError(f"{project}: not a regular file ({kind}): name the project's folder or its .app file")
     apps = sorted(n for n in os.listdir(project) if n.endswith(".app"))
     if len(apps) != 1:
         found = ", ".join(apps) if apps else "none"
@@ -63,22 +72,54 @@ def default_out(app: Application) -> str:
     return os.path.join(os.path.dirname(app.path) or ".", "build", app.board.name)
 
 
+def _write_whole(path: str, data: bytes) -> None:
+    """Writes `data` to a temporary file beside `path` that takes its name
+    once whole: a write that fails partway (a full disk, Ctrl-C) leaves the
+    old file, or none, never a truncated one that a later compile of the
+    folder (arduino-cli on a sketch) would take for whole. OSError naming
+    `path` on failure."""
+    from fswkit.outputs import _new_file_mode
+
+    folder = os.path.dirname(path) or "."
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.", suffix=".part", dir=folder)
+    except OSError as e:
+        raise OSError(e.errno, e.strerror, path) from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        _new_file_mode(tmp, path)
+        os.replace(tmp, path)
+    except BaseException as e:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(e, OSError):
+            raise OSError(e.errno, e.strerror, path) from None
+        raise
+
+
 def write_files(files: dict[str, str], out: str) -> list[str]:
-    """Writes generated files, leaving unchanged ones untouched (so Make
-    rebuilds only what changed), and removes stale generated files."""
+    """Writes generated files, each whole or not at all (`_write_whole`),
+    leaving unchanged ones untouched (so Make rebuilds only what changed),
+    and removes stale generated files."""
+    from fswkit.autocode.diagnostics import InputError, read_head
+
     os.makedirs(out, exist_ok=True)
     written = []
     for name in sorted(files):
         path = os.path.join(out, name)
         text = files[name]
-        try:
-            with open(path) as f:
-                if f.read() == text:
-                    continue
+        data = text.encode()
+        try:  # never opened for long: a FIFO there would wait for a writer, /dev/zero never end
+            if read_head(path, len(data) + 1) == data:
+                continue
+        except InputError as e:
+            if e.strerror != "is a folder, not a file":  # a folder: open() below says so
+                raise OSError(errno.EEXIST, e.strerror.split(":")[0] + ": a generated file replaces only "
+                              "a regular file; move it away", path) from None
         except OSError:
             pass
-        with open(path, "w") as f:
-            f.write(text)
+        _write_whole(path, data)
         written.append(path)
     for name in os.listdir(out):
         if name.endswith((".gen.cpp", ".gen.h")) and name not in files:

@@ -51,6 +51,11 @@ def check_port(port: str, baud: int) -> None:
     ours to open. Opening it resets an Arduino, as avrdude's own open does."""
     if not os.path.exists(port):
         raise FlashError(f"no serial port {port}{_connected_hint()}")
+    from fswkit.link.port import not_a_port
+
+    why = not_a_port(port)  # a regular file or a folder (a slip): said as every command on a port says it
+    if why is not None:
+        raise FlashError(f"cannot open {port}: {why}")
     try:
         import serial
     except ImportError:

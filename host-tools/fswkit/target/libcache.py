@@ -34,6 +34,7 @@ import shutil
 import subprocess
 import time
 
+from fswkit.autocode.diagnostics import read_head
 from fswkit.autocode.kit import BUILD_MK, RUNTIME
 
 LINKED = "fsw-libs"  # the build folder's links to the entry it uses
@@ -193,10 +194,9 @@ def link_into(out: str, entry: str, key: str) -> str | None:
     `out`, or None if that fails."""
     here = os.path.join(out, LINKED)
     stamp = os.path.join(here, ".key")
-    try:
-        with open(stamp) as f:
-            if f.read() == key:
-                return LINKED
+    try:  # a FIFO or a device there is not waited on or read: the folder is made again
+        if read_head(stamp, len(key.encode()) + 1) == key.encode():
+            return LINKED
     except OSError:
         pass
     try:

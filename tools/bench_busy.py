@@ -102,11 +102,13 @@ def build(project: str, out: str):
 def task_steps(elf: str, n_tasks: int) -> list[int]:
     """Each task's step function (flash byte address), from the firmware's
     task table (kTasks: rows whose first member is the step's word address)."""
-    r = subprocess.run(["avr-nm", "-S", "-C", elf], capture_output=True, text=True, check=True)
-    m = re.search(r"(?m)^([0-9a-f]+) ([0-9a-f]+) [tTrRdD] fsw_gen::\(anonymous namespace\)::kTasks$", r.stdout)
-    if m is None:
+    from fswkit.target.build import elf_symbols  # demangles the names LTO gave a suffix too
+
+    rows = [(a, n) for a, n, kind, name in elf_symbols(elf)
+            if kind in "tTrRdD" and name == "fsw_gen::(anonymous namespace)::kTasks"]
+    if not rows:
         sys.exit(f"bench_busy: {elf} has no task table kTasks")
-    start, size = int(m.group(1), 16), int(m.group(2), 16)
+    start, size = rows[0]
     with tempfile.TemporaryDirectory() as tmp:
         image = os.path.join(tmp, "text.bin")  # .text from address 0 (the vectors)
         subprocess.run(["avr-objcopy", "-O", "binary", "-j", ".text", elf, image], check=True)

@@ -158,15 +158,20 @@ def component(name: str, machines: tuple[str, ...]) -> str:
     bare = re.sub(r"\(.*$", "", bare)  # no argument list
     bare = re.sub(r"^_ZN12_GLOBAL__N_1\d+(\w+?)E.*$", r"\1", bare)  # LTO-private statics
     if bare == "main":
-        return "main(): Arduino start-up + inlined set-up"
+        return "main(): start-up, the loop and what they inline"
     if re.search(rf"fsw_gen::({ms})::|task_({ms})\b|fsw::machine_|fsw::roll_|ext_push|"
                  r"_read_key|fsw::(read|write)_F32|real_from_|round_to_f32|fsw::(\w+)_from_real", bare):
         return "generated machines + their runtime"
     if re.search(r"resume|pyro|time_base", bare, re.I):
         return "pyro gates + resuming after a reset"
-    if re.search(r"link|cobs|crc|(^|::)put(_\w+)?$|frame_|send_control|(^|::)apply$|service|pump|"
-                 r"executor_owns|g_rx|g_tx|g_enc|console|uart|__vector_1[89]$", bare, re.I):
+    if re.search(r"link|cobs|crc|(^|::)put(_\w+)?$|frame_|send_control|send_batch|take_sample|tx_room|"
+                 r"(^|::)apply$|service|pump|executor_owns|g_rx|g_tx|g_at|g_w|g_enc|console|uart|__vector_1[89]$",
+                 bare, re.I):
         return "link + UART console"
+    if re.search(r"Recorder|LogConfig|fsw::log_|fifo_put|^lround$", name):
+        return "flight recorder"
+    if re.search(r"ParamStore|ParamConfig|ParamDef|fsw::param_", name):
+        return "parameters"
     if re.search(r"fsw::io_|task_(sense|act)|kAnalog|kDigital|fsw::(read|write)_elem|fsw::convert|"
                  r"cal_|adc|g_scan|__vector_21$", bare, re.I):
         return "I/O (sensing, outputs)"
@@ -190,13 +195,10 @@ def symbol_breakdown(elf: str, machines: tuple[str, ...]) -> dict[str, list[int]
     flash is code and initialised data's image, RAM is .data + .bss +
     .noinit. What no sized symbol covers (vector table, padding, section
     alignment) is `unattributed`."""
-    text = sh(["avr-nm", "-S", "-C", elf]).stdout
+    from fswkit.target.build import elf_symbols  # demangles the names LTO gave a suffix too
+
     out: dict[str, list[int]] = {}
-    for line in text.splitlines():
-        m = re.match(r"^([0-9a-f]+) ([0-9a-f]+) (\w) (.*)$", line)
-        if not m:
-            continue
-        addr, size, kind, name = int(m.group(1), 16), int(m.group(2), 16), m.group(3), m.group(4)
+    for addr, size, kind, name in elf_symbols(elf):
         if kind in "tTwW" and addr < 0x800000:
             row = out.setdefault(component(name, machines), [0, 0])
             row[0] += size

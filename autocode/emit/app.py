@@ -253,7 +253,10 @@ def _app_cpp(app: Application) -> str:
     if _shared_time_store(app):
         # G written by one function for every machine task (8 stores a call
         # on AVR); capitalised, so no machine's or task's name can be it.
-        c.append(f"FSW_NOINLINE void store_G_now(uint8_t* g) {{ fsw::store<uint64_t>(g, {_now(app)}); }}")
+        # With a link, through the link's clock function: one copy of the
+        # clock's code (the 64-bit extension, the time base) for both.
+        now = "link_now()" if has_link else _now(app)
+        c.append(f"FSW_NOINLINE void store_G_now(uint8_t* g) {{ fsw::store<uint64_t>(g, {now}); }}")
         c.append("")
     for t in app.tasks:
         steps[t.name] = (None if (app.pyro and t is pyro_task(app)) or (app.sensors and t is sensor_task(app))
@@ -361,6 +364,19 @@ def _app_cpp(app: Application) -> str:
     c.append("    }")
     c.append("}")
     c.append("void loop() { fsw_gen::poll(); }")
+    if not any(ch.analog and ch.direction == "o" for ch in app.channels):
+        # No PWM output: nothing uses the core's timers, and the sleeping
+        # executor's timer keeps the clock, so the core's init() (Timer0's
+        # millis() tick and its interrupt, the PWM timers) is not needed.
+        c.append("#if defined(__AVR__) && FSW_SLEEP")
+        c.append("// The kit's start-up in place of the core's main() and init() (docs/runtime.md):")
+        c.append("// no PWM output, and the executor's timer keeps the clock.")
+        c.append("int main() {")
+        c.append("    fsw::pal::boot();  // the ADC on, the UART's pins released, interrupts on")
+        c.append("    setup();")
+        c.append("    for (;;) loop();")
+        c.append("}")
+        c.append("#endif")
     c.append("#elif !defined(FSW_NO_MAIN)")
     c += _native_main(app)
     c.append("#endif")
@@ -655,7 +671,10 @@ def _link(app: Application) -> list[str]:
         for e in rows:
             c.append(f"static_assert(fsw::link_writable_ok(E_{e.name}, {ELEM_CODE[e.type.name]}, kSvSize), "
                      f"\"writable element {e.name} lies outside the state vector\");")
-    c.append(f"uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, {app.time_unit}")
+    # Out of line where the machine tasks' store_G_now calls it too (one copy).
+    noinline = "FSW_NOINLINE " if _shared_time_store(app) else ""
+    c.append(f"{noinline}uint64_t link_now() {{ return {_now(app)}; }}  // the time `G` is written from, "
+             f"{app.time_unit}")
     c.append(f"// Link load: about {round(load)} B/s of {round(capacity)} B/s at {app.baud} baud "
              f"({100 * load / capacity:.0f} %).")
     if load > capacity:

@@ -216,15 +216,26 @@ class ExprEmitter:
             guard.append(f"a >= -{limit}LL")
         if limit < ta.hi:
             guard.append(f"a <= {limit}{'LL' if ta.signed else 'ULL'}")
-        r = f"static_cast<int64_t>(a) + ({k}LL)"
         lo_r = max(ta.lo, -limit) + k
         hi_r = min(ta.hi, limit) + k
+        # The sum in the narrowest signed type that holds every value it can
+        # take (on an 8-bit MCU a 64-bit sum and compare are library calls
+        # or long runs of instructions; the value is the same).
+        if -(1 << 15) <= min(lo_r, tt.lo) and max(hi_r, tt.hi) < (1 << 15):
+            rtype, sfx = "int16_t", ""
+        elif -(1 << 31) <= min(lo_r, tt.lo) and max(hi_r, tt.hi) < (1 << 31):
+            rtype, sfx = "int32_t", "L"
+        else:
+            rtype, sfx = "int64_t", "LL"
+        r = f"static_cast<{rtype}>(a) + ({k}{sfx})"
+        sum_ = f"const {rtype} r = static_cast<{rtype}>(static_cast<{rtype}>(a) + ({k}{sfx})); "
         if lo_r < tt.lo:
-            r = f"(r < {tt.lo}LL ? {tt.lo}LL : r)" if hi_r <= tt.hi else f"(r < {tt.lo}LL ? {tt.lo}LL : r > {tt.hi}LL ? {tt.hi}LL : r)"
-            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+            r = f"(r < {tt.lo}{sfx} ? {tt.lo}{sfx} : r)" if hi_r <= tt.hi else \
+                f"(r < {tt.lo}{sfx} ? {tt.lo}{sfx} : r > {tt.hi}{sfx} ? {tt.hi}{sfx} : r)"
+            pre = sum_
         elif hi_r > tt.hi:
-            r = f"(r > {tt.hi}LL ? {tt.hi}LL : r)"
-            pre = f"const int64_t r = static_cast<int64_t>(a) + ({k}LL); "
+            r = f"(r > {tt.hi}{sfx} ? {tt.hi}{sfx} : r)"
+            pre = sum_
         else:
             pre = ""
         ptr = self.ptr(target)

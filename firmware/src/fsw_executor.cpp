@@ -47,13 +47,11 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
 #if FSW_SLEEP
     pal::cycle_timer_begin(c.period_us);
 #endif
+    memset(&ex, 0, sizeof ex);  // the counters (one clear: a store a field was 4 bytes of flash a byte)
+    ex.cfg = cfg;
+#if !FSW_SLEEP
     ex.next_due_us = pal::micros32();
-    ex.cycles = 0;
-    ex.cycles_high = 0;
-    ex.late = 0;
-    ex.late_overrun = 0;
-    ex.late_other = 0;
-    ex.skipped = 0;
+#endif
     ex.mirrors = mirrors;
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;

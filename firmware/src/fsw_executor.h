@@ -58,7 +58,10 @@ struct ExecConfig {
 
 struct Executor {
     const ExecConfig* cfg;   // FSW_FLASH
-    uint32_t next_due_us;    // start of the next cycle: micros32(), which wraps
+#if !FSW_SLEEP
+    uint32_t next_due_us;    // start of the next cycle: micros32(), which wraps (the sleeping
+                             // executor's schedule is its timer's: pal::cycle_wait)
+#endif
     uint32_t cycles;         // cycles run, low 32 bits (health frames carry these)
     uint16_t late;           // cycles that started a full period or more late
     uint8_t reset_cause;     // captured at executor_begin
@@ -91,7 +94,9 @@ inline uint64_t executor_cycles(const Executor& ex) {
 // starts the platform, arms the watchdog, captures the reset cause. The
 // first cycle is due at once. `cfg` points at an FSW_FLASH object that
 // outlives the executor.
-FSW_MUST_CHECK Result executor_begin(Executor& ex, const ExecConfig* cfg);
+// Out of line: its copies of the configuration and of a task's row are on
+// the stack only at boot, not in main()'s frame, which every path pays.
+FSW_MUST_CHECK FSW_NOINLINE Result executor_begin(Executor& ex, const ExecConfig* cfg);
 // Runs one cycle now: kicks the watchdog, then each due task in order.
 void executor_run_cycle(Executor& ex);
 // Runs a cycle if one is due (call from loop()); true when one ran.
@@ -112,8 +117,10 @@ bool executor_poll(Executor& ex, bool background = true);
 ExecConfig executor_config(const Executor& ex);
 // A task's current mode (from its element or its TaskStats).
 uint8_t executor_task_mode(const Executor& ex, uint8_t i);
-// Sets a task's mode (ground command, tests).
-void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode);
+// Sets a task's mode (ground command, tests). Out of line: its copies of
+// the configuration and the task's row are on the stack only while it runs,
+// not in the frame of the uplink's command handler.
+FSW_NOINLINE void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode);
 
 }  // namespace fsw
 

@@ -33,7 +33,6 @@ void inc16(uint16_t& c) {
     if (c != 0xFFFFu) ++c;
 }
 
-void read_config(const Link& l, LinkConfig& c) { flash_read(&c, l.cfg, sizeof c); }
 
 // Copies state vector bytes, atomically when the `lock` option is on.
 void sv_move(bool lock, void* dst, const void* src, uint16_t n) {
@@ -168,23 +167,38 @@ void take_sample(Link& l, const Sampling& c, const LinkStream& s, uint8_t i, uin
     send_batch(l, c, s, st, i, true);
 }
 
+// The parameter store's source byte of hello and health frames.
+uint8_t param_source(const LinkConfig& c) {
+    const ParamStore* const params = flash_get(c.params);
+    return params != 0 ? params->source : static_cast<uint8_t>(kParamNone);
+}
+
 // One control frame: `type` is kFrameAck, kFrameHello, kFrameHealth or
-// kFrameSnapshot.
+// kFrameSnapshot. The control path (service, send_control, the uplink's
+// apply) reads the configuration `c`, an FSW_FLASH object, a field at a
+// time where it uses one: no copy of the whole on the stack, whose deepest
+// reach is on this path (a copy was 54 of the rocket's 192 bytes).
 FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
-    const uint64_t t = c.now();
+    const uint64_t t = flash_get(c.now)();
     uint8_t tb[8];  // t, little-endian: the header takes the low half, hello and health the high half
     memcpy(tb, &t, sizeof tb);
     frame_begin(l, type, tb);
-    const Executor& ex = *c.ex;
+    const Executor& ex = *flash_get(c.ex);
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
         put_u16(l.n.last_seq);
-        if (c.params != 0 && c.param_ack != 0) c.param_ack(l, *c.params);
-        if (c.log != 0 && c.log_ack != 0) c.log_ack(l, *c.log);
-        if (c.reload != 0 && c.reload_ack != 0) c.reload_ack(l, *c.reload);
+        ParamStore* const params = flash_get(c.params);
+        const LinkParamAckFn param_ack = flash_get(c.param_ack);
+        if (params != 0 && param_ack != 0) param_ack(l, *params);
+        Recorder* const log = flash_get(c.log);
+        const LinkLogAckFn log_ack = flash_get(c.log_ack);
+        if (log != 0 && log_ack != 0) log_ack(l, *log);
+        ReloadStore* const reload = flash_get(c.reload);
+        const LinkReloadAckFn reload_ack = flash_get(c.reload_ack);
+        if (reload != 0 && reload_ack != 0) reload_ack(l, *reload);
     } else if (type == kFrameHello) {
         put(kLinkProtocol);
-        put_u32(c.schema);
+        put_u32(flash_get(c.schema));
         put_bytes(tb + 4, 4);
         put_u32(l.n.frames);
         put(FSW_RUNTIME_VERSION_MAJOR);
@@ -192,34 +206,39 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put(FSW_RUNTIME_VERSION_PATCH);
         put(ex.reset_cause);
         put_u16(l.n.last_seq);
-        put(c.params != 0 ? c.params->source : static_cast<uint8_t>(kParamNone));
+        put(param_source(c));
     } else if (type == kFrameHealth) {
         put_bytes(tb + 4, 4);
         put_bytes(&l.n.frames, 8);   // frames, dropped
         put_bytes(&ex.cycles, 7);    // cycles, late, reset_cause
         put_bytes(&l.n.rx_ok, 14);   // rx_ok .. last_seq
-        put(c.params != 0 ? c.params->source : static_cast<uint8_t>(kParamNone));
-        const ExecConfig ec = executor_config(ex);
-        for (uint8_t i = 0; i < ec.n_tasks; ++i) {
-            const TaskStats& s = ec.stats[i];
-            ElemOff mode_off;  // the task's mode: its element, or its record
-            flash_read(&mode_off, &ec.tasks[i].mode_off, sizeof mode_off);
+        put(param_source(c));
+        const ExecConfig& ec = *ex.cfg;  // FSW_FLASH: the fields it uses, one at a time
+        const uint8_t n_tasks = flash_get(ec.n_tasks);
+        const TaskStats* const stats = flash_get(ec.stats);
+        const Task* const tasks = flash_get(ec.tasks);
+        const uint8_t* const sv = flash_get(ec.sv);
+        for (uint8_t i = 0; i < n_tasks; ++i) {
+            const TaskStats& s = stats[i];
+            const ElemOff mode_off = flash_get(tasks[i].mode_off);  // the task's mode: its element, or its record
             const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
-            const uint8_t row[6] = {mode_off != kNoElement ? ec.sv[mode_off] : s.mode,
+            const uint8_t row[6] = {mode_off != kNoElement ? sv[mode_off] : s.mode,
                                     s.faults,  // saturates at 255
                                     static_cast<uint8_t>(s.overruns), static_cast<uint8_t>(s.overruns >> 8),
                                     static_cast<uint8_t>(worst), static_cast<uint8_t>(worst >> 8)};
             put_bytes(row, sizeof row);
         }
-        for (uint8_t i = 0; i < c.n_pyro; ++i) put(c.pyro[i].status);  // kPyro* bits (fsw_io.h)
+        const PyroGate* const pyro = flash_get(c.pyro);
+        const uint8_t n_pyro = flash_get(c.n_pyro);
+        for (uint8_t i = 0; i < n_pyro; ++i) put(pyro[i].status);  // kPyro* bits (fsw_io.h)
         for (uint8_t i = 0; i < l.n_sensors; ++i) put(l.sensors[i]);  // kSensor* codes (fsw_sensor.h)
     } else {
-        const uint16_t off = l.snapshot_at;
-        uint16_t n = static_cast<uint16_t>(c.sv_size - off);
-        if (n > c.snapshot_chunk) n = c.snapshot_chunk;
+        const uint16_t off = l.snapshot_at, sv_size = flash_get(c.sv_size), chunk = flash_get(c.snapshot_chunk);
+        uint16_t n = static_cast<uint16_t>(sv_size - off);
+        if (n > chunk) n = chunk;
         put_u16(off);
-        put_sv(c.sv, c.lock, off, n);
-        l.snapshot_at = static_cast<uint16_t>(off + n) >= c.sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
+        put_sv(flash_get(c.sv), flash_get(c.lock), off, n);
+        l.snapshot_at = static_cast<uint16_t>(off + n) >= sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
     frame_end(l, true);
 }
@@ -231,9 +250,11 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
 // waits for a whole executor cycle to pass, so no cycle with the gap after
 // it composes both.
 void service(Link& l, const LinkConfig& c, bool big) {
-    while (tx_room(l, c.tx_cap)) {
+    const uint16_t tx_cap = flash_get(c.tx_cap);
+    const Executor* const ex = flash_get(c.ex);
+    while (tx_room(l, tx_cap)) {
         const uint8_t p = l.pending;
-        const uint8_t cycle = static_cast<uint8_t>(c.ex->cycles);
+        const uint8_t cycle = static_cast<uint8_t>(ex->cycles);
         const bool big_ok = big && static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;
         uint8_t type;
         if (p & kPendAck) {
@@ -261,11 +282,13 @@ void service(Link& l, const LinkConfig& c, bool big) {
 // overruns or worst_us, the reset cause. Modes change only by MODE, and the
 // executor's records never by the ground, whatever the writable table lists.
 FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
-    const ExecConfig ec = executor_config(*c.ex);
-    if (off == ec.reset_cause_off) return true;
-    for (uint8_t i = 0; i < ec.n_tasks; ++i) {
+    const ExecConfig& ec = *flash_get(c.ex)->cfg;  // FSW_FLASH: the fields, one at a time
+    if (off == flash_get(ec.reset_cause_off)) return true;
+    const uint8_t n_tasks = flash_get(ec.n_tasks);
+    const Task* const tasks = flash_get(ec.tasks);
+    for (uint8_t i = 0; i < n_tasks; ++i) {
         ElemOff own[3];  // mode, overruns, worst_us: adjacent in a Task row
-        flash_read(own, &ec.tasks[i].mode_off, sizeof own);
+        flash_read(own, &tasks[i].mode_off, sizeof own);
         if (off == own[0] || off == own[1] || off == own[2]) return true;
     }
     return false;
@@ -274,18 +297,21 @@ FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
 uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
     if (alen < 2) return kAckBadLength;
     const uint16_t index = load<uint16_t>(a);
-    for (uint8_t k = 0; k < c.n_writable; ++k) {
+    const uint8_t n_writable = flash_get(c.n_writable);
+    const LinkWritable* const rows = flash_get(c.writable);
+    for (uint8_t k = 0; k < n_writable; ++k) {
         LinkWritable w;
-        flash_read(&w, &c.writable[k], sizeof w);
+        flash_read(&w, &rows[k], sizeof w);
         if (w.index != index) continue;
         const uint8_t size = elem_size(w.type);
         if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
         if (executor_owns(c, w.off)) return kAckLocked;
-        uint8_t* const p = c.sv + w.off;
-        const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+        uint8_t* const p = flash_get(c.sv) + w.off;
+        const bool lock = flash_get(c.lock);
+        const pal::IrqState saved = lock ? pal::critical_enter() : 0;
         memcpy(p, a + 2, size);
         if (w.type == kBool) *p = *p != 0 ? 1 : 0;  // a bool is stored as 0 or 1
-        if (c.lock) pal::critical_exit(saved);
+        if (lock) pal::critical_exit(saved);
         return kAckOk;
     }
     return kAckNotWritable;
@@ -294,23 +320,30 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
 FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
     if (op == kOpSet) return apply_set(c, a, alen);
     if (op >= kOpParamGet && op <= kOpParamInfo) {
-        if (c.params == 0 || c.param_apply == 0) return kAckUnknownOp;
-        return c.param_apply(l, *c.params, op, a, alen);
+        ParamStore* const params = flash_get(c.params);
+        const LinkParamApplyFn param_apply = flash_get(c.param_apply);
+        if (params == 0 || param_apply == 0) return kAckUnknownOp;
+        return param_apply(l, *params, op, a, alen);
     }
     if (op >= kOpLogInfo && op <= kOpLogErase) {
-        if (c.log == 0 || c.log_apply == 0) return kAckUnknownOp;
-        return c.log_apply(l, *c.log, op, a, alen);
+        Recorder* const log = flash_get(c.log);
+        const LinkLogApplyFn log_apply = flash_get(c.log_apply);
+        if (log == 0 || log_apply == 0) return kAckUnknownOp;
+        return log_apply(l, *log, op, a, alen);
     }
     if (op >= kOpMachineInfo && op <= kOpMachineActivate) {
-        if (c.reload == 0 || c.reload_apply == 0) return kAckUnknownOp;
-        return c.reload_apply(l, *c.reload, op, a, alen);
+        ReloadStore* const reload = flash_get(c.reload);
+        const LinkReloadApplyFn reload_apply = flash_get(c.reload_apply);
+        if (reload == 0 || reload_apply == 0) return kAckUnknownOp;
+        return reload_apply(l, *reload, op, a, alen);
     }
     if (op == kOpMode) {
         if (alen != 2) return kAckBadLength;
-        if (a[0] >= executor_config(*c.ex).n_tasks) return kAckBadTask;
+        Executor& ex = *flash_get(c.ex);
+        if (a[0] >= flash_get(ex.cfg->n_tasks)) return kAckBadTask;
         if (a[1] > kModeEnabled) return kAckBadMode;
-        if (a[0] == c.uplink_task && a[1] != kModeEnabled) return kAckLocked;
-        executor_set_task_mode(*c.ex, a[0], a[1]);
+        if (a[0] == flash_get(c.uplink_task) && a[1] != kModeEnabled) return kAckLocked;
+        executor_set_task_mode(ex, a[0], a[1]);
         return kAckOk;
     }
     if (op < kOpPing || op > kOpSnapshot) return kAckUnknownOp;
@@ -357,23 +390,28 @@ void handle_frame(Link& l, const LinkConfig& c) {
 void link_begin(Link& l, const LinkConfig* cfg) {
     memset(&l, 0, sizeof l);
     l.cfg = cfg;
-    LinkConfig c;
-    read_config(l, c);
-    for (uint8_t i = 0; i < c.n_streams; ++i) {
+    // The fields one at a time (no copy of the configuration on the stack:
+    // generated code inlines this into main(), whose frame every path pays).
+    const LinkConfig& c = *cfg;
+    const uint8_t n_streams = flash_get(c.n_streams);
+    const LinkStream* const streams = flash_get(c.streams);
+    LinkStreamState* const states = flash_get(c.stream_state);
+    for (uint8_t i = 0; i < n_streams; ++i) {
         LinkStream s;
-        flash_read(&s, &c.streams[i], sizeof s);
-        LinkStreamState& st = c.stream_state[i];
+        flash_read(&s, &streams[i], sizeof s);
+        LinkStreamState& st = states[i];
         memset(&st, 0, sizeof st);
         uint16_t first = i;  // i mod every: streams of equal rate take turns
         while (first >= s.every) first = static_cast<uint16_t>(first - s.every);
         st.countdown = first;
     }
-    l.tx = c.tx;
-    l.tx_size = c.tx_size > c.tx_cap ? c.tx_size : c.tx_cap;
-    l.ctl_rest = static_cast<uint16_t>(l.tx_size - c.tx_cap);
+    l.tx = flash_get(c.tx);
+    const uint16_t tx_cap = flash_get(c.tx_cap), tx_size = flash_get(c.tx_size);
+    l.tx_size = tx_size > tx_cap ? tx_size : tx_cap;
+    l.ctl_rest = static_cast<uint16_t>(l.tx_size - tx_cap);
     l.snapshot_at = kNoSnapshot;
-    l.health_countdown = c.health_every;
-    l.hello_countdown = c.hello_every;
+    l.health_countdown = flash_get(c.health_every);
+    l.hello_countdown = flash_get(c.hello_every);
     l.big_cycle = 0xFEu;  // the boot hello may go in the first cycle
     l.pending = kPendHello;
     // A delimiter first: a reset that cut a frame short leaves the ground
@@ -434,16 +472,11 @@ namespace {
 // The uplink task's run past its first look: the control frames waiting
 // sent (service), then the bytes received, `b` first when the caller read
 // it already (else -1), into the frame being received; at a delimiter the
-// frame is handled and the link serviced. The configuration is copied out
-// of flash once, when first needed.
+// frame is handled and the link serviced. The configuration is read out of
+// flash a field at a time where it is used (send_control).
 FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
-    LinkConfig c;
-    bool have_c = false;
-    if (l.pending != 0 || l.snapshot_at != kNoSnapshot) {
-        read_config(l, c);
-        have_c = true;
-        service(l, c, false);
-    }
+    const LinkConfig& c = *l.cfg;
+    if (l.pending != 0 || l.snapshot_at != kNoSnapshot) service(l, c, false);
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
         if (k != 0 || b < 0) {  // (else b is the byte the caller read)
             if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
@@ -451,10 +484,6 @@ FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
             if (b < 0) break;
         }
         if (b == 0) {
-            if (!have_c) {
-                read_config(l, c);
-                have_c = true;
-            }
             if (l.rx_over) {
                 inc16(l.n.rx_oversized);
             } else if (l.rx_len != 0) {
@@ -476,9 +505,8 @@ FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
 // Most runs have nothing to send and receive nothing: with no control
 // frame waiting, service would only hand the transmit buffer to the
 // console, so such a run does that and looks for a received byte, and
-// nothing more (the rest of the run, with the configuration copied out of
-// flash when it needs it, is out of line: its frame on the stack is not
-// paid by these runs).
+// nothing more (the rest of the run is out of line: its frame on the
+// stack is not paid by these runs).
 Result link_uplink_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     if (l.pending != 0 || l.snapshot_at != kNoSnapshot) {
@@ -500,22 +528,19 @@ void link_poll(Link& l) {
     pump(l);
     if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;
     if (l.tx_len != 0 && static_cast<uint16_t>(l.tx_len - l.tx_pos) > l.ctl_rest) return;  // no room yet
-    LinkConfig c;
-    read_config(l, c);
-    service(l, c, true);
+    service(l, *l.cfg, true);
 }
 
 // What a parameter command's ack carries after its 6 bytes: GET's values
 // (first id, count, values: as many as the transmit buffer holds), INFO's
 // store state, the id a refusal stopped at.
 void link_param_ack(Link& l, const ParamStore& ps) {
-    LinkConfig c;
-    read_config(l, c);
+    const uint16_t tx_cap = flash_get(l.cfg->tx_cap);
     const uint8_t op = l.ack_op;
     if (l.ack_status == kAckOk && op == kOpParamGet) {
         // room for values: the frame (header, ack, first, count, CRC) and its
         // COBS overhead within the transmit buffer
-        uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
+        uint16_t room = static_cast<uint16_t>(tx_cap - 24u - tx_cap / 254u);
         uint8_t n = 0;
         uint8_t v[8];
         for (; n < l.ack_y; ++n) {  // how many whole values fit
@@ -531,9 +556,7 @@ void link_param_ack(Link& l, const ParamStore& ps) {
         put_u16(ps.seq);
         put_u16(param_crc(ps));
         put(param_count(ps));
-        ParamConfig pc;
-        flash_read(&pc, ps.cfg, sizeof pc);
-        put_u32(pc.hash);
+        put_u32(flash_get(ps.cfg->hash));
     } else if (l.ack_status != kAckOk && l.ack_x != 0xFF &&
                (op == kOpParamSet || op == kOpParamStage || op == kOpParamCommit)) {
         put(l.ack_x);
@@ -567,22 +590,20 @@ uint8_t link_param_apply(Link& l, ParamStore& ps, uint8_t op, const uint8_t* a, 
 // What a recorder command's ack carries after its 6 bytes: INFO's state,
 // READ's record, offset, count and bytes (as many as the transmit buffer holds).
 void link_log_ack(Link& l, const Recorder& r) {
-    LinkConfig c;
-    read_config(l, c);
     if (l.ack_status != kAckOk) return;
-    LogConfig lc;
-    flash_read(&lc, r.cfg, sizeof lc);
+    const LogConfig& lc = *r.cfg;  // FSW_FLASH: the fields, one at a time
     if (l.ack_op == kOpLogInfo) {
         put(r.mode);
         put(r.flight);
         put_u16(r.head);
         put_u16(r.seq);
-        put_u16(lc.slots);
-        put(lc.record);
+        put_u16(flash_get(lc.slots));
+        put(flash_get(lc.record));
         put_u16(r.dropped);
-        put_u32(lc.hash);
+        put_u32(flash_get(lc.hash));
     } else if (l.ack_op == kOpLogRead) {
-        const uint16_t room = static_cast<uint16_t>(c.tx_cap - 24u - c.tx_cap / 254u);
+        const uint16_t tx_cap = flash_get(l.cfg->tx_cap);
+        const uint16_t room = static_cast<uint16_t>(tx_cap - 24u - tx_cap / 254u);
         const uint8_t off = l.ack_x;
         const uint8_t n = l.ack_y < room ? l.ack_y : static_cast<uint8_t>(room);
         put_u16(r.rd_slot);
@@ -602,10 +623,10 @@ void link_log_ack(Link& l, const Recorder& r) {
 uint8_t link_log_apply(Link& l, Recorder& r, uint8_t op, const uint8_t* a, uint8_t alen) {
     if (op == kOpLogRead) {
         if (alen != 4) return kAckBadLength;
-        LogConfig lc;
-        flash_read(&lc, r.cfg, sizeof lc);
         const uint16_t slot = load<uint16_t>(a);
-        if (slot >= lc.slots || static_cast<uint16_t>(a[2]) + a[3] > lc.record) return kAckOutOfRange;
+        if (slot >= flash_get(r.cfg->slots) || static_cast<uint16_t>(a[2]) + a[3] > flash_get(r.cfg->record)) {
+            return kAckOutOfRange;
+        }
         r.rd_slot = slot;
         l.ack_x = a[2];
         l.ack_y = a[3];

@@ -48,15 +48,12 @@ bool log_writing(const Recorder& r) {
     return r.w_phase != kWIdle && (r.w_phase != kWBody || r.f_len != 0 || (r.flags & kSealed) != 0);
 }
 
-LogConfig config(const Recorder& r) {
-    LogConfig c;
-    flash_read(&c, r.cfg, sizeof c);
-    return c;
-}
 
 uint8_t table_u8(const uint8_t* table, uint8_t i) { return flash_u8(table + i); }
 
-uint32_t slot_addr(const LogConfig& c, uint16_t slot) { return c.base + static_cast<uint32_t>(slot) * c.record; }
+uint32_t slot_addr(const LogConfig& c, uint16_t slot) {
+    return flash_get(c.base) + static_cast<uint32_t>(slot) * flash_get(c.record);
+}
 
 uint8_t store_read(uint32_t addr) { return pal::eeprom_read(static_cast<uint16_t>(addr)); }
 
@@ -79,7 +76,7 @@ void record_written(const LogConfig& c, Recorder& r) {
     r.flags = static_cast<uint8_t>(r.flags & ~kSealed);
     ++r.head;
     ++r.seq;
-    if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+    if (r.head >= flash_get(c.slots) && !flash_get(c.newest)) r.mode = kLogFull;
 }
 
 // ---- the SPI NOR flash (W25Q-class; docs/recorder.md, "On an SPI NOR flash chip") ----
@@ -132,7 +129,8 @@ void nor_write(uint32_t a, const uint8_t* p, uint8_t n) {
 bool nor_blank(const LogConfig& c, uint16_t s) {
     nor_cmd(kNorRead, slot_addr(c, s));
     bool blank = true;
-    for (uint8_t i = 0; i < c.record && blank; ++i) blank = pal::spi_transfer(0xFF) == 0xFF;
+    const uint8_t record = flash_get(c.record);
+    for (uint8_t i = 0; i < record && blank; ++i) blank = pal::spi_transfer(0xFF) == 0xFF;
     pal::spi_select(false);
     return blank;
 }
@@ -142,9 +140,9 @@ bool nor_blank(const LogConfig& c, uint16_t s) {
 bool nor_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) {
     const uint32_t a = slot_addr(c, s);
     uint8_t tail[kLogTail];
-    nor_read(a + c.record - kLogTail, tail, kLogTail);
+    nor_read(a + flash_get(c.record) - kLogTail, tail, kLogTail);
     const uint8_t used = tail[2];
-    if (used < kLogHeader || used > c.record - kLogTail) return false;
+    if (used < kLogHeader || used > flash_get(c.record) - kLogTail) return false;
     uint8_t head[4];
     uint16_t crc = kCrcInit;
     nor_cmd(kNorRead, a);
@@ -167,7 +165,7 @@ bool nor_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) {
 // last one before it that checks (torn ones, their kind never programmed,
 // are skipped and never written again).
 void nor_begin(const LogConfig& c, Recorder& r) {
-    uint16_t lo = 0, hi = c.slots;  // slots below lo are written, from hi on blank
+    uint16_t lo = 0, hi = flash_get(c.slots);  // slots below lo are written, from hi on blank
     while (lo < hi) {
         const uint16_t mid = static_cast<uint16_t>(lo + (hi - lo) / 2u);
         if (nor_blank(c, mid)) hi = mid;
@@ -183,7 +181,7 @@ void nor_begin(const LogConfig& c, Recorder& r) {
             break;
         }
     }
-    if (r.head >= c.slots) r.mode = kLogFull;
+    if (r.head >= flash_get(c.slots)) r.mode = kLogFull;
 }
 
 // The writer on the flash: one command whenever the chip is not busy (the
@@ -192,7 +190,7 @@ void nor_begin(const LogConfig& c, Recorder& r) {
 // next passes.
 void nor_poll(Recorder& r) {
     if (!log_writing(r) || !nor_ready()) return;
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     const uint32_t a = slot_addr(c, r.w_slot);
     switch (r.w_phase) {
     case kWClear:  // a sector's first record: the sector is erased first
@@ -207,9 +205,11 @@ void nor_poll(Recorder& r) {
         if (r.f_len != 0) {  // every queued byte in one program
             nor_start(kNorProgram, a + r.w_pos);
             r.w_pos = static_cast<uint8_t>(r.w_pos + r.f_len);
+            const uint8_t* const fifo = flash_get(c.fifo);
+            const uint8_t cap = flash_get(c.fifo_cap);
             do {
-                pal::spi_transfer(c.fifo[r.f_head]);
-                r.f_head = static_cast<uint8_t>(r.f_head + 1u == c.fifo_cap ? 0u : r.f_head + 1u);
+                pal::spi_transfer(fifo[r.f_head]);
+                r.f_head = static_cast<uint8_t>(r.f_head + 1u == cap ? 0u : r.f_head + 1u);
             } while (--r.f_len != 0);
             pal::spi_select(false);
             if (r.flags & kSealed) r.w_phase = kWTail;  // the tail in the next pass
@@ -221,7 +221,7 @@ void nor_poll(Recorder& r) {
     case kWTail: {
         uint8_t tail[kLogTail];
         tail_bytes(r, tail);
-        nor_write(a + c.record - kLogTail, tail, kLogTail);
+        nor_write(a + flash_get(c.record) - kLogTail, tail, kLogTail);
         r.w_phase = kWMagic;
         return;
     }
@@ -230,8 +230,8 @@ void nor_poll(Recorder& r) {
         record_written(c, r);  // `full newest` is refused on a flash: full stops it
         return;
     case kWErase: {  // the sectors in use, from the one of `head` down to sector 0; `head` counts down
-        const uint16_t per = static_cast<uint16_t>(kLogNorSector / c.record);
-        uint16_t s = r.head < c.slots ? r.head : static_cast<uint16_t>(c.slots - 1u);
+        const uint16_t per = static_cast<uint16_t>(kLogNorSector / flash_get(c.record));
+        uint16_t s = r.head < flash_get(c.slots) ? r.head : static_cast<uint16_t>(flash_get(c.slots) - 1u);
         s = static_cast<uint16_t>(s - s % per);
         nor_write(slot_addr(c, s), 0, 0);
         if (s == 0) {
@@ -251,12 +251,13 @@ bool slot_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) 
     const uint32_t a = slot_addr(c, s);
     const uint8_t magic = store_read(a);
     if (magic != kLogStart && magic != kLogData) return false;
-    const uint8_t used = store_read(a + c.record - 3u);
-    if (used < kLogHeader || used > c.record - kLogTail) return false;
+    const uint8_t record = flash_get(c.record);
+    const uint8_t used = store_read(a + record - 3u);
+    if (used < kLogHeader || used > record - kLogTail) return false;
     uint16_t crc = kCrcInit;
     for (uint8_t i = 0; i < used; ++i) crc = crc16_update(crc, store_read(a + i));
-    for (uint8_t i = static_cast<uint8_t>(c.record - kLogTail); i < c.record - 2u; ++i) crc = crc16_update(crc, store_read(a + i));
-    const uint16_t stored = static_cast<uint16_t>(store_read(a + c.record - 2u) | (store_read(a + c.record - 1u) << 8));
+    for (uint8_t i = static_cast<uint8_t>(record - kLogTail); i < record - 2u; ++i) crc = crc16_update(crc, store_read(a + i));
+    const uint16_t stored = static_cast<uint16_t>(store_read(a + record - 2u) | (store_read(a + record - 1u) << 8));
     if (crc != stored) return false;
     seq = static_cast<uint16_t>(store_read(a + 1u) | (store_read(a + 2u) << 8));
     flight = store_read(a + 3u);
@@ -265,15 +266,15 @@ bool slot_valid(const LogConfig& c, uint16_t s, uint16_t& seq, uint8_t& flight) 
 
 uint32_t now_ms(const LogConfig& c) {
     uint64_t t;
-    memcpy(&t, c.sv + c.time_off, sizeof t);
-    if (c.time_us) t /= 1000u;
+    memcpy(&t, flash_get(c.sv) + flash_get(c.time_off), sizeof t);
+    if (flash_get(c.time_us)) t /= 1000u;
     return static_cast<uint32_t>(t);
 }
 
 uint8_t state_of(const LogConfig& c) {
     uint32_t s;
-    memcpy(&s, c.sv + c.state_off, sizeof s);
-    return s < c.n_states ? static_cast<uint8_t>(s) : 0u;
+    memcpy(&s, flash_get(c.sv) + flash_get(c.state_off), sizeof s);
+    return s < flash_get(c.n_states) ? static_cast<uint8_t>(s) : 0u;
 }
 
 // round(v * scale), saturated at +-lim: 0x7FFFFFFF (`wide`, a delta's
@@ -292,10 +293,13 @@ int32_t quantise(float v, float scale, bool wide) {
 // One sample of every field, absolute, into `out` (sample_size - 2 bytes).
 // A field's step is read only for the fields that are rounded to it.
 void take(const LogConfig& c, uint8_t* out) {
-    for (uint8_t i = 0; i < c.n_fields; ++i) {
-        const LogField* f = &c.fields[i];
+    const uint8_t n_fields = flash_get(c.n_fields);
+    const LogField* const fields = flash_get(c.fields);
+    const uint8_t* const sv = flash_get(c.sv);
+    for (uint8_t i = 0; i < n_fields; ++i) {
+        const LogField* f = &fields[i];
         const uint8_t* o = reinterpret_cast<const uint8_t*>(&f->off);  // little-endian targets
-        const uint8_t* p = c.sv + static_cast<uint16_t>(flash_u8(o) | flash_u8(o + 1) << 8);
+        const uint8_t* p = sv + static_cast<uint16_t>(flash_u8(o) | flash_u8(o + 1) << 8);
         const uint8_t enc = flash_u8(&f->enc), width = flash_u8(&f->width);
         if (enc == kLogDelta || enc == kLogQuant) {
             float scale, v;
@@ -312,12 +316,13 @@ void take(const LogConfig& c, uint8_t* out) {
 
 uint8_t* ring_at(const LogConfig& c, const Recorder& r, uint8_t k) {
     uint8_t i = static_cast<uint8_t>(r.r_first + k);
-    if (i >= c.ring_cap) i = static_cast<uint8_t>(i - c.ring_cap);
-    return c.ring + static_cast<uint16_t>(i) * c.sample_size;
+    const uint8_t cap = flash_get(c.ring_cap);
+    if (i >= cap) i = static_cast<uint8_t>(i - cap);
+    return flash_get(c.ring) + static_cast<uint16_t>(i) * flash_get(c.sample_size);
 }
 
 void ring_pop(const LogConfig& c, Recorder& r) {
-    r.r_first = static_cast<uint8_t>(r.r_first + 1u == c.ring_cap ? 0u : r.r_first + 1u);
+    r.r_first = static_cast<uint8_t>(r.r_first + 1u == flash_get(c.ring_cap) ? 0u : r.r_first + 1u);
     --r.r_len;
 }
 
@@ -331,7 +336,8 @@ uint32_t sample_time(const uint8_t* s, uint32_t now) {
 // The fifo position after the queued bytes (16-bit sum: a fifo may hold up to 255).
 uint8_t fifo_end(const LogConfig& c, const Recorder& r) {
     uint16_t i = static_cast<uint16_t>(r.f_head + r.f_len);
-    if (i >= c.fifo_cap) i = static_cast<uint16_t>(i - c.fifo_cap);
+    const uint8_t cap = flash_get(c.fifo_cap);
+    if (i >= cap) i = static_cast<uint16_t>(i - cap);
     return static_cast<uint8_t>(i);
 }
 
@@ -362,10 +368,10 @@ struct Stage {
 
 Stage stage(const LogConfig& c, const Recorder& r) {
     Stage w;
-    w.fifo = c.fifo;
-    w.cap = c.fifo_cap;
+    w.fifo = flash_get(c.fifo);
+    w.cap = flash_get(c.fifo_cap);
     w.at = fifo_end(c, r);
-    w.room = static_cast<uint8_t>(c.fifo_cap - r.f_len);
+    w.room = static_cast<uint8_t>(w.cap - r.f_len);
     w.n = 0;
     return w;
 }
@@ -374,9 +380,11 @@ Stage stage(const LogConfig& c, const Recorder& r) {
 void commit(const LogConfig& c, Recorder& r, uint8_t n) {
     uint8_t i = fifo_end(c, r);
     uint8_t hi = static_cast<uint8_t>(r.crc >> 8), lo = static_cast<uint8_t>(r.crc);
+    const uint8_t* const fifo = flash_get(c.fifo);
+    const uint8_t cap = flash_get(c.fifo_cap);
     for (uint8_t k = 0; k < n; ++k) {
-        crc16_step(hi, lo, c.fifo[i]);
-        i = static_cast<uint8_t>(i + 1u == c.fifo_cap ? 0u : i + 1u);
+        crc16_step(hi, lo, fifo[i]);
+        i = static_cast<uint8_t>(i + 1u == cap ? 0u : i + 1u);
     }
     r.crc = static_cast<uint16_t>(hi << 8 | lo);
     r.f_len = static_cast<uint8_t>(r.f_len + n);
@@ -387,8 +395,8 @@ void commit(const LogConfig& c, Recorder& r, uint8_t n) {
 // bytes at `body` after it (a record's opening fits the empty fifo,
 // log_config_ok): false when the store is full.
 bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0, const uint8_t* body, uint8_t n) {
-    if (r.head >= c.slots) {
-        if (!c.newest) {
+    if (r.head >= flash_get(c.slots)) {
+        if (!flash_get(c.newest)) {
             r.mode = kLogFull;
             return false;
         }
@@ -403,10 +411,12 @@ bool open_record(const LogConfig& c, Recorder& r, uint8_t kind, uint32_t t0, con
     r.w_phase = kWClear;
     // seq, flight, t0 (little-endian targets, fsw_config.h), then the body:
     // into the empty fifo, then into the record
-    uint8_t at = fifo_put(c.fifo, c.fifo_cap, fifo_end(c, r), reinterpret_cast<const uint8_t*>(&r.seq), 2);
-    at = fifo_put(c.fifo, c.fifo_cap, at, &r.flight, 1);
-    at = fifo_put(c.fifo, c.fifo_cap, at, reinterpret_cast<const uint8_t*>(&t0), 4);
-    fifo_put(c.fifo, c.fifo_cap, at, body, n);
+    uint8_t* const fifo = flash_get(c.fifo);
+    const uint8_t cap = flash_get(c.fifo_cap);
+    uint8_t at = fifo_put(fifo, cap, fifo_end(c, r), reinterpret_cast<const uint8_t*>(&r.seq), 2);
+    at = fifo_put(fifo, cap, at, &r.flight, 1);
+    at = fifo_put(fifo, cap, at, reinterpret_cast<const uint8_t*>(&t0), 4);
+    fifo_put(fifo, cap, at, body, n);
     commit(c, r, static_cast<uint8_t>(7u + n));
     return true;
 }
@@ -416,7 +426,9 @@ void seal(Recorder& r) { r.flags |= kSealed; }
 // The flight's start record: trigger time, schema and log hashes.
 void write_start(const LogConfig& c, Recorder& r, uint32_t now) {
     static_assert(offsetof(LogConfig, hash) == offsetof(LogConfig, schema) + 4, "LogConfig: schema, hash");
-    if (!open_record(c, r, kLogStart, now, reinterpret_cast<const uint8_t*>(&c.schema), 8)) return;
+    uint8_t hashes[8];  // schema, hash: out of flash, as they lie
+    flash_read(hashes, &c.schema, sizeof hashes);
+    if (!open_record(c, r, kLogStart, now, hashes, sizeof hashes)) return;
     seal(r);
     r.flags = static_cast<uint8_t>(r.flags & ~kStartDue);
 }
@@ -430,14 +442,16 @@ void write_start(const LogConfig& c, Recorder& r, uint32_t now) {
 uint8_t stage_sample(const LogConfig& c, const Recorder& r, const uint8_t* s, uint32_t t, Stage& w) {
     if (r.period == 0 ? t == r.t_next || t - r.t_next > 0xFFFFu : t != r.t_next + r.period) return 0;
     const uint8_t* v = s + 2;
-    const uint8_t* l = c.last;
-    for (uint8_t i = 0; i < c.n_fields; ++i) {
-        const uint8_t enc = flash_u8(&c.fields[i].enc), width = flash_u8(&c.fields[i].width);
+    const uint8_t* l = flash_get(c.last);
+    const uint8_t n_fields = flash_get(c.n_fields);
+    const LogField* const fields = flash_get(c.fields);
+    for (uint8_t i = 0; i < n_fields; ++i) {
+        const uint8_t enc = flash_u8(&fields[i].enc), width = flash_u8(&fields[i].width);
         if (enc == kLogHold) {
             uint8_t k = 0;  // a held value is a few bytes: compared here, not by a library call
             while (k < width && v[k] == l[k]) ++k;
             if (k != width) {
-                if (!c.escape) return 0;
+                if (!flash_get(c.escape)) return 0;
                 w.put(kLogEscape);
                 w.put(i);
                 w.put_n(v, width);
@@ -455,7 +469,7 @@ uint8_t stage_sample(const LogConfig& c, const Recorder& r, const uint8_t* s, ui
         v += width;
         l += width;
     }
-    return r.used + w.n + kLogTail <= c.record ? w.n : 0;
+    return r.used + w.n + kLogTail <= flash_get(c.record) ? w.n : 0;
 }
 
 // Samples the encoder appends to the open record in one run of the task
@@ -483,8 +497,8 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
             const uint8_t* s = ring_at(c, r, 0);
             const uint32_t t = sample_time(s, now);
             // held values, then the first sample: the sample's bytes as they lie
-            if (!open_record(c, r, kLogData, t, s + 2, static_cast<uint8_t>(c.sample_size - 2u))) return;
-            memcpy(c.last, s + 2, c.sample_size - 2u);
+            if (!open_record(c, r, kLogData, t, s + 2, static_cast<uint8_t>(flash_get(c.sample_size) - 2u))) return;
+            memcpy(flash_get(c.last), s + 2, flash_get(c.sample_size) - 2u);
             r.t_next = t;
             ring_pop(c, r);
             return;  // an opening is a whole run's work
@@ -505,7 +519,7 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
         if (r.period == 0) r.period = static_cast<uint16_t>(t - r.t_next);
         r.t_next = t;
         commit(c, r, n);
-        memcpy(c.last, s + 2, c.sample_size - 2u);
+        memcpy(flash_get(c.last), s + 2, flash_get(c.sample_size) - 2u);
         ring_pop(c, r);
     }
 }
@@ -513,7 +527,7 @@ void encode(const LogConfig& c, Recorder& r, uint32_t now) {
 // Before the trigger: drops the oldest samples while the one after it is
 // still at least `before` old, so what is kept covers `before` whole.
 void trim(const LogConfig& c, Recorder& r, uint32_t now) {
-    while (r.r_len >= 2 && now - sample_time(ring_at(c, r, 1), now) >= c.before_ms) ring_pop(c, r);
+    while (r.r_len >= 2 && now - sample_time(ring_at(c, r, 1), now) >= flash_get(c.before_ms)) ring_pop(c, r);
 }
 
 }  // namespace
@@ -521,7 +535,7 @@ void trim(const LogConfig& c, Recorder& r, uint32_t now) {
 void log_nor_begin(Recorder& r, const LogConfig* cfg) {
     memset(&r, 0, sizeof r);
     r.cfg = cfg;
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     pal::spi_begin(log_nor_cs);
     nor_begin(c, r);
     r.state = state_of(c);
@@ -532,18 +546,19 @@ void log_nor_poll(Recorder& r) {
 }
 
 void log_nor_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     nor_read(slot_addr(c, slot) + off, out, n);
 }
 
 void log_eeprom_begin(Recorder& r, const LogConfig* cfg) {
     memset(&r, 0, sizeof r);
     r.cfg = cfg;
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     bool any = false;
     uint16_t best = 0, best_seq = 0;
     uint8_t best_flight = 0;
-    for (uint16_t s = 0; s < c.slots; ++s) {
+    const uint16_t slots = flash_get(c.slots);
+    for (uint16_t s = 0; s < slots; ++s) {
         uint16_t seq;
         uint8_t flight;
         if (!slot_valid(c, s, seq, flight)) continue;
@@ -558,7 +573,7 @@ void log_eeprom_begin(Recorder& r, const LogConfig* cfg) {
         r.head = static_cast<uint16_t>(best + 1u);
         r.seq = static_cast<uint16_t>(best_seq + 1u);
         r.flight = best_flight;
-        if (r.head >= c.slots && !c.newest) r.mode = kLogFull;
+        if (r.head >= slots && !flash_get(c.newest)) r.mode = kLogFull;
     }
     r.state = state_of(c);
 }
@@ -573,12 +588,15 @@ void log_resume(Recorder& r, uint8_t flight, uint8_t mode) {
 namespace {
 
 // The rest of a run that takes a sample, sees the state change or has
-// bytes to encode: out of line, with the whole table copied (its frame on
-// the stack, and the registers it saves, are not paid by the other runs).
+// bytes to encode: out of line (its frame on the stack, and the registers
+// it saves, are not paid by the other runs). The table is read out of
+// flash a field at a time where it is used, here and in the writer: a copy
+// of the whole (49 bytes) made this the deepest frame of the rocket's stack.
 FSW_NOINLINE void log_run(Recorder& r, uint8_t st, uint8_t prev, uint8_t div, bool sample) {
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     const uint32_t now = now_ms(c);
-    if (r.mode == kLogIdle && st == c.trigger && prev != c.trigger) {
+    const uint8_t trigger = flash_get(c.trigger);
+    if (r.mode == kLogIdle && st == trigger && prev != trigger) {
         r.mode = kLogRecording;
         r.flight = static_cast<uint8_t>(r.flight == 0xFF ? 1u : r.flight + 1u);
         r.flags = kStartDue;
@@ -589,14 +607,15 @@ FSW_NOINLINE void log_run(Recorder& r, uint8_t st, uint8_t prev, uint8_t div, bo
         else r.flags = static_cast<uint8_t>(r.flags & ~kEnding);
     }
     if (sample && (r.mode == kLogIdle || r.mode == kLogRecording)) {
-        if (r.r_len == c.ring_cap) {
+        const uint8_t ring_cap = flash_get(c.ring_cap);
+        if (r.r_len == ring_cap) {
             if (r.mode == kLogIdle) {
                 ring_pop(c, r);  // before the trigger: the oldest goes
             } else if (r.dropped != 0xFFFFu) {
                 ++r.dropped;
             }
         }
-        if (r.r_len < c.ring_cap) {
+        if (r.r_len < ring_cap) {
             uint8_t* s = ring_at(c, r, r.r_len);
             const uint16_t t16 = static_cast<uint16_t>(now);
             memcpy(s, &t16, 2);
@@ -646,20 +665,20 @@ void eeprom_next(const LogConfig& c, Recorder& r) {
         return;
     case kWBody:
         if (r.f_len != 0) {
-            pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), c.fifo[r.f_head]);
-            r.f_head = static_cast<uint8_t>(r.f_head + 1u == c.fifo_cap ? 0u : r.f_head + 1u);
+            pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), flash_get(c.fifo)[r.f_head]);
+            r.f_head = static_cast<uint8_t>(r.f_head + 1u == flash_get(c.fifo_cap) ? 0u : r.f_head + 1u);
             --r.f_len;
             ++r.w_pos;
         } else if (r.flags & kSealed) {
             r.w_phase = kWTail;
-            r.w_pos = static_cast<uint8_t>(c.record - kLogTail);
+            r.w_pos = static_cast<uint8_t>(flash_get(c.record) - kLogTail);
         }
         return;
     case kWTail: {
         uint8_t tail[kLogTail];
         tail_bytes(r, tail);
-        pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), tail[r.w_pos - (c.record - kLogTail)]);
-        if (++r.w_pos == c.record) r.w_phase = kWMagic;
+        pal::eeprom_write(static_cast<uint16_t>(a + r.w_pos), tail[r.w_pos - (flash_get(c.record) - kLogTail)]);
+        if (++r.w_pos == flash_get(c.record)) r.w_phase = kWMagic;
         return;
     }
     case kWMagic:
@@ -668,7 +687,7 @@ void eeprom_next(const LogConfig& c, Recorder& r) {
         return;
     case kWErase:
         pal::eeprom_write(static_cast<uint16_t>(a), 0x00);
-        if (++r.w_slot == c.slots) {
+        if (++r.w_slot == flash_get(c.slots)) {
             r.w_phase = kWIdle;
             r.head = 0;
             r.mode = kLogIdle;
@@ -687,16 +706,25 @@ bool log_busy(const Recorder& r) { return log_writing(r); }
 // EEPROM-ready interrupt wakes the loop for the next. A store that is ready
 // again at once (simavr's, the host's model) takes a few per call, so the
 // simulated writer is never slower than the silicon's.
+namespace {
+// Out of line, so that the configuration's copy is on the stack only while
+// bytes are written, not in the frame of the loop that polls (generated
+// code inlines log_eeprom_poll into main(), whose frame every path pays).
+FSW_NOINLINE void eeprom_write_some(Recorder& r) {
+    const LogConfig& c = *r.cfg;
+    for (uint8_t n = 0; n < 8 && log_writing(r) && pal::eeprom_ready(); ++n) eeprom_next(c, r);
+}
+}  // namespace
+
 void log_eeprom_poll(Recorder& r) {
     if (!log_writing(r) || !pal::eeprom_ready()) return;
-    const LogConfig c = config(r);
-    for (uint8_t n = 0; n < 8 && log_writing(r) && pal::eeprom_ready(); ++n) eeprom_next(c, r);
+    eeprom_write_some(r);
 }
 
 bool log_erase(Recorder& r) {
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     if (r.mode == kLogRecording || r.mode == kLogErasing || r.w_phase != kWIdle) return false;
-    if (table_u8(c.erase_ok, state_of(c)) == 0) return false;
+    if (table_u8(flash_get(c.erase_ok), state_of(c)) == 0) return false;
     r.mode = kLogErasing;
     r.r_len = 0;
     r.f_len = 0;
@@ -707,7 +735,7 @@ bool log_erase(Recorder& r) {
 
 // Weak: an application on an SPI NOR flash defines it (generated: log_nor_read).
 __attribute__((weak)) void log_read(const Recorder& r, uint16_t slot, uint8_t off, uint8_t n, uint8_t* out) {
-    const LogConfig c = config(r);
+    const LogConfig& c = *r.cfg;
     const uint32_t a = slot_addr(c, slot) + off;
     for (uint8_t i = 0; i < n; ++i) out[i] = store_read(a + i);
 }

@@ -122,9 +122,10 @@ struct Recorder {
 // Boot: finds the newest valid record (blocking reads of each record's
 // bytes: a few ms for an Uno's EEPROM) and goes on after it. On an SPI NOR
 // flash: a binary search for the first blank slot (every byte 0xFF), then
-// the newest valid record before it; a torn record there is skipped.
-void log_eeprom_begin(Recorder& r, const LogConfig* cfg);
-void log_nor_begin(Recorder& r, const LogConfig* cfg);
+// the newest valid record before it; a torn record there is skipped. Out of
+// line: the frame is on the stack at boot only, not in main()'s.
+FSW_NOINLINE void log_eeprom_begin(Recorder& r, const LogConfig* cfg);
+FSW_NOINLINE void log_nor_begin(Recorder& r, const LogConfig* cfg);
 // After the firmware resumed its flight from a reset in flight
 // (fsw_resume.h): `flight` and `mode` are the recorder's as kept. A flight
 // that was being recorded goes on with the same number: a start record is

@@ -17,6 +17,14 @@ namespace pal {
 // ---- lifecycle --------------------------------------------------------------
 // Starts the platform (called once by executor_begin; idempotent).
 void begin();
+#if defined(__AVR__) && FSW_SLEEP
+// What of the Arduino core's init() a firmware that never uses the core's
+// timers needs: the ADC on at 125 kHz (as analogRead and the background
+// scan expect it), the UART's pins released, interrupts on. The generated
+// main() calls it in place of the core's main() and init(), so Timer0's
+// overflow interrupt and millis()'s state are not linked (docs/runtime.md).
+void boot();
+#endif
 
 // ---- Clock ------------------------------------------------------------------
 // 32-bit microseconds / milliseconds since boot (wrap every 71.6 min / 49.7 d).

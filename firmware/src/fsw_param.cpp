@@ -22,21 +22,16 @@ enum Job : uint8_t {
     kMagic = 6,           // last: the bank is whole
 };
 
-ParamConfig config(const ParamStore& s) {
-    ParamConfig c;
-    flash_read(&c, s.cfg, sizeof c);
-    return c;
-}
 
 ParamDef def(const ParamConfig& c, uint8_t id) {
     ParamDef d;
-    flash_read(&d, &c.defs[id], sizeof d);
+    flash_read(&d, &flash_get(c.defs)[id], sizeof d);
     return d;
 }
 
-uint16_t bank_size(const ParamConfig& c) { return static_cast<uint16_t>(kParamHeader + c.size); }
+uint16_t bank_size(const ParamConfig& c) { return static_cast<uint16_t>(kParamHeader + flash_get(c.size)); }
 uint16_t bank_base(const ParamConfig& c, uint8_t bank) {
-    return static_cast<uint16_t>(c.eeprom_base + (bank ? bank_size(c) : 0u));
+    return static_cast<uint16_t>(flash_get(c.eeprom_base) + (bank ? bank_size(c) : 0u));
 }
 // The bank a save or load writes: the one that is not current.
 uint8_t target_bank(const ParamStore& s) { return (s.source & 3u) == kParamBankA ? 1u : 0u; }
@@ -67,34 +62,41 @@ void order_key(uint8_t type, const uint8_t* v, uint8_t n, uint8_t* key) {
 // Whether `v` is a value parameter `d` may take (ranges are finite).
 bool in_range(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {
     if (d.type == kBool) return v[0] <= 1u;
-    uint8_t lim[16] = {0}, k[8], lo[8], hi[8];
+    // MIN, then MAX, through one buffer (this is on the deepest path of
+    // the stack: a ground's SET, through the check of each value)
+    uint8_t k[8], raw[8] = {0}, bound[8];
     const uint8_t n = elem_size(d.type);
-    flash_read(lim, c.pool + d.range, 2u * n);
+    const uint8_t* const lim = flash_get(c.pool) + d.range;
     order_key(d.type, v, n, k);
-    order_key(d.type, lim, n, lo);
-    order_key(d.type, lim + n, n, hi);
-    return memcmp(lo, k, n) <= 0 && memcmp(k, hi, n) <= 0;
+    flash_read(raw, lim, n);
+    order_key(d.type, raw, n, bound);
+    if (memcmp(bound, k, n) > 0) return false;
+    flash_read(raw, lim + n, n);
+    order_key(d.type, raw, n, bound);
+    return memcmp(k, bound, n) <= 0;
 }
 
 // Whether the declaring machine is in a state that allows a change.
 bool state_allows(const ParamConfig& c, const ParamDef& d) {
     ParamWhen w;
-    flash_read(&w, &c.whens[d.when], sizeof w);
+    flash_read(&w, &flash_get(c.whens)[d.when], sizeof w);
     uint32_t st;
-    memcpy(&st, c.sv + w.state_off, sizeof st);
+    memcpy(&st, flash_get(c.sv) + w.state_off, sizeof st);
     if (st == 0 || (st - 1u) / 8u >= w.n) return false;
-    return (flash_u8(c.pool + w.mask + (st - 1u) / 8u) >> ((st - 1u) % 8u)) & 1u;
+    return (flash_u8(flash_get(c.pool) + w.mask + (st - 1u) / 8u) >> ((st - 1u) % 8u)) & 1u;
 }
 
 void set_bytes(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {
-    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    const bool lock = flash_get(c.lock);
+    const pal::IrqState saved = lock ? pal::critical_enter() : 0;
     memcpy(d.ptr, v, elem_size(d.type));
-    if (c.lock) pal::critical_exit(saved);
+    if (lock) pal::critical_exit(saved);
 }
 void get_bytes(const ParamConfig& c, const ParamDef& d, uint8_t* v) {
-    const pal::IrqState saved = c.lock ? pal::critical_enter() : 0;
+    const bool lock = flash_get(c.lock);
+    const pal::IrqState saved = lock ? pal::critical_enter() : 0;
     memcpy(v, d.ptr, elem_size(d.type));
-    if (c.lock) pal::critical_exit(saved);
+    if (lock) pal::critical_exit(saved);
 }
 
 // Walks `args`, (id, value)...: kParamOk when every entry is a known id
@@ -105,7 +107,7 @@ uint8_t check_entries(const ParamConfig& c, const uint8_t* a, uint8_t len, uint8
     while (i < len) {
         const uint8_t id = a[i];
         bad = id;
-        if (id >= c.n) return kParamNoParam;
+        if (id >= flash_get(c.n)) return kParamNoParam;
         const ParamDef d = def(c, id);
         const uint8_t n = elem_size(d.type);
         if (static_cast<uint16_t>(i) + 1u + n > len) return kParamBadLength;
@@ -118,7 +120,8 @@ uint8_t check_entries(const ParamConfig& c, const uint8_t* a, uint8_t len, uint8
 
 // CRC of the live value block, continuing `crc`.
 uint16_t live_crc(const ParamConfig& c, uint16_t crc) {
-    for (uint8_t id = 0; id < c.n; ++id) {
+    const uint8_t n = flash_get(c.n);
+    for (uint8_t id = 0; id < n; ++id) {
         const ParamDef d = def(c, id);
         uint8_t v[8];
         get_bytes(c, d, v);
@@ -133,9 +136,10 @@ uint16_t bank_crc(const ParamConfig& c, uint16_t seq, uint16_t ee) {
     uint16_t crc = kCrcInit;
     crc = crc16_update(crc, static_cast<uint8_t>(seq));
     crc = crc16_update(crc, static_cast<uint8_t>(seq >> 8));
-    for (uint8_t i = 0; i < 4; ++i) crc = crc16_update(crc, static_cast<uint8_t>(c.hash >> (8u * i)));
+    for (uint8_t i = 0; i < 4; ++i) crc = crc16_update(crc, static_cast<uint8_t>(flash_get(c.hash) >> (8u * i)));
     if (ee == 0xFFFFu) return live_crc(c, crc);
-    for (uint16_t i = 0; i < c.size; ++i) crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(ee + i)));
+    const uint16_t size = flash_get(c.size);
+    for (uint16_t i = 0; i < size; ++i) crc = crc16_update(crc, pal::eeprom_read(static_cast<uint16_t>(ee + i)));
     return crc;
 }
 
@@ -157,11 +161,12 @@ bool bank_valid(const ParamConfig& c, uint8_t b, uint16_t& seq) {
     seq = ee_u16(static_cast<uint16_t>(base + 1u));
     uint32_t hash = 0;
     for (uint8_t i = 4; i-- > 0;) hash = (hash << 8) | pal::eeprom_read(static_cast<uint16_t>(base + 3u + i));
-    if (hash != c.hash) return false;
+    if (hash != flash_get(c.hash)) return false;
     const uint16_t stored = stored_crc(base);
     const uint16_t values = static_cast<uint16_t>(base + kParamHeader);
     if (bank_crc(c, seq, values) != stored) return false;
-    for (uint8_t id = 0; id < c.n; ++id) {
+    const uint8_t n = flash_get(c.n);
+    for (uint8_t id = 0; id < n; ++id) {
         const ParamDef d = def(c, id);
         uint8_t v[8];
         for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
@@ -171,17 +176,24 @@ bool bank_valid(const ParamConfig& c, uint8_t b, uint16_t& seq) {
 }
 
 // The live values differ from the current bank (or the defaults).
+// Whether a live value differs from its default. Out of line: its two
+// buffers are not in refresh_dirty's frame, on the path to the live CRC.
+FSW_NOINLINE bool differs_from_defaults(const ParamConfig& c) {
+    const uint8_t n = flash_get(c.n);
+    for (uint8_t id = 0; id < n; ++id) {
+        const ParamDef d = def(c, id);
+        uint8_t v[8], w[8];
+        get_bytes(c, d, v);
+        flash_read(w, flash_get(c.defaults) + d.off, elem_size(d.type));
+        if (memcmp(v, w, elem_size(d.type)) != 0) return true;
+    }
+    return false;
+}
+
 void refresh_dirty(ParamStore& s, const ParamConfig& c) {
     bool dirty;
     if ((s.source & 3u) == kParamDefaults) {
-        dirty = false;
-        for (uint8_t id = 0; id < c.n && !dirty; ++id) {
-            const ParamDef d = def(c, id);
-            uint8_t v[8], w[8];
-            get_bytes(c, d, v);
-            flash_read(w, c.defaults + d.off, elem_size(d.type));
-            dirty = memcmp(v, w, elem_size(d.type)) != 0;
-        }
+        dirty = differs_from_defaults(c);
     } else {
         const uint16_t base = bank_base(c, static_cast<uint8_t>((s.source & 3u) - kParamBankA));
         dirty = bank_crc(c, s.seq, 0xFFFFu) != stored_crc(base);
@@ -189,14 +201,14 @@ void refresh_dirty(ParamStore& s, const ParamConfig& c) {
     s.source = static_cast<uint8_t>((s.source & ~kParamDirty) | (dirty ? kParamDirty : 0u));
 }
 
-bool staged(const ParamConfig& c, uint8_t id) { return (c.staged[id >> 3] >> (id & 7u)) & 1u; }
+bool staged(const ParamConfig& c, uint8_t id) { return (flash_get(c.staged)[id >> 3] >> (id & 7u)) & 1u; }
 
 // The byte of the header (bank offsets 1..8) being written, new sequence
 // number first.
 uint8_t header_byte(const ParamStore& s, const ParamConfig& c, uint8_t i) {
     const uint16_t seq = static_cast<uint16_t>(s.seq + 1u);
     if (i < 2) return static_cast<uint8_t>(seq >> (8u * i));
-    if (i < 6) return static_cast<uint8_t>(c.hash >> (8u * (i - 2u)));
+    if (i < 6) return static_cast<uint8_t>(flash_get(c.hash) >> (8u * (i - 2u)));
     return i == 6 ? static_cast<uint8_t>(s.w_crc >> 8) : static_cast<uint8_t>(s.w_crc);
 }
 
@@ -207,15 +219,17 @@ bool busy(const ParamStore& s) { return (s.source & kParamWriting) != 0; }
 void param_begin(ParamStore& s, const ParamConfig* cfg) {
     memset(&s, 0, sizeof s);
     s.cfg = cfg;
-    const ParamConfig c = config(s);
-    memset(c.staged, 0, (c.n + 7u) / 8u);
+    const ParamConfig& c = *s.cfg;
+    memset(flash_get(c.staged), 0, (flash_get(c.n) + 7u) / 8u);
     uint16_t seq_a = 0, seq_b = 0;
-    const bool a = pal::eeprom_size() >= param_eeprom_end(c.eeprom_base, c.size) && bank_valid(c, 0, seq_a);
-    const bool b = pal::eeprom_size() >= param_eeprom_end(c.eeprom_base, c.size) && bank_valid(c, 1, seq_b);
+    const bool fits = pal::eeprom_size() >= param_eeprom_end(flash_get(c.eeprom_base), flash_get(c.size));
+    const bool a = fits && bank_valid(c, 0, seq_a);
+    const bool b = fits && bank_valid(c, 1, seq_b);
     if (a || b) {
         const uint8_t bank = a && b ? (static_cast<int16_t>(seq_b - seq_a) > 0 ? 1u : 0u) : b ? 1u : 0u;
         const uint16_t values = static_cast<uint16_t>(bank_base(c, bank) + kParamHeader);
-        for (uint8_t id = 0; id < c.n; ++id) {
+        const uint8_t n = flash_get(c.n);
+        for (uint8_t id = 0; id < n; ++id) {
             const ParamDef d = def(c, id);
             uint8_t v[8];
             for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
@@ -224,10 +238,11 @@ void param_begin(ParamStore& s, const ParamConfig* cfg) {
         s.seq = bank ? seq_b : seq_a;
         s.source = bank ? kParamBankB : kParamBankA;
     } else {
-        for (uint8_t id = 0; id < c.n; ++id) {
+        const uint8_t n = flash_get(c.n);
+        for (uint8_t id = 0; id < n; ++id) {
             const ParamDef d = def(c, id);
             uint8_t v[8];
-            flash_read(v, c.defaults + d.off, elem_size(d.type));
+            flash_read(v, flash_get(c.defaults) + d.off, elem_size(d.type));
             set_bytes(c, d, v);
         }
         s.source = kParamDefaults;
@@ -235,7 +250,7 @@ void param_begin(ParamStore& s, const ParamConfig* cfg) {
 }
 
 uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
-    const ParamConfig c = config(s);
+    const ParamConfig& c = *s.cfg;
     bad = 0xFF;
     if (busy(s)) return kParamBusy;
     const uint8_t st = check_entries(c, a, len, bad);
@@ -270,8 +285,8 @@ uint8_t param_save(ParamStore& s) {
 
 uint8_t param_load_begin(ParamStore& s) {
     if (busy(s) && !s.loading) return kParamBusy;  // a save under way; an open load starts again
-    const ParamConfig c = config(s);
-    memset(c.staged, 0, (c.n + 7u) / 8u);
+    const ParamConfig& c = *s.cfg;
+    memset(flash_get(c.staged), 0, (flash_get(c.n) + 7u) / 8u);
     s.q_len = 0;
     s.loading = 1;
     s.source |= kParamWriting;
@@ -282,7 +297,7 @@ uint8_t param_load_begin(ParamStore& s) {
 uint8_t param_stage(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
     bad = 0xFF;
     if (!s.loading || s.w_job > kStage) return kParamNoLoad;
-    const ParamConfig c = config(s);
+    const ParamConfig& c = *s.cfg;
     const uint8_t st = check_entries(c, a, len, bad);
     if (st != kParamOk) return st;
     if (static_cast<uint16_t>(s.q_len) + len > sizeof s.queue) return kParamBusy;
@@ -290,7 +305,8 @@ uint8_t param_stage(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) 
     s.q_len = static_cast<uint8_t>(s.q_len + len);
     for (uint8_t i = 0; i < len;) {
         const uint8_t id = a[i];
-        c.staged[id >> 3] = static_cast<uint8_t>(c.staged[id >> 3] | (1u << (id & 7u)));
+        uint8_t* const bits = flash_get(c.staged);
+        bits[id >> 3] = static_cast<uint8_t>(bits[id >> 3] | (1u << (id & 7u)));
         i = static_cast<uint8_t>(i + 1u + elem_size(def(c, id).type));
     }
     return kParamOk;
@@ -300,12 +316,13 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
     bad = 0xFF;
     if (!s.loading || s.w_job > kStage) return kParamNoLoad;
     if (s.q_len != 0 || s.w_job != kStage || !pal::eeprom_ready()) return kParamBusy;
-    const ParamConfig c = config(s);
+    const ParamConfig& c = *s.cfg;
     const uint16_t values = static_cast<uint16_t>(bank_base(c, target_bank(s)) + kParamHeader);
     // the block the load makes: staged values from the bank, the others live
     uint16_t sum = kCrcInit;
     uint8_t v[8], w[8];
-    for (uint8_t id = 0; id < c.n; ++id) {
+    const uint8_t count = flash_get(c.n);
+    for (uint8_t id = 0; id < count; ++id) {
         const ParamDef d = def(c, id);
         const uint8_t n = elem_size(d.type);
         get_bytes(c, d, v);
@@ -323,7 +340,7 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
         return kParamMismatch;
     }
     if (bad != 0xFF) return kParamWrongState;
-    for (uint8_t id = 0; id < c.n; ++id) {  // in one step: the loaded set is live
+    for (uint8_t id = 0; id < count; ++id) {  // in one step: the loaded set is live
         if (!staged(c, id)) continue;
         const ParamDef d = def(c, id);
         for (uint8_t k = 0; k < elem_size(d.type); ++k) v[k] = pal::eeprom_read(static_cast<uint16_t>(values + d.off + k));
@@ -336,22 +353,34 @@ uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad) {
 }
 
 uint8_t param_value(const ParamStore& s, uint8_t id, uint8_t* out) {
-    const ParamConfig c = config(s);
-    if (id >= c.n) return 0;
+    const ParamConfig& c = *s.cfg;
+    if (id >= flash_get(c.n)) return 0;
     const ParamDef d = def(c, id);
     get_bytes(c, d, out);
     return elem_size(d.type);
 }
 
-uint8_t param_count(const ParamStore& s) { return config(s).n; }
+uint8_t param_count(const ParamStore& s) { return flash_get(s.cfg->n); }
 
-uint16_t param_crc(const ParamStore& s) { return live_crc(config(s), kCrcInit); }
+uint16_t param_crc(const ParamStore& s) { return live_crc(*s.cfg, kCrcInit); }
 
 bool param_busy(const ParamStore& s) { return s.w_job != kIdle && s.cfg != 0; }
 
+namespace {
+// param_poll's writing, out of line: the configuration's copy is on the
+// stack only while a byte is written, not in the frame of the loop that
+// polls (generated code inlines param_poll into main()).
+FSW_NOINLINE void write_next(ParamStore& s);
+}  // namespace
+
 void param_poll(ParamStore& s) {
     if (s.w_job == kIdle || s.cfg == 0 || !pal::eeprom_ready()) return;
-    const ParamConfig c = config(s);
+    write_next(s);
+}
+
+namespace {
+void write_next(ParamStore& s) {
+    const ParamConfig& c = *s.cfg;
     const uint16_t base = bank_base(c, target_bank(s));
     switch (s.w_job) {
     case kClearThenStage:
@@ -374,7 +403,7 @@ void param_poll(ParamStore& s) {
         return;
     }
     case kValues:
-        while (s.w_id < c.n) {
+        while (s.w_id < flash_get(c.n)) {
             const ParamDef d = def(c, s.w_id);
             if (s.loading && staged(c, s.w_id)) {  // already in the bank
                 ++s.w_id;
@@ -403,12 +432,13 @@ void param_poll(ParamStore& s) {
         s.source = static_cast<uint8_t>(target_bank(s) ? kParamBankB : kParamBankA);  // writing and dirty off
         s.loading = 0;
         s.w_job = kIdle;
-        memset(c.staged, 0, (c.n + 7u) / 8u);
+        memset(flash_get(c.staged), 0, (flash_get(c.n) + 7u) / 8u);
         refresh_dirty(s, c);
         return;
     default:
         s.w_job = kIdle;
     }
 }
+}  // namespace
 
 }  // namespace fsw

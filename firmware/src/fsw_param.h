@@ -97,7 +97,9 @@ enum ParamStatus : uint8_t {
 
 // Boot: reads both banks, takes the newest valid one (else the defaults)
 // into the live value block. Blocking EEPROM reads only (a few hundred us).
-void param_begin(ParamStore& s, const ParamConfig* cfg);
+// Out of line, as every begin function the generated main() calls: its
+// frame is on the stack at boot only, not in main()'s, which every path pays.
+FSW_NOINLINE void param_begin(ParamStore& s, const ParamConfig* cfg);
 
 // The commands (the link calls them; `args` as received, `bad` the id a
 // refusal stopped at, 0xFF when none). Each returns a ParamStatus.
@@ -105,7 +107,9 @@ uint8_t param_set(ParamStore& s, const uint8_t* args, uint8_t len, uint8_t& bad)
 uint8_t param_save(ParamStore& s);
 uint8_t param_load_begin(ParamStore& s);
 uint8_t param_stage(ParamStore& s, const uint8_t* args, uint8_t len, uint8_t& bad);
-uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad);
+// (COMMIT out of line: its two value buffers are not in the frame of the
+// link's command handler, which SET's deeper path runs through.)
+FSW_NOINLINE uint8_t param_commit(ParamStore& s, uint16_t crc, uint8_t& bad);
 
 // The live value of parameter `id` into `out` (8 bytes of room): its size,
 // 0 when there is no such parameter.

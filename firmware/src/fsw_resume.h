@@ -55,8 +55,9 @@ struct Resume {
 // the spans and returns true; otherwise changes nothing and returns false.
 // Otherwise both banks are made invalid, so that no bank from before a
 // fresh start is ever taken for one of this run. Later saves alternate
-// from the bank after the newest.
-bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause);
+// from the bank after the newest. Out of line: the frame is on the stack at
+// boot only, not in main()'s.
+FSW_NOINLINE bool resume_begin(Resume& r, const ResumeConfig* cfg, uint8_t cause);
 // Copies the spans into the older bank, then its sequence number, then its
 // check: a reset part way through leaves that bank invalid and the other one
 // whole. About 9 cycles a byte on AVR.

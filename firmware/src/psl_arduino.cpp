@@ -59,6 +59,24 @@ Clock64 g_millis_ext;
 
 void begin() {}
 
+#if defined(__AVR__) && FSW_SLEEP
+void boot() {
+#if defined(ADCSRA)
+    // ADEN and the prescaler to 125 kHz or the nearest below (init()'s values)
+    ADCSRA = static_cast<uint8_t>(_BV(ADEN) | (F_CPU >= 16000000L  ? 7u
+                                               : F_CPU >= 8000000L ? 6u
+                                               : F_CPU >= 4000000L ? 5u
+                                               : F_CPU >= 2000000L ? 4u
+                                               : F_CPU >= 1000000L ? 3u
+                                                                   : 1u));
+#endif
+#if defined(UCSR0B)
+    UCSR0B = 0;  // a bootloader may leave the UART on: pins 0 and 1 are free until the console takes them
+#endif
+    sei();
+}
+#endif
+
 #if FSW_SLEEP
 // ---- The cycle timer: Timer1 (16-bit) in CTC mode, clk/8 ---------------------
 // A cycle of P us is n equal sub-periods of S = P / n us (n the smallest
@@ -143,9 +161,10 @@ void cycle_timer_begin(uint32_t period_us) {
     const uint16_t top = static_cast<uint16_t>(sub_us * FSW_T1_TICKS_PER_US - 1u);
     const uint16_t early_ticks = FSW_WAKE_EARLY_US * FSW_T1_TICKS_PER_US;
     const IrqState saved = critical_enter();
-    g_ct.base_us = 0;  // the clock counts from here
-    g_ct.ms = 0;
-    g_ct.ms_frac = 0;
+    // The clock counts from here; the cycle's sub-period count, the reasons
+    // and `running` start at 0 (one clear: a store a field was 4 bytes of
+    // flash a byte).
+    memset(&g_ct, 0, sizeof g_ct);
     g_ct.sub_us = sub_us;
     g_ct.sub_ms = static_cast<uint16_t>(sub_us / 1000u);
     g_ct.sub_frac = static_cast<uint16_t>(sub_us % 1000u);
@@ -153,11 +172,8 @@ void cycle_timer_begin(uint32_t period_us) {
     g_ct.early = g_ct.spin ? static_cast<uint16_t>(top / 2u + 1u) : static_cast<uint16_t>(top - early_ticks);
     const uint16_t guard_ticks = FSW_BACKGROUND_GUARD_US * FSW_T1_TICKS_PER_US;
     g_ct.quiet = g_ct.early > guard_ticks ? static_cast<uint16_t>(g_ct.early - guard_ticks) : 0u;
-    g_ct.sub = 0;
     g_ct.last = static_cast<uint8_t>(n - 1u);
-    g_ct.due = 1;  // the first cycle: at once, on time
-    g_ct.why = kCycleOnTime;
-    g_ct.running = 0;
+    g_ct.due = 1;  // the first cycle: at once, on time (why: kCycleOnTime, 0)
     TIMSK0 = static_cast<uint8_t>(TIMSK0 & ~_BV(TOIE0));  // the core's millis() stops here
     TCCR1A = 0;
     TCCR1B = 0;

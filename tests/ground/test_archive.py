@@ -392,3 +392,83 @@ def test_export_refuses_before_any_work(two_sessions, tmp_path):
     assert not (tmp_path / "x.csv").exists()
     r = clean(run_fsw("archive", "export", str(path), "-o", str(old), "--force"))
     assert r.code == 0 and old.read_text().startswith(logs.TIME), r.err
+
+
+def _tables(path) -> dict:
+    con = sqlite3.connect(path)
+    out = {t: con.execute(f"SELECT * FROM {t} ORDER BY rowid").fetchall() for t in ("chunks", "frames")}
+    out["samples"] = con.execute("SELECT * FROM samples ORDER BY frame, i").fetchall()
+    con.close()
+    return out
+
+
+def test_received_writes_what_rx_and_event_write(tmp_path, layout):
+    """The station's one call per read (the bytes, their frames, a tick)
+    keeps the rows the separate calls keep, each frame's samples under its
+    own number."""
+    recorded = [r for r in chunks(layout, 300) if r[0] == RX]
+    paths = [tmp_path / "calls.sqlite", tmp_path / "received.sqlite"]
+    for k, path in enumerate(paths):
+        a = Archive(str(path))
+        a.begin(layout=layout, project="tank", port="p", baud=115200, started=1.0)
+        decoder = Session(layout)
+        for i, (_, t, data) in enumerate(recorded):
+            evs = decoder.feed(data, t / 1e9)
+            if k == 0:
+                a.rx(t, data)
+                for ev in evs:
+                    a.event(ev)
+                a.tick(i * 0.01)
+            else:
+                a.received(t, data, evs, now=i * 0.01)
+        a.close()
+    first, second = _tables(paths[0]), _tables(paths[1])
+    assert first == second
+    assert len(first["frames"]) == 300 and len(first["samples"]) > 250
+
+
+def test_two_writers_number_their_frames_apart(tmp_path, layout):
+    """Frames wait in memory and take their numbers when written: a batch
+    numbers its frames after the archive's last, under the write lock, so
+    another writer's frames between two batches never take a number twice
+    and every sample stays with its frame."""
+    path = tmp_path / "a.sqlite"
+    writers = [Archive(str(path)), Archive(str(path))]
+    decoders = []
+    for k, a in enumerate(writers):
+        a.begin(layout=layout, project="tank", port=f"p{k}", baud=115200, started=1.0)
+        decoders.append(Session(layout))
+    data = b"".join(stream(layout, 0, 200, hello_first=True))
+    for i in range(0, len(data), 97):
+        for k, a in enumerate(writers):
+            piece = data[i:i + 97]
+            a.received(T0 + i, piece, decoders[k].feed(piece, 1.0 + i / 1e6), now=i / 500)
+    for a in writers:
+        a.close()
+    con = sqlite3.connect(path)
+    per_session = con.execute("SELECT session, count(*) FROM frames GROUP BY session ORDER BY session").fetchall()
+    assert per_session == [(1, 200), (2, 200)]
+    # each sample row belongs to a sample frame of the session whose decoder made it, in its order
+    rows = con.execute("SELECT f.session, f.seq, count(*) FROM samples s JOIN frames f ON f.id = s.frame "
+                       "WHERE f.kind = 'sample' GROUP BY s.frame ORDER BY s.frame").fetchall()
+    assert len(rows) == con.execute("SELECT count(*) FROM frames WHERE kind = 'sample'").fetchone()[0]
+    assert con.execute("SELECT count(*) FROM samples s LEFT JOIN frames f ON f.id = s.frame "
+                       "WHERE f.id IS NULL OR f.kind != 'sample'").fetchone()[0] == 0
+    for sid in (1, 2):
+        assert [seq for s, seq, _ in rows if s == sid] == sorted(seq for s, seq, _ in rows if s == sid)
+    con.close()
+
+
+def test_abandon_drops_the_batch_waiting_in_memory(tmp_path, layout):
+    path = tmp_path / "a.sqlite"
+    a = Archive(str(path))
+    a.begin(layout=layout, project="tank", port="p", baud=9600, started=1.0)
+    decoder = Session(layout)
+    data = b"".join(stream(layout, 0, 20, hello_first=True))
+    a.received(1, data, decoder.feed(data, 1.0), now=100.0)  # the first tick commits
+    a.received(2, data[:10], [], now=100.1)  # waits for the next
+    a.abandon()
+    con = sqlite3.connect(path)
+    assert con.execute("SELECT count(*), sum(length(data)) FROM chunks").fetchone() == (1, len(data))
+    assert con.execute("SELECT count(*) FROM frames").fetchone() == (20,)
+    con.close()

@@ -21,7 +21,8 @@ from support.linkstream import TANK, hello, layout_of, sample
 
 # The writer: frames numbered from 0 (a hello, then samples whose 32-bit
 # frame counter is their number), each archived as the station archives a
-# read: rx(), the decoded event(), tick(); about 2,000 frames a second.
+# read: received() with its decoded events (a tick with them); about 2,000
+# frames a second.
 WRITER = r"""
 import json, sys, time
 from fswkit.ground.archive import Archive
@@ -42,10 +43,7 @@ n = 0
 while True:
     data = frames[n % len(frames)]
     t = time.time_ns()
-    a.rx(t, data)
-    for ev in decoder.feed(data, t / 1e9):
-        a.event(ev)
-    a.tick()
+    a.received(t, data, decoder.feed(data, t / 1e9))
     n += 1
     time.sleep(0.0005)
 """

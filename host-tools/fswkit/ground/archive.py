@@ -38,18 +38,24 @@ reads it): a float that is not finite is the string "NaN", "Infinity" or
 "-Infinity"; a whole number beyond SQLite's 64 bits is stored as REAL.
 
 Crash safety: the journal is a write-ahead log (WAL), with
-synchronous=NORMAL. Inserts go into one transaction that `tick()` commits
-at most every 0.5 s (and `close()`). A committed transaction is in the WAL
-file, which the operating system keeps when the process dies: `kill -9` at
-any moment loses only the uncommitted batch (the last half second and the
-time to the next tick), and never what was committed before. NORMAL, not
-FULL: FULL would wait for the disk (fsync) at every commit, while the
-station's serial thread waits for the archive's lock — on an SD card or a
-USB stick, long enough to overrun the port's buffer; NORMAL syncs the WAL at
-checkpoints only, so a power cut (not a killed process) may lose the commits
-since the last checkpoint, the database still whole. A new archive is made
-complete in a temporary file beside its path and takes the name only then:
-no reader ever sees half an archive.
+synchronous=NORMAL. The bytes and frames wait in memory and are written in
+one transaction that `tick()` commits at most every 0.5 s (and `close()`); a
+command or a note goes into that transaction at once. A committed
+transaction is in the WAL file, which the operating system keeps when the
+process dies: `kill -9` at any moment loses only the uncommitted batch (the
+last half second and the time to the next tick), and never what was
+committed before. Rows kept in memory until the commit are lost by a kill
+exactly as rows in an uncommitted transaction are, and writing them at once
+costs a few statements a batch, where a statement each cost the station's
+reader more than anything else it does for a frame; the write lock is held
+only while a batch is written (or from a command or a note to the commit).
+NORMAL, not FULL: FULL would wait for the disk (fsync) at every commit,
+while the station's serial thread waits for the archive's lock — on an SD
+card or a USB stick, long enough to overrun the port's buffer; NORMAL syncs
+the WAL at checkpoints only, so a power cut (not a killed process) may lose
+the commits since the last checkpoint, the database still whole. A new
+archive is made complete in a temporary file beside its path and takes the
+name only then: no reader ever sees half an archive.
 """
 
 from __future__ import annotations
@@ -157,10 +163,11 @@ def _check_version(con: sqlite3.Connection, path) -> None:
 
 class Archive:
     """The writer: sessions appended to an archive (a new file, or an
-    archive that exists). Thread-safe: every call takes one lock. Inserts
-    wait in a transaction that tick() commits every COMMIT_EVERY seconds;
-    close() commits and marks the session ended. Calls after close() are
-    ignored (a reading thread may race the close)."""
+    archive that exists). Thread-safe: every call takes one lock. Chunks
+    and frames wait in memory, commands and notes in a transaction, until
+    tick() writes and commits them every COMMIT_EVERY seconds; close()
+    commits and marks the session ended. Calls after close() are ignored
+    (a reading thread may race the close)."""
 
     def __init__(self, path: str):
         self.path = str(path)
@@ -168,6 +175,9 @@ class Archive:
         self._con: sqlite3.Connection | None = None
         self._session: int | None = None
         self._last_tick: float | None = None
+        # the open batch's chunks and frames, inserted when it is committed (_flush)
+        self._chunks: list[tuple] = []
+        self._frames: list[tuple] = []
         self._regions: list[tuple[str, tuple[str, ...]]] = []  # the session's streams: (region, element names)
         if os.path.isdir(self.path):
             raise ArchiveError(f"cannot write the archive {path}: it is a folder (name a file)")
@@ -227,19 +237,58 @@ class Archive:
     # ---- writing ------------------------------------------------------------------------
 
     def _exec(self, sql: str, params=()) -> sqlite3.Cursor:
-        """A statement in the open batch (one begun if none is)."""
-        if not self._con.in_transaction:
-            self._con.execute("BEGIN")
+        """A statement in the open batch (one begun if none is). IMMEDIATE:
+        the batch holds the write lock from its first statement, so the
+        frames' numbers taken in `_flush` are the ones they get."""
+        self._begin()
         return self._con.execute(sql, params)
 
+    def _begin(self) -> None:
+        if not self._con.in_transaction:
+            self._con.execute("BEGIN IMMEDIATE")
+
+    def _flush(self) -> None:
+        """The rows waiting in memory (chunks and frames, as they came),
+        inserted into the open batch: a few statements for half a second of
+        the link, where one per chunk and per frame cost the station's
+        reader more than anything else it does for a frame."""
+        chunks, frames = self._chunks, self._frames
+        if not chunks and not frames:
+            return
+        self._chunks, self._frames = [], []
+        con = self._con
+        self._begin()
+        if chunks:
+            con.executemany("INSERT INTO chunks (session, dir, t_ns, data) VALUES (?, ?, ?, ?)", chunks)
+        if frames:
+            (last,) = self._exec("SELECT coalesce(max(id), 0) FROM frames").fetchone()
+            rows, samples = [], []
+            for k, (session, ev) in enumerate(frames, last + 1):
+                region = info = None
+                if ev.kind == "sample":
+                    reg = self._regions[ev.stream] if 0 <= ev.stream < len(self._regions) else None
+                    region = reg[0] if reg else f"stream {ev.stream}"
+                    names = reg[1] if reg else ()
+                    samples += [(k, i, _num(t), _json(dict(zip(names, vals)) if names else list(vals)))
+                                for i, (t, vals) in enumerate(ev.samples)]
+                else:
+                    info = _json(ev.info)
+                rows.append((k, session, ev.kind, _num(ev.seq), _num(ev.time), float(ev.host_time), region, info))
+            con.executemany("INSERT INTO frames (id, session, kind, seq, time, host_time, region, info) "
+                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+            if samples:
+                con.executemany("INSERT INTO samples (frame, i, time, vals) VALUES (?, ?, ?, ?)", samples)
+
     def _commit(self) -> None:
-        if self._con.in_transaction:
-            try:
+        try:
+            self._flush()
+            if self._con.in_transaction:
                 self._con.execute("COMMIT")
-            except sqlite3.Error:  # a full disk: the batch is lost, the archive as of the last commit
-                with contextlib.suppress(sqlite3.Error):
+        except sqlite3.Error:  # a full disk, a lock: the batch is lost, the archive as of the last commit
+            with contextlib.suppress(sqlite3.Error):
+                if self._con.in_transaction:
                     self._con.execute("ROLLBACK")
-                raise
+            raise
 
     @contextlib.contextmanager
     def _writing(self, need_session: bool = True):
@@ -269,6 +318,7 @@ class Archive:
             if con is None:
                 raise ArchiveError(f"{self.path}: the archive is closed")
             if self._session is not None:
+                self._flush()  # the rows of the session that ends, under its number
                 self._exec("UPDATE sessions SET ended = ? WHERE id = ?", (started, self._session))
             cur = self._exec("INSERT INTO sessions (project, port, baud, started, layout, fswkit) "
                              "VALUES (?, ?, ?, ?, ?, ?)",
@@ -292,32 +342,28 @@ class Archive:
             return
         with self._writing() as con:
             if con is not None:
-                self._exec("INSERT INTO chunks (session, dir, t_ns, data) VALUES (?, ?, ?, ?)",
-                           (self._session, direction, int(t_ns), bytes(data)))
+                self._chunks.append((self._session, direction, int(t_ns), bytes(data)))
 
     def event(self, ev) -> None:
-        """One decoded frame (fswkit.link.session.Event)."""
-        region = info = None
-        rows = ()
-        if ev.kind == "sample":
-            reg = self._regions[ev.stream] if 0 <= ev.stream < len(self._regions) else None
-            region = reg[0] if reg else f"stream {ev.stream}"
-            names = reg[1] if reg else ()
-            rows = [(i, _num(t), _json(dict(zip(names, vals)) if names else list(vals)))
-                    for i, (t, vals) in enumerate(ev.samples)]
-        else:
-            info = _json(ev.info)
+        """One decoded frame (fswkit.link.session.Event). Its rows are made
+        when the batch is written (`_flush`): an event is not changed once
+        decoded."""
+        with self._writing() as con:
+            if con is not None:
+                self._frames.append((self._session, ev))
+
+    def received(self, t_ns: int, data: bytes, events=(), now: float | None = None) -> None:
+        """What one read of the port brought, as the station archives it: the
+        bytes (`rx`), the frames decoded from them (`event` each) and a
+        `tick`, under the lock once."""
         with self._writing() as con:
             if con is None:
                 return
-            cur = self._exec("INSERT INTO frames (session, kind, seq, time, host_time, region, info) "
-                             "VALUES (?, ?, ?, ?, ?, ?, ?)",
-                             (self._session, ev.kind, _num(ev.seq), _num(ev.time), float(ev.host_time),
-                              region, info))
-            if rows:
-                frame = cur.lastrowid
-                con.executemany("INSERT INTO samples (frame, i, time, vals) VALUES (?, ?, ?, ?)",
-                                [(frame, *r) for r in rows])
+            if data:
+                self._chunks.append((self._session, 0, int(t_ns), bytes(data)))
+            session = self._session
+            self._frames += [(session, ev) for ev in events]
+            self._tick(time.monotonic() if now is None else now)
 
     def command(self, *, who: str, text: str, op: int, args: bytes, sent: float, cmd_seq, status, words: str,
                 acked) -> None:
@@ -343,11 +389,13 @@ class Archive:
         (default time.monotonic())."""
         now = time.monotonic() if now is None else now
         with self._writing(need_session=False) as con:
-            if con is None:
-                return
-            if self._last_tick is None or now - self._last_tick >= COMMIT_EVERY or now < self._last_tick:
-                self._commit()
-                self._last_tick = now
+            if con is not None:
+                self._tick(now)
+
+    def _tick(self, now: float) -> None:
+        if self._last_tick is None or now - self._last_tick >= COMMIT_EVERY or now < self._last_tick:
+            self._commit()
+            self._last_tick = now
 
     def close(self) -> None:
         """Commits, marks the session ended, closes the file (again: nothing)."""
@@ -357,6 +405,7 @@ class Archive:
                 return
             try:
                 if self._session is not None:
+                    self._flush()
                     self._exec("UPDATE sessions SET ended = ? WHERE id = ?", (time.time(), self._session))
                 self._commit()
             except sqlite3.Error as e:
@@ -371,6 +420,7 @@ class Archive:
         full disk), when no further write could be waited for."""
         with self._lock:
             con, self._con = self._con, None
+            self._chunks, self._frames = [], []
             if con is not None:
                 with contextlib.suppress(sqlite3.Error):
                     con.rollback()

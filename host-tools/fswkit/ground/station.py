@@ -3,9 +3,11 @@ port and serves it to every client at once.
 
 - The port is held exclusively (fswkit.link.port): a second opener is told
   "busy: held by fsw ground, pid N".
-- One reader thread reads the port, decodes it (its own Session), archives
-  the bytes, frames and notes (fswkit.ground.archive), and hands every
-  chunk to every client: the in-process ones (the web page's source) get
+- One reader thread reads the port in passes of whole frames (at most one
+  every PASS_S, the frames that came meanwhile together: each pass costs
+  every part of the station a wake-up), decodes it (its own Session),
+  archives the bytes, frames and notes (fswkit.ground.archive), and hands
+  every chunk to every client: the in-process ones (the web page's source) get
   the decoded events, the local ones (the terminal monitor, `fsw cmd`,
   `fsw param`, `fsw dump`, scripts) the raw bytes over a Unix socket,
   cut at frame delimiters so a client that attaches mid-stream starts on
@@ -50,8 +52,9 @@ PROTOCOL = 1
 REOPEN_S = 0.25  # how often a port that went away is tried again
 CLIENT_BACKLOG = 200_000  # messages queued for a client that does not read before it is dropped
 COMMAND_WHO = "fsw ground"
-FRAME_WAIT_S = 0.02  # how long a chunk that ends mid-frame waits for the frame's end
-FRAME_POLL_S = 0.005  # ... looking every 5 ms (about 58 bytes at 115200 baud)
+FRAME_WAIT_S = 0.02  # the longest a frame's first bytes wait for its end before they are handed on
+PASS_S = 0.02  # the least time between two passes of frames to the decoder, the archive and the clients
+FRAME_POLL_S = 0.002  # the margin over a frame's remaining time on the wire, and the least wait
 
 
 def socket_path(port_name: str) -> str:
@@ -200,26 +203,46 @@ class Station:
     # ---- the port ----------------------------------------------------------------------
 
     def _read_loop(self) -> None:
+        """Reads the port in passes of whole frames. A pass costs the decoder,
+        the archive, every client and the page's event loop their work and
+        a wake-up each, which is most of the station's CPU time at a full
+        link's rate; so the thread sleeps while a frame is still on the wire
+        (about its remaining bytes' time at the baud rate, judged by the
+        last whole frame's length) instead of reading it as it trickles in,
+        hands frames on at most once every PASS_S (those that came meanwhile
+        together), and blocks on the port only between frames. A frame
+        waits PASS_S for its pass at the most, and a quiet link's frame goes
+        on as soon as its last byte is read; bytes with no delimiter after
+        them (a frame longer than the last, or no frame) go on after
+        FRAME_WAIT_S as they are."""
         errors = port_errors()
+        byte_s = 10.0 / max(1, self.baud)  # a byte's time on the wire: start, 8 data and stop bits
+        held = b""  # read, not handed on yet: no delimiter among them
+        held_since = 0.0  # monotonic time the oldest held byte was read
+        last_read = 0.0  # ... and the newest
+        part = 0  # bytes handed on of the frame in progress (after the last delimiter)
+        frame_len = 0  # the last whole frame's bytes, its delimiter included
+        next_pass = 0.0  # monotonic time before which no frame is handed on
         while not self._stop.is_set():
             port = self.port
             if port is None:
+                held, part = b"", 0
                 self._reopen()
                 continue
             try:
-                n = port.in_waiting
-                data = port.read(n or 1)
-                # whole frames at a time: a frame's bytes trickle in (a pty, a USB
-                # adapter's latency timer), and each chunk costs the decoder, the
-                # archive and every client a message
-                until = time.monotonic() + FRAME_WAIT_S
-                while data and data[-1] != 0 and time.monotonic() < until:
-                    time.sleep(FRAME_POLL_S)  # let the rest gather rather than read it byte by byte
-                    more = port.in_waiting
+                if not held and not part:  # between frames: the next byte wakes the thread
+                    data = port.read(port.in_waiting or 1)
+                    more = port.in_waiting if data else 0  # the rest of what came with it (a whole frame, often)
                     if more:
                         data += port.read(more)
+                else:  # a frame in progress: its rest gathers meanwhile (and the frames after it)
+                    left = (frame_len - part - len(held)) * byte_s + FRAME_POLL_S
+                    time.sleep(min(FRAME_WAIT_S, max(FRAME_POLL_S, left, next_pass - time.monotonic())))
+                    n = port.in_waiting
+                    data = port.read(n) if n else b""
             except errors as e:
                 self._lost(e)
+                held, part = b"", 0
                 continue
             except (TypeError, AttributeError):
                 # pyserial reading a port closed under it (its descriptor is
@@ -228,9 +251,28 @@ class Station:
                 if self._stop.is_set():
                     break
                 raise
+            now = time.monotonic()
             if data:
-                self._received(data)
-            else:
+                last_read = now
+                if not held:
+                    held_since = now
+                held += data
+            if held:
+                end = held.rfind(b"\0")
+                if (end >= 0 and now >= next_pass) or now - held_since >= FRAME_WAIT_S:
+                    if end >= 0:  # whole frames, handed on with the start of the next one
+                        before = held.rfind(b"\0", 0, end)
+                        frame_len = end - before if before >= 0 else part + end + 1
+                        part = len(held) - end - 1
+                    else:  # a frame longer than the last, or no frame: what came, as it is
+                        part += len(held)
+                    data, held = held, b""
+                    next_pass = now + PASS_S
+                    self._received(data)
+                    continue
+            if not data:
+                if part and not held and now - last_read >= FRAME_WAIT_S:
+                    part = 0  # the rest is not coming: wait on the port again
                 self._archive("tick")
 
     def _lost(self, e: Exception) -> None:
@@ -269,7 +311,6 @@ class Station:
     def _received(self, data: bytes) -> None:
         t_ns = time.time_ns()
         host = t_ns / 1e9
-        self._archive("rx", t_ns, data)
         # clients get whole frames: the chunk up to its last delimiter; decoded
         # and sent under the clients' lock, so a client's welcome (the station's
         # numbering as of then) is never ahead of the first chunk it gets
@@ -278,7 +319,7 @@ class Station:
         self._carry = buf[cut:]
         with self._clients_lock:
             evs = self.session.feed(data, host)
-            if cut:
+            if cut and self._clients:  # encoded once for every client, and not at all for none
                 line = (json.dumps({"t": "rx", "h": host, "d": base64.b64encode(buf[:cut]).decode()}) + "\n").encode()
                 for c in list(self._clients):
                     c.put(line)
@@ -292,10 +333,9 @@ class Station:
                     w["event"].set()
             elif ev.kind == "hello":
                 self._on_hello(ev)
-            self._archive("event", ev)
         for fn in list(self._listeners):
             fn(evs)
-        self._archive("tick")
+        self._archive("received", t_ns, data, evs)  # the bytes, their frames and a tick: one call
 
     def _on_hello(self, ev: Event) -> None:
         i = ev.info

@@ -183,7 +183,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
 
         async def ticks():
             while True:
-                await q.put(source.link())
+                await q.put(json.dumps(source.link()))
                 await asyncio.sleep(0.5)
 
         ticker = asyncio.create_task(ticks())
@@ -193,7 +193,7 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
                 batch = [msg]
                 while not q.empty() and len(batch) < 200:  # what waits goes in one WebSocket message
                     batch.append(q.get_nowait())
-                await ws.send_text(json.dumps(batch))
+                await ws.send_text("[" + ",".join(batch) + "]")  # each message encoded once, for every browser
         except (WebSocketDisconnect, RuntimeError):
             pass
         finally:

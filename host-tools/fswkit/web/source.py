@@ -10,6 +10,7 @@ the link client (fswkit.link.client.Ground) in a reader thread."""
 from __future__ import annotations
 
 import asyncio
+import json
 import time
 from collections import deque
 
@@ -45,6 +46,26 @@ def _message(ev: Event, layout: Layout) -> dict | None:
     return None
 
 
+_STRICT = json.JSONEncoder(allow_nan=False).encode
+
+
+def _text(ev: Event, layout: Layout) -> str | None:
+    """One decoded event as the browser gets it, as JSON text: encoded once,
+    in the station's reader, for every browser. A sample frame whose values
+    are all finite (the common case, at the link's rate) is encoded as it
+    is; anything else goes through `_message`, which names what JSON
+    cannot hold."""
+    if ev.kind == "sample":
+        try:
+            return _STRICT({"t": "samples", "seq": ev.seq, "host": ev.host_time,
+                            "names": layout.streams[ev.stream].region.names,
+                            "rows": [[time, *values] for time, values in ev.samples]})
+        except (ValueError, TypeError):  # a NaN or an infinity
+            pass
+    msg = _message(ev, layout)
+    return None if msg is None else json.dumps(msg)
+
+
 def _json(v):
     if isinstance(v, (bytes, bytearray)):
         return v.hex()  # an ack's data
@@ -68,6 +89,9 @@ class Source:
         self.note = ""  # what the source says about its link (e.g. "port closed")
 
     def subscribe(self) -> asyncio.Queue:
+        """A queue of messages as JSON text (each encoded once for every
+        subscriber; an item may be several, joined by commas: the items
+        joined by commas in brackets are a JSON array of messages)."""
         q: asyncio.Queue = asyncio.Queue(maxsize=10000)
         self._queues.add(q)
         return q
@@ -77,20 +101,22 @@ class Source:
 
     def publish(self, msg: dict) -> None:
         """From the loop's thread."""
-        for q in list(self._queues):
-            try:
-                q.put_nowait(msg)
-            except asyncio.QueueFull:  # a browser that does not keep up loses its oldest message
-                q.get_nowait()
-                q.put_nowait(msg)
+        self.publish_all([json.dumps(msg)])
 
     def publish_threadsafe(self, msg: dict) -> None:
         if self.loop is not None:
             self.loop.call_soon_threadsafe(self.publish, msg)
 
-    def publish_all(self, msgs: list) -> None:
-        for m in msgs:
-            self.publish(m)
+    def publish_all(self, texts: list) -> None:
+        """Messages already encoded (JSON text; several joined by commas go as
+        one), from the loop's thread."""
+        for q in list(self._queues):
+            for text in texts:
+                try:
+                    q.put_nowait(text)
+                except asyncio.QueueFull:  # a browser that does not keep up loses its oldest message
+                    q.get_nowait()
+                    q.put_nowait(text)
 
     def link(self) -> dict:
         age = None if self.last_frame is None else time.monotonic() - self.last_frame
@@ -173,9 +199,11 @@ class LiveSource(Source):
             return
         self.frames += len(evs)
         self.last_frame = time.monotonic()
-        msgs = [m for m in (_message(ev, self.layout) for ev in evs) if m is not None]
-        if msgs and self.loop is not None:  # one wake-up of the loop for the chunk's frames
-            self.loop.call_soon_threadsafe(self.publish_all, msgs)
+        if self.loop is None or not self._queues:  # no browser: nothing to encode, nothing to wake
+            return
+        texts = [m for m in (_text(ev, self.layout) for ev in evs) if m is not None]
+        if texts:  # one wake-up of the loop and one message of each queue for the chunk's frames
+            self.loop.call_soon_threadsafe(self.publish_all, [",".join(texts)])
 
     def _command(self, who: str, op: int, args: bytes, text: str) -> dict:
         from fswkit.link.client import LinkTimeout

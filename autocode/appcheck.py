@@ -21,6 +21,7 @@ from fractions import Fraction
 from . import model as M
 from .appsyntax import AppFile, ConfigFile, Options, Setting, StreamRow, TaskRow, WritableRow
 from .board import Board, BoardError
+from .buses import SS_WHY, spi_ss
 from .check import assignments, check_literals, check_sm, check_sv, machine_exprs
 from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
@@ -79,6 +80,9 @@ class Report:
     def at(self, line: int, col: int, msg: str) -> None:
         self.diags.error(self.src, APP, line, col, msg)
 
+    def warn(self, tok: Tok, msg: str) -> None:
+        self.diags.warning(self.src, APP, tok.line, tok.col, msg)
+
 
 def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_board,
               instead: dict[str, str] | None = None) -> Parts | None:
@@ -131,7 +135,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     pyro, reload = [], None
     if f.pyro:  # the proofs' module is imported for an application that has pyro channels only
         from .pyrocheck import check_pyro
-        pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks)
+        pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks, board)
     if f.reload:
         from .reloadcheck import check_reload
         reload = check_reload(f.reload, tasks, machines, board, log, r)
@@ -364,7 +368,12 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
         if c.path.endswith(".sns"):
             sensors += check_sensor_table(isrc, sv, board, r.diags, channels, used_pins, used_inputs, state)
         else:
-            channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs)
+            refused = {}
+            if state.spi is not None:  # an earlier table's SPI part took SS
+                refused[spi_ss(board)] = (f"it is {SS_WHY} (the SPI part at {os.path.basename(state.spi[0])}:"
+                                          f"{state.spi[1]}); move the channel to another pin")
+            channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs,
+                                    refused)
     return channels, sensors
 
 

@@ -32,6 +32,9 @@ class Board:
     # takes from analog outputs (`executor.timer_pins`)
     timer: str = ""
     timer_pins: frozenset[int] = frozenset()
+    # pins the board's bootloader drives high at a reset, before the firmware
+    # runs (`pins.boot_driven`): pin -> what drives it
+    boot_driven: dict[int, str] = field(default_factory=dict, compare=False)
     # pin -> (port letter, bit) on an AVR board's MCU (`arduino.ports`); empty
     # when the board file does not say (channels then go through pin numbers)
     ports: dict[int, tuple[str, int]] = field(default_factory=dict, compare=False)
@@ -124,6 +127,7 @@ def board_from_dict(name: str, d: dict) -> Board:
         timer=str(d.get("executor", {}).get("timer", "")),
         timer_pins=frozenset(pin(p, "executor.timer_pins") for p in d.get("executor", {}).get("timer_pins", [])),
         ports=_ports(d.get("arduino", {}).get("ports", [])),
+        boot_driven={pin(r["pin"], "pins.boot_driven.pin"): str(r["reason"]) for r in pins.get("boot_driven", [])},
         raw=d,
     )
 

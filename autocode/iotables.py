@@ -43,16 +43,19 @@ def analog_value(count: int, gain: float, offset: float, real) -> float:
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
                 diags: Diagnostics, used_pins: dict[int, tuple[str, int]] | None = None,
-                used_inputs: dict[str, tuple[str, int]] | None = None) -> tuple[Channel, ...]:
+                used_inputs: dict[str, tuple[str, int]] | None = None,
+                refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of one table, parsed and checked. `used_pins` /
     `used_inputs` carry what earlier tables of the same application took, so
-    a pin or an input element used twice across tables is reported too."""
-    return check_channels(parse_table(src, analog, diags), sv, board, diags, used_pins, used_inputs)
+    a pin or an input element used twice across tables is reported too;
+    `refused` maps pins no channel may have (though a chip select may) to why."""
+    return check_channels(parse_table(src, analog, diags), sv, board, diags, used_pins, used_inputs, refused)
 
 
 def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnostics,
                    used_pins: dict[int, tuple[str, int]] | None = None,
-                   used_inputs: dict[str, tuple[str, int]] | None = None) -> tuple[Channel, ...]:
+                   used_inputs: dict[str, tuple[str, int]] | None = None,
+                   refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of a parsed table; every refused row is reported."""
     used_pins = {} if used_pins is None else used_pins
     used_inputs = {} if used_inputs is None else used_inputs
@@ -65,7 +68,7 @@ def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnos
         calibration = _calibration(row, table.analog, board.real, err)
         if calibration is None:
             continue
-        pin = _pin(row, table.analog, board, used_pins, err)
+        pin = _pin(row, table.analog, board, used_pins, err, refused or {})
         if pin is None:
             continue
         e = _element(row, table, sv, used_inputs, err)
@@ -116,7 +119,7 @@ def _value(cal: Calibration, real: str, err) -> float | None:
     return -v if cal.negative else v
 
 
-def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err) -> int | None:
+def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err, refused: dict) -> int | None:
     """The board's number of the row's pin, when the row may use it."""
     text = row.pin.text
     pin = board.pin(text)
@@ -137,6 +140,8 @@ def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err) -> i
     elif pin in used_pins:
         where, line = used_pins[pin]
         problem = f"pin `{text}` is already used ({where}:{line})"
+    elif pin in refused:
+        problem = f"pin `{text}` cannot be a channel's: {refused[pin]}"
     else:
         return pin
     err(row.pin, problem)

@@ -21,12 +21,13 @@ Every problem is reported where it is written."""
 
 from __future__ import annotations
 
+import struct
 from fractions import Fraction
 from os.path import basename
 
 from . import model as M
 from .appsyntax import Setting
-from .buses import i2c_bus, spi_bus
+from .buses import i2c_bus, spi_bus, spi_channel_problem
 from .lexer import ID, NUM, OP, Tok
 from .limits import hz
 from .numeric import exact_literal
@@ -41,6 +42,9 @@ NOR_SIZES = (64 << 10, 16 << 20)  # a power of two between these
 NOR_DEFAULT = 8 << 20  # the W25Q64JV
 UNITS = {"K": 1 << 10, "KiB": 1 << 10, "M": 1 << 20, "MiB": 1 << 20}
 MAX_SLOTS = 65535  # record indexes are u16
+MIN_RECORDS = M.LOG_MIN_SLOTS
+MAX_STEP = 10**6  # delta= and quant= at most
+MIN_STEP = "2.94e-39"  # about 1 / FLT_MAX: smaller, and 1/STEP is no binary32 number
 
 
 
@@ -87,6 +91,9 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if store == "eeprom" and board is not None and board.eeprom == 0:
         r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
     record = _record(once.get("record"), r)
+    if store == "eeprom" and board is not None and board.eeprom:
+        at = once.get("record") or once.get("store")
+        _eeprom_room(board, machines, record, at.values[0] if at is not None and at.values else first, r)
     if store == "spi_nor" and "record" in once and (record & (record - 1) or record > 128):
         r.err(once["record"].values[0], f"`record` on spi_nor is a power of two from 32 to 128 "
                                         f"(records never straddle a {NOR_SECTOR}-byte sector or a 256-byte page): "
@@ -109,6 +116,7 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     fields = _fields(elements, sv, machines, r)
     if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
         return None
+    _trigger_entered(m, trigger[0], once["trigger"].values[0], r)
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
     log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
@@ -166,6 +174,14 @@ def _store(s: Setting | None, board, channels: list[M.Channel] | None, r,
     pin = _cs_pin(rest[0], board, channels, r, sensors)
     if pin is None:
         ok = False
+    if board is not None and not any(p.bus == "spi" for p in sensors):  # an SPI part reported these itself
+        hit = spi_channel_problem(board, channels or ())
+        if hit is not None:
+            c, why = hit
+            r.err(s.values[0], f"the flash is on the SPI bus, and pin {c.pin} is {why}: the "
+                               f"{'input' if c.direction == 'i' else 'output'} channel of `{c.element.name}` "
+                               f"({basename(c.path)}:{c.line}) cannot have it; move the channel to another pin")
+            ok = False
     size = NOR_DEFAULT
     if len(rest) >= 2:
         size = _size(rest[1], rest[2] if len(rest) == 3 else None, r)
@@ -363,6 +379,47 @@ def _fields(rows: list[Setting], sv: M.StateVector, machines: list[M.Machine], r
     return out if ok else None
 
 
+def _trigger_entered(m: M.Machine, trigger: int, at: Tok, r) -> None:
+    """A warning when no transition that can run from the machine's first
+    state leads into the trigger (a state id): the firmware starts a flight
+    on entering it (at boot the first state is not entered, it is where the
+    machine starts), so the recorder would never record."""
+    from .pyrocheck import machine_graph, search
+
+    g = machine_graph(m)
+    t = trigger - 1  # the index
+    if any(e.dst == t for s in search(g) for e in g.edges[s]):
+        return
+    first = m.states[0].name
+    why = (f"it is the machine's first state, where it starts at boot, and no transition leads back to it"
+           if t == 0 else f"no transition that can run from the machine's first state (`{first}`) leads to it")
+    r.warn(at, f"the trigger state `{at.text}` is never entered: {why}, so the recorder never starts a flight")
+
+
+def _eeprom_room(board, machines: list[M.Machine], record: int, at: Tok, r) -> None:
+    """The EEPROM after the parameters' banks holds two records at least:
+    the recorder writes one while the last is still whole."""
+    from .params import HEADER as PHEADER
+
+    psize = sum(v.type.size for m in machines for v in m.vars if v.param is not None)
+    params = 2 * (PHEADER + psize) if psize else 0
+    n = (board.eeprom - params) // record
+    if params <= board.eeprom and n < MIN_RECORDS:
+        r.err(at, f"the parameters' banks take {params:,} B of the {board.name}'s {board.eeprom:,} B of EEPROM, which "
+                  f"leaves {board.eeprom - params:,} B: room for {n} record{'' if n == 1 else 's'} of {record} B, "
+                  f"and the recorder needs {MIN_RECORDS} at least; a smaller `record`, fewer parameters, or "
+                  "`store spi_nor`")
+
+
+def _binary32_finite(x: float) -> bool:
+    """Whether x, a C++ `float` literal, is a finite binary32 number."""
+    try:
+        struct.pack("<f", x)
+    except OverflowError:
+        return False
+    return True
+
+
 def _encoding(s: Setting, e: M.Element, n_states: int | None, r) -> M.LogField | None:
     rest = s.values[1:]
     narrow = 1 if n_states is not None and n_states < 256 else e.type.size  # a state number fits a byte
@@ -377,8 +434,14 @@ def _encoding(s: Setting, e: M.Element, n_states: int | None, r) -> M.LogField |
             r.err(w, f"`{w.text}=STEP` encodes F32 elements; `{e.name}` is {e.type.name} (log it `raw`)")
             return None
         q = exact_literal(rest[2].text)
-        if q is None or q <= 0 or q > 10**6:
-            r.err(rest[2], f"`{w.text}=` takes the value of one count: a positive number, found `{rest[2].text}`")
+        if q is None or q <= 0 or q > MAX_STEP:
+            r.err(rest[2], f"`{w.text}=` takes the value of one count: a positive number up to {MAX_STEP:,}, "
+                           f"found `{rest[2].text}`")
+            return None
+        if not _binary32_finite(float(1 / q)):
+            # the firmware multiplies by 1/STEP in binary32: an infinite factor saturates every sample
+            r.err(rest[2], f"`{w.text}={rest[2].text}` is too small a count: the firmware multiplies by 1/STEP in "
+                           f"binary32, which must be finite (STEP at least about {MIN_STEP})")
             return None
         return M.LogField(e, w.text, q, 4 if w.text == "delta" else 2, s.key.line)
     r.err(w, f"unknown encoding `{' '.join(t.text for t in rest)}`: expected raw, hold, delta=STEP or quant=STEP")

@@ -367,6 +367,9 @@ class LogField:
     line: int
 
 
+LOG_MIN_SLOTS = 2  # records a flight recorder's store holds at least (fsw_log.h log_config_ok)
+
+
 @dataclass(frozen=True)
 class Log:
     """The `[log]` section: what the flight recorder keeps, when, and where."""

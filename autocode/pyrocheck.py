@@ -33,6 +33,7 @@ in the `.sm`, with the path that reaches it unarmed."""
 
 from __future__ import annotations
 
+import math
 import os
 from collections import deque
 from dataclasses import dataclass
@@ -50,6 +51,7 @@ KEYS = ("arm", "continuity", "min", "pulse", "machine", "armed", "fire")
 REQUIRED = ("arm", "pulse", "machine", "armed", "fire")
 LISTS = ("arm", "armed", "fire")  # keys that take a comma-separated list
 PULSE_MIN, PULSE_MAX = Fraction(1, 100), Fraction(10)  # seconds
+MAX_PULSE_RUNS = 0xFFFF  # fsw_io.h PyroGate::left: runs of the outputs task a pulse lasts
 PATH_SHOWN = 8  # states a path in a diagnostic shows before it is cut
 
 
@@ -277,12 +279,12 @@ def _implies(e: M.Expr, pol: bool, a: int, folder: Folder) -> bool:
 # ---- the [pyro] section ---------------------------------------------------------
 
 def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine], machine_srcs: dict,
-               channels: list[M.Channel], uplink, r, task_rows=()) -> list[M.PyroChannel]:
+               channels: list[M.Channel], uplink, r, task_rows=(), board=None) -> list[M.PyroChannel]:
     """The checked channels of the `[pyro]` rows, and the proof for each
     (every problem reported through `r`, appcheck's Report). `uplink`: the
     [uplink] rows, of which none may name a pyro channel; `task_rows`: the
     [tasks] rows (an `outputs` task refused for its own reason is no missing
-    one)."""
+    one); `board`: whose bootloader may drive a pin at a reset."""
     if not rows:
         return []
     outputs = [t for t in tasks if t.kind == "outputs"]
@@ -293,7 +295,7 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
     out: list[M.PyroChannel] = []
     owners: dict[str, tuple[int, int]] = {}  # element name -> (its machine, its row's line)
     for row in rows:
-        ch, midx = _row(row, sv, outputs, machines, tables, declared, r)
+        ch, midx = _row(row, sv, outputs, machines, tables, declared, r, board)
         if midx is not None and row.element.text in declared and declared[row.element.text] == row.element.line:
             owners.setdefault(row.element.text, (midx, row.element.line))
         if ch is not None:
@@ -327,7 +329,7 @@ def _where(c: M.Channel) -> str:
     return f"{os.path.basename(c.path)}:{c.line}"
 
 
-def _row(row, sv, outputs, machines, tables: _Tables, declared: dict[str, int], r):
+def _row(row, sv, outputs, machines, tables: _Tables, declared: dict[str, int], r, board=None):
     """(the channel of a `[pyro]` row or None, the index of its machine or None)."""
     before = r.diags.error_count
     et = row.element
@@ -346,6 +348,12 @@ def _row(row, sv, outputs, machines, tables: _Tables, declared: dict[str, int], 
     if row.stray is not None:
         r.err(row.stray.tok, row.stray.message)
     output = _output(et, sv, tables, declared, r)
+    if output is not None and board is not None and output.pin_number in board.boot_driven:
+        # the bootloader runs before the firmware: no gate holds the pin low then
+        r.err(et, f"pyro channel `{et.text}` is on pin {output.pin} ({_where(output)}), which the {board.name}'s "
+                  f"bootloader drives high at every reset, before the firmware and its gate run "
+                  f"({board.boot_driven[output.pin_number]}): the charge would fire; wire it to another pin")
+        output = None
     missing = [k for k in REQUIRED if k not in settings]
     if missing and row.stray is None:  # a malformed row: what follows its stray token is not read
         r.err(et, f"pyro channel `{et.text}` needs " + ", ".join(f"`{k}=`" for k in missing))
@@ -457,7 +465,15 @@ def _pulse(s, outputs: list[M.Task], r) -> Fraction:
         if q < 1 / fastest.rate:
             r.err(t, f"a pulse of {t.text} s is shorter than a period of the fastest `outputs` task, `{fastest.name}` "
                      f"({float(1 / fastest.rate):g} s), which drives the pin and ends the pulse")
+        elif math.ceil(q * fastest.rate) > MAX_PULSE_RUNS:  # the gate counts the pulse down in 16 bits
+            r.err(t, f"a pulse of {t.text} s is {math.ceil(q * fastest.rate):,} runs of the fastest `outputs` task, "
+                     f"`{fastest.name}` ({_hz(fastest.rate)} Hz), which counts the pulse down: at most "
+                     f"{MAX_PULSE_RUNS:,} runs, {float(Fraction(MAX_PULSE_RUNS) / fastest.rate):g} s at that rate")
     return q
+
+
+def _hz(rate: Fraction) -> str:
+    return str(rate.numerator) if rate.denominator == 1 else f"{float(rate):g}"
 
 
 def _machine(s, machines: list[M.Machine], r) -> int | None:

@@ -146,8 +146,8 @@ def _number(s: Setting | None, default: int, span: tuple[int, int], what: str, r
 
 
 def _eeprom_room(machines: list[M.Machine], board, log: M.Log | None, size: int, tok, r) -> None:
-    """The slots after the parameters' banks, and a record or more of the
-    recorder's after them when it keeps its log in the EEPROM."""
+    """The slots after the parameters' banks, and two records or more of
+    the recorder's after them when it keeps its log in the EEPROM."""
     from .params import HEADER as PHEADER
 
     if board.eeprom == 0:
@@ -157,11 +157,11 @@ def _eeprom_room(machines: list[M.Machine], board, log: M.Log | None, size: int,
     params = 2 * (PHEADER + psize) if psize else 0
     need = params + eeprom_bytes(size)
     record = log.record if log is not None and log.store == "eeprom" else 0
-    if need + record > board.eeprom:
+    if need + M.LOG_MIN_SLOTS * record > board.eeprom:
         parts = [f"the two slots take {eeprom_bytes(size):,} B (2 x ({SLOT_HEADER} + {size}))"]
         if params:
             parts.append(f"the parameters' banks {params:,} B")
         if record:
-            parts.append(f"the recorder at least a {record} B record")
+            parts.append(f"the recorder at least {M.LOG_MIN_SLOTS} records of {record} B")
         r.err(tok, f"{', '.join(parts)}: more than the {board.name}'s {board.eeprom:,} B of EEPROM; "
                    "lower `size`")

@@ -23,7 +23,7 @@ from os.path import basename
 
 from . import model as M
 from .board import Board
-from .buses import i2c_bus, spi_bus
+from .buses import i2c_bus, spi_bus, spi_channel_problem
 from .diagnostics import IO, Columns, Diagnostics, Source
 from .lexer import describe
 from .model import SENSOR_PARTS, Sensor
@@ -233,6 +233,12 @@ def _claim_bus(bus: dict[int, str], name: str, board: Board, channels, used_pins
         if c.pin_number in bus:
             raise _Refused(bw, f"the {name} bus takes pin {c.pin} ({bus[c.pin_number]}) on the {board.name}, but it "
                                f"is the channel of `{c.element.name}` ({_where(c.path, c.line)})")
+    hit = spi_channel_problem(board, channels) if name == "SPI" else None
+    if hit is not None:  # a channel on SS: the master drives it (a later table's is refused at its pin)
+        c, why = hit
+        raise _Refused(bw, f"with a part on the SPI bus, pin {c.pin} is {why}: the channel of "
+                           f"`{c.element.name}` ({_where(c.path, c.line)}) cannot have it; move the channel to "
+                           "another pin")
     for pin in bus:
         used_pins.setdefault(pin, (src.path, pw.line))
 

@@ -72,7 +72,7 @@ def test_a_board_without_eeprom_is_told_so(tmp_path):
 
 def test_the_slots_share_the_eeprom_with_the_parameters_and_the_recorder(tmp_path):
     """The rocket keeps 6 parameters (2 banks of 9 + 24 B) and its record in
-    the Uno's 1,024 B: slots of 440 B leave the recorder less than a record;
+    the Uno's 1,024 B: slots of 440 B leave the recorder less than two records;
     of 300 B, the recorder's area starts after them."""
     from fswkit.autocode.recorder import plan
     from fswkit.target.build import load
@@ -86,7 +86,7 @@ def test_the_slots_share_the_eeprom_with_the_parameters_and_the_recorder(tmp_pat
     assert load(str(folder), diags) is None
     [err] = [d for d in diags.errors]
     assert re.fullmatch(r"the two slots take 898 B \(2 x \(9 \+ 440\)\), the parameters' banks 66 B, the recorder at "
-                        r"least a 64 B record: more than the uno's 1,024 B of EEPROM; lower `size`", err.message), \
+                        r"least 2 records of 64 B: more than the uno's 1,024 B of EEPROM; lower `size`", err.message), \
         err.message
     app_path.write_text(base + "\n[reload]\nmachine mission\nsize 300\nactivate Safe\n")
     diags = Diagnostics()

@@ -6,7 +6,7 @@ reset_cause resetCause
 
 [configs]
 state_vector rig.sv
-machine rig.sm
+machine log_valid.sm
 io rig.aio
 io rig.dio
 
@@ -17,7 +17,7 @@ unit us
 [tasks]
 uplink uplink rate=100
 sense inputs rate=100
-control machine rig rate=50 mode=controlMode overruns=controlOverruns worst_us=controlWorst
+control machine log_valid rate=50 mode=controlMode overruns=controlOverruns worst_us=controlWorst
 act outputs rate=100
 down telemetry rate=100
 rec recorder rate=100
@@ -37,7 +37,7 @@ ram 2000
 store eeprom
 record 64
 full stop
-machine rig
+machine log_valid
 trigger Run
 before 0.5
 rate 10

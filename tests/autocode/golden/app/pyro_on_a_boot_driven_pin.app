@@ -1,0 +1,27 @@
+# pyro: a channel on the pin the bootloader drives at a reset
+[application]
+board uno
+rate 100
+
+[configs]
+state_vector pyro.sv
+machine pyro.sm
+io pyro.aio
+io pyro_on_a_boot_driven_pin.dio
+
+[time]
+source clock
+unit ms
+
+[tasks]
+uplink uplink rate=100
+sense inputs rate=100
+fly machine pyro rate=100
+act outputs rate=100
+
+[uplink]
+abortCmd
+
+[pyro]
+drogue arm=arm,arm2 continuity=sense min=0.5 pulse=1 machine=pyro armed=Armed fire=Apogee
+main   arm=arm,arm2 pulse=0.5 machine=pyro armed=Armed fire=Main

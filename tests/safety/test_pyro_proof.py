@@ -225,18 +225,31 @@ def chain(n: int) -> str:
 
 
 def test_a_2000_state_machine_is_proven_in_linear_time(tmp_path):
-    m = machine(tmp_path, chain(2000))
-    assert len(m.states) == 2000
-    t0 = time.perf_counter()
-    g = P.machine_graph(m)
-    armed = frozenset({1})
-    parents = P.unarmed(g, armed)
-    everywhere = P.search(g)
-    last = P.path(everywhere, 1999)
-    took = time.perf_counter() - t0
+    """The proof of a 2,000-state chain, and its CPU time against a
+    500-state one's: four times the states take about four times the time
+    (a quadratic search would take sixteen). CPU time, the best of three:
+    a wall-clock limit failed on a loaded machine."""
+    def proved(n: int) -> tuple[float, object]:
+        (tmp_path / str(n)).mkdir()
+        m = machine(tmp_path / str(n), chain(n))
+        assert len(m.states) == n
+        best, out = float("inf"), None
+        for _ in range(3):
+            t0 = time.process_time()
+            g = P.machine_graph(m)
+            parents = P.unarmed(g, frozenset({1}))
+            everywhere = P.search(g)
+            last = P.path(everywhere, n - 1)
+            best = min(best, time.process_time() - t0)
+            out = (parents, everywhere, last)
+        return best, out
+
+    small, _ = proved(500)
+    took, (parents, everywhere, last) = proved(2000)
     assert sorted(parents) == [0]
     assert len(last) == 2000 and len(everywhere) == 2000
-    assert took < 0.5, f"{took:.3f} s"
+    print(f"{took:.3f} s for 2,000 states, {small:.3f} s for 500")
+    assert took < 8 * max(small, 1e-3), f"{took:.3f} s for 2,000 states, {small:.3f} s for 500"
 
 
 def test_a_2000_state_bypass_names_its_path_cut_short(tmp_path):

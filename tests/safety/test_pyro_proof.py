@@ -253,12 +253,21 @@ def test_a_2000_state_machine_is_proven_in_linear_time(tmp_path):
 
 
 def test_a_2000_state_bypass_names_its_path_cut_short(tmp_path):
-    m = machine(tmp_path, chain(2000).replace("    arm: -> Armed\n", "    arm: -> Armed\n    accel > 50: -> C2\n", 1))
-    g = P.machine_graph(m)
-    t0 = time.perf_counter()
-    parents = P.unarmed(g, frozenset({1}))
-    took = time.perf_counter() - t0
-    assert len(parents) == 1999 and took < 0.5
+    def bypassed(n: int):
+        (tmp_path / str(n)).mkdir()
+        body = chain(n).replace("    arm: -> Armed\n", "    arm: -> Armed\n    accel > 50: -> C2\n", 1)
+        m = machine(tmp_path / str(n), body)
+        g = P.machine_graph(m)
+        best = float("inf")
+        for _ in range(3):  # CPU time, the best of three (as the proof's own test above)
+            t0 = time.process_time()
+            parents = P.unarmed(g, frozenset({1}))
+            best = min(best, time.process_time() - t0)
+        return m, parents, best
+
+    _m, _p, small = bypassed(500)
+    m, parents, took = bypassed(2000)
+    assert len(parents) == 1999 and took < 8 * max(small, 1e-3), (took, small)
     text = P.path_text(m, P.path(parents, 1999))
     assert text == "Safe -> C2 -> C3 -> ... (1,993 more) -> C1997 -> C1998 -> C1999"
 

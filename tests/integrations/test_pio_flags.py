@@ -52,9 +52,9 @@ PIO_ARDUINO = {
 
 # The flags compared, besides -mmcu, -std, -O and the defines: those that
 # decide the code.
-CODE_FLAGS = {"-ffunction-sections", "-fdata-sections", "-flto", "-mcall-prologues", "-fno-exceptions",
-              "-fno-threadsafe-statics"}
-LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues",
+CODE_FLAGS = {"-ffunction-sections", "-fdata-sections", "-flto", "-mcall-prologues", "-mstrict-X",
+              "-fno-move-loop-invariants", "-fno-exceptions", "-fno-threadsafe-statics"}
+LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues", "-mstrict-X",
               "-ffunction-sections", "-fdata-sections"}  # (at the link: LTO's own compilation, mk/build.mk)
 
 
@@ -204,7 +204,8 @@ def test_a_mismatch_is_reported(tmp_path):
     ini = (ROOT / "platformio.ini").read_text()
     ini = ini.replace("board_build.f_cpu = 16000000L\nboard_build.variant = standard",
                       "board_build.f_cpu = 8000000L\nboard_build.variant = standard", 1)
-    ini = ini.replace("build_flags = -mcall-prologues -Wl,--relax", "build_flags = -O2 -DEXTRA=1", 1)
+    ini = ini.replace("build_flags = -mcall-prologues -mstrict-X -fno-move-loop-invariants -Wl,--relax",
+                      "build_flags = -O2 -DEXTRA=1", 1)
     assert "8000000L" in ini and "-O2 -DEXTRA=1" in ini
     project = tmp_path / "project"
     project.mkdir()
@@ -216,7 +217,7 @@ def test_a_mismatch_is_reported(tmp_path):
     assert "c define EXTRA: only in PlatformIO" in diffs
     assert "link flags: PlatformIO ['-Wl,--gc-sections', '-fdata-sections', '-ffunction-sections', '-flto', " \
            "'-fuse-linker-plugin'], fsw build ['-Wl,--gc-sections', '-Wl,--relax', '-fdata-sections', " \
-           "'-ffunction-sections', '-flto', '-fuse-linker-plugin', '-mcall-prologues']" in diffs
+           "'-ffunction-sections', '-flto', '-fuse-linker-plugin', '-mcall-prologues', '-mstrict-X']" in diffs
 
 
 @needs_pio

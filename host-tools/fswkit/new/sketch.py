@@ -25,7 +25,8 @@ SKETCH_NAME = re.compile(r"[0-9A-Za-z_][0-9A-Za-z_.-]{0,62}\Z")
 # sketch.yaml names them in a comment.
 # (The link's -ffunction-sections -fdata-sections: LTO compiles the program
 # again there, and a board's VM drops its unused features only then.)
-BUILD_PROPERTIES = {"compiler.c.extra_flags": "-mcall-prologues", "compiler.cpp.extra_flags": "-mcall-prologues",
+SIZE_FLAGS = "-mcall-prologues -mstrict-X -fno-move-loop-invariants"  # mk/build.mk's SIZE_OPT
+BUILD_PROPERTIES = {"compiler.c.extra_flags": SIZE_FLAGS, "compiler.cpp.extra_flags": SIZE_FLAGS,
                     "compiler.c.elf.extra_flags": "-Wl,--relax -ffunction-sections -fdata-sections"}
 
 

@@ -51,10 +51,11 @@ docs-img: setup
 test: setup test-python test-firmware
 
 # pytest on every core (pytest-xdist), a test file's tests on one worker so
-# that a module's costly set-up (a wheel, a firmware build) runs once. One
-# worker more than the cores: the link and ground-station tests spend most of
-# their time waiting on a board paced to the wall clock, and the third worker
-# runs meanwhile. The files marked `costly` go out first, costliest first
+# that a module's costly set-up (a wheel, a firmware build) runs once. Two
+# workers more than the cores: the link and ground-station tests spend most of
+# their time waiting on a board paced to the wall clock, and the others run
+# meanwhile (on 2 cores, 2026-12-07: 178 and 181 s with four workers, 190 and
+# 193 s with three). The files marked `costly` go out first, costliest first
 # (tests/conftest.py); xdist's own order (most tests first) is turned off.
 # Python's compiled bytecode, the test modules' with pytest's rewritten
 # asserts included, is kept in $(BUILD)/pycache between runs, outside the
@@ -63,7 +64,7 @@ test: setup test-python test-firmware
 # again, about 4 s of CPU a worker (and the fswkit modules in every `fsw`
 # the tests start). What the last run compiled in its temporary folders is
 # dropped first, so that the cache does not grow from run to run.
-PYTEST_JOBS ?= $(shell echo $$(( $$(nproc 2>/dev/null || echo 2) + 1 )))
+PYTEST_JOBS ?= $(shell echo $$(( $$(nproc 2>/dev/null || echo 2) + 2 )))
 PYCACHE := $(abspath $(BUILD))/pycache
 test-python: setup
 	rm -rf "$(PYCACHE)$$(realpath -m "$${TMPDIR:-/tmp}")"

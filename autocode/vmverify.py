@@ -60,7 +60,7 @@ REASONS = {
     15: "more pending forward jumps than the verifier tracks",
     16: "the RAM buffer is smaller than the image needs",
     17: "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
-    18: "a window function or value type (F32, F64) the board's VM was built without",
+    18: "a window function, value type or lock the board's VM was built without",
 }
 (OK, BAD_MAGIC, BAD_VERSION, BAD_REAL, BAD_SCHEMA, BAD_SIZE, BAD_ELEMENT, BAD_LOCAL, BAD_STATE,
  BAD_WINDOW, BAD_JUMP, BAD_STACK, BAD_OPCODE, BAD_END, BAD_PLACE, TOO_NESTED, NO_RAM, BAD_MASK,

@@ -118,7 +118,7 @@ const char* const kReasons[] = {
     "more pending forward jumps than the verifier tracks",
     "the RAM buffer is smaller than the image needs",
     "the state mask after the image is not a bit per state of it, or no state in it allows a switch",
-    "a window function or value type (F32, F64) the board's VM was built without",
+    "a window function, value type or lock the board's VM was built without",
 };
 const char* const kReasonNames[] = {
     "kVmOk", "kVmBadMagic", "kVmBadVersion", "kVmBadReal", "kVmBadSchema", "kVmBadSize", "kVmBadElement",

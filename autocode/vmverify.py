@@ -72,18 +72,18 @@ REASONS = {
 # than U32, U64 and bool, a locked state vector. A board's VM has those of
 # its application (features_of); libfswsm's has every one.
 FEAT_F32, FEAT_F64, FEAT_LOCK = 0x20, 0x40, 0x80
-FEAT_WINDOWS = 0x1F
 ALL_FEATURES = 0x3FFF
 # the bit of each type's values (0: always taken)
 TYPE_FEATURES = {"I8": 0x100, "I16": 0x200, "I32": 0x400, "I64": 0x800, "U8": 0x1000, "U16": 0x2000,
                  "U32": 0, "U64": 0, "F32": FEAT_F32, "F64": FEAT_F64, "bool": 0}
+_TYPE_BIT = tuple(TYPE_FEATURES[name] for name in TYPE_CODES)  # by type code
 
 
 def takes(type_code: int, features: int) -> bool:
     """Whether a VM of `features` takes values of this type (fsw_vm.cpp takes())."""
     if type_code >= len(TYPE_SIZES):
         return True  # (an unknown type is refused by its own rule)
-    bit = TYPE_FEATURES[list(TYPE_CODES)[type_code]]
+    bit = _TYPE_BIT[type_code]
     return bit == 0 or bool(features & bit)
 
 
@@ -123,9 +123,7 @@ def board_features(app) -> int:
 def feature_names(features: int) -> list[str]:
     """What `features` holds, in the words of a machine: `roll_avg`...,
     the types beyond U32, U64 and bool, lock."""
-    names = [f"roll_{name}" for name, code in WINDOW_FUNCS.items() if features & (1 << code)]
-    names += [t for t, bit in TYPE_FEATURES.items() if bit and features & bit]
-    return names + (["lock"] if features & FEAT_LOCK else [])
+    return [name for name, bit in FEATURE_BITS.items() if features & bit] + (["lock"] if features & FEAT_LOCK else [])
 
 
 @dataclass(frozen=True)

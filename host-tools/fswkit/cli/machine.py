@@ -90,7 +90,7 @@ def _board_runs(app, m, features: int, path: str, diags: Diagnostics) -> bool:
                         + why.format(fix="declare it with a type the board takes"))
             ok = False
     for w in m.windows:
-        if not features & (1 << V.WINDOW_FUNCS[w.func]):
+        if not features & V.FEATURE_BITS[f"roll_{w.func}"]:
             diags.error(source_or_empty(path), SM, w.line, w.col, f"roll_{w.func}: "
                         + why.format(fix="use a window function the board has"))
             ok = False

@@ -44,8 +44,11 @@ def test_a_locked_archive_stops_archiving_not_the_link(tmp_path, monkeypatch, th
         st.start()
         try:
             time.sleep(1.0)
-            lock = sqlite3.connect(path, isolation_level=None)
-            lock.execute("BEGIN IMMEDIATE")  # another program writes: the station waits 5 s, then gives up
+            # another program writes: the station waits 5 s, then gives up. This
+            # side waits as long as it takes to get the lock between two of the
+            # station's batches (on a loaded machine SQLite's 5 s were too few)
+            lock = sqlite3.connect(path, isolation_level=None, timeout=60)
+            lock.execute("BEGIN IMMEDIATE")
             deadline = time.monotonic() + 15
             while not any("archiving stopped" in n for n in notes) and time.monotonic() < deadline:
                 time.sleep(0.1)

@@ -256,28 +256,33 @@ class Archive:
         if not chunks and not frames:
             return
         self._chunks, self._frames = [], []
+        # the rows are made before the write lock is taken, so that the lock
+        # is held only while SQLite inserts them: another program writing
+        # the archive waits for that, not for this thread's Python
+        rows, samples = [], []
+        for k, (session, ev) in enumerate(frames):
+            region = info = None
+            if ev.kind == "sample":
+                reg = self._regions[ev.stream] if 0 <= ev.stream < len(self._regions) else None
+                region = reg[0] if reg else f"stream {ev.stream}"
+                names = reg[1] if reg else ()
+                samples += [(k, i, _num(t), _json(dict(zip(names, vals)) if names else list(vals)))
+                            for i, (t, vals) in enumerate(ev.samples)]
+            else:
+                info = _json(ev.info)
+            rows.append((k, session, ev.kind, _num(ev.seq), _num(ev.time), float(ev.host_time), region, info))
         con = self._con
         self._begin()
         if chunks:
             con.executemany("INSERT INTO chunks (session, dir, t_ns, data) VALUES (?, ?, ?, ?)", chunks)
-        if frames:
-            (last,) = self._exec("SELECT coalesce(max(id), 0) FROM frames").fetchone()
-            rows, samples = [], []
-            for k, (session, ev) in enumerate(frames, last + 1):
-                region = info = None
-                if ev.kind == "sample":
-                    reg = self._regions[ev.stream] if 0 <= ev.stream < len(self._regions) else None
-                    region = reg[0] if reg else f"stream {ev.stream}"
-                    names = reg[1] if reg else ()
-                    samples += [(k, i, _num(t), _json(dict(zip(names, vals)) if names else list(vals)))
-                                for i, (t, vals) in enumerate(ev.samples)]
-                else:
-                    info = _json(ev.info)
-                rows.append((k, session, ev.kind, _num(ev.seq), _num(ev.time), float(ev.host_time), region, info))
+        if rows:
+            (last,) = con.execute("SELECT coalesce(max(id), 0) FROM frames").fetchone()
+            first = last + 1  # the frames' numbers, taken under the lock
             con.executemany("INSERT INTO frames (id, session, kind, seq, time, host_time, region, info) "
-                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", rows)
+                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?)", ((first + r[0],) + r[1:] for r in rows))
             if samples:
-                con.executemany("INSERT INTO samples (frame, i, time, vals) VALUES (?, ?, ?, ?)", samples)
+                con.executemany("INSERT INTO samples (frame, i, time, vals) VALUES (?, ?, ?, ?)",
+                                ((first + r[0],) + r[1:] for r in samples))
 
     def _commit(self) -> None:
         try:

@@ -43,6 +43,7 @@ def tank(tmp_path):
 ])
 def test_a_fifo_where_a_generated_file_goes_is_refused_at_once(tank, argv, place):
     (tank / place).parent.mkdir(parents=True)
+    (tank / "out" / ".lock").touch()  # a folder the kit built in before (a build goes into no other)
     os.mkfifo(tank / place)
     r = fsw(*argv, cwd=tank)
     assert r.returncode == 1, r.stderr
@@ -73,6 +74,7 @@ def test_a_fifo_in_a_sketch_folder_is_not_the_exports_to_replace(tank):
 
 def test_a_fifo_in_the_build_folders_links_does_not_hang_the_build(tank):
     (tank / "out" / "fsw-libs").mkdir(parents=True)
+    (tank / "out" / ".lock").touch()  # a folder the kit built in before
     os.mkfifo(tank / "out" / "fsw-libs" / ".key")
     r = fsw("build", ".", "--board", "native", "--out", "out", cwd=tank)
     assert r.returncode == 0, r.stderr

@@ -36,11 +36,17 @@ def build(app, out: str) -> int:
 # ---- fsw build -------------------------------------------------------------------------
 
 def cmd_build(args) -> int:
-    from fswkit.target.build import default_out
+    from fswkit.target.build import BuildError, check_out_folder, default_out
 
     app = load_app(args.project, args.board, "build")
     if app is None:
         return EXIT_CONFIG
+    if args.out:
+        try:
+            check_out_folder(args.out)
+        except BuildError as e:
+            sys.stderr.write(f"fsw build: {e}\n")
+            return e.code
     return build(app, args.out or default_out(app))
 
 
@@ -49,7 +55,7 @@ def cmd_build(args) -> int:
 def cmd_flash(args) -> int:
     """Builds the firmware, then uploads it with avrdude (or `pio run -t
     upload`) through the port named, else the only one connected."""
-    from fswkit.target.build import BuildError, build_lock, default_out, firmware_name
+    from fswkit.target.build import BuildError, build_lock, check_out_folder, default_out, firmware_name
     from fswkit.target.flash import FlashError, check_board_on_port, check_port, upload_avrdude, upload_pio
     from fswkit.target.ports import PortError, default_port
 
@@ -62,6 +68,8 @@ def cmd_flash(args) -> int:
                          f"upload (`fsw build --board {board.name}` builds it)\n")
         return EXIT_CONFIG
     try:
+        if args.out:
+            check_out_folder(args.out)
         port, listing = default_port(args.port, "flash")
         if not args.port:
             sys.stderr.write(f"fsw flash: using {listing.label() if listing else port}, "

@@ -29,10 +29,12 @@ def build(project: str, board: str | None = None, out: str | None = None) -> tup
     [budget] included; the ELF and board, or an exit status after saying
     why."""
     from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.target.build import BuildError, default_out, firmware, load
+    from fswkit.target.build import BuildError, check_out_folder, default_out, firmware, load
 
     diags = Diagnostics()
     try:
+        if out:
+            check_out_folder(out)
         app = load(project, diags, board)
     except BuildError as e:
         say(str(e))

@@ -186,7 +186,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     const Executor& ex = *flash_get(c.ex);
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
-        put_u16(l.n.last_seq);
+        put_bytes(&l.n.last_seq, 2);
         ParamStore* const params = flash_get(c.params);
         const LinkParamAckFn param_ack = flash_get(c.param_ack);
         if (params != 0 && param_ack != 0) param_ack(l, *params);
@@ -200,12 +200,12 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put(kLinkProtocol);
         put_u32(flash_get(c.schema));
         put_bytes(tb + 4, 4);
-        put_u32(l.n.frames);
+        put_bytes(&l.n.frames, 4);
         put(FSW_RUNTIME_VERSION_MAJOR);
         put(FSW_RUNTIME_VERSION_MINOR);
         put(FSW_RUNTIME_VERSION_PATCH);
         put(ex.reset_cause);
-        put_u16(l.n.last_seq);
+        put_bytes(&l.n.last_seq, 2);
         put(param_source(c));
     } else if (type == kFrameHealth) {
         put_bytes(tb + 4, 4);

@@ -150,7 +150,7 @@ def _now(app: Application) -> str:
         now = f"fsw::executor_cycles(ex) * {per_cycle}u"
     else:
         now = "fsw::pal::millis64()" if app.time_unit == "ms" else "fsw::pal::micros64()"
-    return f"time_base + {now}" if resumes(app) else now
+    return f"plus_time_base({now})" if resumes(app) else now
 
 
 def resumes(app: Application) -> bool:
@@ -201,6 +201,7 @@ def _resume_begin(app: Application) -> list[str]:
     for g in gs:
         c.append(f"        if (fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u > time_base) "
                  f"time_base = fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u;")
+    c.append("        time_based = true;")
     c.append("        ex.reset_cause = static_cast<uint8_t>(ex.reset_cause | fsw::kResetResumed);")
     if app.reset_cause is not None:
         c.append(f"        sv[E_{app.reset_cause.name}] = ex.reset_cause;")
@@ -230,6 +231,12 @@ def _app_cpp(app: Application) -> str:
         c.append(f"fsw::PyroGate Pyro[{len(app.pyro)}];  // the pyro channels' pulses (docs/safety.md), in [pyro] order")
     if resumes(app):
         c.append(f"uint64_t time_base;  // G when the flight resumed ({app.time_unit}): the clock goes on from there")
+        # the 64-bit addition only after a resume: on an 8-bit MCU a library
+        # routine whose operands take sixteen registers, half of them saved
+        # and restored around it in every caller of the clock
+        c.append("bool time_based;  // a resume set time_base")
+        c.append("FSW_NOINLINE uint64_t add_time_base(uint64_t t) { return time_base + t; }")
+        c.append("inline uint64_t plus_time_base(uint64_t t) { return time_based ? add_time_base(t) : t; }")
     if app.pyro:
         c.append("")
     n = len(app.tasks)

@@ -53,6 +53,9 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     ex.next_due_us = pal::micros32();
 #endif
     ex.mirrors = mirrors;
+#if FSW_TASK_TIMING
+    ex.period_us = c.period_us;
+#endif
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
@@ -98,6 +101,16 @@ inline __attribute__((always_inline)) RowHead row_head(const Task* row) {
     return h;
 }
 
+// The clock, for a task run's time: on the sleeping executor micros32()'s
+// code inline (fsw_pal.h).
+inline __attribute__((always_inline)) uint32_t now_us() {
+#if FSW_SLEEP
+    return pal::micros32_inline();
+#else
+    return pal::micros32();
+#endif
+}
+
 // Where a task's mode lives, for a running cycle: its U8 element, else its
 // TaskStats (mode_byte without the copies of the configuration and the row).
 inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
@@ -108,12 +121,15 @@ inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
 
 // A cycle keeps across a task's step only what the next turn needs: the
 // row, its record, the table's end, the clock's mark and where the mode
-// lives. The state vector's address and the base period are read out of
-// flash when a run needs them (a mode element, a mirror, the overrun test):
-// kept in registers for the whole cycle as well, they pushed the others
-// onto the stack in loop(), where the cycle is inlined (on the rocket's
-// seven tasks, 1,221 AVR cycles a cycle between and around the task steps
-// before, about 1,030 since; a per-instruction profile of the demo flight).
+// lives. The state vector's address is read out of flash when a run needs
+// it (a mode element, a mirror), the base period out of the Executor for
+// the overrun test: kept in registers for the whole cycle as well, they
+// pushed the others onto the stack in loop(), where the cycle is inlined
+// (on the rocket's seven tasks, 1,221 AVR cycles a cycle between and
+// around the task steps before, about 1,030 since; a per-instruction
+// profile of the demo flight). The period from RAM and the clock read
+// inline (now_us) took the time between the rocket's task steps from 70
+// to 58 us a cycle (tools/bench_busy.py, 2026-12-07).
 void executor_run_cycle(Executor& ex) {
     pal::watchdog_kick();
     // The configuration's fields read out of flash one at a time, only those
@@ -126,7 +142,7 @@ void executor_run_cycle(Executor& ex) {
     // One clock read per task run: a run is timed from the previous run's
     // end (the cycle's start for the first) to its own end, so it counts
     // the executor's few instructions that find and start it too.
-    uint32_t mark = pal::micros32();
+    uint32_t mark = now_us();
 #endif
     for (; row != end; ++row, ++sp) {  // a row and its record a turn
         TaskStats& s = *sp;
@@ -151,13 +167,13 @@ void executor_run_cycle(Executor& ex) {
             if (safe != 0) safe(h.ctx);
         }
 #if FSW_TASK_TIMING
-        const uint32_t now = pal::micros32();
+        const uint32_t now = now_us();
         const uint32_t took = now - mark;
         mark = now;
         if (took > s.worst_us) s.worst_us = took;
         // A run within the base period is within the task's (divider >= 1):
         // the product, a 32-bit multiplication, only for the longer ones.
-        const uint32_t period_us = flash_get(f.period_us);
+        const uint32_t period_us = ex.period_us;
         if (took > period_us && took > period_us * flash_get(row->divider) && s.overruns != 0xFFFFu) ++s.overruns;
 #endif
         if (ex.mirrors == 0) continue;  // no row has an element to mirror into

@@ -77,6 +77,11 @@ struct Executor {
     // executor_begin from the table: a cycle then looks at no row's offsets
     // when none does).
     uint8_t mirrors;
+#if FSW_TASK_TIMING
+    // The base period (the configuration's), for each task run's overrun
+    // test: four loads from RAM where flash_get's copy was a call a run.
+    uint32_t period_us;
+#endif
 };
 
 // Cycles run, all 64 bits: `[time] source cycle` keeps counting past the

@@ -111,6 +111,62 @@ IrqState critical_enter();
 void critical_exit(IrqState saved);
 #endif
 
+#if FSW_SLEEP
+// ---- The sleeping executor's cycle timer (psl_arduino.cpp) ---------------------
+// Its state, here so that the executor reads the clock around each task run
+// with micros32()'s code inline (micros32_inline) rather than a call of it.
+#if F_CPU == 16000000L
+#define FSW_T1_TICKS_PER_US 2u  // clk/8: 0.5 us a tick
+#elif F_CPU == 8000000L
+#define FSW_T1_TICKS_PER_US 1u
+#else
+#error "fswkit: the sleeping executor's timer needs F_CPU of 8 or 16 MHz: set FSW_SLEEP=0"
+#endif
+#if !defined(TIMSK1) || !defined(OCIE1B) || !defined(WGM12)
+#error "fswkit: the sleeping executor needs a 16-bit Timer1 with two compare units: set FSW_SLEEP=0"
+#endif
+struct CycleTimer {
+    uint32_t base_us;   // the clock at the start of the running sub-period
+    uint32_t ms;        // milliseconds at that start, and the microseconds past them
+    uint16_t ms_frac;   //   (< 1000)
+    uint16_t sub_us;    // a sub-period, us; as whole ms + us:
+    uint16_t sub_ms;
+    uint16_t sub_frac;
+    uint16_t early;     // OCR1B: the count where the CPU wakes to spin
+    uint16_t quiet;     // the count after which the last sub-period starts no background work
+    uint8_t sub;        // sub-periods ended in this cycle
+    uint8_t last;       // n - 1
+    uint8_t spin;       // period too short to sleep in: spin from mid-period
+    volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
+    volatile uint8_t why;       // why the first of them was missed (CycleWait)
+    volatile uint8_t running;   // a cycle's tasks are running
+    volatile uint8_t woke;      // a compare interrupt ran since cycle_wait() last looked
+};
+extern CycleTimer g_ct;
+
+// The timer's count now, in us past the sub-period's start, and whether a
+// sub-period ended that the interrupt has not counted yet (interrupts off).
+// Always inlined: called, its flag would go through the stack and the call
+// would cost micros32() (once per task run) half its 89 cycles.
+inline __attribute__((always_inline)) uint16_t cycle_elapsed_us(bool& wrapped) {
+    const uint16_t t = TCNT1;
+    wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < g_ct.early;
+    return static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
+}
+// micros32(), inline: the executor's one clock read a task run (a call of
+// micros32() cost about 20 AVR cycles more each, on the rocket's seven
+// tasks about 150 a cycle).
+inline __attribute__((always_inline)) uint32_t micros32_inline() {
+    const IrqState saved = critical_enter();
+    bool wrapped;
+    const uint16_t us = cycle_elapsed_us(wrapped);
+    uint32_t t = g_ct.base_us + us;
+    if (wrapped) t += g_ct.sub_us;
+    critical_exit(saved);
+    return t;
+}
+#endif
+
 // ---- EEPROM -----------------------------------------------------------------
 // Bytes of EEPROM (an ATmega328P's 1,024; the host's model has as many).
 uint16_t eeprom_size();

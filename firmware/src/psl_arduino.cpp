@@ -86,38 +86,10 @@ void boot() {
 // ends; in the last one cycle_wait() then spins, interrupts off, until the
 // count wraps, so a cycle starts within one spin (8 CPU cycles) of its time,
 // whatever handler ran when the CPU woke.
-#if F_CPU == 16000000L
-#define FSW_T1_TICKS_PER_US 2u  // clk/8: 0.5 us a tick
-#elif F_CPU == 8000000L
-#define FSW_T1_TICKS_PER_US 1u
-#else
-#error "fswkit: the sleeping executor's timer needs F_CPU of 8 or 16 MHz: set FSW_SLEEP=0"
-#endif
-#if !defined(TIMSK1) || !defined(OCIE1B) || !defined(WGM12)
-#error "fswkit: the sleeping executor needs a 16-bit Timer1 with two compare units: set FSW_SLEEP=0"
-#endif
+CycleTimer g_ct;  // (fsw_pal.h)
 
 namespace {
 const uint16_t kMaxSubUs = 32000u;  // x 2 ticks fits OCR1A; sums below fit 16 bits
-
-struct CycleTimer {
-    uint32_t base_us;   // the clock at the start of the running sub-period
-    uint32_t ms;        // milliseconds at that start, and the microseconds past them
-    uint16_t ms_frac;   //   (< 1000)
-    uint16_t sub_us;    // a sub-period, us; as whole ms + us:
-    uint16_t sub_ms;
-    uint16_t sub_frac;
-    uint16_t early;     // OCR1B: the count where the CPU wakes to spin
-    uint16_t quiet;     // the count after which the last sub-period starts no background work
-    uint8_t sub;        // sub-periods ended in this cycle
-    uint8_t last;       // n - 1
-    uint8_t spin;       // period too short to sleep in: spin from mid-period
-    volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
-    volatile uint8_t why;       // why the first of them was missed (CycleWait)
-    volatile uint8_t running;   // a cycle's tasks are running
-    volatile uint8_t woke;      // a compare interrupt ran since cycle_wait() last looked
-};
-CycleTimer g_ct;
 
 // A sub-period ended (compare interrupt, or cycle_wait() that waited for it,
 // interrupts off): the clock moves on; true when a cycle is due.
@@ -138,15 +110,6 @@ __attribute__((noinline)) bool sub_period_ended() {
     return true;
 }
 
-// The timer's count now, in us past the sub-period's start, and whether a
-// sub-period ended that the interrupt has not counted yet (interrupts off).
-// Always inlined: called, its flag would go through the stack and the call
-// would cost micros32() (once per task run) half its 89 cycles.
-inline __attribute__((always_inline)) uint16_t elapsed_us(bool& wrapped) {
-    const uint16_t t = TCNT1;
-    wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < g_ct.early;
-    return static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
-}
 }  // namespace
 
 void cycle_timer_begin(uint32_t period_us) {
@@ -241,20 +204,12 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
 
 void cycle_end() { g_ct.running = 0; }
 
-uint32_t micros32() {
-    const IrqState saved = critical_enter();
-    bool wrapped;
-    const uint16_t us = elapsed_us(wrapped);
-    uint32_t t = g_ct.base_us + us;
-    if (wrapped) t += g_ct.sub_us;
-    critical_exit(saved);
-    return t;
-}
+FSW_NOINLINE uint32_t micros32() { return micros32_inline(); }  // out of line as before: its callers elsewhere as they were
 
 uint32_t millis32() {
     const IrqState saved = critical_enter();
     bool wrapped;
-    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + elapsed_us(wrapped));  // < 1000 + 32000
+    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
     uint32_t ms = g_ct.ms;
     if (wrapped) {
         ms += g_ct.sub_ms;

@@ -39,12 +39,6 @@ const uint8_t kTypeT = 0xFE;   // ref_type's type of T
 const uint8_t kJumpIf = 0x80;  // kJInt/kJCmp: jump when the test holds (else when it fails)
 const uint8_t kKeyInclusive = 1, kKeyJumpIf = 2;  // kJKey's flags
 
-// The comparisons' truth over the order of x and c: bit 0 when x < c, bit 1
-// when x == c, bit 2 when x > c, bit 3 when unordered (<, <=, >, >=, ==, !=
-// in kLt..kNe's order).
-const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered (order 2: a NaN)
-inline bool cmp_holds(uint8_t cmp, int8_t order) { return ((flash_get(kCmpMask[cmp & 7u]) >> (order + 1)) & 1u) != 0; }
-
 inline bool is_int(uint8_t t) { return t <= kU64; }
 
 // elem_size() of a type the verifier has checked, from a table in flash
@@ -53,6 +47,15 @@ inline bool is_int(uint8_t t) { return t <= kU64; }
 #define FSW_VM_INLINE inline __attribute__((always_inline))
 const uint8_t kSizes[kBool + 1] FSW_FLASH = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
 FSW_VM_INLINE uint8_t size_of(uint8_t t) { return flash_get(kSizes[t]); }
+
+// The comparisons' truth over the order of x and c: bit 0 when x < c, bit 1
+// when x == c, bit 2 when x > c, bit 3 when unordered (<, <=, >, >=, ==, !=
+// in kLt..kNe's order).
+const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered (order 2: a NaN)
+inline bool cmp_holds(uint8_t cmp, int8_t order) {
+    const uint8_t holds = flash_get(kCmpMask[cmp & 7u]);  // (a bit by a test, no shift loop on an AVR)
+    return (holds & (order < 0 ? 1u : order == 0 ? 2u : order == 1 ? 4u : 8u)) != 0;
+}
 
 // N is 16 bits in the image: every runtime holds a window of 65535 samples.
 static_assert(FSW_WINDOW_MAX_N >= 65535UL, "window sizes of the image");
@@ -214,27 +217,14 @@ uint32_t windows_size(const Im& im, const Offs& o) {
     }
     return size;
 }
-uint32_t windows_size(const Parts& p) {
+// The windows' bytes of a verified image, from its table at `win`.
+FSW_NOINLINE uint32_t ram_of_windows(const uint8_t* win, uint8_t windows) {
     uint32_t size = 0;
-    if (!has(kVmFeatWindows)) return size;  // (a verified image has none)
-    for (uint8_t w = 0; w < p.windows; ++w) size += window_size(p.win[4u * w], u16(p.win + 4u * w + 2u));
+    for (uint8_t w = 0; w < windows; ++w) size += window_size(win[4u * w], u16(win + 4u * w + 2u));
     return size;
 }
-
-// Operand bytes after the opcode; 0xFF for an unknown opcode.
-uint8_t operand_bytes(uint8_t op, uint8_t real) {
-    switch (op) {
-        case kEnd: case kLdt: case kNeg: case kAdd: case kSub: case kMul: case kDiv:
-        case kLt: case kLe: case kGt: case kGe: case kEq: case kNe: case kNot: case kTruth:
-            return 0;
-        case kGoto: case kRoll: case kWpush: return 1;
-        case kJmp: case kJf: case kAnd: case kOr: case kLdl: case kStl: return 2;
-        case kLde: case kSte: return 3;
-        case kConst: return real;
-        case kJKey: case kJInt: case kSetK: case kIAdd: return 2;  // the ref; the rest is the ref's type's
-        case kJCmp: return 3;
-        default: return 0xFF;
-    }
+uint32_t windows_size(const Parts& p) {
+    return has(kVmFeatWindows) ? ram_of_windows(p.win, p.windows) : 0;  // (a verified image has none without)
 }
 
 // Bytes of a typed instruction's operands after its variable of type `t`
@@ -248,6 +238,11 @@ inline uint8_t typed_operands(uint8_t op, uint8_t t) {
 
 // The reason that refuses `ref` where its type does not fit the instruction.
 inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRefT ? kVmBadLocal : kVmBadElement; }
+
+// Whether the image's state vector is locked: never where the VM has no
+// lock (the header's check refuses such an image before its code).
+template <class Im>
+FSW_VM_INLINE bool locked(const Im& im) { return has(kVmFeatLock) && (im[6] & kFlagLock) != 0; }
 
 // The type of a typed instruction's variable (kTypeT for T), or why not. An
 // image whose state vector is locked (kFlagLock) reads and writes elements
@@ -304,6 +299,38 @@ VmReason check_header(const Im& im, uint16_t len, const VmLayout& layout, Offs& 
     return kVmOk;
 }
 
+// What the pass checks of each opcode (kOps), a byte each in flash rather
+// than code each: its operand bytes (bits 0-1; kConst's are R's), the
+// values it pops (bits 2-3) and pushes (bit 4), and the kind of its own
+// rules (bits 5-7); kOpUnknown for no opcode.
+enum OpKind : uint8_t {
+    kKindPlain = 0, kKindEnd, kKindGoto, kKindJump, kKindTyped, kKindJCmp, kKindVar, kKindWindow
+};
+#define FSW_VM_OP(bytes, pops, pushes, kind) static_cast<uint8_t>((bytes) | (pops) << 2 | (pushes) << 4 | (kind) << 5)
+const uint8_t kOpUnknown = 0xFF;  // (3 pops: no opcode's)
+const uint8_t kOpInfo[kJCmp + 1] FSW_FLASH = {
+    FSW_VM_OP(0, 0, 0, kKindEnd), FSW_VM_OP(1, 0, 0, kKindGoto),                                // END GOTO
+    FSW_VM_OP(2, 0, 0, kKindJump), FSW_VM_OP(2, 1, 0, kKindJump),                               // JMP JF
+    FSW_VM_OP(2, 1, 0, kKindJump), FSW_VM_OP(2, 1, 0, kKindJump),                               // AND OR
+    FSW_VM_OP(0, 0, 1, kKindPlain),                                                             // CONST
+    FSW_VM_OP(3, 0, 1, kKindVar), FSW_VM_OP(3, 1, 0, kKindVar),                                 // LDE STE
+    FSW_VM_OP(2, 0, 1, kKindVar), FSW_VM_OP(2, 1, 0, kKindVar),                                 // LDL STL
+    FSW_VM_OP(0, 0, 1, kKindPlain),                                                             // LDT
+    FSW_VM_OP(1, 0, 1, kKindWindow), FSW_VM_OP(1, 1, 0, kKindWindow),                           // ROLL WPUSH
+    kOpUnknown, kOpUnknown,
+    FSW_VM_OP(0, 1, 1, kKindPlain),                                                             // NEG
+    FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),                             // ADD SUB
+    FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),                             // MUL DIV
+    kOpUnknown, kOpUnknown, kOpUnknown,
+    FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // LT LE GT
+    FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // GE EQ NE
+    FSW_VM_OP(0, 1, 1, kKindPlain), FSW_VM_OP(0, 1, 1, kKindPlain),                             // NOT TRUTH
+    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // JKEY JINT: the ref,
+    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // SETK IADD: then its type's
+    FSW_VM_OP(3, 2, 0, kKindJCmp),                                                              // JCMP
+};
+#undef FSW_VM_OP
+
 // One instruction of the code (after the block offsets equal to pc were
 // counted, when a block starts there or a jump lands there): kVmMore, or
 // the pass's verdict once the code is over.
@@ -340,34 +367,35 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
     if ((c.flags & kReachable) == 0) return kVmBadEnd;
     const uint8_t real = im[5];
     const uint8_t op = im[p.code + pc];
-    const uint8_t n = operand_bytes(op, real);
-    if (n == 0xFF || n >= p.code_size - pc) return kVmBadOpcode;  // (pc < code_size)
+    const uint8_t info = op < sizeof kOpInfo ? flash_get(kOpInfo[op]) : kOpUnknown;
+    if (info == kOpUnknown) return kVmBadOpcode;
+    const uint8_t n = op == kConst ? real : static_cast<uint8_t>(info & 3u);
+    if (n >= p.code_size - pc) return kVmBadOpcode;  // (pc < code_size)
     const uint16_t a = static_cast<uint16_t>(p.code + pc + 1u);  // the operands
     pc = static_cast<uint16_t>(pc + 1u + n);
-    uint8_t pops = 0, pushes = 0, jump_depth = 0;
+    const uint8_t pops = static_cast<uint8_t>((info >> 2) & 3u), pushes = static_cast<uint8_t>((info >> 4) & 1u);
+    uint8_t jump_depth = depth;
     uint16_t jump_at = 0;  // a jump's offset operand (0: the instruction does not jump)
     bool ends = false;
     const bool prelude = (c.flags & kPrelude) != 0;
-    switch (op) {
-        case kEnd: ends = true; break;
-        case kGoto:
+    switch (info >> 5) {
+        case kKindEnd: ends = true; break;
+        case kKindGoto:
             if ((c.flags & kMayMove) == 0) return kVmBadPlace;
             if (im[a] >= p.states) return kVmBadState;
             ends = true;
             break;
-        case kJmp: case kJf: case kAnd: case kOr: {
-            pops = op == kJmp ? 0 : 1;
+        case kKindJump:
             if (depth < pops) return kVmBadStack;
             jump_at = a;
             // and/or keep their left operand when they jump; jf drops it.
-            jump_depth = static_cast<uint8_t>(op == kJf ? depth - 1u : depth);
+            if (op == kJf) jump_depth = static_cast<uint8_t>(depth - 1u);
             if (op == kJmp) c.flags &= static_cast<uint8_t>(~kReachable);
             break;
-        }
-        case kJKey: case kJInt: case kSetK: case kIAdd: {
+        case kKindTyped: {
             const uint16_t ref = r16(im, a);
             uint8_t t;
-            const VmReason why = ref_type(im, p, layout, ref, (im[6] & kFlagLock) != 0, t);
+            const VmReason why = ref_type(im, p, layout, ref, locked(im), t);
             if (why != kVmOk) return why;
             const bool fits = op == kJKey ? t == kF32 || t == kF64
                               : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
@@ -384,7 +412,7 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             } else if (op == kIAdd) {
                 const uint16_t src = r16(im, b);
                 uint8_t ts;
-                const VmReason w = ref_type(im, p, layout, src, (im[6] & kFlagLock) != 0, ts);
+                const VmReason w = ref_type(im, p, layout, src, locked(im), ts);
                 if (w != kVmOk) return w;
                 if (!is_int(ts)) return wrong_type(src);
                 // |k| below 2^p (p = R's precision): every integer near k is exact in R.
@@ -394,41 +422,34 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
                 if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
                     return kVmBadOpcode;
                 jump_at = static_cast<uint16_t>(b + at);
-                jump_depth = depth;
             }
             break;
         }
-        case kJCmp: {
+        case kKindJCmp:
             if ((im[a] & ~kJumpIf) > 5u) return kVmBadOpcode;
-            pops = 2;
             if (depth < pops) return kVmBadStack;
             jump_at = static_cast<uint16_t>(a + 1u);
             jump_depth = static_cast<uint8_t>(depth - 2u);
             break;
-        }
-        case kConst: case kLdt: pushes = 1; break;
-        case kLde: case kSte: {
-            const uint16_t e = r16(im, a);
-            if (e >= layout.count || flash_get(layout.elems[e].type) != im[static_cast<uint16_t>(a + 2u)]) return kVmBadElement;
-            if (op == kLde) pushes = 1; else pops = 1;
+        case kKindVar:
+            if (op <= kSte) {  // an element
+                const uint16_t e = r16(im, a);
+                if (e >= layout.count || flash_get(layout.elems[e].type) != im[static_cast<uint16_t>(a + 2u)])
+                    return kVmBadElement;
+            } else if (r16(im, a) >= p.locals) {
+                return kVmBadLocal;
+            }
             break;
-        }
-        case kLdl: case kStl:
-            if (r16(im, a) >= p.locals) return kVmBadLocal;
-            if (op == kLdl) pushes = 1; else pops = 1;
+        case kKindWindow:
+            if (op == kRoll) {
+                if (im[a] >= p.windows || (prelude && im[a] >= c.pushed)) return kVmBadWindow;
+            } else {
+                if (!prelude) return kVmBadPlace;
+                if (im[a] != c.pushed) return kVmBadWindow;
+                ++c.pushed;
+            }
             break;
-        case kRoll:
-            if (im[a] >= p.windows || (prelude && im[a] >= c.pushed)) return kVmBadWindow;
-            pushes = 1;
-            break;
-        case kWpush:
-            if (!prelude) return kVmBadPlace;
-            if (im[a] != c.pushed) return kVmBadWindow;
-            ++c.pushed;
-            pops = 1;
-            break;
-        case kNeg: case kNot: case kTruth: pops = 1; pushes = 1; break;
-        default: pops = 2; pushes = 1; break;  // arithmetic and comparisons
+        default: break;  // constants, T, arithmetic and comparisons: their pops and pushes alone
     }
     if (jump_at != 0) {  // a forward jump: its target and the depth there
         const uint16_t off = r16(im, jump_at);
@@ -619,23 +640,26 @@ void vm_reset(const uint8_t* image, uint8_t* ram, Machine& m, uint32_t initial) 
 
 namespace {
 
-// What one step of a verified image works on.
+// What one step of a verified image works on: the parts it reads, as
+// pointers (the header read again each step costs less than the RAM to
+// keep them).
 struct Run {
-    const uint8_t* im;
-    Parts p;
+    const uint8_t* code;
+    const uint8_t* loc;   // the locals' table: type (u8), offset (u16)
+    const uint8_t* win;   // the windows' table: function (u8), 0, N (u16)
     const VmElem* elems;  // the layout's element table (FSW_FLASH)
     uint8_t* sv;
     uint8_t* ram;
-    uint8_t* loc;
+    uint8_t* locals;  // the locals' bytes in ram
     Machine* m;
     bool lock;
 };
 
 uint8_t* window_at(const Run& r, uint8_t w, uint8_t& func, uint16_t& n) {
     uint8_t* at = r.ram;
-    for (uint8_t k = 0; k < w; ++k) at += window_size(r.p.win[4u * k], u16(r.p.win + 4u * k + 2u));
-    func = r.p.win[4u * w];
-    n = u16(r.p.win + 4u * w + 2u);
+    for (uint8_t k = 0; k < w; ++k) at += window_size(r.win[4u * k], u16(r.win + 4u * k + 2u));
+    func = r.win[4u * w];
+    n = u16(r.win + 4u * w + 2u);
     return at;
 }
 
@@ -696,9 +720,9 @@ void window_push(const Run& r, uint8_t w, Real x) {
 // Where a typed instruction's variable (not T) is, and its type.
 FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
     if (ref >= kRefLocal) {
-        const uint8_t* l = r.p.loc + 3u * (ref - kRefLocal);
+        const uint8_t* l = r.loc + 3u * (ref - kRefLocal);
         t = l[0];
-        return r.loc + u16(l + 1);
+        return r.locals + u16(l + 1);
     }
     const VmElem* e = r.elems + ref;
     t = flash_get(e->type);
@@ -788,12 +812,9 @@ const uint32_t kIntMax[8] FSW_FLASH = {127UL, 32767UL, 2147483647UL, 0, 255UL, 6
 FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
     const uint8_t ns = size_of(ts), wb = sizeof(Wide);
     const bool sign = is_signed(ts);
-    if (ns > wb) {  // the bytes past Wide's must be its sign's
-        const uint8_t fill = sign && (x[ns - 1u] & 0x80u) != 0 ? 0xFF : 0x00;
-        for (const uint8_t* p = x + wb; p != x + ns; ++p)
-            if (*p != fill) return false;
+    if (ns > wb) {  // 8 bytes into a 32-bit Wide: the high word must be the low one's sign, in a word compare
         a = load<Wide>(x);
-        return (a < 0) == (fill != 0);
+        return load<uint32_t>(x + 4) == (a < 0 ? 0xFFFFFFFFUL : 0UL) && (sign || a >= 0);
     }
     if (ns == wb) {
         a = load<Wide>(x);
@@ -827,19 +848,27 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
         if (v > hi) v = hi;
         if (sign && v < -hi - 1) v = -hi - 1;
     }
-    if (nd <= sizeof(Wide)) {
-        memcpy(d, &v, nd);  // its low bytes, little-endian
-        return;
+    // its low bytes, little-endian, by a store of the size (no copy loop);
+    // an 8-byte d from a 32-bit Wide: the high word the sum's sign (only a
+    // signed d is negative here)
+    if (nd == 8) {
+        store<Wide>(d, v);
+        if (sizeof(Wide) == 4) store<uint32_t>(d + 4, v < 0 ? 0xFFFFFFFFUL : 0UL);
+    } else if (nd == 4) {
+        store<uint32_t>(d, static_cast<uint32_t>(v));
+    } else if (nd == 2) {
+        store<uint16_t>(d, static_cast<uint16_t>(v));
+    } else {
+        d[0] = static_cast<uint8_t>(v);
     }
-    memcpy(d, &v, sizeof v);
-    const uint8_t fill = v < 0 ? 0xFF : 0x00;  // (only a signed d is negative here)
-    for (uint8_t i = sizeof(Wide); i < nd; ++i) d[i] = fill;
 }
 
-// The typed instructions, one function each (few live registers, so few
-// saved): each takes its opcode's address and returns the next
-// instruction's (a jump's target when it jumps).
-FSW_NOINLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
+// The typed instructions: each takes its opcode's address and returns the
+// next instruction's (a jump's target when it jumps). The tests and the
+// constant store run inline in run_block's loop (no call, no register
+// saves each); the sum is a function of its own, whose many registers
+// run_block would otherwise save on every block.
+FSW_VM_INLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
     uint8_t t;
     uint8_t* x = ref_at(r, u16(ip + 1), t);
     const uint8_t n = size_of(t);
@@ -861,7 +890,7 @@ FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if
     return holds == jump_if ? o + 2 + u16(o) : o + 2;
 }
 
-FSW_NOINLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
+FSW_VM_INLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
     uint8_t t;
     const uint8_t* x = ref_at(r, u16(ip + 1), t);
     const uint8_t n = float_bytes(t);
@@ -878,7 +907,7 @@ FSW_NOINLINE const uint8_t* op_jint_t(const Run& r, const uint8_t* ip) {
     return test_end(ip + 8, holds, (ip[3] & kJumpIf) != 0);
 }
 
-FSW_NOINLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
+FSW_VM_INLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
     const uint16_t ref = u16(ip + 1);
     if (ref == kRefT) return op_jint_t(r, ip);
     uint8_t t;
@@ -888,17 +917,11 @@ FSW_NOINLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
     return test_end(ip + 4 + size_of(t), holds, (flags & kJumpIf) != 0);
 }
 
-// One typed instruction (kJKey, kJInt, kSetK, kIAdd) at `pc`.
-uint16_t typed(const Run& r, uint16_t pc) {
-    const uint8_t* ip = r.p.code + pc;
-    switch (*ip) {
-        case kSetK: ip = op_setk(r, ip); break;
-        case kIAdd: ip = op_iadd(r, ip); break;
-        case kJKey: ip = op_jkey(r, ip); break;
-        default: ip = op_jint(r, ip); break;
-    }
-    return static_cast<uint16_t>(ip - r.p.code);
-}
+uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one);
+
+// truthy() in one place (two float compares a call on an AVR), for the
+// operand stack's tests.
+FSW_NOINLINE bool vm_truthy(Real r) { return truthy(r); }
 
 // The order of two R values for kJCmp: -1, 0, 1, or 2 when unordered (a NaN).
 int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 : 2; }
@@ -911,7 +934,7 @@ int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 :
 FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
     Real st[FSW_VM_STACK];
     uint8_t sp = 0;
-    const uint8_t* code = r.p.code;
+    const uint8_t* code = r.code;
     for (bool first = true;; first = false) {
         if (!first && sp == 0) return pc;  // the stack is empty again
         const uint8_t op = code[pc];
@@ -922,12 +945,12 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kJmp: pc = static_cast<uint16_t>(pc + 3u + u16(a)); continue;
             case kJf:
                 --sp;
-                pc = static_cast<uint16_t>(pc + 3u + (truthy(st[sp]) ? 0u : u16(a)));
+                pc = static_cast<uint16_t>(pc + 3u + (vm_truthy(st[sp]) ? 0u : u16(a)));
                 continue;
             case kAnd:
             case kOr:
                 // `a and b`: a false leaves 0 and skips b; `a or b`: a true leaves 1.
-                if (truthy(st[sp - 1u]) == (op == kOr)) {
+                if (vm_truthy(st[sp - 1u]) == (op == kOr)) {
                     st[sp - 1u] = real_from_truth(op == kOr);
                     pc = static_cast<uint16_t>(pc + 3u + u16(a));
                 } else {
@@ -938,7 +961,7 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kConst: memcpy(&st[sp++], a, sizeof(Real)); pc = static_cast<uint16_t>(pc + 1u + sizeof(Real)); continue;
             case kLde: {
                 const uint8_t* e = r.sv + flash_get(r.elems[u16(a)].off);
-                if (r.lock) {
+                if (has(kVmFeatLock) && r.lock) {  // (folded away where the VM has no lock)
                     SvGuard<true> g;
                     st[sp++] = vm_read(e, a[2]);
                 } else {
@@ -950,7 +973,7 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kSte: {
                 uint8_t* e = r.sv + flash_get(r.elems[u16(a)].off);
                 --sp;
-                if (r.lock) {
+                if (has(kVmFeatLock) && r.lock) {
                     SvGuard<true> g;
                     vm_write(e, a[2], st[sp]);
                 } else {
@@ -961,14 +984,14 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             }
             case kLdl:
             case kStl: {
-                const uint8_t* l = r.p.loc + 3u * u16(a);
-                uint8_t* at = r.loc + u16(l + 1);
+                const uint8_t* l = r.loc + 3u * u16(a);
+                uint8_t* at = r.locals + u16(l + 1);
                 if (op == kLdl) st[sp++] = vm_read(at, l[0]);
                 else vm_write(at, l[0], st[--sp]);
                 pc = static_cast<uint16_t>(pc + 3u);
                 continue;
             }
-            case kJKey: case kJInt: case kSetK: case kIAdd: pc = typed(r, pc); continue;
+            case kJKey: case kJInt: case kSetK: case kIAdd: (void)run_block(r, pc, &pc); continue;
             case kJCmp: {
                 sp = static_cast<uint8_t>(sp - 2u);
                 const bool holds = cmp_holds(a[0], real_order(st[sp], st[sp + 1u]));
@@ -986,8 +1009,8 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 pc = static_cast<uint16_t>(pc + 2u);
                 continue;
             case kNeg: st[sp - 1u] = -st[sp - 1u]; break;
-            case kNot: st[sp - 1u] = real_from_truth(!truthy(st[sp - 1u])); break;
-            case kTruth: st[sp - 1u] = real_from_truth(truthy(st[sp - 1u])); break;
+            case kNot:
+            case kTruth: st[sp - 1u] = real_from_truth(vm_truthy(st[sp - 1u]) == (op == kTruth)); break;
             default: {
                 const Real y = st[--sp];
                 const Real x = st[sp - 1u];
@@ -997,12 +1020,9 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                     case kSub: z = x - y; break;
                     case kMul: z = x * y; break;
                     case kDiv: z = x / y; break;
-                    case kLt: z = real_from_truth(x < y); break;
-                    case kLe: z = real_from_truth(x <= y); break;
-                    case kGt: z = real_from_truth(x > y); break;
-                    case kGe: z = real_from_truth(x >= y); break;
-                    case kEq: z = real_from_truth(x == y); break;
-                    default: z = real_from_truth(x != y); break;
+                    // the comparisons (kLt..kNe: kCmpMask's order) by the one
+                    // order of x and y that kJCmp takes: no compare of its own each
+                    default: z = real_from_truth(cmp_holds(static_cast<uint8_t>(op - kLt), real_order(x, y))); break;
                 }
                 st[sp - 1u] = z;
                 break;
@@ -1013,19 +1033,26 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
 }
 
 // Runs the block at `pc`: the state id it goes to (0: none). Typed
-// instructions and jumps run here, stack code in run_stack.
-uint32_t run_block(const Run& r, uint16_t pc) {
-    const uint8_t* ip = r.p.code + pc;
+// instructions (inline: no call each) and jumps run here, stack code in
+// run_stack. With `one`, runs the typed instruction at `pc` alone and
+// stores where code goes on there (run_stack's: the compiler emits typed
+// instructions only at depth 0, but any verified image runs).
+FSW_NOINLINE uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one) {
+    const uint8_t* ip = r.code + pc;
     for (;;) {
         switch (*ip) {
             case kEnd: return 0;
             case kGoto: return static_cast<uint32_t>(ip[1]) + 1u;
-            case kJmp: ip += 3 + u16(ip + 1); break;
+            case kJmp: ip += 3 + u16(ip + 1); continue;
             case kJKey: ip = op_jkey(r, ip); break;
             case kJInt: ip = op_jint(r, ip); break;
             case kSetK: ip = op_setk(r, ip); break;
             case kIAdd: ip = op_iadd(r, ip); break;
-            default: ip = r.p.code + run_stack(r, static_cast<uint16_t>(ip - r.p.code)); break;
+            default: ip = r.code + run_stack(r, static_cast<uint16_t>(ip - r.code)); continue;
+        }
+        if (one != nullptr) {
+            *one = static_cast<uint16_t>(ip - r.code);
+            return 0;
         }
     }
 }
@@ -1034,13 +1061,18 @@ uint32_t run_block(const Run& r, uint16_t pc) {
 
 namespace {
 
-void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
-    r.im = image;
-    step_parts(image, r.p);
+// The step's view of a verified image (whose parts all lie within its at
+// most 65535 bytes: 16-bit sums); its state table is at kHeader.
+FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram,
+                            Machine& m) {
+    r.loc = image + kHeader + 6u * image[18];
+    r.win = r.loc + 3u * u16(image + 20);
+    r.code = r.win + 4u * image[19] + u16(image + 22);
     r.elems = layout.elems;
     r.sv = sv;
     r.ram = ram;
-    r.loc = r.p.windows == 0 ? ram : ram + windows_size(r.p);
+    r.locals = ram;
+    if (has(kVmFeatWindows) && image[19] != 0) r.locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
     r.m = &m;
     r.lock = has(kVmFeatLock) && (image[6] & kFlagLock) != 0;  // (a verified image is locked only where built so)
 }
@@ -1052,7 +1084,7 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
     run_init(r, image, layout, sv, ram, m);
     uint8_t* g = sv + flash_get(layout.elems[u16(image + 14)].off);
     uint8_t* s = sv + flash_get(layout.elems[u16(image + 16)].off);
-    if (r.lock) {  // as a generated step() over a locked state vector
+    if (has(kVmFeatLock) && r.lock) {  // as a generated step() over a locked state vector
         uint64_t now;
         {
             SvGuard<true> lock;
@@ -1066,15 +1098,17 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
     } else if (machine_begin(m, g, s) != kOk) {
         return kErrTime;
     }
-    if (r.p.code[r.p.prelude] != kEnd && run_block(r, r.p.prelude) != 0) return kErrConfig;  // unreachable when verified
-    if (m.state == 0 || m.state > r.p.states) return kOk;
-    const uint8_t* blocks = r.p.st + 6u * (m.state - 1u);
+    const uint16_t prelude = u16(image + 24);
+    if (r.code[prelude] != kEnd && run_block(r, prelude, nullptr) != 0) return kErrConfig;  // unreachable when verified
+    const uint8_t states = image[18];
+    if (m.state == 0 || m.state > states) return kOk;
+    const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(m.state - 1u);
     const uint16_t entry = u16(blocks), step = u16(blocks + 2), exit = u16(blocks + 4);
     uint32_t next = 0;
-    if (m.entering != 0 && entry != kNone) next = run_block(r, entry);
-    if (next == 0 && step != kNone) next = run_block(r, step);
+    if (m.entering != 0 && entry != kNone) next = run_block(r, entry, nullptr);
+    if (next == 0 && step != kNone) next = run_block(r, step, nullptr);
     if (next != 0) {
-        if (exit != kNone) (void)run_block(r, exit);
+        if (exit != kNone) (void)run_block(r, exit, nullptr);
         machine_transition(m, next);
     }
     return kOk;
@@ -1084,9 +1118,9 @@ void vm_leave(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t
     if (m.started == 0 || m.pending != 0) return;  // no state entered, or the last one already left
     Run r;
     run_init(r, image, layout, sv, ram, m);
-    if (m.state == 0 || m.state > r.p.states) return;
-    const uint16_t exit = u16(r.p.st + 6u * (m.state - 1u) + 4u);
-    if (exit != kNone) (void)run_block(r, exit);
+    if (m.state == 0 || m.state > image[18]) return;
+    const uint16_t exit = u16(image + kHeader + 6u * (m.state - 1u) + 4u);
+    if (exit != kNone) (void)run_block(r, exit, nullptr);
 }
 
 }  // namespace fsw

@@ -10,8 +10,14 @@
 #include <avr/sleep.h>
 
 inline void report_cycles(uint32_t average, uint16_t worst, uint8_t state) {
+    // Two reads back to back with interrupts off: an interrupt between them
+    // (Timer0's, every 16,384 cycles) would count its own cycles as the
+    // timing's cost, subtracted from every step's average.
+    const uint8_t sreg = SREG;
+    cli();
     const uint16_t t0 = TCNT1;
     const uint16_t t1 = TCNT1;
+    SREG = sreg;
     Serial.print("cycles ");
     Serial.print(average);
     Serial.print(" worst ");

@@ -133,10 +133,10 @@ def test_rendering_is_cheap():
 
     v, last = rocket_view()
     con = Console(record=True, width=80, height=24, file=io.StringIO())
-    start = time.perf_counter()
+    start = time.process_time()  # CPU time: a loaded machine's other work is not the view's cost
     for i in range(40):
         con.print(render(v.session, last + i / 8, v.title, (80, 24), v.sparks, v.last_frame, "", T0))
-    assert (time.perf_counter() - start) / 40 < 0.03  # 8 views a second take a small part of one
+    assert (time.process_time() - start) / 40 < 0.03  # 8 views a second take a small part of one
 
 
 # ---- sparklines ---------------------------------------------------------------------

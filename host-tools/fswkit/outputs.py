@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 import signal
 import stat
 import sys
@@ -26,6 +27,11 @@ import threading
 # fswkit.link.log writes it; recordings are never overwritten unasked.
 RECORDING_MAGIC = b"FSWLOG1\n"
 ARCHIVE_ID = 0x46535741  # "FSWA": a ground station archive's PRAGMA application_id (fswkit.ground.archive)
+
+
+# A compiler, assembler or linker that could not write a file says one of
+# these: the disk's fault (full, over quota, read-only), not the code's.
+HOST_WRITE = re.compile(r"No space left on device|Disk quota exceeded|Read-only file system")
 
 
 class OutputError(Exception):
@@ -326,19 +332,36 @@ def stopped_by_signals():
             signal.signal(sig, handler)
 
 
+# The line by which a command's output names it, among its first lines
+# (`fsw graph`: DOT's first, Mermaid's second; `fsw skeleton`: the first):
+# a file that only mentions the command (notes, a README) is not its output.
+OWN_HEADS = {
+    "graph": re.compile(r"\s*(?://|%%) state machine .+: `fsw graph(?: --format mermaid)?` output"),
+    "skeleton": re.compile(r"# State-script skeleton for .+, made by `fsw skeleton`"),
+}
+
+
+def _own_head(start: bytes, command: str) -> bool:
+    """Whether the first lines of a file (`start`) are those of `fsw COMMAND`'s output."""
+    head = OWN_HEADS.get(command)
+    lines = start.decode("utf-8", "replace").splitlines()[:3]
+    if head is None:
+        return any(f"`fsw {command}" in line for line in lines)
+    return any(head.match(line) for line in lines)
+
+
 def only_its_own(path: str | None, command: str, force: bool = False, head: int = 8192,
                  starts: bytes | None = None, what: str = "output") -> None:
     """Refuses (OutputError) to replace a regular, non-empty file at `path`
-    whose first `head` bytes do not name `fsw COMMAND`, as the command's
-    own output does in its first lines (`fsw graph`, `fsw skeleton`), or
-    that does not begin with `starts` when given (a trace's header): a
-    file the user wrote there, a state script beside its machine, is not
-    this command's to replace unless asked (`force`). Standard output,
-    devices, FIFOs and paths with nothing there pass."""
-    mark = f"`fsw {command}"
+    whose first lines are not the command's own head line (OWN_HEADS: `fsw
+    graph`, `fsw skeleton`; a file that only mentions the command is not
+    its output), or that does not begin with `starts` when given (a
+    trace's header): a file the user wrote there, a state script beside
+    its machine, is not this command's to replace unless asked (`force`).
+    Standard output, devices, FIFOs and paths with nothing there pass."""
     if path is None or path == "-" or force or is_direct(path):
         return
     start = file_head(path, head)  # None: nothing there to lose (or unreadable: the write says why)
-    if start and not (start.startswith(starts) if starts is not None else mark.encode() in start):
+    if start and not (start.startswith(starts) if starts is not None else _own_head(start, command)):
         raise OutputError(f"{path} exists and is not an earlier {what} of `fsw {command}` (a file you wrote?): "
                           "it is replaced only when asked (--force)")

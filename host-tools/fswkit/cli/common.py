@@ -75,11 +75,11 @@ def write_output(text: str, out: str | None, command: str, inputs=(), own: bool 
     """`text` to `out` (standard output for None or "-"). `own`: the text
     names `fsw COMMAND` in its first lines, and a file there that does not
     (one the user wrote) is replaced only with `force`."""
-    from fswkit.outputs import OutputError, check, only_its_own, write_text
+    from fswkit.outputs import OutputError, _own_head, check, only_its_own, write_text
 
     try:
         if own:
-            assert f"`fsw {command}" in text[:8192], "the output names its command (in its first lines)"
+            assert _own_head(text[:8192].encode(), command), "the output names its command (its head line)"
             if out not in (None, "-"):
                 check(out, inputs)  # an input, a recording, a folder: said as such first
             only_its_own(out, command, force)

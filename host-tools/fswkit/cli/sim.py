@@ -90,6 +90,9 @@ def board_run(args) -> int:
     if args.link is not None and link_problem(args.link) is not None:
         say(link_problem(args.link))
         return 2
+    if args.eeprom_file is not None and _memory_file_problem(args.eeprom_file, "--eeprom-file") is not None:
+        say(_memory_file_problem(args.eeprom_file, "--eeprom-file"))
+        return 2
     if is_elf(args.project) or args.project.endswith(".elf"):
         if args.board is None:
             say(f"{args.project}: a firmware ELF needs --board (the board it was built for, e.g. uno)")
@@ -153,7 +156,38 @@ def board_run(args) -> int:
                  f"{ram.total:,} of {ram.ram:,} B")
         except SimError as e:
             say(f"stack not measured: {e}")
-    return 1 if r.stop == "crashed" else 0
+    for why in b.save_errors:  # the board's memory was not kept: said, never a silent success
+        say(why)
+    return 1 if r.stop == "crashed" or b.save_errors else 0
+
+
+def _memory_file_problem(path: str, option: str) -> str | None:
+    """What forbids keeping a memory of the board in `path` (read at the
+    start, replaced at the end), or None: it must be a regular file, or
+    nothing yet, in a folder that exists, and never a recording (a FIFO
+    would wait for a writer, a folder or a device is not a memory's file)."""
+    import stat
+
+    from fswkit.outputs import recording
+
+    if not path:
+        return f"{option} needs a path (the file that keeps the memory)"
+    if os.path.isdir(path):
+        return f"{option} {path}: it is a folder (name a file to keep the memory in)"
+    if os.path.exists(path):
+        try:
+            regular = stat.S_ISREG(os.stat(path).st_mode)
+        except OSError as e:
+            return f"{option} {path}: {e.strerror or e}"
+        if not regular:
+            return f"{option} {path}: not a regular file (a FIFO, a device): the memory is kept in a file"
+        kind = recording(path)
+        if kind is not None:
+            return f"{option} {path}: {kind} (a recording) is there: it is never overwritten; choose another name"
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        return f"{option} {path}: no such folder {folder}"
+    return None
 
 
 def plant_run(args) -> int:

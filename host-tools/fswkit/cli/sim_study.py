@@ -20,7 +20,7 @@ def study_run(args) -> int:
     from fswkit.progress import progress
     from fswkit.plant import study
     from fswkit.plant.params import ParamsError
-    from fswkit.plant.run import SetupError, prepare
+    from fswkit.plant.run import SetupError, prepare, refuse_users_files
     from fswkit.sim.command import build, is_elf, say
     from fswkit.target.build import default_out
 
@@ -81,6 +81,7 @@ def study_run(args) -> int:
         os.makedirs(out, exist_ok=True)
         for name in STUDY_FILES:
             check(os.path.join(out, name), [params, args.dispersion], what="study's " + name)
+        refuse_users_files(out, STUDY_FILES)
     except OutputError as e:
         say(str(e))
         return 2

@@ -61,7 +61,11 @@ class LogWriter:
         except OSError as e:
             raise LogError(f"cannot write {path}: {e.strerror or e}") from None
         head = json.dumps({"format": 1, "layout": layout.raw, **meta}, sort_keys=True).encode()
-        self._write(MAGIC + struct.pack("<I", len(head)) + head)
+        try:
+            self._write(MAGIC + struct.pack("<I", len(head)) + head)
+        except LogError:  # a full disk from the start: no temporary file left beside the path
+            self.close(keep=False)
+            raise
 
     def _write(self, data: bytes) -> None:
         view = memoryview(data)

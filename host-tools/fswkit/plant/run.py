@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import os
 import shutil
+import struct
 import sys
 import tempfile
 from dataclasses import dataclass
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.outputs import Stopped, stopped_by_signals
+from fswkit.outputs import RECORDING_MAGIC, OutputError, Stopped, file_head, stopped_by_signals
 
 from . import report as reports
 from .cosim import Run, fly
@@ -172,6 +174,62 @@ def refuse_inputs(out: str, inputs, extra=()) -> None:
 
     for name in list(FILES.values()) + list(extra):
         not_an_input(os.path.join(out, name), inputs, what=f"flight's {name}")
+    refuse_users_files(out, list(FILES.values()) + list(extra) + [INCOMPLETE])
+
+
+def _kit_log(path: str) -> bool:
+    """Whether `path` is a link log a run of `fsw sim` wrote (its header's
+    "source"), not a recording of a real link."""
+    head = file_head(path, len(RECORDING_MAGIC) + 4)
+    if head is None or len(head) < len(RECORDING_MAGIC) + 4 or not head.startswith(RECORDING_MAGIC):
+        return False
+    n = struct.unpack("<I", head[len(RECORDING_MAGIC):])[0]
+    if n > 1 << 22:
+        return False
+    whole = file_head(path, len(head) + n)
+    try:
+        meta = json.loads(whole[len(head):])
+    except (TypeError, ValueError):
+        return False
+    return isinstance(meta, dict) and str(meta.get("source", "")).startswith("fsw sim")
+
+
+# What shows that a folder holds the files of an earlier run of `fsw sim`:
+# the run's link log, the table of a study or of a tape's perturbed
+# replays, the note of a run that did not finish (their first bytes).
+_RUN_MARKS = {"study.txt": b"dispersion study: ", "perturb.txt": b"robustness: ",
+              os.path.join(INCOMPLETE, "INCOMPLETE.txt"): b"This run did not finish"}
+
+
+def is_run_folder(out: str) -> bool:
+    """Whether an earlier run of `fsw sim` wrote the folder `out` (_RUN_MARKS)."""
+    if _kit_log(os.path.join(out, FILES["log"])):
+        return True
+    for name, mark in _RUN_MARKS.items():
+        head = file_head(os.path.join(out, name), len(mark))
+        if head is not None and head == mark:
+            return True
+    return False
+
+
+def refuse_users_files(out: str, names) -> None:
+    """Before any work: an OutputError when `out` holds any of `names`, the
+    files (and the `incomplete` folder) a run writes, replaces or removes
+    there, and is not a folder an earlier run of `fsw sim` wrote
+    (`is_run_folder`): a flight's files replace only an earlier run's,
+    never a user's `flight.csv`, `summary.txt`, link log or folder."""
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise OutputError(f"{out} is a file, not a folder: name a folder for the run's files (--out)")
+    there = [n for n in names if os.path.lexists(os.path.join(out, n))]
+    odd = [n for n in there if n != INCOMPLETE and not os.path.isfile(os.path.join(out, n))]
+    if odd:  # a folder, a FIFO, a device where a file goes: the set could not be moved in whole
+        raise OutputError(f"{os.path.join(out, odd[0])} is not a regular file: a run's {odd[0]} replaces only a "
+                          "file; move it away, or name another --out")
+    if not there or is_run_folder(out):
+        return
+    shown = ", ".join(there[:4]) + (f" and {len(there) - 4} more" if len(there) > 4 else "")
+    raise OutputError(f"{out} holds files an earlier run of fsw sim did not write ({shown}): a run replaces "
+                      "only its own files; name another --out, or move them away")
 
 
 def _execute(sc, elf, board, layout, folder: str | None) -> Flight:

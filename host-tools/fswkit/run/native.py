@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import errno
 import hashlib
 import os
 import re
@@ -97,11 +98,26 @@ def _key(files: dict[str, str], real: Real) -> str:
 
 
 def _compile(cmd: list[str], out: str, cwd: str | None = None) -> None:
+    """Runs the compiler: a failure is NativeError (the kit's defect), or
+    OSError naming the cache folder when the disk there is full or
+    read-only (the machine's: said as such)."""
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
     if r.returncode != 0:
+        from fswkit.outputs import HOST_WRITE
+
         log = out + ".log"
-        with open(log, "w") as f:
-            f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+        folder = os.path.dirname(out)
+        try:
+            with open(log, "w") as f:
+                f.write(" ".join(cmd) + "\n" + r.stdout + r.stderr)
+        except OSError as e:
+            raise OSError(e.errno, f"cannot write the native runner's build there: {e.strerror or e} "
+                          "(FSW_CACHE_DIR names another folder)", folder) from None
+        full = sorted({m.group(0) for line in (r.stdout + r.stderr).splitlines() for m in [HOST_WRITE.search(line)]
+                       if m})
+        if full:  # the disk, not the kit
+            raise OSError(errno.ENOSPC, f"cannot write the native runner's build there: {'; '.join(full)} "
+                          f"(the compiler's output: {log}; FSW_CACHE_DIR names another folder)", folder)
         errors = [line.strip()[:300] for line in r.stderr.splitlines() if "error:" in line]
         raise NativeError("internal error: the generated code did not compile, although the script and "
                           f"its machine are valid: a defect of fswkit, please report it with {log}" +

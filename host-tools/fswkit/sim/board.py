@@ -959,8 +959,11 @@ class SimBoard:
         return RamUsage(end - start, stack, end - start + stack, top - start)
 
     # -- end --
+    save_errors: tuple = ()  # after close(): why a flash or EEPROM file could not be saved (the harness's words)
+
     def close(self) -> int:
-        """Stops the board; returns the harness's exit status."""
+        """Stops the board; returns the harness's exit status (`save_errors`
+        says why, when a memory's file could not be saved)."""
         if self._proc.poll() is None:
             try:
                 if not self._closed:
@@ -978,6 +981,9 @@ class SimBoard:
             self._out.close()
         except OSError:
             pass
+        if self._proc.returncode and not self.save_errors:  # a memory's file it could not write at the end
+            self.save_errors = tuple(line.split("simboard: ", 1)[-1] for line in self._stderr().splitlines()
+                                     if "cannot save the" in line)
         self._err.close()
         return self._proc.returncode
 

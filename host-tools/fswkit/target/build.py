@@ -98,11 +98,39 @@ def check_out_folder(out: str) -> None:
         raise BuildError(f"{out} is a file, not a folder: name a folder for the build (--out)") from None
     except OSError as e:
         raise BuildError(f"cannot read the build folder {out}: {e.strerror or e}") from None
-    if not names or ".lock" in names:
+    if not names or _kit_lock(os.path.join(out, ".lock")):
         return
     shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
+    hint = ""
+    if ".lock" not in names and _kit_log(log_path(out)):
+        hint = (f" (its build.log is a build's, but its .lock is gone: if you know the folder holds nothing of "
+                f"yours, `touch {os.path.join(out, '.lock')}` makes it a build folder again)")
     raise BuildError(f"{out} holds files a build of fswkit did not write ({shown}): a build goes into a new "
-                     "folder, an empty one, or one fswkit built in before; name another --out")
+                     f"folder, an empty one, or one fswkit built in before; name another --out{hint}")
+
+
+def _kit_log(path: str) -> bool:
+    """Whether `path` begins as a build's `build.log` does (`make`'s command line on mk/build.mk)."""
+    from fswkit.outputs import file_head
+
+    head = file_head(path, 4096)
+    first = head.split(b"\n", 1)[0] if head else b""
+    return first.startswith(b"make --no-print-directory ") and b"build.mk " in first
+
+
+def _kit_lock(path: str) -> bool:
+    """Whether `path` is the `.lock` a build of the kit left (`build_lock`):
+    a regular file, not a link, holding nothing or a process id. Another
+    tool's `.lock` in a user's folder does not make it a build folder."""
+    try:
+        st = os.lstat(path)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > 32:
+            return False
+        with open(path, "rb") as f:
+            text = f.read(33)
+    except OSError:
+        return False
+    return re.fullmatch(rb"(\d+\n)?", text) is not None
 
 
 def _write_whole(path: str, data: bytes) -> None:
@@ -307,7 +335,16 @@ def build_lock(out: str, command: str = "build"):
         finally:
             _held[key] -= 1
         return
-    fd = os.open(os.path.join(out, ".lock"), os.O_RDWR | os.O_CREAT, 0o644)
+    lock = os.path.join(out, ".lock")
+    try:  # never through a symbolic link: truncating it would empty whatever file it names
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o644)
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise OSError(errno.EEXIST, "not a regular file")
+    except OSError as e:
+        odd = {errno.ELOOP: "a symbolic link", errno.EEXIST: "not a regular file"}.get(e.errno)
+        why = f"{lock} is {odd} (move it away)" if odd else e.strerror or str(e)
+        raise BuildError(f"cannot lock the build folder {out}: {why}") from None
     try:
         if not _try_lock(fd):
             holder = _holder(fd)
@@ -460,10 +497,11 @@ def overflows(proc: subprocess.CompletedProcess) -> bool:
 
 
 def explain_failure(app: Application, out: str, proc: subprocess.CompletedProcess) -> tuple[bool, str]:
-    """Why a build failed: (the firmware does not fit, the message). A
+    """Why a build failed: (not the kit's fault: exit 1, the message). A
     linker that runs out of the MCU's memory is answered with what uses it
-    (`size_report`); anything else that fails on a checked configuration is
-    a defect of the kit, reported with the build log."""
+    (`size_report`), a disk that is full (or read-only) as such; anything
+    else that fails on a checked configuration is a defect of the kit,
+    reported with the build log."""
     log = log_path(out)
     output = (proc.stdout + proc.stderr).splitlines()
     if app.board.is_avr and overflows(proc):
@@ -474,6 +512,11 @@ def explain_failure(app: Application, out: str, proc: subprocess.CompletedProces
         return True, (f"the firmware does not fit the {app.board.name} ({app.board.mcu}): "
                       + ("; ".join(said) if said else "the linker ran out of memory")
                       + f" (the linker's output: {log})")
+    from fswkit.outputs import HOST_WRITE
+
+    full = sorted({m.group(0) for line in output for m in [HOST_WRITE.search(line)] if m})
+    if full:  # the machine's fault, not the kit's: said as such, exit 1
+        return True, (f"cannot write the build folder {out}: {'; '.join(full)} (the compiler's output: {log})")
     lines = [line.strip() for line in output if ERROR_LINE.search(line)] or [line.strip() for line in output[-3:]]
     shown = [("  " + line[:300] + (" ..." if len(line) > 300 else "")) for line in lines[:6]]
     more = f"\n  ... and {len(lines) - 6} more" if len(lines) > 6 else ""

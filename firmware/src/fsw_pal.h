@@ -9,6 +9,25 @@
 #if defined(__AVR__)
 #include <avr/interrupt.h>
 #include <avr/io.h>
+// The start and end of a naked interrupt handler (ISR_NAKED) that uses
+// r24, r25 and Z and changes the status register: they are saved, the
+// status register through r24, and put back before `reti` (the ADC's scan,
+// the UART's receive handler).
+#define FSW_ISR_SAVE_R24_R25_Z \
+    "push r24\n\t"             \
+    "in   r24, __SREG__\n\t"   \
+    "push r24\n\t"             \
+    "push r25\n\t"             \
+    "push r30\n\t"             \
+    "push r31\n\t"
+#define FSW_ISR_RESTORE_R24_R25_Z_RETI \
+    "pop  r31\n\t"                     \
+    "pop  r30\n\t"                     \
+    "pop  r25\n\t"                     \
+    "pop  r24\n\t"                     \
+    "out  __SREG__, r24\n\t"           \
+    "pop  r24\n\t"                     \
+    "reti\n\t"
 #endif
 
 namespace fsw {

@@ -280,12 +280,7 @@ bool adc_scan_start(const uint8_t* pins, uint8_t stride, uint8_t n, volatile uin
 // r0, r1 and r18 and cleared r1; the C handler below, in assembly.
 ISR(ADC_vect, ISR_NAKED) {
     __asm__ __volatile__(
-        "push r24\n\t"
-        "in   r24, __SREG__\n\t"
-        "push r24\n\t"
-        "push r25\n\t"
-        "push r30\n\t"
-        "push r31\n\t"
+        FSW_ISR_SAVE_R24_R25_Z
         "lds  r24, %[adcl]\n\t"  // ADCL first: it latches ADCH
         "lds  r25, %[adch]\n\t"
         "lds  r30, %[raw]\n\t"
@@ -322,13 +317,7 @@ ISR(ADC_vect, ISR_NAKED) {
         "andi r24, %[stop]\n\t"
         "3:\n\t"
         "sts  %[adcsra], r24\n\t"
-        "pop  r31\n\t"
-        "pop  r30\n\t"
-        "pop  r25\n\t"
-        "pop  r24\n\t"
-        "out  __SREG__, r24\n\t"
-        "pop  r24\n\t"
-        "reti\n\t" ::[adcl] "n"(_SFR_MEM_ADDR(ADCL)),
+        FSW_ISR_RESTORE_R24_R25_Z_RETI ::[adcl] "n"(_SFR_MEM_ADDR(ADCL)),
         [adch] "n"(_SFR_MEM_ADDR(ADCH)), [raw] "i"(&fsw::pal::g_scan.raw), [left] "i"(&fsw::pal::g_scan.left),
         [pin] "i"(&fsw::pal::g_scan.pin), [stride] "i"(&fsw::pal::g_scan.stride), [a0] "M"(A0),
         [refs] "M"(_BV(REFS0)), [admux] "n"(_SFR_MEM_ADDR(ADMUX)), [adcsra] "n"(_SFR_MEM_ADDR(ADCSRA)),

@@ -96,12 +96,7 @@ inline uint8_t tx_index(uint8_t lo) { return static_cast<uint8_t>((lo - reinterp
 //     }
 ISR(FSW_UART_RX_VECT, ISR_NAKED) {
     __asm__ __volatile__(
-        "push r24\n\t"
-        "in   r24, __SREG__\n\t"
-        "push r24\n\t"
-        "push r25\n\t"
-        "push r30\n\t"
-        "push r31\n\t"
+        FSW_ISR_SAVE_R24_R25_Z
         "lds  r25, %[udr]\n\t"  // read whatever happens: it clears the interrupt's flag
         "lds  r30, %[head]\n\t"
         "mov  r24, r30\n\t"
@@ -116,13 +111,7 @@ ISR(FSW_UART_RX_VECT, ISR_NAKED) {
         "st   Z, r25\n\t"
         "sts  %[head], r24\n\t"
         "1:\n\t"
-        "pop  r31\n\t"
-        "pop  r30\n\t"
-        "pop  r25\n\t"
-        "pop  r24\n\t"
-        "out  __SREG__, r24\n\t"
-        "pop  r24\n\t"
-        "reti\n\t" ::[udr] "n"(_SFR_MEM_ADDR(UDR0)),
+        FSW_ISR_RESTORE_R24_R25_Z_RETI ::[udr] "n"(_SFR_MEM_ADDR(UDR0)),
         [head] "i"(&g_rx_head), [tail] "i"(&g_rx_tail), [ring] "i"(g_rx), [mask] "M"(kRxMask)
         : "memory");  // it fills the ring console_read empties
 }

@@ -303,8 +303,8 @@ def firmware(app: Application, out: str, *, command: str = "build", jobs: int = 
             generate(app, os.path.join(out, "gen"))
             artifact, proc = make(app, out, jobs)
             if proc.returncode != 0:
-                too_big, message = explain_failure(app, out, proc)
-                raise BuildError(message, EXIT_FAIL if too_big else EXIT_INTERNAL)
+                not_ours, message = explain_failure(app, out, proc)
+                raise BuildError(message, EXIT_FAIL if not_ours else EXIT_INTERNAL)
             if not app.board.is_avr:
                 return Built(app, out, artifact)
             size = size_of(app, *elf_size(artifact))

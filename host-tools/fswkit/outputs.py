@@ -34,6 +34,12 @@ ARCHIVE_ID = 0x46535741  # "FSWA": a ground station archive's PRAGMA application
 HOST_WRITE = re.compile(r"No space left on device|Disk quota exceeded|Read-only file system")
 
 
+def host_write_faults(lines) -> list[str]:
+    """What a tool's output lines say of a disk it could not write
+    (HOST_WRITE: each line's first, each once, sorted); empty when none."""
+    return sorted({m.group(0) for m in map(HOST_WRITE.search, lines) if m})
+
+
 class OutputError(Exception):
     """An output that cannot be written: message printed, exit 1."""
 

@@ -197,10 +197,9 @@ def library_path(real: str = "f64") -> str:
                    + sources() + ["-o", os.path.join(tmp, os.path.basename(lib))])
             r = subprocess.run(cmd, capture_output=True, text=True)
             if r.returncode != 0:
-                from fswkit.outputs import HOST_WRITE
+                from fswkit.outputs import host_write_faults
 
-                full = sorted({m.group(0) for ln in (r.stdout + r.stderr).splitlines() for m in [HOST_WRITE.search(ln)]
-                               if m})
+                full = host_write_faults((r.stdout + r.stderr).splitlines())
                 if full:  # the disk, not the kit
                     raise BuildError(f"cannot write libfswsm{bits} into the kit's cache {native.cache_dir()}: "
                                      f"{'; '.join(full)} (FSW_CACHE_DIR names another folder)")

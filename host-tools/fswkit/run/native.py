@@ -103,7 +103,7 @@ def _compile(cmd: list[str], out: str, cwd: str | None = None) -> None:
     read-only (the machine's: said as such)."""
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
     if r.returncode != 0:
-        from fswkit.outputs import HOST_WRITE
+        from fswkit.outputs import host_write_faults
 
         log = out + ".log"
         folder = os.path.dirname(out)
@@ -113,8 +113,7 @@ def _compile(cmd: list[str], out: str, cwd: str | None = None) -> None:
         except OSError as e:
             raise OSError(e.errno, f"cannot write the native runner's build there: {e.strerror or e} "
                           "(FSW_CACHE_DIR names another folder)", folder) from None
-        full = sorted({m.group(0) for line in (r.stdout + r.stderr).splitlines() for m in [HOST_WRITE.search(line)]
-                       if m})
+        full = host_write_faults((r.stdout + r.stderr).splitlines())
         if full:  # the disk, not the kit
             raise OSError(errno.ENOSPC, f"cannot write the native runner's build there: {'; '.join(full)} "
                           f"(the compiler's output: {log}; FSW_CACHE_DIR names another folder)", folder)

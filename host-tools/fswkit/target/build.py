@@ -512,9 +512,9 @@ def explain_failure(app: Application, out: str, proc: subprocess.CompletedProces
         return True, (f"the firmware does not fit the {app.board.name} ({app.board.mcu}): "
                       + ("; ".join(said) if said else "the linker ran out of memory")
                       + f" (the linker's output: {log})")
-    from fswkit.outputs import HOST_WRITE
+    from fswkit.outputs import host_write_faults
 
-    full = sorted({m.group(0) for line in output for m in [HOST_WRITE.search(line)] if m})
+    full = host_write_faults(output)
     if full:  # the machine's fault, not the kit's: said as such, exit 1
         return True, (f"cannot write the build folder {out}: {'; '.join(full)} (the compiler's output: {log})")
     lines = [line.strip() for line in output if ERROR_LINE.search(line)] or [line.strip() for line in output[-3:]]

@@ -656,8 +656,7 @@ struct Run {
 };
 
 uint8_t* window_at(const Run& r, uint8_t w, uint8_t& func, uint16_t& n) {
-    uint8_t* at = r.ram;
-    for (uint8_t k = 0; k < w; ++k) at += window_size(r.win[4u * k], u16(r.win + 4u * k + 2u));
+    uint8_t* at = r.ram + ram_of_windows(r.win, w);  // the windows before it
     func = r.win[4u * w];
     n = u16(r.win + 4u * w + 2u);
     return at;

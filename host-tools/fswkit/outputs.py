@@ -11,6 +11,7 @@ half-written file where the old one was."""
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import os
 import re
@@ -19,8 +20,6 @@ import stat
 import sys
 import tempfile
 import threading
-
-
 
 
 # The head of a link recording (`fsw monitor --log`, `fsw sim --plant`):
@@ -341,19 +340,57 @@ def stopped_by_signals():
 # The line by which a command's output names it, among its first lines
 # (`fsw graph`: DOT's first, Mermaid's second; `fsw skeleton`: the first):
 # a file that only mentions the command (notes, a README) is not its output.
+# The line ends with the digest of the text the command wrote (`stamped`):
+# a skeleton is made to be edited in place, and an edited one is the user's.
 OWN_HEADS = {
     "graph": re.compile(r"\s*(?://|%%) state machine .+: `fsw graph(?: --format mermaid)?` output"),
     "skeleton": re.compile(r"# State-script skeleton for .+, made by `fsw skeleton`"),
 }
+_DIGEST = re.compile(rb" \(digest ([0-9a-f]{12})\)$")
+_LARGEST_OWN = 64 << 20  # no graph or skeleton is this big: a bigger file is not read whole
+
+
+def _head_line(lines: list, command: str) -> int | None:
+    """The index of the command's head line among the first three of `lines` (bytes)."""
+    head = OWN_HEADS[command]
+    for i, line in enumerate(lines[:3]):
+        if head.match(line.decode("utf-8", "replace")):
+            return i
+    return None
+
+
+def _digest(text: bytes) -> str:
+    return hashlib.sha256(text).hexdigest()[:12]
+
+
+def stamped(text: str, command: str) -> str:
+    """`text`, the output of `fsw COMMAND` (OWN_HEADS), with the digest of
+    that text at the end of its head line: ` (digest 0123456789ab)`."""
+    lines = text.split("\n")
+    i = _head_line([line.encode() for line in lines], command)
+    assert i is not None, "the output names its command (its head line)"
+    lines[i] += f" (digest {_digest(text.encode())})"
+    return "\n".join(lines)
+
+
+def _unedited(data: bytes, command: str) -> bool:
+    """Whether `data`, a file's whole text, is `fsw COMMAND`'s output as it
+    wrote it: its head line's digest is that of the text without it."""
+    lines = data.split(b"\n")
+    i = _head_line(lines, command)
+    m = _DIGEST.search(lines[i]) if i is not None else None
+    if m is None:
+        return False
+    lines[i] = lines[i][:m.start()]
+    return _digest(b"\n".join(lines)) == m.group(1).decode()
 
 
 def _own_head(start: bytes, command: str) -> bool:
     """Whether the first lines of a file (`start`) are those of `fsw COMMAND`'s output."""
-    head = OWN_HEADS.get(command)
-    lines = start.decode("utf-8", "replace").splitlines()[:3]
-    if head is None:
+    if command not in OWN_HEADS:
+        lines = start.decode("utf-8", "replace").splitlines()[:3]
         return any(f"`fsw {command}" in line for line in lines)
-    return any(head.match(line) for line in lines)
+    return _head_line(start.split(b"\n"), command) is not None
 
 
 def only_its_own(path: str | None, command: str, force: bool = False, head: int = 8192,
@@ -368,6 +405,11 @@ def only_its_own(path: str | None, command: str, force: bool = False, head: int 
     if path is None or path == "-" or force or is_direct(path):
         return
     start = file_head(path, head)  # None: nothing there to lose (or unreadable: the write says why)
-    if start and not (start.startswith(starts) if starts is not None else _own_head(start, command)):
+    if not start:
+        return
+    if not (start.startswith(starts) if starts is not None else _own_head(start, command)):
         raise OutputError(f"{path} exists and is not an earlier {what} of `fsw {command}` (a file you wrote?): "
                           "it is replaced only when asked (--force)")
+    if command in OWN_HEADS and starts is None and not _unedited(file_head(path, _LARGEST_OWN) or b"", command):
+        raise OutputError(f"{path} was edited since `fsw {command}` wrote it (its text no longer has the digest "
+                          "at the end of its head line): it is replaced only when asked (--force)")

@@ -76,3 +76,23 @@ def test_gen_keeps_the_files_it_did_not_generate(tmp_path):
     assert r.code != 0
     assert f"{out / 'sv.gen.h'}: not a file fswkit generated (its first line); move it away" in r.err, r.err
     assert (out / "sv.gen.h").read_text() == "// edited by hand\n"
+
+
+@pytest.mark.parametrize("command", [["build"], ["gen"], ["sim", "--duration", "1", "--fast"],
+                                     ["flash", "--port", "/dev/null"]])
+def test_the_default_build_folder_of_the_users_files_is_refused(tmp_path, command):
+    """Without --out a build goes into build/BOARD beside the application; a
+    folder of that name holding the user's files was built in all the same
+    (and `fsw gen`'s .lock there made it look like the kit's from then on)."""
+    project = tmp_path / "tank"
+    shutil.copytree(TANK, project, ignore=shutil.ignore_patterns("build"))
+    mine = project / "build" / "uno"
+    mine.mkdir(parents=True)
+    (mine / "notes.txt").write_text("valve timings from the last hot fire\n")
+    r = run_fsw(command[0], str(project), *command[1:])
+    assert r.code != 0
+    assert (f"{mine}, the project's build folder, holds files a build of fswkit did not write (notes.txt): a build "
+            "never writes among files of yours; move them, or build elsewhere with --out DIR") in r.err, r.err
+    assert "Traceback" not in r.err
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]  # nothing added, no .lock
+    assert (mine / "notes.txt").read_text() == "valve timings from the last hot fire\n"

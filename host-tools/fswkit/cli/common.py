@@ -73,13 +73,15 @@ def port_or_only(port: str | None, command: str) -> str | None:
 
 def write_output(text: str, out: str | None, command: str, inputs=(), own: bool = False, force: bool = False) -> int:
     """`text` to `out` (standard output for None or "-"). `own`: the text
-    names `fsw COMMAND` in its first lines, and a file there that does not
-    (one the user wrote) is replaced only with `force`."""
-    from fswkit.outputs import OutputError, _own_head, check, only_its_own, write_text
+    names `fsw COMMAND` in its head line (outputs.OWN_HEADS), which gets the
+    text's digest (outputs.stamped); a file there that is not such an output
+    as the command wrote it (one the user wrote or edited) is replaced only
+    with `force`."""
+    from fswkit.outputs import OutputError, check, only_its_own, stamped, write_text
 
     try:
         if own:
-            assert _own_head(text[:8192].encode(), command), "the output names its command (its head line)"
+            text = stamped(text, command)
             if out not in (None, "-"):
                 check(out, inputs)  # an input, a recording, a folder: said as such first
             only_its_own(out, command, force)

@@ -284,7 +284,7 @@ def cmd_skeleton(args) -> int:
 def cmd_gen(args) -> int:
     import contextlib
 
-    from fswkit.target.build import BuildError, build_lock, default_out, generate
+    from fswkit.target.build import BuildError, build_lock, check_out_folder, default_out, generate
 
     app = load_app(args.project, args.board, "gen")
     if app is None:
@@ -294,6 +294,8 @@ def cmd_gen(args) -> int:
         return export(app, args.sketch)
     out = args.out or os.path.join(default_out(app), "gen")
     try:
+        if not args.out:
+            check_out_folder(default_out(app), default=True)  # its .lock would make the folder the kit's
         # the default folder is the build's own: not rewritten while a build compiles it
         with build_lock(os.path.dirname(out), "gen") if not args.out else contextlib.nullcontext():
             files = generate(app, out)

@@ -41,12 +41,11 @@ def cmd_build(args) -> int:
     app = load_app(args.project, args.board, "build")
     if app is None:
         return EXIT_CONFIG
-    if args.out:
-        try:
-            check_out_folder(args.out)
-        except BuildError as e:
-            sys.stderr.write(f"fsw build: {e}\n")
-            return e.code
+    try:
+        check_out_folder(args.out or default_out(app), default=not args.out)
+    except BuildError as e:
+        sys.stderr.write(f"fsw build: {e}\n")
+        return e.code
     return build(app, args.out or default_out(app))
 
 
@@ -68,8 +67,8 @@ def cmd_flash(args) -> int:
                          f"upload (`fsw build --board {board.name}` builds it)\n")
         return EXIT_CONFIG
     try:
-        if args.out:
-            check_out_folder(args.out)
+        if args.out or args.via != "pio":  # `--via pio` builds in PlatformIO's folder
+            check_out_folder(args.out or default_out(app), default=not args.out)
         port, listing = default_port(args.port, "flash")
         if not args.port:
             sys.stderr.write(f"fsw flash: using {listing.label() if listing else port}, "

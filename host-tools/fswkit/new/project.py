@@ -183,9 +183,11 @@ Status     rate=1
 
 
 def _skeleton(name: str, texts: dict[str, str]) -> str:
-    """`fsw skeleton` of the starter machine."""
+    """`fsw skeleton` of the starter machine, as the command writes it
+    (its digest in its head line: `fsw skeleton -o` replaces it until edited)."""
     from fswkit.autocode.project import load_machine
     from fswkit.new.script import skeleton
+    from fswkit.outputs import stamped
 
     with tempfile.TemporaryDirectory(prefix="fsw-new-") as tmp:
         for ext in (".sv", ".sm"):
@@ -195,7 +197,7 @@ def _skeleton(name: str, texts: dict[str, str]) -> str:
         m = load_machine(os.path.join(tmp, name + ".sm"), diags)
         if m is None:  # a bug of the templates, never of the user's input
             raise RuntimeError("the starter machine does not compile:\n" + diags.render())
-        return skeleton(m)
+        return stamped(skeleton(m), "skeleton")
 
 
 def _app_baud(app_text: str) -> int:
@@ -300,8 +302,9 @@ With PlatformIO instead: `pio run`, `pio run -t upload`.
    comments there list the board's pins.
 3. Write the behaviour in `{name}.sm`.
 4. `fsw skeleton {name}.sm -o {name}.ss` writes a new state script that
-   visits every state; replace its TODOs with what must hold, and keep it
-   passing with `fsw test {name}.ss`.
+   visits every state (over the one here until you edit it; an edited
+   script is kept unless you add `--force`); replace its TODOs with what
+   must hold, and keep it passing with `fsw test {name}.ss`.
 5. `fsw build .`, then `fsw flash .`.
 """
 

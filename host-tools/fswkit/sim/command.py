@@ -44,6 +44,12 @@ def build(project: str, board: str | None = None, out: str | None = None) -> tup
     if app is None:
         return 2
     try:
+        if not out:
+            check_out_folder(default_out(app), default=True)
+    except BuildError as e:
+        say(str(e))
+        return 2
+    try:
         sim = sim_board(app.board)
     except SimError as e:
         say(str(e))

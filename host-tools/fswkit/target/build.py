@@ -84,12 +84,13 @@ def generated_file(path: str) -> bool:
     return head is not None and head == GENERATED_HEAD
 
 
-def check_out_folder(out: str) -> None:
-    """A folder the user named for a build (`--out`): a build goes only into
-    a new folder, an empty one, or one a build of the kit wrote before (its
-    `.lock`), so that it never adds its objects to, or replaces, files of
-    the user's (a `build.log`, a `.hex` kept there). BuildError, before any
-    work, otherwise."""
+def check_out_folder(out: str, default: bool = False) -> None:
+    """A build's folder, named by the user (`--out`) or the project's
+    default (`default`: build/BOARD beside the application): a build goes
+    only into a new folder, an empty one, or one a build of the kit wrote
+    before (its `.lock`), so that it never adds its objects to, or
+    replaces, files of the user's (a `build.log`, a `.hex` kept there).
+    BuildError, before any work, otherwise."""
     try:
         names = sorted(os.listdir(out))
     except FileNotFoundError:
@@ -105,6 +106,10 @@ def check_out_folder(out: str) -> None:
     if ".lock" not in names and _kit_log(log_path(out)):
         hint = (f" (its build.log is a build's, but its .lock is gone: if you know the folder holds nothing of "
                 f"yours, `touch {os.path.join(out, '.lock')}` makes it a build folder again)")
+    if default:
+        raise BuildError(f"{out}, the project's build folder, holds files a build of fswkit did not write "
+                         f"({shown}): a build never writes among files of yours; move them, or build elsewhere "
+                         f"with --out DIR{hint}")
     raise BuildError(f"{out} holds files a build of fswkit did not write ({shown}): a build goes into a new "
                      f"folder, an empty one, or one fswkit built in before; name another --out{hint}")
 

@@ -18,7 +18,7 @@ TANK = EXAMPLES / "tank"
 MACHINES = Path(__file__).resolve().parent / "machines"
 DOT = shutil.which("dot")
 
-TANK_DOT = r'''// state machine tank.sm: `fsw graph` output for Graphviz (dot -Tsvg)
+TANK_DOT = r'''// state machine tank.sm: `fsw graph` output for Graphviz (dot -Tsvg) (digest 7d3f510e7cc8)
 digraph "tank" {
     node [shape=box, style=rounded];
     "(start)" [shape=point, label=""];
@@ -32,7 +32,7 @@ digraph "tank" {
 '''
 
 TANK_MERMAID = '''stateDiagram-v2
-    %% state machine tank.sm: `fsw graph --format mermaid` output
+    %% state machine tank.sm: `fsw graph --format mermaid` output (digest c8d058477da6)
     state "TankVentControl" as s1
     state "Abort" as s2
     state "Idle" as s3

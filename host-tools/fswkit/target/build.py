@@ -101,6 +101,10 @@ def check_out_folder(out: str, default: bool = False) -> None:
         raise BuildError(f"cannot read the build folder {out}: {e.strerror or e}") from None
     if not names or _kit_lock(os.path.join(out, ".lock")):
         return
+    lock = os.path.join(out, ".lock")
+    odd = _odd_lock(lock)
+    if odd:  # said as the lock would say it: what to move away
+        raise BuildError(f"cannot lock the build folder {out}: {lock} is {odd} (move it away)")
     shown = ", ".join(names[:4]) + (f" and {len(names) - 4} more" if len(names) > 4 else "")
     hint = ""
     if ".lock" not in names and _kit_log(log_path(out)):
@@ -121,6 +125,18 @@ def _kit_log(path: str) -> bool:
     head = file_head(path, 4096)
     first = head.split(b"\n", 1)[0] if head else b""
     return first.startswith(b"make --no-print-directory ") and b"build.mk " in first
+
+
+def _odd_lock(path: str) -> str | None:
+    """What the `.lock` at `path` is when it is there but no regular file
+    ("a symbolic link", "not a regular file"); None otherwise."""
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return None
+    if stat.S_ISLNK(st.st_mode):
+        return "a symbolic link"
+    return None if stat.S_ISREG(st.st_mode) else "not a regular file"
 
 
 def _kit_lock(path: str) -> bool:

@@ -105,7 +105,7 @@ def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> in
             return EXIT_OK
         params, tx_cap = _parameters(args.project)
         app = create_app(LiveSource(station, params=params, tx_cap=tx_cap, baud=baud),
-                         title=f"fsw ground {args.project}")
+                         title=f"fsw ground {args.project}", host=args.host)
 
         def ready(url: str) -> None:
             sys.stdout.write(f"{url}\n")

@@ -2,26 +2,33 @@
 the layout as JSON, a WebSocket per browser that carries every message of
 the source (and the link's figures twice a second), the command
 endpoint, and the archive browser's read-only queries of the station's
-archive (fswkit.web.archive). Served by uvicorn (`serve`)."""
+archive (fswkit.web.archive). Served by uvicorn (`serve`), behind two
+guards against other sites' pages in the operator's browser (`SameOrigin`,
+and Starlette's TrustedHostMiddleware on a loopback address)."""
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import ipaddress
 import json
 import os
 import shutil
 import socket
 import tempfile
+from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.background import BackgroundTask
 from starlette.concurrency import run_in_threadpool
+from starlette.datastructures import Headers
+from starlette.middleware import Middleware
+from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, JSONResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketClose, WebSocketDisconnect
 
 from fswkit.autocode.types import TYPES
 
@@ -72,7 +79,62 @@ def archive_of(source: Source) -> tuple[str | None, object]:
 NO_ARCHIVE = "this station archives nothing (it was started with --no-archive): there are no sessions to browse"
 
 
-def create_app(source: Source, title: str = "fsw ground") -> Starlette:
+class SameOrigin:
+    """ASGI middleware: what a page of another site open in the operator's
+    browser could make it send is refused. Browsers let any page POST a
+    text/plain body to any address without asking it first, and open a
+    WebSocket to any address; they say whose page asks in `Origin`. So:
+    a POST or a WebSocket whose Origin is not this station's own page (the
+    scheme and the Host the request was sent to) is refused, 403; a POST
+    whose body is not declared `application/json` (which a cross-site page
+    cannot send without the browser asking first, and the station never
+    grants) is refused, 415. A script or a terminal tool sends no Origin."""
+
+    def __init__(self, app):
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        kind = scope["type"]
+        if kind not in ("http", "websocket") or (kind == "http" and scope["method"] in ("GET", "HEAD", "OPTIONS")):
+            await self.app(scope, receive, send)
+            return
+        headers = Headers(scope=scope)
+        origin = headers.get("origin")
+        if origin is not None and not same_origin(origin, headers.get("host", "")):
+            if kind == "websocket":
+                await WebSocketClose(code=1008)(scope, receive, send)  # before the handshake: HTTP 403
+                return
+            words = (f"refused: a request from {origin[:120]}, not from this station's page (a page of another "
+                     "site cannot command the target)")
+            await JSONResponse({"ok": False, "words": words}, status_code=403)(scope, receive, send)
+            return
+        if kind == "http" and headers.get("content-type", "").split(";")[0].strip().lower() != "application/json":
+            words = "a command or a parameter is sent as a JSON body declared `Content-Type: application/json`"
+            await JSONResponse({"ok": False, "words": words}, status_code=415)(scope, receive, send)
+            return
+        await self.app(scope, receive, send)
+
+
+def same_origin(origin: str, host: str) -> bool:
+    """Whether `origin` (a request's Origin header) is the page served at
+    `host` (its Host header): http(s) and the same host and port."""
+    parts = urlsplit(origin)
+    return parts.scheme in ("http", "https") and bool(host) and parts.netloc.lower() == host.lower()
+
+
+def loopback(host: str) -> bool:
+    """Whether the station serves on a loopback address only (`--host`)."""
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return host.lower() == "localhost"
+
+
+def create_app(source: Source, title: str = "fsw ground", host: str = "127.0.0.1") -> Starlette:
+    """The station's application, served on `host` (`--host`). On a
+    loopback address a request must name this machine as its Host
+    (localhost, 127.0.0.1, ::1): a site whose name is made to resolve to
+    127.0.0.1 (DNS rebinding) would otherwise be the page's own origin."""
     assets = uplot_dir()
     archive_path, archive = archive_of(source)
     ignore_schema = bool(getattr(getattr(source, "station", None), "ignore_schema", False))
@@ -220,7 +282,11 @@ def create_app(source: Source, title: str = "fsw ground") -> Starlette:
         WebSocketRoute("/ws", feed),
         Mount("/static", StaticFiles(directory=STATIC)),
         Mount("/uplot", StaticFiles(directory=assets)),
-    ], lifespan=lifespan)
+    ], lifespan=lifespan, middleware=[
+        Middleware(TrustedHostMiddleware,
+                   allowed_hosts=["localhost", "127.0.0.1", "[::1]"] if loopback(host) else ["*"]),
+        Middleware(SameOrigin),
+    ])
     app.state.source = source
     return app
 

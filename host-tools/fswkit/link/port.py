@@ -11,6 +11,7 @@ client can find the station that serves the port."""
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import json
 import os
@@ -35,15 +36,30 @@ def is_url(name: str) -> bool:
     return "://" in name
 
 
+class RuntimeDirError(OSError):
+    """The runtime folder is not this user's own (`runtime_dir`); said as
+    `FOLDER: why` wherever an OSError is."""
+
+    def __str__(self) -> str:
+        return f"{self.filename}: {self.strerror}"
+
+
 def runtime_dir() -> str:
     """Where holder records and stations' sockets live: $XDG_RUNTIME_DIR/fswkit,
     else a folder of this user's in the temporary directory (FSW_RUNTIME_DIR
-    overrides both)."""
+    overrides both). Used only when it is a folder of this user's, not a
+    link, that no one else can write (RuntimeDirError otherwise): in a shared
+    /tmp another user could make it first and plant a record that sends
+    the tools' commands to their own socket."""
     base = os.environ.get("FSW_RUNTIME_DIR")
     if not base:
         xdg = os.environ.get("XDG_RUNTIME_DIR")
         base = os.path.join(xdg, "fswkit") if xdg else os.path.join(tempfile.gettempdir(), f"fswkit-{os.getuid()}")
     os.makedirs(base, mode=0o700, exist_ok=True)
+    st = os.lstat(base)
+    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o022:
+        raise RuntimeDirError(errno.EPERM, "not a folder of this user's that only this user can write (another user "
+                      "could plant a port's holder record there): remove it, or set FSW_RUNTIME_DIR to one", base)
     return base
 
 

@@ -139,3 +139,33 @@ def test_the_telemetry_socket_is_refused_to_another_site(station):
     assert _handshake(station, EVIL) == 403
     assert _handshake(station, f"http://127.0.0.1:{station}") == 101
     assert _handshake(station, None) == 101  # a script's client
+
+
+@pytest.mark.parametrize("path", ["/api/command", "/api/params"])
+def test_a_body_past_the_limit_is_not_read(station, path):
+    """A client that can reach the port sent bodies of any size, each read
+    whole into the station's memory before it was looked at."""
+    from fswkit.web.app import MAX_BODY
+
+    big = b'{"kind": "' + b"x" * MAX_BODY + b'"}'
+    status, text = request(station, "POST", path, {"Content-Type": "application/json"}, big)
+    assert status == 413 and json.loads(text)["words"] == f"the request is over {MAX_BODY:,} bytes", text
+    # without a length, cut off as it streams in
+    c = http.client.HTTPConnection("127.0.0.1", station, timeout=10)
+    try:
+        c.putrequest("POST", path, skip_host=True, skip_accept_encoding=True)
+        for k, v in {"Host": f"127.0.0.1:{station}", "Content-Type": "application/json",
+                     "Transfer-Encoding": "chunked"}.items():
+            c.putheader(k, v)
+        c.endheaders()
+        chunk = b"x" * 65536
+        try:
+            for _ in range(MAX_BODY // len(chunk) + 2):
+                c.send(b"%x\r\n%s\r\n" % (len(chunk), chunk))
+            c.send(b"0\r\n\r\n")
+        except OSError:
+            pass  # the station may close the connection before the rest is sent
+        r = c.getresponse()
+        assert r.status == 413, r.read()
+    finally:
+        c.close()

@@ -130,6 +130,29 @@ def loopback(host: str) -> bool:
         return host.lower() == "localhost"
 
 
+MAX_BODY = 1 << 20  # bytes of a command's or the parameters' JSON (a few hundred bytes each in use)
+
+
+async def json_body(request: Request):
+    """The request's body as JSON, read up to MAX_BODY bytes; or the
+    refusal to answer: 413 past MAX_BODY (read no further: a client on the
+    port cannot fill the station's memory), 400 for a body that is not JSON
+    (nested deeper than the reader recurses included)."""
+    size = request.headers.get("content-length", "")
+    if size.isdigit() and int(size) > MAX_BODY:
+        return JSONResponse({"ok": False, "words": f"the request is over {MAX_BODY:,} bytes"}, status_code=413)
+    chunks, n = [], 0
+    async for chunk in request.stream():
+        n += len(chunk)
+        if n > MAX_BODY:
+            return JSONResponse({"ok": False, "words": f"the request is over {MAX_BODY:,} bytes"}, status_code=413)
+        chunks.append(chunk)
+    try:
+        return json.loads(b"".join(chunks))
+    except (ValueError, RecursionError):
+        return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
+
+
 def create_app(source: Source, title: str = "fsw ground", host: str = "127.0.0.1") -> Starlette:
     """The station's application, served on `host` (`--host`). On a
     loopback address a request must name this machine as its Host
@@ -207,10 +230,9 @@ def create_app(source: Source, title: str = "fsw ground", host: str = "127.0.0.1
         return JSONResponse(layout_json(source) | {"title": title})
 
     async def command(request: Request) -> Response:
-        try:
-            body = await request.json()
-        except (ValueError, RecursionError):  # RecursionError: nested deeper than the reader recurses
-            return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
+        body = await json_body(request)
+        if isinstance(body, Response):
+            return body
         if not isinstance(body, dict) or not all(isinstance(body.get(k), str) for k in ("kind", "target", "value")):
             return JSONResponse({"ok": False, "words": "expected {kind, target, value} as strings"}, status_code=400)
         who = f"web {request.client.host if request.client else '?'}"
@@ -225,10 +247,9 @@ def create_app(source: Source, title: str = "fsw ground", host: str = "127.0.0.1
             if not hasattr(source, "params_now"):
                 return JSONResponse({"ok": False, "words": "this source has no target"})
             return JSONResponse(await source.params_now())
-        try:
-            body = await request.json()
-        except (ValueError, RecursionError):  # RecursionError: nested deeper than the reader recurses
-            return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
+        body = await json_body(request)
+        if isinstance(body, Response):
+            return body
         if not isinstance(body, dict) or not isinstance(body.get("values"), dict):
             return JSONResponse({"ok": False, "words": "expected {values: {NAME: VALUE}}"}, status_code=400)
         who = f"web {request.client.host if request.client else '?'}"

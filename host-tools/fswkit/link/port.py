@@ -181,6 +181,16 @@ def not_a_port(name: str) -> str | None:
     return None
 
 
+def denied(port: str, err: int | None, text: str) -> str | None:
+    """What to say of a port the system would not open for this user (the
+    usual first trouble on Linux: the serial devices belong to `dialout`),
+    or None when that is not the trouble."""
+    if err == errno.EACCES or "permission denied" in text.lower():
+        return (f"no permission to open {port}: add yourself to the `dialout` group "
+                "(sudo usermod -aG dialout $USER, then log in again)")
+    return None
+
+
 def open_port(name: str, baud: int, *, command: str | None = None, socket: str | None = None):
     """The port `name` at `baud`. With `command` (the fswkit command opening
     it), a device is held exclusively and a holder record written, both
@@ -208,7 +218,7 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
                           or "Device or resource busy" in text or getattr(e, "errno", None) == 16):
             rec = holder(name)
             raise PortBusy(busy_message(name, rec), rec) from None
-        raise PortError(f"cannot open {name}: {e}") from None
+        raise PortError(denied(name, getattr(e, "errno", None), text) or f"cannot open {name}: {e}") from None
     if not exclusive:
         return port
     try:

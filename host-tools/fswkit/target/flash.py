@@ -82,9 +82,11 @@ def _port_problem(port: str, err: int | None, text: str) -> str:
                     "(Ctrl-C) and flash again")
         return (f"{port} is busy: another program has it open (a serial monitor, `fsw monitor`, "
                 "the Arduino IDE): close it and flash again")
-    if err == errno.EACCES or "permission denied" in text.lower():
-        return (f"no permission to open {port}: add yourself to the `dialout` group "
-                "(sudo usermod -aG dialout $USER, then log in again)")
+    from fswkit.link.port import denied
+
+    words = denied(port, err, text)
+    if words:
+        return words
     if err == errno.ENOENT:
         return f"no serial port {port}{_connected_hint()}"
     return f"cannot open {port}: {text}"

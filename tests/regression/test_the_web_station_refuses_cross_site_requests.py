@@ -169,3 +169,17 @@ def test_a_body_past_the_limit_is_not_read(station, path):
         assert r.status == 413, r.read()
     finally:
         c.close()
+
+
+def test_serving_beyond_this_machine_is_said():
+    """`--host 0.0.0.0` (a tablet on the range's network) opens the page,
+    which commands the target with no login, to the whole network: `fsw
+    ground` says so when it starts; on a loopback address it says nothing."""
+    from fswkit.web.app import exposure
+
+    for host in ("127.0.0.1", "localhost", "::1", "127.0.0.2"):
+        assert exposure(host, 8000) is None, host
+    for host in ("0.0.0.0", "::", "192.168.1.20", "groundstation.local"):
+        assert exposure(host, 8000) == (f"the page on {host} port 8000 is open to every computer that can reach "
+                                        "this one, and it commands the target with no login (--host 127.0.0.1 "
+                                        "keeps it to this machine)"), host

@@ -72,7 +72,7 @@ def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> in
     from fswkit.ground.archive import Archive, ArchiveError
     from fswkit.ground.station import Station
     from fswkit.link.port import PortError
-    from fswkit.web.app import create_app, serve
+    from fswkit.web.app import create_app, exposure, serve
     from fswkit.web.source import LiveSource
 
     baud = _link_baud(args.baud, app_baud, name)
@@ -111,6 +111,9 @@ def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> in
             sys.stdout.write(f"{url}\n")
             sys.stdout.flush()
             sys.stderr.write(f"fsw {name}: {said}: open {url} (Ctrl-C ends it)\n")
+            warning = exposure(args.host, sock.getsockname()[1])
+            if warning:
+                sys.stderr.write(f"fsw {name}: warning: {warning}\n")
 
         try:
             serve(app, host=args.host, port=args.http_port, on_ready=ready, sock=sock)

@@ -153,6 +153,15 @@ async def json_body(request: Request):
         return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
 
 
+def exposure(host: str, port: int) -> str | None:
+    """What to say when the page is served beyond this machine (`--host`
+    not a loopback address): it has no login, and commands the target."""
+    if loopback(host):
+        return None
+    return (f"the page on {host} port {port} is open to every computer that can reach this one, and it commands "
+            "the target with no login (--host 127.0.0.1 keeps it to this machine)")
+
+
 def create_app(source: Source, title: str = "fsw ground", host: str = "127.0.0.1") -> Starlette:
     """The station's application, served on `host` (`--host`). On a
     loopback address a request must name this machine as its Host

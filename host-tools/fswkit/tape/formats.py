@@ -183,26 +183,27 @@ def _from_liftoff(t: np.ndarray, t_lift: float) -> tuple[np.ndarray, np.ndarray]
     return shifted[kept], kept
 
 
-def _pressure_pa(p: np.ndarray, log: Log, col: int) -> tuple[np.ndarray, str]:
+def _pressure_pa(p: np.ndarray, log: Log, col: int, rows=None) -> tuple[np.ndarray, str]:
     """A pressure column in Pa, its unit told from its magnitude: Pa (median
-    10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise."""
+    10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise.
+    `p` holds one value per row of `rows` (the log's rows when None)."""
     have = p[~np.isnan(p)]
     if have.size == 0:
         raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                          f"`{log.raw_names[col]}` holds no value"])
     med = float(np.median(have))
     if 10_000 <= med <= 120_000:
-        return _positive(p, log, col, "Pa"), "Pa"
+        return _positive(p, log, col, "Pa", rows), "Pa"
     if 100 <= med <= 1_200:
         with np.errstate(over="ignore"):  # a cell beyond binary64 once scaled: refused below, located
-            return _positive(p * 100.0, log, col, "hPa"), "hPa (mbar)"
+            return _positive(p * 100.0, log, col, "hPa", rows), "hPa (mbar)"
     raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: cannot tell the unit of "
                      f"`{log.raw_names[col]}`: its median {med:g} is neither Pa (10,000 to 120,000) nor "
                      "hPa/mbar (100 to 1,200)"])
 
 
-def _positive(p: np.ndarray, log: Log, col: int, unit: str) -> np.ndarray:
-    """`p` (Pa, one value per row of the log) when every value is a finite
+def _positive(p: np.ndarray, log: Log, col: int, unit: str, rows=None) -> np.ndarray:
+    """`p` (Pa, one value per row of `rows`, the log's rows when None) when every value is a finite
     pressure above 0; otherwise TapeError at each cell that is not: a glitch
     row of a sensor (0, negative) is the log's cell to locate, not a tape
     the writer refuses later without a line."""
@@ -211,8 +212,9 @@ def _positive(p: np.ndarray, log: Log, col: int, unit: str) -> np.ndarray:
         return p
     err = log.err()
     name = log.raw_names[col]
+    rows = log.rows if rows is None else rows
     for i in bad.tolist():
-        ln, cells = log.rows[i]
+        ln, cells = rows[i]
         cell = cells[col].strip()[:40]
         why = "is not above 0 Pa" if not p[i] > 0 else f"read as {unit} is beyond the largest number once in Pa"
         err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{cell}` {why}")
@@ -375,7 +377,9 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
         CATS writes exactly 0.0 instead of a measurement: a final run of
         exact zeros after liftoff becomes empty cells.
     barometer log `ts, id, T, P` (the Vega's baro.csv): `P` in Pa as is (hPa
-        told by magnitude), the rows of the first sensor id only; no
+        told by magnitude), the rows of the first row's sensor id only, read
+        on their own (their times, unit and cells; another sensor's rows do
+        not count); no
         acceleration (the IMU log is a separate file whose rocket axis depends
         on mounting: not read here).
 
@@ -386,11 +390,11 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
     No CATS documentation was found with the search tool."""
     log = read_log(path, "cats", lambda n: "ts" in n and ("filtered_altitude_agl" in n or "p" in n),
                    "ts with filtered_altitude_AGL, or ts, id, T, P")
-    t = log.numbers(log.index("ts"), "ts", required=True)
-    keep = _increasing(t)
-    late = int((~keep).sum())
     ih = log.index("filtered_altitude_agl")
     if ih is not None:
+        t = log.numbers(log.index("ts"), "ts", required=True)
+        keep = _increasing(t)
+        late = int((~keep).sum())
         h = log.numbers(ih, "filtered_altitude_AGL")
         _check_altitude_range(h, pad_alt, log, ih, "m AGL")
         ia = log.index("filtered_acceleration")
@@ -414,18 +418,25 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
                                "machine reaches DROGUE")
         layout = "filtered-data export"
     else:
+        # the first sensor's rows, read on their own: another sensor's rows (their times, units,
+        # cells) neither drop nor scale nor refuse them
         ip, iid = log.index("p"), log.index("id")
         rows = log.rows
+        first = ""
         if iid is not None:
-            first = next((c[iid].strip() for _, c in rows if iid < len(c)), "")
-            sel = np.array([iid < len(c) and c[iid].strip() == first for _, c in rows])
-        else:
-            first, sel = "", np.ones(len(rows), dtype=bool)
-        p_raw = log.numbers(ip, "P")
-        p, unit = _pressure_pa(p_raw, log, ip)
-        m = keep & sel
-        t, p = t[m], p[m]
-        late = int((sel & ~keep).sum())
+            err = log.err()
+            for ln, c in rows:
+                if iid >= len(c):
+                    err.at(ln, None, f"the row has {len(c)} cells: no `{log.raw_names[iid]}` (column {iid + 1} "
+                                     f"of the column line at line {log.column_line})")
+            err.raise_if_any()
+            first = rows[0][1][iid].strip()
+            rows = [(ln, c) for ln, c in rows if c[iid].strip() == first]
+        t = log.numbers(log.index("ts"), "ts", required=True, rows=rows)
+        keep = _increasing(t)
+        late = int((~keep).sum())
+        p, unit = _pressure_pa(log.numbers(ip, "P", rows=rows), log, ip, rows)
+        t, p = t[keep], p[keep]
         accel = np.full(t.size, math.nan)
         derived = ["time_s = log column 'ts' as is (CATS: seconds from its liftoff detection)",
                    f"pressure_pa = log column 'P' ({unit})" + (" * 100" if unit != "Pa" else " as is")

@@ -482,7 +482,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
             raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                              f"`{log.raw_names[col]}` has no time column before it"])
         rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and c[tcol].strip()]
-        t = log.numbers(tcol, f"{what} time", rows=rows)
+        t = log.numbers(tcol, f"{what} time", required=True, rows=rows)  # `NaN` refused, as every log's time
         v = log.numbers(col, what, rows=rows)
         ok = ~np.isnan(v)
         t, v = t[ok], v[ok]

@@ -8,7 +8,9 @@ Shared rules
       at most MAX_LOG bytes), UTF-8 text; the column line is the first line
       whose cells (a leading `#` dropped, case and spaces ignored) name the
       format's required columns. Lines before it are the log's preamble;
-      after it, blank lines and `#` lines are skipped.
+      after it, blank lines and `#` lines are skipped. Cells are split at
+      `,` as CSV does (not inside double quotes; a quoted cell's quotes are
+      not part of it); a column line of `;` or tabs is refused, saying so.
     * A cell that is empty or `NaN` in a sensor column is "not available"
       (an empty tape cell); a time that is not a finite number, a sensor cell
       that is not a number, a row too short for the columns used are located
@@ -99,7 +101,7 @@ class Log:
                                  f"(column {col + 1} of the column line at line {self.column_line})")
                 out[i] = math.nan
                 continue
-            s = cells[col].strip()
+            s = _unquote(cells[col])
             if s == "" or s.lower() == "nan":
                 if required:
                     err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`) is empty: "
@@ -118,7 +120,33 @@ class Log:
 
 
 def _norm(name: str) -> str:
-    return " ".join(name.strip().lstrip("#").strip().lower().split())
+    return " ".join(_unquote(_unquote(name).lstrip("#")).lower().split())
+
+
+def _unquote(cell: str) -> str:
+    """A cell's text as CSV reads it: spaces around it dropped, and the
+    quotes around a quoted cell (`"1.5"`, `"ts"`; `""` inside is one `"`)."""
+    s = cell.strip()
+    if len(s) >= 2 and s[0] == '"' and s[-1] == '"':
+        s = s[1:-1].replace('""', '"').strip()
+    return s
+
+
+def _split(line: str, sep: str = ",") -> list[str]:
+    """A line's cells as written (quotes and spaces kept, so a cell's column
+    is where its text starts): split at `sep` outside double quotes, as CSV
+    does (a spreadsheet quotes a cell holding a comma)."""
+    if '"' not in line:
+        return line.split(sep)
+    cells, start, quoted = [], 0, False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == sep and not quoted:
+            cells.append(line[start:i])
+            start = i + 1
+    cells.append(line[start:])
+    return cells
 
 
 def _col_of(cells: list[str], k: int) -> int:
@@ -140,21 +168,28 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
         line = line.rstrip("\r")
         if "," not in line:
             continue
-        names = [_norm(c) for c in line.split(",")]
+        names = [_norm(c) for c in _split(line)]
         if wanted(names):
             header = n
             break
     if header is None:
+        for n, line in enumerate(lines):  # a spreadsheet's CSV of another separator: said, not guessed
+            for sep, said in ((";", "`;`"), ("\t", "tabs")):
+                if sep in line and wanted([_norm(c) for c in _split(line.rstrip("\r"), sep)]):
+                    raise TapeError([f"{path}:{n + 1}:1: not a {FORMATS[fmt].title} log as fswkit reads one: "
+                                     f"its column line separates its cells with {said} (as a spreadsheet saves "
+                                     "CSV where the decimal mark is a comma): save the log as CSV with `,` "
+                                     "between cells and `.` as the decimal point"])
         first = next((l.strip() for l in lines if l.strip()), "")
         raise TapeError([f"{path}:1:1: not a {FORMATS[fmt].title} log: no line names its columns "
                          f"({expected}); the first line is `{first[:80]}`"])
-    raw = [c.strip().lstrip("#").strip() for c in lines[header].rstrip("\r").split(",")]
+    raw = [_unquote(_unquote(c).lstrip("#")) for c in _split(lines[header].rstrip("\r"))]
     rows = []
     for n in range(header + 1, len(lines)):
         line = lines[n].rstrip("\r")
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        rows.append((n + 1, line.split(",")))
+        rows.append((n + 1, _split(line)))
     if not rows:
         raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])
     return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, rows)
@@ -215,7 +250,7 @@ def _positive(p: np.ndarray, log: Log, col: int, unit: str, rows=None) -> np.nda
     rows = log.rows if rows is None else rows
     for i in bad.tolist():
         ln, cells = rows[i]
-        cell = cells[col].strip()[:40]
+        cell = _unquote(cells[col])[:40]
         why = "is not above 0 Pa" if not p[i] > 0 else f"read as {unit} is beyond the largest number once in Pa"
         err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{cell}` {why}")
     err.raise_if_any()
@@ -350,7 +385,7 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
     isr, ifl = log.index("serial"), log.index("flight")
     cells = log.rows[0][1]
     if isr is not None and ifl is not None and max(isr, ifl) < len(cells):
-        flight += f" serial {cells[isr].strip()} flight {cells[ifl].strip()}"
+        flight += f" serial {_unquote(cells[isr])} flight {_unquote(cells[ifl])}"
     derived = ["time_s = log column 'time' as is (AltOS: seconds since its boost detection, so 0 = AltOS liftoff)",
                f"pressure_pa = log column 'pressure' ({unit})" + (" * 100" if unit != "Pa" else " as is"),
                "accel_g = log column 'acceleration' / 9.80665 + 1 (AltOS reports axial acceleration in m/s^2 "
@@ -430,8 +465,8 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
                     err.at(ln, None, f"the row has {len(c)} cells: no `{log.raw_names[iid]}` (column {iid + 1} "
                                      f"of the column line at line {log.column_line})")
             err.raise_if_any()
-            first = rows[0][1][iid].strip()
-            rows = [(ln, c) for ln, c in rows if c[iid].strip() == first]
+            first = _unquote(rows[0][1][iid])
+            rows = [(ln, c) for ln, c in rows if _unquote(c[iid]) == first]
         t = log.numbers(log.index("ts"), "ts", required=True, rows=rows)
         keep = _increasing(t)
         late = int((~keep).sum())
@@ -481,7 +516,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         if tcol is None:
             raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                              f"`{log.raw_names[col]}` has no time column before it"])
-        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and c[tcol].strip()]
+        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and _unquote(c[tcol])]
         t = log.numbers(tcol, f"{what} time", required=True, rows=rows)  # `NaN` refused, as every log's time
         v = log.numbers(col, what, rows=rows)
         ok = ~np.isnan(v)

@@ -60,7 +60,7 @@ def test_a_quoted_cell_that_is_no_number_is_located_at_its_quote(tmp_path):
     with pytest.raises(TapeError) as e:
         convert("cats", write(tmp_path, lines))
     assert str(e.value).endswith(':3:5: filtered_altitude_AGL (`filtered_altitude_AGL`): `1,0` is not a '
-                                 'finite number')
+                                 'finite number (a decimal comma: save the log with `.` as the decimal point)')
 
 
 @pytest.mark.parametrize("sep,said", [(";", "`;`"), ("\t", "tabs")])

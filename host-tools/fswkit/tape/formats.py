@@ -112,8 +112,10 @@ class Log:
             v = number(s)
             if v is None:
                 v = math.nan
+                comma = " (a decimal comma: save the log with `.` as the decimal point)" \
+                    if "," in s and number(s.replace(",", ".")) is not None else ""
                 err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`): `{s[:40]}` is not "
-                                                "a finite number")
+                                                f"a finite number{comma}")
             out[i] = v
         err.raise_if_any()
         return out

@@ -13,7 +13,8 @@ Shared rules
       not part of it); a column line of `;` or tabs is refused, saying so.
     * A cell that is empty or `NaN` in a sensor column is "not available"
       (an empty tape cell); a time that is not a finite number, a sensor cell
-      that is not a number, a row too short for the columns used are located
+      that is not a number, a row too short for the columns used, a row with
+      a non-empty cell beyond the columns of the column line are located
       errors `LOG:LINE:COL: message`, as is a log without the format's
       columns (the wrong FORMAT chosen) or a pressure whose unit cannot be
       told from its magnitude.
@@ -191,7 +192,16 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
         line = lines[n].rstrip("\r")
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        rows.append((n + 1, _split(line)))
+        cells = _split(line)
+        rows.append((n + 1, cells))
+        if len(cells) > len(raw):  # read by position, its cells would land in the wrong columns
+            extra = next((k for k in range(len(raw), len(cells)) if cells[k].strip()), None)
+            if extra is not None:  # empty cells beyond the columns (a spreadsheet's `,,,`) are harmless
+                err.at(n + 1, _col_of(cells, extra), f"the row has {len(cells)} cells, the column line (line "
+                       f"{header + 1}) names {len(raw)}: `{_unquote(cells[extra])[:40]}` lies beyond its columns "
+                       "(a decimal comma, or a comma in a cell not quoted, shifts the cells): save the log with "
+                       "`.` as the decimal point and one cell a column")
+    err.raise_if_any()
     if not rows:
         raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])
     return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, rows)

@@ -14,7 +14,8 @@ Shared rules
     * A cell that is empty or `NaN` in a sensor column is "not available"
       (an empty tape cell); a time that is not a finite number, a sensor cell
       that is not a number, a row too short for the columns used, a row with
-      a non-empty cell beyond the columns of the column line are located
+      a non-empty cell beyond the columns of the column line, a last line
+      cut short (no line end, fewer cells than the column line) are located
       errors `LOG:LINE:COL: message`, as is a log without the format's
       columns (the wrong FORMAT chosen) or a pressure whose unit cannot be
       told from its magnitude.
@@ -201,6 +202,12 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
                        f"{header + 1}) names {len(raw)}: `{_unquote(cells[extra])[:40]}` lies beyond its columns "
                        "(a decimal comma, or a comma in a cell not quoted, shifts the cells): save the log with "
                        "`.` as the decimal point and one cell a column")
+    last = lines[-1].rstrip("\r")
+    if rows and rows[-1][0] == len(lines) and len(rows[-1][1]) < len(raw):
+        # no line end, cells missing: a log cut short, whose last cell may be a number cut short too
+        err.at(len(lines), len(last) + 1, f"the log ends inside a row: its last line has {len(rows[-1][1])} cells "
+               f"of the column line's {len(raw)} and no line end (a download cut short?): complete the row or "
+               "delete it")
     err.raise_if_any()
     if not rows:
         raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])

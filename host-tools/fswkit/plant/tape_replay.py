@@ -40,6 +40,7 @@ import csv
 import hashlib
 import math
 import os
+import re
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -507,13 +508,14 @@ def _continuity_notes(app, igniters: dict) -> list[str]:
 # ---- the tape and its truth -----------------------------------------------------------------
 
 def _column_line(path: str) -> int:
-    """The line of a tape's column names (after its `#` header)."""
-    n = 0
+    """The line of a tape's column names (after its `#` header); lines end
+    as the tape reader ends them (LF, CRLF or CR alone)."""
     with open(path, "rb") as f:
-        for n, line in enumerate(f, 1):
-            if not line.startswith(b"#"):
-                return n
-    return max(n, 1)
+        lines = re.split(rb"\r\n|\r|\n", f.read())
+    for n, line in enumerate(lines, 1):
+        if not line.startswith(b"#"):
+            return n
+    return max(len(lines), 1)
 
 
 MAX_SPAN_S = 3600.0  # s of tape a replay flies, from its first row to its last (as a plant run's max_s)

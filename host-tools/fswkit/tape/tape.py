@@ -251,7 +251,8 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
         lines.pop()  # the final newline
     lines = [l[:-1] if l.endswith("\r") else l for l in lines]
     if not lines or lines[0].rstrip() != MAGIC:
-        err.at(1, 1, f"not a fswkit sensor tape: its first line must be `{MAGIC}` (docs/tapes.md)")
+        err.at(1, 1, f"not a fswkit sensor tape: its first line must be `{MAGIC}` (docs/tapes.md); a "
+                     "recorder's log is made a tape with `fsw tape import FORMAT LOG -o TAPE.csv`")
         err.raise_if_any()
     header: dict[str, list[str]] = {k: [] for k in HEADER_KEYS}
     comments: list[str] = []

@@ -58,8 +58,8 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import (LINE_END, Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number,
-                              read_file)
+from fswkit.tape.tape import (Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file,
+                              split_lines)
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -167,7 +167,7 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
     err = _Errors(path)
     text = _text(data, err, "log")
     err.raise_if_any()
-    lines = LINE_END.split(text)  # LF, CRLF or CR alone
+    lines = split_lines(text)  # LF, CRLF or CR alone
     header = None
     for n, line in enumerate(lines):
         line = line.rstrip("\r")

@@ -49,6 +49,11 @@ HEADER_KEYS = ("source", "flight", "derived", "note")
 MAX_ERRORS = 20  # located messages kept in one TapeError (the rest counted)
 LINE_END = re.compile(r"\r\n|\r|\n")  # LF, CRLF, or CR alone (Excel for Mac's "CSV (Macintosh)")
 
+
+def split_lines(text: str) -> list[str]:
+    """The text's lines, each ended by LF, CRLF or CR alone (the ends dropped)."""
+    return text.split("\n") if "\r" not in text else LINE_END.split(text)
+
 # ISA standard atmosphere (troposphere), the formula of every tape and truth file
 ISA_P0 = 101325.0  # Pa
 ISA_H0 = 44330.77  # m
@@ -246,7 +251,7 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
             err.at(None, None, "empty file: a tape starts with the line `# fswkit sensor tape v1` "
                                "(docs/tapes.md)")
             err.raise_if_any()
-    lines = LINE_END.split(text)
+    lines = split_lines(text)
     if lines and lines[-1] == "":
         lines.pop()  # the final newline
     lines = [l[:-1] if l.endswith("\r") else l for l in lines]

@@ -48,3 +48,18 @@ def test_every_format_refuses_a_wider_row(tmp_path, fmt, text, where):
     with pytest.raises(TapeError) as e:
         convert(fmt, str(log))
     assert f"{log}{where}" in str(e.value) and "the column line (line 1) names" in str(e.value), str(e.value)
+
+
+def test_an_altos_export_wider_than_its_column_line_is_read(tmp_path):
+    # AltosCSV.java writes 9 advanced values (accel, gyro, mag) under 6 names: a TeleMega's rows
+    # are 3 cells wider than its column line, after the basic columns the converter reads
+    head = ("#version,serial,flight,call,time,clock,rssi,lqi,state,state_name,acceleration,pressure,altitude,"
+            "height,accel_speed,baro_speed,temperature,drogue_voltage,main_voltage,battery_voltage,accel_x,"
+            "accel_y,accel_z,gyro_x,gyro_y,gyro_z\n")
+    rows = "".join(f"5, 6583, 3, N0CALL, {i / 10 - 0.2:8.2f}, {i:8.2f}, 0, 0,2,     pad,{0.1 * i:8.2f},"
+                   f"{90000 - i:10.2f},1000.0,{i:8.2f},0,0,20.0,3.9,3.9,4.0,"
+                   "0.1,0.2,9.8,0.0,0.0,0.0,0.3,0.1,0.5\n" for i in range(4))
+    log = tmp_path / "altos.csv"
+    log.write_text(head + rows)
+    t = convert("altos", str(log))
+    assert t.rows == 4 and t.pressure.tolist() == [90000.0, 89999.0, 89998.0, 89997.0]

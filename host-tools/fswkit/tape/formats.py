@@ -160,9 +160,13 @@ def _col_of(cells: list[str], k: int) -> int:
     return sum(len(c) + 1 for c in cells[:k]) + 1 + len(cell) - len(cell.lstrip())
 
 
-def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str) -> Log:
+def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str, *,
+             wider_rows: bool = False) -> Log:
     """Reads a CSV log; its column line is the first line for which
-    `wanted(normalised names)` holds. TapeError (located) otherwise."""
+    `wanted(normalised names)` holds. TapeError (located) otherwise, and
+    for a row with a non-empty cell beyond the columns the column line
+    names, unless `wider_rows` (a recorder whose own writer writes rows
+    wider than its column line, after the columns used)."""
     data = read_file(path, MAX_LOG)
     err = _Errors(path)
     text = _text(data, err, "log")
@@ -196,7 +200,7 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
             continue
         cells = _split(line)
         rows.append((n + 1, cells))
-        if len(cells) > len(raw):  # read by position, its cells would land in the wrong columns
+        if len(cells) > len(raw) and not wider_rows:  # read by position, cells would land in wrong columns
             extra = next((k for k in range(len(raw), len(cells)) if cells[k].strip()), None)
             if extra is not None:  # empty cells beyond the columns (a spreadsheet's `,,,`) are harmless
                 err.at(n + 1, _col_of(cells, extra), f"the row has {len(cells)} cells, the column line (line "
@@ -375,9 +379,11 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
     (altoslib, `write_general_header` ... `write_basic_header`); units and the
     time origin against the two AltOS logs of ../shared/flights (Prometheus,
     TeleMega and TeleMetrum), whose conversion this reproduces row by row."""
+    # AltosCSV.java writes 9 values (accel, gyro, mag) under the 6 names of its advanced header: a
+    # TeleMega's rows are wider than its column line, after the basic columns this reads
     log = read_log(path, "altos", lambda n: "time" in n and "pressure" in n and
                    ("version" in n or "state_name" in n or "acceleration" in n),
-                   "time, pressure, acceleration, with version or state_name")
+                   "time, pressure, acceleration, with version or state_name", wider_rows=True)
     it, ip, ia = log.index("time"), log.index("pressure"), log.index("acceleration")
     t = log.numbers(it, "time", required=True)
     p_raw = log.numbers(ip, "pressure")

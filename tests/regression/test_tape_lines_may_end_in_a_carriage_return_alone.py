@@ -7,7 +7,10 @@ and such a file reads as the same file with LF."""
 
 from __future__ import annotations
 
-from fswkit.tape import read_tape
+import pytest
+
+from conftest import EXAMPLES, run_fsw
+from fswkit.tape import TapeError, read_tape
 from fswkit.tape.formats import convert
 
 CATS = "ts,filtered_altitude_AGL,filtered_acceleration\n-0.02,0.5,0.0981\n0.0,1.0,98.1\n0.01,2.0,100.0\n"
@@ -33,17 +36,12 @@ def test_a_tape_of_cr_line_ends_reads_as_with_lf(tmp_path):
 def test_an_error_is_located_on_the_cr_line(tmp_path):
     cr = tmp_path / "cr.csv"
     cr.write_bytes(CATS.replace("98.1", "9x.1").replace("\n", "\r").encode())
-    import pytest
-    from fswkit.tape import TapeError
-
     with pytest.raises(TapeError) as e:
         convert("cats", str(cr))
     assert str(e.value).startswith(f"{cr}:3:9: filtered_acceleration")
 
 
 def test_a_replay_locates_a_cr_tapes_rows_too(tmp_path):
-    from conftest import EXAMPLES, run_fsw
-
     text = TAPE + "5000,80000,\n"  # row 6, more than 3,600 s after the first
     p = tmp_path / "cr.csv"
     p.write_bytes(text.replace("\n", "\r").encode())

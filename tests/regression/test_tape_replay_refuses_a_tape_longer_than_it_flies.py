@@ -34,7 +34,7 @@ def test_a_tape_beyond_the_replays_span_is_refused_where_it_goes_beyond(tmp_path
     assert not (tmp_path / "out").exists()
 
 
-def test_a_tape_within_the_span_is_loaded():
+def test_a_tape_within_the_span_is_loaded(tmp_path):
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.plant import tape_replay as tr
@@ -43,8 +43,5 @@ def test_a_tape_within_the_span_is_loaded():
     assert tr.MAX_SPAN_S == 3600.0
     app = load(str(HPR), Diagnostics(), None)
     cfg = tr.load_config(app, from_app(app), None)
-    import tempfile, pathlib
-
-    with tempfile.TemporaryDirectory() as d:
-        t, _truth = tr.load_tape(str(tape(pathlib.Path(d), "3598.9")), cfg)  # 3,599.9 s from the first row
-        assert t.span == pytest.approx(3599.9)
+    t, _truth = tr.load_tape(str(tape(tmp_path, "3598.9")), cfg)  # 3,599.9 s after the first row
+    assert t.span == pytest.approx(3599.9)

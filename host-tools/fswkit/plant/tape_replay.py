@@ -40,6 +40,7 @@ import csv
 import hashlib
 import math
 import os
+import re
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -507,25 +508,37 @@ def _continuity_notes(app, igniters: dict) -> list[str]:
 # ---- the tape and its truth -----------------------------------------------------------------
 
 def _column_line(path: str) -> int:
-    """The line of a tape's column names (after its `#` header)."""
-    n = 0
+    """The line of a tape's column names (after its `#` header); lines end
+    as the tape reader ends them (LF, CRLF or CR alone)."""
     with open(path, "rb") as f:
-        for n, line in enumerate(f, 1):
-            if not line.startswith(b"#"):
-                return n
-    return max(n, 1)
+        lines = re.split(rb"\r\n|\r|\n", f.read())
+    for n, line in enumerate(lines, 1):
+        if not line.startswith(b"#"):
+            return n
+    return max(len(lines), 1)
+
+
+MAX_SPAN_S = 3600.0  # s of tape a replay flies, from its first row to its last (as a plant run's max_s)
 
 
 def load_tape(path: str, cfg: Config):
     """(tape, truth) for a replay; ReplayError with located messages: an
-    unreadable tape or truth file, a missing truth file, a column with
-    values that the configuration feeds to no input."""
+    unreadable tape or truth file, a tape whose rows span more than
+    MAX_SPAN_S (its simulated cycles would overflow, or the run last
+    hours), a missing truth file, a column with values that the
+    configuration feeds to no input."""
     from fswkit.tape import TapeError, read_tape, read_truth, truth_path
 
     try:
         tape = read_tape(path)
     except TapeError as e:
         raise ReplayError(str(e)) from None
+    if tape.span > MAX_SPAN_S:
+        i = int(np.argmax(tape.time - tape.start > MAX_SPAN_S))
+        raise ReplayError(f"{path}:{_column_line(path) + 1 + i}: time_s {tape.time[i]:g} is more than "
+                          f"{MAX_SPAN_S:,.0f} s after the first row's {tape.start:g} s: a replay flies at most "
+                          f"{MAX_SPAN_S:,.0f} s of tape (a flight's log, not days of a clock); cut the tape to the "
+                          "flight, or check the unit of its times")
     tpath = truth_path(path)
     if not os.path.exists(tpath):
         raise ReplayError(f"{path}: no truth file beside it ({tpath}): a replay compares the firmware's events "

@@ -8,10 +8,14 @@ Shared rules
       at most MAX_LOG bytes), UTF-8 text; the column line is the first line
       whose cells (a leading `#` dropped, case and spaces ignored) name the
       format's required columns. Lines before it are the log's preamble;
-      after it, blank lines and `#` lines are skipped.
+      after it, blank lines and `#` lines are skipped. Cells are split at
+      `,` as CSV does (not inside double quotes; a quoted cell's quotes are
+      not part of it); a column line of `;` or tabs is refused, saying so.
     * A cell that is empty or `NaN` in a sensor column is "not available"
       (an empty tape cell); a time that is not a finite number, a sensor cell
-      that is not a number, a row too short for the columns used are located
+      that is not a number, a row too short for the columns used, a row with
+      a non-empty cell beyond the columns of the column line, a last line
+      cut short (no line end, fewer cells than the column line) are located
       errors `LOG:LINE:COL: message`, as is a log without the format's
       columns (the wrong FORMAT chosen) or a pressure whose unit cannot be
       told from its magnitude.
@@ -54,7 +58,8 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file
+from fswkit.tape.tape import (Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file,
+                              split_lines)
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -99,7 +104,7 @@ class Log:
                                  f"(column {col + 1} of the column line at line {self.column_line})")
                 out[i] = math.nan
                 continue
-            s = cells[col].strip()
+            s = _unquote(cells[col])
             if s == "" or s.lower() == "nan":
                 if required:
                     err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`) is empty: "
@@ -110,15 +115,43 @@ class Log:
             v = number(s)
             if v is None:
                 v = math.nan
+                comma = " (a decimal comma: save the log with `.` as the decimal point)" \
+                    if "," in s and number(s.replace(",", ".")) is not None else ""
                 err.at(ln, _col_of(cells, col), f"{what} (`{self.raw_names[col]}`): `{s[:40]}` is not "
-                                                "a finite number")
+                                                f"a finite number{comma}")
             out[i] = v
         err.raise_if_any()
         return out
 
 
 def _norm(name: str) -> str:
-    return " ".join(name.strip().lstrip("#").strip().lower().split())
+    return " ".join(_unquote(_unquote(name).lstrip("#")).lower().split())
+
+
+def _unquote(cell: str) -> str:
+    """A cell's text as CSV reads it: spaces around it dropped, and the
+    quotes around a quoted cell (`"1.5"`, `"ts"`; `""` inside is one `"`)."""
+    s = cell.strip()
+    if len(s) >= 2 and s[0] == '"' and s[-1] == '"':
+        s = s[1:-1].replace('""', '"').strip()
+    return s
+
+
+def _split(line: str, sep: str = ",") -> list[str]:
+    """A line's cells as written (quotes and spaces kept, so a cell's column
+    is where its text starts): split at `sep` outside double quotes, as CSV
+    does (a spreadsheet quotes a cell holding a comma)."""
+    if '"' not in line:
+        return line.split(sep)
+    cells, start, quoted = [], 0, False
+    for i, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == sep and not quoted:
+            cells.append(line[start:i])
+            start = i + 1
+    cells.append(line[start:])
+    return cells
 
 
 def _col_of(cells: list[str], k: int) -> int:
@@ -127,34 +160,60 @@ def _col_of(cells: list[str], k: int) -> int:
     return sum(len(c) + 1 for c in cells[:k]) + 1 + len(cell) - len(cell.lstrip())
 
 
-def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str) -> Log:
+def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected: str, *,
+             wider_rows: bool = False) -> Log:
     """Reads a CSV log; its column line is the first line for which
-    `wanted(normalised names)` holds. TapeError (located) otherwise."""
+    `wanted(normalised names)` holds. TapeError (located) otherwise, and
+    for a row with a non-empty cell beyond the columns the column line
+    names, unless `wider_rows` (a recorder whose own writer writes rows
+    wider than its column line, after the columns used)."""
     data = read_file(path, MAX_LOG)
     err = _Errors(path)
     text = _text(data, err, "log")
     err.raise_if_any()
-    lines = text.split("\n")
+    lines = split_lines(text)  # LF, CRLF or CR alone
     header = None
     for n, line in enumerate(lines):
         line = line.rstrip("\r")
         if "," not in line:
             continue
-        names = [_norm(c) for c in line.split(",")]
+        names = [_norm(c) for c in _split(line)]
         if wanted(names):
             header = n
             break
     if header is None:
+        for n, line in enumerate(lines):  # a spreadsheet's CSV of another separator: said, not guessed
+            for sep, said in ((";", "`;`"), ("\t", "tabs")):
+                if sep in line and wanted([_norm(c) for c in _split(line.rstrip("\r"), sep)]):
+                    raise TapeError([f"{path}:{n + 1}:1: not a {FORMATS[fmt].title} log as fswkit reads one: "
+                                     f"its column line separates its cells with {said} (as a spreadsheet saves "
+                                     "CSV where the decimal mark is a comma): save the log as CSV with `,` "
+                                     "between cells and `.` as the decimal point"])
         first = next((l.strip() for l in lines if l.strip()), "")
         raise TapeError([f"{path}:1:1: not a {FORMATS[fmt].title} log: no line names its columns "
                          f"({expected}); the first line is `{first[:80]}`"])
-    raw = [c.strip().lstrip("#").strip() for c in lines[header].rstrip("\r").split(",")]
+    raw = [_unquote(_unquote(c).lstrip("#")) for c in _split(lines[header].rstrip("\r"))]
     rows = []
     for n in range(header + 1, len(lines)):
         line = lines[n].rstrip("\r")
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        rows.append((n + 1, line.split(",")))
+        cells = _split(line)
+        rows.append((n + 1, cells))
+        if len(cells) > len(raw) and not wider_rows:  # read by position, cells would land in wrong columns
+            extra = next((k for k in range(len(raw), len(cells)) if cells[k].strip()), None)
+            if extra is not None:  # empty cells beyond the columns (a spreadsheet's `,,,`) are harmless
+                err.at(n + 1, _col_of(cells, extra), f"the row has {len(cells)} cells, the column line (line "
+                       f"{header + 1}) names {len(raw)}: `{_unquote(cells[extra])[:40]}` lies beyond its columns "
+                       "(a decimal comma, or a comma in a cell not quoted, shifts the cells): save the log with "
+                       "`.` as the decimal point and one cell a column")
+    last = lines[-1].rstrip("\r")
+    if rows and rows[-1][0] == len(lines) and len(rows[-1][1]) < len(raw):
+        # no line end, cells missing: a log cut short, whose last cell may be a number cut short too
+        err.at(len(lines), len(last) + 1, f"the log ends inside a row: its last line has {len(rows[-1][1])} cells "
+               f"of the column line's {len(raw)} and no line end (a download cut short?): complete the row or "
+               "delete it")
+    err.raise_if_any()
     if not rows:
         raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])
     return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, rows)
@@ -183,26 +242,27 @@ def _from_liftoff(t: np.ndarray, t_lift: float) -> tuple[np.ndarray, np.ndarray]
     return shifted[kept], kept
 
 
-def _pressure_pa(p: np.ndarray, log: Log, col: int) -> tuple[np.ndarray, str]:
+def _pressure_pa(p: np.ndarray, log: Log, col: int, rows=None) -> tuple[np.ndarray, str]:
     """A pressure column in Pa, its unit told from its magnitude: Pa (median
-    10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise."""
+    10,000 to 120,000) or hPa = mbar (100 to 1,200); TapeError otherwise.
+    `p` holds one value per row of `rows` (the log's rows when None)."""
     have = p[~np.isnan(p)]
     if have.size == 0:
         raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                          f"`{log.raw_names[col]}` holds no value"])
     med = float(np.median(have))
     if 10_000 <= med <= 120_000:
-        return _positive(p, log, col, "Pa"), "Pa"
+        return _positive(p, log, col, "Pa", rows), "Pa"
     if 100 <= med <= 1_200:
         with np.errstate(over="ignore"):  # a cell beyond binary64 once scaled: refused below, located
-            return _positive(p * 100.0, log, col, "hPa"), "hPa (mbar)"
+            return _positive(p * 100.0, log, col, "hPa", rows), "hPa (mbar)"
     raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: cannot tell the unit of "
                      f"`{log.raw_names[col]}`: its median {med:g} is neither Pa (10,000 to 120,000) nor "
                      "hPa/mbar (100 to 1,200)"])
 
 
-def _positive(p: np.ndarray, log: Log, col: int, unit: str) -> np.ndarray:
-    """`p` (Pa, one value per row of the log) when every value is a finite
+def _positive(p: np.ndarray, log: Log, col: int, unit: str, rows=None) -> np.ndarray:
+    """`p` (Pa, one value per row of `rows`, the log's rows when None) when every value is a finite
     pressure above 0; otherwise TapeError at each cell that is not: a glitch
     row of a sensor (0, negative) is the log's cell to locate, not a tape
     the writer refuses later without a line."""
@@ -211,9 +271,10 @@ def _positive(p: np.ndarray, log: Log, col: int, unit: str) -> np.ndarray:
         return p
     err = log.err()
     name = log.raw_names[col]
+    rows = log.rows if rows is None else rows
     for i in bad.tolist():
-        ln, cells = log.rows[i]
-        cell = cells[col].strip()[:40]
+        ln, cells = rows[i]
+        cell = _unquote(cells[col])[:40]
         why = "is not above 0 Pa" if not p[i] > 0 else f"read as {unit} is beyond the largest number once in Pa"
         err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{cell}` {why}")
     err.raise_if_any()
@@ -318,9 +379,11 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
     (altoslib, `write_general_header` ... `write_basic_header`); units and the
     time origin against the two AltOS logs of ../shared/flights (Prometheus,
     TeleMega and TeleMetrum), whose conversion this reproduces row by row."""
+    # AltosCSV.java writes 9 values (accel, gyro, mag) under the 6 names of its advanced header: a
+    # TeleMega's rows are wider than its column line, after the basic columns this reads
     log = read_log(path, "altos", lambda n: "time" in n and "pressure" in n and
                    ("version" in n or "state_name" in n or "acceleration" in n),
-                   "time, pressure, acceleration, with version or state_name")
+                   "time, pressure, acceleration, with version or state_name", wider_rows=True)
     it, ip, ia = log.index("time"), log.index("pressure"), log.index("acceleration")
     t = log.numbers(it, "time", required=True)
     p_raw = log.numbers(ip, "pressure")
@@ -348,7 +411,7 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
     isr, ifl = log.index("serial"), log.index("flight")
     cells = log.rows[0][1]
     if isr is not None and ifl is not None and max(isr, ifl) < len(cells):
-        flight += f" serial {cells[isr].strip()} flight {cells[ifl].strip()}"
+        flight += f" serial {_unquote(cells[isr])} flight {_unquote(cells[ifl])}"
     derived = ["time_s = log column 'time' as is (AltOS: seconds since its boost detection, so 0 = AltOS liftoff)",
                f"pressure_pa = log column 'pressure' ({unit})" + (" * 100" if unit != "Pa" else " as is"),
                "accel_g = log column 'acceleration' / 9.80665 + 1 (AltOS reports axial acceleration in m/s^2 "
@@ -375,7 +438,9 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
         CATS writes exactly 0.0 instead of a measurement: a final run of
         exact zeros after liftoff becomes empty cells.
     barometer log `ts, id, T, P` (the Vega's baro.csv): `P` in Pa as is (hPa
-        told by magnitude), the rows of the first sensor id only; no
+        told by magnitude), the rows of the first row's sensor id only, read
+        on their own (their times, unit and cells; another sensor's rows do
+        not count); no
         acceleration (the IMU log is a separate file whose rocket axis depends
         on mounting: not read here).
 
@@ -386,11 +451,11 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
     No CATS documentation was found with the search tool."""
     log = read_log(path, "cats", lambda n: "ts" in n and ("filtered_altitude_agl" in n or "p" in n),
                    "ts with filtered_altitude_AGL, or ts, id, T, P")
-    t = log.numbers(log.index("ts"), "ts", required=True)
-    keep = _increasing(t)
-    late = int((~keep).sum())
     ih = log.index("filtered_altitude_agl")
     if ih is not None:
+        t = log.numbers(log.index("ts"), "ts", required=True)
+        keep = _increasing(t)
+        late = int((~keep).sum())
         h = log.numbers(ih, "filtered_altitude_AGL")
         _check_altitude_range(h, pad_alt, log, ih, "m AGL")
         ia = log.index("filtered_acceleration")
@@ -414,18 +479,25 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
                                "machine reaches DROGUE")
         layout = "filtered-data export"
     else:
+        # the first sensor's rows, read on their own: another sensor's rows (their times, units,
+        # cells) neither drop nor scale nor refuse them
         ip, iid = log.index("p"), log.index("id")
         rows = log.rows
+        first = ""
         if iid is not None:
-            first = next((c[iid].strip() for _, c in rows if iid < len(c)), "")
-            sel = np.array([iid < len(c) and c[iid].strip() == first for _, c in rows])
-        else:
-            first, sel = "", np.ones(len(rows), dtype=bool)
-        p_raw = log.numbers(ip, "P")
-        p, unit = _pressure_pa(p_raw, log, ip)
-        m = keep & sel
-        t, p = t[m], p[m]
-        late = int((sel & ~keep).sum())
+            err = log.err()
+            for ln, c in rows:
+                if iid >= len(c):
+                    err.at(ln, None, f"the row has {len(c)} cells: no `{log.raw_names[iid]}` (column {iid + 1} "
+                                     f"of the column line at line {log.column_line})")
+            err.raise_if_any()
+            first = _unquote(rows[0][1][iid])
+            rows = [(ln, c) for ln, c in rows if _unquote(c[iid]) == first]
+        t = log.numbers(log.index("ts"), "ts", required=True, rows=rows)
+        keep = _increasing(t)
+        late = int((~keep).sum())
+        p, unit = _pressure_pa(log.numbers(ip, "P", rows=rows), log, ip, rows)
+        t, p = t[keep], p[keep]
         accel = np.full(t.size, math.nan)
         derived = ["time_s = log column 'ts' as is (CATS: seconds from its liftoff detection)",
                    f"pressure_pa = log column 'P' ({unit})" + (" * 100" if unit != "Pa" else " as is")
@@ -470,8 +542,8 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         if tcol is None:
             raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                              f"`{log.raw_names[col]}` has no time column before it"])
-        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and c[tcol].strip()]
-        t = log.numbers(tcol, f"{what} time", rows=rows)
+        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and _unquote(c[tcol])]
+        t = log.numbers(tcol, f"{what} time", required=True, rows=rows)  # `NaN` refused, as every log's time
         v = log.numbers(col, what, rows=rows)
         ok = ~np.isnan(v)
         t, v = t[ok], v[ok]

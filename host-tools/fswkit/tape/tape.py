@@ -19,7 +19,8 @@ NaN in the arrays (NaN, inf or any other spelling in the file is refused).
 `read_tape` reads a file the user named the way the kit reads every user
 file (fswkit.autocode.diagnostics.read_input: regular files only, a size
 limit, MAX_TAPE here), and raises TapeError with located messages
-`PATH:LINE:COL: message` for anything it cannot take. `write_tape` writes
+`PATH:LINE:COL: message` for anything it cannot take. A line ends in LF,
+CRLF or CR alone. `write_tape` writes
 through fswkit.outputs: a temporary file renamed into place, and an
 existing file is replaced only when asked (`force`).
 
@@ -46,6 +47,12 @@ COLUMN_LINE = ",".join(COLUMNS)
 MAX_TAPE = 64 << 20  # bytes: a whole flight at 1 kHz for an hour is ~100 MB; 100 Hz fits 64 MiB many times
 HEADER_KEYS = ("source", "flight", "derived", "note")
 MAX_ERRORS = 20  # located messages kept in one TapeError (the rest counted)
+LINE_END = re.compile(r"\r\n|\r|\n")  # LF, CRLF, or CR alone (Excel for Mac's "CSV (Macintosh)")
+
+
+def split_lines(text: str) -> list[str]:
+    """The text's lines, each ended by LF, CRLF or CR alone (the ends dropped)."""
+    return text.split("\n") if "\r" not in text else LINE_END.split(text)
 
 # ISA standard atmosphere (troposphere), the formula of every tape and truth file
 ISA_P0 = 101325.0  # Pa
@@ -201,8 +208,9 @@ def _text(data: bytes, err: _Errors, what: str = "tape") -> str | None:
     except UnicodeDecodeError as e:
         bad = e.start if bad < 0 else min(bad, e.start)
     if bad >= 0:
-        line = data.count(b"\n", 0, bad) + 1
-        col = bad - (data.rfind(b"\n", 0, bad) + 1) + 1
+        ends = [m.end() for m in re.finditer(rb"\r\n|\r|\n", data[:bad])]
+        line = len(ends) + 1
+        col = bad - (ends[-1] if ends else 0) + 1
         err.at(line, col, f"not a text file (binary data here): {_UTF8[what]}")
         return None
     return text
@@ -243,12 +251,13 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
             err.at(None, None, "empty file: a tape starts with the line `# fswkit sensor tape v1` "
                                "(docs/tapes.md)")
             err.raise_if_any()
-    lines = text.split("\n")
+    lines = split_lines(text)
     if lines and lines[-1] == "":
         lines.pop()  # the final newline
     lines = [l[:-1] if l.endswith("\r") else l for l in lines]
     if not lines or lines[0].rstrip() != MAGIC:
-        err.at(1, 1, f"not a fswkit sensor tape: its first line must be `{MAGIC}` (docs/tapes.md)")
+        err.at(1, 1, f"not a fswkit sensor tape: its first line must be `{MAGIC}` (docs/tapes.md); a "
+                     "recorder's log is made a tape with `fsw tape import FORMAT LOG -o TAPE.csv`")
         err.raise_if_any()
     header: dict[str, list[str]] = {k: [] for k in HEADER_KEYS}
     comments: list[str] = []

@@ -211,10 +211,13 @@ def parse(text: str, path: str) -> list[EngMotor]:
 
 def load(path: str) -> list[EngMotor]:
     """The motors of a motor file; EngError for a file that cannot be read
-    or is not a motor file."""
+    or is not a motor file. Read as every input of the tools is
+    (fswkit.autocode.diagnostics.read_input): a FIFO, a device or a file
+    over MAX_INPUT bytes is refused unread."""
+    from fswkit.autocode.diagnostics import read_input
+
     try:
-        with open(path, "rb") as f:
-            raw = f.read()
+        raw = read_input(path)
     except FileNotFoundError:
         raise EngError([f"{path}: no such motor file"]) from None
     except IsADirectoryError:
@@ -224,6 +227,8 @@ def load(path: str) -> list[EngMotor]:
     if b"\0" in raw:
         line = raw[:raw.index(b"\0")].count(b"\n") + 1
         raise EngError([f"{path}:{line}:1: a binary file, not a RASP motor file (text)"])
+    if raw.startswith(b"\xef\xbb\xbf"):  # the byte-order mark a Windows editor writes: not the file's text
+        raw = raw[3:]
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

@@ -13,6 +13,10 @@ in kilograms and its maker. Then one `time thrust` pair a line, seconds
 from ignition and newtons, times increasing, ending at zero thrust. A file
 may hold several motors, one after another (each header starts one).
 
+The impulse and the propellant mass are held to each other: a specific
+impulse outside ISP_MIN_S..ISP_MAX_S is a number in the wrong unit (masses
+in grams, times in milliseconds), located at the header's propellant mass.
+
 `load(path)` reads a file into EngMotor records; a bad file is an EngError
 whose lines are located `file:line:col: message`.
 """
@@ -66,6 +70,29 @@ CURVE_MAX_S = 600.0
 CURVE_MAX_N = 1e6
 MAX_MASS_KG = 1000.0
 
+# A rocket motor's specific impulse (total impulse per unit weight of
+# propellant): black powder about 80 s, composites and hybrids up to about
+# 250 s, liquid engines up to about 450 s. A ratio outside this range is a
+# number in the wrong unit: masses in grams, thrust not in newtons, times in
+# milliseconds.
+ISP_MIN_S = 20.0
+ISP_MAX_S = 500.0
+G0 = 9.80665
+
+
+def impulse_problem(impulse: float, propellant_kg: float) -> str | None:
+    """What is wrong with `impulse` N·s delivered by `propellant_kg` of
+    propellant (a specific impulse no rocket motor has, and the unit that is
+    likely wrong), or None."""
+    isp = impulse / (propellant_kg * G0)
+    if ISP_MIN_S <= isp <= ISP_MAX_S:
+        return None
+    shown = f"{isp:,.0f}" if isp >= 100 else f"{isp:.3g}"
+    why = ("a mass in grams, or thrust in another unit than newtons?" if isp < ISP_MIN_S else
+           "times in milliseconds, or a mass that is not all of the propellant's?")
+    return (f"{impulse:,.4g} N·s from {propellant_kg:g} kg of propellant is a specific impulse of {shown} s; "
+            f"a rocket motor's is {ISP_MIN_S:g} to {ISP_MAX_S:g} s (newtons, seconds and kilograms: {why})")
+
 
 def _number(tok: str) -> float | None:
     if "_" in tok:  # Python reads 1_0 as 10; a motor file's numbers are plain
@@ -103,8 +130,16 @@ def parse(text: str, path: str) -> list[EngMotor]:
             elif len(pts) < 2 and pts[0][0] == 0:
                 err(cur["last"], 1, f"motor {cur['name']} has one point at 0 s: no burn")
             else:
-                motors.append(EngMotor(cur["name"], cur["dia"], cur["len"], cur["delays"], cur["prop"], cur["total"],
-                                       cur["maker"], tuple(pts), path, cur["line"]))
+                m = EngMotor(cur["name"], cur["dia"], cur["len"], cur["delays"], cur["prop"], cur["total"],
+                             cur["maker"], tuple(pts), path, cur["line"])
+                if m.total_impulse == 0:
+                    err(cur["line"], 1, f"motor {m.name}: its thrust curve delivers no impulse (every point is 0 N)")
+                    return
+                problem = impulse_problem(m.total_impulse, m.propellant_kg)
+                if problem:
+                    err(cur["line"], cur["prop_col"], f"motor {m.name}: {problem}")
+                    return
+                motors.append(m)
 
     for n, raw in enumerate(text.splitlines(), 1):
         code = raw.split(";", 1)[0]
@@ -154,7 +189,7 @@ def parse(text: str, path: str) -> list[EngMotor]:
                     err(n, cols[4], f"the propellant ({toks[4]} kg) weighs more than the whole motor "
                         f"({toks[5]} kg)")
                     cur["bad"] = True
-                cur.update(vals, delays=toks[3], maker=toks[6])
+                cur.update(vals, delays=toks[3], maker=toks[6], prop_col=cols[4])
             continue
         if cur is None:
             err(n, cols[0], f"a thrust point before any motor header (the first line that is not a comment is "

@@ -508,10 +508,13 @@ def _time_unit_s(app) -> float:
 
 def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     """[motor]'s thrust curve and propellant mass: written in the table, or
-    from the RASP file it names (fswkit.plant.motor)."""
+    from the RASP file it names (fswkit.plant.motor). A propellant mass
+    written here is held to the curve's impulse as a motor file's is (a
+    specific impulse of a rocket motor: fswkit.plant.motor.impulse_problem);
+    0 is a motor whose mass does not change."""
     import os
 
-    from .motor import EngError
+    from .motor import EngError, impulse_problem
     from .motor import load as load_eng
 
     fallback = (((0.0, 0.0), (1.0, 100.0), (1.1, 0.0)), mot["propellant_kg"] or 0.0)  # after an error
@@ -525,18 +528,26 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         if mot["propellant_kg"] is None:
             bind.err("motor", "", "propellant_kg: missing (a thrust_curve written here needs its propellant mass)")
             return fallback
-        return mot["thrust_curve"], mot["propellant_kg"]
-    from .params import key_file
+        curve = mot["thrust_curve"]
+    else:
+        from .params import key_file
 
-    path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
-    try:
-        eng = load_eng(path)[0]
-    except EngError as e:
-        bind.err("motor", "file", f"the motor file {path} cannot be flown:")
-        bind.errors += e.errors
-        return fallback
-    prop = eng.propellant_kg if mot["propellant_kg"] is None else mot["propellant_kg"]
-    return eng.curve(), prop
+        path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
+        try:
+            eng = load_eng(path)[0]
+        except EngError as e:
+            bind.err("motor", "file", f"the motor file {path} cannot be flown:")
+            bind.errors += e.errors
+            return fallback
+        if mot["propellant_kg"] is None:
+            return eng.curve(), eng.propellant_kg  # held to the curve when the file was read
+        curve = eng.curve()
+    impulse = Motor(curve).total
+    if mot["propellant_kg"] > 0:
+        problem = impulse_problem(impulse, mot["propellant_kg"])
+        if problem:
+            bind.err("motor", "propellant_kg", problem)
+    return curve, mot["propellant_kg"]
 
 
 class RocketScenario:

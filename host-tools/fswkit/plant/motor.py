@@ -24,6 +24,7 @@ whose lines are located `file:line:col: message`.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 
@@ -104,6 +105,25 @@ def _number(tok: str) -> float | None:
     return x if math.isfinite(x) else None
 
 
+_NUMERIC = re.compile(r"[-+]?[0-9.,_]*[0-9][0-9.,_]*(?:[eE][-+]?[0-9]+)?")
+COMMA = "(a decimal point, not a comma; the fields of a line are separated by spaces)"
+
+
+def _not_plain(tok: str) -> str | None:
+    """What a token meant as a number lacks to be a motor file's number (a
+    finite one, without `_`, with a decimal point), or None when it is one
+    or does not look like a number at all."""
+    if "," in tok and _NUMERIC.fullmatch(tok):
+        return f"a number {COMMA}"
+    try:
+        x = float(tok)
+    except ValueError:
+        return None
+    if "_" in tok:
+        return "a plain number (no `_`)"
+    return None if math.isfinite(x) else "a finite number"
+
+
 HEADER = "name diameter_mm length_mm delays propellant_kg total_kg maker"
 
 
@@ -117,10 +137,10 @@ def parse(text: str, path: str) -> list[EngMotor]:
         errors.append(f"{path}:{line}:{col}: {msg}")
 
     def finish() -> None:
-        if cur is None:
+        if cur is None or cur.get("orphan"):
             return
         pts = cur["points"]
-        if not pts:
+        if not pts and not cur.get("seen"):  # (a motor whose every point was wrong has its errors already)
             err(cur["line"], 1, f"motor {cur['name']} has no thrust points (after its header, one `seconds newtons` "
                 "pair a line)")
         elif not cur["bad"]:
@@ -141,6 +161,12 @@ def parse(text: str, path: str) -> list[EngMotor]:
                     return
                 motors.append(m)
 
+    start = len(text) - len(text.lstrip())
+    if text[start:start + 1] == "<":  # a RockSim .rse (XML) under a RASP file's name
+        line = text.count("\n", 0, start) + 1
+        col = start - (text.rfind("\n", 0, start) + 1) + 1
+        raise EngError([f"{path}:{line}:{col}: an XML file (a RockSim .rse motor file?), not a RASP .eng motor "
+                        "file: download the motor's RASP (.eng) file instead"])
     for n, raw in enumerate(text.splitlines(), 1):
         code = raw.split(";", 1)[0]
         if not code.strip():
@@ -158,6 +184,13 @@ def parse(text: str, path: str) -> list[EngMotor]:
             cols.append(i + 1)
             i = j
         first = _number(toks[0])
+        why = _not_plain(toks[0]) if first is None and len(toks) < 4 else None
+        if why:  # a thrust point whose time is written wrong (nan, 1_0, 0,5), not a header of 7 fields
+            err(n, cols[0], f"`{toks[0]}`: expected the time in seconds, {why}")
+            if cur is None:
+                cur = {"name": "?", "line": n, "points": [], "bad": True, "orphan": True}
+            cur["bad"] = cur["seen"] = True
+            continue
         if first is None:  # a header
             finish()
             cur = {"name": toks[0], "line": n, "points": [], "bad": False, "last": n, "last_col": 1,
@@ -177,7 +210,8 @@ def parse(text: str, path: str) -> list[EngMotor]:
                                      ("prop", 4, 0.0, "propellant mass in kg"), ("total", 5, 0.0, "total mass in kg")):
                 x = _number(toks[idx])
                 if x is None or x <= lo:
-                    err(n, cols[idx], f"`{toks[idx]}`: expected the motor's {what}, a positive number")
+                    err(n, cols[idx], f"`{toks[idx]}`: expected the motor's {what}, a positive number"
+                        + (f" {COMMA}" if "," in toks[idx] and _NUMERIC.fullmatch(toks[idx]) else ""))
                     cur["bad"] = True
                 elif k in ("prop", "total") and x > MAX_MASS_KG:
                     err(n, cols[idx], f"{toks[idx]} kg: the motor's {what.split(' in ')[0]} is at most "
@@ -194,8 +228,9 @@ def parse(text: str, path: str) -> list[EngMotor]:
         if cur is None:
             err(n, cols[0], f"a thrust point before any motor header (the first line that is not a comment is "
                 f"the header: {HEADER})")
-            cur = {"name": "?", "line": n, "points": [], "bad": True, "last": n, "last_col": 1}
+            cur = {"name": "?", "line": n, "points": [], "bad": True, "orphan": True}
             continue
+        cur["seen"] = True
         if len(toks) != 2:
             err(n, cols[min(2, len(toks) - 1)] if len(toks) > 2 else cols[0] + len(toks[0]),
                 f"a thrust point is two numbers, `seconds newtons`; this line has {len(toks)} field"
@@ -204,7 +239,7 @@ def parse(text: str, path: str) -> list[EngMotor]:
             continue
         t, f = first, _number(toks[1])
         if f is None:
-            err(n, cols[1], f"`{toks[1]}`: expected the thrust in newtons, a number")
+            err(n, cols[1], f"`{toks[1]}`: expected the thrust in newtons, {_not_plain(toks[1]) or 'a number'}")
             cur["bad"] = True
             continue
         if t < 0:

@@ -122,15 +122,17 @@ ROCKET_SCHEMA = {
         "body_cd_area_m2": F("float", "drag coefficient × reference area of the body, m²", lo=0, hi=10),
     }),
     "motor": Table("the motor: a thrust curve written here, or a RASP motor file", {
-        "file": F("str", "a RASP .eng motor file (relative to this file): its first motor's thrust curve, and its "
+        "file": F("str", "a RASP .eng motor file (relative to this file): its motor's thrust curve, and its "
                   "propellant mass unless propellant_kg says otherwise", required=False),
+        "name": F("str", "with file: the designation of the motor to fly (\"H128W\"), needed when the file holds "
+                  "more than one", required=False),
         "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0,
                            hi=MAX_MASS_KG, required=False),
         "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated",
                           x_hi=CURVE_MAX_S, hi=CURVE_MAX_N, required=False),
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
-    }, alternatives=(("file",), ("thrust_curve",)), follows=(("propellant_kg", "thrust_curve"),)),
+    }, alternatives=(("file", "name"), ("thrust_curve",)), follows=(("propellant_kg", "thrust_curve"),)),
     "drogue": _chute("the drogue parachute"),
     "main": _chute("the main parachute"),
     "atmosphere": Table("the standard atmosphere", {
@@ -522,6 +524,9 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         bind.err("motor", "file", "a motor file or a thrust_curve, not both")
         return fallback
     if mot["file"] is None:
+        if mot["name"] is not None:
+            bind.err("motor", "name", "names a motor of the motor file (`file`), and there is none")
+            return fallback
         if mot["thrust_curve"] is None:
             bind.err("motor", "", "missing: a thrust_curve, or a RASP motor file (file = \"motors/G80T.eng\")")
             return fallback
@@ -534,10 +539,13 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
 
         path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
         try:
-            eng = load_eng(path)[0]
+            motors = load_eng(path)
         except EngError as e:
             bind.err("motor", "file", f"the motor file {path} cannot be flown:")
             bind.errors += e.errors
+            return fallback
+        eng = _named_motor(bind, path, motors, mot["name"])
+        if eng is None:
             return fallback
         if mot["propellant_kg"] is None:
             return eng.curve(), eng.propellant_kg  # held to the curve when the file was read
@@ -548,6 +556,31 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         if problem:
             bind.err("motor", "propellant_kg", problem)
     return curve, mot["propellant_kg"]
+
+
+def _named_motor(bind: _Binder, path: str, motors: list, name: str | None):
+    """The motor of a motor file that [motor] `name` names, or its only one;
+    None after a located error (several and no name, a name the file does
+    not hold, or holds more than once)."""
+    names = list(dict.fromkeys(m.name for m in motors))
+    if name is None:
+        if len(motors) == 1:
+            return motors[0]
+        listed = ", ".join(f"{m.name} at line {m.line}" for m in motors[:8]) + (", ..." if len(motors) > 8 else "")
+        bind.err("motor", "file", f"{path} holds {len(motors)} motors ({listed}): name the one to fly, "
+                 f"[motor] name = \"{motors[0].name}\"")
+        return None
+    same = [m for m in motors if m.name == name]
+    if not same:
+        listed = ", ".join(names[:20]) + (", ..." if len(names) > 20 else "")
+        bind.err("motor", "name", f"{path} holds no motor named {name} (it holds {listed})")
+        return None
+    if len(same) > 1:
+        lines = ", ".join(str(m.line) for m in same[:-1]) + f" and {same[-1].line}"
+        bind.err("motor", "name", f"{path} holds {len(same)} motors named {name} (at lines {lines}): keep the one "
+                 "to fly")
+        return None
+    return same[0]
 
 
 class RocketScenario:

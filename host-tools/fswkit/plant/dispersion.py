@@ -52,7 +52,8 @@ SCHEMA = {
     "": Table("the study", {}),
     "motor": Table("motor-to-motor spread", {
         "impulse_sd": F("float", "the thrust scaled by 1 + impulse_sd × a standard normal draw (replaces "
-                        "plant.toml's impulse_sd)", default=0.0, lo=0, hi=0.2),
+                        "plant.toml's impulse_sd, 0 included; absent: plant.toml's spread)", lo=0, hi=0.2,
+                        required=False),
     }),
     "vehicle": Table("the vehicle as built", {
         "mass_sd": F("float", "dry mass scaled by 1 + mass_sd × a standard normal draw", default=0.0, lo=0, hi=0.3),
@@ -178,7 +179,7 @@ def draw(disp: Dispersion, seed: int, index: int) -> Draw:
     rngs = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1))))
             for i, k in enumerate(KEYS)}
     d = Draw(seed, index, noise_seed)
-    if v["motor"]["impulse_sd"]:
+    if v["motor"]["impulse_sd"] is not None:  # written, 0 included: the study's spread replaces plant.toml's
         d.impulse = _factor(rngs["motor"], v["motor"]["impulse_sd"])
     veh = v["vehicle"]
     r = rngs["vehicle"]

@@ -62,7 +62,7 @@ def study_run(args) -> int:
         return 2
     seed = 1 if args.seed is None else args.seed
     try:
-        app, layout, _sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
+        app, layout, sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
     except SetupError as e:
         for line in str(e).splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
@@ -83,8 +83,9 @@ def study_run(args) -> int:
     if args.dispersion:
         command += ["--dispersion", args.dispersion]
 
+    span = study.span_of(sc)  # each run's events drawn up to the end of its flight
     if args.run is not None:
-        return _one_run(args, app, layout, params, disp, seed, default_out)
+        return _one_run(args, app, layout, params, disp, seed, default_out, span)
 
     out = args.out or os.path.join(default_out(app), "rocket-study")
     try:
@@ -103,7 +104,7 @@ def study_run(args) -> int:
         return built
     elf, board = built
     jobs = min(args.jobs or study.cores(), args.runs)  # never more at a time than there are runs
-    setup = study.Setup(app, layout, params, elf, board, disp, seed, command)
+    setup = study.Setup(app, layout, params, elf, board, disp, seed, command, span)
     say(f"dispersion study: {args.runs} flight{'s' if args.runs != 1 else ''} of the real firmware on simulated "
         f"{board.name}s, {jobs} at a time, seed {seed}")
     finished: list = []
@@ -138,17 +139,16 @@ def study_run(args) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
-def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
+def _one_run(args, app, layout, params, disp, seed, default_out, span) -> int:
     """`--run I`: run I of the study flown again alone, its files written."""
     from fswkit.cli.common import flown, folder_and_firmware
     from fswkit.plant import study
-    from fswkit.plant.dispersion import draw
     from fswkit.outputs import OutputError
     from fswkit.plant.run import execute, refuse_inputs
     from fswkit.sim.command import say
 
-    d = draw(disp, seed, args.run)
-    setup = study.Setup(app, layout, params, "", None, disp, seed)
+    setup = study.Setup(app, layout, params, "", None, disp, seed, span_s=span)
+    d = study.draw_run(setup, args.run)
     sc = study.scenario_for(setup, d)
     out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
     try:

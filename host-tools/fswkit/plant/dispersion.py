@@ -146,37 +146,50 @@ def _factor(rng: np.random.Generator, sd: float) -> float:
     return max(0.2, 1.0 + sd * float(rng.standard_normal())) if sd else 1.0
 
 
-def _events(rng: np.random.Generator, rate: float, span: float) -> list[float]:
-    """Poisson event times in [0, span)."""
-    if rate <= 0:
+def _events(rng: np.random.Generator, rate: float, start: float, end: float) -> list[float]:
+    """Poisson event times in [start, end)."""
+    if rate <= 0 or end <= start:
         return []
-    n = int(rng.poisson(rate * span))
-    return sorted(float(x) for x in rng.uniform(0.0, span, n))
+    n = int(rng.poisson(rate * (end - start)))
+    return sorted(float(x) for x in rng.uniform(start, end, n))
 
 
-SPAN_S = 120.0  # events are drawn over this many seconds after ignition (longer than any flight of the example)
+# Events are drawn over this many seconds after ignition from each kind's generator, and past them, up to
+# the end of a longer flight (draw's span_s: plant.toml's max_s less ignition_s), from a generator of their
+# own: a study of a flight within SPAN_S draws what it drew before longer flights were drawn to their end.
+SPAN_S = 120.0
 
 
-def _sensor_draw(rng: np.random.Generator, p: dict) -> SensorDraw:
+def _windows(rng: np.random.Generator, late: np.random.Generator, span_s: float) -> tuple:
+    """(generator, start, end) of the two stretches events are drawn over."""
+    return (rng, 0.0, SPAN_S), (late, SPAN_S, span_s)
+
+
+def _sensor_draw(rng: np.random.Generator, late: np.random.Generator, p: dict, span_s: float) -> SensorDraw:
     d = SensorDraw(dropout_volts=p["dropout_volts"])
     d.bias = float(rng.normal(0.0, p["bias_sd"])) if p["bias_sd"] else 0.0
     lo, hi = p["noise_scale"]
     d.noise_scale = float(rng.uniform(lo, hi)) if hi > lo else lo
-    for t in _events(rng, p["spike_rate_hz"], SPAN_S):
-        size = float(rng.uniform(*p["spike"])) * (1.0 if rng.random() < 0.5 else -1.0)
-        d.spikes.append((t, t + p["spike_s"], size))
-    for t in _events(rng, p["dropout_rate_hz"], SPAN_S):
-        d.dropouts.append((t, t + float(rng.uniform(*p["dropout_s"]))))
+    for r, start, end in _windows(rng, late, span_s):
+        for t in _events(r, p["spike_rate_hz"], start, end):
+            size = float(r.uniform(*p["spike"])) * (1.0 if r.random() < 0.5 else -1.0)
+            d.spikes.append((t, t + p["spike_s"], size))
+        for t in _events(r, p["dropout_rate_hz"], start, end):
+            d.dropouts.append((t, t + float(r.uniform(*p["dropout_s"]))))
     return d
 
 
-def draw(disp: Dispersion, seed: int, index: int) -> Draw:
+def draw(disp: Dispersion, seed: int, index: int, span_s: float = SPAN_S) -> Draw:
     """Run `index` of the study with seed `seed`: one generator per kind of
     dispersion, each from SeedSequence((seed, index, kind)), so that a key
-    added to the file leaves the other kinds' draws as they were."""
+    added to the file leaves the other kinds' draws as they were. Spikes,
+    dropouts and gusts cover `span_s` seconds after ignition (the flight's
+    end), those past SPAN_S from SeedSequence((seed, index, kind, 2))."""
     v = disp.values
     noise_seed = int(np.random.SeedSequence((seed, index)).generate_state(1)[0])
     rngs = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1))))
+            for i, k in enumerate(KEYS)}
+    late = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1, 2))))
             for i, k in enumerate(KEYS)}
     d = Draw(seed, index, noise_seed)
     if v["motor"]["impulse_sd"] is not None:  # written, 0 included: the study's spread replaces plant.toml's
@@ -186,11 +199,11 @@ def draw(disp: Dispersion, seed: int, index: int) -> Draw:
     d.mass, d.drag = _factor(r, veh["mass_sd"]), _factor(r, veh["drag_sd"])
     d.drogue_drag, d.main_drag = _factor(r, veh["chute_drag_sd"]), _factor(r, veh["chute_drag_sd"])
     w = v["wind"]
-    r = rngs["wind"]
-    for t in _events(r, w["gust_rate_hz"], SPAN_S):
-        d.gusts.append((t, float(r.uniform(*w["gust_s"])), float(r.normal(0.0, w["gust_sd_m_s"]))))
-    d.baro = _sensor_draw(rngs["barometer"], v["barometer"])
-    d.accel = _sensor_draw(rngs["accelerometer"], v["accelerometer"])
+    for r, start, end in _windows(rngs["wind"], late["wind"], span_s):
+        for t in _events(r, w["gust_rate_hz"], start, end):
+            d.gusts.append((t, float(r.uniform(*w["gust_s"])), float(r.normal(0.0, w["gust_sd_m_s"]))))
+    d.baro = _sensor_draw(rngs["barometer"], late["barometer"], v["barometer"], span_s)
+    d.accel = _sensor_draw(rngs["accelerometer"], late["accelerometer"], v["accelerometer"], span_s)
     b = v["brownout"]
     r = rngs["brownout"]
     if b["probability"] and r.random() < b["probability"]:

@@ -125,6 +125,7 @@ def _not_plain(tok: str) -> str | None:
 
 
 HEADER = "name diameter_mm length_mm delays propellant_kg total_kg maker"
+_CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")  # not a tab, a line's end or a form feed
 
 
 def parse(text: str, path: str) -> list[EngMotor]:
@@ -161,6 +162,9 @@ def parse(text: str, path: str) -> list[EngMotor]:
                     return
                 motors.append(m)
 
+    eof = text.find("\x1a")  # DOS's end-of-file mark, which old RASP files end with
+    if eof >= 0 and not text[eof:].replace("\x1a", "").strip():
+        text = text[:eof]
     start = len(text) - len(text.lstrip())
     if text[start:start + 1] == "<":  # a RockSim .rse (XML) under a RASP file's name
         line = text.count("\n", 0, start) + 1
@@ -170,6 +174,18 @@ def parse(text: str, path: str) -> list[EngMotor]:
     for n, raw in enumerate(text.splitlines(), 1):
         code = raw.split(";", 1)[0]
         if not code.strip():
+            continue
+        ctrl = _CONTROL.search(code)
+        if ctrl:  # invisible in a message: named, and the line not read
+            err(n, ctrl.start() + 1, f"a control character (U+{ord(ctrl.group()):04X}) in the text: delete it (a "
+                "motor file is plain text)")
+            words = _CONTROL.sub(" ", code).split()
+            if not words or _number(words[0]) is not None:  # a thrust point's line, or nothing else
+                if cur is not None:
+                    cur["bad"] = cur["seen"] = True
+            else:  # a header's: its points are not another motor's
+                finish()
+                cur = {"name": "?", "line": n, "points": [], "bad": True, "orphan": True}
             continue
         toks, cols = [], []
         i = 0

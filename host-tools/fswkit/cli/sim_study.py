@@ -84,6 +84,11 @@ def study_run(args) -> int:
         command += ["--dispersion", args.dispersion]
 
     span = study.span_of(sc)  # each run's events drawn up to the end of its flight
+    past = disp.past_flight(span)
+    for line in past:
+        sys.stderr.write(f"fsw sim: {line}\n")
+    if past:
+        return 2
     if args.run is not None:
         return _one_run(args, app, layout, params, disp, seed, default_out, span)
 

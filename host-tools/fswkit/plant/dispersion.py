@@ -74,8 +74,8 @@ SCHEMA = {
     "accelerometer": _sensor("g", "accelerometer", 10, 100),
     "brownout": Table("a brown-out: the MCU resets in flight and its firmware starts again", {
         "probability": F("float", "the share of flights whose MCU resets once", default=0.0, lo=0, hi=1),
-        "window_s": F("range", "when, in seconds after ignition, uniform in [low, high]", default=(0.0, 30.0),
-                      lo=0, hi=3600),
+        "window_s": F("range", "when, in seconds after ignition, uniform in [low, high] (cut at the end of the "
+                      "flight, plant.toml's max_s less ignition_s)", default=(0.0, 30.0), lo=0, hi=3600),
     }),
 }
 
@@ -85,8 +85,21 @@ KEYS = ("motor", "vehicle", "wind", "barometer", "accelerometer", "brownout")
 class Dispersion:
     """A checked dispersion file: `values[table][key]`."""
 
-    def __init__(self, values: dict, path: str | None):
-        self.values, self.path = values, path
+    def __init__(self, values: dict, path: str | None, where: dict | None = None):
+        self.values, self.path, self.where = values, path, where or {}
+
+    def past_flight(self, span_s: float) -> list[str]:
+        """Located errors for what the file can only draw after a flight that
+        lasts at most `span_s` after ignition has ended: a brown-out window
+        that starts past it (draw cuts a window that only ends past it)."""
+        lo, hi = self.values["brownout"]["window_s"]
+        if not self.values["brownout"]["probability"] or lo < span_s:
+            return []
+        from .params import error_at
+
+        return [error_at(self.path or "", self.where, "brownout", "window_s",
+                         f"[{lo:g}, {hi:g}] starts after the end of the flight, {span_s:g} s after ignition (the "
+                         "plant's max_s less its ignition_s): no brown-out could happen in flight")]
 
     @classmethod
     def none(cls) -> "Dispersion":
@@ -101,8 +114,8 @@ def load(path: str) -> Dispersion:
     """A dispersion file, checked; ParamsError with every located error."""
     if not os.path.exists(path):
         raise ParamsError([f"{path}: no such file (a dispersion file: see docs/sim.md, Dispersion studies)"])
-    values, _where = load_params(path, SCHEMA)
-    return Dispersion(values, path)
+    values, where = load_params(path, SCHEMA)
+    return Dispersion(values, path, where)
 
 
 @dataclass
@@ -179,12 +192,17 @@ def _sensor_draw(rng: np.random.Generator, late: np.random.Generator, p: dict, s
     return d
 
 
-def draw(disp: Dispersion, seed: int, index: int, span_s: float = SPAN_S) -> Draw:
+def draw(disp: Dispersion, seed: int, index: int, span_s: float | None = None) -> Draw:
     """Run `index` of the study with seed `seed`: one generator per kind of
     dispersion, each from SeedSequence((seed, index, kind)), so that a key
-    added to the file leaves the other kinds' draws as they were. Spikes,
-    dropouts and gusts cover `span_s` seconds after ignition (the flight's
-    end), those past SPAN_S from SeedSequence((seed, index, kind, 2))."""
+    added to the file leaves the other kinds' draws as they were. With
+    `span_s`, the seconds from ignition to the flight's end: spikes,
+    dropouts and gusts cover them (those past SPAN_S from
+    SeedSequence((seed, index, kind, 2))), and a brown-out window that ends
+    past them is cut there (`probability` stays the share of flights that
+    reset in flight)."""
+    cut = span_s
+    span_s = SPAN_S if span_s is None else span_s
     v = disp.values
     noise_seed = int(np.random.SeedSequence((seed, index)).generate_state(1)[0])
     rngs = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1))))
@@ -207,7 +225,8 @@ def draw(disp: Dispersion, seed: int, index: int, span_s: float = SPAN_S) -> Dra
     b = v["brownout"]
     r = rngs["brownout"]
     if b["probability"] and r.random() < b["probability"]:
-        d.brownout_s = float(r.uniform(*b["window_s"]))
+        lo, hi = b["window_s"]
+        d.brownout_s = float(r.uniform(lo, hi if cut is None else max(lo, min(hi, cut))))
     return d
 
 

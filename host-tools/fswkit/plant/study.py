@@ -29,7 +29,7 @@ import numpy as np
 
 from . import report as reports
 from .cosim import CosimError, fly
-from .dispersion import SPAN_S, Dispersion, Draw, apply, draw
+from .dispersion import Dispersion, Draw, apply, draw
 from .params import ParamsError
 from .scenario import load as load_scenario
 
@@ -48,7 +48,7 @@ class Setup:
     disp: Dispersion
     seed: int
     command: list = field(default_factory=list)  # `fsw sim PROJECT --plant rocket ...` without --runs/--run
-    span_s: float = SPAN_S  # the flight's end, s after ignition (span_of): events are drawn up to it
+    span_s: float | None = None  # the flight's end, s after ignition (span_of): events drawn up to it
 
 
 def span_of(sc) -> float:

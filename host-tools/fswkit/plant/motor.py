@@ -310,6 +310,9 @@ def load(path: str) -> list[EngMotor]:
         raise EngError([f"{path}: a folder, not a motor file"]) from None
     except OSError as e:
         raise EngError([f"{path}: {e.strerror or e}"]) from None
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):  # a UTF-16 byte-order mark: every other byte is 0
+        raise EngError([f"{path}:1:1: UTF-16 text (Notepad's \"Unicode\"): save the motor file as UTF-8 or ASCII "
+                        "text"])
     if b"\0" in raw:
         line = raw[:raw.index(b"\0")].count(b"\n") + 1
         raise EngError([f"{path}:{line}:1: a binary file, not a RASP motor file (text)"])

@@ -27,6 +27,8 @@ import math
 import re
 from dataclasses import dataclass
 
+from fswkit.autocode.diagnostics import PER_FILE
+
 
 class EngError(Exception):
     """One or more located errors in a motor file."""
@@ -125,6 +127,11 @@ def _not_plain(tok: str) -> str | None:
 
 
 HEADER = "name diameter_mm length_mm delays propellant_kg total_kg maker"
+SHOWN_CHARS = 40  # of a name or a number a message shows
+
+
+def _clip(tok: str) -> str:
+    return tok if len(tok) <= SHOWN_CHARS else tok[:SHOWN_CHARS] + "..."
 _CONTROL = re.compile(r"[\x00-\x08\x0e-\x1f\x7f]")  # not a tab, a line's end or a form feed
 
 
@@ -134,31 +141,37 @@ def parse(text: str, path: str) -> list[EngMotor]:
     motors: list[EngMotor] = []
     cur: dict | None = None
 
+    hidden = 0  # errors past PER_FILE: counted, not shown
+
     def err(line: int, col: int, msg: str) -> None:
-        errors.append(f"{path}:{line}:{col}: {msg}")
+        nonlocal hidden
+        if len(errors) < PER_FILE:
+            errors.append(f"{path}:{line}:{col}: {msg}")
+        else:
+            hidden += 1
 
     def finish() -> None:
         if cur is None or cur.get("orphan"):
             return
         pts = cur["points"]
         if not pts and not cur.get("seen"):  # (a motor whose every point was wrong has its errors already)
-            err(cur["line"], 1, f"motor {cur['name']} has no thrust points (after its header, one `seconds newtons` "
+            err(cur["line"], 1, f"motor {_clip(cur['name'])} has no thrust points (after its header, one `seconds newtons` "
                 "pair a line)")
         elif not cur["bad"]:
             if pts[-1][1] != 0:
-                err(cur["last"], cur["last_col"], f"the thrust curve of {cur['name']} must end at zero thrust "
+                err(cur["last"], cur["last_col"], f"the thrust curve of {_clip(cur['name'])} must end at zero thrust "
                     f"(its last point is {pts[-1][1]:g} N at {pts[-1][0]:g} s)")
             elif len(pts) < 2 and pts[0][0] == 0:
-                err(cur["last"], 1, f"motor {cur['name']} has one point at 0 s: no burn")
+                err(cur["last"], 1, f"motor {_clip(cur['name'])} has one point at 0 s: no burn")
             else:
                 m = EngMotor(cur["name"], cur["dia"], cur["len"], cur["delays"], cur["prop"], cur["total"],
                              cur["maker"], tuple(pts), path, cur["line"])
                 if m.total_impulse == 0:
-                    err(cur["line"], 1, f"motor {m.name}: its thrust curve delivers no impulse (every point is 0 N)")
+                    err(cur["line"], 1, f"motor {_clip(m.name)}: its thrust curve delivers no impulse (every point is 0 N)")
                     return
                 problem = impulse_problem(m.total_impulse, m.propellant_kg)
                 if problem:
-                    err(cur["line"], cur["prop_col"], f"motor {m.name}: {problem}")
+                    err(cur["line"], cur["prop_col"], f"motor {_clip(m.name)}: {problem}")
                     return
                 motors.append(m)
 
@@ -199,10 +212,11 @@ def parse(text: str, path: str) -> list[EngMotor]:
             toks.append(code[i:j])
             cols.append(i + 1)
             i = j
+        shown = [_clip(t) for t in toks]  # as messages show them
         first = _number(toks[0])
         why = _not_plain(toks[0]) if first is None and len(toks) < 4 else None
         if why:  # a thrust point whose time is written wrong (nan, 1_0, 0,5), not a header of 7 fields
-            err(n, cols[0], f"`{toks[0]}`: expected the time in seconds, {why}")
+            err(n, cols[0], f"`{shown[0]}`: expected the time in seconds, {why}")
             if cur is None:
                 cur = {"name": "?", "line": n, "points": [], "bad": True, "orphan": True}
             cur["bad"] = cur["seen"] = True
@@ -226,18 +240,18 @@ def parse(text: str, path: str) -> list[EngMotor]:
                                      ("prop", 4, 0.0, "propellant mass in kg"), ("total", 5, 0.0, "total mass in kg")):
                 x = _number(toks[idx])
                 if x is None or x <= lo:
-                    err(n, cols[idx], f"`{toks[idx]}`: expected the motor's {what}, a positive number"
+                    err(n, cols[idx], f"`{shown[idx]}`: expected the motor's {what}, a positive number"
                         + (f" {COMMA}" if "," in toks[idx] and _NUMERIC.fullmatch(toks[idx]) else ""))
                     cur["bad"] = True
                 elif k in ("prop", "total") and x > MAX_MASS_KG:
-                    err(n, cols[idx], f"{toks[idx]} kg: the motor's {what.split(' in ')[0]} is at most "
+                    err(n, cols[idx], f"{shown[idx]} kg: the motor's {what.split(' in ')[0]} is at most "
                         f"{MAX_MASS_KG:g} kg")
                     cur["bad"] = True
                 vals[k] = x
             if not cur["bad"]:
                 if vals["prop"] > vals["total"]:
-                    err(n, cols[4], f"the propellant ({toks[4]} kg) weighs more than the whole motor "
-                        f"({toks[5]} kg)")
+                    err(n, cols[4], f"the propellant ({shown[4]} kg) weighs more than the whole motor "
+                        f"({shown[5]} kg)")
                     cur["bad"] = True
                 cur.update(vals, delays=toks[3], maker=toks[6], prop_col=cols[4])
             continue
@@ -255,23 +269,23 @@ def parse(text: str, path: str) -> list[EngMotor]:
             continue
         t, f = first, _number(toks[1])
         if f is None:
-            err(n, cols[1], f"`{toks[1]}`: expected the thrust in newtons, {_not_plain(toks[1]) or 'a number'}")
+            err(n, cols[1], f"`{shown[1]}`: expected the thrust in newtons, {_not_plain(toks[1]) or 'a number'}")
             cur["bad"] = True
             continue
         if t < 0:
-            err(n, cols[0], f"{toks[0]} s: a thrust point's time is seconds after ignition, never negative")
+            err(n, cols[0], f"{shown[0]} s: a thrust point's time is seconds after ignition, never negative")
             cur["bad"] = True
             continue
         if f < 0:
-            err(n, cols[1], f"{toks[1]} N: thrust is never negative")
+            err(n, cols[1], f"{shown[1]} N: thrust is never negative")
             cur["bad"] = True
             continue
         if t > CURVE_MAX_S:
-            err(n, cols[0], f"{toks[0]} s: a thrust curve lasts at most {CURVE_MAX_S:g} s")
+            err(n, cols[0], f"{shown[0]} s: a thrust curve lasts at most {CURVE_MAX_S:g} s")
             cur["bad"] = True
             continue
         if f > CURVE_MAX_N:
-            err(n, cols[1], f"{toks[1]} N: a thrust curve's points are at most {CURVE_MAX_N:g} N")
+            err(n, cols[1], f"{shown[1]} N: a thrust curve's points are at most {CURVE_MAX_N:g} N")
             cur["bad"] = True
             continue
         pts = cur["points"]
@@ -290,6 +304,9 @@ def parse(text: str, path: str) -> list[EngMotor]:
     if not errors and not motors:
         errors.append(f"{path}:1:1: no motor in this file (a RASP .eng file: `;` comments, a header `{HEADER}`, "
                       "then `seconds newtons` lines ending at zero thrust)")
+    if hidden:
+        errors.append(f"{path}: {hidden:,} more error{'s' if hidden != 1 else ''} not shown (at most {PER_FILE} a "
+                      "file are)")
     if errors:
         raise EngError(errors)
     return motors

@@ -562,23 +562,26 @@ def _named_motor(bind: _Binder, path: str, motors: list, name: str | None):
     """The motor of a motor file that [motor] `name` names, or its only one;
     None after a located error (several and no name, a name the file does
     not hold, or holds more than once)."""
-    names = list(dict.fromkeys(m.name for m in motors))
+    from .motor import _clip
+
+    names = list(dict.fromkeys(_clip(m.name) for m in motors))
     if name is None:
         if len(motors) == 1:
             return motors[0]
-        listed = ", ".join(f"{m.name} at line {m.line}" for m in motors[:8]) + (", ..." if len(motors) > 8 else "")
+        listed = ", ".join(f"{_clip(m.name)} at line {m.line}" for m in motors[:8]) + (", ..." if len(motors) > 8
+                                                                                          else "")
         bind.err("motor", "file", f"{path} holds {len(motors)} motors ({listed}): name the one to fly, "
-                 f"[motor] name = \"{motors[0].name}\"")
+                 f"[motor] name = \"{_clip(motors[0].name)}\"")
         return None
     same = [m for m in motors if m.name == name]
     if not same:
         listed = ", ".join(names[:20]) + (", ..." if len(names) > 20 else "")
-        bind.err("motor", "name", f"{path} holds no motor named {name} (it holds {listed})")
+        bind.err("motor", "name", f"{path} holds no motor named {_clip(name)} (it holds {listed})")
         return None
     if len(same) > 1:
         lines = ", ".join(str(m.line) for m in same[:-1]) + f" and {same[-1].line}"
-        bind.err("motor", "name", f"{path} holds {len(same)} motors named {name} (at lines {lines}): keep the one "
-                 "to fly")
+        bind.err("motor", "name", f"{path} holds {len(same)} motors named {_clip(name)} (at lines {lines}): keep "
+                 "the one to fly")
         return None
     return same[0]
 

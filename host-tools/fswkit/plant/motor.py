@@ -155,8 +155,8 @@ def parse(text: str, path: str) -> list[EngMotor]:
             return
         pts = cur["points"]
         if not pts and not cur.get("seen"):  # (a motor whose every point was wrong has its errors already)
-            err(cur["line"], 1, f"motor {_clip(cur['name'])} has no thrust points (after its header, one `seconds newtons` "
-                "pair a line)")
+            err(cur["line"], 1, f"motor {_clip(cur['name'])} has no thrust points (after its header, one "
+                "`seconds newtons` pair a line)")
         elif not cur["bad"]:
             if pts[-1][1] != 0:
                 err(cur["last"], cur["last_col"], f"the thrust curve of {_clip(cur['name'])} must end at zero thrust "
@@ -167,7 +167,8 @@ def parse(text: str, path: str) -> list[EngMotor]:
                 m = EngMotor(cur["name"], cur["dia"], cur["len"], cur["delays"], cur["prop"], cur["total"],
                              cur["maker"], tuple(pts), path, cur["line"])
                 if m.total_impulse == 0:
-                    err(cur["line"], 1, f"motor {_clip(m.name)}: its thrust curve delivers no impulse (every point is 0 N)")
+                    err(cur["line"], 1, f"motor {_clip(m.name)}: its thrust curve delivers no impulse (every point "
+                        "is 0 N)")
                     return
                 problem = impulse_problem(m.total_impulse, m.propellant_kg)
                 if problem:

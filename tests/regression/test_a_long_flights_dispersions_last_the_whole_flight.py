@@ -83,3 +83,25 @@ def test_a_study_draws_up_to_its_flights_end(tmp_path: Path, monkeypatch, projec
     assert "Traceback" not in r.err, r.err
     assert seen["setup"].span_s == span
     assert _times(seen["draw"]) == _times(dispersion.draw(dispersion.load(str(f)), 1, 0, span_s=span))
+
+
+def test_events_a_run_cannot_hold_are_located(tmp_path: Path, monkeypatch):
+    """Drawn to the flight's end, a rate's events grow with max_s: 1,000
+    spikes a second over a flight of an hour would be 3.6 million a run per
+    sensor. A rate whose events over the flight pass MAX_EVENTS is an error
+    at its line, before anything is built."""
+    text = (EXAMPLES / "rocket" / "plant.toml").read_text()
+    assert "max_s      = 90" in text
+    plant = tmp_path / "plant.toml"
+    plant.write_text(text.replace("max_s      = 90", "max_s      = 3600"))
+    f = tmp_path / "d.toml"
+    f.write_text("[barometer]\nspike_rate_hz = 1000\n[wind]\ngust_rate_hz = 100\n")
+    r = run_fsw("sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--params", str(plant), "--runs", "1",
+                "--dispersion", str(f), "--out", str(tmp_path / "study"))
+    assert r.code == 2, r.err
+    assert (f"{f}:2: [barometer] spike_rate_hz: 1000 a second over a flight of 3,597 s is 3,597,000 events a run: "
+            f"at most {dispersion.MAX_EVENTS:,} (a lower rate, or a shorter max_s)") in r.err, r.err
+    assert f"{f}:4: [wind] gust_rate_hz: 100 a second over a flight of 3,597 s is 359,700 events a run" in r.err
+    assert "built" not in r.err
+    # within the bound over the example's flight (87 s): taken
+    assert dispersion.load(str(f)).past_flight(87.0) == []

@@ -89,17 +89,28 @@ class Dispersion:
         self.values, self.path, self.where = values, path, where or {}
 
     def past_flight(self, span_s: float) -> list[str]:
-        """Located errors for what the file can only draw after a flight that
-        lasts at most `span_s` after ignition has ended: a brown-out window
-        that starts past it (draw cuts a window that only ends past it)."""
-        lo, hi = self.values["brownout"]["window_s"]
-        if not self.values["brownout"]["probability"] or lo < span_s:
-            return []
+        """Located errors for what the file draws over a flight that lasts at
+        most `span_s` after ignition: a brown-out window that starts past
+        its end (draw cuts a window that only ends past it), a rate of
+        events whose events over it would pass MAX_EVENTS a run."""
         from .params import error_at
 
-        return [error_at(self.path or "", self.where, "brownout", "window_s",
-                         f"[{lo:g}, {hi:g}] starts after the end of the flight, {span_s:g} s after ignition (the "
-                         "plant's max_s less its ignition_s): no brown-out could happen in flight")]
+        out = []
+        over = max(SPAN_S, span_s)  # what draw draws events over
+        for table, key in (("wind", "gust_rate_hz"), ("barometer", "spike_rate_hz"),
+                           ("barometer", "dropout_rate_hz"), ("accelerometer", "spike_rate_hz"),
+                           ("accelerometer", "dropout_rate_hz")):
+            rate = self.values[table][key]
+            if rate * over > MAX_EVENTS:
+                out.append(error_at(self.path or "", self.where, table, key,
+                                    f"{rate:g} a second over a flight of {over:,.0f} s is {rate * over:,.0f} events "
+                                    f"a run: at most {MAX_EVENTS:,} (a lower rate, or a shorter max_s)"))
+        lo, hi = self.values["brownout"]["window_s"]
+        if self.values["brownout"]["probability"] and lo >= span_s:
+            out.append(error_at(self.path or "", self.where, "brownout", "window_s",
+                                f"[{lo:g}, {hi:g}] starts after the end of the flight, {span_s:g} s after ignition "
+                                "(the plant's max_s less its ignition_s): no brown-out could happen in flight"))
+        return out
 
     @classmethod
     def none(cls) -> "Dispersion":
@@ -171,6 +182,9 @@ def _events(rng: np.random.Generator, rate: float, start: float, end: float) -> 
 # the end of a longer flight (draw's span_s: plant.toml's max_s less ignition_s), from a generator of their
 # own: a study of a flight within SPAN_S draws what it drew before longer flights were drawn to their end.
 SPAN_S = 120.0
+# The events of one kind a run may draw (rate × the flight's seconds): each is held in memory for the run,
+# in every worker. 1,000 spikes a second over SPAN_S are 120,000.
+MAX_EVENTS = 200_000
 
 
 def _windows(rng: np.random.Generator, late: np.random.Generator, span_s: float) -> tuple:

@@ -516,7 +516,7 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     0 is a motor whose mass does not change."""
     import os
 
-    from .motor import EngError, impulse_problem
+    from .motor import EngError, _clip, impulse_problem
     from .motor import load as load_eng
 
     fallback = (((0.0, 0.0), (1.0, 100.0), (1.1, 0.0)), mot["propellant_kg"] or 0.0)  # after an error
@@ -549,6 +549,10 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
             return fallback
         if mot["propellant_kg"] is None:
             return eng.curve(), eng.propellant_kg  # held to the curve when the file was read
+        if mot["propellant_kg"] > eng.total_kg:
+            bind.err("motor", "propellant_kg", f"{mot['propellant_kg']:g} kg of propellant weighs more than the whole "
+                     f"motor {_clip(eng.name)} ({eng.path}:{eng.line}: {eng.total_kg:g} kg)")
+            return fallback
         curve = eng.curve()
     impulse = Motor(curve).total
     if mot["propellant_kg"] > 0:

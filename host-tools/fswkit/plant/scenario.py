@@ -552,7 +552,6 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         if mot["propellant_kg"] > eng.total_kg:
             bind.err("motor", "propellant_kg", f"{mot['propellant_kg']:g} kg of propellant weighs more than the whole "
                      f"motor {_clip(eng.name)} ({eng.path}:{eng.line}: {eng.total_kg:g} kg)")
-            return fallback
         curve = eng.curve()
     impulse = Motor(curve).total
     if mot["propellant_kg"] > 0:

@@ -48,7 +48,7 @@ def main() -> int:
     from fswkit.sim.command import build
 
     try:
-        app, layout, _sc = prepare(PROJECT, "rocket", seed=args.seed)
+        app, layout, sc = prepare(PROJECT, "rocket", seed=args.seed)
     except SetupError as e:
         sys.exit(f"bench_study: {e}")
     built = build(PROJECT, out=OUT)
@@ -58,7 +58,8 @@ def main() -> int:
     disp = dispersion.load(DISPERSION)
     rel = os.path.relpath(DISPERSION, ROOT)
     setup = study.Setup(app, layout, os.path.join(PROJECT, "plant.toml"), elf, board, disp, args.seed,
-                        ["fsw", "sim", "examples/rocket", "--plant", "rocket", "--dispersion", rel])
+                        ["fsw", "sim", "examples/rocket", "--plant", "rocket", "--dispersion", rel],
+                        study.span_of(sc))
     done = failed = 0
     t0 = time.monotonic()
     with progress("study", total=args.runs, unit="runs") as bar:

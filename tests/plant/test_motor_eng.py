@@ -31,7 +31,7 @@ def test_example_curves_match_the_figures_they_were_shaped_from(name, impulse, a
 
 GOOD = """; a comment line
 ; another
-X10 29 124 4-7 0.05 0.10 Maker   ; a trailing comment
+X10 29 124 4-7 0.005 0.010 Maker   ; a trailing comment
   0.1 10.0
   0.5 12.0 ; mid-curve comment
   1.0 0.0
@@ -86,7 +86,7 @@ def test_unreadable_files(tmp_path: Path):
     with pytest.raises(EngError, match=r"b.eng:2:1: a binary file"):
         load(str(binary))
     latin = tmp_path / "l.eng"
-    latin.write_bytes("; Fabriqu\xe9\nX10 29 124 4-7 0.05 0.10 M\n0.1 1\n1 0\n".encode("latin-1"))
+    latin.write_bytes("; Fabriqu\xe9\nX10 29 124 4-7 0.05 0.10 M\n0.1 100\n1 0\n".encode("latin-1"))
     assert load(str(latin))[0].name == "X10"
 
 

@@ -29,18 +29,22 @@ def _firmware_param_file(path: str) -> bool:
 
 
 def cmd_sim(args) -> int:
+    given = "--fw-params"  # the option that named the firmware's parameters, for messages
     if getattr(args, "params", None) is not None and _firmware_param_file(args.params):
         if getattr(args, "fw_params", None) is not None:
             sys.stderr.write("fsw sim: --params and --fw-params both name the firmware's parameters: give one\n")
             return EXIT_CONFIG
         args.fw_params, args.params = args.params, None
-    if any(getattr(args, k, None) is not None for k in ("runs", "run", "dispersion")):
+        given = "--params"
+    if any(getattr(args, k, None) is not None for k in ("runs", "run", "dispersion", "jobs")):
         if getattr(args, "fw_params", None) is not None:
-            sys.stderr.write("fsw sim: --fw-params flies one firmware's parameters; a study draws its own "
-                             "flights (not with --runs, --run or --dispersion)\n")
+            what = (f"--params {args.fw_params} holds the firmware's parameters (NAME = value lines, as --fw-params "
+                    "takes)" if given == "--params" else "--fw-params flies one firmware's parameters")
+            sys.stderr.write(f"fsw sim: {what}; a study flies the firmware as built (not with --runs, --jobs, --run "
+                             "or --dispersion)\n")
             return EXIT_CONFIG
         if getattr(args, "tape", None) is not None or getattr(args, "perturb", None) is not None:
-            sys.stderr.write("fsw sim: --runs, --run and --dispersion fly the rocket plant, not a --tape\n")
+            sys.stderr.write("fsw sim: --runs, --jobs, --run and --dispersion fly the rocket plant, not a --tape\n")
             return EXIT_CONFIG
         if getattr(args, "eeprom_file", None) is not None:
             sys.stderr.write("fsw sim: --eeprom-file is for the free-running board on a pty, not a study\n")

@@ -12,6 +12,9 @@ import time
 
 STUDY_FILES = ("study.txt", "study.csv")
 MAX_JOBS = 256
+# The runs of one study (numbered 0 to MAX_RUNS - 1): two weeks of flights at 3,000 an hour, the table's
+# results held in memory meanwhile. A larger study is several, each with its own --seed.
+MAX_RUNS = 1_000_000
 
 
 def study_run(args) -> int:
@@ -24,6 +27,16 @@ def study_run(args) -> int:
     from fswkit.sim.command import build, is_elf, say
     from fswkit.target.build import default_out
 
+    if args.jobs is not None and args.runs is None:
+        say("--jobs needs --runs N (how many flights of a study fly at a time)")
+        return 2
+    if args.runs is not None and args.runs > MAX_RUNS:
+        say(f"--runs {args.runs}: at most {MAX_RUNS:,} flights in one study (a larger one is several, each with "
+            "its own --seed)")
+        return 2
+    if args.run is not None and args.run >= MAX_RUNS:
+        say(f"--run {args.run}: no study has that run (they are numbered 0 to {MAX_RUNS - 1:,})")
+        return 2
     what = "--runs" if args.runs is not None else "--run" if args.run is not None else "--dispersion"
     if args.plant != "rocket":
         say(f"{what} flies the rocket plant: add --plant rocket" if args.plant is None else
@@ -34,9 +47,6 @@ def study_run(args) -> int:
         return 2
     if args.runs is not None and args.run is not None:
         say("--runs N flies a study; --run I flies one of its runs again: one or the other")
-        return 2
-    if args.jobs is not None and args.runs is None:
-        say("--jobs needs --runs N")
         return 2
     if args.jobs is not None and args.jobs > MAX_JOBS:
         say(f"--jobs {args.jobs}: at most {MAX_JOBS} flights at a time (each is a process and a simulated board)")
@@ -52,7 +62,7 @@ def study_run(args) -> int:
         return 2
     seed = 1 if args.seed is None else args.seed
     try:
-        app, layout, _sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
+        app, layout, sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
     except SetupError as e:
         for line in str(e).splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
@@ -73,8 +83,14 @@ def study_run(args) -> int:
     if args.dispersion:
         command += ["--dispersion", args.dispersion]
 
+    span = study.span_of(sc)  # each run's events drawn up to the end of its flight
+    past = disp.past_flight(span)
+    for line in past:
+        sys.stderr.write(f"fsw sim: {line}\n")
+    if past:
+        return 2
     if args.run is not None:
-        return _one_run(args, app, layout, params, disp, seed, default_out)
+        return _one_run(args, app, layout, params, disp, seed, default_out, span)
 
     out = args.out or os.path.join(default_out(app), "rocket-study")
     try:
@@ -92,10 +108,10 @@ def study_run(args) -> int:
     if isinstance(built, int):
         return built
     elf, board = built
-    jobs = args.jobs or study.cores()
-    setup = study.Setup(app, layout, params, elf, board, disp, seed, command)
-    say(f"dispersion study: {args.runs} flights of the real firmware on simulated {board.name}s, {min(jobs, args.runs)} "
-        f"at a time, seed {seed}")
+    jobs = min(args.jobs or study.cores(), args.runs)  # never more at a time than there are runs
+    setup = study.Setup(app, layout, params, elf, board, disp, seed, command, span)
+    say(f"dispersion study: {args.runs} flight{'s' if args.runs != 1 else ''} of the real firmware on simulated "
+        f"{board.name}s, {jobs} at a time, seed {seed}")
     finished: list = []
     t0 = time.monotonic()
     with progress("study", total=args.runs, unit="runs") as bar:
@@ -128,17 +144,16 @@ def study_run(args) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
-def _one_run(args, app, layout, params, disp, seed, default_out) -> int:
+def _one_run(args, app, layout, params, disp, seed, default_out, span) -> int:
     """`--run I`: run I of the study flown again alone, its files written."""
     from fswkit.cli.common import flown, folder_and_firmware
     from fswkit.plant import study
-    from fswkit.plant.dispersion import draw
     from fswkit.outputs import OutputError
     from fswkit.plant.run import execute, refuse_inputs
     from fswkit.sim.command import say
 
-    d = draw(disp, seed, args.run)
-    setup = study.Setup(app, layout, params, "", None, disp, seed)
+    setup = study.Setup(app, layout, params, "", None, disp, seed, span_s=span)
+    d = study.draw_run(setup, args.run)
     sc = study.scenario_for(setup, d)
     out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
     try:

@@ -52,7 +52,8 @@ SCHEMA = {
     "": Table("the study", {}),
     "motor": Table("motor-to-motor spread", {
         "impulse_sd": F("float", "the thrust scaled by 1 + impulse_sd × a standard normal draw (replaces "
-                        "plant.toml's impulse_sd)", default=0.0, lo=0, hi=0.2),
+                        "plant.toml's impulse_sd, 0 included; absent: plant.toml's spread)", lo=0, hi=0.2,
+                        required=False),
     }),
     "vehicle": Table("the vehicle as built", {
         "mass_sd": F("float", "dry mass scaled by 1 + mass_sd × a standard normal draw", default=0.0, lo=0, hi=0.3),
@@ -73,8 +74,8 @@ SCHEMA = {
     "accelerometer": _sensor("g", "accelerometer", 10, 100),
     "brownout": Table("a brown-out: the MCU resets in flight and its firmware starts again", {
         "probability": F("float", "the share of flights whose MCU resets once", default=0.0, lo=0, hi=1),
-        "window_s": F("range", "when, in seconds after ignition, uniform in [low, high]", default=(0.0, 30.0),
-                      lo=0, hi=3600),
+        "window_s": F("range", "when, in seconds after ignition, uniform in [low, high] (cut at the end of the "
+                      "flight, plant.toml's max_s less ignition_s)", default=(0.0, 30.0), lo=0, hi=3600),
     }),
 }
 
@@ -84,8 +85,32 @@ KEYS = ("motor", "vehicle", "wind", "barometer", "accelerometer", "brownout")
 class Dispersion:
     """A checked dispersion file: `values[table][key]`."""
 
-    def __init__(self, values: dict, path: str | None):
-        self.values, self.path = values, path
+    def __init__(self, values: dict, path: str | None, where: dict | None = None):
+        self.values, self.path, self.where = values, path, where or {}
+
+    def past_flight(self, span_s: float) -> list[str]:
+        """Located errors for what the file draws over a flight that lasts at
+        most `span_s` after ignition: a brown-out window that starts past
+        its end (draw cuts a window that only ends past it), a rate of
+        events whose events over it would pass MAX_EVENTS a run."""
+        from .params import error_at
+
+        out = []
+        over = max(SPAN_S, span_s)  # what draw draws events over
+        for table, key in (("wind", "gust_rate_hz"), ("barometer", "spike_rate_hz"),
+                           ("barometer", "dropout_rate_hz"), ("accelerometer", "spike_rate_hz"),
+                           ("accelerometer", "dropout_rate_hz")):
+            rate = self.values[table][key]
+            if rate * over > MAX_EVENTS:
+                out.append(error_at(self.path or "", self.where, table, key,
+                                    f"{rate:g} a second over a flight of {over:,.0f} s is {rate * over:,.0f} events "
+                                    f"a run: at most {MAX_EVENTS:,} (a lower rate, or a shorter max_s)"))
+        lo, hi = self.values["brownout"]["window_s"]
+        if self.values["brownout"]["probability"] and lo >= span_s:
+            out.append(error_at(self.path or "", self.where, "brownout", "window_s",
+                                f"[{lo:g}, {hi:g}] starts after the end of the flight, {span_s:g} s after ignition "
+                                "(the plant's max_s less its ignition_s): no brown-out could happen in flight"))
+        return out
 
     @classmethod
     def none(cls) -> "Dispersion":
@@ -100,8 +125,8 @@ def load(path: str) -> Dispersion:
     """A dispersion file, checked; ParamsError with every located error."""
     if not os.path.exists(path):
         raise ParamsError([f"{path}: no such file (a dispersion file: see docs/sim.md, Dispersion studies)"])
-    values, _where = load_params(path, SCHEMA)
-    return Dispersion(values, path)
+    values, where = load_params(path, SCHEMA)
+    return Dispersion(values, path, where)
 
 
 @dataclass
@@ -145,55 +170,77 @@ def _factor(rng: np.random.Generator, sd: float) -> float:
     return max(0.2, 1.0 + sd * float(rng.standard_normal())) if sd else 1.0
 
 
-def _events(rng: np.random.Generator, rate: float, span: float) -> list[float]:
-    """Poisson event times in [0, span)."""
-    if rate <= 0:
+def _events(rng: np.random.Generator, rate: float, start: float, end: float) -> list[float]:
+    """Poisson event times in [start, end)."""
+    if rate <= 0 or end <= start:
         return []
-    n = int(rng.poisson(rate * span))
-    return sorted(float(x) for x in rng.uniform(0.0, span, n))
+    n = int(rng.poisson(rate * (end - start)))
+    return sorted(float(x) for x in rng.uniform(start, end, n))
 
 
-SPAN_S = 120.0  # events are drawn over this many seconds after ignition (longer than any flight of the example)
+# Events are drawn over this many seconds after ignition from each kind's generator, and past them, up to
+# the end of a longer flight (draw's span_s: plant.toml's max_s less ignition_s), from a generator of their
+# own: a study of a flight within SPAN_S draws what it drew before longer flights were drawn to their end.
+SPAN_S = 120.0
+# The events of one kind a run may draw (rate × the flight's seconds): each is held in memory for the run,
+# in every worker. 1,000 spikes a second over SPAN_S are 120,000.
+MAX_EVENTS = 200_000
 
 
-def _sensor_draw(rng: np.random.Generator, p: dict) -> SensorDraw:
+def _windows(rng: np.random.Generator, late: np.random.Generator, span_s: float) -> tuple:
+    """(generator, start, end) of the two stretches events are drawn over."""
+    return (rng, 0.0, SPAN_S), (late, SPAN_S, span_s)
+
+
+def _sensor_draw(rng: np.random.Generator, late: np.random.Generator, p: dict, span_s: float) -> SensorDraw:
     d = SensorDraw(dropout_volts=p["dropout_volts"])
     d.bias = float(rng.normal(0.0, p["bias_sd"])) if p["bias_sd"] else 0.0
     lo, hi = p["noise_scale"]
     d.noise_scale = float(rng.uniform(lo, hi)) if hi > lo else lo
-    for t in _events(rng, p["spike_rate_hz"], SPAN_S):
-        size = float(rng.uniform(*p["spike"])) * (1.0 if rng.random() < 0.5 else -1.0)
-        d.spikes.append((t, t + p["spike_s"], size))
-    for t in _events(rng, p["dropout_rate_hz"], SPAN_S):
-        d.dropouts.append((t, t + float(rng.uniform(*p["dropout_s"]))))
+    for r, start, end in _windows(rng, late, span_s):
+        for t in _events(r, p["spike_rate_hz"], start, end):
+            size = float(r.uniform(*p["spike"])) * (1.0 if r.random() < 0.5 else -1.0)
+            d.spikes.append((t, t + p["spike_s"], size))
+        for t in _events(r, p["dropout_rate_hz"], start, end):
+            d.dropouts.append((t, t + float(r.uniform(*p["dropout_s"]))))
     return d
 
 
-def draw(disp: Dispersion, seed: int, index: int) -> Draw:
+def draw(disp: Dispersion, seed: int, index: int, span_s: float | None = None) -> Draw:
     """Run `index` of the study with seed `seed`: one generator per kind of
     dispersion, each from SeedSequence((seed, index, kind)), so that a key
-    added to the file leaves the other kinds' draws as they were."""
+    added to the file leaves the other kinds' draws as they were. With
+    `span_s`, the seconds from ignition to the flight's end: spikes,
+    dropouts and gusts cover them (those past SPAN_S from
+    SeedSequence((seed, index, kind, 2))), and a brown-out window that ends
+    past them is cut there (`probability` stays the share of flights that
+    reset in flight)."""
+    cut = span_s
+    span_s = SPAN_S if span_s is None else span_s
     v = disp.values
     noise_seed = int(np.random.SeedSequence((seed, index)).generate_state(1)[0])
     rngs = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1))))
             for i, k in enumerate(KEYS)}
+    late = {k: np.random.Generator(np.random.PCG64(np.random.SeedSequence((seed, index, i + 1, 2))))
+            for i, k in enumerate(KEYS)}
     d = Draw(seed, index, noise_seed)
-    if v["motor"]["impulse_sd"]:
+    if v["motor"]["impulse_sd"] is not None:  # written, 0 included: the study's spread replaces plant.toml's
         d.impulse = _factor(rngs["motor"], v["motor"]["impulse_sd"])
     veh = v["vehicle"]
     r = rngs["vehicle"]
     d.mass, d.drag = _factor(r, veh["mass_sd"]), _factor(r, veh["drag_sd"])
     d.drogue_drag, d.main_drag = _factor(r, veh["chute_drag_sd"]), _factor(r, veh["chute_drag_sd"])
     w = v["wind"]
-    r = rngs["wind"]
-    for t in _events(r, w["gust_rate_hz"], SPAN_S):
-        d.gusts.append((t, float(r.uniform(*w["gust_s"])), float(r.normal(0.0, w["gust_sd_m_s"]))))
-    d.baro = _sensor_draw(rngs["barometer"], v["barometer"])
-    d.accel = _sensor_draw(rngs["accelerometer"], v["accelerometer"])
+    for r, start, end in _windows(rngs["wind"], late["wind"], span_s):
+        for t in _events(r, w["gust_rate_hz"], start, end):
+            d.gusts.append((t, float(r.uniform(*w["gust_s"])), float(r.normal(0.0, w["gust_sd_m_s"]))))
+    d.baro = _sensor_draw(rngs["barometer"], late["barometer"], v["barometer"], span_s)
+    d.accel = _sensor_draw(rngs["accelerometer"], late["accelerometer"], v["accelerometer"], span_s)
     b = v["brownout"]
     r = rngs["brownout"]
     if b["probability"] and r.random() < b["probability"]:
-        d.brownout_s = float(r.uniform(*b["window_s"]))
+        lo, hi = b["window_s"]
+        d.brownout_s = float(r.uniform(lo, hi if cut is None else max(lo, min(hi, cut))))
     return d
 
 

@@ -122,15 +122,17 @@ ROCKET_SCHEMA = {
         "body_cd_area_m2": F("float", "drag coefficient × reference area of the body, m²", lo=0, hi=10),
     }),
     "motor": Table("the motor: a thrust curve written here, or a RASP motor file", {
-        "file": F("str", "a RASP .eng motor file (relative to this file): its first motor's thrust curve, and its "
+        "file": F("str", "a RASP .eng motor file (relative to this file): its motor's thrust curve, and its "
                   "propellant mass unless propellant_kg says otherwise", required=False),
+        "name": F("str", "with file: the designation of the motor to fly (\"H128W\"), needed when the file holds "
+                  "more than one", required=False),
         "propellant_kg": F("float", "propellant mass, burnt in proportion to the impulse delivered", lo=0,
                            hi=MAX_MASS_KG, required=False),
         "thrust_curve": F("curve", "[[seconds from ignition, newtons], ...], linearly interpolated",
                           x_hi=CURVE_MAX_S, hi=CURVE_MAX_N, required=False),
         "impulse_sd": F("float", "motor-to-motor spread: each seed's motor has its thrust scaled by 1 + "
                         "impulse_sd × a standard normal draw (0: every motor is nominal)", default=0.0, lo=0, hi=0.2),
-    }, alternatives=(("file",), ("thrust_curve",)), follows=(("propellant_kg", "thrust_curve"),)),
+    }, alternatives=(("file", "name"), ("thrust_curve",)), follows=(("propellant_kg", "thrust_curve"),)),
     "drogue": _chute("the drogue parachute"),
     "main": _chute("the main parachute"),
     "atmosphere": Table("the standard atmosphere", {
@@ -508,10 +510,13 @@ def _time_unit_s(app) -> float:
 
 def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     """[motor]'s thrust curve and propellant mass: written in the table, or
-    from the RASP file it names (fswkit.plant.motor)."""
+    from the RASP file it names (fswkit.plant.motor). A propellant mass
+    written here is held to the curve's impulse as a motor file's is (a
+    specific impulse of a rocket motor: fswkit.plant.motor.impulse_problem);
+    0 is a motor whose mass does not change."""
     import os
 
-    from .motor import EngError
+    from .motor import EngError, _clip, impulse_problem
     from .motor import load as load_eng
 
     fallback = (((0.0, 0.0), (1.0, 100.0), (1.1, 0.0)), mot["propellant_kg"] or 0.0)  # after an error
@@ -519,24 +524,69 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         bind.err("motor", "file", "a motor file or a thrust_curve, not both")
         return fallback
     if mot["file"] is None:
+        if mot["name"] is not None:
+            bind.err("motor", "name", "names a motor of the motor file (`file`), and there is none")
+            return fallback
         if mot["thrust_curve"] is None:
             bind.err("motor", "", "missing: a thrust_curve, or a RASP motor file (file = \"motors/G80T.eng\")")
             return fallback
         if mot["propellant_kg"] is None:
             bind.err("motor", "", "propellant_kg: missing (a thrust_curve written here needs its propellant mass)")
             return fallback
-        return mot["thrust_curve"], mot["propellant_kg"]
-    from .params import key_file
+        curve = mot["thrust_curve"]
+    else:
+        from .params import key_file
 
-    path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
-    try:
-        eng = load_eng(path)[0]
-    except EngError as e:
-        bind.err("motor", "file", f"the motor file {path} cannot be flown:")
-        bind.errors += e.errors
-        return fallback
-    prop = eng.propellant_kg if mot["propellant_kg"] is None else mot["propellant_kg"]
-    return eng.curve(), prop
+        path = os.path.join(os.path.dirname(key_file(bind.path, bind.where, "motor", "file")), mot["file"])
+        try:
+            motors = load_eng(path)
+        except EngError as e:
+            bind.err("motor", "file", f"the motor file {path} cannot be flown:")
+            bind.errors += e.errors
+            return fallback
+        eng = _named_motor(bind, path, motors, mot["name"])
+        if eng is None:
+            return fallback
+        if mot["propellant_kg"] is None:
+            return eng.curve(), eng.propellant_kg  # held to the curve when the file was read
+        if mot["propellant_kg"] > eng.total_kg:
+            bind.err("motor", "propellant_kg", f"{mot['propellant_kg']:g} kg of propellant weighs more than the whole "
+                     f"motor {_clip(eng.name)} ({eng.path}:{eng.line}: {eng.total_kg:g} kg)")
+        curve = eng.curve()
+    impulse = Motor(curve).total
+    if mot["propellant_kg"] > 0:
+        problem = impulse_problem(impulse, mot["propellant_kg"])
+        if problem:
+            bind.err("motor", "propellant_kg", problem)
+    return curve, mot["propellant_kg"]
+
+
+def _named_motor(bind: _Binder, path: str, motors: list, name: str | None):
+    """The motor of a motor file that [motor] `name` names, or its only one;
+    None after a located error (several and no name, a name the file does
+    not hold, or holds more than once)."""
+    from .motor import _clip
+
+    names = list(dict.fromkeys(_clip(m.name) for m in motors))
+    if name is None:
+        if len(motors) == 1:
+            return motors[0]
+        listed = ", ".join(f"{_clip(m.name)} at line {m.line}" for m in motors[:8]) + (", ..." if len(motors) > 8
+                                                                                          else "")
+        bind.err("motor", "file", f"{path} holds {len(motors)} motors ({listed}): name the one to fly, "
+                 f"[motor] name = \"{_clip(motors[0].name)}\"")
+        return None
+    same = [m for m in motors if m.name == name]
+    if not same:
+        listed = ", ".join(names[:20]) + (", ..." if len(names) > 20 else "")
+        bind.err("motor", "name", f"{path} holds no motor named {_clip(name)} (it holds {listed})")
+        return None
+    if len(same) > 1:
+        lines = ", ".join(str(m.line) for m in same[:-1]) + f" and {same[-1].line}"
+        bind.err("motor", "name", f"{path} holds {len(same)} motors named {_clip(name)} (at lines {lines}): keep "
+                 "the one to fly")
+        return None
+    return same[0]
 
 
 class RocketScenario:

@@ -48,6 +48,18 @@ class Setup:
     disp: Dispersion
     seed: int
     command: list = field(default_factory=list)  # `fsw sim PROJECT --plant rocket ...` without --runs/--run
+    span_s: float | None = None  # the flight's end, s after ignition (span_of): events drawn up to it
+
+
+def span_of(sc) -> float:
+    """How long after ignition a scenario's flight may last (its max_s less
+    its ignition_s): a run's spikes, dropouts and gusts are drawn that far."""
+    return sc.max_s - (sc.ignition_s or 0.0)
+
+
+def draw_run(setup: Setup, index: int) -> Draw:
+    """Run `index` of the study's draw, its events up to the flight's end."""
+    return draw(setup.disp, setup.seed, index, span_s=setup.span_s)
 
 
 @dataclass
@@ -91,7 +103,7 @@ def _cpu() -> float:
 
 def fly_run(setup: Setup, index: int) -> RunResult:
     """Flies run `index` of the study (no files)."""
-    d = draw(setup.disp, setup.seed, index)
+    d = draw_run(setup, index)
     res = RunResult(index, d)
     cpu0, wall0 = _cpu(), time.perf_counter()
     try:

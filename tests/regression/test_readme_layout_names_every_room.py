@@ -1,8 +1,10 @@
 """README.md's Layout named the rooms, test folders and examples of an
 older tree: `host-tools/fswkit/`'s `param/`, `recorder/`, `reload/` and
 `web/`, a third of `tests/`'s folders and two of the five examples
-(`stand`, `hpr_digital`) were missing. A doc claim is a test: every room,
-every test folder and every example is named in its row."""
+(`stand`, `hpr_digital`) were missing; its Documentation list left out
+docs/safety.md, sensors.md and sensor-table.md. A doc claim is a test:
+every room, every test folder and every example is named in its row, and
+every doc in the list."""
 
 from __future__ import annotations
 
@@ -40,3 +42,15 @@ def test_every_test_folder_is_named():
 def test_every_example_is_named():
     row = _row("examples/")
     assert [d for d in _folders(ROOT / "examples") if f"`{d}`" not in row] == []
+
+
+def test_the_documentation_list_names_every_doc():
+    """docs/safety.md, sensors.md and sensor-table.md were missing from it
+    (platformio.md and arduino-cli.md only point to integrations/, which the
+    README links itself)."""
+    section = README.split("## Documentation", 1)[1].split("\n## ", 1)[0]
+    moved = {p.name for p in (ROOT / "docs").glob("*.md") if "Moved to [" in p.read_text()[:400]}
+    assert moved == {"platformio.md", "arduino-cli.md"}
+    assert "integrations/platformio/" in README and "integrations/arduino-cli/" in README
+    assert [p.name for p in sorted((ROOT / "docs").glob("*.md"))
+            if p.name not in moved and f"(docs/{p.name})" not in section] == []

@@ -4,10 +4,11 @@ of the short options (`--output` of `-o`, `cmd`'s `--project`, `plot`'s
 `--element`, `flash`'s `--verbose`) were nowhere, `fsw sim --run I`'s
 synopsis left out the `--params` and `--board` that the study's rerun
 command prints, and `fsw sim --plant` refused `--eeprom-file` with the pty
-mode's options while the doc listed only four of them. A doc claim is a
+mode's options while the doc listed only four of them; "Where the commands
+live" left out three of the command line's modules. A doc claim is a
 test: every option of every command's parser is named in that command's
-section of docs/cli.md, and every option a synopsis line shows is one of
-the command's."""
+section of docs/cli.md, every option a synopsis line shows is one of the
+command's, and every module of the command line is placed."""
 
 from __future__ import annotations
 
@@ -93,3 +94,17 @@ def test_the_pty_options_the_doc_says_plant_refuses_are_refused(tmp_path, option
                 *[str(tmp_path / v) if opt in ("--link", "--eeprom-file") else v for v in value])
     assert r.code == 2, r.err
     assert f"{opt} is for the free-running board on a pty" in r.err
+
+
+def test_where_the_commands_live_names_every_module_of_the_cli():
+    """The section left out `machine.py`, `sim_study.py` and `common.py`,
+    and gave `web.py` only `fsw web`."""
+    section = _section_any("## Where the commands live")
+    modules = sorted(p.name for p in (ROOT / "host-tools" / "fswkit" / "cli").glob("*.py")
+                     if p.name not in ("__init__.py", "__main__.py", "main.py"))
+    assert [m for m in modules if f"`{m}`" not in section] == []
+    assert re.search(r"`web\.py` \(`ground`", section)
+
+
+def _section_any(heading: str) -> str:
+    return DOC.split(heading + "\n", 1)[1].split("\n## ", 1)[0]

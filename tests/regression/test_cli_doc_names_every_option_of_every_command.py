@@ -86,7 +86,7 @@ def test_the_study_rerun_synopsis_takes_what_a_study_prints_for_it():
 
 @pytest.mark.parametrize("option", ["--duration 1", "--fast", "--analog A0=1", "--link x", "--eeprom-file x"])
 def test_the_pty_options_the_doc_says_plant_refuses_are_refused(tmp_path, option):
-    listed = re.search(r"((?:`--[\w-]+`(?:,\s|\sand\s)?)+)\s+belong to the pty mode and\s+are refused with\s+`--plant`",
+    listed = re.search(r"((?:`--[\w-]+`(?:,\s|\sand\s)?)+)\s+belong\s+to\s+the\s+pty\s+mode\s+and\s+are\s+refused\s+with\s+`--plant`",
                        _section("sim"))
     assert listed and f"`{option.split()[0]}`" in listed.group(1)
     opt, *value = option.split()

@@ -274,3 +274,27 @@ def test_replay_with_sparklines(tmp_path, monkeypatch):
     r = clean(run_fsw("replay", str(log), "--headless", "--spark", "tankPresure"))
     assert r.code == 1 and "unknown element `tankPresure`" in r.err and "valveOpen" in r.err
     assert r.out == ""
+
+
+def test_at_80x24_the_rocket_shows_whole_as_docs_cli_md_says():
+    """docs/cli.md counted the rocket's elements as 14 when it had 17: the
+    count it gives is the rocket's, and the 80×24 view shows every one of
+    them, every task and both sparklines, nothing left out."""
+    import re
+
+    from conftest import ROOT
+
+    said = re.search(r"the rocket example \((\d+) elements, (\d+) tasks\) shows whole with two sparklines",
+                     (ROOT / "docs" / "cli.md").read_text())
+    assert said
+    v, last = rocket_view()
+    names = [e.name for e in v.session.layout.elements]
+    tasks = ("uplink", "sense", "nav", "mission", "log", "act", "downlink")
+    assert (len(names), len(tasks)) == (int(said.group(1)), int(said.group(2)))
+    lines = shown(v, last + 0.05, (80, 24))
+    fits(lines, (80, 24))
+    words = " ".join(lines).split()
+    assert [n for n in names if n not in words] == [] and "more" not in words
+    assert all(t in words for t in tasks)
+    assert sum(ln.startswith(("altitude ▁", "altitude ▂", "altitude ▃", "altitude ▄", "altitude ▅", "accel "))
+               and "min" in ln for ln in lines) == 2

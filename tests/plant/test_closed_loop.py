@@ -232,3 +232,45 @@ def test_the_readme_plot_is_the_demo_flight_of_this_firmware(flights):
     digest = hashlib.sha256(Path(flights["seed1"].files["csv"]).read_bytes()).hexdigest()
     shown = png_text(str(ROOT / "docs" / "img" / "rocket-flight.png")).get(DIGEST_KEY)
     assert shown == digest, "docs/img/rocket-flight.png is not this tree's demo flight: run `make docs-img`"
+
+
+MEMORY = ("RAM (measured", "PASS  flash within", "PASS  RAM within")  # the build's bytes, quoted as measured
+
+
+def _shown_lines(block: list[str]) -> list[str]:
+    """A doc's quoted run, less what is not the report's (the command, its
+    `fsw sim:` lines on standard error, `...`, the wall time) and the
+    firmware's sizes, which the docs quote as measured on their day: what
+    is left is the flight, which a seed makes the same byte for byte."""
+    return [ln for ln in block if ln.strip() != "..." and not ln.startswith(("$ ", "fsw sim:")) and " wall (" not in ln
+            and not ln.strip().startswith(MEMORY)]
+
+
+def _in_report(line: str, text: str) -> bool:
+    if line.endswith("..."):  # a line the doc cuts short: the report's begins so
+        return any(r.startswith(line[:-3]) for r in text.splitlines())
+    return line in text.splitlines()
+
+
+@pytest.mark.parametrize("doc,seed", [("README.md", 1), ("docs/cli.md", 2)])
+def test_the_runs_the_docs_quote_are_this_firmwares(flights, doc, seed):
+    """README.md's demo flight (`make demo`, seed 1) and docs/cli.md's
+    `--seed 2` flight are quoted as the report prints them (cli.md quoted
+    a seed-3 flight with a RAM line of another build). Stale after a change
+    to the firmware's behaviour, the configs or the plant: fly the seed
+    again and paste its lines."""
+    text = (ROOT / doc).read_text()
+    if doc == "README.md":
+        block = text.split("```\napogee, true", 1)[1].split("```", 1)[0]
+        lines = ("apogee, true" + block).splitlines()
+    else:
+        start = text.index(f"    $ fsw sim examples/rocket --plant rocket --out build/flight --seed {seed}\n")
+        lines = []
+        for ln in text[start:].splitlines():
+            if not ln.startswith("    "):
+                break
+            lines.append(ln[4:])
+    shown = _shown_lines(lines)
+    assert len(shown) >= 8 and shown[-1] == "9 of 9 checks passed"
+    report = flights[f"seed{seed}"].report.text()
+    assert [ln for ln in shown if not _in_report(ln, report)] == []

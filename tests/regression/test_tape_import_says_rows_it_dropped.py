@@ -22,3 +22,12 @@ def test_rows_dropped_are_said_by_the_command(tmp_path):
     assert "30 rows of the log dropped: their time is not after the previous row's" in r.err, r.err
     r = run_fsw("tape", "import", "cats", str(log), "-o", "-")
     assert "30 rows of the log dropped" in r.err
+
+
+def test_one_row_dropped_is_said_in_the_singular(tmp_path):
+    """It said `1 rows of the log dropped: their time is ...`."""
+    log = tmp_path / "log.csv"
+    log.write_text("ts,filtered_altitude_AGL,filtered_acceleration\n-0.1,0,0\n0,0.5,30\n0.1,3,30\n0.1,3,30\n")
+    r = run_fsw("tape", "import", "cats", str(log), "-o", str(tmp_path / "t.csv"))
+    assert r.code == 0, r.err
+    assert "fsw tape import: 1 row of the log dropped: its time is not after the previous row's" in r.err, r.err

@@ -63,8 +63,13 @@ def cmd_compile(args) -> int:
         return EXIT_INTERNAL
     layout = getattr(args, "layout", None)
     if layout is not None and (layout == "-" or (args.output != "-" and same_file(layout, args.output))):
-        sys.stderr.write(f"fsw compile: --layout {layout}: " + ("the image goes to standard output; the layout "
-                         "needs a file" if layout == "-" else "the image's own path: name another file") + "\n")
+        if layout != "-":
+            words = "the image's own path: name another file"
+        elif args.output == "-":
+            words = "the image goes to standard output; the layout needs a file"
+        else:
+            words = "a layout is written to a file, not to standard output: the layout needs a file"
+        sys.stderr.write(f"fsw compile: --layout {layout}: {words}\n")
         return EXIT_CONFIG
     try:
         for path in (args.output, layout):  # checked before anything is written

@@ -122,7 +122,7 @@ def parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
-    c = sub.add_parser("check", help="check configs (.sv .sm .ss) or folders of them")
+    c = sub.add_parser("check", help="check configs (.sv .sm .ss .app) or folders of them")
     c.add_argument("paths", nargs="+", metavar="PATH")
     c.add_argument("--strict", action="store_true", help="warnings fail the check too")
     c.add_argument("--sv", help="the state vector config to check machines against")

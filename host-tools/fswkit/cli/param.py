@@ -94,7 +94,7 @@ def cmd_param(args) -> int:
             _say(str(e))
             return EXIT_FAIL
         if os.path.lexists(args.output) and not args.force:
-            _say(f"{args.output} exists: a parameter file is never overwritten without --force")
+            _say(f"{args.output} exists: it is replaced only when asked (--force)")
             return EXIT_FAIL
     return _talk(args, app, params, by_name, wanted, file_values, from_app(app), link_plan(app).tx_cap,
                  params_text)

@@ -43,8 +43,9 @@ def cmd_import(args) -> int:
         sys.stderr.write(f"fsw tape import: --pad-alt is not used: {why}\n")
     late = _dropped_late(tape)
     if late:  # a clock that restarted mid-log loses what follows: said here, not only in the header
-        sys.stderr.write(f"fsw tape import: {late:,} rows of the log dropped: their time is not after the "
-                         "previous row's (the tape's header counts them)\n")
+        rows = f"{late:,} rows of the log dropped: their time is" if late != 1 else \
+            "1 row of the log dropped: its time is"
+        sys.stderr.write(f"fsw tape import: {rows} not after the previous row's (the tape's header counts them)\n")
     return EXIT_OK
 
 

@@ -35,6 +35,14 @@ def archive_path(args) -> str | None:
     return os.path.join(base, ARCHIVE)
 
 
+def _reason(e: OSError) -> str:
+    """The system's reason for a socket that could not be served on, in its
+    own words (socket.create_server adds its bind's address as a tuple)."""
+    if isinstance(e.errno, int) and e.errno > 0:  # a name that does not resolve has a negative one (EAI_*)
+        return os.strerror(e.errno)
+    return e.strerror or str(e)
+
+
 def cmd_ground(args) -> int:
     from fswkit.cli.ground import _link_layout
     from fswkit.web.app import AssetsMissing, listen, uplot_dir
@@ -56,7 +64,7 @@ def cmd_ground(args) -> int:
             sys.stderr.write(f"fsw {name}: {e}\n")
             return EXIT_FAIL
         except OSError as e:
-            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
+            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {_reason(e)}\n")
             return EXIT_FAIL
     try:
         return _station(args, name, layout, app_baud, port_name, sock)
@@ -118,7 +126,7 @@ def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> in
         try:
             serve(app, host=args.host, port=args.http_port, on_ready=ready, sock=sock)
         except OSError as e:
-            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {e.strerror or e}\n")
+            sys.stderr.write(f"fsw {name}: cannot serve on {args.host}:{args.http_port}: {_reason(e)}\n")
             return EXIT_FAIL
         return EXIT_OK
     except KeyboardInterrupt:

@@ -66,10 +66,18 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
     view = View(session, headless, f"{layout.name} on {port_name}", spark=spark)
     start = time.monotonic()
     status = 0
+    shown = 0  # frames decoded and shown (--frames counts these: a read may bring more than are left)
+
+    def show(ev) -> None:
+        nonlocal shown
+        if max_frames is None or shown < max_frames:
+            view.event(ev)
+            shown += 1
+
     try:
         with outputs.stopped_by_signals(), view:
             try:
-                ground.handshake(timeout=3.0 if layout.has_uplink else 12.0, on_event=view.event)
+                ground.handshake(timeout=3.0 if layout.has_uplink else 12.0, on_event=show)
             except LinkTimeout as e:
                 if not ignore_schema:
                     raise GroundError(f"{e}: is the firmware running on {port_name}, at {baud} baud? "
@@ -79,21 +87,19 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
             verified = True
             if log is not None:
                 log.commit()
-            if layout.has_uplink:
+            if layout.has_uplink and (max_frames is None or shown < max_frames):
                 try:
-                    ground.command(wire.OP_SNAPSHOT, timeout=1.0, on_event=view.event)
+                    ground.command(wire.OP_SNAPSHOT, timeout=1.0, on_event=show)
                 except LinkTimeout:
                     pass
-            while True:
+            while max_frames is None or shown < max_frames:
                 for ev in ground.read():
-                    view.event(ev)
+                    show(ev)
                     if ev.kind == "hello" and not ev.info["schema_ok"] and not ignore_schema:
                         raise GroundError(schema_message(session, project))
                 view.note = ground.note  # the station's word on its link (went away, reconnected)
                 view.update()
                 if duration is not None and time.monotonic() - start >= duration:
-                    break
-                if max_frames is not None and session.stats.frames >= max_frames:
                     break
     except KeyboardInterrupt as e:  # Ctrl-C: 0; SIGTERM, SIGHUP: 128 + the signal
         status = 128 + e.signum if isinstance(e, outputs.Stopped) else 0

@@ -181,6 +181,16 @@ def not_a_port(name: str) -> str | None:
     return None
 
 
+def no_terminal(port: str, err: int | None, text: str) -> str | None:
+    """What to say of a device that opened but is not a terminal (`/dev/null`,
+    a disk: the system refuses a serial port's settings on it), or None when
+    that is not the trouble."""
+    if err == errno.ENOTTY or os.strerror(errno.ENOTTY) in text:
+        return (f"cannot open {port}: it is a device that is not a terminal, not a serial port "
+                "(`fsw ports` lists the serial ports connected)")
+    return None
+
+
 def denied(port: str, err: int | None, text: str) -> str | None:
     """What to say of a port the system would not open for this user (the
     usual first trouble on Linux: the serial devices belong to `dialout`),
@@ -218,7 +228,9 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
                           or "Device or resource busy" in text or getattr(e, "errno", None) == 16):
             rec = holder(name)
             raise PortBusy(busy_message(name, rec), rec) from None
-        raise PortError(denied(name, getattr(e, "errno", None), text) or f"cannot open {name}: {e}") from None
+        err = getattr(e, "errno", None)
+        raise PortError(denied(name, err, text) or no_terminal(name, err, text) or f"cannot open {name}: {e}") \
+            from None
     if not exclusive:
         return port
     try:

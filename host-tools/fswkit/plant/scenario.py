@@ -733,8 +733,9 @@ class RocketScenario:
         if name in ("pinned-baro", "pinned-accel"):
             role = "barometer" if name == "pinned-baro" else "accelerometer"
             if parts[role] is not None:
+                own = [k for k in PART_FAULTS if k.startswith(name.split("-")[1] + "-")]  # baro-nack, ...
                 bind.err(role, "part", f"--fault {name} pins an analog sensor's output at full scale; this "
-                         f"{role} is a digital part: its failures are {role[:5]}-nack and {role[:5]}-stuck")
+                         f"{role} is a digital part: its failures are {', '.join(own[:-1])} and {own[-1]}")
         if name in PART_FAULTS:
             role = "barometer" if name.startswith("baro") else "accelerometer"
             if parts[role] is None:

@@ -82,9 +82,9 @@ def _port_problem(port: str, err: int | None, text: str) -> str:
                     "(Ctrl-C) and flash again")
         return (f"{port} is busy: another program has it open (a serial monitor, `fsw monitor`, "
                 "the Arduino IDE): close it and flash again")
-    from fswkit.link.port import denied
+    from fswkit.link.port import denied, no_terminal
 
-    words = denied(port, err, text)
+    words = denied(port, err, text) or no_terminal(port, err, text)
     if words:
         return words
     if err == errno.ENOENT:

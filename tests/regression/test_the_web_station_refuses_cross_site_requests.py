@@ -20,11 +20,9 @@ from __future__ import annotations
 
 import http.client
 import json
-import threading
-import time
 
 import pytest
-from support.browser import free_port
+from support.browser import served
 from support.linkfw import tank_layout
 
 from fswkit.web.app import AssetsMissing, create_app, uplot_dir
@@ -44,20 +42,8 @@ EVIL = "http://evil.example"
 
 @pytest.fixture(scope="module")
 def station():
-    import uvicorn
-
-    port = free_port()
-    server = uvicorn.Server(uvicorn.Config(create_app(Source(tank_layout())), host="127.0.0.1", port=port,
-                                           log_level="warning", ws="websockets-sansio"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 30
-    while not server.started:
-        assert time.monotonic() < deadline, "the web station did not start"
-        time.sleep(0.02)
-    yield port
-    server.should_exit = True
-    thread.join(10)
+    with served(create_app(Source(tank_layout()))) as url:
+        yield int(url.rstrip("/").rsplit(":", 1)[1])
 
 
 def request(port: int, method: str, path: str, headers: dict, body: bytes | None = None):

@@ -1,11 +1,13 @@
 """Debian's Chromium, headless, driven by Selenium through chromedriver
 (installed by `make setup`), for the web ground station's tests; and a free
-TCP port for the station to serve on."""
+TCP port for the station to serve on, and an app served there in a thread."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import socket
+import threading
 import time
 
 import pytest
@@ -57,3 +59,24 @@ def browser():
     drv = chromium()
     yield drv
     drv.quit()
+
+
+@contextlib.contextmanager
+def served(app):
+    """The app on a free localhost port, in a thread: its URL."""
+    import uvicorn
+
+    http = free_port()
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=http, log_level="warning",
+                                           ws="websockets-sansio"))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 10
+    while not server.started:
+        assert time.monotonic() < deadline, "the server did not start"
+        time.sleep(0.02)
+    try:
+        yield f"http://127.0.0.1:{http}/"
+    finally:
+        server.should_exit = True
+        thread.join(5)

@@ -10,13 +10,11 @@ writes it."""
 
 from __future__ import annotations
 
-import contextlib
 import io
 import json
 import math
 import os
 import re
-import threading
 import time
 import urllib.error
 import urllib.request
@@ -25,7 +23,7 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import run_fsw
-from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = pytest.mark.costly(10)
@@ -81,27 +79,6 @@ def test_gaps_stay_where_a_span_has_no_value_and_series_sampled_together_thin_al
 
 
 # ---- the routes, on an archive written here ----------------------------------------------------
-
-
-@contextlib.contextmanager
-def served(app):
-    """The app on a free localhost port, in a thread: its URL."""
-    import uvicorn
-
-    http = free_port()
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=http, log_level="warning",
-                                           ws="websockets-sansio"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 10
-    while not server.started:
-        assert time.monotonic() < deadline, "the server did not start"
-        time.sleep(0.02)
-    try:
-        yield f"http://127.0.0.1:{http}/"
-    finally:
-        server.should_exit = True
-        thread.join(5)
 
 
 def get(url: str) -> tuple[int, bytes]:

@@ -13,7 +13,7 @@ from .appsyntax import Calibration, ChannelRow, Problem, Table, parse_table
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
 from .model import Channel
-from .numeric import REALS, f32_from_fraction
+from .numeric import REALS, f32_from_fraction, to_type
 
 __all__ = ["Channel", "analog_gain", "analog_value", "check_channels", "check_table"]
 
@@ -37,7 +37,10 @@ def analog_value(count: int, gain: float, offset: float, real) -> float:
     """count * gain + offset as the firmware computes it in R: the product
     rounded to R, then the sum rounded to R (never fused)."""
     if real.bits == 32:
-        return f32_from_fraction(Fraction(f32_from_fraction(Fraction(count) * Fraction(gain))) + Fraction(offset))
+        product = f32_from_fraction(Fraction(count) * Fraction(gain))
+        if not math.isfinite(product):  # overflowed: IEEE's infinity plus a finite offset
+            return product + offset
+        return f32_from_fraction(Fraction(product) + Fraction(offset))
     return float(count) * gain + offset
 
 
@@ -74,6 +77,8 @@ def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnos
         e = _element(row, table, sv, used_inputs, err)
         if e is None:
             continue
+        if table.analog and row.direction.text == "i" and not _span(row, *calibration, e, board, err):
+            continue
         used_pins[pin] = (table.src.path, row.direction.line)
         out.append(Channel(table.analog, row.direction.text, row.pin.text, pin, e, *calibration,
                            table.src.path, row.direction.line))
@@ -101,6 +106,44 @@ def _calibration(row: ChannelRow, analog: bool, real: str, err) -> tuple[float, 
         err(row.stray.tok, row.stray.message)
         return None
     return values["scale"], values["offset"]
+
+
+def _span(row: ChannelRow, scale: float, offset: float, e: M.Element, board: Board, err) -> bool:
+    """Whether an analog input's calibration gives its element a finite
+    value that follows the pin: the span per count (analog_gain) is not 0
+    in the board's numbers, and the value at both ends of the converter,
+    count 0 and 2^bits - 1, computed as the firmware computes it and stored
+    in the element's type, is finite. Reported at `scale=` (at `offset=`
+    when the row gives no scale)."""
+    real = REALS[board.real]
+    cals = {c.key.text: c.number for c in row.calibrations}
+    at = cals.get("scale") or cals.get("offset")
+    gain = analog_gain(scale, board.adc_vref, board.adc_bits, real)
+    if gain == 0:
+        err(at, f"`scale={_g(scale)}` gives `{e.name}` the offset ({_g(offset)}) whatever the pin reads: its span, "
+                f"scale x {_g(board.adc_vref)} V / {(1 << board.adc_bits) - 1} counts, is 0 in the board's "
+                f"numbers ({_BINARY[real.bits].split(':')[0]}); give the sensor's scale (element units per volt), negative if it falls "
+                "as the volts rise")
+        return False
+    full = (1 << board.adc_bits) - 1
+    for count, volts in ((0, 0), (full, board.adc_vref)):
+        v = to_type(e.type, analog_value(count, gain, real.literal(repr(offset)), real))
+        if not math.isfinite(v):
+            what = (f"its {e.type} element (binary32: 3.4028235e38 at most)" if e.type.size == 4 and real.bits != 32
+                    else f"the board's numbers ({_BINARY[real.bits]} at most)")
+            err(at, f"`{e.name}` = volts x {_g(scale)} {'-' if offset < 0 else '+'} {_g(abs(offset))} overflows {what} at "
+                    + (f"the pin's full scale ({_g(volts)} V, count {count})" if count else "0 V (count 0)")
+                    + f": the firmware would store {'-' if v < 0 else ''}infinity; check the calibration's units")
+            return False
+    return True
+
+
+_BINARY = {32: "binary32: 3.4028235e38", 64: "binary64: 1.7976931348623157e308"}
+
+
+def _g(v: float) -> str:
+    """A number as a message shows it: `250`, `1e+39`, `0.5`."""
+    return f"{v:g}" if v == v and abs(v) < 1e16 else repr(v)
 
 
 def _value(cal: Calibration, real: str, err) -> float | None:

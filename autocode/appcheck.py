@@ -362,10 +362,17 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
     used_pins: dict = {}
     used_inputs: dict = {}
     state = SensorState()
+    listed: dict[str, int] = {}  # a table's real path -> the line of its `io`
     for c in files:
         if not c.path.endswith((".aio", ".dio", ".sns")):
             r.err(c.file, "an I/O table is a `.aio` (analog), `.dio` (digital) or `.sns` (sensor parts) file")
             continue
+        real = os.path.realpath(c.path)
+        if real in listed:  # its rows would all clash with themselves
+            r.err(c.file, f"`{os.path.basename(c.path)}` is already listed on line {listed[real]}: an I/O table "
+                          "is listed once")
+            continue
+        listed[real] = c.file.line
         isrc = read_source(c.path, r.diags, APP)
         if isrc is None:
             continue

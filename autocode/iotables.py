@@ -45,18 +45,20 @@ def analog_value(count: int, gain: float, offset: float, real) -> float:
 
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
-                diags: Diagnostics, used_pins: dict[int, tuple[str, int]] | None = None,
+                diags: Diagnostics, used_pins: dict[int, tuple] | None = None,
                 used_inputs: dict[str, tuple[str, int]] | None = None,
                 refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of one table, parsed and checked. `used_pins` /
     `used_inputs` carry what earlier tables of the same application took, so
-    a pin or an input element used twice across tables is reported too;
+    a pin or an input element used twice across tables is reported too
+    (`used_pins`: pin -> (path, line), and for a sensor part's pin what it
+    is there, sensors.py);
     `refused` maps pins no channel may have (though a chip select may) to why."""
     return check_channels(parse_table(src, analog, diags), sv, board, diags, used_pins, used_inputs, refused)
 
 
 def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnostics,
-                   used_pins: dict[int, tuple[str, int]] | None = None,
+                   used_pins: dict[int, tuple] | None = None,
                    used_inputs: dict[str, tuple[str, int]] | None = None,
                    refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of a parsed table; every refused row is reported."""
@@ -181,8 +183,8 @@ def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err, refu
     elif not analog and pin not in board.digital_pins:
         problem = f"pin `{text}` of `{board.name}` cannot be used as a digital pin"
     elif pin in used_pins:
-        where, line = used_pins[pin]
-        problem = f"pin `{text}` is already used ({where}:{line})"
+        where, line, *role = used_pins[pin]  # a sensor part's pins say what they are there
+        problem = f"pin `{text}` is already used ({where}:{line})" + (f": {role[0]}" if role else "")
     elif pin in refused:
         problem = f"pin `{text}` cannot be a channel's: {refused[pin]}"
     else:

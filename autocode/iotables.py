@@ -122,10 +122,10 @@ def _span(row: ChannelRow, scale: float, offset: float, e: M.Element, board: Boa
     at = cals.get("scale") or cals.get("offset")
     gain = analog_gain(scale, board.adc_vref, board.adc_bits, real)
     if gain == 0:
-        err(at, f"`scale={_g(scale)}` gives `{e.name}` the offset ({_g(offset)}) whatever the pin reads: its span, "
-                f"scale x {_g(board.adc_vref)} V / {(1 << board.adc_bits) - 1} counts, is 0 in the board's "
-                f"numbers ({_BINARY[real.bits].split(':')[0]}); give the sensor's scale (element units per volt), negative if it falls "
-                "as the volts rise")
+        err(at, f"`scale={_g(scale)}` gives `{e.name}` the offset ({_g(offset)}) whatever the pin reads: its "
+                f"span, scale x {_g(board.adc_vref)} V / {(1 << board.adc_bits) - 1} counts, is 0 in the board's "
+                f"numbers ({_BINARY[real.bits].split(':')[0]}); give the sensor's scale (element units per volt), "
+                "negative if it falls as the volts rise")
         return False
     full = (1 << board.adc_bits) - 1
     for count, volts in ((0, 0), (full, board.adc_vref)):
@@ -133,7 +133,8 @@ def _span(row: ChannelRow, scale: float, offset: float, e: M.Element, board: Boa
         if not math.isfinite(v):
             what = (f"its {e.type} element (binary32: 3.4028235e38 at most)" if e.type.size == 4 and real.bits != 32
                     else f"the board's numbers ({_BINARY[real.bits]} at most)")
-            err(at, f"`{e.name}` = volts x {_g(scale)} {'-' if offset < 0 else '+'} {_g(abs(offset))} overflows {what} at "
+            sign = "-" if offset < 0 else "+"
+            err(at, f"`{e.name}` = volts x {_g(scale)} {sign} {_g(abs(offset))} overflows {what} at "
                     + (f"the pin's full scale ({_g(volts)} V, count {count})" if count else "0 V (count 0)")
                     + f": the firmware would store {'-' if v < 0 else ''}infinity; check the calibration's units")
             return False
@@ -144,8 +145,8 @@ _BINARY = {32: "binary32: 3.4028235e38", 64: "binary64: 1.7976931348623157e308"}
 
 
 def _g(v: float) -> str:
-    """A number as a message shows it: `250`, `1e+39`, `0.5`."""
-    return f"{v:g}" if v == v and abs(v) < 1e16 else repr(v)
+    """A number as a message shows it, exactly: `250`, `1e+39`, `0.5`."""
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
 
 
 def _value(cal: Calibration, real: str, err) -> float | None:

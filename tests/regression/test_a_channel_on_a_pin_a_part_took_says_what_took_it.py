@@ -27,7 +27,8 @@ def test_the_message_names_the_pins_role(tmp_path, sns, dio, what):
     (tmp_path / "parts.sns").write_text(sns + "\n")
     (tmp_path / "tank.dio").write_text((tmp_path / "tank.dio").read_text() + dio + "\n")
     app = (tmp_path / "tank.app").read_text()
-    (tmp_path / "tank.app").write_text(app.replace("io           tank.aio\n", "io           parts.sns\nio           tank.aio\n"))
+    app = app.replace("io           tank.aio\n", "io           parts.sns\nio           tank.aio\n")
+    (tmp_path / "tank.app").write_text(app)
     r = run_fsw("check", "tank.app", cwd=tmp_path)
     assert r.code == 1, r.err
     assert "is already used (parts.sns:1)" in r.err and what in r.err, r.err

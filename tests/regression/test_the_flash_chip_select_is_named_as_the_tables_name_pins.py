@@ -30,7 +30,8 @@ def rocket(tmp_path):
 def store(rocket, pin):
     app = (rocket / "rocket.app").read_text()
     old = next(ln for ln in app.splitlines() if ln.startswith("store"))
-    (rocket / "rocket.app").write_text(app.replace(old, f"store   spi_nor {pin} 1 M").replace("record  64 ", "record  128"))
+    app = app.replace(old, f"store   spi_nor {pin} 1 M").replace("record  64 ", "record  128")
+    (rocket / "rocket.app").write_text(app)
     return run_fsw("check", "rocket.app", cwd=rocket)
 
 

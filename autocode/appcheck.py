@@ -119,14 +119,18 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
                    f"(one cycle must be a whole number of ms); rate is {rate}")
 
     tasks, task_opts = _tasks(f.tasks, sv, rate, machines, machine_files, r)
-    if sensors and not any(t.kind == "inputs" for t in tasks):
+    # a task row refused for its own reason is no missing task, and a row of an unknown kind may be the one
+    unknown = any(row.kind is None or row.kind.text not in TASK_KINDS for row in f.tasks)
+    has = lambda kind: unknown or any(row.kind.text == kind for row in f.tasks)  # noqa: E731
+    if sensors and not has("inputs"):
         tok = next(c.file for c in io_files if c.path.endswith(".sns"))
         r.err(tok, "the sensor parts are read by the `inputs` task: add one to [tasks] (e.g. `sense inputs rate=100`)")
+    pyro_names = {row.element.text for row in f.pyro}
+    _channel_tasks(channels, io_files, has, pyro_names, r)
     _clock_steps(tasks, board, time_source, time_unit, r)
     streams = _telemetry(f.telemetry, sv, tasks, r)
     writable = _uplink(f.uplink, sv, tasks, machines, channels, settings.get("reset_cause"), r, sensors)
     reset_cause = _reset_cause(settings.get("reset_cause"), sv, r)
-    pyro_names = {row.element.text for row in f.pyro}
     _one_writer(r, channels, tasks, task_opts, settings.get("reset_cause"), reset_cause, machines, machine_srcs,
                 pyro_names, sensors)
     budget = _budget(f.budget, board, r)
@@ -358,10 +362,17 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
     used_pins: dict = {}
     used_inputs: dict = {}
     state = SensorState()
+    listed: dict[str, int] = {}  # a table's real path -> the line of its `io`
     for c in files:
         if not c.path.endswith((".aio", ".dio", ".sns")):
             r.err(c.file, "an I/O table is a `.aio` (analog), `.dio` (digital) or `.sns` (sensor parts) file")
             continue
+        real = os.path.realpath(c.path)
+        if real in listed:  # its rows would all clash with themselves
+            r.err(c.file, f"`{os.path.basename(c.path)}` is already listed on line {listed[real]}: an I/O table "
+                          "is listed once")
+            continue
+        listed[real] = c.file.line
         isrc = read_source(c.path, r.diags, APP)
         if isrc is None:
             continue
@@ -375,6 +386,28 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
             channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs,
                                     refused)
     return channels, sensors
+
+
+def _channel_tasks(channels: list[M.Channel], io_files: list[ConfigFile], has, pyro_names: set[str],
+                   r: Report) -> None:
+    """A channel table's `i` rows run in the `inputs` task and its `o` rows in
+    the `outputs` task: without the task, a table that has such rows is
+    reported at its `io` line (pyro channels report their own missing
+    `outputs` task, pyrocheck.py). `has(kind)`: whether [tasks] has a row of
+    that kind."""
+    for direction, kind, verb, example in (("i", "inputs", "read", "sense inputs rate=100"),
+                                           ("o", "outputs", "driven", "act outputs rate=100")):
+        if has(kind):
+            continue
+        for c in io_files:
+            rows = [ch for ch in channels if ch.path == c.path and ch.direction == direction
+                    and ch.element.name not in pyro_names]
+            if rows:
+                first = rows[0]
+                r.err(c.file, f"the {'input' if direction == 'i' else 'output'} channels of "
+                              f"`{os.path.basename(c.path)}` (`{first.element.name}`, pin {first.pin}, line "
+                              f"{first.line}{' and more' if len(rows) > 1 else ''}) are {verb} by the `{kind}` "
+                              f"task, and [tasks] has none: add one (e.g. `{example}`)")
 
 
 # ---- [time] ---------------------------------------------------------------------

@@ -13,7 +13,7 @@ from .appsyntax import Calibration, ChannelRow, Problem, Table, parse_table
 from .board import Board
 from .diagnostics import IO, Diagnostics, Source
 from .model import Channel
-from .numeric import REALS, f32_from_fraction
+from .numeric import REALS, f32_from_fraction, to_type
 
 __all__ = ["Channel", "analog_gain", "analog_value", "check_channels", "check_table"]
 
@@ -37,23 +37,28 @@ def analog_value(count: int, gain: float, offset: float, real) -> float:
     """count * gain + offset as the firmware computes it in R: the product
     rounded to R, then the sum rounded to R (never fused)."""
     if real.bits == 32:
-        return f32_from_fraction(Fraction(f32_from_fraction(Fraction(count) * Fraction(gain))) + Fraction(offset))
+        product = f32_from_fraction(Fraction(count) * Fraction(gain))
+        if not math.isfinite(product):  # overflowed: IEEE's infinity plus a finite offset
+            return product + offset
+        return f32_from_fraction(Fraction(product) + Fraction(offset))
     return float(count) * gain + offset
 
 
 def check_table(src: Source, analog: bool, sv: M.StateVector, board: Board,
-                diags: Diagnostics, used_pins: dict[int, tuple[str, int]] | None = None,
+                diags: Diagnostics, used_pins: dict[int, tuple] | None = None,
                 used_inputs: dict[str, tuple[str, int]] | None = None,
                 refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of one table, parsed and checked. `used_pins` /
     `used_inputs` carry what earlier tables of the same application took, so
-    a pin or an input element used twice across tables is reported too;
+    a pin or an input element used twice across tables is reported too
+    (`used_pins`: pin -> (path, line), and for a sensor part's pin what it
+    is there, sensors.py);
     `refused` maps pins no channel may have (though a chip select may) to why."""
     return check_channels(parse_table(src, analog, diags), sv, board, diags, used_pins, used_inputs, refused)
 
 
 def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnostics,
-                   used_pins: dict[int, tuple[str, int]] | None = None,
+                   used_pins: dict[int, tuple] | None = None,
                    used_inputs: dict[str, tuple[str, int]] | None = None,
                    refused: dict[int, str] | None = None) -> tuple[Channel, ...]:
     """The channels of a parsed table; every refused row is reported."""
@@ -73,6 +78,8 @@ def check_channels(table: Table, sv: M.StateVector, board: Board, diags: Diagnos
             continue
         e = _element(row, table, sv, used_inputs, err)
         if e is None:
+            continue
+        if table.analog and row.direction.text == "i" and not _span(row, *calibration, e, board, err):
             continue
         used_pins[pin] = (table.src.path, row.direction.line)
         out.append(Channel(table.analog, row.direction.text, row.pin.text, pin, e, *calibration,
@@ -101,6 +108,45 @@ def _calibration(row: ChannelRow, analog: bool, real: str, err) -> tuple[float, 
         err(row.stray.tok, row.stray.message)
         return None
     return values["scale"], values["offset"]
+
+
+def _span(row: ChannelRow, scale: float, offset: float, e: M.Element, board: Board, err) -> bool:
+    """Whether an analog input's calibration gives its element a finite
+    value that follows the pin: the span per count (analog_gain) is not 0
+    in the board's numbers, and the value at both ends of the converter,
+    count 0 and 2^bits - 1, computed as the firmware computes it and stored
+    in the element's type, is finite. Reported at `scale=` (at `offset=`
+    when the row gives no scale)."""
+    real = REALS[board.real]
+    cals = {c.key.text: c.number for c in row.calibrations}
+    at = cals.get("scale") or cals.get("offset")
+    gain = analog_gain(scale, board.adc_vref, board.adc_bits, real)
+    if gain == 0:
+        err(at, f"`scale={_g(scale)}` gives `{e.name}` the offset ({_g(offset)}) whatever the pin reads: its "
+                f"span, scale x {_g(board.adc_vref)} V / {(1 << board.adc_bits) - 1} counts, is 0 in the board's "
+                f"numbers ({_BINARY[real.bits].split(':')[0]}); give the sensor's scale (element units per volt), "
+                "negative if it falls as the volts rise")
+        return False
+    full = (1 << board.adc_bits) - 1
+    for count, volts in ((0, 0), (full, board.adc_vref)):
+        v = to_type(e.type, analog_value(count, gain, real.literal(repr(offset)), real))
+        if not math.isfinite(v):
+            what = (f"its {e.type} element (binary32: 3.4028235e38 at most)" if e.type.size == 4 and real.bits != 32
+                    else f"the board's numbers ({_BINARY[real.bits]} at most)")
+            sign = "-" if offset < 0 else "+"
+            err(at, f"`{e.name}` = volts x {_g(scale)} {sign} {_g(abs(offset))} overflows {what} at "
+                    + (f"the pin's full scale ({_g(volts)} V, count {count})" if count else "0 V (count 0)")
+                    + f": the firmware would store {'-' if v < 0 else ''}infinity; check the calibration's units")
+            return False
+    return True
+
+
+_BINARY = {32: "binary32: 3.4028235e38", 64: "binary64: 1.7976931348623157e308"}
+
+
+def _g(v: float) -> str:
+    """A number as a message shows it, exactly: `250`, `1e+39`, `0.5`."""
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
 
 
 def _value(cal: Calibration, real: str, err) -> float | None:
@@ -138,8 +184,8 @@ def _pin(row: ChannelRow, analog: bool, board: Board, used_pins: dict, err, refu
     elif not analog and pin not in board.digital_pins:
         problem = f"pin `{text}` of `{board.name}` cannot be used as a digital pin"
     elif pin in used_pins:
-        where, line = used_pins[pin]
-        problem = f"pin `{text}` is already used ({where}:{line})"
+        where, line, *role = used_pins[pin]  # a sensor part's pins say what they are there
+        problem = f"pin `{text}` is already used ({where}:{line})" + (f": {role[0]}" if role else "")
     elif pin in refused:
         problem = f"pin `{text}` cannot be a channel's: {refused[pin]}"
     else:

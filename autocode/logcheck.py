@@ -193,12 +193,13 @@ def _store(s: Setting | None, board, channels: list[M.Channel] | None, r,
 def _cs_pin(t: Tok, board, channels: list[M.Channel] | None, r, sensors=()) -> int | None:
     if board is None:
         return None
-    if t.kind != NUM or not t.text.isdigit() or len(t.text) > 3 or int(t.text) not in board.digital_pins:
+    # named as the I/O tables name pins (`A0` or `14`; board.pin), as a sensor part's `spi:PIN` is
+    pin = board.pin(t.text) if t.kind in (NUM, ID) and t.text.isascii() else None
+    if pin is None or pin not in board.digital_pins:
         pins = sorted(board.digital_pins)
         r.err(t, f"the {board.name} has no digital pin `{t.text}` for the flash's chip select "
                  f"(digital pins: {pins[0]}..{pins[-1]})" if pins else f"the {board.name} has no digital pins")
         return None
-    pin = int(t.text)
     if pin in board.reserved:
         r.err(t, f"pin {pin} is reserved on the {board.name}: {board.reserved[pin]}")
         return None

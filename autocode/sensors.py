@@ -163,7 +163,7 @@ def _check_row(row, src, sv, board, channels, used_pins, used_inputs, state) -> 
             _claim_bus(spi_bus(board), "SPI", board, channels, used_pins, pw, src, bw)
             state.spi = (src.path, pw.line)
         state.cs_pins[cs_pin] = (src.path, pw.line, part)
-        used_pins[cs_pin] = (src.path, pw.line)
+        used_pins[cs_pin] = (src.path, pw.line, f"the chip select of the {part} there")
     for _, el in outputs:
         used_inputs[el.name] = (src.path, pw.line)
     for el in (fault, health):
@@ -220,7 +220,7 @@ def _cs_pin(w: Word, part: str, board: Board, channels, used_pins: dict, state: 
         if c.pin_number == pin:
             raise _Refused(w, f"pin {pin} is already the channel of `{c.element.name}` ({_where(c.path, c.line)})")
     if pin in used_pins:
-        path, line = used_pins[pin]
+        path, line = used_pins[pin][:2]
         raise _Refused(w, f"pin {pin} is already used ({_where(path, line)})")
     return pin
 
@@ -239,8 +239,8 @@ def _claim_bus(bus: dict[int, str], name: str, board: Board, channels, used_pins
         raise _Refused(bw, f"with a part on the SPI bus, pin {c.pin} is {why}: the channel of "
                            f"`{c.element.name}` ({_where(c.path, c.line)}) cannot have it; move the channel to "
                            "another pin")
-    for pin in bus:
-        used_pins.setdefault(pin, (src.path, pw.line))
+    for pin, role in bus.items():
+        used_pins.setdefault(pin, (src.path, pw.line, f"the {name} bus's {role}, which the {pw.text} there is on"))
 
 
 def _pairs(ws: list[Word], part: str, sv: M.StateVector, used_inputs: dict, bw: Word):

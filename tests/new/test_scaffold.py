@@ -21,7 +21,7 @@ def test_scaffold_files(fsw, tmp_path):
                      "rocket.sm", "rocket.ss", "rocket.sv"]
     aio = (tmp_path / "rocket" / "rocket.aio").read_text()
     assert "analog inputs: A0=14 A1=15 A2=16 A3=17 A4=18 A5=19" in aio
-    assert "PWM pins (analog outputs): 3 5-6 9-11" in aio
+    assert "PWM pins (analog outputs): 3 5-6 11\n#   not 9 or 10: their timer (Timer1) paces the executor" in aio
     dio = (tmp_path / "rocket" / "rocket.dio").read_text()
     assert "digital pins: 2-19 (A0-A5 are 14-19)" in dio
     assert "reserved: 0: serial RX (USART0)" in dio

@@ -70,9 +70,11 @@ def test_an_analog_calibration_beyond_the_boards_numbers_is_refused(tank, option
 
 
 def test_calibration_boundaries(tank):
-    edit(tank / "tank.aio", "scale=250", "scale=3.4028235e38")  # binary32's largest, as written
+    # binary32's largest is a number the board has, but volts x scale must be too (5 V at full scale:
+    # test_an_analog_calibration_gives_a_finite_varying_element.py)
+    edit(tank / "tank.aio", "scale=250", "scale=6.8e37")
     assert run_fsw("check", "tank.app", cwd=tank).code == 0
-    edit(tank / "tank.aio", "scale=3.4028235e38", "scale=1e39")
+    edit(tank / "tank.aio", "scale=6.8e37", "scale=1e39")
     edit(tank / "tank.app", "board uno", "board native")  # R is binary64 there
     r = run_fsw("check", "tank.app", cwd=tank)
     assert r.code == 0, r.err

@@ -106,6 +106,10 @@ F32 P_Close = 700 @read_only    # psi: close it again below this
 """
 
     vref = f"{board.adc_vref:g}"
+    # the executor's timer takes its PWM pins from analog outputs (iotables.py refuses them)
+    timer_pwm = sorted(board.pwm_pins & board.timer_pins)
+    timer_note = (f"\n#   not {' or '.join(str(p) for p in timer_pwm)}: their timer ({board.timer}) paces the executor"
+                  if timer_pwm else "")
     out[f"{name}.aio"] = f"""\
 # Analog I/O of {name}: one channel per line (docs/application.md of fswkit).
 #   i  reads the pin into the element: volts = raw * {vref} / {2 ** board.adc_bits - 1}, then
@@ -114,7 +118,7 @@ F32 P_Close = 700 @read_only    # psi: close it again below this
 #
 # {title}
 #   analog inputs: {analog_list}
-#   PWM pins (analog outputs): {ranges(board.pwm_pins, " ") or "none"}
+#   PWM pins (analog outputs): {ranges(board.pwm_pins - board.timer_pins, " ") or "none"}{timer_note}
 #
 # A 0.5-4.5 V transducer reading 0-1000 psi: psi = volts * 250 - 125.
 # dir  pin  element    calibration

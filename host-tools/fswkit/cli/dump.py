@@ -14,6 +14,16 @@ def _say(msg: str) -> None:
     sys.stderr.write(f"fsw dump: {msg}\n")
 
 
+def _lost(n: int, before: int | None, after: int | None) -> str:
+    """A flight's records missing from the sequence, in words."""
+    what = f", {n} record{'' if n == 1 else 's'} lost"
+    if before is not None and after is not None:
+        return f"{what} between {before / 1000:.2f} s and {after / 1000:.2f} s (samples missing)"
+    if before is None:
+        return f"{what} before {after / 1000:.2f} s"
+    return f"{what} after {before / 1000:.2f} s"
+
+
 def cmd_dump(args) -> int:
     from fswkit.autocode.recorder import plan
     from fswkit.cli.common import load_app
@@ -90,6 +100,12 @@ def _talk(args, app, p) -> int:
         except OutputError as e:
             _say(str(e))
             return EXIT_FAIL
+        skipped = [f for f in chosen if f.foreign is not None]
+        for f in skipped:  # never decoded with this project's layout: its numbers would be wrong
+            _say(f"flight {f.number} was recorded with another [log] (log hash {f.foreign:08x}; this project's is "
+                 f"{p.hash:08x}): not decoded, not written; dump it with the project of the firmware that "
+                 "recorded it (docs/recorder.md)")
+        chosen = [f for f in chosen if f.foreign is None]
         for f in chosen:
             path = paths[f.number]
             try:
@@ -100,14 +116,19 @@ def _talk(args, app, p) -> int:
             s = f.samples
             span = f"{s[0][0] / 1000:.2f}–{s[-1][0] / 1000:.2f} s" if s else "no samples"
             trig = f", trigger at {f.start.t0 / 1000:.2f} s" if f.start else ", its start record overwritten"
+            if f.start is None and any(a is None for _, a, _ in f.lost):
+                trig = ", its start record lost"
             trig += "".join(f", resumed after a reset in flight at {r.t0 / 1000:.2f} s" for r in f.resumed)
+            trig += "".join(_lost(n, a, b) for n, a, b in f.lost)
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
         if args.erase:
-            kept = {f.number for f in chosen}
-            left = [f.number for f in flights if f.number not in kept]
+            kept = {id(f) for f in chosen}
+            left = [f.number for f in flights if id(f) not in kept]
             if left:  # nothing recorded is erased before it is dumped
+                how = ("add --all" if not skipped else
+                       "dump the flights of another [log] with their own project first")
                 _say(f"--erase erases every flight on the target, and flight(s) {', '.join(map(str, left))} "
-                     "were not dumped: add --all")
+                     f"were not dumped: {how}; nothing erased")
                 return EXIT_FAIL
             if not args.yes:
                 if not sys.stdin.isatty():
@@ -129,6 +150,6 @@ def _talk(args, app, p) -> int:
                      f"{', '.join(allowed)}, and never while a flight is recorded)")
                 return EXIT_FAIL
             print("erasing the record on the target")
-        return EXIT_OK
+        return EXIT_FAIL if skipped else EXIT_OK
 
     return talk_on_link(args, from_app(app), args.baud or app.baud, _say, talk, (LinkTimeout,))

@@ -90,3 +90,23 @@ def test_erase_is_refused_while_a_flight_of_another_log_is_on_the_target(tmp_pat
         r = run_fsw("dump", str(RIG), "--port", "fake", "-o", str(tmp_path / "d"), "--all", "--erase", "--yes")
     assert r.code == 1 and not g.erased, r.out + r.err
     assert "not erased" in r.err or "erase" in r.err
+
+
+def test_a_delta_past_the_32_bit_count_is_no_record_of_this_log():
+    """The firmware's counts are i32; a record whose deltas run past them
+    (one written by another layout, whose bytes happen to parse) was an
+    OverflowError out of the decoder."""
+    from fswkit.autocode.recorder import RecordError
+
+    p = _plan()
+    top = (2**31 - 1).to_bytes(4, "little", signed=True)
+    over = [[b"\x02", top, b"\x00\x00"], [b"\x02", top, b"\x00\x00"]]
+    raw = bytearray(data_record(p, 1, 1, 100, 20, over))
+    raw[15] = 1  # the second sample's delta: +1 count, past 2**31 - 1
+    raw = seal(p, bytes(raw[:raw[p.record - 3]]), 20)
+    try:
+        decode(p, image(p, {0: start_record(p, 0, 1, 100), 1: raw}))
+    except RecordError as e:
+        assert "record 1" in str(e)
+    else:
+        raise AssertionError("a delta past the 32-bit count was decoded")

@@ -24,6 +24,19 @@ def _lost(n: int, before: int | None, after: int | None) -> str:
     return f"{what} after {before / 1000:.2f} s"
 
 
+def _file_names(flights) -> dict[int, str]:
+    """Each flight's file name by id(): `flight-N.log`; a number the store
+    holds more than once (numbers go 1..255, then 1 again) `flight-N.log`,
+    `flight-N-2.log`, ... oldest first, so a flight has the same name
+    whichever flights a dump writes."""
+    seen: dict[int, int] = {}
+    out = {}
+    for f in flights:  # oldest first
+        k = seen[f.number] = seen.get(f.number, 0) + 1
+        out[id(f)] = f"flight-{f.number}.log" if k == 1 else f"flight-{f.number}-{k}.log"
+    return out
+
+
 def cmd_dump(args) -> int:
     from fswkit.autocode.recorder import plan
     from fswkit.cli.common import load_app
@@ -92,7 +105,8 @@ def _talk(args, app, p) -> int:
         except OSError as e:
             _say(f"cannot create the folder {args.output}: {e.strerror or e}")
             return EXIT_FAIL
-        paths = {f.number: os.path.join(args.output, f"flight-{f.number}.log") for f in chosen}
+        names = _file_names(flights)
+        paths = {id(f): os.path.join(args.output, names[id(f)]) for f in chosen}
         try:  # every file before the first is written: a flight log replaces only a flight log, with --force
             for path in paths.values():
                 check(path, config_paths(app) + [args.port], force=args.force, log=True, ask=True,
@@ -107,7 +121,7 @@ def _talk(args, app, p) -> int:
                  "recorded it (docs/recorder.md)")
         chosen = [f for f in chosen if f.foreign is None]
         for f in chosen:
-            path = paths[f.number]
+            path = paths[id(f)]
             try:
                 n = write_flight(path, app, p, f, force=args.force)
             except LogError as e:

@@ -82,6 +82,7 @@ def _talk(args, app, p) -> int:
             print(f"recorder: {inf['mode_name']}, flight {inf['flight']}, {inf['slots']} records of "
                   f"{inf['record']} B, next {inf['head']}; {inf['dropped']} samples dropped")
             image = read_image(command, p, link_plan(app).tx_cap, head=inf["head"])
+            after = query_info(command)  # what the target did while it was read
         except (DumpError, LinkTimeout) as e:
             _say(str(e))
             return EXIT_FAIL
@@ -91,6 +92,11 @@ def _talk(args, app, p) -> int:
             _say(f"{e}: the records were not written by this project's firmware")
             return EXIT_FAIL
         print(f"{len(flights)} flight(s) in {p.slots - empty} record(s); {empty} record(s) empty or torn")
+        written = (after["seq"] - inf["seq"]) & 0xFFFF
+        if written:  # read slot by slot: a record in a slot read before it was written is not in the image
+            _say(f"{written} record{' was' if written == 1 else 's were'} written while the records were read "
+                 "(those in slots already read are not in this dump): dump again once the flight has ended")
+        recording = after["mode"] == 1 and flights and flights[-1].number == after["flight"]
         chosen = flights
         if args.flight is not None:
             chosen = [f for f in flights if f.number == args.flight]
@@ -134,6 +140,8 @@ def _talk(args, app, p) -> int:
                 trig = ", its start record lost"
             trig += "".join(f", resumed after a reset in flight at {r.t0 / 1000:.2f} s" for r in f.resumed)
             trig += "".join(_lost(n, a, b) for n, a, b in f.lost)
+            if recording and f is flights[-1]:
+                trig += ", still being recorded (dump again once it has ended)"
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
         if args.erase:
             kept = {id(f) for f in chosen}
@@ -157,9 +165,22 @@ def _talk(args, app, p) -> int:
                 if answer.strip() != "erase":
                     print("not erased")
                     return EXIT_OK
+            try:
+                now = query_info(command)
+            except DumpError as e:
+                _say(f"{e}; nothing erased")
+                return EXIT_FAIL
+            allowed = [n for i, n in enumerate(p.states) if p.erase_ok[i + 1]]
+            if now["mode"] == 1:  # the target would refuse; and a flight that ended now would go undumped
+                _say(f"not erased: the target is recording flight {now['flight']} (erasing is allowed in "
+                     f"{', '.join(allowed)}, and never while a flight is recorded)")
+                return EXIT_FAIL
+            if written or now["seq"] != inf["seq"]:  # nothing recorded is erased before it is dumped
+                _say("the target wrote records since this dump began reading them: they are not in it; "
+                     "dump again, then erase; nothing erased")
+                return EXIT_FAIL
             ack = command(OP_LOG_ERASE, b"")
             if ack["status"] != 0:
-                allowed = [n for i, n in enumerate(p.states) if p.erase_ok[i + 1]]
                 _say(f"the target refused to erase: {ack['reason']} (erasing is allowed in "
                      f"{', '.join(allowed)}, and never while a flight is recorded)")
                 return EXIT_FAIL

@@ -88,7 +88,7 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
         r.err(first, "[log] needs at least one `element`")
 
     store, cs_pin, flash_size = _store(once.get("store"), board, channels, r, sensors)
-    if store == "eeprom" and board is not None and board.eeprom == 0:
+    if store == "eeprom" and "store" in once and board is not None and board.eeprom == 0:  # none: said above
         r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
     record = _record(once.get("record"), r)
     if store == "eeprom" and board is not None and board.eeprom:

@@ -65,7 +65,7 @@ def _talk(args, app, p) -> int:
     from fswkit.link.client import LinkTimeout
     from fswkit.link.layout import from_app
     from fswkit.link.log import LogError
-    from fswkit.outputs import OutputError, check
+    from fswkit.outputs import OutputError, check, is_direct, recording
     from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
 
     def talk(ground) -> int:
@@ -96,7 +96,7 @@ def _talk(args, app, p) -> int:
         if written:  # read slot by slot: a record in a slot read before it was written is not in the image
             _say(f"{written} record{' was' if written == 1 else 's were'} written while the records were read "
                  "(those in slots already read are not in this dump): dump again once the flight has ended")
-        recording = after["mode"] == 1 and flights and flights[-1].number == after["flight"]
+        still = after["mode"] == 1 and flights and flights[-1].number == after["flight"]
         chosen = flights
         if args.flight is not None:
             chosen = [f for f in flights if f.number == args.flight]
@@ -117,6 +117,9 @@ def _talk(args, app, p) -> int:
             for path in paths.values():
                 check(path, config_paths(app) + [args.port], force=args.force, log=True, ask=True,
                       what="flight log")
+                if os.path.lexists(path) and not is_direct(path) and recording(path) != "a link log":
+                    raise OutputError(f"{path} is there and is not a flight log: it is never replaced, even with "
+                                      "--force; move it away, or dump into another folder")
         except OutputError as e:
             _say(str(e))
             return EXIT_FAIL
@@ -140,7 +143,7 @@ def _talk(args, app, p) -> int:
                 trig = ", its start record lost"
             trig += "".join(f", resumed after a reset in flight at {r.t0 / 1000:.2f} s" for r in f.resumed)
             trig += "".join(_lost(n, a, b) for n, a, b in f.lost)
-            if recording and f is flights[-1]:
+            if still and f is flights[-1]:
                 trig += ", still being recorded (dump again once it has ended)"
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")
         if args.erase:

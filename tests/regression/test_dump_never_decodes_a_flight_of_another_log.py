@@ -110,3 +110,17 @@ def test_a_delta_past_the_32_bit_count_is_no_record_of_this_log():
         assert "record 1" in str(e)
     else:
         raise AssertionError("a delta past the 32-bit count was decoded")
+
+
+def test_the_simulators_record_check_takes_only_this_logs_flights():
+    """`fsw sim -E FILE` keeps the EEPROM between runs: a run that recorded
+    nothing found the earlier [log]'s flight the newest and checked it."""
+    from types import SimpleNamespace
+
+    from fswkit.recorder.check import newest_flight
+
+    app = load_app(str(RIG / "logged.app"), Diagnostics())
+    p = plan(app)
+    store = image(p, dict(enumerate(_flight(p, 0, 1, 100, 2) + _flight(p, 3, 2, 5000, 2, OTHER))))
+    _, flight, flights, _ = newest_flight(app, SimpleNamespace(eeprom=bytes(p.base) + store))
+    assert len(flights) == 2 and flight is flights[0] and flight.number == 1

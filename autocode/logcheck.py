@@ -117,6 +117,8 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
         return None
     _trigger_entered(m, trigger[0], once["trigger"].values[0], r)
+    if before and once["before"].values:
+        _before_recorded(m, trigger[0], state_rates, once["before"].values[0], r)
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
     log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
@@ -394,6 +396,19 @@ def _trigger_entered(m: M.Machine, trigger: int, at: Tok, r) -> None:
     why = (f"it is the machine's first state, where it starts at boot, and no transition leads back to it"
            if t == 0 else f"no transition that can run from the machine's first state (`{first}`) leads to it")
     r.warn(at, f"the trigger state `{at.text}` is never entered: {why}, so the recorder never starts a flight")
+
+
+def _before_recorded(m: M.Machine, trigger: int, rates, at: Tok, r) -> None:
+    """A warning when `before` can keep nothing: every state with a
+    transition into the trigger records nothing (rate 0), so no sample is
+    ever taken before a flight starts."""
+    from .recorder import _predecessors
+
+    preds = sorted(s for s in _predecessors(m, trigger) if s != trigger)
+    if preds and all(rates[s] == 0 for s in preds):
+        names = ", ".join(m.states[s - 1].name for s in preds)
+        r.warn(at, f"`before {at.text}` keeps nothing: the states that lead to the trigger ({names}) record nothing "
+                   "(rate 0), so no sample is taken before a flight starts; give them a rate, or drop `before`")
 
 
 def _eeprom_room(board, machines: list[M.Machine], record: int, at: Tok, r) -> None:

@@ -106,6 +106,12 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
         elif not args.all and flights:
             chosen = flights[-1:]  # the newest
+        skipped = [f for f in chosen if f.foreign is not None]
+        for f in skipped:  # never decoded with this project's layout: its numbers would be wrong
+            _say(f"flight {f.number} was recorded with another [log] (log hash {f.foreign:08x}; this project's is "
+                 f"{p.hash:08x}): not decoded, not written; dump it with the project of the firmware that "
+                 "recorded it (docs/recorder.md)")
+        chosen = [f for f in chosen if f.foreign is None]
         try:  # its own words: an OSError here would be taken for the port going away
             os.makedirs(args.output, exist_ok=True)
         except OSError as e:
@@ -123,12 +129,6 @@ def _talk(args, app, p) -> int:
         except OutputError as e:
             _say(str(e))
             return EXIT_FAIL
-        skipped = [f for f in chosen if f.foreign is not None]
-        for f in skipped:  # never decoded with this project's layout: its numbers would be wrong
-            _say(f"flight {f.number} was recorded with another [log] (log hash {f.foreign:08x}; this project's is "
-                 f"{p.hash:08x}): not decoded, not written; dump it with the project of the firmware that "
-                 "recorded it (docs/recorder.md)")
-        chosen = [f for f in chosen if f.foreign is None]
         for f in chosen:
             path = paths[id(f)]
             try:
@@ -142,7 +142,7 @@ def _talk(args, app, p) -> int:
             if f.start is None and any(a is None for _, a, _ in f.lost):
                 trig = ", its start record lost"
             trig += "".join(f", resumed after a reset in flight at {r.t0 / 1000:.2f} s" for r in f.resumed)
-            trig += "".join(_lost(n, a, b) for n, a, b in f.lost)
+            trig += "".join(_lost(k, a, b) for k, a, b in f.lost)
             if still and f is flights[-1]:
                 trig += ", still being recorded (dump again once it has ended)"
             print(f"flight {f.number}: {n} samples, {span}{trig} -> {path}")

@@ -75,3 +75,14 @@ def test_a_quiet_target_is_dumped_and_erased_as_before(tmp_path, monkeypatch):
         r = run_fsw("dump", str(RIG), "--port", "fake", "-o", str(tmp_path / "d"), "--erase", "--yes")
     assert r.code == 0 and g.erased, r.out + r.err
     assert "still being recorded" not in r.out and "while the records were read" not in r.err
+
+
+def test_a_flight_begun_with_no_record_written_yet_is_said(tmp_path, monkeypatch):
+    """Flight 2 has just started (its `before` seconds still in RAM): the
+    store holds flight 1 alone, which is not the flight being recorded."""
+    p = plan(load_app(str(RIG / "logged.app"), Diagnostics()))
+    recs = {0: start_record(p, 0, 1, 100), 1: _rec(p, 1, 100)}
+    with fake_target(monkeypatch, FakeGround(p, image(p, recs), mode=1, flight=2, head=2, seq=2)):
+        r = run_fsw("dump", str(RIG), "--port", "fake", "-o", str(tmp_path / "d"))
+    assert r.code == 0, r.err
+    assert "flight 2 is being recorded" in r.err and "still being recorded" not in r.out, r.out + r.err

@@ -100,6 +100,9 @@ def _talk(args, app, p) -> int:
             _say(f"{written} record{' was' if written == 1 else 's were'} written while the records were read "
                  "(those in slots already read are not in this dump): dump again once the flight has ended")
         still = after["mode"] == 1 and flights and flights[-1].number == after["flight"]
+        if after["mode"] == 1 and not still:
+            _say(f"flight {after['flight']} is being recorded and none of its records is written yet: it is not in "
+                 "this dump; dump again once it has ended")
         chosen = flights
         if args.flight is not None:
             chosen = [f for f in flights if f.number == args.flight]

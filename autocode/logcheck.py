@@ -119,6 +119,12 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     _trigger_entered(m, trigger[0], once["trigger"].values[0], r)
     if before and once["before"].values:
         _before_recorded(m, trigger[0], state_rates, once["before"].values[0], r)
+    if store == "spi_nor" and flash_size // record > MAX_SLOTS + 1:  # one record short (8 M of 128 B) is no news
+        vals = once["store"].values
+        at = vals[2] if len(vals) > 2 else vals[0]
+        used = MAX_SLOTS * record
+        r.warn(at, f"the recorder uses {used:,} B of the {flash_size:,} B chip: records are numbered in 16 bits "
+                   f"(at most {MAX_SLOTS:,} of {record} B); a larger `record` (up to 128) uses more of it")
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
     log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,

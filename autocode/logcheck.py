@@ -129,7 +129,38 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
     log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
                 cs_pin, flash_size)
-    return log if _sizes(log, m, once, elements, r) else None
+    if not _sizes(log, m, once, elements, r):
+        return None
+    if store == "eeprom" and board is not None and board.is_avr:
+        _eeprom_rate(log, rates, r)
+    return log
+
+
+def _eeprom_rate(log: M.Log, rows: list[Setting], r) -> None:
+    """A warning when the log needs more bytes a second at its fastest rate
+    than an AVR's EEPROM writes (a byte in 3.4 ms): the RAM ring would
+    overflow and samples be dropped on the board (the simulator's EEPROM
+    writes at once and would not show it). A record's samples are counted
+    at their usual size (no held change), with its opening, tail and kind."""
+    from .recorder import EEPROM_WRITE_S, TAIL, encoded_size, record_sizes
+
+    _ss, n_hold, _esc, opening, _worst = record_sizes(log.fields)
+    usual = sum(encoded_size(f.enc, f.width) for f in log.fields[n_hold:])
+    fastest = max(log.rates)
+    room = log.record - TAIL - opening
+    per_record = 1 + (room // usual if usual else 0)
+    written = opening + (per_record - 1) * usual + TAIL + 2  # the kind cleared first and written last
+    need = float(fastest) / per_record * written
+    can = 1 / EEPROM_WRITE_S
+    if need <= can:
+        return
+    row = next((s for s in rows if s.values and exact_literal(s.values[0].text) == fastest), None)
+    if row is None:
+        return
+    r.warn(row.values[0], f"at {row.values[0].text} Hz the log needs about {need:,.0f} B/s ({per_record} samples "
+                          f"a {log.record}-byte record), and an AVR's EEPROM writes {can:.0f} B/s: samples would be "
+                          "dropped on the board (`fsw sim` writes its EEPROM at once and would not show it); lower "
+                          "the rate, encode F32 elements with delta=, or `store spi_nor`")
 
 
 def _sizes(log: M.Log, m: M.Machine, once: dict[str, Setting], elements: list[Setting], r) -> bool:

@@ -51,7 +51,8 @@ class Garbled(FakeGround):
 def test_a_malformed_answer_is_said(tmp_path, monkeypatch, how, said):
     p = plan(load_app(str(RIG / "logged.app"), Diagnostics()))
     recs = {0: start_record(p, 0, 1, 100),
-            1: data_record(p, 1, 1, 100, 20, [[b"\x02", (k * 20).to_bytes(4, "little"), b"\x00\x00"] for k in range(3)])}
+            1: data_record(p, 1, 1, 100, 20,
+                           [[b"\x02", (k * 20).to_bytes(4, "little"), b"\x00\x00"] for k in range(3)])}
     with fake_target(monkeypatch, Garbled(p, image(p, recs), how, head=2, seq=2)):
         r = run_fsw("dump", str(RIG), "--port", "fake", "-o", str(tmp_path / "d"))
     assert r.code == 1 and "internal error" not in r.err, r.out + r.err

@@ -18,7 +18,8 @@ def _project(tmp_path, rates: str):
     proj = tmp_path / "p"
     shutil.copytree(RIG, proj)
     app = (proj / "logged.app").read_text()
-    log = f"[log]\nstore eeprom\nmachine logged\ntrigger Run\nbefore 0.5\n{rates}element level\nelement count\n"
+    log = (f"[log]\nstore eeprom\nmachine logged\ntrigger Run\nbefore 0.5\n{rates}"
+           "element level delta=0.25\nelement count\n")
     (proj / "logged.app").write_text(app[:app.index("[log]")] + log)
     return proj / "logged.app"
 

@@ -140,4 +140,13 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
             line = next(x.line for x in app.telemetry if x.region is s.region)
             at(line, 1, f"stream `{s.region.name}` needs a {plan.tx_cap:,} B transmit buffer: more than the "
                         f"{b.name}'s RAM ({b.ram:,} B)")
+        if app.log is not None:
+            from .recorder import plan as log_plan
+
+            lp = log_plan(app)
+            if lp.ram > b.ram:
+                at(app.log.line, 1, f"the flight recorder takes {lp.ram:,} B of RAM (a ring of {lp.ring_cap} samples "
+                                    f"of {lp.sample_size} B: `before` at the rate of the states before the trigger, "
+                                    f"and its other buffers): more than the {b.name}'s RAM ({b.ram:,} B); lower "
+                                    "`before` or those rates, or log fewer elements")
     return diags.error_count == before

@@ -88,7 +88,7 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
         r.err(first, "[log] needs at least one `element`")
 
     store, cs_pin, flash_size = _store(once.get("store"), board, channels, r, sensors)
-    if store == "eeprom" and board is not None and board.eeprom == 0:
+    if store == "eeprom" and "store" in once and board is not None and board.eeprom == 0:  # none: said above
         r.err(once["store"].values[0], f"the {board.name} has no EEPROM")
     record = _record(once.get("record"), r)
     if store == "eeprom" and board is not None and board.eeprom:
@@ -117,11 +117,50 @@ def check_log(rows: tuple[Setting, ...], sv: M.StateVector, tasks: list[M.Task],
     if r.diags.error_count != before_errors or m is None or not trigger or state_rates is None or fields is None:
         return None
     _trigger_entered(m, trigger[0], once["trigger"].values[0], r)
+    if before and once["before"].values:
+        _before_recorded(m, trigger[0], state_rates, once["before"].values[0], r)
+    if store == "spi_nor" and flash_size // record > MAX_SLOTS + 1:  # one record short (8 M of 128 B) is no news
+        vals = once["store"].values
+        at = vals[2] if len(vals) > 2 else vals[0]
+        used = MAX_SLOTS * record
+        r.warn(at, f"the recorder uses {used:,} B of the {flash_size:,} B chip: records are numbered in 16 bits "
+                   f"(at most {MAX_SLOTS:,} of {record} B); a larger `record` (up to 128) uses more of it")
     order = {"hold": 0, "delta": 1, "quant": 2, "raw": 3}
     fields = tuple(sorted(fields, key=lambda f: order[f.enc]))  # stable: as written within a kind
     log = M.Log(store, record, full == "newest", machine, trigger[0], before, state_rates, erase, fields, first.line,
                 cs_pin, flash_size)
-    return log if _sizes(log, m, once, elements, r) else None
+    if not _sizes(log, m, once, elements, r):
+        return None
+    if store == "eeprom" and board is not None and board.is_avr:
+        _eeprom_rate(log, rates, r)
+    return log
+
+
+def _eeprom_rate(log: M.Log, rows: list[Setting], r) -> None:
+    """A warning when the log needs more bytes a second at its fastest rate
+    than an AVR's EEPROM writes (a byte in 3.4 ms): the RAM ring would
+    overflow and samples be dropped on the board (the simulator's EEPROM
+    writes at once and would not show it). A record's samples are counted
+    at their usual size (no held change), with its opening, tail and kind."""
+    from .recorder import EEPROM_WRITE_S, TAIL, encoded_size, record_sizes
+
+    _ss, n_hold, _esc, opening, _worst = record_sizes(log.fields)
+    usual = sum(encoded_size(f.enc, f.width) for f in log.fields[n_hold:])
+    fastest = max(log.rates)
+    room = log.record - TAIL - opening
+    per_record = 1 + (room // usual if usual else 0)
+    written = opening + (per_record - 1) * usual + TAIL + 2  # the kind cleared first and written last
+    need = float(fastest) / per_record * written
+    can = 1 / EEPROM_WRITE_S
+    if need <= can:
+        return
+    row = next((s for s in rows if s.values and exact_literal(s.values[0].text) == fastest), None)
+    if row is None:
+        return
+    r.warn(row.values[0], f"at {row.values[0].text} Hz the log needs about {need:,.0f} B/s ({per_record} samples "
+                          f"a {log.record}-byte record), and an AVR's EEPROM writes {can:.0f} B/s: samples would be "
+                          "dropped on the board (`fsw sim` writes its EEPROM at once and would not show it); lower "
+                          "the rate, encode F32 elements with delta=, or `store spi_nor`")
 
 
 def _sizes(log: M.Log, m: M.Machine, once: dict[str, Setting], elements: list[Setting], r) -> bool:
@@ -395,6 +434,19 @@ def _trigger_entered(m: M.Machine, trigger: int, at: Tok, r) -> None:
     why = (f"it is the machine's first state, where it starts at boot, and no transition leads back to it"
            if t == 0 else f"no transition that can run from the machine's first state (`{first}`) leads to it")
     r.warn(at, f"the trigger state `{at.text}` is never entered: {why}, so the recorder never starts a flight")
+
+
+def _before_recorded(m: M.Machine, trigger: int, rates, at: Tok, r) -> None:
+    """A warning when `before` can keep nothing: every state with a
+    transition into the trigger records nothing (rate 0), so no sample is
+    ever taken before a flight starts."""
+    from .recorder import _predecessors
+
+    preds = sorted(s for s in _predecessors(m, trigger) if s != trigger)
+    if preds and all(rates[s] == 0 for s in preds):
+        names = ", ".join(m.states[s - 1].name for s in preds)
+        r.warn(at, f"`before {at.text}` keeps nothing: the states that lead to the trigger ({names}) record nothing "
+                   "(rate 0), so no sample is taken before a flight starts; give them a rate, or drop `before`")
 
 
 def _eeprom_room(board, machines: list[M.Machine], record: int, at: Tok, r) -> None:

@@ -242,8 +242,9 @@ def valid(p: Plan, raw: bytes) -> bool:
     return crc == int.from_bytes(raw[p.record - 2:], "little")
 
 
-def decode_slot(p: Plan, slot: int, raw: bytes) -> Record | None:
-    """The record in one slot, None when it is not whole."""
+def decode_slot(p: Plan, slot: int, raw: bytes, samples: bool = True) -> Record | None:
+    """The record in one slot, None when it is not whole; `samples=False`:
+    its header only (a record of samples is parsed with `parse_samples`)."""
     if not valid(p, raw):
         return None
     used = raw[p.record - 3]
@@ -257,6 +258,16 @@ def decode_slot(p: Plan, slot: int, raw: bytes) -> Record | None:
         rec.schema = int.from_bytes(raw[8:12], "little")
         rec.hash = int.from_bytes(raw[12:16], "little")
         return rec
+    if samples:
+        parse_samples(p, rec, raw)
+    return rec
+
+
+def parse_samples(p: Plan, rec: Record, raw: bytes) -> None:
+    """A whole record of samples' samples, into `rec.samples` (RecordError
+    when the body does not parse with this plan's fields)."""
+    slot, t0, period = rec.slot, rec.t0, rec.period
+    used = raw[p.record - 3]
     body = raw[:used]
     i = HEADER
     cur: list[bytes] = []
@@ -282,6 +293,8 @@ def decode_slot(p: Plan, slot: int, raw: bytes) -> Record | None:
                     raise RecordError(f"record {slot}: a sample cut short at byte {i}")
                 d = body[i] - 256 if body[i] >= 128 else body[i]
                 q = int.from_bytes(cur[k], "little", signed=True) + d
+                if not -2**31 <= q < 2**31:  # the firmware's counts are i32: never a record it wrote
+                    raise RecordError(f"record {slot}: a delta beyond the 32-bit count at byte {i}")
                 cur[k] = q.to_bytes(4, "little", signed=True)
                 i += 1
             else:
@@ -294,7 +307,6 @@ def decode_slot(p: Plan, slot: int, raw: bytes) -> Record | None:
             raise RecordError(f"record {slot}: samples without a period")
         t += period
         rec.samples.append((t, _values(p, cur)))
-    return rec
 
 
 def _values(p: Plan, cur: list[bytes]) -> dict:
@@ -309,6 +321,15 @@ class Flight:
     # the start records written again for the same flight after the firmware
     # resumed it from a reset in flight (docs/safety.md): the flight goes on
     resumed: list[Record] = field(default_factory=list)
+    # another log's hash when its start record says it was recorded with
+    # another `[log]` (a firmware flashed since): its samples are not decoded
+    foreign: int | None = None
+    # records missing from the sequence numbers (a slot whose check fails
+    # between valid ones: damaged, or written while it was read): (how
+    # many, the time of the last sample before them or None before the
+    # flight's first record, the time of the first after or None after
+    # its last), ms
+    lost: list[tuple[int, int | None, int | None]] = field(default_factory=list)
 
     @property
     def samples(self) -> list:
@@ -317,15 +338,20 @@ class Flight:
 
 def decode(p: Plan, image: bytes) -> tuple[list[Flight], int]:
     """The flights in a store image (`p.slots` records from its start), oldest
-    first, and how many slots held no whole record."""
+    first, and how many slots held no whole record. A flight whose start
+    record names another log hash is not decoded (`Flight.foreign`); a
+    hole in the sequence numbers is a lost record (`Flight.lost`)."""
     records: list[Record] = []
+    raws: dict[int, bytes] = {}
     empty = 0
     for s in range(p.slots):
-        r = decode_slot(p, s, image[s * p.record:(s + 1) * p.record])
+        raw = image[s * p.record:(s + 1) * p.record]
+        r = decode_slot(p, s, raw, samples=False)
         if r is None:
             empty += 1
         else:
             records.append(r)
+            raws[s] = raw
     if not records:
         return [], empty
     newest = records[0]
@@ -334,11 +360,32 @@ def decode(p: Plan, image: bytes) -> tuple[list[Flight], int]:
             newest = r
     records.sort(key=lambda r: (newest.seq - r.seq) & 0xFFFF, reverse=True)  # oldest first
     flights: list[Flight] = []
+    owner: list[Flight] = []  # each record's flight, in the order of `records`
     for r in records:
-        if r.kind == START and flights and flights[-1].number == r.flight and flights[-1].start is not None:
-            flights[-1].resumed.append(r)  # the same flight, resumed after a reset in flight
-        elif r.kind == START or not flights or flights[-1].number != r.flight:
-            flights.append(Flight(r.flight, r if r.kind == START else None, []))
+        last = flights[-1] if flights else None
+        if r.kind == START and last is not None and last.number == r.flight and last.start is not None \
+                and last.start.hash == r.hash:
+            last.resumed.append(r)  # the same flight, resumed after a reset in flight
+        elif r.kind == START or last is None or last.number != r.flight:
+            flights.append(Flight(r.flight, r if r.kind == START else None, [],
+                                  foreign=r.hash if r.kind == START and r.hash != p.hash else None))
+        f = flights[-1]
         if r.kind == DATA:
-            flights[-1].records.append(r)
+            if f.foreign is None:
+                parse_samples(p, r, raws[r.slot])
+            f.records.append(r)
+        owner.append(f)
+    for k in range(1, len(records)):
+        a, b = records[k - 1], records[k]
+        gap = (b.seq - a.seq - 1) & 0xFFFF
+        if not gap:
+            continue
+        t_a = a.samples[-1][0] if a.samples else a.t0
+        t_b = b.samples[0][0] if b.samples else b.t0
+        if owner[k - 1] is owner[k]:
+            owner[k].lost.append((gap, t_a, t_b))
+        elif b.kind == START:  # a flight's start follows: the records lost were the last flight's end
+            owner[k - 1].lost.append((gap, t_a, None))
+        else:  # this flight's first records, its start among them
+            owner[k].lost.append((gap, None, t_b))
     return flights, empty

@@ -14,7 +14,7 @@ def newest_flight(app, run):
     """(plan, the newest flight, every flight, empty records) of the store a
     run read after its flight: the whole EEPROM (`run.eeprom`), or the
     written part of an SPI NOR chip from address 0 (`run.flash`, the rest
-    blank); the flight is None when there is none."""
+    blank); the flight is None when there is none of this `[log]`'s."""
     p = plan(app)
     if p is None:
         return p, None, [], 0
@@ -27,7 +27,8 @@ def newest_flight(app, run):
     if image is None:
         return p, None, [], 0
     flights, empty = decode(p, image)
-    return p, (flights[-1] if flights else None), flights, empty
+    own = [f for f in flights if f.foreign is None]  # a kept store (`-E FILE`) may hold flights of an earlier [log]
+    return p, (own[-1] if own else None), flights, empty
 
 
 def flight_report(app, run, check_cls, *, truth=None, alt_element: str | None = None, offset: float = 0.0):

@@ -67,6 +67,10 @@ def write_flight(path: str, app, p: Plan, flight: Flight, *, force: bool = False
 
 
 def info(ack: dict) -> dict:
+    """LOG_INFO's fields; DumpError when the answer is shorter than they are."""
+    if len(ack["data"]) < _INFO.size:
+        raise DumpError(f"a malformed answer to LOG_INFO ({len(ack['data'])} bytes, not {_INFO.size}): is the "
+                        "firmware built by this kit's version from this project?")
     mode, flight, head, seq, slots, record, dropped, h = _INFO.unpack_from(ack["data"])
     return {"mode": mode, "mode_name": MODES.get(mode, f"mode {mode}"), "flight": flight, "head": head, "seq": seq,
             "slots": slots, "record": record, "dropped": dropped, "hash": h}
@@ -90,8 +94,8 @@ def read_image(command, p: Plan, tx_cap: int, progress=None, head: int | None = 
             if ack["status"] != 0:
                 raise DumpError(f"the target refused to read record {slot}: {ack['reason']}")
             data = ack["data"]
-            got_slot, got_off, got_n = struct.unpack_from("<HBB", data)
-            if (got_slot, got_off) != (slot, off) or got_n == 0 or len(data) != 4 + got_n:
+            got_slot, got_off, got_n = struct.unpack_from("<HBB", data) if len(data) >= 4 else (None, None, 0)
+            if (got_slot, got_off) != (slot, off) or not 0 < got_n <= n or len(data) != 4 + got_n:
                 raise DumpError(f"a malformed answer to reading record {slot} at byte {off}")
             image += data[4:]
             off += got_n

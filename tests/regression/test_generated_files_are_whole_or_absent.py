@@ -7,6 +7,7 @@ a failed export leaves is every file either whole or as it was."""
 
 from __future__ import annotations
 
+import os
 import resource
 import shutil
 import subprocess
@@ -25,6 +26,11 @@ def limited():
     resource.setrlimit(resource.RLIMIT_FSIZE, (LIMIT, LIMIT))
 
 
+# and no compiled bytecode written under the limit: importlib ignores a short
+# write, and a cut .pyc would fail every later import of its module
+LIMITED_ENV = os.environ | {"PYTHONDONTWRITEBYTECODE": "1"}
+
+
 @pytest.fixture
 def tank(tmp_path):
     for name in ("tank.sv", "tank.sm", "tank.app", "tank.aio", "tank.dio"):
@@ -39,7 +45,7 @@ def test_a_write_that_fails_partway_leaves_no_truncated_file(tank, option, folde
     whole = {p.name: p.read_bytes() for p in (tank / "whole").iterdir()}
     assert max(len(b) for b in whole.values()) > LIMIT  # the limit falls inside a file
     r = subprocess.run([FSW, "gen", ".", option, folder], cwd=tank, capture_output=True, text=True, timeout=120,
-                       preexec_fn=limited)
+                       preexec_fn=limited, env=LIMITED_ENV)
     assert r.returncode == 1, r.stderr
     assert "File too large" in r.stderr and "Traceback" not in r.stderr
     left = {p.name: p.read_bytes() for p in (tank / folder).iterdir()} if (tank / folder).exists() else {}

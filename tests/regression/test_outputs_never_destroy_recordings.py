@@ -8,9 +8,11 @@ file whole."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import resource
 import signal
+import sys
 
 import pytest
 from conftest import run_fsw
@@ -74,23 +76,33 @@ def test_monitor_log_keeps_an_existing_recording(tmp_path):
     _no_parts(tmp_path)
 
 
-@pytest.fixture
-def file_size_limit():
-    """Writes past 64 KB fail (EFBIG), as on a full disk."""
+@contextlib.contextmanager
+def writes_fail_past(limit: int):
+    """In the block, a file's bytes past `limit` are not written (EFBIG), as
+    on a full disk. Python writes no compiled bytecode meanwhile: importlib
+    ignores a short write, and a module first imported in the block (`fsw
+    new`'s, say) would leave a cut .pyc that every later import of it in
+    the test run fails on ("marshal data too short")."""
     old = resource.getrlimit(resource.RLIMIT_FSIZE)
     old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-    yield lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (65536, old[1]))
-    resource.setrlimit(resource.RLIMIT_FSIZE, old)
-    signal.signal(signal.SIGXFSZ, old_sig)
+    old_dont = sys.dont_write_bytecode
+    sys.dont_write_bytecode = True
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, old[1]))
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old)
+        signal.signal(signal.SIGXFSZ, old_sig)
+        sys.dont_write_bytecode = old_dont
 
 
-def test_a_failed_write_leaves_the_old_file(tmp_path, file_size_limit):
+def test_a_failed_write_leaves_the_old_file(tmp_path):
     log = tmp_path / "x.log"
     _log(log, n=3000)
     csv = tmp_path / "x.csv"
     csv.write_text("the previous export\n")
-    file_size_limit()
-    r = run_fsw("log2csv", str(log), "-o", str(csv), "--force")
+    with writes_fail_past(65536):
+        r = run_fsw("log2csv", str(log), "-o", str(csv), "--force")
     assert r.code == 1 and "File too large" in r.err and "Traceback" not in r.err, r.err
     assert csv.read_text() == "the previous export\n"
     _no_parts(tmp_path)
@@ -101,14 +113,8 @@ def test_a_small_output_that_cannot_be_written_is_named(tmp_path, command):
     # the whole text fails at the last flush, and again as the file closes: the message still names the file
     project = tank_copy(tmp_path)
     out = tmp_path / "out.txt"
-    old = resource.getrlimit(resource.RLIMIT_FSIZE)
-    old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-    try:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (100, old[1]))
+    with writes_fail_past(100):
         r = run_fsw(command, str(project / "tank.sm"), "-o", str(out))
-    finally:
-        resource.setrlimit(resource.RLIMIT_FSIZE, old)
-        signal.signal(signal.SIGXFSZ, old_sig)
     assert r.code == 1 and f"cannot write {out}: File too large" in r.err, r.err
     assert not out.exists()
     _no_parts(tmp_path)
@@ -117,14 +123,8 @@ def test_a_small_output_that_cannot_be_written_is_named(tmp_path, command):
 @pytest.mark.parametrize("limit", [100, 1024])  # fails making the starter script, or writing the project
 def test_new_project_on_a_full_disk_leaves_no_half_project(tmp_path, limit):
     # a half-written project would stand in the way of the next `fsw new` ("already exists")
-    old = resource.getrlimit(resource.RLIMIT_FSIZE)
-    old_sig = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-    try:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, old[1]))
+    with writes_fail_past(limit):
         r = run_fsw("new", "probe", cwd=tmp_path)
-    finally:
-        resource.setrlimit(resource.RLIMIT_FSIZE, old)
-        signal.signal(signal.SIGXFSZ, old_sig)
     assert r.code == 1 and "cannot write" in r.err and "File too large" in r.err, r.err
     assert os.listdir(tmp_path) == []
     r = run_fsw("new", "probe", cwd=tmp_path)

@@ -18,22 +18,13 @@ from __future__ import annotations
 
 import pytest
 
-from conftest import EXAMPLES, run_fsw
-
-TANK = EXAMPLES / "tank"
+from conftest import run_fsw
+from support.configs import edit, tank_configs
 
 
 @pytest.fixture
 def tank(tmp_path):
-    for name in ("tank.sv", "tank.sm", "tank.ss", "tank.app", "tank.aio", "tank.dio"):
-        (tmp_path / name).write_bytes((TANK / name).read_bytes())
-    return tmp_path
-
-
-def edit(path, old, new):
-    text = path.read_text()
-    assert old in text
-    path.write_text(text.replace(old, new, 1))
+    return tank_configs(tmp_path)
 
 
 def column(tank, key):

@@ -12,26 +12,18 @@ import tomllib
 
 import pytest
 
-from conftest import EXAMPLES, ROOT, run_fsw
+from conftest import ROOT, run_fsw
+from support.configs import edit, tank_configs
 
 from fswkit.autocode.board import board_from_dict
 
-TANK = EXAMPLES / "tank"
 BIG = "1" * 401  # about 1.1e400: beyond binary64
 OUT = "number is outside the representable range"
 
 
 @pytest.fixture
 def tank(tmp_path):
-    for name in ("tank.sv", "tank.sm", "tank.ss", "tank.app", "tank.aio", "tank.dio"):
-        (tmp_path / name).write_bytes((TANK / name).read_bytes())
-    return tmp_path
-
-
-def edit(path, old, new):
-    text = path.read_text()
-    assert old in text
-    path.write_text(text.replace(old, new, 1))
+    return tank_configs(tmp_path)
 
 
 @pytest.mark.parametrize("literal", ["1e400", BIG, "1.5e309", "0." + "0" * 400 + "1e800"])

@@ -34,7 +34,7 @@ def test_commands_are_checked_before_the_port_is_opened():
     ]
     for argv, msg in cases:
         r = clean(run_fsw("cmd", *argv, "--port", "/dev/no-such-port", "-p", str(TANK)))
-        assert r.code == 1 and msg in r.err, (argv, r.err)
+        assert r.code == 2 and msg in r.err, (argv, r.err)  # a wrong command line
 
 
 def test_values_out_of_range_for_the_type():
@@ -93,7 +93,7 @@ def test_truncated_log_and_unknown_plot_element(tmp_path):
     assert r.code == 0 and "cut short" in r.err
     assert r.out.splitlines()[1].startswith("0.010,0.000000,1,Sensors,7,")  # 10 ms; the element `time` is 7
     r = clean(run_fsw("plot", str(path), "-e", "pressure", "-o", str(tmp_path / "p.png")))
-    assert r.code == 1 and "unknown element(s) pressure" in r.err
+    assert r.code == 2 and "-e: unknown element `pressure`" in r.err
     r = clean(run_fsw("plot", str(path), "-e", "tankPressure", "-o", str(tmp_path / "no" / "p.png")))
     assert r.code == 1 and "cannot write" in r.err
 

@@ -244,7 +244,7 @@ def clean(r):
 def test_unknown_spark_element_before_the_port_is_opened():
     r = clean(run_fsw("monitor", str(ROCKET), "--port", "/dev/no-such-port", "--spark", "altitude",
                       "--spark", "altitud"))
-    assert r.code == 1, r.err
+    assert r.code == 2, r.err
     assert "unknown element `altitud`" in r.err and "did you mean `altitude`" in r.err
     assert "elements are time, state, altitude" in r.err and "cannot open" not in r.err
 
@@ -272,7 +272,7 @@ def test_replay_with_sparklines(tmp_path, monkeypatch):
     assert line.rstrip().endswith("min 801  max 829") and " 829 " in line
     assert all(cell_len(ln) <= 80 for ln in r.out.splitlines())
     r = clean(run_fsw("replay", str(log), "--headless", "--spark", "tankPresure"))
-    assert r.code == 1 and "unknown element `tankPresure`" in r.err and "valveOpen" in r.err
+    assert r.code == 2 and "unknown element `tankPresure`" in r.err and "valveOpen" in r.err
     assert r.out == ""
 
 

@@ -176,7 +176,7 @@ def test_a_script_runs_with_its_parameters_and_param_overrides_them():
     r = run_fsw("test", script, "--param", "OPEN_AT=5000")
     assert r.code == 2 and "outside its range 100..900 psi" in r.err
     r = run_fsw("test", script, "--param", "SPEED=3")
-    assert r.code == 2 and "not a parameter of machine `tuned`" in r.err
+    assert r.code == 2 and "unknown parameter `SPEED`: machine `tuned`'s parameters are OPEN_AT" in r.err
 
 
 def test_fsw_sim_flies_one_image_with_another_parameter_file(tmp_path):

@@ -134,6 +134,7 @@ def _with_params(script, given: list[str]):
     import dataclasses
 
     from fswkit.autocode.params import check_value, machine_with_values, var_param
+    from fswkit.usage import unknown_name
 
     m = script.machine
     values = {}
@@ -145,9 +146,9 @@ def _with_params(script, given: list[str]):
             sys.stderr.write(f"fsw test: --param {g}: expected NAME=VALUE\n")
             return None
         if v is None or v.param is None:
-            names = ", ".join(x.name for x in m.vars if x.param is not None) or "none"
-            sys.stderr.write(f"fsw test: --param {g}: `{name}` is not a parameter of machine `{m.name}` "
-                             f"(its parameters: {names})\n")
+            names = [x.name for x in m.vars if x.param is not None]
+            sys.stderr.write(f"fsw test: --param {g}: "
+                             + unknown_name("parameter", [name], names, f"machine `{m.name}`'s") + "\n")
             return None
         value, why = check_value(var_param(m, v), text)
         if why is not None:

@@ -51,9 +51,13 @@ def _ground(command: str, fn, *a) -> int:
     from fswkit.ground.archive import ArchiveError
     from fswkit.ground.monitor import GroundError
     from fswkit.outputs import OutputError
+    from fswkit.usage import UsageError
 
     try:
         return fn(*a)
+    except UsageError as e:  # a name or a value on the command line that names nothing: before any port or output
+        sys.stderr.write(f"fsw {command}: {e}\n")
+        return EXIT_CONFIG
     except (GroundError, PortError, LogError, LayoutError, OutputError, ArchiveError) as e:
         sys.stderr.write(f"fsw {command}: {e}\n")
         return EXIT_FAIL
@@ -61,8 +65,9 @@ def _ground(command: str, fn, *a) -> int:
 
 def cmd_monitor(args) -> int:
     from fswkit.ground.monitor import monitor
-
+    from fswkit.ground.view import spark_elements
     from fswkit.outputs import OutputError, check
+    from fswkit.usage import UsageError
 
     if args.log == "-":  # `-` is standard output elsewhere; here that carries the view, and a log is binary
         sys.stderr.write("fsw monitor: --log -: a link log is written to a file, never to standard output: "
@@ -73,6 +78,11 @@ def cmd_monitor(args) -> int:
     if link is None:
         return EXIT_CONFIG
     layout, app_baud = link
+    try:  # a name that is no element is a wrong command line, said before a port is looked for
+        spark_elements(layout, args.spark)
+    except UsageError as e:
+        sys.stderr.write(f"fsw monitor: {e}\n")
+        return EXIT_CONFIG
     port = port_or_only(args.port, "monitor")
     if port is None:
         return EXIT_FAIL

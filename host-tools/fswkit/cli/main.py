@@ -484,6 +484,35 @@ def _empty_option(p: argparse.ArgumentParser, args) -> str | None:
     return None
 
 
+_TO_STDOUT = " (standard output replaces no file)"
+
+# Options that can take effect only with another (command, option, whether it
+# was given without what it needs, what it goes with): refused, not ignored,
+# as `fsw machine` refuses an option its action means nothing to.
+_IDLE_OPTIONS = (
+    ("test", "--force", lambda a: a.force and not a.trace, "--trace FILE"),
+    ("graph", "--force", lambda a: a.force and a.output in (None, "-"), "-o FILE" + _TO_STDOUT),
+    ("skeleton", "--force", lambda a: a.force and a.output in (None, "-"), "-o FILE" + _TO_STDOUT),
+    ("log2csv", "--force", lambda a: a.force and a.output in (None, "-"), "-o FILE" + _TO_STDOUT),
+    ("compile", "--force", lambda a: a.force and a.output == "-" and a.layout is None,
+     "-o FILE or --layout FILE" + _TO_STDOUT),
+    ("tape import", "--force", lambda a: a.force and a.output == "-", "-o FILE" + _TO_STDOUT),
+    ("monitor", "--force", lambda a: a.force and a.log is None, "--log FILE"),
+    ("param", "--force", lambda a: a.force and a.output is None, "`list -o FILE`"),
+    ("dump", "--yes", lambda a: a.yes and not a.erase, "--erase (it answers the question before erasing)"),
+)
+
+
+def _idle_option(args) -> str | None:
+    """The message for an option given without the one it works with (it
+    would do nothing, leaving the user believing it did something), or None."""
+    command = " ".join(filter(None, (args.command, getattr(args, "tape_command", None))))
+    for name, option, idle, needs in _IDLE_OPTIONS:
+        if name == command and idle(args):
+            return f"fsw {command}: {option} goes with {needs}"
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the command `argv` (None: this process's arguments, the process
     ending with it) and returns its exit status."""
@@ -496,6 +525,10 @@ def main(argv: list[str] | None = None) -> int:
     if empty is not None:  # `--trace ""` is no trace, `--out ""` not the default folder
         sys.stderr.write(f"fsw {args.command}: {empty}: an empty string names nothing: give a path or name, "
                          "or leave the option out\n")
+        return EXIT_CONFIG
+    idle = _idle_option(args)
+    if idle is not None:
+        sys.stderr.write(idle + "\n")
         return EXIT_CONFIG
     # every print of every command: a failed write says it was standard output
     saved = sys.stdout

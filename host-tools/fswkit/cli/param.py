@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_OK, config_paths, load_app
+from fswkit.usage import unknown_name
 
 
 def _say(msg: str) -> None:
@@ -44,7 +45,7 @@ def cmd_param(args) -> int:
             return EXIT_CONFIG
         for n in args.args:
             if n not in by_name:
-                _say(f"unknown parameter `{n}` (the project's parameters: {', '.join(by_name)})")
+                _say("get: " + unknown_name("parameter", [n], by_name))
                 return EXIT_CONFIG
     elif args.action == "set":
         if not args.args:
@@ -57,7 +58,7 @@ def cmd_param(args) -> int:
                 return EXIT_CONFIG
             p = by_name.get(name.strip())
             if p is None:
-                _say(f"unknown parameter `{name.strip()}` (the project's parameters: {', '.join(by_name)})")
+                _say("set: " + unknown_name("parameter", [name.strip()], by_name))
                 return EXIT_CONFIG
             v, why = check_value(p, text)
             if why is not None:

@@ -14,9 +14,10 @@ from dataclasses import dataclass
 
 from fswkit import outputs
 from fswkit.link.session import Session
+from fswkit.usage import UsageError, unknown_name
 
 from .monitor import GroundError, summary
-from .view import View
+from .view import View, spark_elements
 
 
 # ---- logs --------------------------------------------------------------------------
@@ -222,6 +223,7 @@ def _rows(layout, ordered):
 def replay(path: str, headless: bool, speed: float, ignore_schema: bool, session: int | None = None,
            spark=()) -> int:
     reader, session, events = _log_session(path, ignore_schema, session)
+    spark = spark_elements(reader.layout, spark, "the log's")  # the names checked against the log's elements
     view = View(session, headless, f"{reader.layout.name}: replay of {path}", spark=spark)
     first_host = first_wall = None
     with view:
@@ -268,8 +270,7 @@ def plot(path: str, elements: list[str], out: str, ignore_schema: bool, session:
     lay = reader.layout
     missing = [e for e in elements if lay.element(e) is None]
     if missing:
-        raise GroundError(f"unknown element(s) {', '.join(missing)}: the log's elements are "
-                          + ", ".join(e.name for e in lay.elements))
+        raise UsageError("-e: " + unknown_name("element", missing, [e.name for e in lay.elements], "the log's"))
     data = plot_data(lay, events, elements)
     said_incomplete("plot", reader)
     fig, unlabelled = figure(lay, data, elements, f"{lay.name}: {path}")

@@ -12,6 +12,7 @@ from fswkit import outputs
 from fswkit.link import wire
 from fswkit.link.layout import Layout
 from fswkit.link.session import Session
+from fswkit.usage import UsageError, unknown_name
 
 from .view import View, spark_elements
 
@@ -140,32 +141,31 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
     # the command is checked before the port is opened
     if what == "set":
         if len(args) != 2:
-            raise GroundError("usage: fsw cmd set ELEMENT VALUE")
+            raise UsageError("usage: fsw cmd set ELEMENT VALUE")
         el = layout.element(args[0])
         if el is None:
-            raise GroundError(f"unknown element `{args[0]}`: elements are "
-                              + ", ".join(e.name for e in layout.elements))
+            raise UsageError("set: " + unknown_name("element", [args[0]], [e.name for e in layout.elements]))
         try:
             value = encode_value(el, args[1])
         except LayoutError as e:
-            raise GroundError(str(e)) from None
+            raise UsageError(str(e)) from None
         op, payload = wire.OP_SET, el.index.to_bytes(2, "little") + value
     elif what == "mode":
         if len(args) != 2:
-            raise GroundError("usage: fsw cmd mode TASK disabled|safed|enabled")
+            raise UsageError("usage: fsw cmd mode TASK disabled|safed|enabled")
         ti = layout.task_index(args[0])
         if ti is None:
-            raise GroundError(f"unknown task `{args[0]}`: tasks are " + ", ".join(n for n, _ in layout.tasks))
+            raise UsageError("mode: " + unknown_name("task", [args[0]], [n for n, _ in layout.tasks]))
         modes = TASK_MODES
         if args[1] not in modes:
-            raise GroundError(f"unknown mode `{args[1]}`: one of disabled, safed, enabled")
+            raise UsageError(f"mode: unknown mode `{args[1]}`: one of disabled, safed, enabled")
         op, payload = wire.OP_MODE, bytes((ti, modes[args[1]]))
     elif what in ("ping", "hello", "snapshot"):
         if args:
-            raise GroundError(f"`{what}` takes no arguments")
+            raise UsageError(f"`{what}` takes no arguments")
         op, payload = {"ping": wire.OP_PING, "hello": wire.OP_HELLO, "snapshot": wire.OP_SNAPSHOT}[what], b""
     else:
-        raise GroundError(f"unknown command `{what}`: set, mode, ping, hello or snapshot")
+        raise UsageError(f"unknown command `{what}`: set, mode, ping, hello or snapshot")
 
     session = Session(layout, ignore_schema=ignore_schema)
     try:

@@ -5,14 +5,14 @@ out by priority (docs/cli.md, fsw monitor)."""
 
 from __future__ import annotations
 
-import difflib
 import math
 import time
 from collections import deque
 
 from fswkit import outputs
-from fswkit.link.layout import Layout, LayoutError
+from fswkit.link.layout import Layout
 from fswkit.link.session import Event, Session, describe
+from fswkit.usage import UsageError, unknown_name
 from fswkit.web.source import reset_words
 
 SPARK_VALUES = 60  # the values a sparkline keeps and shows at most
@@ -38,15 +38,13 @@ class Spark:
         self.values: deque = deque(values, maxlen=SPARK_VALUES)
 
 
-def spark_elements(layout: Layout, names) -> tuple[str, ...]:
+def spark_elements(layout: Layout, names, whose: str = "the project's") -> tuple[str, ...]:
     """The elements asked for sparklines, each once, in the order asked;
-    LayoutError naming the elements for a name that is not one."""
-    known = [e.name for e in layout.elements]
+    UsageError naming the elements (`whose`: the project's, the log's) for
+    a name that is not one."""
     for n in names:
         if layout.element(n) is None:
-            close = difflib.get_close_matches(n, known, n=1)
-            hint = f" (did you mean `{close[0]}`?)" if close else ""
-            raise LayoutError(f"--spark: unknown element `{n}`{hint}: elements are " + ", ".join(known))
+            raise UsageError("--spark: " + unknown_name("element", [n], [e.name for e in layout.elements], whose))
     return tuple(dict.fromkeys(names))
 
 

@@ -12,7 +12,12 @@ gave the key, through `extends`), exit status 2. Only the checks that
 depend on the bad value itself are skipped: a `reset_state` of the wrong
 type is not also "absent" (no "needs reset_state" for its reset_after_s),
 a barometer `channel` of the wrong type does not also make the barometer
-"missing", a `max_s` out of range is not compared with the motor's burn."""
+"missing", a `max_s` out of range is not compared with the motor's burn.
+
+A study (`--runs`) was the same across its two files: an error in
+plant.toml hid every error of the dispersion file, and a value the
+dispersion file's schema refused hid its other keys' checks against the
+flight (a brown-out window past its end). They too come in one run."""
 
 from __future__ import annotations
 
@@ -122,3 +127,35 @@ def test_a_tape_config_type_error_and_an_unknown_local_in_one_run(tmp_path):
     assert f"{cfg}:3: [tape] missing: expected a non-empty string" in err
     assert f"{cfg}:5: [firmware] main_alt: machine `mission` has no local `NOPE`" in err
     assert len(err.strip().splitlines()) == 3, err
+
+
+# ---- a study: the plant file and the dispersion file ------------------------------------
+
+def _study(tmp_path: Path, params: Path | None, disp: Path):
+    args = ["sim", str(EXAMPLES / "rocket"), "--plant", "rocket", "--runs", "2", "--dispersion", str(disp),
+            "--out", str(tmp_path / "study")]
+    if params is not None:
+        args += ["--params", str(params)]
+    r = run_fsw(*args)
+    assert "Traceback" not in r.err and "internal error" not in r.err, r.err
+    assert not (tmp_path / "study").exists()
+    return r
+
+
+def test_a_studys_plant_file_and_dispersion_file_errors_in_one_run(tmp_path):
+    p = _variant(tmp_path, ROCKET_TOML, ('altitude_element = "altitude"', 'altitude_element = "altitud"'))
+    d = tmp_path / "d.toml"
+    d.write_text("[motor]\nimpulse_sd = \"lots\"\n")
+    r = _study(tmp_path, p, d)
+    assert r.code == 2
+    assert f"{p}:{_line(p, 'altitude_element')}: [firmware] altitude_element: the project has no element" in r.err
+    assert f'{d}:2: [motor] impulse_sd: expected a number, found a string "lots"' in r.err
+
+
+def test_a_dispersion_files_type_error_and_a_window_past_the_flight_in_one_run(tmp_path):
+    d = tmp_path / "d.toml"
+    d.write_text("[motor]\nimpulse_sd = 0.9\n\n[brownout]\nprobability = 0.5\nwindow_s = [88, 90]\n")
+    r = _study(tmp_path, None, d)
+    assert r.code == 2
+    assert f"{d}:2: [motor] impulse_sd: 0.9 is out of range (0 to 0.2)" in r.err
+    assert f"{d}:6: [brownout] window_s: [88, 90] starts after the end of the flight" in r.err

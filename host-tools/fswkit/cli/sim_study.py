@@ -61,20 +61,25 @@ def study_run(args) -> int:
         say(f"{args.project}: {what} needs the project (its folder or .app), not a firmware ELF")
         return 2
     seed = 1 if args.seed is None else args.seed
+    # the plant file's errors and the dispersion file's, all in one run (past_flight's need both files' values)
+    setup_error = None
     try:
         app, layout, sc = prepare(args.project, "rocket", params=args.params, seed=seed, board=args.board)
     except SetupError as e:
-        for line in str(e).splitlines():
+        setup_error = str(e)
+    try:
+        disp, disp_errors = (dispersion_mod.load_all(args.dispersion) if args.dispersion is not None
+                             else (dispersion_mod.Dispersion.none(), []))
+    except ParamsError as e:
+        disp, disp_errors = None, e.errors
+    if setup_error is not None:
+        for line in setup_error.splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
+    for line in disp_errors:
+        sys.stderr.write(f"fsw sim: {line}\n")
+    if setup_error is not None or disp is None:
         return 2
     params = args.params or os.path.join(os.path.dirname(app.path) or ".", "plant.toml")
-    try:
-        disp = (dispersion_mod.load(args.dispersion) if args.dispersion is not None
-                else dispersion_mod.Dispersion.none())
-    except ParamsError as e:
-        for line in e.errors:
-            sys.stderr.write(f"fsw sim: {line}\n")
-        return 2
     command = ["fsw", "sim", args.project, "--plant", "rocket"]
     if args.params:
         command += ["--params", args.params]
@@ -87,7 +92,7 @@ def study_run(args) -> int:
     past = disp.past_flight(span)
     for line in past:
         sys.stderr.write(f"fsw sim: {line}\n")
-    if past:
+    if past or disp_errors:
         return 2
     if args.run is not None:
         return _one_run(args, app, layout, params, disp, seed, default_out, span)

@@ -25,7 +25,7 @@ import numpy as np
 
 from .params import Field as F
 from .params import ParamsError, Table
-from .params import load as load_params
+from .params import load_all as load_params
 from .rocket import Chute, Motor
 
 
@@ -101,12 +101,13 @@ class Dispersion:
                            ("barometer", "dropout_rate_hz"), ("accelerometer", "spike_rate_hz"),
                            ("accelerometer", "dropout_rate_hz")):
             rate = self.values[table][key]
-            if rate * over > MAX_EVENTS:
+            if rate is not None and rate * over > MAX_EVENTS:  # (None: refused by the schema, said)
                 out.append(error_at(self.path or "", self.where, table, key,
                                     f"{rate:g} a second over a flight of {over:,.0f} s is {rate * over:,.0f} events "
                                     f"a run: at most {MAX_EVENTS:,} (a lower rate, or a shorter max_s)"))
-        lo, hi = self.values["brownout"]["window_s"]
-        if self.values["brownout"]["probability"] and lo >= span_s:
+        window, probability = self.values["brownout"]["window_s"], self.values["brownout"]["probability"]
+        if window is not None and probability and window[0] >= span_s:
+            lo, hi = window
             out.append(error_at(self.path or "", self.where, "brownout", "window_s",
                                 f"[{lo:g}, {hi:g}] starts after the end of the flight, {span_s:g} s after ignition "
                                 "(the plant's max_s less its ignition_s): no brown-out could happen in flight"))
@@ -123,10 +124,21 @@ class Dispersion:
 
 def load(path: str) -> Dispersion:
     """A dispersion file, checked; ParamsError with every located error."""
+    disp, errors = load_all(path)
+    if errors:
+        raise ParamsError(errors)
+    return disp
+
+
+def load_all(path: str) -> tuple[Dispersion, list[str]]:
+    """A dispersion file, checked, and its located errors, returned rather
+    than raised so that a study reports them with the plant file's and
+    `past_flight`'s (which skips a value refused: None); ParamsError only
+    for a file that cannot be read."""
     if not os.path.exists(path):
         raise ParamsError([f"{path}: no such file (a dispersion file: see docs/sim.md, Dispersion studies)"])
-    values, where = load_params(path, SCHEMA)
-    return Dispersion(values, path, where)
+    values, where, errors, _bad = load_params(path, SCHEMA)
+    return Dispersion(values, path, where), errors
 
 
 @dataclass

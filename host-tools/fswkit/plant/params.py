@@ -222,9 +222,12 @@ def _value(v, f: Field, name: str) -> tuple[object, str | None]:
     raise ValueError(f"unknown field kind {f.kind}")
 
 
-def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, list[str]]:
+def check(data: dict, schema: Schema, where: dict, path: str, bad: set | None = None) -> tuple[dict, list[str]]:
     """The checked values as {table: {key: value}} (defaults filled in), and
-    the located errors."""
+    the located errors. A key whose value is in error (missing, of the wrong
+    type, out of range, in a table that is not one) is None in the values,
+    and added to `bad` as (table, key)."""
+    bad = set() if bad is None else bad
     errors: list[tuple[int, str]] = []
     out: dict[str, dict] = {}
 
@@ -243,17 +246,20 @@ def check(data: dict, schema: Schema, where: dict, path: str) -> tuple[dict, lis
             err(where.get(("", tname), 1), f"`{tname}` must be a table [{tname}]"
                 + (f", not an array of tables [[{tname}]]" if many else ""))
             got = {}
+            bad.update((tname, key) for key in table.fields)
         vals = {}
         for key, f in table.fields.items():
             label = f"[{tname}] {key}" if tname else key
             if key not in got:
                 if f.required:
                     err(tline, f"{label}: missing ({f.doc})")
+                    bad.add((tname, key))
                 vals[key] = f.default
                 continue
             v, e = _value(got[key], f, label)
             if e:
                 err(where.get((tname, key), tline), e)
+                bad.add((tname, key))
             vals[key] = v
         for key in got:
             if tname == "" and key in schema:  # a table's name: its own check reports a value that is not one
@@ -361,11 +367,24 @@ def resolve(path: str, schema: Schema | None = None, _chain: tuple[str, ...] = (
 def load(path: str, schema: Schema) -> tuple[dict, dict]:
     """Reads and checks a parameters file (its `extends` chain merged);
     (values, locations). ParamsError with every located error."""
-    data, where = resolve(path, schema)
-    values, errors = check(data, schema, where, path)
+    values, where, errors, _bad = load_all(path, schema)
     if errors:
         raise ParamsError(errors)
     return values, where
+
+
+def load_all(path: str, schema: Schema) -> tuple[dict, dict, list[str], set]:
+    """Reads and checks a parameters file (its `extends` chain merged), its
+    errors returned rather than raised, so that the checks of its names and
+    pins against a project can run on the values that are good and every
+    error of the file be reported in one run: (values, locations, errors,
+    bad), where `bad` holds the (table, key) of each value in error (None in
+    `values`). ParamsError only for a file that cannot be read as TOML at
+    all (or its `extends`)."""
+    data, where = resolve(path, schema)
+    bad: set = set()
+    values, errors = check(data, schema, where, path, bad)
+    return values, where, errors, bad
 
 
 def key_file(path: str, where: dict, table: str, key: str) -> str:

@@ -28,8 +28,7 @@ from .atmosphere import G0
 from .cosim import PinEvent
 from .motor import CURVE_MAX_N, CURVE_MAX_S, MAX_MASS_KG
 from .params import Field as F
-from .params import ParamsError, Table, error_at
-from .params import load as load_params
+from .params import ParamsError, Table, error_at, load_all
 from .rocket import Chute, Motor, Rocket
 from .tank import PSI, Tank
 
@@ -321,16 +320,26 @@ class Igniter:
 # ---- binding a parameters file to the project --------------------------------------------
 
 class _Binder:
-    """Checks names and pins of the parameters against the project."""
+    """Checks names and pins of the parameters against the project. `bad`:
+    the (table, key) of values the schema refused (None in the values): a
+    check that needs one is skipped, its error already said; a name or pin
+    of None is not checked."""
 
-    def __init__(self, path, where, app, layout):
+    def __init__(self, path, where, app, layout, bad=frozenset()):
         self.path, self.where, self.app, self.layout = path, where, app, layout
+        self.bad = set(bad)
         self.errors: list[str] = []
+
+    def good(self, table, *keys) -> bool:
+        """Whether none of these keys of `table` holds a value the schema refused."""
+        return not any((table, k) in self.bad for k in keys)
 
     def err(self, table, key, msg):
         self.errors.append(error_at(self.path, self.where, table, key, msg))
 
     def machine(self, name):
+        if name is None:
+            return None
         m = next((m for m in self.app.machines if m.name == name), None)
         if m is None:
             self.err("firmware", "machine", f"the project has no machine `{name}` (it has "
@@ -342,13 +351,16 @@ class _Binder:
         that machine's `S`."""
         m = self.machine(fw["machine"])
         self.streamed("state_element", fw["state_element"])
-        if m is not None and self.layout.element(fw["state_element"]) is not None \
-                and m.vars[m.s].name != fw["state_element"]:
+        name = fw["state_element"]
+        if m is not None and name is not None and self.layout.element(name) is not None \
+                and m.vars[m.s].name != name:
             self.err("firmware", "state_element", f"`{fw['state_element']}` is not machine `{m.name}`'s state "
                      f"(that is `{m.vars[m.s].name}`)")
         return m
 
     def streamed(self, key, name):
+        if name is None:
+            return
         streamed = {n for s in self.layout.streams for n in s.region.names}
         if self.layout.element(name) is None:
             self.err("firmware", key, f"the project has no element `{name}`")
@@ -356,12 +368,12 @@ class _Binder:
             self.err("firmware", key, f"`{name}` is not in any telemetry stream (the ground never sees it)")
 
     def state(self, m, key, name, table="firmware"):
-        if m is not None and m.state(name) is None:
+        if m is not None and name is not None and m.state(name) is None:
             self.err(table, key, f"machine `{m.name}` has no state `{name}` (its states: "
                      + ", ".join(s.name for s in m.states) + ")")
 
     def local(self, m, key, name):
-        if m is None:
+        if m is None or name is None:
             return None
         v = m.var(name)
         if v is None or v.kind != M.LOCAL:
@@ -381,7 +393,9 @@ class _Binder:
     def channel(self, table, key, pin, analog, direction):
         """The project's channel on `pin`, named as the I/O tables name pins
         (`"A0"`) or by the board's pin number (14, "14"), or None after an
-        error."""
+        error (None for a pin of None: a value the schema refused)."""
+        if pin is None:
+            return None
         what = ("an analog input" if analog else "a digital input" if direction == "i" else "a digital output")
         pin_text = str(pin)
         board = self.app.board
@@ -413,11 +427,11 @@ def _bind_reset(sc, bind: _Binder, m, sc_table: dict) -> None:
     sc.reset_cause = sc_table["reset_cause"]
     if sc.reset_state is not None:
         bind.state(m, "reset_state", sc.reset_state, table="scenario")
-    else:
+    elif bind.good("scenario", "reset_state"):
         for key in ("reset_after_s", "reset_cause"):
             if ("scenario", key) in bind.where:
                 bind.err("scenario", key, "needs reset_state (the state whose first sighting starts the count)")
-    if sc.reset_cause not in RESET_CAUSES:
+    if sc.reset_cause is not None and sc.reset_cause not in RESET_CAUSES:
         bind.err("scenario", "reset_cause", f"`{sc.reset_cause}` is not a reset cause (one of "
                  + ", ".join(RESET_CAUSES) + ")")
 
@@ -429,7 +443,16 @@ def _sensor(bind: _Binder, t: dict, role: str, transfer: tuple[str, str], kinds:
     """[barometer] / [accelerometer]: (the project's analog channel, None)
     or (None, the project's digital part), checked: one of channel and
     part, an analog sensor's transfer function, a part of the project's
-    sensor tables of a kind that measures this. `t`: the table's values."""
+    sensor tables of a kind that measures this. `t`: the table's values.
+    With `channel` or `part` refused by the schema, which of the two the
+    sensor is is unknown: only the other, if given, is checked."""
+    if not bind.good(role, "channel", "part"):
+        if t["part"] is not None:
+            part, why = find_part(getattr(bind.app, "sensors", ()) or (), t["part"], kinds)
+            if part is None:
+                bind.err(role, "part", why)
+            return None, part
+        return bind.channel(role, "channel", t["channel"], True, "i"), None
     if t["channel"] is not None and t["part"] is not None:
         bind.err(role, "part", "an analog `channel` or a digital `part`, not both")
         return None, None
@@ -446,7 +469,7 @@ def _sensor(bind: _Binder, t: dict, role: str, transfer: tuple[str, str], kinds:
                  f"(a digital {role} of the project's sensor tables, \"{kinds[0]}@...\")")
         return None, None
     for key in transfer:
-        if t[key] is None:
+        if t[key] is None and bind.good(role, key):
             bind.err(role, key, f"missing (with channel: {_transfer_doc(role, key)})")
     return bind.channel(role, "channel", t["channel"], True, "i"), None
 
@@ -460,7 +483,7 @@ def _axis(bind: _Binder, t: dict, part) -> tuple[str, float]:
     axis = t["axis"]
     if axis is None:
         return "z", 1.0
-    if part is None and t["channel"] is not None:
+    if part is None and t["channel"] is not None and bind.good("accelerometer", "part"):
         bind.err("accelerometer", "axis", "belongs to a digital `part`; an analog accelerometer has one axis")
     a = axis.strip().lower()
     sign = -1.0 if a.startswith("-") else 1.0
@@ -482,22 +505,26 @@ def _output(part, quantity: str) -> str | None:
 
 
 def load(kind: str, path: str, app, layout, seed: int, fault: str | None):
-    """The scenario of a parameters file, checked against the project."""
+    """The scenario of a parameters file, checked against the project:
+    every error of the file in one ParamsError. A value the schema refuses
+    is reported and skips only the checks that need it; the names and pins
+    of the rest are still checked against the project."""
     if kind not in SCHEMAS:
         raise ValueError(kind)
-    values, where = load_params(path, SCHEMAS[kind])
-    if values[""]["plant"] != kind:
-        raise ParamsError([error_at(path, where, "", "plant", f"this file describes a `{values['']['plant']}` "
-                                    f"plant, not a `{kind}`")])
+    values, where, errors, bad = load_all(path, SCHEMAS[kind])
+    plant = values[""]["plant"]
+    if plant is not None and plant != kind:  # the file's names and pins are another plant's: not checked
+        raise ParamsError([error_at(path, where, "", "plant", f"this file describes a `{plant}` plant, not a "
+                                    f"`{kind}`")] + errors)
     rate = values[""]["rate_hz"]
-    bind = _Binder(path, where, app, layout)
-    if app.board.f_cpu % rate:
+    bind = _Binder(path, where, app, layout, bad)
+    if rate is not None and app.board.f_cpu % rate:
         bind.err("", "rate_hz", f"{rate} Hz does not divide the {app.board.name}'s clock ({app.board.f_cpu} Hz): "
                  "every plant step must end on a whole CPU cycle")
     cls = RocketScenario if kind == "rocket" else TankScenario
     sc = cls(values, bind, seed, fault)
-    if bind.errors:
-        raise ParamsError(bind.errors)
+    if errors or bind.errors:
+        raise ParamsError(errors + bind.errors)
     sc.app = app  # its [budget] is checked after the run
     return sc
 
@@ -507,6 +534,9 @@ def _time_unit_s(app) -> float:
 
 
 # ---- the rocket -----------------------------------------------------------------------------
+
+_NO_CURVE = ((0.0, 0.0), (1.0, 100.0), (1.1, 0.0))  # _motor's curve after an error: no check is made of it
+
 
 def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     """[motor]'s thrust curve and propellant mass: written in the table, or
@@ -519,7 +549,9 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     from .motor import EngError, _clip, impulse_problem
     from .motor import load as load_eng
 
-    fallback = (((0.0, 0.0), (1.0, 100.0), (1.1, 0.0)), mot["propellant_kg"] or 0.0)  # after an error
+    fallback = (_NO_CURVE, mot["propellant_kg"] or 0.0)  # after an error
+    if not bind.good("motor", "file", "name", "thrust_curve"):  # which motor it is depends on the value refused
+        return fallback
     if mot["file"] is not None and mot["thrust_curve"] is not None:
         bind.err("motor", "file", "a motor file or a thrust_curve, not both")
         return fallback
@@ -531,6 +563,8 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
             bind.err("motor", "", "missing: a thrust_curve, or a RASP motor file (file = \"motors/G80T.eng\")")
             return fallback
         if mot["propellant_kg"] is None:
+            if not bind.good("motor", "propellant_kg"):
+                return fallback
             bind.err("motor", "", "propellant_kg: missing (a thrust_curve written here needs its propellant mass)")
             return fallback
         curve = mot["thrust_curve"]
@@ -548,6 +582,8 @@ def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
         if eng is None:
             return fallback
         if mot["propellant_kg"] is None:
+            if not bind.good("motor", "propellant_kg"):
+                return fallback
             return eng.curve(), eng.propellant_kg  # held to the curve when the file was read
         if mot["propellant_kg"] > eng.total_kg:
             bind.err("motor", "propellant_kg", f"{mot['propellant_kg']:g} kg of propellant weighs more than the whole "
@@ -605,9 +641,9 @@ class RocketScenario:
         bind.streamed("altitude_element", fw["altitude_element"])
         for key in ("armed_state", "apogee_state", "landed_state"):
             bind.state(m, key, fw[key])
-        for name in fw["pad_states"]:
+        for name in fw["pad_states"] or ():
             bind.state(m, "pad_states", name)
-        for name in p["checks"]["sequence"]:
+        for name in p["checks"]["sequence"] or ():
             bind.state(m, "sequence", name, table="checks")
         _bind_reset(self, bind, m, sc)
         self.main_alt = bind.local(m, "main_altitude", fw["main_altitude"])
@@ -627,7 +663,8 @@ class RocketScenario:
         bind.channel("pins", "arm", pins["arm"], False, "i")
         bind.channel("pins", "drogue", pins["drogue"], False, "o")
         bind.channel("pins", "main", pins["main"], False, "o")
-        if len({pins["arm"], pins["drogue"], pins["main"]}) < 3:
+        if None not in (pins["arm"], pins["drogue"], pins["main"]) \
+                and len({pins["arm"], pins["drogue"], pins["main"]}) < 3:
             bind.err("pins", "main", "the arm, drogue and main pins must be three different pins")
         self.vref = float(bind.app.board.adc_vref)
         veh, mot = p["vehicle"], p["motor"]
@@ -635,28 +672,31 @@ class RocketScenario:
                                           for s in np.random.SeedSequence(seed).spawn(3))
         curve, propellant = _motor(bind, mot)
         nominal = Motor(curve)
-        liftoff_weight = (veh["dry_mass_kg"] + propellant) * G0
-        if nominal.peak <= liftoff_weight:
+        liftoff_weight = None if veh["dry_mass_kg"] is None else (veh["dry_mass_kg"] + propellant) * G0
+        if curve is not _NO_CURVE and liftoff_weight is not None and nominal.peak <= liftoff_weight:
             bind.err("motor", "file" if mot["file"] else "thrust_curve", f"the peak thrust ({nominal.peak:g} N) never exceeds the "
                      f"vehicle's weight ({liftoff_weight:.1f} N): it would never leave the pad")
         # this seed's motor: the nominal curve scaled (the clamp only matters for a draw beyond 2.5 sigma
         # with the largest impulse_sd allowed)
-        self.motor_factor = max(0.5, 1.0 + mot["impulse_sd"] * float(motor_rng.standard_normal()))
+        self.motor_factor = max(0.5, 1.0 + (mot["impulse_sd"] or 0.0) * float(motor_rng.standard_normal()))
         self.nominal_impulse = nominal.total
         self.curve, self.propellant_kg = curve, propellant
         self.motor = Motor([(t, f * self.motor_factor) for t, f in curve])
-        if sc["ignition_s"] + self.motor.burn_time >= sc["max_s"]:
+        if curve is not _NO_CURVE and sc["ignition_s"] is not None and sc["max_s"] is not None \
+                and sc["ignition_s"] + self.motor.burn_time >= sc["max_s"]:
             bind.err("scenario", "max_s", "the run must outlast the motor's burn")
-        self.rocket = Rocket(dry_mass=veh["dry_mass_kg"], propellant_mass=propellant, motor=self.motor,
-                             body_cd_area=veh["body_cd_area_m2"],
-                             drogue=Chute(p["drogue"]["cd_area_m2"], p["drogue"]["inflate_s"]),
-                             main=Chute(p["main"]["cd_area_m2"], p["main"]["inflate_s"]),
-                             pad_altitude=p["atmosphere"]["pad_altitude_m"])
+        # a file with an error is never flown: its vehicle is not built from the values the schema refused
+        self.rocket = None if bind.bad else Rocket(
+            dry_mass=veh["dry_mass_kg"], propellant_mass=propellant, motor=self.motor,
+            body_cd_area=veh["body_cd_area_m2"],
+            drogue=Chute(p["drogue"]["cd_area_m2"], p["drogue"]["inflate_s"]),
+            main=Chute(p["main"]["cd_area_m2"], p["main"]["inflate_s"]),
+            pad_altitude=p["atmosphere"]["pad_altitude_m"])
         self.pins = {pins["drogue"]: "drogue", pins["main"]: "main"}
         self.outputs = tuple(self.pins)
         self.arm_pin = pins["arm"]
-        self.pyros = {pins["drogue"]: Pyro(p["drogue"]["fire_ms"] / 1000),
-                      pins["main"]: Pyro(p["main"]["fire_ms"] / 1000)}
+        self.pyros = {pins["drogue"]: Pyro((p["drogue"]["fire_ms"] or 0.0) / 1000),  # (or: refused, never flown)
+                      pins["main"]: Pyro((p["main"]["fire_ms"] or 0.0) / 1000)}
         self.levels = {pin: False for pin in self.pins}
         self.igniters = self._igniters(bind, fault, (baro, accel))
         # each continuity input's volts in the truth rows, only when there are any (columns as before otherwise)
@@ -697,6 +737,8 @@ class RocketScenario:
         for role in ("drogue", "main"):
             chute = p[role]
             pin = chute["continuity_channel"]
+            if pin is None and not bind.good(role, "continuity_channel"):
+                continue  # refused by the schema: said
             if pin is None:
                 for key in ("intact_volts", "open_volts"):
                     if (role, key) in bind.where:
@@ -739,25 +781,29 @@ class RocketScenario:
         if name in PART_FAULTS:
             role = "barometer" if name.startswith("baro") else "accelerometer"
             if parts[role] is None:
-                bind.err(role, "channel", f"--fault {fault} fails a digital part; this {role} is analog "
-                         f"(set [{role}] part to one of the project's sensor tables' parts)")
+                if bind.good(role, "channel", "part"):  # (else whether it is analog depends on a refused value)
+                    bind.err(role, "channel", f"--fault {fault} fails a digital part; this {role} is analog "
+                             f"(set [{role}] part to one of the project's sensor tables' parts)")
             else:
                 when = at if at is not None else sc["ignition_s"]
-                self.part_fail_plan.append((when, parts[role], name.split("-")[1]))
-        if name == "stuck-baro" and self.baro_part is not None:
+                if when is not None:
+                    self.part_fail_plan.append((when, parts[role], name.split("-")[1]))
+        if name == "stuck-baro" and self.baro_part is not None and sc["ignition_s"] is not None:
             self.part_fail_plan.append((sc["ignition_s"], self.baro_part, "stuck"))
         if sc["part_fail"] is not None:
             part, why = find_part(getattr(bind.app, "sensors", ()) or (), sc["part_fail"], SENSOR_KINDS)
             if part is None:
                 bind.err("scenario", "part_fail", why)
-            if sc["part_fail_s"] is None:
+            if sc["part_fail_s"] is None and bind.good("scenario", "part_fail_s"):
                 bind.err("scenario", "part_fail_s", "missing: the simulated second the part fails at")
-            if sc["part_fail_mode"] not in ("nack", "stuck", "noisy"):
+            if sc["part_fail_mode"] is None:
+                pass  # refused by the schema
+            elif sc["part_fail_mode"] not in ("nack", "stuck", "noisy"):
                 bind.err("scenario", "part_fail_mode",
                          f"\"{sc['part_fail_mode']}\": one of \"nack\", \"stuck\", \"noisy\"")
             elif part is not None and sc["part_fail_s"] is not None:
                 self.part_fail_plan.append((sc["part_fail_s"], part, sc["part_fail_mode"]))
-        else:
+        elif bind.good("scenario", "part_fail"):
             for key in ("part_fail_s", "part_fail_mode"):
                 if ("scenario", key) in bind.where:
                     bind.err("scenario", key, "needs part_fail (the part that fails)")
@@ -905,10 +951,11 @@ class TankScenario:
         self.vent_psi = fw["vent_psi"]
         transducer = bind.channel("transducer", "channel", p["transducer"]["channel"], True, "i")
         bind.channel("pins", "valve", p["pins"]["valve"], False, "o")
-        if sc["failure_s"] >= sc["max_s"]:
+        if sc["failure_s"] is not None and sc["max_s"] is not None and sc["failure_s"] >= sc["max_s"]:
             bind.err("scenario", "failure_s", "the regulator must fail before the run's end (max_s)")
         tk = p["tank"]
-        self.tank = Tank(volume=tk["volume_l"] / 1000, temperature=tk["temperature_k"],
+        # a file with an error is never flown: its tank is not built from the values the schema refused
+        self.tank = None if bind.bad else Tank(volume=tk["volume_l"] / 1000, temperature=tk["temperature_k"],
                          gas_constant=tk["gas_constant_j_kg_k"], gamma=tk["gamma"],
                          initial_pa=tk["initial_psi"] * PSI + 101325.0,
                          vent_cd_area=p["vent"]["cd_area_mm2"] * 1e-6, valve_time=p["vent"]["response_ms"] / 1000)

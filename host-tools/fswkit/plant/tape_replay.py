@@ -60,7 +60,7 @@ from . import report as reports
 from .cosim import CosimError, PinEvent, Run, Telemetry, _nor, _one_cpu, nor_image, stop_words
 from .params import Field as F
 from .params import ParamsError, Table, _at
-from .params import load as load_params
+from .params import load_all
 from .params import resolve as resolve_params
 from .scenario import ROCKET_SCHEMA, _Binder
 
@@ -305,24 +305,29 @@ def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
 def load_config(app, layout: Layout, path: str | None = None) -> Config:
     """The replay's configuration: `path` (default PROJECT/tape.toml, if it
     exists) over plant.toml's defaults, checked against the project;
-    ReplayError with every located problem."""
+    ReplayError with every located problem, in one run: a value tape.toml
+    gives that the schema refuses is reported, and only the checks that need
+    it are skipped (it is None in the values, not plant.toml's default)."""
     project_dir = os.path.dirname(app.path) or "."
     if path is None:
         cand = os.path.join(project_dir, "tape.toml")
         path = cand if os.path.exists(cand) else None
     defaults, origins = _plant_defaults(project_dir)
     given: dict = {t: {} for t in TAPE_SCHEMA}
+    errors: list[str] = []  # the schema's
     if path is not None:
         try:
-            values, where = load_params(path, TAPE_SCHEMA)
+            values, where, errors, _bad = load_all(path, TAPE_SCHEMA)
         except ParamsError as e:
             raise ReplayError("\n".join(e.errors)) from None
         raw, _ = resolve_params(path, TAPE_SCHEMA)
         for t in TAPE_SCHEMA:
             origins[(t, "")] = _at(path, where.get((t, ''), 1))
-            for k in (raw.get(t) or {}):
-                given[t][k] = values[t][k]
-                origins[(t, k)] = _at(path, where.get((t, k), 1))
+            table = raw.get(t)
+            for k in (table if isinstance(table, dict) else {}):
+                if k in TAPE_SCHEMA[t].fields:  # (an unknown key: the schema's error)
+                    given[t][k] = values[t][k]  # None: refused by the schema
+                    origins[(t, k)] = _at(path, where.get((t, k), 1))
     else:
         for t in TAPE_SCHEMA:
             origins.setdefault((t, ""), os.path.join(project_dir, "tape.toml (absent)"))
@@ -333,17 +338,17 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
             v[t][k] = given[t].get(k, defaults.get(t, {}).get(k, f.default))
     bind = _Origins(app, layout, origins)
     tp, pins, fw = v["tape"], v["pins"], v["firmware"]
-    if tp["missing"] not in ("hold", "silent"):
+    if tp["missing"] is not None and tp["missing"] not in ("hold", "silent"):
         bind.err("tape", "missing", f"\"{tp['missing']}\": one of \"hold\", \"silent\"")
-    if not 0 <= tp["silent_volts"] <= app.board.adc_vref:
+    if tp["silent_volts"] is not None and not 0 <= tp["silent_volts"] <= app.board.adc_vref:
         bind.err("tape", "silent_volts", f"{tp['silent_volts']:g} V is beyond the converter's 0..{app.board.adc_vref:g} V")
     sensors: dict = {}
     parts: dict = {}
     used: dict = {}
     for col in TAPE_COLUMNS:
         pin = tp[col]
-        if pin == _UNSET:
-            continue  # checked against the tape's columns later
+        if pin == _UNSET or pin is None:
+            continue  # checked against the tape's columns later (None: refused by the schema)
         if str(pin).lower() == "none":
             sensors[col] = None
             continue
@@ -355,6 +360,8 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
                 continue
             axis = ("pressure", 1.0)
             if col == "accel_g":
+                if tp["accel_axis"] is None:
+                    continue  # refused by the schema
                 a = str(tp["accel_axis"]).strip().lower()
                 if a.lstrip("+-") not in AXES:
                     bind.err("tape", "accel_axis", f"\"{tp['accel_axis']}\": one of x, y, z (\"-z\": the axis "
@@ -378,6 +385,9 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
     pin_no = {}
     for key, direction in (("arm", "i"), ("drogue", "o"), ("main", "o")):
         pin = pins[key]
+        if pin is None:  # refused by the schema
+            pin_no[key] = None
+            continue
         if pin == _UNSET or (key == "arm" and str(pin).lower() == "none"):
             pin_no[key] = None
             if key != "arm":
@@ -387,7 +397,9 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
         ch = bind.channel("pins", key, pin, False, direction)
         pin_no[key] = ch.pin_number if ch is not None else None
     machine = None
-    if fw["machine"] == _UNSET:
+    if fw["machine"] is None or fw["state_element"] is None:
+        pass  # refused by the schema
+    elif fw["machine"] == _UNSET:
         bind.err("firmware", "machine", "the mission machine is not named (set [firmware] machine)")
     elif fw["state_element"] == _UNSET:
         bind.err("firmware", "state_element", "the telemetry element of its state is not named")
@@ -398,13 +410,15 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
     states = {}
     for ev in ("launch", "burnout", "apogee", "landed"):
         name = fw[f"{ev}_state"]
-        if machine is not None and machine.state(name) is None:
+        if machine is not None and name is not None and machine.state(name) is None:
             bind.err("firmware", f"{ev}_state", f"machine `{machine.name}` has no state `{name}` (its states: "
                      + ", ".join(s.name for s in machine.states) + ")")
         states[ev] = name
     main_alt = None
     main_name = fw["main_alt"]
-    if main_name == _UNSET:
+    if main_name is None:
+        pass  # refused by the schema
+    elif main_name == _UNSET:
         bind.err("firmware", "main_alt", "the main's configured altitude is not named (\"MACHINE.LOCAL\", e.g. "
                  "\"mission.MAIN_ALT\")")
     else:
@@ -415,8 +429,8 @@ def load_config(app, layout: Layout, path: str | None = None) -> Config:
                      f"project ({', '.join(x.name for x in app.machines)})")
         else:
             main_alt = bind.local(m, "main_alt", local)
-    if bind.errors:
-        raise ReplayError("\n".join(bind.errors))
+    if errors or bind.errors:
+        raise ReplayError("\n".join(errors + bind.errors))
     accel = sensors.get("accel_g")
     accel_element = accel.element if accel is not None else None
     if "accel_g" in parts:
@@ -444,7 +458,7 @@ def _igniters(app, bind: _Origins, ig: dict, given: dict, defaults: dict, origin
     for role in IGNITER_ROLES:
         key = f"{role}_channel"
         pin = ig[key]
-        if pin == _UNSET or str(pin).lower() == "none":
+        if pin is None or pin == _UNSET or str(pin).lower() == "none":  # (None: refused by the schema)
             continue
         ch = bind.channel("igniters", key, pin, True, "i")
         volts = {}
@@ -455,7 +469,9 @@ def _igniters(app, bind: _Origins, ig: dict, given: dict, defaults: dict, origin
                 x, where = defaults[f"{role}:{k}"], origins.get(("igniters", f"{role}:{k}"))
             else:
                 x, where = TAPE_SCHEMA["igniters"].fields[k].default, None
-            if isinstance(x, str) or not 0 <= x <= vref:
+            if x is None:  # refused by the schema: said
+                x = 0.0
+            elif isinstance(x, str) or not 0 <= x <= vref:
                 msg = f"{where or 'tape config'}: [igniters] {k}: " + (
                     f'expected a number (volts), found a string "{x}"' if isinstance(x, str)
                     else f"{x:g} V is beyond the converter's 0..{vref:g} V")

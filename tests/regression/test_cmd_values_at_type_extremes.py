@@ -61,7 +61,7 @@ def test_cmd_set_documented_f32_maximum():
     assert r.code == 1 and "cannot open /dev/no-such-port" in r.err, r.err
     r = run_fsw("cmd", "set", "padPressure", "3.4028236e38", "--port", "/dev/no-such-port",
                 "-p", str(EXAMPLES / "rocket"))
-    assert r.code == 1 and "out of its range" in r.err and "cannot open" not in r.err, r.err
+    assert r.code == 2 and "out of its range" in r.err and "cannot open" not in r.err, r.err  # bad input
 
 
 @pytest.mark.parametrize("value", ["-3.4028235e38", "-inf", "-1e-46", "-.5e3", "-Infinity", "-nan", "-0x7f"])
@@ -73,6 +73,6 @@ def test_cmd_set_negative_values_are_values_not_options(value):
         r = run_fsw(*argv)
         assert "unrecognized arguments" not in r.err, r.err
         if value == "-0x7f":  # a hex integer is no F32 value: refused as a value, by fsw cmd
-            assert r.code == 1 and "is not a number" in r.err and "cannot open" not in r.err, r.err
+            assert r.code == 2 and "is not a number" in r.err and "cannot open" not in r.err, r.err
         else:
             assert r.code == 1 and "cannot open /dev/no-such-port" in r.err, r.err

@@ -17,10 +17,8 @@ refuses over the link stays the target's answer (status 1)."""
 from __future__ import annotations
 
 from conftest import EXAMPLES, run_fsw
-from fswkit.autocode.protocol import HELLO_PAYLOAD
-from fswkit.link import wire
-from fswkit.link.log import LogWriter
-from support.linkfw import TANK, tank_layout
+from support.linkfw import TANK
+from support.linkstream import write_log
 
 ROCKET = EXAMPLES / "rocket"
 NO_PORT = "/dev/no-such-port"
@@ -30,19 +28,6 @@ def clean(r):
     assert "Traceback" not in r.err and "internal error" not in r.err, r.err
     assert "cannot open" not in r.err, r.err  # refused before the port is opened
     return r
-
-
-def _tank_log(path):
-    lay = tank_layout()
-    w = LogWriter(str(path), lay)
-    w.record(0, 1_000_000_000, wire.downlink(wire.HELLO, 0, 0,
-                                             HELLO_PAYLOAD.pack(wire.PROTOCOL, lay.schema, 0, 0, 0, 1, 0, 0, 0, 0)))
-    region = lay.streams[0].region
-    for k in range(1, 5):
-        w.record(0, 1_000_000_000 + k * 10_000_000,
-                 wire.downlink(0x80, k, 10 * k, region.struct.pack(10 * k, 2, 800.0 + k)))
-    w.close()
-    return path
 
 
 def test_an_unknown_element_of_the_project():
@@ -73,7 +58,7 @@ def test_a_wrong_value_or_mode_for_cmd_is_a_wrong_command_line_too():
 
 
 def test_an_unknown_element_of_the_log(tmp_path):
-    log = _tank_log(tmp_path / "tank.fswlog")
+    log = write_log(tmp_path / "tank.fswlog", 5)
     r = clean(run_fsw("replay", str(log), "--headless", "--spark", "tankPresure"))
     assert r.code == 2 and r.out == "", r.err
     assert "fsw replay: --spark: unknown element `tankPresure` (did you mean `tankPressure`?): " \

@@ -14,7 +14,7 @@ from fswkit.link.layout import Layout
 from fswkit.link.session import Session
 from fswkit.usage import UsageError, unknown_name
 
-from .view import View, spark_elements
+from .view import View
 
 
 class GroundError(Exception):
@@ -47,7 +47,6 @@ def monitor(layout: Layout, project: str, port_name: str, baud: int, log_path: s
 
     from .client import StationRefused, connect
 
-    spark = spark_elements(layout, spark)  # an unknown element is refused before the port is opened
     session = Session(layout, ignore_schema=ignore_schema)
     # the log is checked first and takes its name only once the target is known
     # to be the right one: a refused session leaves an old recording as it was

@@ -40,7 +40,6 @@ import csv
 import hashlib
 import math
 import os
-import re
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -526,8 +525,10 @@ def _continuity_notes(app, igniters: dict) -> list[str]:
 def _column_line(path: str) -> int:
     """The line of a tape's column names (after its `#` header); lines end
     as the tape reader ends them (LF, CRLF or CR alone)."""
+    from fswkit.tape.tape import LINE_END_BYTES
+
     with open(path, "rb") as f:
-        lines = re.split(rb"\r\n|\r|\n", f.read())
+        lines = LINE_END_BYTES.split(f.read())
     for n, line in enumerate(lines, 1):
         if not line.startswith(b"#"):
             return n

@@ -48,6 +48,7 @@ MAX_TAPE = 64 << 20  # bytes: a whole flight at 1 kHz for an hour is ~100 MB; 10
 HEADER_KEYS = ("source", "flight", "derived", "note")
 MAX_ERRORS = 20  # located messages kept in one TapeError (the rest counted)
 LINE_END = re.compile(r"\r\n|\r|\n")  # LF, CRLF, or CR alone (Excel for Mac's "CSV (Macintosh)")
+LINE_END_BYTES = re.compile(LINE_END.pattern.encode())  # the same, in the file's bytes
 
 
 def split_lines(text: str) -> list[str]:
@@ -208,7 +209,7 @@ def _text(data: bytes, err: _Errors, what: str = "tape") -> str | None:
     except UnicodeDecodeError as e:
         bad = e.start if bad < 0 else min(bad, e.start)
     if bad >= 0:
-        ends = [m.end() for m in re.finditer(rb"\r\n|\r|\n", data[:bad])]
+        ends = [m.end() for m in LINE_END_BYTES.finditer(data, 0, bad)]
         line = len(ends) + 1
         col = bad - (ends[-1] if ends else 0) + 1
         err.at(line, col, f"not a text file (binary data here): {_UTF8[what]}")

@@ -67,7 +67,7 @@ def _talk(args, app, p) -> int:
     from fswkit.link.log import LogError
     from fswkit.outputs import OutputError, check, is_direct, recording
     from fswkit.progress import progress
-    from fswkit.recorder.dump import DumpError, query_info, read_image, write_flight
+    from fswkit.recorder.dump import DumpError, query_info, read_image, slots_read, write_flight
 
     def talk(ground) -> int:
         def command(op, a):
@@ -82,8 +82,8 @@ def _talk(args, app, p) -> int:
                 return EXIT_FAIL
             print(f"recorder: {inf['mode_name']}, flight {inf['flight']}, {inf['slots']} records of "
                   f"{inf['record']} B, next {inf['head']}; {inf['dropped']} samples dropped")
-            to_read = p.slots if p.store != "spi_nor" else min(p.slots, inf["head"] + 1)  # read_image's
-            with progress("reading records", total=to_read, unit="records") as bar:  # minutes on a large chip
+            with progress("reading records", total=slots_read(p, inf["head"]),
+                          unit="records") as bar:  # minutes on a large chip
                 image = read_image(command, p, link_plan(app).tx_cap, head=inf["head"], progress=bar.update)
             after = query_info(command)  # what the target did while it was read
         except (DumpError, LinkTimeout) as e:

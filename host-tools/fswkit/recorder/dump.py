@@ -76,6 +76,12 @@ def info(ack: dict) -> dict:
             "slots": slots, "record": record, "dropped": dropped, "hash": h}
 
 
+def slots_read(p: Plan, head: int | None) -> int:
+    """How many record slots `read_image` reads: on an SPI NOR chip those
+    before `head` (LOG_INFO's next record) and the one at it, else all."""
+    return p.slots if head is None or p.store != "spi_nor" else min(p.slots, head + 1)
+
+
 def read_image(command, p: Plan, tx_cap: int, progress=None, head: int | None = None) -> bytes:
     """The records' bytes, read over the link: `command(op, args)` sends a
     command and returns its ack's fields (fswkit.link.client.Ground.command).
@@ -85,7 +91,7 @@ def read_image(command, p: Plan, tx_cap: int, progress=None, head: int | None = 
     room = tx_cap - 24 - tx_cap // 254
     chunk = max(1, min(p.record, room - 4))
     image = bytearray()
-    last = p.slots if head is None or p.store != "spi_nor" else min(p.slots, head + 1)
+    last = slots_read(p, head)
     for slot in range(last):
         off = 0
         while off < p.record:

@@ -250,14 +250,17 @@ class _Origins(_Binder):
 
 def _plant_defaults(project_dir: str) -> tuple[dict, dict]:
     """Keys of plant.toml a tape replay can take as defaults (read without
-    its schema: a tank's file has none of them); (values, origins)."""
+    its schema: a tank's file has none of them); (values, origins).
+    ReplayError when the file cannot be read (not TOML, a broken `extends`)."""
     path = os.path.join(project_dir, "plant.toml")
     if not os.path.exists(path):
         return {}, {}
     try:
         data, where = resolve_params(path, ROCKET_SCHEMA)  # its `extends` chain merged
-    except ParamsError:
-        return {}, {}
+    except ParamsError as e:  # never passed over: the replay would say plant.toml's keys are not named
+        raise ReplayError("\n".join(e.errors + [
+            f"{path}: a tape replay takes its defaults from this file (the sensors' channels, the pyro pins, "
+            "the mission machine): mend it, or move it away and give them in tape.toml"])) from None
 
     def at(table, key):
         line = where.get((table, key), 1)

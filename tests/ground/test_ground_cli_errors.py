@@ -59,7 +59,8 @@ def test_project_without_uplink(tmp_path):
     app = (other / "tank.app").read_text().replace("uplink   uplink        rate=100\n", "")
     (other / "tank.app").write_text(app)
     r = clean(run_fsw("cmd", "ping", "--port", "/dev/null", "-p", str(other)))
-    assert r.code == 1 and "has no `uplink` task" in r.err
+    # a project missing the section a command needs is status 2, as for fsw param, dump and machine
+    assert r.code == 2 and "has no `uplink` task" in r.err
 
 
 def test_project_that_is_not_one(tmp_path):

@@ -136,7 +136,7 @@ def command(layout: Layout, project: str, port_name: str, baud: int, what: str, 
     from fswkit.autocode.app import TASK_MODES
 
     if not layout.has_uplink:
-        raise GroundError(f"{project}: the application has no `uplink` task: the target takes no commands")
+        raise UsageError(f"{project}: the application has no `uplink` task: the target takes no commands")
     # the command is checked before the port is opened
     if what == "set":
         if len(args) != 2:

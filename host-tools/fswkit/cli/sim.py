@@ -97,6 +97,17 @@ def board_run(args) -> int:
     if args.eeprom_file is not None and _memory_file_problem(args.eeprom_file, "--eeprom-file") is not None:
         say(_memory_file_problem(args.eeprom_file, "--eeprom-file"))
         return 2
+    image = None  # --fw-params: checked before any build
+    if args.fw_params is not None:
+        if is_elf(args.project) or args.project.endswith(".elf"):
+            say("--fw-params needs the project (its parameters' table), not a firmware ELF")
+            return 2
+        image = _fw_image(args)
+        if isinstance(image, int):
+            return image
+    if image is not None and args.eeprom_file is not None:
+        say("--fw-params programs the EEPROM that --eeprom-file keeps: give one of them")
+        return 2
     if is_elf(args.project) or args.project.endswith(".elf"):
         if args.board is None:
             say(f"{args.project}: a firmware ELF needs --board (the board it was built for, e.g. uno)")
@@ -108,21 +119,13 @@ def board_run(args) -> int:
             return 2
         elf = args.project
     else:
-        built = build(args.project, args.board, args.out)
+        def analog_problem(board):
+            problem = analog_args(args.analog or [], board)
+            return problem if isinstance(problem, str) else None
+        built = build(args.project, args.board, args.out, before=analog_problem)
         if isinstance(built, int):
             return built
         elf, board = built
-    image = None
-    if args.fw_params is not None:
-        if is_elf(args.project) or args.project.endswith(".elf"):
-            say("--fw-params needs the project (its parameters' table), not a firmware ELF")
-            return 2
-        image = _fw_image(args)
-        if isinstance(image, int):
-            return image
-    if image is not None and args.eeprom_file is not None:
-        say("--fw-params programs the EEPROM that --eeprom-file keeps: give one of them")
-        return 2
     analog = analog_args(args.analog or [], board)
     if isinstance(analog, str):
         say(analog)

@@ -23,11 +23,13 @@ def is_elf(path: str) -> bool:
         return False
 
 
-def build(project: str, board: str | None = None, out: str | None = None) -> tuple[str, Board] | int:
+def build(project: str, board: str | None = None, out: str | None = None,
+          before=None) -> tuple[str, Board] | int:
     """Builds the project for its (or `board`'s) board into `out` (None:
     its default build folder) with the build service, as `fsw build` does,
     [budget] included; the ELF and board, or an exit status after saying
-    why."""
+    why. `before(board)`: what is wrong with the command for the board,
+    said (status 2) before anything is built; None when nothing is."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.target.build import BuildError, check_out_folder, default_out, firmware, load
 
@@ -54,6 +56,10 @@ def build(project: str, board: str | None = None, out: str | None = None) -> tup
     except SimError as e:
         say(str(e))
         return 2
+    problem = before(sim) if before is not None else None
+    if problem is not None:
+        say(problem)
+        return 2
     try:  # one build of a folder at a time (fsw build, fsw flash, fsw sim)
         built = firmware(app, out or default_out(app), command="sim")
     except BuildError as e:
@@ -67,16 +73,20 @@ def build(project: str, board: str | None = None, out: str | None = None) -> tup
 
 
 def analog_args(items: list[str], board: Board) -> dict[str, float] | str:
-    """--analog PIN=VOLTS settings, or what is wrong with one."""
+    """--analog PIN=VOLTS settings by the board's analog input names, or
+    what is wrong with one. PIN is an input's name (`A0`) or the pin number
+    the board gives it (`14` on an Uno), as the I/O tables take it."""
     out = {}
     for item in items:
         pin, sep, volts = item.partition("=")
         pin = pin.strip()
         if not sep:
             return f"--analog {item}: expected PIN=VOLTS, e.g. A0=3.2"
+        if pin.isdigit():
+            pin = next((n for n, number in board.analog_pins.items() if number == int(pin)), pin)
         if pin not in board.analog_pins:
             return f"--analog {item}: board `{board.name}` has no analog input `{pin}` " \
-                   f"(it has {', '.join(board.analog_pins)})"
+                   f"(it has {', '.join(f'{n} ({number})' for n, number in board.analog_pins.items())})"
         try:
             v = float(volts)
         except ValueError:

@@ -273,7 +273,10 @@ def text(setup: Setup, results: list[RunResult], runs: int, jobs: int, wall: flo
                      "under it):")
         for r in bad:
             why = r.error or "; ".join(f"{c[1]}: {c[3]}" for c in r.checks if not c[2])
-            extra = f" [brown-out {r.draw.brownout_s:.2f} s after ignition]" if r.draw.brownout_s is not None else ""
+            extra = ""
+            if r.draw.brownout_s is not None:  # drawn; a flight that ended first had no reset
+                extra = (f" [brown-out {r.draw.brownout_s:.2f} s after ignition]" if r.resets else
+                         f" [brown-out drawn at {r.draw.brownout_s:.2f} s after ignition, after the run's end: no reset]")
             lines.append(f"  run {r.index}{extra}: {why}")
             lines.append(f"    {replay_command(setup, r.index)}")
     lines.append(f"{n - len(bad)} of {n} runs passed every check")

@@ -67,6 +67,31 @@ G_CATS = 9.81  # m/s^2, the GRAVITY constant CATS subtracts
 FT = 0.3048  # m
 
 
+class Rows:
+    """A log's data rows as (line number, cells), kept as their lines and
+    split when a row is asked for: split up front, with a str a cell, a
+    long log took about 25 times its size in memory (a 65 MB AltOS export
+    1 GB)."""
+
+    def __init__(self, lines: list[tuple[int, str]]):
+        self._lines = lines
+
+    def __len__(self) -> int:
+        return len(self._lines)
+
+    def __getitem__(self, i: int) -> tuple[int, list[str]]:
+        ln, line = self._lines[i]
+        return ln, _split(line)
+
+    def __iter__(self):
+        for ln, line in self._lines:
+            yield ln, _split(line)
+
+    def where(self, keep: Callable[[list[str]], bool]) -> "Rows":
+        """The rows whose cells `keep` takes, as Rows."""
+        return Rows([(ln, line) for ln, line in self._lines if keep(_split(line))])
+
+
 @dataclass
 class Log:
     """A CSV log: its column names (normalised: lower case, spaces kept
@@ -78,7 +103,7 @@ class Log:
     names: list[str]
     raw_names: list[str]
     column_line: int
-    rows: list[tuple[int, list[str]]]
+    rows: Rows
 
     def index(self, *aliases: str) -> int | None:
         """The first column named one of `aliases` (normalised), or None."""
@@ -170,8 +195,10 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
     data = read_file(path, MAX_LOG)
     err = _Errors(path)
     text = _text(data, err, "log")
+    del data  # (a long log: the bytes, the text and the lines are not all kept at once)
     err.raise_if_any()
     lines = split_lines(text)  # LF, CRLF or CR alone
+    del text
     header = None
     for n, line in enumerate(lines):
         line = line.rstrip("\r")
@@ -194,12 +221,13 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
                          f"({expected}); the first line is `{first[:80]}`"])
     raw = [_unquote(_unquote(c).lstrip("#")) for c in _split(lines[header].rstrip("\r"))]
     rows = []
+    cells: list[str] = []
     for n in range(header + 1, len(lines)):
         line = lines[n].rstrip("\r")
         if not line.strip() or line.lstrip().startswith("#"):
             continue
         cells = _split(line)
-        rows.append((n + 1, cells))
+        rows.append((n + 1, line))
         if len(cells) > len(raw) and not wider_rows:  # read by position, cells would land in wrong columns
             extra = next((k for k in range(len(raw), len(cells)) if cells[k].strip()), None)
             if extra is not None:  # empty cells beyond the columns (a spreadsheet's `,,,`) are harmless
@@ -208,15 +236,15 @@ def read_log(path: str, fmt: str, wanted: Callable[[list[str]], bool], expected:
                        "(a decimal comma, or a comma in a cell not quoted, shifts the cells): save the log with "
                        "`.` as the decimal point and one cell a column")
     last = lines[-1].rstrip("\r")
-    if rows and rows[-1][0] == len(lines) and len(rows[-1][1]) < len(raw):
+    if rows and rows[-1][0] == len(lines) and len(cells) < len(raw):  # (cells: the last row's)
         # no line end, cells missing: a log cut short, whose last cell may be a number cut short too
-        err.at(len(lines), len(last) + 1, f"the log ends inside a row: its last line has {len(rows[-1][1])} cells "
+        err.at(len(lines), len(last) + 1, f"the log ends inside a row: its last line has {len(cells)} cells "
                f"of the column line's {len(raw)} and no line end (a download cut short?): complete the row or "
                "delete it")
     err.raise_if_any()
     if not rows:
         raise TapeError([f"{path}:{header + 1}: no data rows after the column line"])
-    return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, rows)
+    return Log(path, fmt, [_norm(c) for c in raw], raw, header + 1, Rows(rows))
 
 
 # ---- helpers shared by the converters ---------------------------------------------------
@@ -492,7 +520,7 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
                                      f"of the column line at line {log.column_line})")
             err.raise_if_any()
             first = _unquote(rows[0][1][iid])
-            rows = [(ln, c) for ln, c in rows if _unquote(c[iid]) == first]
+            rows = rows.where(lambda c: _unquote(c[iid]) == first)
         t = log.numbers(log.index("ts"), "ts", required=True, rows=rows)
         keep = _increasing(t)
         late = int((~keep).sum())
@@ -542,7 +570,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         if tcol is None:
             raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                              f"`{log.raw_names[col]}` has no time column before it"])
-        rows = [(ln, c) for ln, c in log.rows if tcol < len(c) and _unquote(c[tcol])]
+        rows = log.rows.where(lambda c: tcol < len(c) and bool(_unquote(c[tcol])))
         t = log.numbers(tcol, f"{what} time", required=True, rows=rows)  # `NaN` refused, as every log's time
         v = log.numbers(col, what, rows=rows)
         ok = ~np.isnan(v)

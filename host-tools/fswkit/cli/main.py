@@ -403,9 +403,9 @@ def parser() -> argparse.ArgumentParser:
     ae.add_argument("--ignore-schema", action="store_true", help="decode even when the schema hash differs")
     ae.set_defaults(func=_command("ground", "cmd_archive_export"))
 
-    tp = sub.add_parser("tape", help="sensor tapes of real flights: import a recorder's log, show a tape "
-                        "(docs/tapes.md)")
-    tsub = tp.add_subparsers(dest="tape_command", metavar="import|show")
+    tp = sub.add_parser("tape", help="sensor tapes of real flights: import a recorder's log, work out its truth, "
+                        "show a tape (docs/tapes.md)")
+    tsub = tp.add_subparsers(dest="tape_command", metavar="import|truth|show")
     tsub.required = True
     ti = tsub.add_parser("import", help="convert an altimeter's CSV log into a sensor tape")
     ti.add_argument("format", choices=("altos", "cats", "raven", "eggtimer", "rrc3"), metavar="FORMAT",
@@ -417,6 +417,13 @@ def parser() -> argparse.ArgumentParser:
                     "from a log's altitude (default 0)")
     ti.add_argument("--force", action="store_true", help="replace TAPE.csv if it exists")
     ti.set_defaults(func=_command("tape", "cmd_import"))
+    tt = tsub.add_parser("truth", help="work out a tape's truth (liftoff, burnout, apogee, landing) from the "
+                         "tape, for fsw sim --tape")
+    tt.add_argument("tape", metavar="TAPE.csv")
+    tt.add_argument("-o", "--output", metavar="FILE", help="the truth file to write (default TAPE.truth.toml "
+                    "beside the tape; - for standard output)")
+    tt.add_argument("--force", action="store_true", help="replace the truth file if it exists")
+    tt.set_defaults(func=_command("tape", "cmd_truth"))
     ts = tsub.add_parser("show", help="a tape's header, span, rates, columns, and its truth events")
     ts.add_argument("tape", metavar="TAPE.csv")
     ts.set_defaults(func=_command("tape", "cmd_show"))
@@ -497,6 +504,7 @@ _IDLE_OPTIONS = (
     ("compile", "--force", lambda a: a.force and a.output == "-" and a.layout is None,
      "-o FILE or --layout FILE" + _TO_STDOUT),
     ("tape import", "--force", lambda a: a.force and a.output == "-", "-o FILE" + _TO_STDOUT),
+    ("tape truth", "--force", lambda a: a.force and a.output == "-", "a file" + _TO_STDOUT),
     ("monitor", "--force", lambda a: a.force and a.log is None, "--log FILE"),
     ("param", "--force", lambda a: a.force and a.output is None, "`list -o FILE`"),
     ("dump", "--yes", lambda a: a.yes and not a.erase, "--erase (it answers the question before erasing)"),

@@ -1,6 +1,7 @@
-"""`fsw tape import` (a recorder's log to a sensor tape) and `fsw tape show`
-(a tape's header, span, rates, columns, and its truth file's events):
-fswkit.tape. Bad input is a located message and exit 1, never a traceback."""
+"""`fsw tape import` (a recorder's log to a sensor tape), `fsw tape truth`
+(a tape's truth worked out from it) and `fsw tape show` (a tape's header,
+span, rates, columns, and its truth file's events): fswkit.tape. Bad input
+is a located message and exit 1, never a traceback."""
 
 from __future__ import annotations
 
@@ -46,6 +47,39 @@ def cmd_import(args) -> int:
         rows = f"{late:,} rows of the log dropped: their time is" if late != 1 else \
             "1 row of the log dropped: its time is"
         sys.stderr.write(f"fsw tape import: {rows} not after the previous row's (the tape's header counts them)\n")
+    return EXIT_OK
+
+
+def cmd_truth(args) -> int:
+    from fswkit.outputs import OutputError, check, output
+    from fswkit.tape import TapeError, read_tape, truth_path
+    from fswkit.tape.truth import compute, format_truth
+
+    for option, value in (("--output", args.output), ("TAPE", args.tape)):
+        if value == "":
+            sys.stderr.write(f"fsw tape truth: {option}: an empty string names nothing: give a path\n")
+            return EXIT_CONFIG
+    path = args.output or truth_path(args.tape)
+    try:  # the output is refused before any work: an input, a folder, a file there without --force
+        if path != "-":
+            check(path, (args.tape,), force=args.force, ask=True, what="truth file")
+        tape = read_tape(args.tape)
+        values = compute(tape)
+        name = os.path.splitext(os.path.basename(args.tape))[0]
+        text = format_truth(name, tape, values, os.path.basename(args.tape))
+        with output(path, (args.tape,), force=args.force, ask=True, what="truth file") as f:
+            f.write(text)
+    except (TapeError, OutputError) as e:
+        return _fail("truth", e)
+    missing = [k for k in ("apogee_s", "burnout_s") if not any(key == k and v is not None for key, v, _ in values)]
+    if path != "-":
+        got = {k: v for k, v, _ in values if v is not None}
+        said = ", ".join(f"{k} {got[k]:.2f} s" for k in ("burnout_s", "apogee_s", "landing_s") if k in got)
+        sys.stderr.write(f"fsw tape truth: {path}: {said or 'no events'}\n")
+    if missing:  # written all the same: the user gives what the tape cannot, as its comment says
+        sys.stderr.write(f"fsw tape truth: the tape gives no {' and no '.join(missing)}: `fsw sim --tape` needs "
+                         f"{'them' if len(missing) > 1 else 'it'}: write {' and '.join(missing)} into the truth "
+                         "file by hand (its comments say why they are missing)\n")
     return EXIT_OK
 
 

@@ -50,6 +50,7 @@ from fswkit.link.layout import Layout
 from fswkit.link.log import LogWriter
 from fswkit.progress import progress
 from fswkit.sim.board import EdgeOverflow, SimBoard, SimError
+from fswkit.tape.truth import smoothed_altitude  # the truth's altitude, by its apogee's rule
 from fswkit.autocode.model import SENSOR_PARTS
 from fswkit.sim.sensors import (ACCELEROMETERS, AXES, BAROMETERS, AnalogSensor, PartFeed, board_parts, find_part,
                                 from_channel, part_name)
@@ -65,7 +66,6 @@ from .scenario import ROCKET_SCHEMA, _Binder
 
 TAPE_COLUMNS = ("pressure_pa", "accel_g")  # the sensor columns of tape v1
 RECORD_HZ = 100  # CSV rows per second of tape time
-SMOOTH_S = 0.5  # the truth's altitude: centered moving average, as the truth files' apogee
 
 _UNSET = ""  # an optional string/pin key not given
 
@@ -627,21 +627,6 @@ def counts_series(values: np.ndarray, sensor: AnalogSensor, missing: str, silent
         else:
             last = out[i] = sensor.count_of(v)
     return out
-
-
-def smoothed_altitude(tape, pad_pa: float):
-    """(times, altitude m above the pad): the tape's ISA altitude, a
-    centered SMOOTH_S moving average by time (as the truth's apogee), at the
-    rows that have a pressure."""
-    have = tape.available("pressure_pa")
-    t = tape.time[have]
-    h = tape.altitude_agl(pad_pa)[have]
-    if t.size == 0:
-        return t, h
-    c = np.concatenate(([0.0], np.cumsum(h)))
-    lo = np.searchsorted(t, t - SMOOTH_S / 2, side="left")
-    hi = np.searchsorted(t, t + SMOOTH_S / 2, side="right")
-    return t, (c[hi] - c[lo]) / (hi - lo)
 
 
 # ---- the replay ----------------------------------------------------------------------------

@@ -399,12 +399,12 @@ def only_its_own(path: str | None, command: str, force: bool = False, head: int 
     whose first lines are not the command's own head line (OWN_HEADS: `fsw
     graph`, `fsw skeleton`; a file that only mentions the command is not
     its output), or that does not begin with `starts` when given (a
-    trace's header): a file the user wrote there, a state script beside
+    trace's whole first line): a file the user wrote there, a state script beside
     its machine, is not this command's to replace unless asked (`force`).
     Standard output, devices, FIFOs and paths with nothing there pass."""
     if path is None or path == "-" or force or is_direct(path):
         return
-    start = file_head(path, head)  # None: nothing there to lose (or unreadable: the write says why)
+    start = file_head(path, max(head, len(starts or b"")))  # None: nothing there to lose (or unreadable)
     if not start:
         return
     if not (start.startswith(starts) if starts is not None else _own_head(start, command)):

@@ -183,9 +183,11 @@ def _test_one(path: str, args, real):
     trace = None
     if args.trace:  # written beside its path and renamed into place once whole
         from fswkit.outputs import OutputError, Replacement, check, only_its_own
+        from fswkit.run.script import trace_header
         try:
             check(args.trace, [path, script.machine.path, script.machine.sv.path], what="trace")
-            only_its_own(args.trace, "test", args.force, starts=b"step,", what="trace")  # its header's start
+            only_its_own(args.trace, "test", args.force, starts=trace_header(script.machine),  # its whole header
+                         what="trace of this machine")
             trace = Replacement(args.trace)
         except OutputError as e:
             sys.stderr.write(f"fsw test: {e}\n")

@@ -146,13 +146,27 @@ def run(script: M.Script, real: Real, trace_path: str | None = None, source_line
                   frozenset(run_.taken), frozenset(run_.visited))
 
 
+def _trace_order(m: M.Machine) -> list:
+    return sorted(m.vars, key=lambda var: var.display.encode())
+
+
+def trace_header(m: M.Machine) -> bytes:
+    """The first line of `m`'s trace, its line end included, as the trace
+    writes it: what marks a file as an earlier trace of this machine."""
+    import io
+
+    buf = io.StringIO(newline="")
+    csv.writer(buf).writerow(["step"] + [var.display for var in _trace_order(m)])
+    return buf.getvalue().encode()
+
+
 class _Tracer:
     """`--trace FILE.csv`: every variable after every step."""
 
     def __init__(self, path: str, m: M.Machine):
         self.f = open(path, "w", newline="")
         self.w = csv.writer(self.f)
-        order = sorted(m.vars, key=lambda var: var.display.encode())
+        order = _trace_order(m)
         self.idx = [var.index for var in order]
         self.kinds = [var.type.kind for var in order]
         self.w.writerow(["step"] + [var.display for var in order])

@@ -415,6 +415,8 @@ def parser() -> argparse.ArgumentParser:
                     "standard output)")
     ti.add_argument("--pad-alt", type=_pad_alt, metavar="M", help="pad elevation in m ASL, for pressure made "
                     "from a log's altitude (default 0)")
+    ti.add_argument("--alt-unit", choices=("ft", "m"), help="eggtimer, rrc3: the unit of the log's altitude "
+                    "(default ft, the recorders' default; m for one set to metres)")
     ti.add_argument("--force", action="store_true", help="replace TAPE.csv if it exists")
     ti.set_defaults(func=_command("tape", "cmd_import"))
     tt = tsub.add_parser("truth", help="work out a tape's truth (liftoff, burnout, apogee, landing) from the "

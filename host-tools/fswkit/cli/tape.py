@@ -20,17 +20,21 @@ def _fail(command: str, e) -> int:
 def cmd_import(args) -> int:
     from fswkit.outputs import OutputError, check
     from fswkit.tape import TapeError, write_tape
-    from fswkit.tape.formats import convert
+    from fswkit.tape.formats import FORMATS, convert
     from dataclasses import replace
 
     for option, value in (("--output", args.output), ("LOG", args.log)):
         if value == "":  # as main.py refuses an empty option of the other commands
             sys.stderr.write(f"fsw tape import: {option}: an empty string names nothing: give a path\n")
             return EXIT_CONFIG
+    if args.alt_unit is not None and not FORMATS[args.format].alt_unit:
+        sys.stderr.write(f"fsw tape import: --alt-unit: a {FORMATS[args.format].title} log says its altitude's "
+                         "unit; the option is for eggtimer and rrc3 logs, whose altitude has none\n")
+        return EXIT_CONFIG
     try:  # the output is refused before any work (an input, a folder, a missing folder, a file there)
         if args.output != "-":
             check(args.output, (args.log,), force=args.force, ask=True, what="tape")
-        tape = convert(args.format, args.log, args.pad_alt)
+        tape = convert(args.format, args.log, args.pad_alt, args.alt_unit)
         write_tape(args.output, replace(tape, path=args.output), force=args.force, inputs=(args.log,))
     except (TapeError, OutputError) as e:
         return _fail("import", e)
@@ -42,6 +46,12 @@ def cmd_import(args) -> int:
         why = "the log has pressure of its own" if "pressure_pa" in tape.columns_available() \
             else "the log has no altitude to make pressure from"
         sys.stderr.write(f"fsw tape import: --pad-alt is not used: {why}\n")
+    from_alt = any("ISA standard atmosphere with the pad at" in d for d in tape.derived)
+    if FORMATS[args.format].alt_unit and from_alt and args.alt_unit is None:  # assumed: said, never silent
+        sys.stderr.write("fsw tape import: the log's altitude read in feet, the recorder's default (--alt-unit m "
+                         "for a recorder set to metres)\n")
+    elif args.alt_unit is not None and not from_alt:
+        sys.stderr.write("fsw tape import: --alt-unit is not used: the log has pressure of its own\n")
     late = _dropped_late(tape)
     if late:  # a clock that restarted mid-log loses what follows: said here, not only in the header
         rows = f"{late:,} rows of the log dropped: their time is" if late != 1 else \

@@ -620,15 +620,16 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
 
 # ---- Eggtimer ---------------------------------------------------------------------
 
-def eggtimer(path: str, pad_alt: float | None = None) -> Tape:
+def eggtimer(path: str, pad_alt: float | None = None, alt_unit: str = "ft") -> Tape:
     """Eggtimer (TRS, Quantum, Proton...) flight data download:
     `T,Alt,Veloc,FAlt,FVeloc,FVeloc2,LDA,LowV,Apogee,N-O,Drogue,Main`.
 
     Used: `T` (ms from the Eggtimer's flight start: 0 at liftoff, the row
     where the recorder's launch detect fired carrying its altitude in `LDA`;
-    time_s = T / 1000, kept as is) and `Alt` (ft above the pad, the raw
-    barometric altitude; `FAlt` is the recorder's filtered one and is not
-    used): pressure through ISA with the pad at --pad-alt. No acceleration
+    time_s = T / 1000, kept as is) and `Alt` (above the pad, the raw
+    barometric altitude, in `alt_unit`: ft, the recorder's default, or m;
+    `FAlt` is the recorder's filtered one and is not used): pressure
+    through ISA with the pad at --pad-alt. No acceleration
     (the Eggtimer logs none).
 
     Verified: column names, units (ms, ft, ft/s) and the time origin against
@@ -639,11 +640,12 @@ def eggtimer(path: str, pad_alt: float | None = None) -> Tape:
     log = read_log(path, "eggtimer", lambda n: "t" in n and "alt" in n, "T, Alt (Eggtimer)")
     it, ih = log.index("t"), log.index("alt")
     t = log.numbers(it, "T", required=True) / 1000.0
-    h = log.numbers(ih, "Alt") * FT
+    scale, what = _alt_unit(alt_unit)
+    h = log.numbers(ih, "Alt") * scale
     keep = _increasing(t)
-    _check_altitude_range(h, pad_alt, log, ih, "ft AGL")
+    _check_altitude_range(h, pad_alt, log, ih, f"{alt_unit} AGL")
     t, h = t[keep], h[keep]
-    p, how = _from_altitude(h, pad_alt, "'Alt' (ft AGL) * 0.3048")
+    p, how = _from_altitude(h, pad_alt, f"'Alt' {what}")
     derived = ["time_s = log column 'T' / 1000 (Eggtimer: ms from its flight start, 0 = liftoff)", how,
                "accel_g empty: an Eggtimer logs no acceleration"] + _dropped(int((~keep).sum()))
     flight = f"recorder Eggtimer; pad elevation {_pad_text(pad_alt)}"
@@ -652,14 +654,14 @@ def eggtimer(path: str, pad_alt: float | None = None) -> Tape:
 
 # ---- Missile Works RRC3 --------------------------------------------------------------
 
-def rrc3(path: str, pad_alt: float | None = None) -> Tape:
+def rrc3(path: str, pad_alt: float | None = None, alt_unit: str = "ft") -> Tape:
     """Missile Works RRC3, CSV export of mDACS:
     `time,altitude,pressure,velocity,temperature,events,voltages`.
 
     Used: `time` (s from the start of the recording, 20 Hz), `pressure`
     (hPa = mbar; Pa told by magnitude) and, only where `pressure` is absent,
-    `altitude` (ft AGL, mDACS's default unit: pressure through ISA with the
-    pad at --pad-alt). Liftoff is defined by the BARO rule on the pressure
+    `altitude` (AGL, in `alt_unit`: ft, mDACS's default unit, or m; pressure
+    through ISA with the pad at --pad-alt). Liftoff is defined by the BARO rule on the pressure
     altitude and subtracted. No acceleration (the RRC3 logs none); the
     `events` column (the RRC3's Drogue/Main events) is not read.
 
@@ -682,10 +684,11 @@ def rrc3(path: str, pad_alt: float | None = None) -> Tape:
         how = f"pressure_pa = log column 'pressure' ({unit})" + (" * 100" if unit != "Pa" else " as is")
         h = isa_altitude(p)
     else:
-        hft = log.numbers(ih, "altitude")
-        _check_altitude_range(hft * FT, pad_alt, log, ih, "ft AGL")
-        t, h = t[keep], hft[keep] * FT
-        p, how = _from_altitude(h, pad_alt, "'altitude' (ft AGL) * 0.3048")
+        scale, what = _alt_unit(alt_unit)
+        h = log.numbers(ih, "altitude") * scale
+        _check_altitude_range(h, pad_alt, log, ih, f"{alt_unit} AGL")
+        t, h = t[keep], h[keep]
+        p, how = _from_altitude(h, pad_alt, f"'altitude' {what}")
     t_lift = _liftoff_baro(t, h)
     if t_lift is None:
         raise TapeError([f"{log.path}: no liftoff found: the altitude is never 10 m above the pad for 0.5 s"])
@@ -702,28 +705,40 @@ def rrc3(path: str, pad_alt: float | None = None) -> Tape:
     return Tape(path, t, p, np.full(t.size, math.nan), (_source(path, "rrc3"),), flight, tuple(derived))
 
 
+def _alt_unit(unit: str) -> tuple[float, str]:
+    """An altitude column's unit (`ft` or `m`, `--alt-unit`): (metres per
+    unit, how the tape's header says it)."""
+    return (FT, "(ft AGL) * 0.3048") if unit == "ft" else (1.0, "(m AGL)")
+
+
 @dataclass(frozen=True)
 class Format:
     name: str
     title: str
-    convert: Callable[[str, float | None], Tape]
+    convert: Callable[..., Tape]
+    alt_unit: bool = False  # its log's altitude has no unit of its own: `--alt-unit` (ft, or m)
 
 
 FORMATS: dict[str, Format] = {
     "altos": Format("altos", "AltOS CSV export", altos),
     "cats": Format("cats", "CATS flight computer", cats),
     "raven": Format("raven", "Featherweight Raven (FIP export)", raven),
-    "eggtimer": Format("eggtimer", "Eggtimer", eggtimer),
-    "rrc3": Format("rrc3", "Missile Works RRC3 (mDACS export)", rrc3),
+    "eggtimer": Format("eggtimer", "Eggtimer", eggtimer, alt_unit=True),
+    "rrc3": Format("rrc3", "Missile Works RRC3 (mDACS export)", rrc3, alt_unit=True),
 }
 
 
-def convert(fmt: str, path: str, pad_alt: float | None = None) -> Tape:
+def convert(fmt: str, path: str, pad_alt: float | None = None, alt_unit: str | None = None) -> Tape:
     """The tape of the log at `path` in format `fmt` (a key of FORMATS);
-    TapeError with located messages when it cannot be read."""
+    `alt_unit` (`ft`, the default, or `m`) for a format whose altitude has
+    no unit of its own (Format.alt_unit). TapeError with located messages
+    when it cannot be read."""
     if pad_alt is not None and not (-500.0 <= pad_alt <= 9_000.0):
         raise TapeError([f"--pad-alt {pad_alt:g}: expected a pad elevation from -500 to 9,000 m ASL"])
-    tape = FORMATS[fmt].convert(path, pad_alt)
+    f = FORMATS[fmt]
+    if alt_unit is not None and not f.alt_unit:
+        raise ValueError(f"{fmt} logs say their altitude's unit")  # the command line refuses it first
+    tape = f.convert(path, pad_alt, alt_unit or "ft") if f.alt_unit else f.convert(path, pad_alt)
     if tape.rows == 0:
         raise TapeError([f"{path}: no rows left to write"])
     return tape

@@ -132,3 +132,29 @@ def test_an_imported_shared_tape_copy_gets_its_truth(tmp_path):
     assert r.code == 0, r.err
     assert read_truth(str(tmp_path / "ndrt.truth.toml")).apogee_s == pytest.approx(
         read_truth(truth_path(str(src))).apogee_s, abs=0.006)
+
+
+@shared
+def test_a_flight_imported_from_its_recorders_export_gets_the_shared_truth(tmp_path):
+    """The team's path: the recorder's export, `fsw tape import`, `fsw tape truth`. The TeleMega's flight
+    written back as an AltOS export (m/s^2 with the rest's 1 g removed, as AltOS writes) comes back with
+    every value of its shared truth file."""
+    import math
+
+    src = str(FLIGHTS / "prometheus_telemega.csv")
+    t = read_tape(src)
+    rows = ["#version,serial,flight,call,time,state,state_name,acceleration,pressure,altitude,height,speed,"
+            "temperature,connected"]
+    for tt, p, a in zip(t.time.tolist(), t.pressure.tolist(), t.accel.tolist()):
+        acc = "NaN" if math.isnan(a) else f"{(a - 1) * 9.80665:.4f}"
+        rows.append(f"6, 6583, 3,N0CALL,{tt:.3f}, 3, boost,{acc},{'NaN' if math.isnan(p) else f'{p:.2f}'}, 0, 0, 0, "
+                    "20, 1")
+    (tmp_path / "export.csv").write_text("\n".join(rows) + "\n")
+    assert run_fsw("tape", "import", "altos", str(tmp_path / "export.csv"), "-o", str(tmp_path / "mine.csv")).code == 0
+    r = run_fsw("tape", "truth", str(tmp_path / "mine.csv"))
+    assert r.code == 0, r.err
+    got, ref = read_truth(str(tmp_path / "mine.truth.toml")), read_truth(truth_path(src))
+    for key in ("burnout_s", "max_boost_accel_g", "pad_pressure_pa", "apogee_s", "apogee_m_agl", "landing_s",
+                "log_end_s"):
+        assert getattr(got, key) == pytest.approx(getattr(ref, key), abs=0.06), key
+    assert got.recorder == "AltOS serial 6583 flight 3"

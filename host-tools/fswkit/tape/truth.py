@@ -80,7 +80,7 @@ def compute(tape: Tape) -> list[tuple[str, float | None, str]]:
         out.append(("log_end_s", float(t_all[-1]), ""))
         return out
     before = int((tape.available("pressure_pa") & (t_all < 0)).sum())
-    out.append(("pad_pressure_pa", pad, f"mean of the {before} pre-liftoff pressure samples" if before else
+    out.append(("pad_pressure_pa", pad, f"mean of the {before} pre-liftoff pressure sample{'s' if before != 1 else ''}" if before else
                 "the first pressure sample (none before liftoff)"))
     t, h = smoothed_altitude(tape, pad)
     raw = tape.altitude_agl(pad)[tape.available("pressure_pa")]

@@ -15,7 +15,7 @@ namespace fsw {
 namespace {
 
 // ---- the format (docs/bytecode.md, "The image") --------------------------------
-const uint8_t kVersion = 2;
+const uint8_t kVersion = 3;
 const uint16_t kHeader = 28;
 const uint16_t kNone = 0xFFFFu;  // a state without this block
 const uint8_t kFlagLock = 1;
@@ -31,11 +31,15 @@ enum Op : uint8_t {
     kJKey = 0x20, kJInt = 0x21, kSetK = 0x22, kIAdd = 0x23, kJCmp = 0x24,
 };
 
-// A typed instruction's variable: an element's index (below kRefLocal), a
-// local's index plus kRefLocal, or kRefT (T, kJInt only).
+// A typed instruction's variable (version 3): where it is, u16, and its
+// type, u8: an element's byte offset in the state vector (below kRefLocal),
+// a local's byte offset in the locals plus kRefLocal, or kRefT (T, kJInt
+// only, with U64's type): the VM adds the offset to the state vector's or the
+// locals' address, with no table to read.
 const uint16_t kRefLocal = 0x8000u;
 const uint16_t kRefT = 0xFFFFu;
 const uint8_t kTypeT = 0xFE;   // ref_type's type of T
+const uint8_t kVarBytes = 3;   // where, type
 const uint8_t kJumpIf = 0x80;  // kJInt/kJCmp: jump when the test holds (else when it fails)
 const uint8_t kKeyInclusive = 1, kKeyJumpIf = 2;  // kJKey's flags
 
@@ -231,7 +235,7 @@ uint32_t windows_size(const Parts& p) {
 // (kTypeT: T): a test's flags or comparison, its constant and its jump
 // offset; kSetK's value; kIAdd's source and constant.
 inline uint8_t typed_operands(uint8_t op, uint8_t t) {
-    if (op == kIAdd) return 6;
+    if (op == kIAdd) return kVarBytes + 4;
     const uint8_t size = t == kTypeT ? 4u : op == kJKey ? float_bytes(t) : elem_size(t);
     return op == kSetK ? size : static_cast<uint8_t>(1u + size + 2u);
 }
@@ -244,19 +248,28 @@ inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRe
 template <class Im>
 FSW_VM_INLINE bool locked(const Im& im) { return has(kVmFeatLock) && (im[6] & kFlagLock) != 0; }
 
-// The type of a typed instruction's variable (kTypeT for T), or why not. An
-// image whose state vector is locked (kFlagLock) reads and writes elements
-// through the general instructions, which take the lock.
+// The type of the typed instruction's variable at `a` (kTypeT for T), or
+// why not: T's type is U64's; an element's offset and type must be an
+// element's of the layout (the first at that offset); a local's type one the
+// VM takes, its bytes within the locals'. An image whose state vector is
+// locked (kFlagLock) reads and writes elements through the general
+// instructions, which take the lock.
 template <class Im>
-VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t ref, bool lock, uint8_t& t) {
+VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t) {
+    const uint16_t ref = r16(im, a);
+    t = im[static_cast<uint16_t>(a + 2u)];
     if (ref == kRefT) {
+        if (t != kU64) return kVmBadElement;
         t = kTypeT;
     } else if (ref >= kRefLocal) {
-        if (ref - kRefLocal >= p.locals) return kVmBadLocal;
-        t = im[static_cast<uint16_t>(p.loc + 3u * (ref - kRefLocal))];
+        const uint8_t n = elem_size(t);
+        if (n == 0 || ref - kRefLocal > p.loc_size - n) return kVmBadLocal;  // (int: below n, none fits)
+        if (!takes(t)) return kVmNoFeature;
     } else {
-        if (ref >= layout.count || lock) return kVmBadElement;
-        t = flash_get(layout.elems[ref].type);
+        if (lock) return kVmBadElement;
+        uint16_t e = 0;
+        while (e < layout.count && flash_get(layout.elems[e].off) != ref) ++e;
+        if (e == layout.count || flash_get(layout.elems[e].type) != t) return kVmBadElement;
     }
     return kVmOk;
 }
@@ -325,8 +338,8 @@ const uint8_t kOpInfo[kJCmp + 1] FSW_FLASH = {
     FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // LT LE GT
     FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // GE EQ NE
     FSW_VM_OP(0, 1, 1, kKindPlain), FSW_VM_OP(0, 1, 1, kKindPlain),                             // NOT TRUTH
-    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // JKEY JINT: the ref,
-    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // SETK IADD: then its type's
+    FSW_VM_OP(3, 0, 0, kKindTyped), FSW_VM_OP(3, 0, 0, kKindTyped),                             // JKEY JINT: the var,
+    FSW_VM_OP(3, 0, 0, kKindTyped), FSW_VM_OP(3, 0, 0, kKindTyped),                             // SETK IADD: then its type's
     FSW_VM_OP(3, 2, 0, kKindJCmp),                                                              // JCMP
 };
 #undef FSW_VM_OP
@@ -393,16 +406,17 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if (op == kJmp) c.flags &= static_cast<uint8_t>(~kReachable);
             break;
         case kKindTyped: {
+            if (depth != 0) return kVmBadStack;  // (the VM runs them outside the stack's code)
             const uint16_t ref = r16(im, a);
             uint8_t t;
-            const VmReason why = ref_type(im, p, layout, ref, locked(im), t);
+            const VmReason why = ref_type(im, p, layout, a, locked(im), t);
             if (why != kVmOk) return why;
             const bool fits = op == kJKey ? t == kF32 || t == kF64
                               : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
                               : op == kSetK ? t != kTypeT
                                             : is_int(t);
             if (!fits) return wrong_type(ref);
-            const uint16_t b = static_cast<uint16_t>(a + 2u);  // the operands after the ref
+            const uint16_t b = static_cast<uint16_t>(a + kVarBytes);  // the operands after the variable
             const uint8_t more = typed_operands(op, t);
             const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
             if (more > p.code_size - pc) return kVmBadOpcode;  // (pc <= code_size)
@@ -410,13 +424,12 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if (op == kSetK) {
                 if (t == kBool && im[b] > 1u) return kVmBadOpcode;
             } else if (op == kIAdd) {
-                const uint16_t src = r16(im, b);
                 uint8_t ts;
-                const VmReason w = ref_type(im, p, layout, src, locked(im), ts);
+                const VmReason w = ref_type(im, p, layout, b, locked(im), ts);
                 if (w != kVmOk) return w;
-                if (!is_int(ts)) return wrong_type(src);
+                if (!is_int(ts)) return wrong_type(r16(im, b));
                 // |k| below 2^p (p = R's precision): every integer near k is exact in R.
-                const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + 2u)));
+                const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + kVarBytes)));
                 if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
             } else {
                 if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
@@ -716,16 +729,11 @@ void window_push(const Run& r, uint8_t w, Real x) {
     }
 }
 
-// Where a typed instruction's variable (not T) is, and its type.
-FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
-    if (ref >= kRefLocal) {
-        const uint8_t* l = r.loc + 3u * (ref - kRefLocal);
-        t = l[0];
-        return r.locals + u16(l + 1);
-    }
-    const VmElem* e = r.elems + ref;
-    t = flash_get(e->type);
-    return r.sv + flash_get(e->off);
+// Where the typed instruction's variable (not T) at `v` is, and its type.
+FSW_VM_INLINE uint8_t* ref_at(const Run& r, const uint8_t* v, uint8_t& t) {
+    t = v[2];
+    const uint8_t hi = v[1];
+    return ((hi & 0x80u) != 0 ? r.locals : r.sv) + static_cast<uint16_t>((hi & 0x7Fu) << 8 | v[0]);
 }
 
 // The order of the n-byte little-endian numbers at x and c, compared from
@@ -869,18 +877,18 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
 // run_block would otherwise save on every block.
 FSW_VM_INLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    uint8_t* x = ref_at(r, u16(ip + 1), t);
+    uint8_t* x = ref_at(r, ip + 1, t);
     const uint8_t n = size_of(t);
-    for (uint8_t i = 0; i < n; ++i) x[i] = ip[3 + i];  // (no call: a leaf saves fewer registers)
-    return ip + 3 + n;
+    for (uint8_t i = 0; i < n; ++i) x[i] = ip[4 + i];  // (no call: a leaf saves fewer registers)
+    return ip + 4 + n;
 }
 
 FSW_NOINLINE const uint8_t* op_iadd(const Run& r, const uint8_t* ip) {
     uint8_t td, ts;
-    uint8_t* d = ref_at(r, u16(ip + 1), td);
-    const uint8_t* x = ref_at(r, u16(ip + 3), ts);
-    int_add(d, td, x, ts, static_cast<int32_t>(u32(ip + 5)));
-    return ip + 9;
+    uint8_t* d = ref_at(r, ip + 1, td);
+    const uint8_t* x = ref_at(r, ip + 4, ts);
+    int_add(d, td, x, ts, static_cast<int32_t>(u32(ip + 7)));
+    return ip + 11;
 }
 
 // The end of a test's instruction (its jump offset `o`, 2 bytes, last):
@@ -891,32 +899,29 @@ FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if
 
 FSW_VM_INLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    const uint8_t* x = ref_at(r, u16(ip + 1), t);
+    const uint8_t* x = ref_at(r, ip + 1, t);
     const uint8_t n = float_bytes(t);
-    const uint8_t flags = ip[3];
-    const bool holds = key_holds(x, n, ip + 4, (flags & kKeyInclusive) != 0);
-    return test_end(ip + 4 + n, holds, (flags & kKeyJumpIf) != 0);
+    const uint8_t flags = ip[4];
+    const bool holds = key_holds(x, n, ip + 5, (flags & kKeyInclusive) != 0);
+    return test_end(ip + 5 + n, holds, (flags & kKeyJumpIf) != 0);
 }
 
 // kJInt of T: a function of its own, which calls machine_T32, so that the
 // test of a variable calls nothing and saves few registers.
 FSW_NOINLINE const uint8_t* op_jint_t(const Run& r, const uint8_t* ip) {
-    const uint32_t v = machine_T32(*r.m), c = u32(ip + 4);
-    const bool holds = cmp_holds(ip[3], v < c ? -1 : v > c ? 1 : 0);
-    return test_end(ip + 8, holds, (ip[3] & kJumpIf) != 0);
+    const uint32_t v = machine_T32(*r.m), c = u32(ip + 5);
+    const bool holds = cmp_holds(ip[4], v < c ? -1 : v > c ? 1 : 0);
+    return test_end(ip + 9, holds, (ip[4] & kJumpIf) != 0);
 }
 
 FSW_VM_INLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
-    const uint16_t ref = u16(ip + 1);
-    if (ref == kRefT) return op_jint_t(r, ip);
+    if (ip[1] == 0xFFu && ip[2] == 0xFFu) return op_jint_t(r, ip);  // kRefT
     uint8_t t;
-    const uint8_t* x = ref_at(r, ref, t);
-    const uint8_t flags = ip[3];
-    const bool holds = cmp_holds(flags, int_order(x, t, ip + 4));
-    return test_end(ip + 4 + size_of(t), holds, (flags & kJumpIf) != 0);
+    const uint8_t* x = ref_at(r, ip + 1, t);
+    const uint8_t flags = ip[4];
+    const bool holds = cmp_holds(flags, int_order(x, t, ip + 5));
+    return test_end(ip + 5 + size_of(t), holds, (flags & kJumpIf) != 0);
 }
-
-uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one);
 
 // truthy() in one place (two float compares a call on an AVR), for the
 // operand stack's tests.
@@ -928,8 +933,8 @@ int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 :
 // Code that evaluates on the operand stack, from `pc` (at depth 0) to the
 // instruction after the one that empties the stack again: where the block
 // goes on. Apart from run_block, so that the stack's frame is only set up
-// for such code. (The compiler emits typed instructions only at depth 0, but
-// any verified image runs: they are handled here too.)
+// for such code. (Typed instructions run at depth 0 only, a verifier's rule:
+// never here.)
 FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
     Real st[FSW_VM_STACK];
     uint8_t sp = 0;
@@ -990,7 +995,6 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
                 pc = static_cast<uint16_t>(pc + 3u);
                 continue;
             }
-            case kJKey: case kJInt: case kSetK: case kIAdd: (void)run_block(r, pc, &pc); continue;
             case kJCmp: {
                 sp = static_cast<uint8_t>(sp - 2u);
                 const bool holds = cmp_holds(a[0], real_order(st[sp], st[sp + 1u]));
@@ -1033,25 +1037,19 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
 
 // Runs the block at `pc`: the state id it goes to (0: none). Typed
 // instructions (inline: no call each) and jumps run here, stack code in
-// run_stack. With `one`, runs the typed instruction at `pc` alone and
-// stores where code goes on there (run_stack's: the compiler emits typed
-// instructions only at depth 0, but any verified image runs).
-FSW_NOINLINE uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one) {
+// run_stack.
+FSW_NOINLINE uint32_t run_block(const Run& r, uint16_t pc) {
     const uint8_t* ip = r.code + pc;
     for (;;) {
         switch (*ip) {
             case kEnd: return 0;
             case kGoto: return static_cast<uint32_t>(ip[1]) + 1u;
             case kJmp: ip += 3 + u16(ip + 1); continue;
-            case kJKey: ip = op_jkey(r, ip); break;
-            case kJInt: ip = op_jint(r, ip); break;
-            case kSetK: ip = op_setk(r, ip); break;
-            case kIAdd: ip = op_iadd(r, ip); break;
+            case kJKey: ip = op_jkey(r, ip); continue;
+            case kJInt: ip = op_jint(r, ip); continue;
+            case kSetK: ip = op_setk(r, ip); continue;
+            case kIAdd: ip = op_iadd(r, ip); continue;
             default: ip = r.code + run_stack(r, static_cast<uint16_t>(ip - r.code)); continue;
-        }
-        if (one != nullptr) {
-            *one = static_cast<uint16_t>(ip - r.code);
-            return 0;
         }
     }
 }
@@ -1098,16 +1096,16 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
         return kErrTime;
     }
     const uint16_t prelude = u16(image + 24);
-    if (r.code[prelude] != kEnd && run_block(r, prelude, nullptr) != 0) return kErrConfig;  // unreachable when verified
+    if (r.code[prelude] != kEnd && run_block(r, prelude) != 0) return kErrConfig;  // unreachable when verified
     const uint8_t states = image[18];
     if (m.state == 0 || m.state > states) return kOk;
     const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(m.state - 1u);
     const uint16_t entry = u16(blocks), step = u16(blocks + 2), exit = u16(blocks + 4);
     uint32_t next = 0;
-    if (m.entering != 0 && entry != kNone) next = run_block(r, entry, nullptr);
-    if (next == 0 && step != kNone) next = run_block(r, step, nullptr);
+    if (m.entering != 0 && entry != kNone) next = run_block(r, entry);
+    if (next == 0 && step != kNone) next = run_block(r, step);
     if (next != 0) {
-        if (exit != kNone) (void)run_block(r, exit, nullptr);
+        if (exit != kNone) (void)run_block(r, exit);
         machine_transition(m, next);
     }
     return kOk;
@@ -1119,7 +1117,7 @@ void vm_leave(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t
     run_init(r, image, layout, sv, ram, m);
     if (m.state == 0 || m.state > image[18]) return;
     const uint16_t exit = u16(image + kHeader + 6u * (m.state - 1u) + 4u);
-    if (exit != kNone) (void)run_block(r, exit, nullptr);
+    if (exit != kNone) (void)run_block(r, exit);
 }
 
 }  // namespace fsw

@@ -263,7 +263,8 @@ VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t 
         t = kTypeT;
     } else if (ref >= kRefLocal) {
         const uint8_t n = elem_size(t);
-        if (n == 0 || ref - kRefLocal > p.loc_size - n) return kVmBadLocal;  // (int: below n, none fits)
+        const uint16_t off = static_cast<uint16_t>(ref - kRefLocal);  // (16-bit: unsigned on an AVR)
+        if (n == 0 || n > p.loc_size || off > p.loc_size - n) return kVmBadLocal;
         if (!takes(t)) return kVmNoFeature;
     } else {
         if (lock) return kVmBadElement;
@@ -800,15 +801,18 @@ FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, const uint8_t* c) {
 template <bool Narrow>
 struct IntFast {
     typedef int64_t T;
+    typedef uint64_t U;
 };
 template <>
 struct IntFast<true> {
     typedef int32_t T;
+    typedef uint32_t U;
 };
 
 // The integers of kIAdd's fast path: |x| <= 2^p - 1 - |k| and x + k, with p
 // R's precision (24 or 53), fit this type with a byte to spare.
 typedef IntFast<sizeof(Real) == 4>::T Wide;
+typedef IntFast<sizeof(Real) == 4>::U UWide;
 
 // The largest value of each integer type narrower than 8 bytes, in a
 // Wide (kIAdd's clamp; unused for the 8-byte types).
@@ -834,14 +838,18 @@ FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
 }
 
 // `d = x + k` for integers d and x (kIAdd): the integer sum clamped to d's
-// range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
+// range when |x| + |k| <= 2^p - 1 (x, x + k and the sum exact in R), else
 // the sum in R as the general instructions compute it. Bytes of d above
 // Wide's are filled with the sum's sign.
 void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
-    const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
-    const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
+    const UWide exact = sizeof(Real) == 4 ? static_cast<UWide>(0xFFFFFFUL) : static_cast<UWide>(0x1FFFFFFFFFFFFFULL);
     Wide v;
-    if (!as_wide(x, ts, v) || v < -limit || v > limit) {
+    // |x| + |k| in unsigned arithmetic: |x| <= 2^31 (2^63), |k| < 2^24 in
+    // binary32 (a verifier's rule), < 2^31 in binary64: no wrap
+    if (!as_wide(x, ts, v) ||
+        (v < 0 ? UWide(0) - static_cast<UWide>(v) : static_cast<UWide>(v)) +
+                (k < 0 ? UWide(0) - static_cast<UWide>(static_cast<Wide>(k)) : static_cast<UWide>(k)) >
+            exact) {
         vm_write(d, td, vm_read(x, ts) + static_cast<Real>(k));
         return;
     }

@@ -665,6 +665,7 @@ struct Run {
     uint8_t* sv;
     uint8_t* ram;
     uint8_t* locals;  // the locals' bytes in ram
+    uintptr_t local_ref;  // their address less kRefLocal: a typed local's at local_ref + its operand
     Machine* m;
     bool lock;
 };
@@ -733,8 +734,7 @@ void window_push(const Run& r, uint8_t w, Real x) {
 // Where the typed instruction's variable (not T) at `v` is, and its type.
 FSW_VM_INLINE uint8_t* ref_at(const Run& r, const uint8_t* v, uint8_t& t) {
     t = v[2];
-    const uint8_t hi = v[1];
-    return ((hi & 0x80u) != 0 ? r.locals : r.sv) + static_cast<uint16_t>((hi & 0x7Fu) << 8 | v[0]);
+    return reinterpret_cast<uint8_t*>(((v[1] & 0x80u) != 0 ? r.local_ref : reinterpret_cast<uintptr_t>(r.sv)) + u16(v));
 }
 
 // The order of the n-byte little-endian numbers at x and c, compared from
@@ -1046,12 +1046,12 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
 // Runs the block at `pc`: the state id it goes to (0: none). Typed
 // instructions (inline: no call each) and jumps run here, stack code in
 // run_stack.
-FSW_NOINLINE uint32_t run_block(const Run& r, uint16_t pc) {
+FSW_NOINLINE uint16_t run_block(const Run& r, uint16_t pc) {
     const uint8_t* ip = r.code + pc;
     for (;;) {
         switch (*ip) {
             case kEnd: return 0;
-            case kGoto: return static_cast<uint32_t>(ip[1]) + 1u;
+            case kGoto: return static_cast<uint16_t>(ip[1] + 1u);
             case kJmp: ip += 3 + u16(ip + 1); continue;
             case kJKey: ip = op_jkey(r, ip); continue;
             case kJInt: ip = op_jint(r, ip); continue;
@@ -1078,6 +1078,7 @@ FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout
     r.ram = ram;
     r.locals = ram;
     if (has(kVmFeatWindows) && image[19] != 0) r.locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
+    r.local_ref = reinterpret_cast<uintptr_t>(r.locals) - kRefLocal;
     r.m = &m;
     r.lock = has(kVmFeatLock) && (image[6] & kFlagLock) != 0;  // (a verified image is locked only where built so)
 }
@@ -1105,15 +1106,15 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
     }
     const uint16_t prelude = u16(image + 24);
     if (r.code[prelude] != kEnd && run_block(r, prelude) != 0) return kErrConfig;  // unreachable when verified
-    const uint8_t states = image[18];
-    if (m.state == 0 || m.state > states) return kOk;
-    const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(m.state - 1u);
-    const uint16_t entry = u16(blocks), step = u16(blocks + 2), exit = u16(blocks + 4);
-    uint32_t next = 0;
-    if (m.entering != 0 && entry != kNone) next = run_block(r, entry);
-    if (next == 0 && step != kNone) next = run_block(r, step);
+    const uint32_t index = m.state - 1u;  // (state 0, none: past every state)
+    if (index >= image[18]) return kOk;
+    // the state's .entry, .step and .exit, each read where it is needed
+    const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(index);
+    uint16_t next = 0;
+    if (m.entering != 0 && u16(blocks) != kNone) next = run_block(r, u16(blocks));
+    if (next == 0 && u16(blocks + 2) != kNone) next = run_block(r, u16(blocks + 2));
     if (next != 0) {
-        if (exit != kNone) (void)run_block(r, exit);
+        if (u16(blocks + 4) != kNone) (void)run_block(r, u16(blocks + 4));
         machine_transition(m, next);
     }
     return kOk;

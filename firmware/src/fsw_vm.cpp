@@ -255,8 +255,9 @@ FSW_VM_INLINE bool locked(const Im& im) { return has(kVmFeatLock) && (im[6] & kF
 // locked (kFlagLock) reads and writes elements through the general
 // instructions, which take the lock.
 template <class Im>
-VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t) {
-    const uint16_t ref = r16(im, a);
+VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t,
+                  uint16_t& ref) {
+    ref = r16(im, a);
     t = im[static_cast<uint16_t>(a + 2u)];
     if (ref == kRefT) {
         if (t != kU64) return kVmBadElement;
@@ -379,11 +380,10 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
         }
     }
     if ((c.flags & kReachable) == 0) return kVmBadEnd;
-    const uint8_t real = im[5];
     const uint8_t op = im[p.code + pc];
     const uint8_t info = op < sizeof kOpInfo ? flash_get(kOpInfo[op]) : kOpUnknown;
     if (info == kOpUnknown) return kVmBadOpcode;
-    const uint8_t n = op == kConst ? real : static_cast<uint8_t>(info & 3u);
+    const uint8_t n = op == kConst ? im[5] : static_cast<uint8_t>(info & 3u);  // (R's bytes: read where needed)
     if (n >= p.code_size - pc) return kVmBadOpcode;  // (pc < code_size)
     const uint16_t a = static_cast<uint16_t>(p.code + pc + 1u);  // the operands
     pc = static_cast<uint16_t>(pc + 1u + n);
@@ -408,9 +408,11 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             break;
         case kKindTyped: {
             if (depth != 0) return kVmBadStack;  // (the VM runs them outside the stack's code)
-            const uint16_t ref = r16(im, a);
+            // (each byte read once: the EEPROM verifier's reads a unit are bounded, fsw_vm.h)
+            const bool lock = locked(im);
+            uint16_t ref;
             uint8_t t;
-            const VmReason why = ref_type(im, p, layout, a, locked(im), t);
+            const VmReason why = ref_type(im, p, layout, a, lock, t, ref);
             if (why != kVmOk) return why;
             const bool fits = op == kJKey ? t == kF32 || t == kF64
                               : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
@@ -425,13 +427,14 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if (op == kSetK) {
                 if (t == kBool && im[b] > 1u) return kVmBadOpcode;
             } else if (op == kIAdd) {
+                uint16_t src;
                 uint8_t ts;
-                const VmReason w = ref_type(im, p, layout, b, locked(im), ts);
+                const VmReason w = ref_type(im, p, layout, b, lock, ts, src);
                 if (w != kVmOk) return w;
-                if (!is_int(ts)) return wrong_type(r16(im, b));
+                if (!is_int(ts)) return wrong_type(src);
                 // |k| below 2^p (p = R's precision): every integer near k is exact in R.
                 const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + kVarBytes)));
-                if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
+                if (im[5] == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
             } else {
                 if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
                     return kVmBadOpcode;

@@ -902,6 +902,22 @@ FSW_NOINLINE const uint8_t* op_iadd(const Run& r, const uint8_t* ip) {
     return ip + 11;
 }
 
+// kIAdd of a counter, the machines' commonest sum: a U64 from a U64 plus k
+// (0 <= k < 2^24, as the compiler writes `n = n + 1`), in 32-bit words,
+// int_add's integer path where x + k < 2^24 (exact in R: no clamp); else
+// null. Inline in run_block: a leaf of few registers.
+FSW_VM_INLINE const uint8_t* op_count(const Run& r, const uint8_t* ip) {
+    if (ip[3] != kU64 || ip[6] != kU64 || ip[10] != 0) return nullptr;  // (k < 2^24: its top byte 0)
+    uint8_t t;
+    const uint8_t* x = ref_at(r, ip + 4, t);
+    const uint32_t lo = load<uint32_t>(x), v = lo + u32(ip + 7);  // (both below 2^24: no wrap)
+    if (load<uint32_t>(x + 4) != 0 || lo > 0xFFFFFFUL || v > 0xFFFFFFUL) return nullptr;
+    uint8_t* d = ref_at(r, ip + 1, t);
+    store<uint32_t>(d, v);
+    store<uint32_t>(d + 4, 0);
+    return ip + 11;
+}
+
 // The end of a test's instruction (its jump offset `o`, 2 bytes, last):
 // where to go on when the test `holds`, under the instruction's `jump_if`.
 FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if) {
@@ -1059,7 +1075,11 @@ FSW_NOINLINE uint16_t run_block(const Run& r, uint16_t pc) {
             case kJKey: ip = op_jkey(r, ip); continue;
             case kJInt: ip = op_jint(r, ip); continue;
             case kSetK: ip = op_setk(r, ip); continue;
-            case kIAdd: ip = op_iadd(r, ip); continue;
+            case kIAdd: {
+                const uint8_t* next = op_count(r, ip);
+                ip = next != nullptr ? next : op_iadd(r, ip);
+                continue;
+            }
             default: ip = r.code + run_stack(r, static_cast<uint16_t>(ip - r.code)); continue;
         }
     }

@@ -737,7 +737,8 @@ void window_push(const Run& r, uint8_t w, Real x) {
 // Where the typed instruction's variable (not T) at `v` is, and its type.
 FSW_VM_INLINE uint8_t* ref_at(const Run& r, const uint8_t* v, uint8_t& t) {
     t = v[2];
-    return reinterpret_cast<uint8_t*>(((v[1] & 0x80u) != 0 ? r.local_ref : reinterpret_cast<uintptr_t>(r.sv)) + u16(v));
+    const uint16_t w = u16(v);
+    return reinterpret_cast<uint8_t*>(((w & kRefLocal) != 0 ? r.local_ref : reinterpret_cast<uintptr_t>(r.sv)) + w);
 }
 
 // The order of the n-byte little-endian numbers at x and c, compared from

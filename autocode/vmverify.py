@@ -462,8 +462,9 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
     p = parts(im)
     if p.total != len(im):
         return BAD_SIZE
-    g, s = struct.unpack_from("<HH", im, 14)
-    if g >= count or s >= count or layout.elems[g][1] != TYPE_CODES["U64"] or layout.elems[s][1] != TYPE_CODES["U32"]:
+    # G and S by their byte offsets (version 3), as a typed instruction's elements
+    g, s = (next((e for e in layout.elems if e[0] == off), None) for off in struct.unpack_from("<HH", im, 14))
+    if g is None or s is None or g[1] != TYPE_CODES["U64"] or s[1] != TYPE_CODES["U32"]:
         return BAD_ELEMENT
     if p.states == 0:
         return BAD_STATE

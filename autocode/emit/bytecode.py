@@ -468,9 +468,9 @@ def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes
     from ..schema import schema_hash
     g, s = m.vars[m.g], m.vars[m.s]
     head = bytearray(V.MAGIC + bytes((V.VERSION, real.bits // 8, V.FLAG_LOCK if m.sv.lock else 0, 0)))
-    head += struct.pack("<IHHHBBHHHH", schema_hash(m.sv), len(m.sv.elements), elem_index[g.name],
-                        elem_index[s.name], len(m.states), len(m.windows), len(locs), len(init), prelude,
-                        len(code.b))
+    head += struct.pack("<IHHHBBHHHH", schema_hash(m.sv), len(m.sv.elements),
+                        m.sv.elements[elem_index[g.name]].offset, m.sv.elements[elem_index[s.name]].offset,
+                        len(m.states), len(m.windows), len(locs), len(init), prelude, len(code.b))
     assert len(head) == V.HEADER
     body = b"".join(struct.pack("<HHH", *row) for row in offsets)
     body += b"".join(struct.pack("<BH", V.TYPE_CODES[v.type.name], offs[v.index]) for v in locs)

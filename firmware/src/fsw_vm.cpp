@@ -248,6 +248,13 @@ inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRe
 template <class Im>
 FSW_VM_INLINE bool locked(const Im& im) { return has(kVmFeatLock) && (im[6] & kFlagLock) != 0; }
 
+// The layout's first element at byte offset `off` (layout.count: none).
+uint16_t elem_at(const VmLayout& layout, uint16_t off) {
+    uint16_t e = 0;
+    while (e < layout.count && flash_get(layout.elems[e].off) != off) ++e;
+    return e;
+}
+
 // The type of the typed instruction's variable at `a` (kTypeT for T), or
 // why not: T's type is U64's; an element's offset and type must be an
 // element's of the layout (the first at that offset); a local's type one the
@@ -269,8 +276,7 @@ VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t 
         if (!takes(t)) return kVmNoFeature;
     } else {
         if (lock) return kVmBadElement;
-        uint16_t e = 0;
-        while (e < layout.count && flash_get(layout.elems[e].off) != ref) ++e;
+        const uint16_t e = elem_at(layout, ref);
         if (e == layout.count || flash_get(layout.elems[e].type) != t) return kVmBadElement;
     }
     return kVmOk;
@@ -306,8 +312,9 @@ VmReason check_header(const Im& im, uint16_t len, const VmLayout& layout, Offs& 
             if (!takes(flash_get(layout.elems[e].type))) return kVmNoFeature;
     offsets(im, p);
     if (p.total != len) return kVmBadSize;
-    const uint16_t g = r16(im, 14), s = r16(im, 16);
-    if (g >= layout.count || s >= layout.count || flash_get(layout.elems[g].type) != kU64 ||
+    // G and S by their byte offsets (version 3), as a typed instruction's elements
+    const uint16_t g = elem_at(layout, r16(im, 14)), s = elem_at(layout, r16(im, 16));
+    if (g == layout.count || s == layout.count || flash_get(layout.elems[g].type) != kU64 ||
         flash_get(layout.elems[s].type) != kU32)
         return kVmBadElement;
     if (p.states == 0) return kVmBadState;
@@ -1112,8 +1119,8 @@ FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout
 Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     Run r;
     run_init(r, image, layout, sv, ram, m);
-    uint8_t* g = sv + flash_get(layout.elems[u16(image + 14)].off);
-    uint8_t* s = sv + flash_get(layout.elems[u16(image + 16)].off);
+    uint8_t* g = sv + u16(image + 14);
+    uint8_t* s = sv + u16(image + 16);
     if (has(kVmFeatLock) && r.lock) {  // as a generated step() over a locked state vector
         uint64_t now;
         {

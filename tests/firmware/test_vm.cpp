@@ -73,8 +73,8 @@ void build(Image& im, const uint8_t* code, uint16_t n, const uint16_t offs[6], u
     put16(h + 8, 0x5678);
     put16(h + 10, 0x1234);
     put16(h + 12, 4);  // elements
-    put16(h + 14, 0);  // G
-    put16(h + 16, 1);  // S
+    put16(h + 14, 0);  // G, at 0
+    put16(h + 16, 8);  // S, at 8
     h[18] = 2;         // states
     h[19] = 1;         // windows
     put16(h + 20, 1);  // locals
@@ -171,10 +171,16 @@ void test_element_rules(void) {
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, patched(29, kI32)); // a store of n as I32
     Image im;
     good(im);
-    put16(im.b + 14, 2);  // G bound to x (F32)
+    put16(im.b + 14, 12);  // G bound to x (F32)
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
     good(im);
     put16(im.b + 16, 0);  // S bound to G (U64)
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    good(im);
+    put16(im.b + 14, 1);  // G inside itself: no element's offset
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    good(im);
+    put16(im.b + 16, 1);  // S by its index (format 2): G's second byte
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
 }
 

@@ -674,8 +674,7 @@ struct Run {
     const VmElem* elems;  // the layout's element table (FSW_FLASH)
     uint8_t* sv;
     uint8_t* ram;
-    uint8_t* locals;  // the locals' bytes in ram
-    uintptr_t local_ref;  // their address less kRefLocal: a typed local's at local_ref + its operand
+    uintptr_t local_ref;  // the locals' address in ram less kRefLocal: a typed local's at local_ref + its operand
     Machine* m;
     bool lock;
 };
@@ -810,12 +809,13 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
 
 // kJInt's order of the variable at `x` (type t; T: op_jint_t)
 // against the constant at `c`.
-FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, const uint8_t* c) {
+// (n: the type's size, read once by the caller)
+FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, uint8_t n, const uint8_t* c) {
     if (t == kBool) {  // 0 or 1 against any byte (the compiler writes 0 or 1)
         const uint8_t v = load_bool(x) ? 1 : 0;
         return v < c[0] ? -1 : v > c[0] ? 1 : 0;
     }
-    return le_order(x, c, size_of(t), is_signed(t) ? 0x80 : 0x00);
+    return le_order(x, c, n, is_signed(t) ? 0x80 : 0x00);
 }
 
 template <bool Narrow>
@@ -964,8 +964,9 @@ FSW_VM_INLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
     uint8_t t;
     const uint8_t* x = ref_at(r, ip + 1, t);
     const uint8_t flags = ip[4];
-    const bool holds = cmp_holds(flags, int_order(x, t, ip + 5));
-    return test_end(ip + 5 + size_of(t), holds, (flags & kJumpIf) != 0);
+    const uint8_t n = size_of(t);
+    const bool holds = cmp_holds(flags, int_order(x, t, n, ip + 5));
+    return test_end(ip + 5 + n, holds, (flags & kJumpIf) != 0);
 }
 
 // truthy() in one place (two float compares a call on an AVR), for the
@@ -1034,7 +1035,7 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kLdl:
             case kStl: {
                 const uint8_t* l = r.loc + 3u * u16(a);
-                uint8_t* at = r.locals + u16(l + 1);
+                uint8_t* at = reinterpret_cast<uint8_t*>(r.local_ref + kRefLocal + u16(l + 1));
                 if (op == kLdl) st[sp++] = vm_read(at, l[0]);
                 else vm_write(at, l[0], st[--sp]);
                 pc = static_cast<uint16_t>(pc + 3u);
@@ -1117,9 +1118,9 @@ FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout
     r.elems = layout.elems;
     r.sv = sv;
     r.ram = ram;
-    r.locals = ram;
-    if (has(kVmFeatWindows) && image[19] != 0) r.locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
-    r.local_ref = reinterpret_cast<uintptr_t>(r.locals) - kRefLocal;
+    uint8_t* locals = ram;
+    if (has(kVmFeatWindows) && image[19] != 0) locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
+    r.local_ref = reinterpret_cast<uintptr_t>(locals) - kRefLocal;
     r.m = &m;
     r.lock = has(kVmFeatLock) && (image[6] & kFlagLock) != 0;  // (a verified image is locked only where built so)
 }

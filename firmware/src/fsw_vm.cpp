@@ -52,13 +52,14 @@ inline bool is_int(uint8_t t) { return t <= kU64; }
 const uint8_t kSizes[kBool + 1] FSW_FLASH = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
 FSW_VM_INLINE uint8_t size_of(uint8_t t) { return flash_get(kSizes[t]); }
 
-// The comparisons' truth over the order of x and c: bit 0 when x < c, bit 1
-// when x == c, bit 2 when x > c, bit 3 when unordered (<, <=, >, >=, ==, !=
-// in kLt..kNe's order).
-const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered (order 2: a NaN)
-inline bool cmp_holds(uint8_t cmp, int8_t order) {
-    const uint8_t holds = flash_get(kCmpMask[cmp & 7u]);  // (a bit by a test, no shift loop on an AVR)
-    return (holds & (order < 0 ? 1u : order == 0 ? 2u : order == 1 ? 4u : 8u)) != 0;
+// The order of x and c as one bit (the order functions' answer): x < c,
+// x == c, x > c, unordered (a NaN).
+const uint8_t kBelow = 1, kEqual = 2, kAbove = 4, kUnordered = 8;
+// The comparisons' truth over that order: the bits of the orders for which
+// each holds (<, <=, >, >=, ==, != in kLt..kNe's order).
+const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered
+inline bool cmp_holds(uint8_t cmp, uint8_t order) {
+    return (flash_get(kCmpMask[cmp & 7u]) & order) != 0;  // (a bit by a test, no shift loop on an AVR)
 }
 
 // N is 16 bits in the image: every runtime holds a window of 65535 samples.
@@ -749,22 +750,22 @@ FSW_VM_INLINE uint8_t* ref_at(const Run& r, const uint8_t* v, uint8_t& t) {
 
 // The order of the n-byte little-endian numbers at x and c, compared from
 // their top down as unsigned ones after `flip` is xored into both top
-// bytes (0x80: as signed ones): -1, 0 or 1. A 16-bit word at a time (n
+// bytes (0x80: as signed ones): kBelow, kEqual or kAbove. A 16-bit word at a time (n
 // even; a byte for n = 1): no 64-bit arithmetic on an 8-bit MCU, and half
 // the loop's turns over the equal high bytes of a small value.
-FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
+FSW_VM_INLINE uint8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
     if (n == 1) {
         const uint8_t a = static_cast<uint8_t>(x[0] ^ flip), b = static_cast<uint8_t>(c[0] ^ flip);
-        return a < b ? -1 : a > b ? 1 : 0;
+        return a < b ? kBelow : a > b ? kAbove : kEqual;
     }
     x += n;
     c += n;
     const uint16_t top = static_cast<uint16_t>(flip << 8);
     uint16_t a = static_cast<uint16_t>(load<uint16_t>(x - 2) ^ top), b = static_cast<uint16_t>(load<uint16_t>(c - 2) ^ top);
     for (;;) {
-        if (a != b) return a < b ? -1 : 1;
+        if (a != b) return a < b ? kBelow : kAbove;
         n = static_cast<uint8_t>(n - 2u);
-        if (n == 0) return 0;
+        if (n == 0) return kEqual;
         x -= 2;
         c -= 2;
         a = load<uint16_t>(x - 2);
@@ -810,10 +811,10 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
 // kJInt's order of the variable at `x` (type t; T: op_jint_t)
 // against the constant at `c`.
 // (n: the type's size, read once by the caller)
-FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, uint8_t n, const uint8_t* c) {
+FSW_VM_INLINE uint8_t int_order(const uint8_t* x, uint8_t t, uint8_t n, const uint8_t* c) {
     if (t == kBool) {  // 0 or 1 against any byte (the compiler writes 0 or 1)
         const uint8_t v = load_bool(x) ? 1 : 0;
-        return v < c[0] ? -1 : v > c[0] ? 1 : 0;
+        return v < c[0] ? kBelow : v > c[0] ? kAbove : kEqual;
     }
     return le_order(x, c, n, is_signed(t) ? 0x80 : 0x00);
 }
@@ -955,7 +956,7 @@ FSW_VM_INLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
 // test of a variable calls nothing and saves few registers.
 FSW_NOINLINE const uint8_t* op_jint_t(const Run& r, const uint8_t* ip) {
     const uint32_t v = machine_T32(*r.m), c = u32(ip + 5);
-    const bool holds = cmp_holds(ip[4], v < c ? -1 : v > c ? 1 : 0);
+    const bool holds = cmp_holds(ip[4], v < c ? kBelow : v > c ? kAbove : kEqual);
     return test_end(ip + 9, holds, (ip[4] & kJumpIf) != 0);
 }
 
@@ -973,8 +974,8 @@ FSW_VM_INLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
 // operand stack's tests.
 FSW_NOINLINE bool vm_truthy(Real r) { return truthy(r); }
 
-// The order of two R values for kJCmp: -1, 0, 1, or 2 when unordered (a NaN).
-int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 : 2; }
+// The order of two R values for kJCmp and the comparisons (a NaN: unordered).
+uint8_t real_order(Real x, Real y) { return x < y ? kBelow : x > y ? kAbove : x == y ? kEqual : kUnordered; }
 
 // Code that evaluates on the operand stack, from `pc` (at depth 0) to the
 // instruction after the one that empties the stack again: where the block

@@ -58,7 +58,7 @@ const uint8_t kBelow = 1, kEqual = 2, kAbove = 4, kUnordered = 8;
 // The comparisons' truth over that order: the bits of the orders for which
 // each holds (<, <=, >, >=, ==, != in kLt..kNe's order).
 const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered
-inline bool cmp_holds(uint8_t cmp, uint8_t order) {
+FSW_VM_INLINE bool cmp_holds(uint8_t cmp, uint8_t order) {
     return (flash_get(kCmpMask[cmp & 7u]) & order) != 0;  // (a bit by a test, no shift loop on an AVR)
 }
 

@@ -256,24 +256,21 @@ uint16_t elem_at(const VmLayout& layout, uint16_t off) {
     return e;
 }
 
-// The type of the typed instruction's variable at `a` (kTypeT for T), or
-// why not: T's type is U64's; an element's offset and type must be an
-// element's of the layout (the first at that offset); a local's type one the
-// VM takes, its bytes within the locals'. An image whose state vector is
-// locked (kFlagLock) reads and writes elements through the general
-// instructions, which take the lock.
-template <class Im>
-VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t,
-                  uint16_t& ref) {
-    ref = r16(im, a);
-    t = im[static_cast<uint16_t>(a + 2u)];
+// Why the typed instruction's variable `ref` of type `t` may not be (kVmOk:
+// it may), and its type (kTypeT for T): T's type is U64's; an element's
+// offset and type must be an element's of the layout (the first at that
+// offset); a local's type one the VM takes, its bytes within the locals'.
+// An image whose state vector is locked (kFlagLock) reads and writes
+// elements through the general instructions, which take the lock. (One
+// function for both readers of the image.)
+FSW_NOINLINE VmReason var_rule(uint16_t loc_size, const VmLayout& layout, bool lock, uint16_t ref, uint8_t& t) {
     if (ref == kRefT) {
         if (t != kU64) return kVmBadElement;
         t = kTypeT;
     } else if (ref >= kRefLocal) {
         const uint8_t n = elem_size(t);
         const uint16_t off = static_cast<uint16_t>(ref - kRefLocal);  // (16-bit: unsigned on an AVR)
-        if (n == 0 || n > p.loc_size || off > p.loc_size - n) return kVmBadLocal;
+        if (n == 0 || n > loc_size || off > loc_size - n) return kVmBadLocal;
         if (!takes(t)) return kVmNoFeature;
     } else {
         if (lock) return kVmBadElement;
@@ -281,6 +278,16 @@ VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t 
         if (e == layout.count || flash_get(layout.elems[e].type) != t) return kVmBadElement;
     }
     return kVmOk;
+}
+
+// The typed instruction's variable at `a`: its operand, its type, and the
+// rule's answer.
+template <class Im>
+VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t,
+                  uint16_t& ref) {
+    ref = r16(im, a);
+    t = im[static_cast<uint16_t>(a + 2u)];
+    return var_rule(p.loc_size, layout, lock, ref, t);
 }
 
 // ---- the verifier: one pass over the image, resumable -------------------------

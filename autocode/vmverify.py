@@ -53,7 +53,7 @@ REASONS = {
     3: "compiled for the other evaluation type (f32/f64)",
     4: "bound to another state vector (schema hash or element count)",
     5: "the lengths in the header do not add up to the image",
-    6: "an element index out of range, or its type not the layout's",
+    6: "an element index or offset not the layout's, or its type not the layout's",
     7: "a local index out of range, or a local outside the locals",
     8: "no states, a state index out of range, or a code offset out of range",
     9: "a window index, function or size out of range, or pushed out of order",

@@ -106,7 +106,7 @@ const char* const kReasons[] = {
     "compiled for the other evaluation type (f32/f64)",
     "bound to another state vector (schema hash or element count)",
     "the lengths in the header do not add up to the image",
-    "an element index out of range, or its type not the layout's",
+    "an element index or offset not the layout's, or its type not the layout's",
     "a local index out of range, or a local outside the locals",
     "no states, a state index out of range, or a code offset out of range",
     "a window index, function or size out of range, or pushed out of order",

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from . import model as M
 
 MAGIC = b"FSMB"
-VERSION = 2
+VERSION = 3
 HEADER = 28
 NONE = 0xFFFF  # a state without this block
 FLAG_LOCK = 1
@@ -27,8 +27,13 @@ ARITH = {"+": ADD, "-": SUB, "*": MUL, "/": DIV}
 COMPARE = {"<": LT, "<=": LE, ">": GT, ">=": GE, "==": EQ, "!=": NE}
 # Typed tests and stores (version 2): the generated code's fast paths.
 JKEY, JINT, SETK, IADD, JCMP = 0x20, 0x21, 0x22, 0x23, 0x24
-REF_LOCAL = 0x8000  # a typed instruction's variable: element k, local REF_LOCAL + k
-REF_T = 0xFFFF  # or T (JINT only)
+# A typed instruction's variable (version 3): where, u16, and type, u8: an
+# element's byte offset in the state vector, a local's byte offset in the
+# locals plus REF_LOCAL, or REF_T (T, JINT only; U64's type code).
+REF_LOCAL = 0x8000
+REF_T = 0xFFFF
+VAR_BYTES = 3
+T_VAR = bytes((0xFF, 0xFF, 7))  # T as a typed instruction's variable
 TYPE_T = 0xFE
 JUMP_IF = 0x80  # JINT/JCMP: jump when the test holds (else when it fails)
 KEY_INCLUSIVE, KEY_JUMP_IF = 1, 2  # JKEY's flags
@@ -48,7 +53,7 @@ REASONS = {
     3: "compiled for the other evaluation type (f32/f64)",
     4: "bound to another state vector (schema hash or element count)",
     5: "the lengths in the header do not add up to the image",
-    6: "an element index out of range, or its type not the layout's",
+    6: "an element index or offset not the layout's, or its type not the layout's",
     7: "a local index out of range, or a local outside the locals",
     8: "no states, a state index out of range, or a code offset out of range",
     9: "a window index, function or size out of range, or pushed out of order",
@@ -151,7 +156,7 @@ def operand_bytes(op: int, real: int) -> int | None:
     if op == CONST:
         return real
     if op in (JKEY, JINT, SETK, IADD):
-        return 2  # the ref; the rest is its type's
+        return VAR_BYTES  # the variable; the rest is its type's
     if op == JCMP:
         return 3
     return None
@@ -162,7 +167,7 @@ def _typed_operands(op: int, t: int) -> int:
     (TYPE_T: T): a test's flags or comparison, its constant and its jump
     offset; SETK's value; IADD's source and constant."""
     if op == IADD:
-        return 6
+        return VAR_BYTES + 4
     size = 4 if t == TYPE_T else TYPE_SIZES[t]
     return size if op == SETK else 1 + size + 2
 
@@ -171,17 +176,26 @@ def _wrong_type(ref: int) -> int:
     return BAD_LOCAL if REF_LOCAL <= ref != REF_T else BAD_ELEMENT
 
 
-def _ref_type(im: bytes, p: "Parts", layout: Layout, ref: int, lock: bool) -> tuple[int, int]:
-    """(reason, type code) of a typed instruction's variable (TYPE_T: T)."""
+def _ref_type(code: bytes, a: int, p: "Parts", layout: Layout, lock: bool, features: int) -> tuple[int, int]:
+    """(reason, type code) of the typed instruction's variable at code
+    offset `a` (TYPE_T: T): T's type is U64's; an element's offset and type
+    an element's of the layout (the first at that offset); a local's type
+    one the VM takes, its bytes within the locals'."""
+    ref, t = _u16(code, a), code[a + 2]
     if ref == REF_T:
-        return OK, TYPE_T
+        return (OK, TYPE_T) if t == TYPE_CODES["U64"] else (BAD_ELEMENT, 0)
     if ref >= REF_LOCAL:
-        if ref - REF_LOCAL >= p.locals:
+        if t >= len(TYPE_SIZES) or ref - REF_LOCAL > p.loc_size - TYPE_SIZES[t]:
             return BAD_LOCAL, 0
-        return OK, im[p.loc + 3 * (ref - REF_LOCAL)]
-    if ref >= len(layout.elems) or lock:
+        if not takes(t, features):
+            return NO_FEATURE, 0
+        return OK, t
+    if lock:
         return BAD_ELEMENT, 0
-    return OK, layout.elems[ref][1]
+    at = next((e for e in layout.elems if e[0] == ref), None)
+    if at is None or at[1] != t:
+        return BAD_ELEMENT, 0
+    return OK, t
 
 
 @dataclass
@@ -216,7 +230,7 @@ def _u16(im: bytes, at: int) -> int:
 
 
 def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int,
-                 nested: list | None = None) -> tuple[int, int]:
+                 nested: list | None = None, features: int = ALL_FEATURES) -> tuple[int, int]:
     """(reason, deepest stack) of the code pass. `nested`: gets the code
     offset of the jump that made too many pending (TOO_NESTED)."""
     real = im[5]
@@ -298,12 +312,14 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int,
             if op == JMP:
                 reachable = False
         elif op in (JKEY, JINT, SETK, IADD):
+            if depth != 0:
+                return BAD_STACK, deepest  # (the VM runs them outside the stack's code)
             ref = _u16(code, a)
             lock = bool(im[6] & FLAG_LOCK)
-            why, t = _ref_type(im, p, layout, ref, lock)
+            why, t = _ref_type(code, a, p, layout, lock, features)
             if why != OK:
                 return why, deepest
-            b = a + 2
+            b = a + VAR_BYTES
             if op == JKEY:
                 fits = t in (TYPE_CODES["F32"], TYPE_CODES["F64"])
             elif op == JINT:
@@ -323,13 +339,12 @@ def _verify_code(im: bytes, p: Parts, layout: Layout, stack: int, pending: int,
                 if t == TYPE_CODES["bool"] and code[b] > 1:
                     return BAD_OPCODE, deepest
             elif op == IADD:
-                src = _u16(code, b)
-                why, ts = _ref_type(im, p, layout, src, lock)
+                why, ts = _ref_type(code, b, p, layout, lock, features)
                 if why != OK:
                     return why, deepest
                 if ts > TYPE_CODES["U64"]:
-                    return _wrong_type(src), deepest
-                k = struct.unpack_from("<i", code, b + 2)[0]
+                    return _wrong_type(_u16(code, b)), deepest
+                k = struct.unpack_from("<i", code, b + VAR_BYTES)[0]
                 if real == 4 and not -16777215 <= k <= 16777215:
                     return BAD_OPCODE, deepest
             else:
@@ -447,8 +462,9 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
     p = parts(im)
     if p.total != len(im):
         return BAD_SIZE
-    g, s = struct.unpack_from("<HH", im, 14)
-    if g >= count or s >= count or layout.elems[g][1] != TYPE_CODES["U64"] or layout.elems[s][1] != TYPE_CODES["U32"]:
+    # G and S by their byte offsets (version 3), as a typed instruction's elements
+    g, s = (next((e for e in layout.elems if e[0] == off), None) for off in struct.unpack_from("<HH", im, 14))
+    if g is None or s is None or g[1] != TYPE_CODES["U64"] or s[1] != TYPE_CODES["U32"]:
         return BAD_ELEMENT
     if p.states == 0:
         return BAD_STATE
@@ -465,7 +481,7 @@ def verify(im: bytes, layout: Layout, real_bytes: int, stack: int = VM_STACK, pe
             return BAD_WINDOW
         if not features & (1 << im[p.win + 4 * w]):
             return NO_FEATURE
-    return _verify_code(im, p, layout, stack, pending)[0]
+    return _verify_code(im, p, layout, stack, pending, features=features)[0]
 
 
 def opcodes(im: bytes, layout: Layout) -> list[int]:
@@ -479,7 +495,7 @@ def opcodes(im: bytes, layout: Layout) -> list[int]:
         op = code[pc]
         n = operand_bytes(op, im[5])
         if op in (JKEY, JINT, SETK, IADD):
-            n += _typed_operands(op, _ref_type(im, p, layout, _u16(code, pc + 1), lock)[1])
+            n += _typed_operands(op, _ref_type(code, pc + 1, p, layout, lock, ALL_FEATURES)[1])
         out.append(op)
         pc += 1 + n
     return out

@@ -90,6 +90,7 @@ class _Code:
         self.b = bytearray()
         self.starts: list[tuple[int, int, int]] = []  # (code offset, line, col) of each statement, in order
         self.elem_index, self.loc_index = elem_index, loc_index
+        self.loc_offset = local_offsets(m)
         self.fmt = "<f" if real.bits == 32 else "<d"
 
     def op(self, *bs: int) -> None:
@@ -174,17 +175,23 @@ class _Code:
     # -- conditions: a tree of tests, compiled to jumps ---------------------------
     # ("const", b) | ("key", ref, size, key, inclusive) | ("int", ref, cmp, c bytes)
     # | ("cmp", op, left, right) | ("value", e) | ("not", n) | ("and"|"or", a, b)
-    def ref(self, i: int) -> int | None:
-        """A typed instruction's operand for variable `i`, or None (T, an
-        element of a locked state vector, an index past the encoding)."""
+    def ref(self, i: int) -> bytes | None:
+        """A typed instruction's variable `i` (where, u16, and type, u8:
+        the element's byte offset in the state vector, or the local's in the
+        locals plus REF_LOCAL), or None (T, an element of a locked state
+        vector, an offset past the encoding)."""
         v = self.m.vars[i]
         if v.kind == M.ELEMENT:
-            k = self.elem_index[v.name]
-            return k if k < V.REF_LOCAL and not self.m.sv.lock else None
-        if v.kind == M.LOCAL:
-            k = self.loc_index[v.index]
-            return V.REF_LOCAL + k if k < V.REF_T - V.REF_LOCAL else None
-        return None
+            at = self.m.sv.elements[self.elem_index[v.name]].offset
+            if at >= V.REF_LOCAL or self.m.sv.lock:
+                return None
+        elif v.kind == M.LOCAL:
+            at = V.REF_LOCAL + self.loc_offset[v.index]
+            if at >= V.REF_T:
+                return None
+        else:
+            return None
+        return struct.pack("<HB", at, V.TYPE_CODES[v.type.name])
 
     def known(self, e: M.Expr):
         """The R value of a literal or of a local read as a constant."""
@@ -220,7 +227,7 @@ class _Code:
         if v.kind == M.TIME_IN_STATE:
             if not 0 <= c < 0xFFFFFFFF:
                 return None
-            return ("int", V.REF_T, V.CMP_CODES[op], struct.pack("<I", c))
+            return ("int", V.T_VAR, V.CMP_CODES[op], struct.pack("<I", c))
         cb = bytes((c,)) if t.kind == "bool" else c.to_bytes(t.size, "little", signed=t.signed)
         return ("int", self.ref(v.index), V.CMP_CODES[op], cb)
 
@@ -289,12 +296,12 @@ class _Code:
         if kind == "key":
             _, ref, size, key, inclusive = n
             flags = (V.KEY_INCLUSIVE if inclusive else 0) | (V.KEY_JUMP_IF if sense else 0)
-            self.op(V.JKEY, *struct.pack("<HB", ref, flags))
+            self.op(V.JKEY, *ref, flags)
             self.b += key.to_bytes(size, "little")
             return [self.jump_offset()]
         if kind == "int":
             _, ref, cmp, cb = n
-            self.op(V.JINT, *struct.pack("<HB", ref, cmp | (V.JUMP_IF if sense else 0)))
+            self.op(V.JINT, *ref, cmp | (V.JUMP_IF if sense else 0))
             self.b += cb
             return [self.jump_offset()]
         if kind == "cmp":
@@ -328,7 +335,7 @@ class _Code:
         except NotConstant:
             x = None
         if x is not None:
-            self.op(V.SETK, *struct.pack("<H", ref))
+            self.op(V.SETK, *ref)
             self.b += value_bytes(target.type, to_type(target.type, x))
             return True
         if type(e) is not M.Arith or e.op not in ("+", "-") or target.type.kind != "int":
@@ -339,7 +346,7 @@ class _Code:
         a, k = got
         if not -(1 << 31) <= k < (1 << 31) or exact_sum_limit(k, self.real) < 0:
             return False
-        self.op(V.IADD, *struct.pack("<HHi", ref, self.ref(a.index), k))
+        self.op(V.IADD, *ref, *self.ref(a.index), *struct.pack("<i", k))
         return True
 
     def truth(self, e: M.Expr) -> None:
@@ -461,9 +468,9 @@ def compile_machine(m: M.Machine, real: Real, scriptable: bool = False) -> bytes
     from ..schema import schema_hash
     g, s = m.vars[m.g], m.vars[m.s]
     head = bytearray(V.MAGIC + bytes((V.VERSION, real.bits // 8, V.FLAG_LOCK if m.sv.lock else 0, 0)))
-    head += struct.pack("<IHHHBBHHHH", schema_hash(m.sv), len(m.sv.elements), elem_index[g.name],
-                        elem_index[s.name], len(m.states), len(m.windows), len(locs), len(init), prelude,
-                        len(code.b))
+    head += struct.pack("<IHHHBBHHHH", schema_hash(m.sv), len(m.sv.elements),
+                        m.sv.elements[elem_index[g.name]].offset, m.sv.elements[elem_index[s.name]].offset,
+                        len(m.states), len(m.windows), len(locs), len(init), prelude, len(code.b))
     assert len(head) == V.HEADER
     body = b"".join(struct.pack("<HHH", *row) for row in offsets)
     body += b"".join(struct.pack("<BH", V.TYPE_CODES[v.type.name], offs[v.index]) for v in locs)

@@ -106,7 +106,7 @@ const char* const kReasons[] = {
     "compiled for the other evaluation type (f32/f64)",
     "bound to another state vector (schema hash or element count)",
     "the lengths in the header do not add up to the image",
-    "an element index out of range, or its type not the layout's",
+    "an element index or offset not the layout's, or its type not the layout's",
     "a local index out of range, or a local outside the locals",
     "no states, a state index out of range, or a code offset out of range",
     "a window index, function or size out of range, or pushed out of order",
@@ -827,8 +827,10 @@ int fswsm_load_image(fswsm* h, const uint8_t* image, uint32_t len) {
     for (uint32_t k = 0; h->aliases != 0 && k < h->count; ++k) {
         const char* alias = h->aliases[k];
         if (alias == 0 || (strcmp(alias, "G") != 0 && strcmp(alias, "S") != 0)) continue;
-        const unsigned at = alias[0] == 'G' ? 14u : 16u;  // the header's G and S element indices
-        const unsigned index = static_cast<unsigned>(copy[at] | (copy[at + 1u] << 8));
+        const unsigned at = alias[0] == 'G' ? 14u : 16u;  // the header's G and S: their byte offsets
+        const unsigned off = static_cast<unsigned>(copy[at] | (copy[at + 1u] << 8));
+        unsigned index = 0;  // the element there (the verifier found one)
+        while (index < h->count && h->elems[index].off != off) ++index;
         if (index != k) {
             free(copy);
             free(ram);
@@ -922,7 +924,7 @@ int fswsm_step(fswsm* h) {
     const fsw::Result r = fsw::vm_step(h->image, layout, h->sv, h->ram, h->m);
     if (r == fsw::kErrTime) return fail(h, FSWSM_STEP_TIME, "G did not increase: %llu after %llu",
                                         static_cast<unsigned long long>(fsw::load<uint64_t>(
-                                            h->sv + h->elems[h->image[14] | (h->image[15] << 8)].off)),
+                                            h->sv + (h->image[14] | (h->image[15] << 8)))),
                                         static_cast<unsigned long long>(h->m.last_g));
     if (r != fsw::kOk) return fail(h, static_cast<int>(r), "the runtime refused the step (Result %d)", static_cast<int>(r));
     return ok(h);

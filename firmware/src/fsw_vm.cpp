@@ -15,7 +15,7 @@ namespace fsw {
 namespace {
 
 // ---- the format (docs/bytecode.md, "The image") --------------------------------
-const uint8_t kVersion = 2;
+const uint8_t kVersion = 3;
 const uint16_t kHeader = 28;
 const uint16_t kNone = 0xFFFFu;  // a state without this block
 const uint8_t kFlagLock = 1;
@@ -31,11 +31,15 @@ enum Op : uint8_t {
     kJKey = 0x20, kJInt = 0x21, kSetK = 0x22, kIAdd = 0x23, kJCmp = 0x24,
 };
 
-// A typed instruction's variable: an element's index (below kRefLocal), a
-// local's index plus kRefLocal, or kRefT (T, kJInt only).
+// A typed instruction's variable (version 3): where it is, u16, and its
+// type, u8: an element's byte offset in the state vector (below kRefLocal),
+// a local's byte offset in the locals plus kRefLocal, or kRefT (T, kJInt
+// only, with U64's type): the VM adds the offset to the state vector's or the
+// locals' address, with no table to read.
 const uint16_t kRefLocal = 0x8000u;
 const uint16_t kRefT = 0xFFFFu;
 const uint8_t kTypeT = 0xFE;   // ref_type's type of T
+const uint8_t kVarBytes = 3;   // where, type
 const uint8_t kJumpIf = 0x80;  // kJInt/kJCmp: jump when the test holds (else when it fails)
 const uint8_t kKeyInclusive = 1, kKeyJumpIf = 2;  // kJKey's flags
 
@@ -48,13 +52,14 @@ inline bool is_int(uint8_t t) { return t <= kU64; }
 const uint8_t kSizes[kBool + 1] FSW_FLASH = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
 FSW_VM_INLINE uint8_t size_of(uint8_t t) { return flash_get(kSizes[t]); }
 
-// The comparisons' truth over the order of x and c: bit 0 when x < c, bit 1
-// when x == c, bit 2 when x > c, bit 3 when unordered (<, <=, >, >=, ==, !=
-// in kLt..kNe's order).
-const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered (order 2: a NaN)
-inline bool cmp_holds(uint8_t cmp, int8_t order) {
-    const uint8_t holds = flash_get(kCmpMask[cmp & 7u]);  // (a bit by a test, no shift loop on an AVR)
-    return (holds & (order < 0 ? 1u : order == 0 ? 2u : order == 1 ? 4u : 8u)) != 0;
+// The order of x and c as one bit (the order functions' answer): x < c,
+// x == c, x > c, unordered (a NaN).
+const uint8_t kBelow = 1, kEqual = 2, kAbove = 4, kUnordered = 8;
+// The comparisons' truth over that order: the bits of the orders for which
+// each holds (<, <=, >, >=, ==, != in kLt..kNe's order).
+const uint8_t kCmpMask[6] FSW_FLASH = {1, 3, 4, 6, 2, 5 | 8};  // != also holds unordered
+FSW_VM_INLINE bool cmp_holds(uint8_t cmp, uint8_t order) {
+    return (flash_get(kCmpMask[cmp & 7u]) & order) != 0;  // (a bit by a test, no shift loop on an AVR)
 }
 
 // N is 16 bits in the image: every runtime holds a window of 65535 samples.
@@ -231,7 +236,7 @@ uint32_t windows_size(const Parts& p) {
 // (kTypeT: T): a test's flags or comparison, its constant and its jump
 // offset; kSetK's value; kIAdd's source and constant.
 inline uint8_t typed_operands(uint8_t op, uint8_t t) {
-    if (op == kIAdd) return 6;
+    if (op == kIAdd) return kVarBytes + 4;
     const uint8_t size = t == kTypeT ? 4u : op == kJKey ? float_bytes(t) : elem_size(t);
     return op == kSetK ? size : static_cast<uint8_t>(1u + size + 2u);
 }
@@ -244,21 +249,45 @@ inline VmReason wrong_type(uint16_t ref) { return ref >= kRefLocal && ref != kRe
 template <class Im>
 FSW_VM_INLINE bool locked(const Im& im) { return has(kVmFeatLock) && (im[6] & kFlagLock) != 0; }
 
-// The type of a typed instruction's variable (kTypeT for T), or why not. An
-// image whose state vector is locked (kFlagLock) reads and writes elements
-// through the general instructions, which take the lock.
-template <class Im>
-VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t ref, bool lock, uint8_t& t) {
+// The layout's first element at byte offset `off` (layout.count: none).
+uint16_t elem_at(const VmLayout& layout, uint16_t off) {
+    uint16_t e = 0;
+    while (e < layout.count && flash_get(layout.elems[e].off) != off) ++e;
+    return e;
+}
+
+// Why the typed instruction's variable `ref` of type `t` may not be (kVmOk:
+// it may), and its type (kTypeT for T): T's type is U64's; an element's
+// offset and type must be an element's of the layout (the first at that
+// offset); a local's type one the VM takes, its bytes within the locals'.
+// An image whose state vector is locked (kFlagLock) reads and writes
+// elements through the general instructions, which take the lock. (One
+// function for both readers of the image.)
+FSW_NOINLINE VmReason var_rule(uint16_t loc_size, const VmLayout& layout, bool lock, uint16_t ref, uint8_t& t) {
     if (ref == kRefT) {
+        if (t != kU64) return kVmBadElement;
         t = kTypeT;
     } else if (ref >= kRefLocal) {
-        if (ref - kRefLocal >= p.locals) return kVmBadLocal;
-        t = im[static_cast<uint16_t>(p.loc + 3u * (ref - kRefLocal))];
+        const uint8_t n = elem_size(t);
+        const uint16_t off = static_cast<uint16_t>(ref - kRefLocal);  // (16-bit: unsigned on an AVR)
+        if (n == 0 || n > loc_size || off > loc_size - n) return kVmBadLocal;
+        if (!takes(t)) return kVmNoFeature;
     } else {
-        if (ref >= layout.count || lock) return kVmBadElement;
-        t = flash_get(layout.elems[ref].type);
+        if (lock) return kVmBadElement;
+        const uint16_t e = elem_at(layout, ref);
+        if (e == layout.count || flash_get(layout.elems[e].type) != t) return kVmBadElement;
     }
     return kVmOk;
+}
+
+// The typed instruction's variable at `a`: its operand, its type, and the
+// rule's answer.
+template <class Im>
+VmReason ref_type(const Im& im, const Offs& p, const VmLayout& layout, uint16_t a, bool lock, uint8_t& t,
+                  uint16_t& ref) {
+    ref = r16(im, a);
+    t = im[static_cast<uint16_t>(a + 2u)];
+    return var_rule(p.loc_size, layout, lock, ref, t);
 }
 
 // ---- the verifier: one pass over the image, resumable -------------------------
@@ -291,8 +320,9 @@ VmReason check_header(const Im& im, uint16_t len, const VmLayout& layout, Offs& 
             if (!takes(flash_get(layout.elems[e].type))) return kVmNoFeature;
     offsets(im, p);
     if (p.total != len) return kVmBadSize;
-    const uint16_t g = r16(im, 14), s = r16(im, 16);
-    if (g >= layout.count || s >= layout.count || flash_get(layout.elems[g].type) != kU64 ||
+    // G and S by their byte offsets (version 3), as a typed instruction's elements
+    const uint16_t g = elem_at(layout, r16(im, 14)), s = elem_at(layout, r16(im, 16));
+    if (g == layout.count || s == layout.count || flash_get(layout.elems[g].type) != kU64 ||
         flash_get(layout.elems[s].type) != kU32)
         return kVmBadElement;
     if (p.states == 0) return kVmBadState;
@@ -325,8 +355,8 @@ const uint8_t kOpInfo[kJCmp + 1] FSW_FLASH = {
     FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // LT LE GT
     FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain), FSW_VM_OP(0, 2, 1, kKindPlain),  // GE EQ NE
     FSW_VM_OP(0, 1, 1, kKindPlain), FSW_VM_OP(0, 1, 1, kKindPlain),                             // NOT TRUTH
-    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // JKEY JINT: the ref,
-    FSW_VM_OP(2, 0, 0, kKindTyped), FSW_VM_OP(2, 0, 0, kKindTyped),                             // SETK IADD: then its type's
+    FSW_VM_OP(3, 0, 0, kKindTyped), FSW_VM_OP(3, 0, 0, kKindTyped),                             // JKEY JINT: the var,
+    FSW_VM_OP(3, 0, 0, kKindTyped), FSW_VM_OP(3, 0, 0, kKindTyped),                             // SETK IADD: then its type's
     FSW_VM_OP(3, 2, 0, kKindJCmp),                                                              // JCMP
 };
 #undef FSW_VM_OP
@@ -365,11 +395,10 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
         }
     }
     if ((c.flags & kReachable) == 0) return kVmBadEnd;
-    const uint8_t real = im[5];
     const uint8_t op = im[p.code + pc];
     const uint8_t info = op < sizeof kOpInfo ? flash_get(kOpInfo[op]) : kOpUnknown;
     if (info == kOpUnknown) return kVmBadOpcode;
-    const uint8_t n = op == kConst ? real : static_cast<uint8_t>(info & 3u);
+    const uint8_t n = op == kConst ? im[5] : static_cast<uint8_t>(info & 3u);  // (R's bytes: read where needed)
     if (n >= p.code_size - pc) return kVmBadOpcode;  // (pc < code_size)
     const uint16_t a = static_cast<uint16_t>(p.code + pc + 1u);  // the operands
     pc = static_cast<uint16_t>(pc + 1u + n);
@@ -393,16 +422,19 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if (op == kJmp) c.flags &= static_cast<uint8_t>(~kReachable);
             break;
         case kKindTyped: {
-            const uint16_t ref = r16(im, a);
+            if (depth != 0) return kVmBadStack;  // (the VM runs them outside the stack's code)
+            // (each byte read once: the EEPROM verifier's reads a unit are bounded, fsw_vm.h)
+            const bool lock = locked(im);
+            uint16_t ref;
             uint8_t t;
-            const VmReason why = ref_type(im, p, layout, ref, locked(im), t);
+            const VmReason why = ref_type(im, p, layout, a, lock, t, ref);
             if (why != kVmOk) return why;
             const bool fits = op == kJKey ? t == kF32 || t == kF64
                               : op == kJInt ? t == kTypeT || is_int(t) || t == kBool
                               : op == kSetK ? t != kTypeT
                                             : is_int(t);
             if (!fits) return wrong_type(ref);
-            const uint16_t b = static_cast<uint16_t>(a + 2u);  // the operands after the ref
+            const uint16_t b = static_cast<uint16_t>(a + kVarBytes);  // the operands after the variable
             const uint8_t more = typed_operands(op, t);
             const uint8_t at = static_cast<uint8_t>(more - 2u);  // a test's jump offset, last
             if (more > p.code_size - pc) return kVmBadOpcode;  // (pc <= code_size)
@@ -410,14 +442,14 @@ uint8_t check_instruction(const Im& im, VmCheck& c, const Offs& p, const VmLayou
             if (op == kSetK) {
                 if (t == kBool && im[b] > 1u) return kVmBadOpcode;
             } else if (op == kIAdd) {
-                const uint16_t src = r16(im, b);
+                uint16_t src;
                 uint8_t ts;
-                const VmReason w = ref_type(im, p, layout, src, locked(im), ts);
+                const VmReason w = ref_type(im, p, layout, b, lock, ts, src);
                 if (w != kVmOk) return w;
                 if (!is_int(ts)) return wrong_type(src);
                 // |k| below 2^p (p = R's precision): every integer near k is exact in R.
-                const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + 2u)));
-                if (real == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
+                const int32_t k = static_cast<int32_t>(r32(im, static_cast<uint16_t>(b + kVarBytes)));
+                if (im[5] == 4 && (k > 16777215L || k < -16777215L)) return kVmBadOpcode;
             } else {
                 if (op == kJKey ? (im[b] & ~(kKeyInclusive | kKeyJumpIf)) != 0 : (im[b] & ~kJumpIf) > 5u)
                     return kVmBadOpcode;
@@ -650,7 +682,7 @@ struct Run {
     const VmElem* elems;  // the layout's element table (FSW_FLASH)
     uint8_t* sv;
     uint8_t* ram;
-    uint8_t* locals;  // the locals' bytes in ram
+    uintptr_t local_ref;  // the locals' address in ram less kRefLocal: a typed local's at local_ref + its operand
     Machine* m;
     bool lock;
 };
@@ -716,31 +748,35 @@ void window_push(const Run& r, uint8_t w, Real x) {
     }
 }
 
-// Where a typed instruction's variable (not T) is, and its type.
-FSW_VM_INLINE uint8_t* ref_at(const Run& r, uint16_t ref, uint8_t& t) {
-    if (ref >= kRefLocal) {
-        const uint8_t* l = r.loc + 3u * (ref - kRefLocal);
-        t = l[0];
-        return r.locals + u16(l + 1);
-    }
-    const VmElem* e = r.elems + ref;
-    t = flash_get(e->type);
-    return r.sv + flash_get(e->off);
+// Where the typed instruction's variable (not T) at `v` is, and its type.
+FSW_VM_INLINE uint8_t* ref_at(const Run& r, const uint8_t* v, uint8_t& t) {
+    t = v[2];
+    const uint16_t w = u16(v);
+    return reinterpret_cast<uint8_t*>(((w & kRefLocal) != 0 ? r.local_ref : reinterpret_cast<uintptr_t>(r.sv)) + w);
 }
 
 // The order of the n-byte little-endian numbers at x and c, compared from
-// their top bytes down as unsigned ones after `flip` is xored into both top
-// bytes (0x80: as signed ones): -1, 0 or 1. Byte by byte: no 64-bit
-// arithmetic on an 8-bit MCU.
-FSW_VM_INLINE int8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
+// their top down as unsigned ones after `flip` is xored into both top
+// bytes (0x80: as signed ones): kBelow, kEqual or kAbove. A 16-bit word at a time (n
+// even; a byte for n = 1): no 64-bit arithmetic on an 8-bit MCU, and half
+// the loop's turns over the equal high bytes of a small value.
+FSW_VM_INLINE uint8_t le_order(const uint8_t* x, const uint8_t* c, uint8_t n, uint8_t flip) {
+    if (n == 1) {
+        const uint8_t a = static_cast<uint8_t>(x[0] ^ flip), b = static_cast<uint8_t>(c[0] ^ flip);
+        return a < b ? kBelow : a > b ? kAbove : kEqual;
+    }
     x += n;
     c += n;
-    uint8_t a = static_cast<uint8_t>(*--x ^ flip), b = static_cast<uint8_t>(*--c ^ flip);
+    const uint16_t top = static_cast<uint16_t>(flip << 8);
+    uint16_t a = static_cast<uint16_t>(load<uint16_t>(x - 2) ^ top), b = static_cast<uint16_t>(load<uint16_t>(c - 2) ^ top);
     for (;;) {
-        if (a != b) return a < b ? -1 : 1;
-        if (--n == 0) return 0;
-        a = *--x;
-        b = *--c;
+        if (a != b) return a < b ? kBelow : kAbove;
+        n = static_cast<uint8_t>(n - 2u);
+        if (n == 0) return kEqual;
+        x -= 2;
+        c -= 2;
+        a = load<uint16_t>(x - 2);
+        b = load<uint16_t>(c - 2);
     }
 }
 
@@ -781,26 +817,30 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
 
 // kJInt's order of the variable at `x` (type t; T: op_jint_t)
 // against the constant at `c`.
-FSW_VM_INLINE int8_t int_order(const uint8_t* x, uint8_t t, const uint8_t* c) {
+// (n: the type's size, read once by the caller)
+FSW_VM_INLINE uint8_t int_order(const uint8_t* x, uint8_t t, uint8_t n, const uint8_t* c) {
     if (t == kBool) {  // 0 or 1 against any byte (the compiler writes 0 or 1)
         const uint8_t v = load_bool(x) ? 1 : 0;
-        return v < c[0] ? -1 : v > c[0] ? 1 : 0;
+        return v < c[0] ? kBelow : v > c[0] ? kAbove : kEqual;
     }
-    return le_order(x, c, size_of(t), is_signed(t) ? 0x80 : 0x00);
+    return le_order(x, c, n, is_signed(t) ? 0x80 : 0x00);
 }
 
 template <bool Narrow>
 struct IntFast {
     typedef int64_t T;
+    typedef uint64_t U;
 };
 template <>
 struct IntFast<true> {
     typedef int32_t T;
+    typedef uint32_t U;
 };
 
 // The integers of kIAdd's fast path: |x| <= 2^p - 1 - |k| and x + k, with p
 // R's precision (24 or 53), fit this type with a byte to spare.
 typedef IntFast<sizeof(Real) == 4>::T Wide;
+typedef IntFast<sizeof(Real) == 4>::U UWide;
 
 // The largest value of each integer type narrower than 8 bytes, in a
 // Wide (kIAdd's clamp; unused for the 8-byte types).
@@ -826,14 +866,18 @@ FSW_VM_INLINE bool as_wide(const uint8_t* x, uint8_t ts, Wide& a) {
 }
 
 // `d = x + k` for integers d and x (kIAdd): the integer sum clamped to d's
-// range when |x| <= 2^p - 1 - |k| (x, x + k and the sum exact in R), else
+// range when |x| + |k| <= 2^p - 1 (x, x + k and the sum exact in R), else
 // the sum in R as the general instructions compute it. Bytes of d above
 // Wide's are filled with the sum's sign.
 void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
-    const Wide exact = sizeof(Real) == 4 ? static_cast<Wide>(0xFFFFFFL) : static_cast<Wide>(0x1FFFFFFFFFFFFFLL);
-    const Wide limit = exact - (k < 0 ? -static_cast<Wide>(k) : static_cast<Wide>(k));
+    const UWide exact = sizeof(Real) == 4 ? static_cast<UWide>(0xFFFFFFUL) : static_cast<UWide>(0x1FFFFFFFFFFFFFULL);
     Wide v;
-    if (!as_wide(x, ts, v) || v < -limit || v > limit) {
+    // |x| + |k| in unsigned arithmetic: |x| <= 2^31 (2^63), |k| < 2^24 in
+    // binary32 (a verifier's rule), < 2^31 in binary64: no wrap
+    if (!as_wide(x, ts, v) ||
+        (v < 0 ? UWide(0) - static_cast<UWide>(v) : static_cast<UWide>(v)) +
+                (k < 0 ? UWide(0) - static_cast<UWide>(static_cast<Wide>(k)) : static_cast<UWide>(k)) >
+            exact) {
         vm_write(d, td, vm_read(x, ts) + static_cast<Real>(k));
         return;
     }
@@ -869,18 +913,35 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
 // run_block would otherwise save on every block.
 FSW_VM_INLINE const uint8_t* op_setk(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    uint8_t* x = ref_at(r, u16(ip + 1), t);
-    const uint8_t n = size_of(t);
-    for (uint8_t i = 0; i < n; ++i) x[i] = ip[3 + i];  // (no call: a leaf saves fewer registers)
-    return ip + 3 + n;
+    uint8_t* x = ref_at(r, ip + 1, t);
+    const uint8_t* v = ip + 4;
+    x[0] = *v++;  // (a flag's one byte without the loop; no call: a leaf saves fewer registers)
+    for (uint8_t n = size_of(t); --n != 0;) *++x = *v++;
+    return v;
 }
 
 FSW_NOINLINE const uint8_t* op_iadd(const Run& r, const uint8_t* ip) {
     uint8_t td, ts;
-    uint8_t* d = ref_at(r, u16(ip + 1), td);
-    const uint8_t* x = ref_at(r, u16(ip + 3), ts);
-    int_add(d, td, x, ts, static_cast<int32_t>(u32(ip + 5)));
-    return ip + 9;
+    uint8_t* d = ref_at(r, ip + 1, td);
+    const uint8_t* x = ref_at(r, ip + 4, ts);
+    int_add(d, td, x, ts, static_cast<int32_t>(u32(ip + 7)));
+    return ip + 11;
+}
+
+// kIAdd of a counter, the machines' commonest sum: a U64 from a U64 plus k
+// (0 <= k < 2^24, as the compiler writes `n = n + 1`), in 32-bit words,
+// int_add's integer path where x + k < 2^24 (exact in R: no clamp); else
+// null. Inline in run_block: a leaf of few registers.
+FSW_VM_INLINE const uint8_t* op_count(const Run& r, const uint8_t* ip) {
+    if (ip[3] != kU64 || ip[6] != kU64 || ip[10] != 0) return nullptr;  // (k < 2^24: its top byte 0)
+    uint8_t t;
+    const uint8_t* x = ref_at(r, ip + 4, t);
+    const uint32_t lo = load<uint32_t>(x), v = lo + u32(ip + 7);  // (both below 2^24: no wrap)
+    if (load<uint32_t>(x + 4) != 0 || lo > 0xFFFFFFUL || v > 0xFFFFFFUL) return nullptr;
+    uint8_t* d = ref_at(r, ip + 1, t);
+    store<uint32_t>(d, v);
+    store<uint32_t>(d + 4, 0);
+    return ip + 11;
 }
 
 // The end of a test's instruction (its jump offset `o`, 2 bytes, last):
@@ -891,45 +952,43 @@ FSW_VM_INLINE const uint8_t* test_end(const uint8_t* o, bool holds, bool jump_if
 
 FSW_VM_INLINE const uint8_t* op_jkey(const Run& r, const uint8_t* ip) {
     uint8_t t;
-    const uint8_t* x = ref_at(r, u16(ip + 1), t);
+    const uint8_t* x = ref_at(r, ip + 1, t);
     const uint8_t n = float_bytes(t);
-    const uint8_t flags = ip[3];
-    const bool holds = key_holds(x, n, ip + 4, (flags & kKeyInclusive) != 0);
-    return test_end(ip + 4 + n, holds, (flags & kKeyJumpIf) != 0);
+    const uint8_t flags = ip[4];
+    const bool holds = key_holds(x, n, ip + 5, (flags & kKeyInclusive) != 0);
+    return test_end(ip + 5 + n, holds, (flags & kKeyJumpIf) != 0);
 }
 
 // kJInt of T: a function of its own, which calls machine_T32, so that the
 // test of a variable calls nothing and saves few registers.
 FSW_NOINLINE const uint8_t* op_jint_t(const Run& r, const uint8_t* ip) {
-    const uint32_t v = machine_T32(*r.m), c = u32(ip + 4);
-    const bool holds = cmp_holds(ip[3], v < c ? -1 : v > c ? 1 : 0);
-    return test_end(ip + 8, holds, (ip[3] & kJumpIf) != 0);
+    const uint32_t v = machine_T32(*r.m), c = u32(ip + 5);
+    const bool holds = cmp_holds(ip[4], v < c ? kBelow : v > c ? kAbove : kEqual);
+    return test_end(ip + 9, holds, (ip[4] & kJumpIf) != 0);
 }
 
 FSW_VM_INLINE const uint8_t* op_jint(const Run& r, const uint8_t* ip) {
-    const uint16_t ref = u16(ip + 1);
-    if (ref == kRefT) return op_jint_t(r, ip);
+    if (ip[1] == 0xFFu && ip[2] == 0xFFu) return op_jint_t(r, ip);  // kRefT
     uint8_t t;
-    const uint8_t* x = ref_at(r, ref, t);
-    const uint8_t flags = ip[3];
-    const bool holds = cmp_holds(flags, int_order(x, t, ip + 4));
-    return test_end(ip + 4 + size_of(t), holds, (flags & kJumpIf) != 0);
+    const uint8_t* x = ref_at(r, ip + 1, t);
+    const uint8_t flags = ip[4];
+    const uint8_t n = size_of(t);
+    const bool holds = cmp_holds(flags, int_order(x, t, n, ip + 5));
+    return test_end(ip + 5 + n, holds, (flags & kJumpIf) != 0);
 }
-
-uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one);
 
 // truthy() in one place (two float compares a call on an AVR), for the
 // operand stack's tests.
 FSW_NOINLINE bool vm_truthy(Real r) { return truthy(r); }
 
-// The order of two R values for kJCmp: -1, 0, 1, or 2 when unordered (a NaN).
-int8_t real_order(Real x, Real y) { return x < y ? -1 : x > y ? 1 : x == y ? 0 : 2; }
+// The order of two R values for kJCmp and the comparisons (a NaN: unordered).
+uint8_t real_order(Real x, Real y) { return x < y ? kBelow : x > y ? kAbove : x == y ? kEqual : kUnordered; }
 
 // Code that evaluates on the operand stack, from `pc` (at depth 0) to the
 // instruction after the one that empties the stack again: where the block
 // goes on. Apart from run_block, so that the stack's frame is only set up
-// for such code. (The compiler emits typed instructions only at depth 0, but
-// any verified image runs: they are handled here too.)
+// for such code. (Typed instructions run at depth 0 only, a verifier's rule:
+// never here.)
 FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
     Real st[FSW_VM_STACK];
     uint8_t sp = 0;
@@ -984,13 +1043,12 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
             case kLdl:
             case kStl: {
                 const uint8_t* l = r.loc + 3u * u16(a);
-                uint8_t* at = r.locals + u16(l + 1);
+                uint8_t* at = reinterpret_cast<uint8_t*>(r.local_ref + kRefLocal + u16(l + 1));
                 if (op == kLdl) st[sp++] = vm_read(at, l[0]);
                 else vm_write(at, l[0], st[--sp]);
                 pc = static_cast<uint16_t>(pc + 3u);
                 continue;
             }
-            case kJKey: case kJInt: case kSetK: case kIAdd: (void)run_block(r, pc, &pc); continue;
             case kJCmp: {
                 sp = static_cast<uint8_t>(sp - 2u);
                 const bool holds = cmp_holds(a[0], real_order(st[sp], st[sp + 1u]));
@@ -1033,25 +1091,23 @@ FSW_NOINLINE uint16_t run_stack(const Run& r, uint16_t pc) {
 
 // Runs the block at `pc`: the state id it goes to (0: none). Typed
 // instructions (inline: no call each) and jumps run here, stack code in
-// run_stack. With `one`, runs the typed instruction at `pc` alone and
-// stores where code goes on there (run_stack's: the compiler emits typed
-// instructions only at depth 0, but any verified image runs).
-FSW_NOINLINE uint32_t run_block(const Run& r, uint16_t pc, uint16_t* one) {
+// run_stack.
+FSW_NOINLINE uint16_t run_block(const Run& r, uint16_t pc) {
     const uint8_t* ip = r.code + pc;
     for (;;) {
         switch (*ip) {
             case kEnd: return 0;
-            case kGoto: return static_cast<uint32_t>(ip[1]) + 1u;
+            case kGoto: return static_cast<uint16_t>(ip[1] + 1u);
             case kJmp: ip += 3 + u16(ip + 1); continue;
-            case kJKey: ip = op_jkey(r, ip); break;
-            case kJInt: ip = op_jint(r, ip); break;
-            case kSetK: ip = op_setk(r, ip); break;
-            case kIAdd: ip = op_iadd(r, ip); break;
+            case kJKey: ip = op_jkey(r, ip); continue;
+            case kJInt: ip = op_jint(r, ip); continue;
+            case kSetK: ip = op_setk(r, ip); continue;
+            case kIAdd: {
+                const uint8_t* next = op_count(r, ip);
+                ip = next != nullptr ? next : op_iadd(r, ip);
+                continue;
+            }
             default: ip = r.code + run_stack(r, static_cast<uint16_t>(ip - r.code)); continue;
-        }
-        if (one != nullptr) {
-            *one = static_cast<uint16_t>(ip - r.code);
-            return 0;
         }
     }
 }
@@ -1070,8 +1126,9 @@ FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout
     r.elems = layout.elems;
     r.sv = sv;
     r.ram = ram;
-    r.locals = ram;
-    if (has(kVmFeatWindows) && image[19] != 0) r.locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
+    uint8_t* locals = ram;
+    if (has(kVmFeatWindows) && image[19] != 0) locals += ram_of_windows(r.win, image[19]);  // (none where the VM takes none)
+    r.local_ref = reinterpret_cast<uintptr_t>(locals) - kRefLocal;
     r.m = &m;
     r.lock = has(kVmFeatLock) && (image[6] & kFlagLock) != 0;  // (a verified image is locked only where built so)
 }
@@ -1081,8 +1138,8 @@ FSW_VM_INLINE void run_init(Run& r, const uint8_t* image, const VmLayout& layout
 Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t* ram, Machine& m) {
     Run r;
     run_init(r, image, layout, sv, ram, m);
-    uint8_t* g = sv + flash_get(layout.elems[u16(image + 14)].off);
-    uint8_t* s = sv + flash_get(layout.elems[u16(image + 16)].off);
+    uint8_t* g = sv + u16(image + 14);
+    uint8_t* s = sv + u16(image + 16);
     if (has(kVmFeatLock) && r.lock) {  // as a generated step() over a locked state vector
         uint64_t now;
         {
@@ -1098,16 +1155,16 @@ Result vm_step(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_
         return kErrTime;
     }
     const uint16_t prelude = u16(image + 24);
-    if (r.code[prelude] != kEnd && run_block(r, prelude, nullptr) != 0) return kErrConfig;  // unreachable when verified
-    const uint8_t states = image[18];
-    if (m.state == 0 || m.state > states) return kOk;
-    const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(m.state - 1u);
-    const uint16_t entry = u16(blocks), step = u16(blocks + 2), exit = u16(blocks + 4);
-    uint32_t next = 0;
-    if (m.entering != 0 && entry != kNone) next = run_block(r, entry, nullptr);
-    if (next == 0 && step != kNone) next = run_block(r, step, nullptr);
+    if (r.code[prelude] != kEnd && run_block(r, prelude) != 0) return kErrConfig;  // unreachable when verified
+    const uint32_t index = m.state - 1u;  // (state 0, none: past every state)
+    if (index >= image[18]) return kOk;
+    // the state's .entry, .step and .exit, each read where it is needed
+    const uint8_t* blocks = image + kHeader + 6u * static_cast<uint8_t>(index);
+    uint16_t next = 0;
+    if (m.entering != 0 && u16(blocks) != kNone) next = run_block(r, u16(blocks));
+    if (next == 0 && u16(blocks + 2) != kNone) next = run_block(r, u16(blocks + 2));
     if (next != 0) {
-        if (exit != kNone) (void)run_block(r, exit, nullptr);
+        if (u16(blocks + 4) != kNone) (void)run_block(r, u16(blocks + 4));
         machine_transition(m, next);
     }
     return kOk;
@@ -1119,7 +1176,7 @@ void vm_leave(const uint8_t* image, const VmLayout& layout, uint8_t* sv, uint8_t
     run_init(r, image, layout, sv, ram, m);
     if (m.state == 0 || m.state > image[18]) return;
     const uint16_t exit = u16(image + kHeader + 6u * (m.state - 1u) + 4u);
-    if (exit != kNone) (void)run_block(r, exit, nullptr);
+    if (exit != kNone) (void)run_block(r, exit);
 }
 
 }  // namespace fsw

@@ -18,7 +18,7 @@ enum VmReason : uint8_t {
     kVmBadReal = 3,      // compiled for the other evaluation type (f32 / f64)
     kVmBadSchema = 4,    // bound to another state vector (schema hash, element count)
     kVmBadSize = 5,      // the lengths in the header do not add up to the image
-    kVmBadElement = 6,   // an element index out of range, or its type not the layout's
+    kVmBadElement = 6,   // an element index or offset not the layout's, or its type not the layout's
     kVmBadLocal = 7,     // a local index out of range, or a local outside the locals
     kVmBadState = 8,     // no states, a state index out of range, a code offset out of range
     kVmBadWindow = 9,    // a window index, function or size out of range, or pushed out of order

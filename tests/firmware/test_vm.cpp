@@ -29,7 +29,8 @@ enum : uint8_t {
     LT = 0x18, GT = 0x1A, NOT = 0x1E, TRUTH = 0x1F,
     JKEY = 0x20, JINT = 0x21, SETK = 0x22, IADD = 0x23, JCMP = 0x24,
 };
-// A typed instruction's variable: element k, or local k + L0, or T.
+// A typed instruction's variable: an element's byte offset (x at 12, n at
+// 16), or a local's plus L0 << 8, or T; then its type.
 const uint8_t L0 = 0x80, TLO = 0xFF, THI = 0xFF;
 const uint16_t NO = 0xFFFFu;
 
@@ -65,15 +66,15 @@ void build(Image& im, const uint8_t* code, uint16_t n, const uint16_t offs[6], u
     memset(im.b, 0, sizeof im.b);
     uint8_t* h = im.b;
     h[0] = 'F'; h[1] = 'S'; h[2] = 'M'; h[3] = 'B';
-    h[4] = 2;
+    h[4] = 3;
     h[5] = sizeof(Real);
     h[6] = 0;
     h[7] = stack;
     put16(h + 8, 0x5678);
     put16(h + 10, 0x1234);
     put16(h + 12, 4);  // elements
-    put16(h + 14, 0);  // G
-    put16(h + 16, 1);  // S
+    put16(h + 14, 0);  // G, at 0
+    put16(h + 16, 8);  // S, at 8
     h[18] = 2;         // states
     h[19] = 1;         // windows
     put16(h + 20, 1);  // locals
@@ -144,6 +145,9 @@ void test_header_rules(void) {
     im.b[4] = 1;  // the format before the typed instructions
     TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
     good(im);
+    im.b[4] = 2;  // typed instructions naming a variable by its index
+    TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
+    good(im);
     im.b[6] = 0x80;  // an unknown flag
     TEST_ASSERT_EQUAL_UINT(kVmBadVersion, verify(im));
     good(im);
@@ -167,10 +171,16 @@ void test_element_rules(void) {
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, patched(29, kI32)); // a store of n as I32
     Image im;
     good(im);
-    put16(im.b + 14, 2);  // G bound to x (F32)
+    put16(im.b + 14, 12);  // G bound to x (F32)
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
     good(im);
     put16(im.b + 16, 0);  // S bound to G (U64)
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    good(im);
+    put16(im.b + 14, 1);  // G inside itself: no element's offset
+    TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
+    good(im);
+    put16(im.b + 16, 1);  // S by its index (format 2): G's second byte
     TEST_ASSERT_EQUAL_UINT(kVmBadElement, verify(im));
 }
 
@@ -364,30 +374,38 @@ void test_nesting_rule(void) {
 // A typed instruction's rule: the step's code (in flash, as the table is
 // long for an Uno) and the reason it gets.
 struct TypedCase {
-    uint8_t code[12];
+    uint8_t code[14];
     uint8_t n, stack, reason;
 };
 const uint8_t kIfF32 = sizeof(Real) == 4 ? kVmBadOpcode : kVmOk;
 const TypedCase kTypedCases[] FSW_FLASH = {
     // JKEY x > 1.5 (its key 0xBFC00000), jump past END to END
-    {{JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmOk},
-    {{JKEY, 3, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadElement},  // n: an I16
-    {{JKEY, 4, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadElement},  // past the layout
-    {{JKEY, 0, L0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadLocal},   // local 0: a U8
-    {{JKEY, 1, L0, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadLocal},   // one local only
-    {{JKEY, 2, 0, 4, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 12, 1, kVmBadOpcode},   // an unknown flag
-    // JINT T > 0x00000FA0 (4 bytes for T), jump past END
-    {{JINT, TLO, THI, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 12, 1, kVmOk},
-    {{JINT, TLO, THI, 0x86, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 12, 1, kVmBadOpcode},  // comparison 6: none
-    {{JINT, 2, 0, 0x02, 0, 0, 0, 0, 1, 0, END, END}, 12, 1, kVmBadElement},          // x is no integer
-    {{JINT, TLO, THI, 0x82, 0, 0, 0, 0, 9, 0, END, END}, 12, 1, kVmBadJump},          // past the code
+    {{JKEY, 12, 0, kF32, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmOk},
+    {{JKEY, 16, 0, kI16, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadElement},  // n: an I16
+    {{JKEY, 12, 0, kF64, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadElement},  // x is no F64
+    {{JKEY, 14, 0, kF32, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadElement},  // inside x
+    {{JKEY, 20, 0, kF32, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadElement},  // past the layout
+    {{JKEY, 0, L0, kU8, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadLocal},    // local 0: a U8
+    {{JKEY, 0, L0, kF32, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadLocal},   // 4 bytes of 1
+    {{JKEY, 1, L0, kU8, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadLocal},    // past the locals
+    {{JKEY, 0, L0, 11, 2, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadLocal},     // no type
+    {{JKEY, 12, 0, kF32, 4, 0x00, 0x00, 0xC0, 0xBF, 1, 0, END, END}, 13, 1, kVmBadOpcode},  // an unknown flag
+    // JINT T > 0x00000FA0 (4 bytes for T, whose type is U64's), jump past END
+    {{JINT, TLO, THI, kU64, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 13, 1, kVmOk},
+    {{JINT, TLO, THI, kU32, 0x82, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 13, 1, kVmBadElement},  // T of another type
+    {{JINT, TLO, THI, kU64, 0x86, 0xA0, 0x0F, 0, 0, 1, 0, END, END}, 13, 1, kVmBadOpcode},  // comparison 6: none
+    {{JINT, 12, 0, kF32, 0x02, 0, 0, 0, 0, 1, 0, END, END}, 13, 1, kVmBadElement},         // x is no integer
+    {{JINT, TLO, THI, kU64, 0x82, 0, 0, 0, 0, 9, 0, END, END}, 13, 1, kVmBadJump},         // past the code
     // SETK: T takes nothing
-    {{SETK, 0, L0, 7, END}, 5, 1, kVmOk},
-    {{SETK, TLO, THI, 0, 0, 0, 0, 0, 0, 0, 0, END}, 12, 1, kVmBadElement},
+    {{SETK, 0, L0, kU8, 7, END}, 6, 1, kVmOk},
+    {{SETK, TLO, THI, kU64, 0, 0, 0, 0, 0, 0, 0, 0, END}, 13, 1, kVmBadElement},
+    // typed instructions run at depth 0 only
+    {{LDT, SETK, 0, L0, kU8, 7, STE, 3, 0, kI16, END}, 11, 1, kVmBadStack},
     // IADD n = l + k: integers only, |k| below 2^24 in binary32
-    {{IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END}, 10, 1, kVmOk},                 // k = -10
-    {{IADD, 2, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF, END}, 10, 1, kVmBadElement},         // into x: a float
-    {{IADD, 3, 0, 0, L0, 0x00, 0x00, 0x00, 0x01, END}, 10, 1, kIfF32},                // k = 2^24
+    {{IADD, 16, 0, kI16, 0, L0, kU8, 0xF6, 0xFF, 0xFF, 0xFF, END}, 12, 1, kVmOk},         // k = -10
+    {{IADD, 12, 0, kF32, 0, L0, kU8, 0xF6, 0xFF, 0xFF, 0xFF, END}, 12, 1, kVmBadElement}, // into x: a float
+    {{IADD, 16, 0, kI16, 1, L0, kU8, 0xF6, 0xFF, 0xFF, 0xFF, END}, 12, 1, kVmBadLocal},   // from past the locals
+    {{IADD, 16, 0, kI16, 0, L0, kU8, 0x00, 0x00, 0x00, 0x01, END}, 12, 1, kIfF32},        // k = 2^24
     // JCMP pops two
     {{LDT, LDT, JCMP, 0x00, 1, 0, END, END}, 8, 2, kVmOk},
     {{LDT, JCMP, 0x00, 1, 0, END, END}, 7, 1, kVmBadStack},
@@ -412,13 +430,13 @@ void test_typed_instruction_rules(void) {
 
 void test_the_vm_steps_typed_instructions(void) {
     const uint8_t code[] = {
-        SETK, 0, L0, 7,                           // 0: l = 7
-        IADD, 3, 0, 0, L0, 0xF6, 0xFF, 0xFF, 0xFF,   // 4: n = l - 10
-        JINT, 3, 0, 0x80, 0, 0, 4, 0,             // 13: n < 0: past the next
-        SETK, 0, L0, 99,                          // 21
-        JKEY, 2, 0, 2, 0x00, 0x00, 0xC0, 0xBF, 2, 0,  // 25: x > 1.5: past the goto
-        GOTO, 1,                                  // 35: to B
-        END,                                      // 37
+        SETK, 0, L0, kU8, 7,                                 // 0: l = 7
+        IADD, 16, 0, kI16, 0, L0, kU8, 0xF6, 0xFF, 0xFF, 0xFF,  // 5: n = l - 10
+        JINT, 16, 0, kI16, 0x80, 0, 0, 5, 0,                 // 16: n < 0: past the next
+        SETK, 0, L0, kU8, 99,                                // 25
+        JKEY, 12, 0, kF32, 2, 0x00, 0x00, 0xC0, 0xBF, 2, 0,  // 30: x > 1.5: past the goto
+        GOTO, 1,                                             // 41: to B
+        END,                                                 // 43
     };
     Image im;
     step_image(im, code, sizeof code, 1);
@@ -453,7 +471,7 @@ void test_the_vm_steps_typed_instructions(void) {
     TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
     TEST_ASSERT_EQUAL_UINT32(2, m.state);
     // IADD saturates at its target's range: n = l + 40000 is 32767
-    const uint8_t sat[] = {IADD, 3, 0, 0, L0, 0x40, 0x9C, 0x00, 0x00, END};
+    const uint8_t sat[] = {IADD, 16, 0, kI16, 0, L0, kU8, 0x40, 0x9C, 0x00, 0x00, END};
     step_image(im, sat, sizeof sat, 1);
     TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
     vm_reset(im.b, ram, m, 1);

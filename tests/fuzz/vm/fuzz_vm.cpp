@@ -46,7 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     put16(im + 10, static_cast<uint16_t>(kSchema >> 16));
     put16(im + 12, kCount);
     put16(im + 14, 0);
-    put16(im + 16, 1);
+    put16(im + 16, 8);  // (G and S by their offsets)
     const uint16_t len = static_cast<uint16_t>(size);
     uint32_t need = vm_ram_size(im, len);
     const uint32_t ram_len = need == 0 ? 1u : need > kRamCap ? kRamCap : need;

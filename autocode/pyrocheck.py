@@ -276,6 +276,23 @@ def _implies(e: M.Expr, pol: bool, a: int, folder: Folder) -> bool:
     return False
 
 
+def element_var(m: M.Machine, name: str) -> M.Var | None:
+    """The machine's variable for the state vector element `name`: the one
+    declared under that element name, not one whose `@alias` is `name` (a
+    machine may call another element so: `bool led @alias armSwitch` is
+    the LED, whatever it is called)."""
+    return next((v for v in m.vars if v.kind == M.ELEMENT and v.name == name), None)
+
+
+def _alias_note(m: M.Machine, name: str) -> str:
+    """` (in machine `m`, `name` is an alias of element `x`, not the input)`
+    when the machine calls another element `name`, else nothing."""
+    v = m.var(name)
+    if v is None or v.name == name:
+        return ""
+    return f" (in machine `{m.name}`, `{name}` is an alias of element `{v.name}`, not the input)"
+
+
 # ---- the [pyro] section ---------------------------------------------------------
 
 def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine], machine_srcs: dict,
@@ -539,7 +556,7 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
         parents = unarmed(g, armed)
         name = ch.element.name
         where = f"{app}:{ch.line}"
-        var = m.var(name)
+        var = element_var(m, name)
         for w in (g.writes.get(var.index, ()) if var is not None and var.kind == M.ELEMENT else ()):
             if not w.fires:
                 continue
@@ -572,14 +589,14 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
                             f"leads to sets `{name}` true")
         arm_vars = []
         for c in ch.arm:
-            v = m.var(c.element.name)
-            arm_vars.append((c.element.name, v.index if v is not None and v.kind == M.ELEMENT else None))
+            v = element_var(m, c.element.name)
+            arm_vars.append((c.element.name, v.index if v is not None else None))
         for s in parents:
             for e in g.edges[s]:
                 if e.dst not in armed:
                     continue
                 cont = ch.continuity.element.name if ch.continuity is not None else None
-                cv = m.var(cont) if cont is not None else None
+                cv = element_var(m, cont) if cont is not None else None
                 if cont is not None and (cv is None or not any(cv.index in _reads(c) for c, _ in e.conds)):
                     # arming without a look at the igniter: warned once per transition and channel
                     r.diags.warning(msrc, SM, e.goto.line, e.goto.col,
@@ -596,7 +613,7 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
                 entry[2].append(f"`{name}` ({where})")
     for (midx, _, _), (e, missing, chs) in sorted(guards.items(), key=lambda kv: kv[0]):
         m = machines[midx]
-        need = " and ".join(f"`{n}`" for n in missing)
+        need = " and ".join(f"`{n}`" for n in missing) + "".join(_alias_note(m, n) for n in missing)
         what = "pyro channel" if len(chs) == 1 else "pyro channels"
         r.diags.error(machine_srcs[m.name], SM, e.goto.line, e.goto.col,
                       f"transition from `{m.states[e.src].name}`, reached unarmed, into armed state "
@@ -643,7 +660,7 @@ def pyro_report(app: M.Application) -> str:
         lines.append("  arming transitions (each requires " + " and ".join(c.element.name for c in ch.arm) + "):")
         lines += [f"    {m.states[e.src].name} -> {m.states[e.dst].name}  {sm}:{e.goto.line}" for e in arming] \
             or ["    none"]
-        var = m.var(ch.element.name)
+        var = element_var(m, ch.element.name)
         fires = [w for w in g.writes.get(var.index, ()) if w.fires] if var is not None else []
         live = [w for w in fires if w.state in everywhere]
         lines.append("  states that can fire it:")

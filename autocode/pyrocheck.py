@@ -307,6 +307,8 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
     outputs = [t for t in tasks if t.kind == "outputs"]
     if not outputs and not any(t.kind is not None and t.kind.text == "outputs" for t in task_rows):
         r.err(rows[0].element, "pyro channels need an `outputs` task in [tasks]: nothing would drive their pins")
+    if outputs:
+        _no_mode(max(outputs, key=lambda t: t.rate), rows, task_rows, r)
     tables = _Tables(channels)
     declared: dict[str, int] = {}  # element name -> its row's line
     out: list[M.PyroChannel] = []
@@ -326,6 +328,25 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
                              "would drive the charge whatever the arming and the machine's state)")
     _prove(out, machines, machine_srcs, app, r, {row.element.line: row.element.col for row in rows})
     return out
+
+
+def _no_mode(task: M.Task, rows, task_rows, r) -> None:
+    """The outputs task that drives the pyro pins (the first of the fastest,
+    autocode/emit/app.py `pyro_task`) ends their pulses: it runs at every
+    one of its cycles, so it takes no `mode=` (a disabled or safed task runs
+    no step, and a pin high when the ground disabled it would stay high)."""
+    if task.mode is None:
+        return
+    row = next((t for t in task_rows if t.name.text == task.name), None)
+    at = next((o.key for o in row.options.items if o.key.text == "mode"), row.name) if row is not None else None
+    names = ", ".join(dict.fromkeys(p.element.text for p in rows))
+    message = (f"task `{task.name}` drives the pyro channels ({names}) and counts their pulses down: it cannot "
+               f"have a mode (`fsw cmd mode {task.name} disabled` in a pulse would leave the charge's pin high); "
+               "drop its `mode=`")
+    if at is not None:
+        r.err(at, message)
+    else:
+        r.diags.error(r.src, APP, task.line, 1, message)
 
 
 class _Tables:

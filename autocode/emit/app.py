@@ -172,6 +172,9 @@ def _resume(app: Application) -> list[str]:
         if stored_locals(m, real):
             spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
     spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
+    if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
+        spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
+        spans.append(("reload_ram", "sizeof reload_ram", "an uploaded machine's windows and locals"))
     if app.log is not None:
         spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
     c = ["// ---- resuming the flight after a reset (docs/safety.md) ----",
@@ -295,7 +298,11 @@ def _app_cpp(app: Application) -> str:
         c.append("    const bool resumed = fsw::resume_begin(resume, &kResumeConfig, fsw::pal::reset_cause());")
     if app.log is not None and resumes(app):
         c.append("    const uint8_t log_flight = rec.flight, log_mode = rec.mode;  // as kept")
-    if app.reload is not None:
+    if app.reload is not None and resumes(app):
+        c.append("    const uint8_t reload_active = reload.active;  // as kept")
+        c.append("    // the newest activated image, else the generated machine; after a resume the one that ran, as kept")
+        c.append("    fsw::reload_begin(reload, &kReloadConfig, resumed ? reload_active : fsw::kReloadNone);")
+    elif app.reload is not None:
         c.append("    fsw::reload_begin(reload, &kReloadConfig);  // the newest activated image, else the generated machine")
     if app.log is not None:
         c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")

@@ -12,7 +12,8 @@ from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
 from ..params import app_parameters
-from ..schema import app_schema_hash, link_plan
+from ..schema import app_schema_hash, link_plan, link_text, schema_hash
+from ..version import __version__
 from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
 from .expr import float_key_test
@@ -188,10 +189,28 @@ def _resume(app: Application) -> list[str]:
     c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
     c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a check")
     c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
-             f"0x{app_schema_hash(app):08x}UL, kResumeSize, {len(spans)}}};")
+             f"0x{resume_hash(app):08x}UL, kResumeSize, {len(spans)}}};  // the check's seed: resume_hash")
     c.append("fsw::Resume resume;")
     c.append("")
     return c
+
+
+def resume_hash(app: Application) -> int:
+    """The seed of the banks' check: what gives the kept bytes their
+    meaning. The link schema (the state vector's layout, the machines'
+    state numbers, the pyro channels), and beyond it each machine's stored
+    locals (types and names, in their order), the evaluation type, the
+    runtime's version, the recorder's flight and an uploaded machine's RAM:
+    a bank of a build that lays them out otherwise does not check."""
+    real = real_of(app)
+    lines = [f"resume {__version__} {app.board.real}"]
+    for m in app.machines:
+        lines.append(f"locals {m.name} " + " ".join(f"{v.type.name}:{v.name}" for v in stored_locals(m, real)))
+    if app.log is not None:
+        lines.append("recorder")
+    if app.reload is not None:
+        lines.append(f"reload {app.machines[app.reload.machine].name} {app.reload.ram}")
+    return schema_hash(app.sv, link_text(app) + "\n".join(lines) + "\n")
 
 
 def _resume_begin(app: Application) -> list[str]:

@@ -333,16 +333,17 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
 def _no_mode(task: M.Task, rows, task_rows, r) -> None:
     """The outputs task that drives the pyro pins (the first of the fastest,
     autocode/emit/app.py `pyro_task`) ends their pulses: it runs at every
-    one of its cycles, so it takes no `mode=` (a disabled or safed task runs
-    no step, and a pin high when the ground disabled it would stay high)."""
+    one of its cycles (a disabled or safed task runs no step, and a pin high
+    then would stay high; the target refuses a MODE that would stop it), so
+    it takes no `mode=`."""
     if task.mode is None:
         return
     row = next((t for t in task_rows if t.name.text == task.name), None)
     at = next((o.key for o in row.options.items if o.key.text == "mode"), row.name) if row is not None else None
     names = ", ".join(dict.fromkeys(p.element.text for p in rows))
     message = (f"task `{task.name}` drives the pyro channels ({names}) and counts their pulses down: it cannot "
-               f"have a mode (`fsw cmd mode {task.name} disabled` in a pulse would leave the charge's pin high); "
-               "drop its `mode=`")
+               f"have a mode (it runs always: `fsw cmd mode {task.name} disabled` in a pulse would leave the charge's "
+               "pin high, and the target refuses it); drop its `mode=`")
     if at is not None:
         r.err(at, message)
     else:

@@ -735,7 +735,8 @@ def _link_stores(app: Application) -> str:
     (every field written: a partial initializer warns under -Wextra)."""
     out = ", &params, fsw::link_param_apply, fsw::link_param_ack" if app_parameters(app) else ", 0, 0, 0"
     out += ", &rec, fsw::link_log_apply, fsw::link_log_ack" if app.log is not None else ", 0, 0, 0"
-    out += f", Pyro, {len(app.pyro)}" if app.pyro else ", 0, 0"
+    # the outputs task that ends the pulses: the target refuses a MODE that would stop it (LOCKED)
+    out += f", Pyro, {len(app.pyro)}, {app.tasks.index(pyro_task(app))}" if app.pyro else ", 0, 0, 0xFF"
     return out
 
 

@@ -1,11 +1,10 @@
 """The outputs task that drives the pyro pins could take `mode=`: with
-`act outputs rate=100 mode=actMode`, `fsw check` passed, and the ground's
-`fsw cmd mode act disabled` (or `safed`, or `start=disabled`) in the
-middle of a drogue's pulse stopped the only code that ends it: a disabled
-or safed task runs no step, so the pin stayed high with the firing
-current on for as long as the ground liked (docs/safety.md said so under
-"What the gate does not do"). The pulse's bound, the gate's promise, was
-the ground's to break.
+`act outputs rate=100 mode=actMode start=disabled`, `fsw check` passed,
+and the firmware booted with the charges' task stopped: no charge could
+fire until the ground enabled it (and, until the target locked that
+task's mode, the ground's `fsw cmd
+mode act disabled` in a pulse left the pin high:
+test_the_ground_cannot_stop_a_pulse.py). That task runs always.
 
 Now `fsw check` refuses a `mode=` (and so a `start=`) on the outputs task
 that drives the pyro channels, at its `mode=`; another outputs task may
@@ -36,7 +35,8 @@ def test_a_mode_on_the_pyro_outputs_task_is_refused(fsw, tmp_path):
     assert r.code == 1, r.err
     assert "rocket.app:28:38:" in r.err
     assert ("task `act` drives the pyro channels (drogue, main) and counts their pulses down: it cannot have a "
-            "mode (`fsw cmd mode act disabled` in a pulse would leave the charge's pin high)") in r.err
+            "mode (it runs always: `fsw cmd mode act disabled` in a pulse would leave the charge's pin high, and "
+            "the target refuses it); drop its `mode=`") in r.err
     assert "Traceback" not in r.err
 
 

@@ -321,8 +321,8 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
             out.append(ch)
     _other_writers(owners, machines, machine_srcs, r)
     app = os.path.basename(r.src.path)
-    for u in uplink:
-        if u.element.text in declared:
+    for u in uplink:  # (a row refused because no .dio row drives its element is no channel to name)
+        if u.element.text in declared and u.element.text in tables.outputs:
             r.err(u.element, f"element `{u.element.text}` is pyro channel `{u.element.text}` (line "
                              f"{declared[u.element.text]}): the ground cannot write it (a SET over the uplink "
                              "would drive the charge whatever the arming and the machine's state)")

@@ -15,7 +15,7 @@ from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan, link_text, schema_hash
 from ..version import __version__
 from ..types import TYPES
-from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
+from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check, window_type
 from .expr import float_key_test
 from .machine import emit_machine, stored_locals
 from .sv import emit_sv
@@ -40,7 +40,8 @@ def emit_app(app: Application) -> dict[str, str]:
     real = real_of(app)
     files = dict(emit_sv(app.sv))
     for m in app.machines:
-        files.update(emit_machine(m, real, leave=app.reload is not None and app.machines[app.reload.machine] is m))
+        files.update(emit_machine(m, real, leave=app.reload is not None and app.machines[app.reload.machine] is m,
+                                  kept=resumes(app)))
     files["app.gen.cpp"] = _app_cpp(app)
     return files
 
@@ -172,6 +173,9 @@ def _resume(app: Application) -> list[str]:
                       f"{m.name}: its state, entry time and last G"))
         if stored_locals(m, real):
             spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
+        if m.windows:  # a window not full uses the samples so far: emptied, a launch detector's 5 would be 1
+            spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::win)", f"sizeof {ns}::win",
+                          f"{m.name}: its rolling windows"))
     spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
     if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
         spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
@@ -206,6 +210,7 @@ def resume_hash(app: Application) -> int:
     lines = [f"resume {__version__} {app.board.real}"]
     for m in app.machines:
         lines.append(f"locals {m.name} " + " ".join(f"{v.type.name}:{v.name}" for v in stored_locals(m, real)))
+        lines.append(f"windows {m.name} " + " ".join(window_type(w) for w in m.windows))
     if app.log is not None:
         lines.append("recorder")
     if app.reload is not None:

@@ -203,7 +203,8 @@ def resume_hash(app: Application) -> int:
     """The seed of the banks' check: what gives the kept bytes their
     meaning. The link schema (the state vector's layout, the machines'
     state numbers, the pyro channels), and beyond it each machine's stored
-    locals (types and names, in their order), the evaluation type, the
+    locals (types and names, in their order) and rolling windows, the
+    evaluation type, the
     runtime's version, the recorder's flight and an uploaded machine's RAM:
     a bank of a build that lays them out otherwise does not check."""
     real = real_of(app)

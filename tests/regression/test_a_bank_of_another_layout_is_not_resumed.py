@@ -9,7 +9,7 @@ written by one was taken by the other: after the reset the apogee
 detector's `peak` would have been the landing detector's `still`.
 
 Now the seed also covers the kept locals (their types and names in their
-order), the evaluation type, the runtime's version, and which of the
+order) and rolling windows, the evaluation type, the runtime's version, and which of the
 recorder's flight and an uploaded machine's RAM the banks hold; the same
 project still gets the same seed."""
 

@@ -204,9 +204,9 @@ def resume_hash(app: Application) -> int:
     meaning. The link schema (the state vector's layout, the machines'
     state numbers, the pyro channels), and beyond it each machine's stored
     locals (types and names, in their order) and rolling windows, the
-    evaluation type, the
-    runtime's version, the recorder's flight and an uploaded machine's RAM:
-    a bank of a build that lays them out otherwise does not check."""
+    evaluation type, the runtime's version, the recorder's flight and an
+    uploaded machine's RAM: a bank of a build that lays them out otherwise
+    does not check."""
     real = real_of(app)
     lines = [f"resume {__version__} {app.board.real}"]
     for m in app.machines:

@@ -41,8 +41,9 @@ STATUS = {
     4: ("NOT_WRITABLE", "the element is not in the application's [uplink] list"),
     5: ("BAD_TASK", "no such task"),
     6: ("BAD_MODE", "mode must be 0 disabled, 1 safed or 2 enabled"),
-    7: ("LOCKED", "the executor keeps it: the uplink task's own mode, a task's mode, overruns or worst_us "
-                  "element, the reset cause (modes change only by `mode`)"),
+    7: ("LOCKED", "the executor keeps it: the uplink task's own mode, the mode of the outputs task that ends "
+                  "the pyro pulses, a task's mode, overruns or worst_us element, the reset cause (modes change "
+                  "only by `mode`)"),
     8: ("NO_PARAM", "no such parameter"),
     9: ("OUT_OF_RANGE", "a value outside the parameter's range"),
     10: ("WRONG_STATE", "the declaring machine is not in a state that allows a change"),

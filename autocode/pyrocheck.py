@@ -276,6 +276,23 @@ def _implies(e: M.Expr, pol: bool, a: int, folder: Folder) -> bool:
     return False
 
 
+def element_var(m: M.Machine, name: str) -> M.Var | None:
+    """The machine's variable for the state vector element `name`: the one
+    declared under that element name, not one whose `@alias` is `name` (a
+    machine may call another element so: `bool led @alias armSwitch` is
+    the LED, whatever it is called)."""
+    return next((v for v in m.vars if v.kind == M.ELEMENT and v.name == name), None)
+
+
+def _alias_note(m: M.Machine, name: str) -> str:
+    """` (in machine `m`, `name` is an alias of element `x`, not the input)`
+    when the machine calls another element `name`, else nothing."""
+    v = m.var(name)
+    if v is None or v.name == name:
+        return ""
+    return f" (in machine `{m.name}`, `{name}` is an alias of element `{v.name}`, not the input)"
+
+
 # ---- the [pyro] section ---------------------------------------------------------
 
 def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine], machine_srcs: dict,
@@ -290,6 +307,8 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
     outputs = [t for t in tasks if t.kind == "outputs"]
     if not outputs and not any(t.kind is not None and t.kind.text == "outputs" for t in task_rows):
         r.err(rows[0].element, "pyro channels need an `outputs` task in [tasks]: nothing would drive their pins")
+    if outputs:
+        _no_mode(max(outputs, key=lambda t: t.rate), rows, task_rows, r)
     tables = _Tables(channels)
     declared: dict[str, int] = {}  # element name -> its row's line
     out: list[M.PyroChannel] = []
@@ -302,13 +321,33 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
             out.append(ch)
     _other_writers(owners, machines, machine_srcs, r)
     app = os.path.basename(r.src.path)
-    for u in uplink:
-        if u.element.text in declared:
+    for u in uplink:  # (a row refused because no .dio row drives its element is no channel to name)
+        if u.element.text in declared and u.element.text in tables.outputs:
             r.err(u.element, f"element `{u.element.text}` is pyro channel `{u.element.text}` (line "
                              f"{declared[u.element.text]}): the ground cannot write it (a SET over the uplink "
                              "would drive the charge whatever the arming and the machine's state)")
     _prove(out, machines, machine_srcs, app, r, {row.element.line: row.element.col for row in rows})
     return out
+
+
+def _no_mode(task: M.Task, rows, task_rows, r) -> None:
+    """The outputs task that drives the pyro pins (the first of the fastest,
+    autocode/emit/app.py `pyro_task`) ends their pulses: it runs at every
+    one of its cycles (a disabled or safed task runs no step, and a pin high
+    then would stay high; the target refuses a MODE that would stop it), so
+    it takes no `mode=`."""
+    if task.mode is None:
+        return
+    row = next((t for t in task_rows if t.name.text == task.name), None)
+    at = next((o.key for o in row.options.items if o.key.text == "mode"), row.name) if row is not None else None
+    names = ", ".join(dict.fromkeys(p.element.text for p in rows))
+    message = (f"task `{task.name}` drives the pyro channels ({names}) and counts their pulses down: it cannot "
+               f"have a mode (it runs always: `fsw cmd mode {task.name} disabled` in a pulse would leave the charge's "
+               "pin high, and the target refuses it); drop its `mode=`")
+    if at is not None:
+        r.err(at, message)
+    else:
+        r.diags.error(r.src, APP, task.line, 1, message)
 
 
 class _Tables:
@@ -539,7 +578,7 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
         parents = unarmed(g, armed)
         name = ch.element.name
         where = f"{app}:{ch.line}"
-        var = m.var(name)
+        var = element_var(m, name)
         for w in (g.writes.get(var.index, ()) if var is not None and var.kind == M.ELEMENT else ()):
             if not w.fires:
                 continue
@@ -572,14 +611,14 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
                             f"leads to sets `{name}` true")
         arm_vars = []
         for c in ch.arm:
-            v = m.var(c.element.name)
-            arm_vars.append((c.element.name, v.index if v is not None and v.kind == M.ELEMENT else None))
+            v = element_var(m, c.element.name)
+            arm_vars.append((c.element.name, v.index if v is not None else None))
         for s in parents:
             for e in g.edges[s]:
                 if e.dst not in armed:
                     continue
                 cont = ch.continuity.element.name if ch.continuity is not None else None
-                cv = m.var(cont) if cont is not None else None
+                cv = element_var(m, cont) if cont is not None else None
                 if cont is not None and (cv is None or not any(cv.index in _reads(c) for c, _ in e.conds)):
                     # arming without a look at the igniter: warned once per transition and channel
                     r.diags.warning(msrc, SM, e.goto.line, e.goto.col,
@@ -596,7 +635,7 @@ def _prove(chans: list[M.PyroChannel], machines, machine_srcs, app: str, r, cols
                 entry[2].append(f"`{name}` ({where})")
     for (midx, _, _), (e, missing, chs) in sorted(guards.items(), key=lambda kv: kv[0]):
         m = machines[midx]
-        need = " and ".join(f"`{n}`" for n in missing)
+        need = " and ".join(f"`{n}`" for n in missing) + "".join(_alias_note(m, n) for n in missing)
         what = "pyro channel" if len(chs) == 1 else "pyro channels"
         r.diags.error(machine_srcs[m.name], SM, e.goto.line, e.goto.col,
                       f"transition from `{m.states[e.src].name}`, reached unarmed, into armed state "
@@ -643,7 +682,7 @@ def pyro_report(app: M.Application) -> str:
         lines.append("  arming transitions (each requires " + " and ".join(c.element.name for c in ch.arm) + "):")
         lines += [f"    {m.states[e.src].name} -> {m.states[e.dst].name}  {sm}:{e.goto.line}" for e in arming] \
             or ["    none"]
-        var = m.var(ch.element.name)
+        var = element_var(m, ch.element.name)
         fires = [w for w in g.writes.get(var.index, ()) if w.fires] if var is not None else []
         live = [w for w in fires if w.state in everywhere]
         lines.append("  states that can fire it:")

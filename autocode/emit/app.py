@@ -12,9 +12,10 @@ from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
 from ..params import app_parameters
-from ..schema import app_schema_hash, link_plan
+from ..schema import app_schema_hash, link_plan, link_text, schema_hash
+from ..version import __version__
 from ..types import TYPES
-from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
+from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check, window_type
 from .expr import float_key_test
 from .machine import emit_machine, stored_locals
 from .sv import emit_sv
@@ -39,7 +40,8 @@ def emit_app(app: Application) -> dict[str, str]:
     real = real_of(app)
     files = dict(emit_sv(app.sv))
     for m in app.machines:
-        files.update(emit_machine(m, real, leave=app.reload is not None and app.machines[app.reload.machine] is m))
+        files.update(emit_machine(m, real, leave=app.reload is not None and app.machines[app.reload.machine] is m,
+                                  kept=resumes(app)))
     files["app.gen.cpp"] = _app_cpp(app)
     return files
 
@@ -171,7 +173,13 @@ def _resume(app: Application) -> list[str]:
                       f"{m.name}: its state, entry time and last G"))
         if stored_locals(m, real):
             spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
+        if m.windows:  # a window not full uses the samples so far: emptied, a launch detector's 5 would be 1
+            spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::win)", f"sizeof {ns}::win",
+                          f"{m.name}: its rolling windows"))
     spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
+    if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
+        spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
+        spans.append(("reload_ram", "sizeof reload_ram", "an uploaded machine's windows and locals"))
     if app.log is not None:
         spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
     c = ["// ---- resuming the flight after a reset (docs/safety.md) ----",
@@ -185,10 +193,30 @@ def _resume(app: Application) -> list[str]:
     c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
     c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a check")
     c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
-             f"0x{app_schema_hash(app):08x}UL, kResumeSize, {len(spans)}}};")
+             f"0x{resume_hash(app):08x}UL, kResumeSize, {len(spans)}}};  // the check's seed: resume_hash")
     c.append("fsw::Resume resume;")
     c.append("")
     return c
+
+
+def resume_hash(app: Application) -> int:
+    """The seed of the banks' check: what gives the kept bytes their
+    meaning. The link schema (the state vector's layout, the machines'
+    state numbers, the pyro channels), and beyond it each machine's stored
+    locals (types and names, in their order) and rolling windows, the
+    evaluation type, the runtime's version, the recorder's flight and an
+    uploaded machine's RAM: a bank of a build that lays them out otherwise
+    does not check."""
+    real = real_of(app)
+    lines = [f"resume {__version__} {app.board.real}"]
+    for m in app.machines:
+        lines.append(f"locals {m.name} " + " ".join(f"{v.type.name}:{v.name}" for v in stored_locals(m, real)))
+        lines.append(f"windows {m.name} " + " ".join(window_type(w) for w in m.windows))
+    if app.log is not None:
+        lines.append("recorder")
+    if app.reload is not None:
+        lines.append(f"reload {app.machines[app.reload.machine].name} {app.reload.ram}")
+    return schema_hash(app.sv, link_text(app) + "\n".join(lines) + "\n")
 
 
 def _resume_begin(app: Application) -> list[str]:
@@ -295,7 +323,11 @@ def _app_cpp(app: Application) -> str:
         c.append("    const bool resumed = fsw::resume_begin(resume, &kResumeConfig, fsw::pal::reset_cause());")
     if app.log is not None and resumes(app):
         c.append("    const uint8_t log_flight = rec.flight, log_mode = rec.mode;  // as kept")
-    if app.reload is not None:
+    if app.reload is not None and resumes(app):
+        c.append("    const uint8_t reload_active = reload.active;  // as kept")
+        c.append("    // the newest activated image, else the generated machine; after a resume the one that ran, as kept")
+        c.append("    fsw::reload_begin(reload, &kReloadConfig, resumed ? reload_active : fsw::kReloadNone);")
+    elif app.reload is not None:
         c.append("    fsw::reload_begin(reload, &kReloadConfig);  // the newest activated image, else the generated machine")
     if app.log is not None:
         c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")
@@ -709,7 +741,8 @@ def _link_stores(app: Application) -> str:
     (every field written: a partial initializer warns under -Wextra)."""
     out = ", &params, fsw::link_param_apply, fsw::link_param_ack" if app_parameters(app) else ", 0, 0, 0"
     out += ", &rec, fsw::link_log_apply, fsw::link_log_ack" if app.log is not None else ", 0, 0, 0"
-    out += f", Pyro, {len(app.pyro)}" if app.pyro else ", 0, 0"
+    # the outputs task that ends the pulses: the target refuses a MODE that would stop it (LOCKED)
+    out += f", Pyro, {len(app.pyro)}, {app.tasks.index(pyro_task(app))}" if app.pyro else ", 0, 0, 0xFF"
     return out
 
 

@@ -103,16 +103,19 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
 
 
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
-                 ns: str = "fsw_gen", leave: bool = False) -> dict[str, str]:
+                 ns: str = "fsw_gen", leave: bool = False, kept: bool = False) -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
     keeps every local in memory, for a state script that writes locals;
     otherwise locals that never change are folded into the code. `ns` is
     the outer namespace (the state vector's, see emit_sv). `leave` adds
     leave(), the current state's .exit, for a machine that an uploaded
-    image may take over from (`[reload]`, docs/reload.md)."""
+    image may take over from (`[reload]`, docs/reload.md). `kept` puts
+    the rolling windows in one object, `win`, declared in the header, that
+    the resume keeps with the locals (docs/safety.md)."""
     name = c_ident(m.name)
     src = basename(m.path)
-    ex = ExprEmitter(m, real, scriptable)
+    wp = "win.w" if kept and m.windows else "w"  # how the code names window i: f"{wp}{i}"
+    ex = ExprEmitter(m, real, scriptable, windows=wp)
     values = local_values(m, real)
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
     stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
@@ -144,6 +147,13 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         h.append("};")
         h.append(f"static const uint16_t kPrmSize = {psize};")
         h.append("extern uint8_t prm[kPrmSize];")
+    if wp != "w":
+        h.append("// Its rolling windows, kept across a reset in flight with its locals (docs/safety.md).")
+        h.append("struct Windows {")
+        for w in m.windows:
+            h.append(f"    {window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
+        h.append("};")
+        h.append("extern Windows win;")
     h.append("")
     h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
     h.append("FSW_MUST_CHECK fsw::Result step();")
@@ -163,11 +173,14 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
     if params:
         c.append(f"uint8_t prm[kPrmSize] = {{{', '.join(str(b) for b in param_bytes)}}};")
+    if wp != "w":
+        c.append("Windows win;  // every window empty")
     c += ["", "namespace {", ""]
-    for w in m.windows:
-        c.append(f"{window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
-    if m.windows:
-        c.append("")
+    if wp == "w":
+        for w in m.windows:
+            c.append(f"{window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
+        if m.windows:
+            c.append("")
     if stored:
         c.append(f"const uint8_t kLocInit[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
         c.append("")
@@ -230,11 +243,11 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             c.append("    {")
             pad = "        "
         if len(ws) == 1:
-            c.append(f"{pad}w{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
+            c.append(f"{pad}{wp}{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
         else:
             c.append(f"{pad}const fsw::Real x{k} = {arg};")
             for w in ws:
-                c.append(f"{pad}w{w.index}.push(x{k});  // {src}:{w.line}")
+                c.append(f"{pad}{wp}{w.index}.push(x{k});  // {src}:{w.line}")
         if where != every:
             c += ["        break;", "    }", "    default:", "        break;", "    }"]
     moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
@@ -264,7 +277,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     if stored:
         c.append("    memcpy(loc, kLocInit, sizeof loc);")
     for w in m.windows:
-        c.append(f"    memset(&w{w.index}, 0, sizeof w{w.index});")
+        c.append(f"    memset(&{wp}{w.index}, 0, sizeof {wp}{w.index});")
     c.append("}")
     if leave:
         c += ["", "void leave() {",

@@ -342,7 +342,10 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
         Executor& ex = *flash_get(c.ex);
         if (a[0] >= flash_get(ex.cfg->n_tasks)) return kAckBadTask;
         if (a[1] > kModeEnabled) return kAckBadMode;
-        if (a[0] == flash_get(c.uplink_task) && a[1] != kModeEnabled) return kAckLocked;
+        // the uplink task (the ground would lock itself out) and the task that ends the pyro
+        // pulses (a pin high then would stay high) run always
+        if ((a[0] == flash_get(c.uplink_task) || a[0] == flash_get(c.pyro_task)) && a[1] != kModeEnabled)
+            return kAckLocked;
         executor_set_task_mode(ex, a[0], a[1]);
         return kAckOk;
     }

@@ -62,8 +62,9 @@ enum LinkStatus : uint8_t {
     kAckNotWritable = 4,  // the element is not in the application's [uplink] list
     kAckBadTask = 5,      // no such task
     kAckBadMode = 6,      // mode not 0, 1 or 2
-    kAckLocked = 7,       // the executor's: the uplink task's mode, or a SET of a task's mode,
-                          // overruns or worst_us element or of the reset cause
+    kAckLocked = 7,       // the executor's: the uplink task's mode, the mode of the task that ends
+                          // the pyro pulses, or a SET of a task's mode, overruns or worst_us element
+                          // or of the reset cause
     // the parameter store's (ParamStatus, fsw_param.h)
     kAckNoParam = 8,      // no such parameter
     kAckOutOfRange = 9,   // a value outside its range
@@ -147,6 +148,7 @@ struct LinkConfig {
     LinkLogAckFn log_ack;             // link_log_ack, with a recorder
     const PyroGate* pyro;             // the pyro channels' gates: a status byte each in health frames
     uint8_t n_pyro;
+    uint8_t pyro_task;                // index of the outputs task that ends their pulses (0xFF: none)
     uint16_t tx_size;                 // bytes of `tx` (0: tx_cap). Above tx_cap, a sample frame may wait
                                       // behind the unsent rest of the one before (a link near its line
                                       // rate); a control frame behind a rest of tx_size - tx_cap

@@ -81,8 +81,9 @@ uint8_t check_slot(const ReloadConfig& c, const ReloadSlot& sl, uint8_t which) {
 }
 
 // Copies slot `which` (checked) into the running image's buffer and starts
-// it from its first state.
-FSW_NOINLINE void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
+// it from its first state; with `fresh` false (a resumed flight) the
+// machine's record and its RAM are left as they were kept.
+FSW_NOINLINE void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which, bool fresh = true) {
     const ReloadSlot& sl = s.slot[which - 1u];
     // (the bounds in registers: a store to the image could alias the store's
     // record, which the loop would read again each byte: 66 AVR cycles a
@@ -91,8 +92,38 @@ FSW_NOINLINE void run_slot(ReloadStore& s, const ReloadConfig& c, uint8_t which)
     const uint16_t n = static_cast<uint16_t>(sl.len + sl.nmask);
     uint8_t* const im = c.image;
     for (uint16_t i = 0; i < n; ++i) im[i] = pal::eeprom_read(static_cast<uint16_t>(a + i));
-    vm_reset(c.image, c.ram, *c.machine, 1);
+    if (fresh) vm_reset(c.image, c.ram, *c.machine, 1);
     s.active = which;
+}
+
+// Slot `which` made the one to boot: activated after the other slot (as
+// ACTIVATE does), both written back in the background.
+void mark_boot(ReloadStore& s, uint8_t which) {
+    ReloadSlot& sl = s.slot[which - 1u];
+    const ReloadSlot& o = s.slot[2u - which];  // the order after the other slot's (this one's own may be stale)
+    sl.seq = static_cast<uint16_t>((o.status != kSlotEmpty ? o.seq : sl.seq) + 1u);
+    sl.status = kSlotBoot;
+    s.sync = true;
+}
+
+// The slot a boot runs first: the newest activated one (0: none).
+uint8_t newest_boot(const ReloadStore& s) {
+    uint8_t best = 0;
+    for (uint8_t w = 1; w <= 2; ++w) {
+        const ReloadSlot& sl = s.slot[w - 1u];
+        if (sl.status == kSlotBoot && (best == 0 || later(sl.seq, s.slot[best - 1u].seq))) best = w;
+    }
+    return best;
+}
+
+// No slot boots: the generated machine runs (ACTIVATE 0), written back in the background.
+void mark_built_in(ReloadStore& s) {
+    for (uint8_t i = 0; i < 2; ++i) {
+        if (s.slot[i].status == kSlotBoot) {
+            s.slot[i].status = kSlotStored;
+            s.sync = true;
+        }
+    }
 }
 
 // Whether the running machine's current state allows another to take over.
@@ -119,18 +150,13 @@ void activate_now(ReloadStore& s, const ReloadConfig& c, uint8_t which) {
         leave(s, c);
         s.active = kReloadBuiltIn;
         c.reset(1);
-        for (uint8_t i = 0; i < 2; ++i)
-            if (s.slot[i].status == kSlotBoot) s.slot[i].status = kSlotStored;  // boot the generated machine
+        mark_built_in(s);  // boot the generated machine
         s.sync = true;
         return;
     }
-    ReloadSlot& sl = s.slot[which - 1u];  // checked (check_slice): its CRC and the verifier passed
-    leave(s, c);
+    leave(s, c);  // the slot is checked (check_slice): its CRC and the verifier passed
     run_slot(s, c, which);
-    const ReloadSlot& o = s.slot[2u - which];  // the order after the other slot's (this one's own may be stale)
-    sl.seq = static_cast<uint16_t>((o.status != kSlotEmpty ? o.seq : sl.seq) + 1u);
-    sl.status = kSlotBoot;
-    s.sync = true;
+    mark_boot(s, which);
 }
 
 // Queues a run of bytes for the writer (`seg` 0 or 1; run 0 starts first).
@@ -199,7 +225,7 @@ FSW_NOINLINE void check_slice(ReloadStore& s, const ReloadConfig& c) {
 
 }  // namespace
 
-void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
+void reload_begin(ReloadStore& s, const ReloadConfig* cfg, uint8_t resumed) {
     memset(&s, 0, sizeof s);
     s.cfg = cfg;
     s.pending = kReloadNone;
@@ -207,12 +233,17 @@ void reload_begin(ReloadStore& s, const ReloadConfig* cfg) {
     s.ck_result = kReloadNone;
     const ReloadConfig c = config(s);
     for (uint8_t w = 1; w <= 2; ++w) read_slot(c, w, s.slot[w - 1u]);
+    if (resumed == kReloadBuiltIn) {  // a resumed flight: the generated machine goes on, as kept
+        mark_built_in(s);  // (a reset may have cut the write of an ACTIVATE 0 short)
+        return;
+    }
+    if ((resumed == 1u || resumed == 2u) && check_slot(c, s.slot[resumed - 1u], resumed) == kVmOk) {
+        run_slot(s, c, resumed, false);  // the uploaded machine goes on, its state and RAM as kept
+        if (newest_boot(s) != resumed) mark_boot(s, resumed);  // (... or of its ACTIVATE)
+        return;
+    }
     for (uint8_t tries = 0; tries < 2; ++tries) {  // the newest activated image first
-        uint8_t best = 0;
-        for (uint8_t w = 1; w <= 2; ++w) {
-            const ReloadSlot& sl = s.slot[w - 1u];
-            if (sl.status == kSlotBoot && (best == 0 || later(sl.seq, s.slot[best - 1u].seq))) best = w;
-        }
+        const uint8_t best = newest_boot(s);
         if (best == 0) return;  // the generated machine
         const uint8_t r = check_slot(c, s.slot[best - 1u], best);
         if (r == kVmOk) {

@@ -125,7 +125,12 @@ enum ReloadStatus : uint8_t {
 // Boot: reads both slots' headers, checks their CRCs, and runs the newest
 // activated image that the verifier accepts (else the other, else the
 // generated machine), from its first state. Blocking EEPROM reads only.
-void reload_begin(ReloadStore& s, const ReloadConfig* cfg);
+// After a reset in flight (docs/safety.md), `resumed` is the machine that
+// ran when the flight's state was kept (`active`: kReloadBuiltIn, 1 or 2),
+// whose record and RAM the resume put back: that one goes on in its state,
+// not from its first (the generated machine, or the slot's image if it
+// still checks; else the boot goes on as above). kReloadNone: a fresh start.
+void reload_begin(ReloadStore& s, const ReloadConfig* cfg, uint8_t resumed = kReloadNone);
 
 // The machine task's step: a slice of the check that runs (at most
 // FSW_RELOAD_SLICE EEPROM reads and the unit of work it ends in), else an

@@ -55,7 +55,8 @@ const ParamConfig kParamConfig = {kParamDefs, kParamWhens, kParamPool, kParamDef
                                   0x5A5A0001UL, 6, 0, 3, false};
 
 const LinkConfig kConfig = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0x12345678UL, 21, 96, 5,
-                            21, 2, 5, 2, 0, false, &params, link_param_apply, link_param_ack};
+                            21, 2, 5, 2, 0, false, &params, link_param_apply, link_param_ack,
+                            0, 0, 0, 0, 0, 0xFF};
 
 
 static_assert(link_stream_ok(0, 8, 1, 2, true, 21, 96) && link_stream_ok(8, 13, 3, 1, false, 21, 96) &&

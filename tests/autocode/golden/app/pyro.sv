@@ -13,3 +13,4 @@ bool arm2
 bool abortCmd
 bool led
 bool spare
+U8 actMode

@@ -1,0 +1,149 @@
+"""The ground could hold a charge's pin high. The outputs task that drives
+the pyro pins is the only code that ends a pulse (docs/safety.md, "the
+gate"), and the uplink's MODE command changes any task's mode, with a
+mode element or without: `fsw cmd mode act disabled` in the middle of a
+pulse was acknowledged (OK) and the pin stayed high with the firing
+current on, the pulse's end and the machine's own `charge = false` never
+reaching it. (The uplink task's own mode was already LOCKED.)
+
+Now the target refuses a MODE that would disable or safe the task that
+drives the pyro channels (LOCKED, as for the uplink task's), and `fsw
+check` refuses a `mode=` on it: the pulse ends on time whatever the
+ground sends. A small project on the simulated Uno: armed, fired with a
+0.5 s pulse, MODE act disabled 0.1 s in."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+
+pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
+                                reason="gcc-avr and libsimavr-dev are needed (make setup)")
+
+SV = """[Flight]
+U64 time
+U32 state
+bool armSwitch
+bool go
+bool charge
+"""
+
+SM = """[state_vector]
+U64 time         @alias G
+U32 state        @alias S
+bool armSwitch   @read_only
+bool go          @read_only
+bool charge
+
+[Safe]
+.step
+    armSwitch: -> Armed
+[Armed]
+.step
+    go: -> Fire
+[Fire]
+.entry
+    charge = true
+.step
+    T >= 1000: -> Done
+.exit
+    charge = false
+[Done]
+"""
+
+DIO = """# dir  pin  element
+i      2    armSwitch
+i      3    go
+o      5    charge
+"""
+
+APP = """[application]
+board uno
+rate  100
+
+[configs]
+state_vector gate.sv
+machine      gate.sm
+io           gate.dio
+
+[time]
+source clock
+unit   ms
+
+[tasks]
+uplink   uplink        rate=100
+sense    inputs        rate=100
+fly      machine gate  rate=100
+act      outputs       rate=100
+down     telemetry     rate=100
+
+[telemetry]
+Flight   rate=10
+
+[pyro]
+charge   arm=armSwitch  pulse=0.5  machine=gate  armed=Armed  fire=Fire
+"""
+
+CHARGE, KEY, GO = 5, 2, 3
+ACT = 3  # the outputs task's index in [tasks]
+OK, LOCKED = 0, 7
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory):
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.target.build import firmware, load
+
+    d = tmp_path_factory.mktemp("mode_in_a_pulse")
+    for name, text in (("gate.sv", SV), ("gate.sm", SM), ("gate.dio", DIO), ("gate.app", APP)):
+        (d / name).write_text(text)
+    diags = Diagnostics()
+    app = load(str(d / "gate.app"), diags)
+    assert app is not None, diags.render()
+    built = firmware(app, str(d / "build"))
+    assert built.fits, built.report
+    return app, built.artifact
+
+
+@pytest.mark.parametrize("mode", [0, 1])  # disabled, safed
+def test_a_mode_command_in_a_pulse_is_locked_and_the_pulse_ends(project, mode):
+    from fswkit.link import wire
+    from fswkit.link.client import Numbers, exchange
+    from fswkit.link.layout import from_app
+    from fswkit.link.session import Session
+    from fswkit.param.client import SimTransport
+    from fswkit.sim.board import SimBoard
+
+    app, elf = project
+    b = SimBoard(elf, "uno", uart="control", sim_limit=60)
+    try:
+        session = Session(from_app(app))
+        t = SimTransport(b, session)
+        t.events(0.3)
+        assert session.hello is not None
+        b.set_digital(KEY, True)
+        t.events(0.1)
+        b.set_digital(GO, True)
+        while not b.digital(CHARGE) and b.time < 2:
+            t.events(0.005)
+        rise = b.time
+        assert b.digital(CHARGE)
+        t.events(0.1)
+
+        def send_and_wait(seq, frame):
+            t.send(frame)
+            end = b.time + 0.3
+            while b.time < end:
+                for ev in t.events(0.01):
+                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq:
+                        return ev.info
+            return None
+
+        ack = exchange(Numbers(session), wire.OP_MODE, bytes([ACT, mode]), 3, send_and_wait)
+        assert ack["status"] == LOCKED, ack
+        t.events(rise + 0.55 - b.time)
+        assert not b.digital(CHARGE), "the pin is still high past the pulse"
+    finally:
+        b.close()

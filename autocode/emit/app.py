@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from ..app import TASK_MODES, Application, Task
-from ..cnames import comment
+from ..cnames import comment, enumerator
 from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
@@ -835,7 +835,7 @@ def _params(app: Application, params) -> list[str]:
          f"const fsw::ParamDef kParamDefs[{len(params)}] FSW_FLASH = {{"]
     for p, rng, w in defs:
         m = c_ident(p.machine)
-        c.append(f"    {{{m}::prm + {m}::P_{p.name}, {p.off}, {rng}, {ELEM_CODE[p.type.name]}, {w}}},  "
+        c.append(f"    {{{m}::prm + {m}::{enumerator('P_', p.name)}, {p.off}, {rng}, {ELEM_CODE[p.type.name]}, {w}}},  "
                  f"// {basename(p.path)}:{p.line} {p.name} ({p.type.name}, {p.range_text()}{' ' + p.unit if p.unit else ''})")
     c.append("};")
     c.append(f"const fsw::ParamWhen kParamWhens[{len(whens)}] FSW_FLASH = {{")

@@ -109,14 +109,11 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
 
     def talk(ground) -> int:
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
-        from fswkit.autocode.params import param_hash
-
-        inf = client.info()
-        if inf["hash"] != param_hash(params) or inf["count"] != len(params):
+        try:
+            client.table_info(args.project)
+        except ParamError as e:
             if not args.ignore_schema:
-                _say(f"the target's parameter table (hash 0x{inf['hash']:08x}, {inf['count']} parameters) is not "
-                     f"the one of {args.project} (0x{param_hash(params):08x}, {len(params)}): its firmware was "
-                     "built from other configs; build and flash it again")
+                _say(str(e))
                 return EXIT_FAIL
         return _action(args, client, params, by_name, wanted, file_values, params_text)
 

@@ -250,6 +250,22 @@ class ParamClient:
         return {"source": source & 3, "source_name": PARAM_SOURCES[source & 3], "dirty": bool(source & 0x40),
                 "writing": bool(source & PARAM_WRITING), "seq": seq, "crc": crc, "count": count, "hash": h}
 
+    def table_info(self, project: str) -> dict:
+        """PARAM_INFO, once the target's parameter table is this client's
+        (the table hash and count): the link's schema does not cover the
+        parameters, so a board flashed with other ones says hello as this
+        project's would, and its values read or set by this table would be
+        other parameters'. ParamError, saying so, when it is not."""
+        from fswkit.autocode.params import param_hash
+
+        inf = self.info()
+        mine = param_hash(self.params)
+        if inf["hash"] != mine or inf["count"] != len(self.params):
+            raise ParamError(f"the target's parameter table (hash 0x{inf['hash']:08x}, {inf['count']} parameters) is "
+                             f"not the one of {project} (0x{mine:08x}, {len(self.params)}): its firmware was built "
+                             "from other configs; build and flash it again")
+        return inf
+
     def get_all(self) -> dict[str, object]:
         """Every parameter's live value, by name."""
         room = self.tx_cap - 24 - self.tx_cap // 254

@@ -224,7 +224,7 @@ class LiveSource(Source):
         with _StationTransport(self.station) as transport:
             try:
                 c = self._param_client(transport)
-                info = c.info()
+                info = c.table_info(self.station.project)
                 values = c.get_all()
             except ParamError as e:
                 return {"ok": False, "words": str(e)}
@@ -244,7 +244,9 @@ class LiveSource(Source):
 
         with _StationTransport(self.station) as transport:
             try:
-                self._param_client(transport).set(values)
+                c = self._param_client(transport)
+                c.table_info(self.station.project)  # the ids are the board's
+                c.set(values)
             except ParamError as e:
                 return str(e)
         return None

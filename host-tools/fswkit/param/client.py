@@ -145,13 +145,18 @@ class ParamClient:
         self.stats = Stats()
         self.numbers = Numbers(transport.session)
         self.on_event = None  # every decoded event is passed here (a monitor may show them)
+        # what a target that answers BUSY till the deadline is doing (a client of other commands says its own)
+        self.busy_words = ("it is still writing a parameter bank (`fsw param list` says `writing` while it does); "
+                           "try again once it is done, or reset the target if it never is")
 
     def run(self, cmds: list[tuple[int, bytes]], busy_retry: bool = True) -> list[dict]:
         """Each command sent (several in flight), until each has its
         acknowledgement; the acks in the commands' order. A REPLAY answer
         resynchronises the sequence numbers; BUSY is tried again a little
         later (when busy_retry); a command unanswered in time goes again with
-        a new number, and an acknowledgement of any of its copies counts."""
+        a new number, and an acknowledgement of any of its copies counts.
+        ParamError past the deadline: the target answered BUSY (busy_words),
+        or nothing came."""
         t = self.t
         results: list[dict | None] = [None] * len(cmds)
         queue = deque(range(len(cmds)))
@@ -160,6 +165,7 @@ class ParamClient:
         not_before = 0.0
         start = t.now()
         resent: set[int] = set()  # commands sent more than once: their round trips are ambiguous
+        busy: set[int] = set()  # commands whose latest answer was BUSY
 
         def service(i: int) -> float:
             """How long command i keeps the link busy: its frame up, its ack
@@ -172,6 +178,8 @@ class ParamClient:
         while any(r is None for r in results):
             now = t.now()
             if now - start > self.deadline:
+                if busy:  # it answers: not the link's fault
+                    raise ParamError(f"the target answered BUSY for {self.deadline:g} s: {self.busy_words}")
                 raise ParamError(f"no answer from the target after {self.deadline:g} s "
                                  f"({self.stats.resent} commands sent again)")
             busy_bytes = sum(b for _, _, b in inflight.values())
@@ -212,11 +220,13 @@ class ParamClient:
                     queue.appendleft(i)
                 elif st == BUSY and busy_retry:
                     self.stats.busy += 1
+                    busy.add(i)
                     self._drop_copies(inflight, copies, i)
                     queue.appendleft(i)
                     not_before = t.now() + 0.02
                 else:
                     results[i] = ev.info
+                    busy.discard(i)
                     self._drop_copies(inflight, copies, i)
             # a command waits behind those sent before it: its ack is due after
             # theirs, plus a margin (a quarter of the round trips measured)

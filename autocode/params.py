@@ -148,7 +148,7 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
     if t.is_int:
         if isinstance(value, float):
             if not math.isfinite(value) or value != int(value):  # int() of an infinity overflows
-                return None, f"`{p.name}` is {t.name}: give a whole number, not {value:g}"
+                return None, f"`{p.name}` is {t.name}: give a whole number, not {value!r}"
             value = int(value)
         if not isinstance(value, int):
             return None, f"`{p.name}` is {t.name}: give a whole number, not {value!r}"

@@ -63,7 +63,8 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
             known = ", ".join(by_name) or "none"
             problems.append(f"{path}:{line}:{col}: unknown parameter `{key}` (the project's parameters: {known})")
             continue
-        v, why = check_value(p, value)
+        why = _not_a_value(p, value)
+        v, why = (None, why) if why is not None else check_value(p, value)
         if why is not None:
             problems.append(f"{path}:{line}:{vcol}: {why}")
             continue
@@ -71,6 +72,32 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
     if problems:
         raise ParamFileError("\n".join(problems))
     return out
+
+
+def _not_a_value(p: AppParam, value) -> str | None:
+    """Why a TOML value is none a parameter takes, in the file's words
+    (None for a boolean, an integer or a float: check_value judges those).
+    A string is not typed text here: a quoted value belongs to a file
+    written for something else."""
+    import datetime
+
+    if isinstance(value, (bool, int, float)):
+        return None
+    if isinstance(value, str):
+        want = "true or false" if p.type.is_bool else "the number"
+        text = value if len(value) <= 40 else value[:40] + "..."
+        return f"`{p.name}` is {p.type.name}: {_quoted(text)} is text; give {want} without quotes"
+    kind = ("a date and time" if isinstance(value, datetime.datetime) else "a date"
+            if isinstance(value, datetime.date) else "a time" if isinstance(value, datetime.time)
+            else "an array" if isinstance(value, list) else "a table")
+    return f"`{p.name}` is {p.type.name}: {kind} is not a value of it"
+
+
+def _quoted(text: str) -> str:
+    """`text` between double quotes, as TOML writes a basic string."""
+    import json
+
+    return json.dumps(text, ensure_ascii=False)
 
 
 def _toml_value(p: AppParam, v) -> str:

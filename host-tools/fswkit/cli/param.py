@@ -109,12 +109,11 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
 
     def talk(ground) -> int:
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
-        try:
+        try:  # whatever --ignore-schema says: a value means a parameter only through its table
             client.table_info(args.project)
         except ParamError as e:
-            if not args.ignore_schema:
-                _say(str(e))
-                return EXIT_FAIL
+            _say(str(e))
+            return EXIT_FAIL
         return _action(args, client, params, by_name, wanted, file_values, params_text)
 
     return talk_on_link(args, layout, baud, _say, talk, (ParamError,))

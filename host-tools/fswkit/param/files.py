@@ -17,16 +17,31 @@ class ParamFileError(Exception):
     """A located problem in a parameter file (`path:line:col: message`)."""
 
 
+def _blank_strings(text: str) -> str:
+    """`text` with the inside of its multi-line strings blanked (line breaks
+    kept), so that a `NAME = ...` written in one is not taken for a key."""
+    return re.sub(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'',
+                  lambda m: re.sub(r"[^\n]", " ", m.group()), text)
+
+
 def _where(text: str, key: str) -> tuple[int, int, int]:
-    """Line, the key's column and the value's column of `key = ...` at the
-    top level ((1, 1, 1) when not found)."""
-    pat = re.compile(rf'^([ \t]*)(?:"{re.escape(key)}"|{re.escape(key)})[ \t]*=[ \t]*', re.M)
-    m = pat.search(text)
-    if m is None:
+    """Line, the key's column and the value's column of the top-level key
+    `key` as the file writes it: `key = ...`, a dotted `key.sub = ...` or a
+    table header `[key]`, `[[key]]`, `[key.sub]` (the header's column for
+    both); (1, 1, 1) when not found."""
+    name = rf'(?:"{re.escape(key)}"|\'{re.escape(key)}\'|{re.escape(key)})'
+    pats = (re.compile(rf"^([ \t]*){name}[ \t]*=[ \t]*", re.M),
+            re.compile(rf"^([ \t]*){name}[ \t]*\.", re.M),
+            re.compile(rf"^([ \t]*)\[\[?[ \t]*{name}[ \t]*[.\]]", re.M))
+    plain = _blank_strings(text)
+    found = [m for m in (p.search(plain) for p in pats) if m is not None]
+    if not found:
         return 1, 1, 1
-    line = text.count("\n", 0, m.start()) + 1
-    bol = text.rfind("\n", 0, m.start()) + 1
-    return line, m.start() + len(m.group(1)) - bol + 1, m.end() - bol + 1
+    m = min(found, key=lambda m: m.start())
+    line = plain.count("\n", 0, m.start()) + 1
+    bol = plain.rfind("\n", 0, m.start()) + 1
+    key_col = m.start() + len(m.group(1)) - bol + 1
+    return line, key_col, (m.end() - bol + 1 if m.re is pats[0] else key_col)
 
 
 def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
@@ -54,9 +69,10 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
     problems = []
     for key, value in doc.items():
         line, col, vcol = _where(text, key)
-        if isinstance(value, dict):
-            problems.append(f"{path}:{line}:{col}: `{key}` is a table: a parameter file holds one "
-                            "`NAME = value` per parameter, no tables")
+        tables = isinstance(value, list) and value and all(isinstance(v, dict) for v in value)
+        if isinstance(value, dict) or tables:
+            problems.append(f"{path}:{line}:{col}: `{key}` is {'an array of tables' if tables else 'a table'}: "
+                            "a parameter file holds one `NAME = value` per parameter, no tables")
             continue
         p = by_name.get(key)
         if p is None:

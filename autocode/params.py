@@ -160,9 +160,12 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
             return None, f"`{p.name}`: NaN is not a value a parameter may take"
         if t.size == 4:
             try:
-                value = struct.unpack("<f", struct.pack("<f", value))[0]
+                held = struct.unpack("<f", struct.pack("<f", value))[0]
             except OverflowError:
                 return None, f"`{p.name}` is F32: {value:g} is beyond its range"
+            if held == 0 and value != 0:  # a value the user set apart from 0 would be 0
+                return None, f"`{p.name}` is F32: {value:g} is held as 0; give 0, or a number from 1.4e-45"
+            value = held
     if not p.min <= value <= p.max:
         return None, f"`{p.name}` = {_num(value)} is outside its range {p.range_text()}" + \
             (f" {p.unit}" if p.unit else "")

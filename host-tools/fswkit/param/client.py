@@ -34,7 +34,7 @@ RX_CAP = 24  # the target's uplink frame buffer (FSW_LINK_RX_CAP): encoded bytes
 # brings one), so a window a little over the buffer keeps the pipe full
 # without ever overflowing it
 RX_WINDOW = 90
-REPLAY, BUSY, NO_LOAD = 1, 11, 12
+REPLAY, UNKNOWN_OP, BUSY, NO_LOAD = 1, 2, 11, 12
 
 
 class ParamError(Exception):
@@ -252,6 +252,9 @@ class ParamClient:
 
     def info(self) -> dict:
         ack = self.run([(OP_PARAM_INFO, b"")])[0]
+        if ack["status"] == UNKNOWN_OP:  # a firmware without parameters links none of their commands
+            raise ParamError("the target's firmware has no parameters (it does not know PARAM_INFO): it was built "
+                             "from other configs; build and flash it again")
         if ack["status"] != 0:
             raise ParamError(f"the target refused PARAM_INFO: {ack['status_name']}: {ack['reason']}")
         if len(ack["data"]) < PARAM_INFO.size:

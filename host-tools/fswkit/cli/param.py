@@ -38,6 +38,7 @@ def cmd_param(args) -> int:
     by_name = {p.name: p for p in params}
     # everything the user typed is checked before the port is opened
     wanted: dict[str, object] = {}
+    typed: dict[str, str] = {}  # each value as given
     file_values = None
     if args.action in ("get",):
         if not args.args:
@@ -64,7 +65,11 @@ def cmd_param(args) -> int:
             if why is not None:
                 _say(why)
                 return EXIT_CONFIG
+            if p.name in wanted:  # which one was meant is not ours to guess
+                _say(f"`{p.name}` is given twice ({typed[p.name]} and {text.strip()}): give it once")
+                return EXIT_CONFIG
             wanted[p.name] = v
+            typed[p.name] = text.strip()
     elif args.action in ("load", "diff"):
         if args.action == "load" and len(args.args) != 1:
             _say("usage: fsw param PROJECT load FILE.toml")

@@ -849,8 +849,8 @@ def _params(app: Application, params) -> list[str]:
     c.append(f"const fsw::ParamConfig kParamConfig FSW_FLASH = {{kParamDefs, kParamWhens, kParamPool, kParamDefaults, "
              f"param_staged, sv, 0x{param_hash(params):08x}UL, {size}, 0, {len(params)}, kSvLock}};")
     c.append("fsw::ParamStore params;")
-    c.append(f"// {name}: {len(params)} parameter(s), {size} B of values; the EEPROM from "
-             f"{2 * (9 + size)} on is free (kParamEepromEnd)")
+    c.append(f"// {name}: {len(params)} parameter(s), {size} B of values; their two banks take EEPROM bytes "
+             f"0..{2 * (9 + size) - 1} (fsw::param_eeprom_end), the machine slots and the recorder follow")
     c.append("")
     return c
 

@@ -83,6 +83,10 @@ def cmd_param(args) -> int:
             except ParamFileError as e:
                 sys.stderr.write(f"{e}\n")
                 return EXIT_CONFIG
+            if args.action == "load" and not file_values:  # a load saves: it would save the live values, unasked
+                sys.stderr.write(f"{args.args[0]}: names no parameter: nothing to load (a file holds one "
+                                 "`NAME = value` per parameter it sets; `fsw param save` keeps the live values)\n")
+                return EXIT_CONFIG
     elif args.args:
         _say(f"`{args.action}` takes no arguments")
         return EXIT_CONFIG

@@ -112,7 +112,7 @@ def cmd_param(args) -> int:
 
 def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
     from fswkit.cli.common import talk_on_link
-    from fswkit.param.client import ParamClient, ParamError, PortTransport
+    from fswkit.param.client import ParamClient, ParamError, PortTransport, not_read, uploaded_note
 
     baud = args.baud or app.baud
 
@@ -123,6 +123,16 @@ def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, param
         except ParamError as e:
             _say(str(e))
             return EXIT_FAIL
+        machine = app.machines[app.reload.machine].name if getattr(app, "reload", None) is not None else None
+        slot = client.uploaded_slot(machine)
+        if args.action in ("set", "load"):
+            why = not_read(params, set(wanted) | set(file_values or ()), machine, slot, args.project)
+            if why is not None:
+                _say(f"{args.action} refused: {why}")
+                return EXIT_FAIL
+        note = uploaded_note(params, machine, slot, args.project)
+        if note is not None:
+            _say(f"note: {note}")
         return _action(args, client, params, by_name, wanted, file_values, params_text)
 
     return talk_on_link(args, layout, baud, _say, talk, (ParamError,))

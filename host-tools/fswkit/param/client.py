@@ -22,8 +22,9 @@ from dataclasses import dataclass
 
 from fswkit.autocode.params import AppParam
 from fswkit.autocode.protocol import crc16
-from fswkit.autocode.protocol import (OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO, OP_PARAM_SAVE,
-                                      OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES, PARAM_WRITING)
+from fswkit.autocode.protocol import (OP_MACHINE_INFO, OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO,
+                                      OP_PARAM_SAVE, OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES,
+                                      PARAM_WRITING)
 from fswkit.link import wire
 from fswkit.link.client import Numbers
 from fswkit.link.session import Session
@@ -39,6 +40,31 @@ REPLAY, UNKNOWN_OP, BUSY, NO_LOAD = 1, 2, 11, 12
 
 class ParamError(Exception):
     """A refusal or a failure, said in words."""
+
+
+def not_read(params, names, machine: str | None, slot: int, project: str) -> str | None:
+    """Why a change of `names` would not reach the machine that runs: the
+    first of them declared by `machine` (the project's [reload] machine)
+    while the image uploaded in `slot` runs in its place (docs/reload.md:
+    an uploaded machine reads its own defaults); None when none is."""
+    if not slot or machine is None:
+        return None
+    for p in params:
+        if p.name in names and p.machine == machine:
+            return (f"`{p.name}` is a parameter of machine `{machine}`, which runs the image uploaded in slot {slot}: "
+                    "an uploaded machine reads its own defaults, never these values (docs/reload.md), so the change "
+                    f"would not reach it; `fsw machine {project} revert` runs the generated machine again, which "
+                    "reads them")
+    return None
+
+
+def uploaded_note(params, machine: str | None, slot: int, project: str) -> str | None:
+    """What to say beside the values while the image uploaded in `slot`
+    runs in place of `machine`, when it declares parameters; else None."""
+    if not slot or machine is None or not any(p.machine == machine for p in params):
+        return None
+    return (f"machine `{machine}` runs the image uploaded in slot {slot}, which reads its own defaults: the values of "
+            f"its parameters here reach the generated machine only (`fsw machine {project} revert`)")
 
 
 @dataclass
@@ -278,6 +304,16 @@ class ParamClient:
                              f"not the one of {project} (0x{mine:08x}, {len(self.params)}): its firmware was built "
                              "from other configs; build and flash it again")
         return inf
+
+    def uploaded_slot(self, machine: str | None) -> int:
+        """The slot (1, 2) whose uploaded image runs in place of `machine`
+        (the project's [reload] machine), 0 when its generated code runs;
+        asked (MACHINE_INFO) only when `machine` declares parameters."""
+        if machine is None or not any(p.machine == machine for p in self.params):
+            return 0
+        ack = self.run([(OP_MACHINE_INFO, b"")])[0]
+        data = ack.get("data") or b""
+        return data[0] if ack["status"] == 0 and data and data[0] in (1, 2) else 0
 
     def get_all(self) -> dict[str, object]:
         """Every parameter's live value, by name."""

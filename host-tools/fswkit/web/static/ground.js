@@ -355,6 +355,7 @@ async function readParams() {
   $("param-err").textContent = "";
   const r = await (await fetch("/api/params")).json();
   if (!r.ok) { $("param-err").textContent = r.words; return; }
+  if (r.note) $("param-err").textContent = r.note;  // an uploaded machine runs: its values reach the generated one only
   const i = r.info;
   $("param-state").textContent = `${SOURCES[i.source]}${i.source >= 2 ? ", sequence " + i.seq : ""}` +
     `${i.dirty ? ", unsaved changes" : ""}${i.writing ? ", writing" : ""}`;

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 import struct
 from dataclasses import dataclass
 
@@ -138,7 +139,7 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
                 value = None
             if value is None:
                 kind = "a whole number" if t.is_int else "a number"
-                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}"
+                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}{_unit_hint(p, text)}"
     if t.is_bool:
         if isinstance(value, bool):
             return value, None
@@ -170,6 +171,18 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
         return None, f"`{p.name}` = {_num(value)} is outside its range {p.range_text()}" + \
             (f" {p.unit}" if p.unit else "")
     return value, None
+
+
+_NUMBER_THEN_WORD = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*[^\d\s.+-].*")
+
+
+def _unit_hint(p: AppParam, text: str) -> str:
+    """For a number typed with a unit after it (`2s`, `650 psi`): that the
+    number goes alone, in the parameter's unit; else nothing."""
+    if not _NUMBER_THEN_WORD.fullmatch(text):
+        return ""
+    return f": give the number alone, in {p.unit} (its unit)" if p.unit else \
+        f": give the number alone (`{p.name}` has no unit)"
 
 
 def value_block(params, values: dict[str, object]) -> bytes:

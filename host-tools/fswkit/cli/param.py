@@ -13,12 +13,12 @@ def _say(msg: str) -> None:
     sys.stderr.write(f"fsw param: {msg}\n")
 
 
-def _show(p, v) -> str:
+def _show(p, v, unit: bool = False) -> str:
+    """A value as the ground shows it (with its unit when `unit` and it has one)."""
     if p.type.is_bool:
         return "true" if v else "false"
-    if p.type.is_float:
-        return f"{v:.9g}"
-    return str(v)
+    text = f"{v:.9g}" if p.type.is_float else str(v)
+    return f"{text} {p.unit}" if unit and p.unit else text
 
 
 def cmd_param(args) -> int:
@@ -142,7 +142,7 @@ def _action(args, client, params, by_name, wanted, file_values, params_text) -> 
     a = args.action
     if a == "set":
         client.set(wanted)
-        print("fsw param: set " + ", ".join(f"{k} = {_show(by_name[k], v)}" for k, v in wanted.items())
+        print("fsw param: set " + ", ".join(f"{k} = {_show(by_name[k], v, unit=True)}" for k, v in wanted.items())
               + " (live, not saved: `fsw param save` keeps them across power cycles)")
         return EXIT_OK
     if a == "save":

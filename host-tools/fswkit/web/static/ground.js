@@ -374,7 +374,7 @@ async function readParams() {
 
 async function setParam(p, text) {
   $("param-err").textContent = "";
-  if (!(await ask(`Set parameter ${p.name} = ${text} on the target (live, until saved)?`))) return;
+  if (!(await ask(`Set parameter ${p.name} = ${text}${p.unit ? " " + p.unit : ""} on the target (live, until saved)?`))) return;
   const r = await fetch("/api/params", { method: "POST", headers: { "Content-Type": "application/json" },
                                          body: JSON.stringify({ values: { [p.name]: text } }) });
   const answer = await r.json();

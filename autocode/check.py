@@ -496,6 +496,11 @@ def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_, what: str =
                 res.error(e.line, e.col, f"initial value of `{d.name}` uses parameter `{e.name}`: a local's "
                                          "initial value cannot depend on a value the ground may change")
                 ok = False
+            elif (owner is not None and e.name != who and e.name in res.names
+                  and vars_[res.names[e.name]].param is not None):  # a bound: fixed when the firmware is built
+                res.diags.warning(res.src, res.lang, e.line, e.col,
+                                  f"{what} of `{who}` uses parameter `{e.name}`: its default, fixed when the firmware "
+                                  f"is built; the range does not follow a change of `{e.name}` from the ground")
             elif e.name == who:
                 res.error(e.line, e.col, f"parameter `{who}` cannot be used in its own {what}" if param else
                           f"local `{d.name}` cannot be used in its own initial value")

@@ -3,7 +3,8 @@
 // defaults; SET all or nothing, refused out of range (NaN too), for an
 // unknown id, or outside the declaring machine's allowed states; SAVE into
 // the other bank in the background; a load staged into the other bank and
-// committed whole after a CRC check; BUSY while a bank is written; and a
+// committed whole after a CRC check; BUSY while a bank is written (a load
+// left open holds neither SET nor SAVE); and a
 // power cut after every write of a save or a load leaves the old set or the
 // new one, never a mix.
 #include "test_support.h"

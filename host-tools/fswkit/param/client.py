@@ -423,7 +423,11 @@ class ParamClient:
         for ack in self.run([(OP_PARAM_STAGE, f) for f in frames]):
             if ack["status"] != 0:
                 raise self._refusal(ack, "load")
+        resent = self.stats.resent
         ack = self.run([(OP_PARAM_COMMIT, struct.pack("<H", crc))])[0]
+        if ack["status"] == NO_LOAD and self.stats.resent == resent:  # no copy of it was applied
+            raise ParamError("the target lost the load before its COMMIT (it restarted during the load?): nothing "
+                             "was loaded; run the load again")
         if ack["status"] == NO_LOAD:  # an earlier copy of the commit was applied, its ack lost
             pass
         elif ack["status"] != 0:

@@ -156,7 +156,7 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
     else:
         if not isinstance(value, (int, float)):
             return None, f"`{p.name}` is {t.name}: give a number, not {value!r}"
-        value = float(value)
+        value = float(value) + 0.0  # -0 is 0: the board tells a change by the bytes
         if value != value:
             return None, f"`{p.name}`: NaN is not a value a parameter may take"
         if t.size == 4:

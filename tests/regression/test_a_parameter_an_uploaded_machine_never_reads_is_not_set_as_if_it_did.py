@@ -35,7 +35,8 @@ def rig(tmp_path_factory):
         shutil.copy(EXAMPLES / "tank" / n, root / "tank" / n)
     sm = (EXAMPLES / "tank" / "tank.sm").read_text()
     sm = sm.replace("[TankVentControl]", "[parameters]\nF64 VENT_AT = 775 @min 500 @max 900 @unit psi "
-                    "@when TankVentControl Idle\n\n[TankVentControl]", 1).replace("tankPressure > 775", "tankPressure > VENT_AT")
+                    "@when TankVentControl Idle\n\n[TankVentControl]", 1)
+    sm = sm.replace("tankPressure > 775", "tankPressure > VENT_AT")
     (root / "tank" / "tank.sm").write_text(sm)
     app = (EXAMPLES / "stand" / "stand.app").read_text().replace("board uno", "board native")
     (root / "stand" / "stand.app").write_text(app)

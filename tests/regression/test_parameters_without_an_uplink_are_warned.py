@@ -20,7 +20,8 @@ def test_parameters_without_an_uplink_task_are_warned(tmp_path):
     rig = tmp_path / "rig"
     shutil.copytree(RIG, rig)
     app = rig / "tuned.app"
-    app.write_text(app.read_text().replace("up   uplink          rate=100\n", "").replace("[uplink]\narm\npressure\n", ""))
+    text = app.read_text().replace("up   uplink          rate=100\n", "")
+    app.write_text(text.replace("[uplink]\narm\npressure\n", ""))
     r = run_fsw("check", str(app))
     assert r.code == 0, r.err
     assert ("application config warning @ " in r.err and "tuned.app:8:9:" in r.err

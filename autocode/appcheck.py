@@ -122,6 +122,8 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     # a task row refused for its own reason is no missing task, and a row of an unknown kind may be the one
     unknown = any(row.kind is None or row.kind.text not in TASK_KINDS for row in f.tasks)
     has = lambda kind: unknown or any(row.kind.text == kind for row in f.tasks)  # noqa: E731
+    if not has("uplink"):
+        _parameters_unreachable(machines, machine_files, r)
     if sensors and not has("inputs"):
         tok = next(c.file for c in io_files if c.path.endswith(".sns"))
         r.err(tok, "the sensor parts are read by the `inputs` task: add one to [tasks] (e.g. `sense inputs rate=100`)")
@@ -334,6 +336,17 @@ def _parameters(machines: list[M.Machine], files: list[ConfigFile], board: Board
     if count and board is not None and 2 * (HEADER + size) > board.eeprom:
         r.err(last, f"the parameters' two EEPROM banks take {2 * (HEADER + size):,} B (2 x ({HEADER} + {size})) "
                     f"but the {board.name} has {board.eeprom:,} B of EEPROM")
+
+
+def _parameters_unreachable(machines: list[M.Machine], files: list[ConfigFile], r: Report) -> None:
+    """A warning at the first machine that declares parameters, when no
+    `uplink` task receives the parameter commands."""
+    by_file = {os.path.splitext(os.path.basename(c.path))[0]: c.file for c in files}
+    m = next((m for m in machines if any(v.param is not None for v in m.vars)), None)
+    if m is not None and by_file.get(m.name) is not None:
+        r.warn(by_file[m.name], "parameters without an `uplink` task in [tasks]: the ground can neither read nor "
+                                "change them; the firmware boots with what an earlier firmware of the same parameter "
+                                "table saved in the EEPROM, else the defaults")
 
 
 def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]) -> str | None:

@@ -417,40 +417,47 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
 
 def _param_var(v: M.Var, d: S.ParamDecl, lo_e, hi_e, consts, state_index, err) -> M.Var:
     """A parameter's Var with its range (values of its type) and the ids of
-    the states that allow a change; errors for a range outside the type, a
-    default outside the range, an unknown state."""
+    the states that allow a change; errors for a default or a bound that is
+    not a value of the type (a fraction for an integer, beyond binary32, a
+    number F32 holds as 0), a default outside the range, an unknown state."""
     from .numeric import to_type
 
     t = v.type
+
+    def value(label: str, e, col: int):
+        """`e` as a value of the type, or None (said when it is none)."""
+        try:
+            x = evaluate(e, F64MODE, lambda i: _const(consts, i))
+        except NotConstant:
+            return None
+        if x != x or x in (math.inf, -math.inf):
+            err(d.line, col, f"{label} of `{d.name}` must be a finite number, not {x}")
+            return None
+        if t.is_int and (x != int(x) or not t.lo <= x <= t.hi):
+            err(d.line, col, f"{label} of `{d.name}` must be a whole number in {t.lo}..{t.hi} ({t}), not {x:g}")
+            return None
+        if t.is_float and t.size == 4 and abs(x) > 3.4028234663852886e38:
+            err(d.line, col, f"{label} of `{d.name}` is beyond binary32 (F32): {x:g}")
+            return None
+        y = to_type(t, x)
+        if t.is_float and x != 0 and y == 0:  # a bound or default the user set apart from 0 would be 0
+            err(d.line, col, f"{label} of `{d.name}` is {x:g}, which {t} holds as 0: give 0, or a number {t} "
+                             f"holds apart from 0 (from {'1.4e-45' if t.size == 4 else '4.9e-324'})")
+            return None
+        return y
+
+    default_ok = t.is_bool or v.init is None or value("the default", v.init, d.name_col) is not None
     bounds = []
     for what, e in (("@min", lo_e), ("@max", hi_e)):
         if e is None:
             bounds.append(None)
             continue
-        col = dict(d.annot_cols).get(what, d.name_col)
-        try:
-            x = evaluate(e, F64MODE, lambda i: _const(consts, i))
-        except NotConstant:
-            bounds.append(None)
-            continue
-        if x != x or x in (math.inf, -math.inf):
-            err(d.line, col, f"`{what}` of `{d.name}` must be a finite number, not {x}")
-            bounds.append(None)
-            continue
-        if t.is_int and (x != int(x) or not t.lo <= x <= t.hi):
-            err(d.line, col, f"`{what}` of `{d.name}` must be a whole number in {t.lo}..{t.hi} ({t}), not {x:g}")
-            bounds.append(None)
-            continue
-        if t.is_float and t.size == 4 and abs(x) > 3.4028234663852886e38:
-            err(d.line, col, f"`{what}` of `{d.name}` is beyond binary32 (F32): {x:g}")
-            bounds.append(None)
-            continue
-        bounds.append(to_type(t, x))
+        bounds.append(value(f"`{what}`", e, dict(d.annot_cols).get(what, d.name_col)))
     lo, hi = bounds
     if lo is not None and hi is not None:
         if lo > hi:
             err(d.line, dict(d.annot_cols)["@max"], f"`@max` of `{d.name}` ({hi:g}) is below its `@min` ({lo:g})")
-        elif v.index in consts and not lo <= consts[v.index] <= hi:
+        elif default_ok and v.index in consts and not lo <= consts[v.index] <= hi:
             err(d.line, d.name_col, f"the default of `{d.name}` ({consts[v.index]:g}) is outside its range "
                                     f"{lo:g}..{hi:g}")
     when: list[int] = []
@@ -489,6 +496,11 @@ def _resolve_init(res: Resolver, d: S.LocalDecl, local_decls, vars_, what: str =
                 res.error(e.line, e.col, f"initial value of `{d.name}` uses parameter `{e.name}`: a local's "
                                          "initial value cannot depend on a value the ground may change")
                 ok = False
+            elif (owner is not None and e.name != who and e.name in res.names
+                  and vars_[res.names[e.name]].param is not None):  # a bound: fixed when the firmware is built
+                res.diags.warning(res.src, res.lang, e.line, e.col,
+                                  f"{what} of `{who}` uses parameter `{e.name}`: its default, fixed when the firmware "
+                                  f"is built; the range does not follow a change of `{e.name}` from the ground")
             elif e.name == who:
                 res.error(e.line, e.col, f"parameter `{who}` cannot be used in its own {what}" if param else
                           f"local `{d.name}` cannot be used in its own initial value")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 import struct
 from dataclasses import dataclass
 
@@ -138,7 +139,7 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
                 value = None
             if value is None:
                 kind = "a whole number" if t.is_int else "a number"
-                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}"
+                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}{_unit_hint(p, text)}"
     if t.is_bool:
         if isinstance(value, bool):
             return value, None
@@ -148,25 +149,40 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
     if t.is_int:
         if isinstance(value, float):
             if not math.isfinite(value) or value != int(value):  # int() of an infinity overflows
-                return None, f"`{p.name}` is {t.name}: give a whole number, not {value:g}"
+                return None, f"`{p.name}` is {t.name}: give a whole number, not {value!r}"
             value = int(value)
         if not isinstance(value, int):
             return None, f"`{p.name}` is {t.name}: give a whole number, not {value!r}"
     else:
         if not isinstance(value, (int, float)):
             return None, f"`{p.name}` is {t.name}: give a number, not {value!r}"
-        value = float(value)
+        value = float(value) + 0.0  # -0 is 0: the board tells a change by the bytes
         if value != value:
             return None, f"`{p.name}`: NaN is not a value a parameter may take"
         if t.size == 4:
             try:
-                value = struct.unpack("<f", struct.pack("<f", value))[0]
+                held = struct.unpack("<f", struct.pack("<f", value))[0]
             except OverflowError:
                 return None, f"`{p.name}` is F32: {value:g} is beyond its range"
+            if held == 0 and value != 0:  # a value the user set apart from 0 would be 0
+                return None, f"`{p.name}` is F32: {value:g} is held as 0; give 0, or a number from 1.4e-45"
+            value = held
     if not p.min <= value <= p.max:
         return None, f"`{p.name}` = {_num(value)} is outside its range {p.range_text()}" + \
             (f" {p.unit}" if p.unit else "")
     return value, None
+
+
+_NUMBER_THEN_WORD = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*[^\d\s.+-].*")
+
+
+def _unit_hint(p: AppParam, text: str) -> str:
+    """For a number typed with a unit after it (`2s`, `650 psi`): that the
+    number goes alone, in the parameter's unit; else nothing."""
+    if not _NUMBER_THEN_WORD.fullmatch(text):
+        return ""
+    return f": give the number alone, in {p.unit} (its unit)" if p.unit else \
+        f": give the number alone (`{p.name}` has no unit)"
 
 
 def value_block(params, values: dict[str, object]) -> bytes:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from ..app import TASK_MODES, Application, Task
-from ..cnames import comment
+from ..cnames import comment, enumerator
 from ..iotables import analog_gain
 from ..limits import link_load
 from ..numeric import REALS
@@ -868,7 +868,7 @@ def _params(app: Application, params) -> list[str]:
          f"const fsw::ParamDef kParamDefs[{len(params)}] FSW_FLASH = {{"]
     for p, rng, w in defs:
         m = c_ident(p.machine)
-        c.append(f"    {{{m}::prm + {m}::P_{p.name}, {p.off}, {rng}, {ELEM_CODE[p.type.name]}, {w}}},  "
+        c.append(f"    {{{m}::prm + {m}::{enumerator('P_', p.name)}, {p.off}, {rng}, {ELEM_CODE[p.type.name]}, {w}}},  "
                  f"// {basename(p.path)}:{p.line} {p.name} ({p.type.name}, {p.range_text()}{' ' + p.unit if p.unit else ''})")
     c.append("};")
     c.append(f"const fsw::ParamWhen kParamWhens[{len(whens)}] FSW_FLASH = {{")
@@ -882,8 +882,8 @@ def _params(app: Application, params) -> list[str]:
     c.append(f"const fsw::ParamConfig kParamConfig FSW_FLASH = {{kParamDefs, kParamWhens, kParamPool, kParamDefaults, "
              f"param_staged, sv, 0x{param_hash(params):08x}UL, {size}, 0, {len(params)}, kSvLock}};")
     c.append("fsw::ParamStore params;")
-    c.append(f"// {name}: {len(params)} parameter(s), {size} B of values; the EEPROM from "
-             f"{2 * (9 + size)} on is free (kParamEepromEnd)")
+    c.append(f"// {name}: {len(params)} parameter(s), {size} B of values; their two banks take EEPROM bytes "
+             f"0..{2 * (9 + size) - 1} (fsw::param_eeprom_end), the machine slots and the recorder follow")
     c.append("")
     return c
 

@@ -212,7 +212,13 @@ uint8_t header_byte(const ParamStore& s, const ParamConfig& c, uint8_t i) {
     return i == 6 ? static_cast<uint8_t>(s.w_crc >> 8) : static_cast<uint8_t>(s.w_crc);
 }
 
-bool busy(const ParamStore& s) { return (s.source & kParamWriting) != 0; }
+// A bank is being written that a SET, a SAVE or a BEGIN must wait for (the
+// writer past kStage): a save, or a committed load. A load still open
+// (BEGIN .. COMMIT) holds none of them, so that a ground that left one open
+// stops nothing till a reset: a SET changes live values, which the load's
+// COMMIT then finds in its CRC; a SAVE ends the load and writes the bank
+// the load was staging into; a BEGIN starts the load again.
+bool bank_busy(const ParamStore& s) { return s.w_job >= kClear; }
 
 }  // namespace
 
@@ -252,7 +258,7 @@ void param_begin(ParamStore& s, const ParamConfig* cfg) {
 uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
     const ParamConfig& c = *s.cfg;
     bad = 0xFF;
-    if (busy(s)) return kParamBusy;
+    if (bank_busy(s)) return kParamBusy;
     const uint8_t st = check_entries(c, a, len, bad);
     if (st != kParamOk) return st;
     for (uint8_t i = 0; i < len;) {  // a change only in an allowed state
@@ -277,14 +283,15 @@ uint8_t param_set(ParamStore& s, const uint8_t* a, uint8_t len, uint8_t& bad) {
 }
 
 uint8_t param_save(ParamStore& s) {
-    if (busy(s)) return kParamBusy;
+    if (bank_busy(s)) return kParamBusy;
+    s.loading = 0;  // an open load ends: its STAGE and COMMIT answer NO_LOAD, its staged values never live
     s.source |= kParamWriting;
     s.w_job = kClear;
     return kParamOk;
 }
 
 uint8_t param_load_begin(ParamStore& s) {
-    if (busy(s) && !s.loading) return kParamBusy;  // a save under way; an open load starts again
+    if (bank_busy(s)) return kParamBusy;
     const ParamConfig& c = *s.cfg;
     memset(flash_get(c.staged), 0, (flash_get(c.n) + 7u) / 8u);
     s.q_len = 0;

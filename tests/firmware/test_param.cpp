@@ -3,7 +3,8 @@
 // defaults; SET all or nothing, refused out of range (NaN too), for an
 // unknown id, or outside the declaring machine's allowed states; SAVE into
 // the other bank in the background; a load staged into the other bank and
-// committed whole after a CRC check; BUSY while a bank is written; and a
+// committed whole after a CRC check; BUSY while a bank is written (a load
+// left open holds neither SET nor SAVE); and a
 // power cut after every write of a save or a load leaves the old set or the
 // new one, never a mix.
 #include "test_support.h"
@@ -280,6 +281,49 @@ static void test_a_load_is_applied_whole_after_its_crc_and_states_are_checked(vo
     TEST_ASSERT_EQUAL_INT16(-5, i16_at(9));
 }
 
+// A load left open (the ground gone between BEGIN and COMMIT) holds
+// neither SET nor SAVE: a SET changes live values, which the load's COMMIT
+// then finds in its CRC; a SAVE ends the load (STAGE and COMMIT answer
+// NO_LOAD) and writes the live values, the staged one never live. A BEGIN
+// waits for a committed load's bank as it does for a save's.
+static void test_an_open_load_holds_neither_set_nor_save(void) {
+    uint8_t bad;
+    TEST_ASSERT_EQUAL(kParamOk, param_load_begin(g_store));
+    entry_u32(1, 40000);
+    TEST_ASSERT_EQUAL(kParamOk, param_stage(g_store, args, nargs, bad));
+    nargs = 0;
+    for (int i = 0; i < 50; ++i) param_poll(g_store);  // staged into bank A
+    entry_f32(0, 250.0f);
+    TEST_ASSERT_EQUAL(kParamOk, set(bad));
+    TEST_ASSERT_EQUAL_FLOAT(250.0f, f32_at(0));
+    TEST_ASSERT_EQUAL(kParamMismatch, param_commit(g_store, block_crc_with(150.0f, 40000), bad));
+    TEST_ASSERT_EQUAL(kParamOk, param_save(g_store));
+    entry_u32(1, 40000);
+    TEST_ASSERT_EQUAL(kParamNoLoad, param_stage(g_store, args, nargs, bad));
+    nargs = 0;
+    TEST_ASSERT_EQUAL(kParamNoLoad, param_commit(g_store, block_crc_with(250.0f, 40000), bad));
+    drain();
+    TEST_ASSERT_EQUAL_HEX8(kParamBankA, g_store.source);
+    boot();
+    TEST_ASSERT_EQUAL_HEX8(kParamBankA, g_store.source);
+    TEST_ASSERT_EQUAL_FLOAT(250.0f, f32_at(0));
+    TEST_ASSERT_EQUAL_UINT32(10000, u32_at(4));  // the staged value never took effect
+    // a committed load's bank is written before another load begins
+    TEST_ASSERT_EQUAL(kParamOk, param_load_begin(g_store));
+    entry_u32(1, 40000);
+    TEST_ASSERT_EQUAL(kParamOk, param_stage(g_store, args, nargs, bad));
+    nargs = 0;
+    for (int i = 0; i < 50; ++i) param_poll(g_store);
+    TEST_ASSERT_EQUAL(kParamOk, param_commit(g_store, block_crc_with(250.0f, 40000), bad));
+    TEST_ASSERT_EQUAL(kParamBusy, param_load_begin(g_store));
+    entry_f32(0, 300.0f);
+    TEST_ASSERT_EQUAL(kParamBusy, set(bad));
+    TEST_ASSERT_EQUAL(kParamBusy, param_save(g_store));
+    drain();
+    TEST_ASSERT_EQUAL_HEX8(kParamBankB, g_store.source);
+    TEST_ASSERT_EQUAL(kParamOk, param_load_begin(g_store));
+}
+
 static void test_the_stage_queue_says_busy_when_full(void) {
     uint8_t bad;
     TEST_ASSERT_EQUAL(kParamOk, param_load_begin(g_store));
@@ -359,6 +403,7 @@ static void run(void) {
     RUN_TEST(test_a_change_needs_an_allowed_state);
     RUN_TEST(test_busy_while_a_bank_is_written);
     RUN_TEST(test_a_load_is_applied_whole_after_its_crc_and_states_are_checked);
+    RUN_TEST(test_an_open_load_holds_neither_set_nor_save);
     RUN_TEST(test_the_stage_queue_says_busy_when_full);
     RUN_TEST(test_a_power_cut_at_any_write_leaves_the_old_or_the_new_set);
     (void)UNITY_END();

@@ -138,6 +138,7 @@ def _with_params(script, given: list[str]):
 
     m = script.machine
     values = {}
+    typed: dict[str, str] = {}  # each value as given
     for g in given:
         name, eq, text = g.partition("=")
         name = name.strip()
@@ -154,7 +155,12 @@ def _with_params(script, given: list[str]):
         if why is not None:
             sys.stderr.write(f"fsw test: --param {g}: {why}\n")
             return None
+        if name in values:  # which one was meant is not ours to guess
+            sys.stderr.write(f"fsw test: --param {g}: `{name}` is given twice ({typed[name]} and {text.strip()}): "
+                             "give it once\n")
+            return None
         values[name] = value
+        typed[name] = text.strip()
     return dataclasses.replace(script, machine=machine_with_values(m, values))
 
 

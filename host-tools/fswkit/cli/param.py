@@ -13,12 +13,12 @@ def _say(msg: str) -> None:
     sys.stderr.write(f"fsw param: {msg}\n")
 
 
-def _show(p, v) -> str:
+def _show(p, v, unit: bool = False) -> str:
+    """A value as the ground shows it (with its unit when `unit` and it has one)."""
     if p.type.is_bool:
         return "true" if v else "false"
-    if p.type.is_float:
-        return f"{v:.9g}"
-    return str(v)
+    text = f"{v:.9g}" if p.type.is_float else str(v)
+    return f"{text} {p.unit}" if unit and p.unit else text
 
 
 def cmd_param(args) -> int:
@@ -38,6 +38,7 @@ def cmd_param(args) -> int:
     by_name = {p.name: p for p in params}
     # everything the user typed is checked before the port is opened
     wanted: dict[str, object] = {}
+    typed: dict[str, str] = {}  # each value as given
     file_values = None
     if args.action in ("get",):
         if not args.args:
@@ -64,7 +65,11 @@ def cmd_param(args) -> int:
             if why is not None:
                 _say(why)
                 return EXIT_CONFIG
+            if p.name in wanted:  # which one was meant is not ours to guess
+                _say(f"`{p.name}` is given twice ({typed[p.name]} and {text.strip()}): give it once")
+                return EXIT_CONFIG
             wanted[p.name] = v
+            typed[p.name] = text.strip()
     elif args.action in ("load", "diff"):
         if args.action == "load" and len(args.args) != 1:
             _say("usage: fsw param PROJECT load FILE.toml")
@@ -77,6 +82,10 @@ def cmd_param(args) -> int:
                 file_values = read_params(args.args[0], params)
             except ParamFileError as e:
                 sys.stderr.write(f"{e}\n")
+                return EXIT_CONFIG
+            if args.action == "load" and not file_values:  # a load saves: it would save the live values, unasked
+                sys.stderr.write(f"{args.args[0]}: names no parameter: nothing to load (a file holds one "
+                                 "`NAME = value` per parameter it sets; `fsw param save` keeps the live values)\n")
                 return EXIT_CONFIG
     elif args.args:
         _say(f"`{args.action}` takes no arguments")
@@ -103,21 +112,27 @@ def cmd_param(args) -> int:
 
 def _talk(args, app, params, by_name, wanted, file_values, layout, tx_cap, params_text) -> int:
     from fswkit.cli.common import talk_on_link
-    from fswkit.param.client import ParamClient, ParamError, PortTransport
+    from fswkit.param.client import ParamClient, ParamError, PortTransport, not_read, uploaded_note
 
     baud = args.baud or app.baud
 
     def talk(ground) -> int:
         client = ParamClient(PortTransport(ground), params, tx_cap, baud=baud)
-        from fswkit.autocode.params import param_hash
-
-        inf = client.info()
-        if inf["hash"] != param_hash(params) or inf["count"] != len(params):
-            if not args.ignore_schema:
-                _say(f"the target's parameter table (hash 0x{inf['hash']:08x}, {inf['count']} parameters) is not "
-                     f"the one of {args.project} (0x{param_hash(params):08x}, {len(params)}): its firmware was "
-                     "built from other configs; build and flash it again")
+        try:  # whatever --ignore-schema says: a value means a parameter only through its table
+            client.table_info(args.project)
+        except ParamError as e:
+            _say(str(e))
+            return EXIT_FAIL
+        machine = app.machines[app.reload.machine].name if getattr(app, "reload", None) is not None else None
+        slot = client.uploaded_slot(machine)
+        if args.action in ("set", "load"):
+            why = not_read(params, set(wanted) | set(file_values or ()), machine, slot, args.project)
+            if why is not None:
+                _say(f"{args.action} refused: {why}")
                 return EXIT_FAIL
+        note = uploaded_note(params, machine, slot, args.project)
+        if note is not None:
+            _say(f"note: {note}")
         return _action(args, client, params, by_name, wanted, file_values, params_text)
 
     return talk_on_link(args, layout, baud, _say, talk, (ParamError,))
@@ -127,7 +142,7 @@ def _action(args, client, params, by_name, wanted, file_values, params_text) -> 
     a = args.action
     if a == "set":
         client.set(wanted)
-        print("fsw param: set " + ", ".join(f"{k} = {_show(by_name[k], v)}" for k, v in wanted.items())
+        print("fsw param: set " + ", ".join(f"{k} = {_show(by_name[k], v, unit=True)}" for k, v in wanted.items())
               + " (live, not saved: `fsw param save` keeps them across power cycles)")
         return EXIT_OK
     if a == "save":

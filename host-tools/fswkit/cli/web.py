@@ -16,14 +16,18 @@ ARCHIVE = "ground-archive.sqlite"  # in the project's folder, unless --archive n
 
 
 def _parameters(project: str):
-    """(the application's parameter table, its link's transmit buffer size)."""
+    """(the application's parameter table, its link's transmit buffer size,
+    the name of its [reload] machine or None)."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.params import app_parameters
     from fswkit.autocode.schema import link_plan
     from fswkit.target.build import load
 
     app = load(project, Diagnostics())
-    return (app_parameters(app), link_plan(app).tx_cap) if app is not None else ((), 0)
+    if app is None:
+        return (), 0, None
+    reload = app.machines[app.reload.machine].name if getattr(app, "reload", None) is not None else None
+    return app_parameters(app), link_plan(app).tx_cap, reload
 
 
 def archive_path(args) -> str | None:
@@ -111,8 +115,8 @@ def _station(args, name: str, layout, app_baud: int, port_name: str, sock) -> in
             while not stop.wait(0.5):
                 pass
             return EXIT_OK
-        params, tx_cap = _parameters(args.project)
-        app = create_app(LiveSource(station, params=params, tx_cap=tx_cap, baud=baud),
+        params, tx_cap, reload_machine = _parameters(args.project)
+        app = create_app(LiveSource(station, params=params, tx_cap=tx_cap, baud=baud, reload_machine=reload_machine),
                          title=f"fsw ground {args.project}", host=args.host)
 
         def ready(url: str) -> None:

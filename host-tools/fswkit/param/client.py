@@ -22,8 +22,9 @@ from dataclasses import dataclass
 
 from fswkit.autocode.params import AppParam
 from fswkit.autocode.protocol import crc16
-from fswkit.autocode.protocol import (OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO, OP_PARAM_SAVE,
-                                      OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES, PARAM_WRITING)
+from fswkit.autocode.protocol import (OP_MACHINE_INFO, OP_PARAM_BEGIN, OP_PARAM_COMMIT, OP_PARAM_GET, OP_PARAM_INFO,
+                                      OP_PARAM_SAVE, OP_PARAM_SET, OP_PARAM_STAGE, PARAM_INFO, PARAM_SOURCES,
+                                      PARAM_WRITING)
 from fswkit.link import wire
 from fswkit.link.client import Numbers
 from fswkit.link.session import Session
@@ -34,11 +35,36 @@ RX_CAP = 24  # the target's uplink frame buffer (FSW_LINK_RX_CAP): encoded bytes
 # brings one), so a window a little over the buffer keeps the pipe full
 # without ever overflowing it
 RX_WINDOW = 90
-REPLAY, BUSY, NO_LOAD = 1, 11, 12
+REPLAY, UNKNOWN_OP, BUSY, NO_LOAD = 1, 2, 11, 12
 
 
 class ParamError(Exception):
     """A refusal or a failure, said in words."""
+
+
+def not_read(params, names, machine: str | None, slot: int, project: str) -> str | None:
+    """Why a change of `names` would not reach the machine that runs: the
+    first of them declared by `machine` (the project's [reload] machine)
+    while the image uploaded in `slot` runs in its place (docs/reload.md:
+    an uploaded machine reads its own defaults); None when none is."""
+    if not slot or machine is None:
+        return None
+    for p in params:
+        if p.name in names and p.machine == machine:
+            return (f"`{p.name}` is a parameter of machine `{machine}`, which runs the image uploaded in slot {slot}: "
+                    "an uploaded machine reads its own defaults, never these values (docs/reload.md), so the change "
+                    f"would not reach it; `fsw machine {project} revert` runs the generated machine again, which "
+                    "reads them")
+    return None
+
+
+def uploaded_note(params, machine: str | None, slot: int, project: str) -> str | None:
+    """What to say beside the values while the image uploaded in `slot`
+    runs in place of `machine`, when it declares parameters; else None."""
+    if not slot or machine is None or not any(p.machine == machine for p in params):
+        return None
+    return (f"machine `{machine}` runs the image uploaded in slot {slot}, which reads its own defaults: the values of "
+            f"its parameters here reach the generated machine only (`fsw machine {project} revert`)")
 
 
 @dataclass
@@ -145,13 +171,18 @@ class ParamClient:
         self.stats = Stats()
         self.numbers = Numbers(transport.session)
         self.on_event = None  # every decoded event is passed here (a monitor may show them)
+        # what a target that answers BUSY till the deadline is doing (a client of other commands says its own)
+        self.busy_words = ("it is still writing a parameter bank (`fsw param list` says `writing` while it does); "
+                           "try again once it is done, or reset the target if it never is")
 
     def run(self, cmds: list[tuple[int, bytes]], busy_retry: bool = True) -> list[dict]:
         """Each command sent (several in flight), until each has its
         acknowledgement; the acks in the commands' order. A REPLAY answer
         resynchronises the sequence numbers; BUSY is tried again a little
         later (when busy_retry); a command unanswered in time goes again with
-        a new number, and an acknowledgement of any of its copies counts."""
+        a new number, and an acknowledgement of any of its copies counts.
+        ParamError past the deadline: the target answered BUSY (busy_words),
+        or nothing came."""
         t = self.t
         results: list[dict | None] = [None] * len(cmds)
         queue = deque(range(len(cmds)))
@@ -160,6 +191,7 @@ class ParamClient:
         not_before = 0.0
         start = t.now()
         resent: set[int] = set()  # commands sent more than once: their round trips are ambiguous
+        busy: set[int] = set()  # commands whose latest answer was BUSY
 
         def service(i: int) -> float:
             """How long command i keeps the link busy: its frame up, its ack
@@ -172,6 +204,8 @@ class ParamClient:
         while any(r is None for r in results):
             now = t.now()
             if now - start > self.deadline:
+                if busy:  # it answers: not the link's fault
+                    raise ParamError(f"the target answered BUSY for {self.deadline:g} s: {self.busy_words}")
                 raise ParamError(f"no answer from the target after {self.deadline:g} s "
                                  f"({self.stats.resent} commands sent again)")
             busy_bytes = sum(b for _, _, b in inflight.values())
@@ -212,11 +246,13 @@ class ParamClient:
                     queue.appendleft(i)
                 elif st == BUSY and busy_retry:
                     self.stats.busy += 1
+                    busy.add(i)
                     self._drop_copies(inflight, copies, i)
                     queue.appendleft(i)
                     not_before = t.now() + 0.02
                 else:
                     results[i] = ev.info
+                    busy.discard(i)
                     self._drop_copies(inflight, copies, i)
             # a command waits behind those sent before it: its ack is due after
             # theirs, plus a margin (a quarter of the round trips measured)
@@ -242,6 +278,9 @@ class ParamClient:
 
     def info(self) -> dict:
         ack = self.run([(OP_PARAM_INFO, b"")])[0]
+        if ack["status"] == UNKNOWN_OP:  # a firmware without parameters links none of their commands
+            raise ParamError("the target's firmware has no parameters (it does not know PARAM_INFO): it was built "
+                             "from other configs; build and flash it again")
         if ack["status"] != 0:
             raise ParamError(f"the target refused PARAM_INFO: {ack['status_name']}: {ack['reason']}")
         if len(ack["data"]) < PARAM_INFO.size:
@@ -249,6 +288,32 @@ class ParamClient:
         source, seq, crc, count, h = PARAM_INFO.unpack_from(ack["data"])
         return {"source": source & 3, "source_name": PARAM_SOURCES[source & 3], "dirty": bool(source & 0x40),
                 "writing": bool(source & PARAM_WRITING), "seq": seq, "crc": crc, "count": count, "hash": h}
+
+    def table_info(self, project: str) -> dict:
+        """PARAM_INFO, once the target's parameter table is this client's
+        (the table hash and count): the link's schema does not cover the
+        parameters, so a board flashed with other ones says hello as this
+        project's would, and its values read or set by this table would be
+        other parameters'. ParamError, saying so, when it is not."""
+        from fswkit.autocode.params import param_hash
+
+        inf = self.info()
+        mine = param_hash(self.params)
+        if inf["hash"] != mine or inf["count"] != len(self.params):
+            raise ParamError(f"the target's parameter table (hash 0x{inf['hash']:08x}, {inf['count']} parameters) is "
+                             f"not the one of {project} (0x{mine:08x}, {len(self.params)}): its firmware was built "
+                             "from other configs; build and flash it again")
+        return inf
+
+    def uploaded_slot(self, machine: str | None) -> int:
+        """The slot (1, 2) whose uploaded image runs in place of `machine`
+        (the project's [reload] machine), 0 when its generated code runs;
+        asked (MACHINE_INFO) only when `machine` declares parameters."""
+        if machine is None or not any(p.machine == machine for p in self.params):
+            return 0
+        ack = self.run([(OP_MACHINE_INFO, b"")])[0]
+        data = ack.get("data") or b""
+        return data[0] if ack["status"] == 0 and data and data[0] in (1, 2) else 0
 
     def get_all(self) -> dict[str, object]:
         """Every parameter's live value, by name."""
@@ -358,7 +423,11 @@ class ParamClient:
         for ack in self.run([(OP_PARAM_STAGE, f) for f in frames]):
             if ack["status"] != 0:
                 raise self._refusal(ack, "load")
+        resent = self.stats.resent
         ack = self.run([(OP_PARAM_COMMIT, struct.pack("<H", crc))])[0]
+        if ack["status"] == NO_LOAD and self.stats.resent == resent:  # no copy of it was applied
+            raise ParamError("the target lost the load before its COMMIT (it restarted during the load?): nothing "
+                             "was loaded; run the load again")
         if ack["status"] == NO_LOAD:  # an earlier copy of the commit was applied, its ack lost
             pass
         elif ack["status"] != 0:

@@ -17,16 +17,31 @@ class ParamFileError(Exception):
     """A located problem in a parameter file (`path:line:col: message`)."""
 
 
+def _blank_strings(text: str) -> str:
+    """`text` with the inside of its multi-line strings blanked (line breaks
+    kept), so that a `NAME = ...` written in one is not taken for a key."""
+    return re.sub(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'',
+                  lambda m: re.sub(r"[^\n]", " ", m.group()), text)
+
+
 def _where(text: str, key: str) -> tuple[int, int, int]:
-    """Line, the key's column and the value's column of `key = ...` at the
-    top level ((1, 1, 1) when not found)."""
-    pat = re.compile(rf'^([ \t]*)(?:"{re.escape(key)}"|{re.escape(key)})[ \t]*=[ \t]*', re.M)
-    m = pat.search(text)
-    if m is None:
+    """Line, the key's column and the value's column of the top-level key
+    `key` as the file writes it: `key = ...`, a dotted `key.sub = ...` or a
+    table header `[key]`, `[[key]]`, `[key.sub]` (the header's column for
+    both); (1, 1, 1) when not found."""
+    name = rf'(?:"{re.escape(key)}"|\'{re.escape(key)}\'|{re.escape(key)})'
+    pats = (re.compile(rf"^([ \t]*){name}[ \t]*=[ \t]*", re.M),
+            re.compile(rf"^([ \t]*){name}[ \t]*\.", re.M),
+            re.compile(rf"^([ \t]*)\[\[?[ \t]*{name}[ \t]*[.\]]", re.M))
+    plain = _blank_strings(text)
+    found = [m for m in (p.search(plain) for p in pats) if m is not None]
+    if not found:
         return 1, 1, 1
-    line = text.count("\n", 0, m.start()) + 1
-    bol = text.rfind("\n", 0, m.start()) + 1
-    return line, m.start() + len(m.group(1)) - bol + 1, m.end() - bol + 1
+    m = min(found, key=lambda m: m.start())
+    line = plain.count("\n", 0, m.start()) + 1
+    bol = plain.rfind("\n", 0, m.start()) + 1
+    key_col = m.start() + len(m.group(1)) - bol + 1
+    return line, key_col, (m.end() - bol + 1 if m.re is pats[0] else key_col)
 
 
 def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
@@ -54,16 +69,18 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
     problems = []
     for key, value in doc.items():
         line, col, vcol = _where(text, key)
-        if isinstance(value, dict):
-            problems.append(f"{path}:{line}:{col}: `{key}` is a table: a parameter file holds one "
-                            "`NAME = value` per parameter, no tables")
+        tables = isinstance(value, list) and value and all(isinstance(v, dict) for v in value)
+        if isinstance(value, dict) or tables:
+            problems.append(f"{path}:{line}:{col}: `{key}` is {'an array of tables' if tables else 'a table'}: "
+                            "a parameter file holds one `NAME = value` per parameter, no tables")
             continue
         p = by_name.get(key)
         if p is None:
             known = ", ".join(by_name) or "none"
             problems.append(f"{path}:{line}:{col}: unknown parameter `{key}` (the project's parameters: {known})")
             continue
-        v, why = check_value(p, value)
+        why = _not_a_value(p, value)
+        v, why = (None, why) if why is not None else check_value(p, value)
         if why is not None:
             problems.append(f"{path}:{line}:{vcol}: {why}")
             continue
@@ -71,6 +88,32 @@ def read_params(path: str, params: tuple[AppParam, ...]) -> dict[str, object]:
     if problems:
         raise ParamFileError("\n".join(problems))
     return out
+
+
+def _not_a_value(p: AppParam, value) -> str | None:
+    """Why a TOML value is none a parameter takes, in the file's words
+    (None for a boolean, an integer or a float: check_value judges those).
+    A string is not typed text here: a quoted value belongs to a file
+    written for something else."""
+    import datetime
+
+    if isinstance(value, (bool, int, float)):
+        return None
+    if isinstance(value, str):
+        want = "true or false" if p.type.is_bool else "the number"
+        text = value if len(value) <= 40 else value[:40] + "..."
+        return f"`{p.name}` is {p.type.name}: {_quoted(text)} is text; give {want} without quotes"
+    kind = ("a date and time" if isinstance(value, datetime.datetime) else "a date"
+            if isinstance(value, datetime.date) else "a time" if isinstance(value, datetime.time)
+            else "an array" if isinstance(value, list) else "a table")
+    return f"`{p.name}` is {p.type.name}: {kind} is not a value of it"
+
+
+def _quoted(text: str) -> str:
+    """`text` between double quotes, as TOML writes a basic string."""
+    import json
+
+    return json.dumps(text, ensure_ascii=False)
 
 
 def _toml_value(p: AppParam, v) -> str:

@@ -83,6 +83,8 @@ def payload(image: bytes, mask: bytes) -> bytes:
 class MachineClient:
     def __init__(self, transport, tx_cap: int, baud: int = 115200, timeout: float = 0.5, deadline: float = 60.0):
         self.cmd = ParamClient(transport, (), tx_cap, timeout=timeout, deadline=deadline, baud=baud)
+        self.cmd.busy_words = ("its EEPROM writer or the check of an uploaded image is still under way "
+                               "(`fsw machine list` shows the upload)")
         self.t = transport
         self.on_progress = None  # called with (bytes written, bytes in all)
 
@@ -157,10 +159,11 @@ class MachineClient:
         busy = self.stats.busy
         try:
             ack = self._one(OP_MACHINE_COMMIT)
-        except ParamError as e:
+        except ParamError:
             if self.stats.busy - busy < 10:
                 raise
-            raise MachineError(f"COMMIT: the target answered BUSY {self.stats.busy - busy} times ({e}): it was "
+            raise MachineError(f"COMMIT: the target answered BUSY {self.stats.busy - busy} times in "
+                               f"{self.cmd.deadline:g} s: it was "
                                "still checking the image (a slice at each step of the machine's task and at each "
                                "COMMIT); `fsw machine list` shows the upload, and `upload` again commits it") \
                 from None

@@ -137,7 +137,8 @@ async def json_body(request: Request):
     """The request's body as JSON, read up to MAX_BODY bytes; or the
     refusal to answer: 413 past MAX_BODY (read no further: a client on the
     port cannot fill the station's memory), 400 for a body that is not JSON
-    (nested deeper than the reader recurses included)."""
+    (nested deeper than the reader recurses included) or names a key twice
+    in one object."""
     size = request.headers.get("content-length", "")
     if size.isdigit() and int(size) > MAX_BODY:
         return JSONResponse({"ok": False, "words": f"the request is over {MAX_BODY:,} bytes"}, status_code=413)
@@ -148,9 +149,27 @@ async def json_body(request: Request):
             return JSONResponse({"ok": False, "words": f"the request is over {MAX_BODY:,} bytes"}, status_code=413)
         chunks.append(chunk)
     try:
-        return json.loads(b"".join(chunks))
+        return json.loads(b"".join(chunks), object_pairs_hook=_members)
+    except _Twice as e:
+        return JSONResponse({"ok": False, "words": f"the request names `{e}` twice in one object"}, status_code=400)
     except (ValueError, RecursionError):
         return JSONResponse({"ok": False, "words": "the request is not JSON"}, status_code=400)
+
+
+class _Twice(ValueError):
+    """A JSON object of the request names a key twice (its args: the key)."""
+
+
+def _members(pairs: list) -> dict:
+    """A JSON object of a request as a dict; _Twice for a key named twice
+    (JSON's reader keeps the last, and which one was meant is not ours to
+    guess)."""
+    out = {}
+    for k, v in pairs:
+        if k in out:
+            raise _Twice(k if len(k) <= 60 else k[:60] + "...")
+        out[k] = v
+    return out
 
 
 def exposure(host: str, port: int) -> str | None:

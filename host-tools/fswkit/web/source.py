@@ -166,10 +166,11 @@ class LiveSource(Source):
     firmware's parameters are listed and set through the same station
     (fswkit.param.client), on a lease of its uplink."""
 
-    def __init__(self, station, *, params=(), tx_cap: int = 0, baud: int = 115200):
+    def __init__(self, station, *, params=(), tx_cap: int = 0, baud: int = 115200, reload_machine: str | None = None):
         super().__init__(station.layout)
         self.station = station
         self.params, self.tx_cap, self.baud = tuple(params), tx_cap, baud
+        self.reload_machine = reload_machine  # the [reload] machine, whose uploaded images read their own defaults
 
     async def start(self) -> None:
         await super().start()
@@ -219,19 +220,21 @@ class LiveSource(Source):
         return ParamClient(transport, self.params, self.tx_cap, baud=self.baud, deadline=10.0)
 
     def _params_now(self) -> dict:
-        from fswkit.param.client import ParamError
+        from fswkit.param.client import ParamError, uploaded_note
 
         with _StationTransport(self.station) as transport:
             try:
                 c = self._param_client(transport)
-                info = c.info()
+                info = c.table_info(self.station.project)
                 values = c.get_all()
+                note = uploaded_note(self.params, self.reload_machine, c.uploaded_slot(self.reload_machine),
+                                     self.station.project)
             except ParamError as e:
                 return {"ok": False, "words": str(e)}
         rows = [{"name": p.name, "machine": p.machine, "type": p.type.name, "unit": p.unit,
                  "value": _json(values[p.name]), "default": _json(p.default), "min": _json(p.min),
                  "max": _json(p.max), "when": list(p.when), "range": p.range_text()} for p in self.params]
-        return {"ok": True, "info": info, "params": rows}
+        return {"ok": True, "info": info, "params": rows, "note": note or ""}
 
     async def params_now(self) -> dict:
         """The target's parameters and its store's state (PARAM_INFO)."""
@@ -240,11 +243,17 @@ class LiveSource(Source):
         return await asyncio.get_running_loop().run_in_executor(None, self._params_now)
 
     def _params_set(self, values: dict) -> str | None:
-        from fswkit.param.client import ParamError
+        from fswkit.param.client import ParamError, not_read
 
         with _StationTransport(self.station) as transport:
             try:
-                self._param_client(transport).set(values)
+                c = self._param_client(transport)
+                c.table_info(self.station.project)  # the ids are the board's
+                why = not_read(self.params, values, self.reload_machine, c.uploaded_slot(self.reload_machine),
+                               self.station.project)
+                if why is not None:
+                    return f"set refused: {why}"
+                c.set(values)
             except ParamError as e:
                 return str(e)
         return None

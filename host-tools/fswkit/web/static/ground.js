@@ -329,11 +329,33 @@ function buildCommands() {
 // ---- parameters (docs/parameters.md) -------------------------------------------
 
 const SOURCES = ["no parameters", "defaults", "bank A", "bank B"];
+let paramState = null;  // the store state byte of the last hello or health frame
+let paramTimer = null;
+
+// The target's parameters may have changed under the page: another client
+// set, loaded or saved them through the station, or the target restarted.
+// They are read again (once for a burst of such news).
+function paramsChanged() {
+  if (!layout.has_params) return;
+  clearTimeout(paramTimer);
+  paramTimer = setTimeout(readParams, 300);
+}
+
+function watchParams(msg) {
+  if (msg.t === "ack") {
+    if (msg.info.status === 0 && ["param_set", "param_commit", "param_save"].includes(msg.info.op_name)) paramsChanged();
+  } else if (msg.info.params !== undefined) {  // hello, health: the store's source, unsaved changes, writing
+    if (paramState !== null && msg.info.params !== paramState) paramsChanged();
+    paramState = msg.info.params;
+  }
+}
 
 async function readParams() {
+  clearTimeout(paramTimer);
   $("param-err").textContent = "";
   const r = await (await fetch("/api/params")).json();
   if (!r.ok) { $("param-err").textContent = r.words; return; }
+  if (r.note) $("param-err").textContent = r.note;  // an uploaded machine runs: its values reach the generated one only
   const i = r.info;
   $("param-state").textContent = `${SOURCES[i.source]}${i.source >= 2 ? ", sequence " + i.seq : ""}` +
     `${i.dirty ? ", unsaved changes" : ""}${i.writing ? ", writing" : ""}`;
@@ -352,7 +374,7 @@ async function readParams() {
 
 async function setParam(p, text) {
   $("param-err").textContent = "";
-  if (!(await ask(`Set parameter ${p.name} = ${text} on the target (live, until saved)?`))) return;
+  if (!(await ask(`Set parameter ${p.name} = ${text}${p.unit ? " " + p.unit : ""} on the target (live, until saved)?`))) return;
   const r = await fetch("/api/params", { method: "POST", headers: { "Content-Type": "application/json" },
                                          body: JSON.stringify({ values: { [p.name]: text } }) });
   const answer = await r.json();
@@ -365,8 +387,9 @@ async function setParam(p, text) {
 function handle(msg) {
   switch (msg.t) {
     case "samples": addSamples(msg); break;
-    case "health": showHealth(msg.info); break;
-    case "hello": break;
+    case "health": showHealth(msg.info); watchParams(msg); break;
+    case "hello": watchParams(msg); break;
+    case "ack": watchParams(msg); break;
     case "link": showLink(msg); break;
     case "note": showNote(msg.text, msg.up); break;
     case "command": addHistory(msg); break;

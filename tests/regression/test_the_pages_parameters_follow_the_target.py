@@ -1,0 +1,66 @@
+"""The web station's page read the target's parameters when it loaded and
+after a value set in the page, and never again: a value set or a file
+loaded from a terminal (`fsw param`, through the same station), a save, or
+a restart of the target left the page showing values and a store state
+the board no longer had, with nothing to say so. Now the page reads them
+again when an acknowledged SET, COMMIT or SAVE goes by on the link, or
+when the store state that every hello and health frame carries changes."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from conftest import ROOT, run_fsw
+from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.linkfw import PtyTarget, needs_cxx
+from support.simfw import kept_native
+
+pytestmark = [needs_cxx(), needs_chromium]
+RIG = ROOT / "tests" / "param" / "tuned"
+
+
+@pytest.fixture(scope="module")
+def exe():
+    return kept_native(RIG) / "tuned"
+
+
+def test_a_terminals_set_and_save_show_in_the_page(exe, browser, tmp_path):
+    from selenium.webdriver.common.by import By
+
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.params import app_parameters
+    from fswkit.autocode.schema import link_plan
+    from fswkit.ground.station import Station
+    from fswkit.link.layout import from_app
+    from fswkit.target.build import load
+    from fswkit.web.app import create_app
+    from fswkit.web.source import LiveSource
+
+    app = load(str(RIG), Diagnostics())
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
+        ground = Station(from_app(app), str(RIG), target.port, 115200)
+        ground.start()
+        try:
+            source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
+            with served(create_app(source)) as url:
+                browser.get(url)
+                text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+                wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+                assert text("param-state") == "defaults"
+                # another client, through the station: the page was not asked
+                r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
+                assert r.code == 0, r.out + r.err
+                wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
+                wait_for(lambda: "unsaved changes" in text("param-state"), "the unsaved changes")
+                r = run_fsw("param", str(RIG), "set", "TRIM=7", "--port", target.port)
+                assert r.code == 0, r.err  # the store state stays the same: the SET's acknowledgement tells
+                wait_for(lambda: text("pval-TRIM") == "7", "the second value")
+                r = run_fsw("param", str(RIG), "save", "--port", target.port)
+                assert r.code == 0, r.err
+                wait_for(lambda: text("param-state") == "bank A, sequence 1", "the saved bank")
+                time.sleep(0.5)
+                assert text("param-err") == ""
+        finally:
+            ground.stop()

@@ -13,6 +13,7 @@ from . import model as M
 from . import syntax as S
 from .diagnostics import SM, SS, SV, Diagnostic, Diagnostics, Source, visual_col
 from .evaluate import NotConstant, evaluate, local_values
+from .lexer import KEYWORDS
 from .numeric import F64MODE, exact_literal, truthy
 from .types import TYPES, U32, U64
 
@@ -58,6 +59,8 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
         malformed = h.name == "<malformed>"  # already reported by the parser
         if malformed:
             pass
+        elif h.name in KEYWORDS:  # spec §1: a keyword is never a name
+            diags.error(src, lang, h.line, h.col + 1, f"`{h.name}` is a keyword and cannot name a region")
         elif h.name in region_lines:
             diags.error(src, lang, h.line, h.col + 1,
                         f"reuse of region name `{h.name}` (previously used on line {region_lines[h.name]})")
@@ -382,6 +385,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     state_index: dict[str, int] = {}
     for st in f.states:
         h = st.header
+        if h.name in KEYWORDS:  # spec §1: a keyword is never a name (no `-> else` could reach it)
+            err(h.line, h.col + 1, f"`{h.name}` is a keyword and cannot name a state")
         if h.name in state_lines:
             err(h.line, h.col + 1, f"reuse of state name `{h.name}` (previously used on line {state_lines[h.name]})")
         else:

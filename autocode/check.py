@@ -802,6 +802,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
     before = diags.error_count
     err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
     delta_t = init_state = max_steps = None
+    delta_t_at = (1, 1)
     seen: dict[str, int] = {}
     for o in f.options:
         if o.name in seen:
@@ -813,6 +814,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
             if v is not None:
                 if o.name == "delta_t":
                     delta_t = v
+                    delta_t_at = (o.line, o.args[0].col)
                 else:
                     max_steps = v
         elif o.name == "init_state":
@@ -913,7 +915,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         m = machine_with_values(m, values)
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
-                    tuple(sections), tuple(windows), tuple(idle_guards))
+                    tuple(sections), tuple(windows), tuple(idle_guards), delta_t_at)
 
 
 def _script_params(f: S.SsFile, m: M.Machine, err) -> dict:
@@ -979,8 +981,8 @@ def failure_diagnostics(script: M.Script, source_line) -> dict:
         "max_steps": located(stop.line, stop.col, None,
                              f"`@stop` not reached within {script.max_steps} steps "
                              "(raise `max_steps` in [options] if the script needs more)"),
-        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
-                                          "(it wrapped around at 2^64: lower `delta_t`)"),
+        "step_error": located(*script.delta_t_at, None, "the machine refused the step: `G` did not increase "
+                                                        "(it wrapped around at 2^64: lower `delta_t`)"),
         "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
                     for sec in script.sections for g in sec.checks for c in g.checks
                     if isinstance(c, M.Assert)],

@@ -288,6 +288,7 @@ class Script:
     # Guards of blocks with nothing in them: checked like every guard, never
     # evaluated (a guard is evaluated only before an input or a check).
     idle_guards: tuple[Expr, ...] = ()
+    delta_t_at: tuple[int, int] = (1, 1)  # (line, column) of `delta_t`'s value: a refused step points there
 
 
 # ---- channel tables (spec §6) ---------------------------------------------------

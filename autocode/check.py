@@ -41,7 +41,12 @@ def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
 def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     lang = SV
     lock = False
+    seen: dict[str, int] = {}
     for o in f.options:
+        if o.name in seen:
+            diags.error(src, lang, o.line, o.col, f"duplicate option `{o.name}` (previously on line {seen[o.name]})")
+            continue
+        seen[o.name] = o.line
         if o.name == "lock" and not o.args:
             lock = True
         elif o.name == "lock":

@@ -802,10 +802,11 @@ def gotos(stmts):
 
 # ---- state script -----------------------------------------------------------------
 
-def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
-    lang = SS
-    before = diags.error_count
-    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+def _script_options(f: S.SsFile, src: Source, m: M.Machine | None, err):
+    """A script's `[options]`, checked: (delta_t, where its value stands,
+    init_state, max_steps), None for one not given or wrong. Without its
+    machine (`m` None: the machine has errors) every check but the name of
+    `init_state`'s state is made."""
     delta_t = init_state = max_steps = None
     delta_t_at = (1, 1)
     seen: dict[str, int] = {}
@@ -827,6 +828,8 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
                 col = o.args[0].col if o.args else o.col + len(o.name)
                 err(o.line, col, "`init_state` takes one state name")
                 continue
+            if m is None:  # its machine did not check: a state's name cannot be told
+                continue
             st = m.state(o.args[0].text)
             if st is None:
                 err(o.line, o.args[0].col, f"unknown state `{o.args[0].text}`")
@@ -837,6 +840,32 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
     if delta_t is None and "delta_t" not in seen:
         line, col = _options_pos(src)
         err(line, col, "missing option `delta_t` (how much `G` grows per step)")
+    return delta_t, delta_t_at, init_state, max_steps
+
+
+def check_ss_alone(f: S.SsFile, src: Source, diags: Diagnostics) -> None:
+    """The checks of a script that need no machine (its options, a
+    `@stop`), for a script whose machine has errors: spec §8, every
+    independent error in one run."""
+    err = lambda line, col, msg: diags.error(src, SS, line, col, msg)  # noqa: E731
+    before = diags.error_count
+    _script_options(f, src, None, err)
+    has_stop = any(not isinstance(st, (S.Assign, S.Assert)) for sec in f.sections for g in sec.stmts for st in g.body)
+    if not has_stop and not before:
+        _no_stop(src, err)
+
+
+def _no_stop(src: Source, err) -> None:
+    n = len(src.lines)
+    last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
+    err(last, 1, "the state script has no `@stop`: it would never end")
+
+
+def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
+    lang = SS
+    before = diags.error_count
+    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+    delta_t, delta_t_at, init_state, max_steps = _script_options(f, src, m, err)
 
     names: dict[str, int] = {}
     for v in m.vars:
@@ -907,9 +936,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         if state != -1:
             sections.append(M.ScriptSection(state, tuple(inputs), tuple(checks), h.line))
     if not has_stop and not before:  # after a syntax error, the `@stop` may be in the broken part
-        n = len(src.lines)
-        last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
-        err(last, 1, "the state script has no `@stop`: it would never end")
+        _no_stop(src, err)
     if diags.error_count != before:
         return None
     values = _script_params(f, m, err)

@@ -58,6 +58,7 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     elements: list[M.Element] = []
     region_lines: dict[str, int] = {}
     elem_lines: dict[str, int] = {}
+    unreadable: set[str] = set()
     offset = 0
     for r in f.regions:
         h = r.header
@@ -79,6 +80,7 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
             t = TYPES.get(d.type)
             if t is None:
                 diags.error(src, lang, d.line, d.type_col, unknown_type(d.type))
+                unreadable.add(d.name)
                 continue
             if d.name in elem_lines:
                 diags.error(src, lang, d.line, d.name_col,
@@ -94,7 +96,8 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
             mine.append(e)
         elements.extend(mine)
         regions.append(M.Region(h.name, start, offset - start, tuple(mine), h.line))
-    return M.StateVector(src.path, lock, tuple(regions), tuple(elements), offset)
+    return M.StateVector(src.path, lock, tuple(regions), tuple(elements), offset,
+                         frozenset(unreadable - set(elem_lines)))
 
 
 # ---- expressions ------------------------------------------------------------
@@ -260,7 +263,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         listed[d.name] = d.line
         e = sv.find(d.name)
         if e is None:
-            err(d.line, d.name_col, f"element `{d.name}` is not in the state vector config ({sv.path})")
+            if d.name not in sv.unreadable:  # else the state vector config's own error said it
+                err(d.line, d.name_col, f"element `{d.name}` is not in the state vector config ({sv.path})")
         elif e.type is not t:
             err(d.line, d.type_col, f"type mismatch: `{d.name}` is {e.type} in the state vector config, not {t}")
         for n, col in ((d.name, d.name_col), (d.alias, d.alias_col)):

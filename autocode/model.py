@@ -41,6 +41,9 @@ class StateVector:
     regions: tuple[Region, ...]
     elements: tuple[Element, ...]  # layout order
     size: int
+    # Names declared with an error (an unknown type): a machine listing one
+    # is not told again that the element is missing.
+    unreadable: frozenset = frozenset()
 
     def find(self, name: str) -> Element | None:
         for e in self.elements:

@@ -71,7 +71,12 @@ def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
         if sv_path is None:
             diags.error(src, SM, 1, 1, f"no state vector config (.sv) found beside {sm_path}: "
                                        "name one with --sv")
-            parse_sm(src, diags)  # its syntax errors still count
+            # Its own errors still count (spec §8): checked against a state
+            # vector that has every element it lists, as it lists it.
+            mine = Diagnostics()
+            f = parse_sm(src, mine)
+            check_sm(f, src, M.StateVector(sm_path, False, (), (), 0, frozenset(d.name for d in f.elements)), mine)
+            diags.extend(mine)
             return None
     # Counted apart: errors already in `diags` (another file's, or this
     # state vector's reported before) must not decide, and neither may

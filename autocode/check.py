@@ -106,9 +106,10 @@ class Resolver:
     """Resolves names of a syntax expression to model variables."""
 
     def __init__(self, src: Source, diags: Diagnostics, lang: str, names: dict[str, int],
-                 vars_: list[M.Var], windows: list[M.Window], size_value):
+                 vars_: list[M.Var], windows: list[M.Window], size_value, silent: frozenset = frozenset()):
         self.src, self.diags, self.lang = src, diags, lang
         self.names = names
+        self.silent = silent  # names whose malformed declaration was reported: not unknown again
         self.vars = vars_
         self.windows = windows
         self.size_value = size_value  # resolves a window size expression to a value
@@ -127,7 +128,8 @@ class Resolver:
         if t is S.Name:
             i = self.names.get(e.name)
             if i is None:
-                self.error(e.line, e.col, self.unknown.format(e.name))
+                if e.name not in self.silent:
+                    self.error(e.line, e.col, self.unknown.format(e.name))
                 return M.Const("0", e.line, e.col)
             self.used.add(i)
             return M.Ref(i, e.line, e.col)
@@ -209,7 +211,7 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
             res.error(x.line, x.col, "window size must be a constant: literals and locals' initial values")
             return None
         todo.extend(_children(x))
-    sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None)
+    sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None, res.silent)
     me = sub.expr(n)
     res.used |= sub.used
     if res.diags.error_count != reported:
@@ -248,6 +250,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     names: dict[str, int] = {}
     name_lines: dict[str, int] = {}
     listed: dict[str, int] = {}
+    broken = frozenset(f.broken)  # declared on a malformed line, reported there
     g = s = None
     for d in f.elements:
         t = TYPES.get(d.type)
@@ -327,7 +330,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         t = declared(d, "local")
         if t is None:
             continue
-        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)  # no copy: quadratic in locals
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None, broken)  # no copy: quadratic in locals
         init = _resolve_init(init_resolver, d, local_decls, vars_,
                              param_names=frozenset(p.name for p in f.params))
         init_used |= init_resolver.used
@@ -346,7 +349,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         t = declared(d, "parameter")
         if t is None:
             continue
-        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None, broken)
         init = _resolve_init(init_resolver, d, {**local_decls, **param_decls}, vars_, "default value")
         bounds = []
         for what, e in (("@min", d.min), ("@max", d.max)):
@@ -386,7 +389,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     def size_value(res: Resolver, n: S.Expr):
         return constant_size(res, n, vars_, consts)
 
-    res = Resolver(src, diags, lang, names, vars_, windows, size_value)
+    res = Resolver(src, diags, lang, names, vars_, windows, size_value, broken)
     res.used |= init_used
 
     # states
@@ -553,7 +556,8 @@ def _stmts(stmts, res: Resolver, state_index, in_exit: bool, err) -> tuple[M.Stm
             i = res.names.get(st.target)
             expr = res.expr(st.expr)
             if i is None:
-                err(st.line, st.col, f"unknown element `{st.target}`")
+                if st.target not in res.silent:
+                    err(st.line, st.col, f"unknown element `{st.target}`")
                 continue
             v = res.vars[i]
             res.used.add(i)

@@ -13,6 +13,7 @@ from . import model as M
 from . import syntax as S
 from .diagnostics import SM, SS, SV, Diagnostic, Diagnostics, Source, visual_col
 from .evaluate import NotConstant, evaluate, local_values
+from .lexer import KEYWORDS
 from .numeric import F64MODE, exact_literal, truthy
 from .types import TYPES, U32, U64
 
@@ -40,7 +41,12 @@ def check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
 def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     lang = SV
     lock = False
+    seen: dict[str, int] = {}
     for o in f.options:
+        if o.name in seen:
+            diags.error(src, lang, o.line, o.col, f"duplicate option `{o.name}` (previously on line {seen[o.name]})")
+            continue
+        seen[o.name] = o.line
         if o.name == "lock" and not o.args:
             lock = True
         elif o.name == "lock":
@@ -52,12 +58,15 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
     elements: list[M.Element] = []
     region_lines: dict[str, int] = {}
     elem_lines: dict[str, int] = {}
+    unreadable: set[str] = set()
     offset = 0
     for r in f.regions:
         h = r.header
         malformed = h.name == "<malformed>"  # already reported by the parser
         if malformed:
             pass
+        elif h.name in KEYWORDS:  # spec §1: a keyword is never a name
+            diags.error(src, lang, h.line, h.col + 1, f"`{h.name}` is a keyword and cannot name a region")
         elif h.name in region_lines:
             diags.error(src, lang, h.line, h.col + 1,
                         f"reuse of region name `{h.name}` (previously used on line {region_lines[h.name]})")
@@ -71,6 +80,7 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
             t = TYPES.get(d.type)
             if t is None:
                 diags.error(src, lang, d.line, d.type_col, unknown_type(d.type))
+                unreadable.add(d.name)
                 continue
             if d.name in elem_lines:
                 diags.error(src, lang, d.line, d.name_col,
@@ -86,7 +96,8 @@ def _check_sv(f: S.SvFile, src: Source, diags: Diagnostics) -> M.StateVector:
             mine.append(e)
         elements.extend(mine)
         regions.append(M.Region(h.name, start, offset - start, tuple(mine), h.line))
-    return M.StateVector(src.path, lock, tuple(regions), tuple(elements), offset)
+    return M.StateVector(src.path, lock, tuple(regions), tuple(elements), offset,
+                         frozenset(unreadable - set(elem_lines)))
 
 
 # ---- expressions ------------------------------------------------------------
@@ -95,9 +106,10 @@ class Resolver:
     """Resolves names of a syntax expression to model variables."""
 
     def __init__(self, src: Source, diags: Diagnostics, lang: str, names: dict[str, int],
-                 vars_: list[M.Var], windows: list[M.Window], size_value):
+                 vars_: list[M.Var], windows: list[M.Window], size_value, silent: frozenset = frozenset()):
         self.src, self.diags, self.lang = src, diags, lang
         self.names = names
+        self.silent = silent  # names whose malformed declaration was reported: not unknown again
         self.vars = vars_
         self.windows = windows
         self.size_value = size_value  # resolves a window size expression to a value
@@ -116,7 +128,8 @@ class Resolver:
         if t is S.Name:
             i = self.names.get(e.name)
             if i is None:
-                self.error(e.line, e.col, self.unknown.format(e.name))
+                if e.name not in self.silent:
+                    self.error(e.line, e.col, self.unknown.format(e.name))
                 return M.Const("0", e.line, e.col)
             self.used.add(i)
             return M.Ref(i, e.line, e.col)
@@ -198,7 +211,7 @@ def constant_size(res: Resolver, n: S.Expr, vars_, consts):
             res.error(x.line, x.col, "window size must be a constant: literals and locals' initial values")
             return None
         todo.extend(_children(x))
-    sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None)
+    sub = Resolver(res.src, res.diags, res.lang, res.names, vars_, [], None, res.silent)
     me = sub.expr(n)
     res.used |= sub.used
     if res.diags.error_count != reported:
@@ -237,6 +250,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     names: dict[str, int] = {}
     name_lines: dict[str, int] = {}
     listed: dict[str, int] = {}
+    broken = frozenset(f.broken)  # declared on a malformed line, reported there
     g = s = None
     for d in f.elements:
         t = TYPES.get(d.type)
@@ -252,7 +266,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         listed[d.name] = d.line
         e = sv.find(d.name)
         if e is None:
-            err(d.line, d.name_col, f"element `{d.name}` is not in the state vector config ({sv.path})")
+            if d.name not in sv.unreadable:  # else the state vector config's own error said it
+                err(d.line, d.name_col, f"element `{d.name}` is not in the state vector config ({sv.path})")
         elif e.type is not t:
             err(d.line, d.type_col, f"type mismatch: `{d.name}` is {e.type} in the state vector config, not {t}")
         for n, col in ((d.name, d.name_col), (d.alias, d.alias_col)):
@@ -315,7 +330,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         t = declared(d, "local")
         if t is None:
             continue
-        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)  # no copy: quadratic in locals
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None, broken)  # no copy: quadratic in locals
         init = _resolve_init(init_resolver, d, local_decls, vars_,
                              param_names=frozenset(p.name for p in f.params))
         init_used |= init_resolver.used
@@ -334,7 +349,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
         t = declared(d, "parameter")
         if t is None:
             continue
-        init_resolver = Resolver(src, diags, lang, names, vars_, [], None)
+        init_resolver = Resolver(src, diags, lang, names, vars_, [], None, broken)
         init = _resolve_init(init_resolver, d, {**local_decls, **param_decls}, vars_, "default value")
         bounds = []
         for what, e in (("@min", d.min), ("@max", d.max)):
@@ -374,7 +389,7 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     def size_value(res: Resolver, n: S.Expr):
         return constant_size(res, n, vars_, consts)
 
-    res = Resolver(src, diags, lang, names, vars_, windows, size_value)
+    res = Resolver(src, diags, lang, names, vars_, windows, size_value, broken)
     res.used |= init_used
 
     # states
@@ -382,6 +397,8 @@ def _check_sm(f: S.SmFile, src: Source, sv: M.StateVector, diags: Diagnostics):
     state_index: dict[str, int] = {}
     for st in f.states:
         h = st.header
+        if h.name in KEYWORDS:  # spec §1: a keyword is never a name (no `-> else` could reach it)
+            err(h.line, h.col + 1, f"`{h.name}` is a keyword and cannot name a state")
         if h.name in state_lines:
             err(h.line, h.col + 1, f"reuse of state name `{h.name}` (previously used on line {state_lines[h.name]})")
         else:
@@ -551,7 +568,8 @@ def _stmts(stmts, res: Resolver, state_index, in_exit: bool, err) -> tuple[M.Stm
             i = res.names.get(st.target)
             expr = res.expr(st.expr)
             if i is None:
-                err(st.line, st.col, f"unknown element `{st.target}`")
+                if st.target not in res.silent:
+                    err(st.line, st.col, f"unknown element `{st.target}`")
                 continue
             v = res.vars[i]
             res.used.add(i)
@@ -804,11 +822,13 @@ def gotos(stmts):
 
 # ---- state script -----------------------------------------------------------------
 
-def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
-    lang = SS
-    before = diags.error_count
-    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+def _script_options(f: S.SsFile, src: Source, m: M.Machine | None, err):
+    """A script's `[options]`, checked: (delta_t, where its value stands,
+    init_state, max_steps), None for one not given or wrong. Without its
+    machine (`m` None: the machine has errors) every check but the name of
+    `init_state`'s state is made."""
     delta_t = init_state = max_steps = None
+    delta_t_at = (1, 1)
     seen: dict[str, int] = {}
     for o in f.options:
         if o.name in seen:
@@ -820,12 +840,15 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
             if v is not None:
                 if o.name == "delta_t":
                     delta_t = v
+                    delta_t_at = (o.line, o.args[0].col)
                 else:
                     max_steps = v
         elif o.name == "init_state":
             if len(o.args) != 1 or o.args[0].kind != "id":
                 col = o.args[0].col if o.args else o.col + len(o.name)
                 err(o.line, col, "`init_state` takes one state name")
+                continue
+            if m is None:  # its machine did not check: a state's name cannot be told
                 continue
             st = m.state(o.args[0].text)
             if st is None:
@@ -837,6 +860,32 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
     if delta_t is None and "delta_t" not in seen:
         line, col = _options_pos(src)
         err(line, col, "missing option `delta_t` (how much `G` grows per step)")
+    return delta_t, delta_t_at, init_state, max_steps
+
+
+def check_ss_alone(f: S.SsFile, src: Source, diags: Diagnostics) -> None:
+    """The checks of a script that need no machine (its options, a
+    `@stop`), for a script whose machine has errors: spec §8, every
+    independent error in one run."""
+    err = lambda line, col, msg: diags.error(src, SS, line, col, msg)  # noqa: E731
+    before = diags.error_count
+    _script_options(f, src, None, err)
+    has_stop = any(not isinstance(st, (S.Assign, S.Assert)) for sec in f.sections for g in sec.stmts for st in g.body)
+    if not has_stop and not before:
+        _no_stop(src, err)
+
+
+def _no_stop(src: Source, err) -> None:
+    n = len(src.lines)
+    last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
+    err(last, 1, "the state script has no `@stop`: it would never end")
+
+
+def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Script | None:
+    lang = SS
+    before = diags.error_count
+    err = lambda line, col, msg: diags.error(src, lang, line, col, msg)  # noqa: E731
+    delta_t, delta_t_at, init_state, max_steps = _script_options(f, src, m, err)
 
     names: dict[str, int] = {}
     for v in m.vars:
@@ -907,9 +956,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         if state != -1:
             sections.append(M.ScriptSection(state, tuple(inputs), tuple(checks), h.line))
     if not has_stop and not before:  # after a syntax error, the `@stop` may be in the broken part
-        n = len(src.lines)
-        last = max(1, n - 1 if n > 1 and src.lines[-1] == "" else n)
-        err(last, 1, "the state script has no `@stop`: it would never end")
+        _no_stop(src, err)
     if diags.error_count != before:
         return None
     values = _script_params(f, m, err)
@@ -920,7 +967,7 @@ def check_ss(f: S.SsFile, src: Source, m: M.Machine, diags: Diagnostics) -> M.Sc
         m = machine_with_values(m, values)
     return M.Script(src.path, m, delta_t, init_state if init_state is not None else 0,
                     max_steps if max_steps is not None else DEFAULT_MAX_STEPS,
-                    tuple(sections), tuple(windows), tuple(idle_guards))
+                    tuple(sections), tuple(windows), tuple(idle_guards), delta_t_at)
 
 
 def _script_params(f: S.SsFile, m: M.Machine, err) -> dict:
@@ -986,8 +1033,8 @@ def failure_diagnostics(script: M.Script, source_line) -> dict:
         "max_steps": located(stop.line, stop.col, None,
                              f"`@stop` not reached within {script.max_steps} steps "
                              "(raise `max_steps` in [options] if the script needs more)"),
-        "step_error": located(1, 1, None, "the machine refused the step: `G` did not increase "
-                                          "(it wrapped around at 2^64: lower `delta_t`)"),
+        "step_error": located(*script.delta_t_at, None, "the machine refused the step: `G` did not increase "
+                                                        "(it wrapped around at 2^64: lower `delta_t`)"),
         "asserts": [located(c.line, c.col, "assertion failure", "assertion failed")
                     for sec in script.sections for g in sec.checks for c in g.checks
                     if isinstance(c, M.Assert)],

@@ -41,6 +41,9 @@ class StateVector:
     regions: tuple[Region, ...]
     elements: tuple[Element, ...]  # layout order
     size: int
+    # Names declared with an error (an unknown type): a machine listing one
+    # is not told again that the element is missing.
+    unreadable: frozenset = frozenset()
 
     def find(self, name: str) -> Element | None:
         for e in self.elements:
@@ -288,6 +291,7 @@ class Script:
     # Guards of blocks with nothing in them: checked like every guard, never
     # evaluated (a guard is evaluated only before an input or a check).
     idle_guards: tuple[Expr, ...] = ()
+    delta_t_at: tuple[int, int] = (1, 1)  # (line, column) of `delta_t`'s value: a refused step points there
 
 
 # ---- channel tables (spec §6) ---------------------------------------------------

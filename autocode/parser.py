@@ -590,6 +590,7 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
     locals_: list[S.LocalDecl] = []
     states: list[S.StateDecl] = []
     params: list[S.ParamDecl] = []
+    broken: list[str] = []  # names whose declaring line was malformed after the name
     sv_header = local_header = param_header = None
     for header, body in sections:
         name = header.name
@@ -604,6 +605,8 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
                 d = _param_decl(toks, src, diags, lang)
                 if d is not None:
                     params.append(d)
+                else:
+                    broken.extend(_declared_name(toks))
             continue
         if name == "state_vector" or name == "local":
             prev = sv_header if name == "state_vector" else local_header
@@ -625,6 +628,8 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
                     d = _local_decl(toks, src, diags, lang)
                     if d is not None:
                         locals_.append(d)
+                    else:
+                        broken.extend(_declared_name(toks))
             continue
         if name in ("all_states", "options"):
             diags.error(src, lang, header.line, header.col + 1,
@@ -634,7 +639,13 @@ def _parse_sm(src: Source, diags: Diagnostics) -> S.SmFile:
             continue
         states.append(S.StateDecl(header, _state_blocks(body, src, diags, lang)))
     return S.SmFile(src.path, tuple(elements), tuple(locals_), tuple(states), sv_header, local_header,
-                    tuple(params), param_header)
+                    tuple(params), param_header, tuple(broken))
+
+
+def _declared_name(toks: list[Tok]) -> list[str]:
+    """The name a malformed `TYPE name ...` line declares, if it got that
+    far: its uses are not reported again as unknown names."""
+    return [toks[1].text] if len(toks) > 1 and toks[0].kind == ID and toks[1].kind == ID else []
 
 
 def _sm_elem(toks: list[Tok], src, diags, lang) -> S.SmElem | None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from . import model as M
-from .check import check_literals, check_sm, check_ss, check_sv, machine_exprs, script_exprs
+from .check import check_literals, check_sm, check_ss, check_ss_alone, check_sv, machine_exprs, script_exprs
 from .diagnostics import SM, SS, Diagnostics, Source, decode, read_input, read_source
 from .parser import parse_sm, parse_ss, parse_sv
 
@@ -71,7 +71,12 @@ def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
         if sv_path is None:
             diags.error(src, SM, 1, 1, f"no state vector config (.sv) found beside {sm_path}: "
                                        "name one with --sv")
-            parse_sm(src, diags)  # its syntax errors still count
+            # Its own errors still count (spec §8): checked against a state
+            # vector that has every element it lists, as it lists it.
+            mine = Diagnostics()
+            f = parse_sm(src, mine)
+            check_sm(f, src, M.StateVector(sm_path, False, (), (), 0, frozenset(d.name for d in f.elements)), mine)
+            diags.extend(mine)
             return None
     # Counted apart: errors already in `diags` (another file's, or this
     # state vector's reported before) must not decide, and neither may
@@ -99,12 +104,18 @@ def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
         if sm_path is None:
             diags.error(src, SS, 1, 1, f"no state machine config (.sm) found beside {ss_path}: "
                                        "name one with --sm")
-            parse_ss(src, diags)  # its syntax errors still count
+            mine = Diagnostics()
+            check_ss_alone(parse_ss(src, mine), src, mine)  # its own errors still count
+            diags.extend(mine)
             return None
     m = load_machine(sm_path, diags, sv_path)
     mine = Diagnostics()
     f = parse_ss(src, mine)
-    script = check_ss(f, src, m, mine) if m is not None else None
+    if m is None:  # what can be said without the machine is said now (spec §8)
+        check_ss_alone(f, src, mine)
+        script = None
+    else:
+        script = check_ss(f, src, m, mine)
     if script is not None and real is not None:
         check_literals(machine_exprs(m), real, source_of(m.path), mine, SM)
         check_literals(script_exprs(script), real, src, mine, SS)

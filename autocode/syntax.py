@@ -231,6 +231,7 @@ class SmFile:
     local_header: Header | None = None
     params: tuple[ParamDecl, ...] = ()
     param_header: Header | None = None
+    broken: tuple[str, ...] = ()  # locals and parameters whose line was malformed after the name
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,7 @@ def window_ram(m: M.Machine, real: Real, idx_bytes: int = 4, align: int = 8) -> 
     size = 0
     for w in m.windows:
         n = w.size
-        size += {"avg": up(2 * r + 2 * idx_bytes) + up(n * r), "min": ext(n), "max": ext(n),
+        size += {"avg": up(2 * r + 4 * idx_bytes) + up(n * r), "min": ext(n), "max": ext(n),
                  "range": 2 * ext(n), "median": up(2 * idx_bytes) + 2 * up(n * r)}[w.func]
     return size + sum(v.type.size for v in local_order(m))
 

@@ -25,9 +25,18 @@ static inline uint32_t order_key(Real x) {
     return (b & 0x80000000UL) != 0 ? ~b : b | 0x80000000UL;
 }
 static inline bool nonzero(Real x) { return (real_bits(x) & 0x7FFFFFFFUL) != 0; }
+// +1 for +inf, -1 for -inf, 0 for any other sample (never NaN).
+static inline int8_t infinity_sign(Real x) {
+    const uint32_t b = real_bits(x);
+    return (b & 0x7FFFFFFFUL) != 0x7F800000UL ? 0 : (b & 0x80000000UL) != 0 ? -1 : 1;
+}
 #else
 static inline Real order_key(Real x) { return x; }
 static inline bool nonzero(Real x) { return x != 0; }
+static inline int8_t infinity_sign(Real x) {
+    const Real inf = static_cast<Real>(__builtin_inf());
+    return x == inf ? 1 : x == -inf ? -1 : 0;
+}
 #endif
 
 template <typename I>
@@ -36,15 +45,23 @@ void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real 
     // same operations in the same order, with fewer values to keep across
     // the float routines' calls (on AVR no call of the register-saving
     // routine around them).
+    // An infinite sample is counted, never summed: subtracting it from a sum
+    // that holds it would leave NaN (inf - inf) in `base` until the next lap.
     Real* const slot = ring + w.head;
     const Real oldest = *slot;
     *slot = window_sample(x);
-    if (w.count == n) {
-        w.base = w.base - oldest;  // the oldest sample leaves
+    if (w.count == n) {  // the oldest sample leaves
+        const int8_t inf = infinity_sign(oldest);
+        if (inf == 0) w.base = w.base - oldest;
+        else if (inf > 0) --w.pinf;
+        else --w.ninf;
     } else {
         ++w.count;
     }
-    w.fresh = w.fresh + *slot;
+    const int8_t inf = infinity_sign(*slot);
+    if (inf == 0) w.fresh = w.fresh + *slot;
+    else if (inf > 0) ++w.pinf;
+    else ++w.ninf;
     w.head = step_fwd(w.head, n);
     if (w.head == 0) {
         // A full lap: `fresh` is the in-order sum of exactly the samples in
@@ -154,7 +171,7 @@ Real roll_median_value(const RollMedianS<I>& w, const Real* sorted) {
 #if defined(__AVR__)
 template <typename I>
 Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv) {
-    if (w.count == n && nonzero(inv)) return (w.base + w.fresh) * inv;
+    if (w.count == n && nonzero(inv) && (w.pinf | w.ninf) == 0) return (w.base + w.fresh) * inv;
     return roll_avg_value(w);
 }
 template Real roll_avg_mean<uint8_t>(const RollAvgS<uint8_t>&, uint8_t, Real);

@@ -38,13 +38,16 @@ inline Real window_sample(Real x) { return (x != x || x == 0) ? Real(0) : x; }
 // the RAM and fewer instructions), WinIdx above. The plain names (RollAvg,
 // ...) are the WinIdx ones.
 
-// roll_avg: sum = base + fresh; see docs/runtime.md for the exact order.
+// roll_avg: sum of the finite samples = base + fresh, the infinite ones
+// counted; see docs/runtime.md for the exact order.
 template <typename I>
 struct RollAvgS {
     Real base;
     Real fresh;
     I count;  // samples held, 0..n
     I head;   // ring position of the next sample
+    I pinf;   // +inf samples held
+    I ninf;   // -inf samples held
 };
 
 // roll_min / roll_max: a monotonic deque of (value, sequence number).
@@ -83,8 +86,16 @@ struct same_t {
 
 template <typename I>
 void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x);
+// The mean while the window holds an infinite sample: that infinity, or NaN
+// with both (inf + -inf). Only called when pinf or ninf is not 0.
+template <typename I>
+inline Real roll_avg_infinite(const RollAvgS<I>& w) {
+    const Real inf = static_cast<Real>(__builtin_inf());
+    return w.ninf == 0 ? inf : w.pinf == 0 ? -inf : static_cast<Real>(__builtin_nan(""));
+}
 template <typename I>
 inline Real roll_avg_value(const RollAvgS<I>& w) {
+    if ((w.pinf | w.ninf) != 0) return roll_avg_infinite(w);
     return w.count == 0 ? Real(0) : (w.base + w.fresh) / static_cast<Real>(w.count);
 }
 
@@ -98,7 +109,7 @@ FSW_NOINLINE Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n
 #else
 template <typename I>
 inline Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv) {
-    if (inv != 0 && w.count == n) return (w.base + w.fresh) * inv;
+    if (inv != 0 && w.count == n && (w.pinf | w.ninf) == 0) return (w.base + w.fresh) * inv;
     return roll_avg_value(w);
 }
 #endif

@@ -93,6 +93,8 @@ static const Real kInf = static_cast<Real>(__builtin_inf());
 
 static bool close_enough(Real expected, Real got) {
     if (expected != expected || got != got) return expected != expected && got != got;
+    if (expected == got) return true;  // infinities too
+    if (expected - expected != 0 || got - got != 0) return false;  // an infinity and another value
     Real d = expected - got;
     if (d < 0) d = -d;
     Real m = expected < 0 ? -expected : expected;
@@ -128,9 +130,10 @@ static void run_sequence(uint16_t n, uint16_t len, uint8_t kind) {
         ASSERT_REAL_SAME(ref.max(), roll_ext_value(w.mx, w.mx_v));
         ASSERT_REAL_SAME(ref.min(), roll_ext_value(w.mn, w.mn_v));
         ASSERT_REAL_SAME(ref.median(), roll_median_value(w.med, w.med_sorted));
-        if (kind != 4) {
-            TEST_ASSERT_TRUE_MESSAGE(close_enough(ref.mean(), roll_avg_value(w.avg)), "roll_avg far from the mean");
-        }
+        // With +-inf among the samples too: the mean of the window's samples
+        // (inf, -inf or NaN while it holds infinities), not NaN left behind
+        // by an infinite sample that has left it.
+        TEST_ASSERT_TRUE_MESSAGE(close_enough(ref.mean(), roll_avg_value(w.avg)), "roll_avg far from the mean");
     }
 }
 
@@ -231,6 +234,37 @@ static void test_avg_follows_the_documented_operation_order(void) {
     }
 }
 
+// An infinite sample is counted, not summed: while the window holds one the
+// mean is that infinity (NaN with both signs), and once the infinities have
+// left it is the finite samples' mean at once, not NaN (inf - inf) until the
+// next lap. The typed wrapper of a power-of-two N (times 1/N) likewise.
+static void test_avg_forgets_an_infinite_sample_that_left(void) {
+    w.reset(3);
+    static RollAvgN<2> two;
+    w.push(kInf); two.push(kInf);
+    ASSERT_REAL_SAME(kInf, roll_avg_value(w.avg));
+    ASSERT_REAL_SAME(kInf, two.value());
+    w.push(1); two.push(1);
+    w.push(1); two.push(1);
+    ASSERT_REAL_SAME(kInf, roll_avg_value(w.avg));    // inf, 1, 1
+    ASSERT_REAL_SAME(Real(1), two.value());           // 1, 1
+    w.push(1); two.push(-kInf);
+    ASSERT_REAL_SAME(Real(1), roll_avg_value(w.avg));  // 1, 1, 1
+    ASSERT_REAL_SAME(-kInf, two.value());             // 1, -inf
+    w.push(-kInf); two.push(kInf);
+    ASSERT_REAL_SAME(-kInf, roll_avg_value(w.avg));   // 1, 1, -inf
+    TEST_ASSERT_TRUE(two.value() != two.value());     // -inf, inf: NaN
+    w.push(kInf); two.push(Real(0.5));
+    TEST_ASSERT_TRUE(roll_avg_value(w.avg) != roll_avg_value(w.avg));  // 1, -inf, inf
+    ASSERT_REAL_SAME(kInf, two.value());              // inf, 0.5
+    w.push(4); two.push(Real(1.5));
+    w.push(5);
+    ASSERT_REAL_SAME(Real(1), two.value());           // 0.5, 1.5: times 1/2
+    ASSERT_REAL_SAME(kInf, roll_avg_value(w.avg));    // inf, 4, 5
+    w.push(6);
+    ASSERT_REAL_SAME(Real(5), roll_avg_value(w.avg));  // 4, 5, 6
+}
+
 static void test_avg_does_not_drift(void) {
     w.reset(10);
     for (uint16_t k = 0; k < 1000; ++k) w.push(Real(0.1));
@@ -319,6 +353,7 @@ static void run(void) {
     RUN_TEST(test_nan_samples_are_stored_as_zero);
     RUN_TEST(test_random_sequences_match_brute_force);
     RUN_TEST(test_avg_follows_the_documented_operation_order);
+    RUN_TEST(test_avg_forgets_an_infinite_sample_that_left);
     RUN_TEST(test_avg_does_not_drift);
     RUN_TEST(test_typed_wrappers_and_range);
     RUN_TEST(test_byte_indexed_windows_match_the_winidx_core);

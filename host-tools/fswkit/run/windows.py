@@ -10,7 +10,9 @@ from __future__ import annotations
 from bisect import bisect_left, insort
 from collections import deque
 
-from fswkit.autocode.numeric import Real
+from fswkit.autocode.numeric import INF, Real
+
+NAN = float("nan")
 
 
 class Window:
@@ -23,19 +25,22 @@ class Window:
 
 
 class AvgWindow(Window):
-    """Mean of the samples, exactly as the firmware computes it: the sum is
-    `base + fresh`; each new sample is added to `fresh` and the leaving one
-    subtracted from `base`; at the end of every full lap of the ring `fresh`
-    holds the in-order sum of exactly the window's samples and replaces
-    `base`, so rounding drift cannot accumulate."""
+    """Mean of the samples, exactly as the firmware computes it: the sum of
+    the finite samples is `base + fresh`; each new one is added to `fresh`
+    and the leaving one subtracted from `base`; at the end of every full lap
+    of the ring `fresh` holds the in-order sum of exactly the window's finite
+    samples and replaces `base`, so rounding drift cannot accumulate. The
+    infinite samples are counted instead (`pinf`, `ninf`): while the window
+    holds any, the mean is that infinity (NaN with both), and once they have
+    left it is the finite samples' mean again."""
 
-    __slots__ = ("ring", "base", "fresh", "count", "head")
+    __slots__ = ("ring", "base", "fresh", "count", "head", "pinf", "ninf")
 
     def __init__(self, n, real):
         super().__init__(n, real)
         self.ring = [0.0] * n
         self.base = self.fresh = 0.0
-        self.count = self.head = 0
+        self.count = self.head = self.pinf = self.ninf = 0
 
     def push(self, x: float) -> float:
         r = self.real.rnd
@@ -43,16 +48,29 @@ class AvgWindow(Window):
             x = 0.0
         n, head = self.n, self.head
         if self.count == n:
-            self.base = r(self.base - self.ring[head])
+            old = self.ring[head]
+            if old == INF:
+                self.pinf -= 1
+            elif old == -INF:
+                self.ninf -= 1
+            else:
+                self.base = r(self.base - old)
         else:
             self.count += 1
         self.ring[head] = x
-        self.fresh = r(self.fresh + x)
+        if x == INF:
+            self.pinf += 1
+        elif x == -INF:
+            self.ninf += 1
+        else:
+            self.fresh = r(self.fresh + x)
         head += 1
         if head == n:
             head = 0
             self.base, self.fresh = self.fresh, 0.0
         self.head = head
+        if self.pinf or self.ninf:
+            return NAN if self.pinf and self.ninf else INF if self.pinf else -INF
         return r(r(self.base + self.fresh) / self.count)
 
 

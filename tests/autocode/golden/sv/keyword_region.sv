@@ -1,0 +1,5 @@
+[Sensors]
+F64 pressure
+
+[and]
+bool valve

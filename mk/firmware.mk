@@ -23,8 +23,8 @@ FW_AVR_CXX    ?= avr-g++
 FW_AVR_CC     ?= avr-gcc
 
 # Suites: one file per scenario, tests/firmware/test_<name>.cpp.
-FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume parts vm
-FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts vm
+FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume parts vm vm_step
+FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts vm vm_step
 # Suites that talk to the simulated board's sensor parts on the AVR (harness
 # -I): built and run natively and on AVR like the others, but not in the
 # PlatformIO view (tests/integrations/pio has one folder per FW_SUITES
@@ -41,7 +41,7 @@ FW_HARNESS_CASE = $(foreach s,$(FW_AVR_SUITES),$(if $(FW_HARNESS_OPTS_$(s)),*/te
 
 FW_RT_SRCS    := $(wildcard $(FW_SRC)/*.cpp)
 FW_RT_HDRS    := $(wildcard $(FW_SRC)/*.h)
-FW_TEST_HDRS  := $(FW_TESTS)/test_support.h $(FW_TESTS)/unity_config.h $(wildcard $(FW_TESTS)/*.inc)
+FW_TEST_HDRS  := $(FW_TESTS)/test_support.h $(FW_TESTS)/unity_config.h $(FW_TESTS)/vm_images.h $(wildcard $(FW_TESTS)/*.inc)
 FW_UNITY_SRC  := $(FW_UNITY)/unity.c
 
 # ---- flags --------------------------------------------------------------------

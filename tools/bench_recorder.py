@@ -79,7 +79,7 @@ def variant_spi(dst: Path) -> Path:
     app = (dst / "rocket.app").read_text()
     app = re.sub(r"\[log\][^\[]*", SPI_LOG, app)
     app = re.sub(r"(?m)^flash \d+", "flash 26624", app)
-    app = re.sub(r"(?m)^ram   \d+", "ram   1920", app)
+    app = re.sub(r"(?m)^ram   \d+", "ram   1984", app)
     (dst / "rocket.app").write_text(app)
     dio = (dst / "rocket.dio").read_text()
     (dst / "rocket.dio").write_text(re.sub(r"(?m)^o(\s+)13(\s+)led", r"o\g<1>7 \g<2>led", dio))

@@ -218,6 +218,17 @@ def _task_row(toks: list[Tok]) -> TaskRow:
     return TaskRow(toks[0], kind, machine, parse_options(toks, start))
 
 
+def _follows(a: Tok, b: Tok) -> bool:
+    """`b` stands right after `a` on its line, no blank between: a setting's
+    value after its `=` (`arm=  continuity=x` is `arm=` with no value, not
+    `arm=continuity`)."""
+    return b.line == a.line and b.col == a.col + len(a.text)
+
+
+def _no_value(key: Tok) -> str:
+    return f"`{key.text}=` has no value: write it right after the `=` (`{key.text}=VALUE`, no blank between)"
+
+
 def _pyro_row(toks: list[Tok]) -> PyroRow:
     """`element key=value key=a,b ...`: values are names or numbers, a list
     is separated by commas, a number may be negative."""
@@ -228,6 +239,8 @@ def _pyro_row(toks: list[Tok]) -> PyroRow:
         if not (t.kind == ID and i + 1 < n and toks[i + 1].kind == OP and toks[i + 1].text == "="):
             return PyroRow(toks[0], tuple(settings), Problem(t, f"unexpected {show(t)}: expected `key=value`"))
         j = i + 2
+        if j >= n or not _follows(toks[i + 1], toks[j]):
+            return PyroRow(toks[0], tuple(settings), Problem(t, _no_value(t)))
         negative = j < n and toks[j].kind == OP and toks[j].text == "-" and j + 1 < n and toks[j + 1].kind == NUM
         j += negative
         values: list[Tok] = []
@@ -254,6 +267,9 @@ def parse_options(toks: list[Tok], start: int) -> Options:
     i = start
     while i < len(toks):
         t = toks[i]
+        if (t.kind == ID and i + 1 < len(toks) and toks[i + 1].kind == OP and toks[i + 1].text == "="
+                and (i + 2 >= len(toks) or not _follows(toks[i + 1], toks[i + 2]))):
+            return Options(tuple(items), Problem(t, _no_value(t)))
         if not (t.kind == ID and i + 2 < len(toks) and toks[i + 1].kind == OP and toks[i + 1].text == "="
                 and toks[i + 2].kind in (ID, NUM)):
             return Options(tuple(items), Problem(t, f"unexpected {show(t)}: expected `key=value`"))

@@ -19,13 +19,13 @@ from dataclasses import dataclass, replace
 from fractions import Fraction
 
 from . import model as M
-from .appsyntax import AppFile, ConfigFile, Options, Setting, StreamRow, TaskRow, WritableRow
+from .appsyntax import AppFile, ConfigFile, Options, Problem, Setting, StreamRow, TaskRow, WritableRow, parse_table
 from .board import Board, BoardError
 from .buses import SS_WHY, spi_ss
 from .check import assignments, check_literals, check_sm, check_sv, machine_exprs
 from .cnames import machine_clashes, machine_ident
 from .diagnostics import APP, SM, Diagnostics, Source, read_source
-from .iotables import check_table
+from .iotables import check_channels
 from .lexer import ID, NUM, Tok
 from .logcheck import check_log
 from .sensors import SensorState, check_sensor_table, sensor_name
@@ -110,7 +110,7 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     sv = check_sv(parse_sv(sv_src, diags), sv_src, diags)
     machines, machine_srcs = _machines(machine_files, sv, board, r, instead or {})
     _parameters(machines, machine_files, board, r)
-    channels, sensors = _channels(io_files, sv, board, r) if board is not None else ([], [])
+    channels, sensors, refused_outputs = _channels(io_files, sv, board, r) if board is not None else ([], [], set())
 
     time_source, time_unit = _time(f.time, r)
     time_element = _time_element(machines, sv, r)
@@ -141,7 +141,8 @@ def check_app(f: AppFile, diags: Diagnostics, board_override: str | None, load_b
     pyro, reload = [], None
     if f.pyro:  # the proofs' module is imported for an application that has pyro channels only
         from .pyrocheck import check_pyro
-        pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks, board)
+        pyro = check_pyro(f.pyro, sv, tasks, machines, machine_srcs, channels, f.uplink, r, f.tasks, board,
+                          refused_outputs)
     if f.reload:
         from .reloadcheck import check_reload
         reload = check_reload(f.reload, tasks, machines, board, log, r)
@@ -366,12 +367,14 @@ def _machine_name_problem(m: M.Machine, c: ConfigFile, machines: list[M.Machine]
 
 
 def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
-              r: Report) -> tuple[list[M.Channel], list[M.Sensor]]:
+              r: Report) -> tuple[list[M.Channel], list[M.Sensor], set[str]]:
     """The channels of the `.aio`/`.dio` tables and the parts of the `.sns`
     tables, in [configs] order: a pin or an input element is taken once
-    across all of them."""
+    across all of them; and the elements of the digital `o` rows refused
+    (reported at the row: a pyro channel says nothing more of them)."""
     channels: list[M.Channel] = []
     sensors: list[M.Sensor] = []
+    refused_outputs: set[str] = set()
     used_pins: dict = {}
     used_inputs: dict = {}
     state = SensorState()
@@ -396,9 +399,14 @@ def _channels(files: list[ConfigFile], sv: M.StateVector, board: Board,
             if state.spi is not None:  # an earlier table's SPI part took SS
                 refused[spi_ss(board)] = (f"it is {SS_WHY} (the SPI part at {os.path.basename(state.spi[0])}:"
                                           f"{state.spi[1]}); move the channel to another pin")
-            channels += check_table(isrc, c.path.endswith(".aio"), sv, board, r.diags, used_pins, used_inputs,
-                                    refused)
-    return channels, sensors
+            table = parse_table(isrc, c.path.endswith(".aio"), r.diags)
+            taken = check_channels(table, sv, board, r.diags, used_pins, used_inputs, refused)
+            channels += taken
+            if not table.analog:
+                kept = {ch.element.name for ch in taken}
+                refused_outputs |= {row.element.text for row in table.rows
+                                    if not isinstance(row, Problem) and row.direction.text == "o"} - kept
+    return channels, sensors, refused_outputs
 
 
 def _channel_tasks(channels: list[M.Channel], io_files: list[ConfigFile], has, pyro_names: set[str],

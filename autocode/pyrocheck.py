@@ -296,12 +296,14 @@ def _alias_note(m: M.Machine, name: str) -> str:
 # ---- the [pyro] section ---------------------------------------------------------
 
 def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Machine], machine_srcs: dict,
-               channels: list[M.Channel], uplink, r, task_rows=(), board=None) -> list[M.PyroChannel]:
+               channels: list[M.Channel], uplink, r, task_rows=(), board=None,
+               refused_outputs: set[str] = frozenset()) -> list[M.PyroChannel]:
     """The checked channels of the `[pyro]` rows, and the proof for each
     (every problem reported through `r`, appcheck's Report). `uplink`: the
     [uplink] rows, of which none may name a pyro channel; `task_rows`: the
     [tasks] rows (an `outputs` task refused for its own reason is no missing
-    one); `board`: whose bootloader may drive a pin at a reset."""
+    one); `board`: whose bootloader may drive a pin at a reset;
+    `refused_outputs`: elements whose `o` row a table refused (said there)."""
     if not rows:
         return []
     outputs = [t for t in tasks if t.kind == "outputs"]
@@ -309,7 +311,7 @@ def check_pyro(rows, sv: M.StateVector, tasks: list[M.Task], machines: list[M.Ma
         r.err(rows[0].element, "pyro channels need an `outputs` task in [tasks]: nothing would drive their pins")
     if outputs:
         _no_mode(max(outputs, key=lambda t: t.rate), rows, task_rows, r)
-    tables = _Tables(channels)
+    tables = _Tables(channels, refused_outputs)
     declared: dict[str, int] = {}  # element name -> its row's line
     out: list[M.PyroChannel] = []
     owners: dict[str, tuple[int, int]] = {}  # element name -> (its machine, its row's line)
@@ -353,7 +355,8 @@ def _no_mode(task: M.Task, rows, task_rows, r) -> None:
 class _Tables:
     """The I/O channels by element: digital outputs, digital and analog inputs."""
 
-    def __init__(self, channels: list[M.Channel]):
+    def __init__(self, channels: list[M.Channel], refused_outputs=frozenset()):
+        self.refused_outputs = refused_outputs  # elements of `o` rows their table refused
         self.outputs: dict[str, list[M.Channel]] = {}
         self.digital_in: dict[str, M.Channel] = {}
         self.analog_in: dict[str, M.Channel] = {}
@@ -422,6 +425,8 @@ def _output(et, sv, tables: _Tables, declared: dict[str, int], r) -> M.Channel |
         problem = f"unknown element `{name}`"
     elif name in declared:
         problem = f"pyro channel `{name}` is declared twice (first on line {declared[name]})"
+    elif name not in tables.outputs and name in tables.refused_outputs:  # its row's own error said it
+        problem = None
     elif name not in tables.outputs:
         problem = (f"`{name}` is not a digital output: a pyro channel is a bool element that an `o` row of a "
                    ".dio table drives")
@@ -438,7 +443,8 @@ def _output(et, sv, tables: _Tables, declared: dict[str, int], r) -> M.Channel |
         return tables.outputs[name][0]
     if e is not None and name not in declared:
         declared[name] = et.line
-    r.err(et, problem)
+    if problem is not None:
+        r.err(et, problem)
     return None
 
 

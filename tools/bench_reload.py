@@ -72,7 +72,7 @@ def rocket_variant(name: str, baud: int) -> str:
         text = re.sub(r"(?m)^(name\s+\w+)", rf"\1\nbaud  {baud}", text, count=1)
         text = re.sub(r"(?m)^Flight\s+rate=\d+", "Flight   rate=5", text)
         text = re.sub(r"(?m)^Outputs\s+rate=\d+", "Outputs  rate=1", text)
-    text += "\n[reload]\nmachine  mission\nsize     768\nram      192\nactivate Safe\n"
+    text += "\n[reload]\nmachine  mission\nsize     1024\nram      192\nactivate Safe\n"
     with open(app, "w") as f:
         f.write(text)
     return folder

@@ -47,7 +47,7 @@ def test_the_rocket_mission_machine_uploaded_and_activated_at_100_hz_on_a_mega25
     from fswkit.reload.sim import timed_upload
 
     app, built, image, mask = rocket_with_reload(str(tmp_path), 115200)
-    assert len(image) + len(mask) == 758  # (731 B in bytecode format 2, before a typed variable's type byte)
+    assert len(image) + len(mask) == 769  # (758 B before its launch test waited 40 ms armed; 731 B in bytecode format 2)
     # before: 2 late cycles, an overrun each for the uplink task (the commit's
     # step: 11.4 ms) and the mission's (the activation's: 14.2 ms)
     r = timed_upload(built.artifact, "mega2560", app, image, mask)

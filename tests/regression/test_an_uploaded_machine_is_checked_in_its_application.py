@@ -85,7 +85,7 @@ def rocket(tmp_path):
     app = folder / "rocket.app"
     text = re.sub(r"(?m)^board\s+\w+", "board mega2560", app.read_text(), count=1)
     text = re.sub(r"(?m)^\[budget\][^\[]*", "", text)
-    app.write_text(text + "\n[reload]\nmachine  mission\nsize     768\nram      192\nactivate Safe\n")
+    app.write_text(text + "\n[reload]\nmachine  mission\nsize     1024\nram      192\nactivate Safe\n")
     return folder
 
 

@@ -671,6 +671,9 @@ def _sm_elem(toks: list[Tok], src, diags, lang) -> S.SmElem | None:
                 return S.SmElem(d.line, d.type_col, d.type, d.name_col, d.name, read_only, alias, alias_col)
             if alias is not None:
                 diags.error(src, lang, t.line, t.col, f"element `{d.name}` already has an alias (`{alias}`)")
+            elif toks[i + 1].text == d.name:
+                diags.error(src, lang, t.line, toks[i + 1].col, f"`@alias {d.name}` is the element's own name: an "
+                            "alias is another name for it (remove the `@alias`, or give one)")
             else:
                 alias, alias_col = toks[i + 1].text, toks[i + 1].col
             i += 2

@@ -6,7 +6,6 @@ anything is built — never a traceback."""
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import pytest
@@ -14,6 +13,7 @@ import pytest
 from conftest import EXAMPLES, run_fsw
 from fswkit.plant.params import Field, ParamsError, Table, load, locate
 from fswkit.plant.run import SetupError, prepare
+from support.configs import edit, example_copy
 
 ROCKET_TOML = (EXAMPLES / "rocket" / "plant.toml").read_text()
 TANK_TOML = (EXAMPLES / "tank" / "plant.toml").read_text()
@@ -62,12 +62,8 @@ def test_the_examples_load_and_read_the_machines_locals():
 
 
 def test_a_changed_local_changes_the_check(tmp_path):
-    proj = tmp_path / "rocket"
-    shutil.copytree(EXAMPLES / "rocket", proj, ignore=shutil.ignore_patterns("build"))
-    sm = proj / "mission.sm"
-    text = sm.read_text()
-    assert "F32 MAIN_ALT      = 150" in text
-    sm.write_text(text.replace("F32 MAIN_ALT      = 150", "F32 MAIN_ALT      = 120"))
+    proj = example_copy("rocket", tmp_path)
+    edit(proj / "mission.sm", "F32 MAIN_ALT      = 150", "F32 MAIN_ALT      = 120")
     _app, _lay, sc = prepare(str(proj), "rocket")
     assert sc.main_alt == 120.0
 

@@ -7,18 +7,13 @@ the fault is."""
 
 from __future__ import annotations
 
-import shutil
-
-from conftest import EXAMPLES, run_fsw
+from conftest import run_fsw
+from support.configs import edit, example_copy
 
 
 def test_one_error_at_the_refused_row(tmp_path):
-    proj = tmp_path / "rocket"
-    shutil.copytree(EXAMPLES / "rocket", proj, ignore=shutil.ignore_patterns("build"))
-    dio = proj / "rocket.dio"
-    text = dio.read_text()
-    assert "o      5    drogue" in text
-    dio.write_text(text.replace("o      5    drogue", "o      6    drogue"))  # main's pin
+    proj = example_copy("rocket", tmp_path)
+    edit(proj / "rocket.dio", "o      5    drogue", "o      6    drogue")  # main's pin
     r = run_fsw("check", str(proj))
     out = r.out + r.err
     assert r.code == 1 and out.count(" error @ ") == 1, out
@@ -26,8 +21,7 @@ def test_one_error_at_the_refused_row(tmp_path):
 
 
 def test_an_output_the_tables_do_not_have_is_still_said(tmp_path):
-    proj = tmp_path / "rocket"
-    shutil.copytree(EXAMPLES / "rocket", proj, ignore=shutil.ignore_patterns("build"))
+    proj = example_copy("rocket", tmp_path)
     dio = proj / "rocket.dio"
     dio.write_text("\n".join(l for l in dio.read_text().splitlines() if "    main " not in l) + "\n")
     r = run_fsw("check", str(proj))

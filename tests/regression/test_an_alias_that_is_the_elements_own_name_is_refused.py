@@ -5,18 +5,13 @@ a machine). It is now an error at the alias."""
 
 from __future__ import annotations
 
-import shutil
-
-from conftest import EXAMPLES, run_fsw
+from conftest import run_fsw
+from support.configs import edit, tank_configs
 
 
 def test_an_alias_equal_to_the_name_is_an_error_at_it(tmp_path):
-    tank = tmp_path / "tank"
-    shutil.copytree(EXAMPLES / "tank", tank, ignore=shutil.ignore_patterns("build"))
-    sm = tank / "tank.sm"
-    text = sm.read_text()
-    assert "\nbool valveOpen\n" in text
-    sm.write_text(text.replace("\nbool valveOpen\n", "\nbool valveOpen @alias valveOpen\n", 1))
+    sm = tank_configs(tmp_path) / "tank.sm"
+    edit(sm, "\nbool valveOpen\n", "\nbool valveOpen @alias valveOpen\n")
     line = next(n for n, l in enumerate(sm.read_text().splitlines(), 1) if "@alias valveOpen" in l)
     r = run_fsw("check", str(sm))
     out = r.out + r.err

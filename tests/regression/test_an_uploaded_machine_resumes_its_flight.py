@@ -27,6 +27,8 @@ import shutil
 
 import pytest
 
+from support.gate import gate_app, gate_firmware
+
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
@@ -78,31 +80,7 @@ i      3    go
 o      5    charge
 """
 
-APP = """[application]
-board uno
-rate  100
-reset_cause cause
-
-[configs]
-state_vector gate.sv
-machine      gate.sm
-io           gate.dio
-
-[time]
-source clock
-unit   ms
-
-[tasks]
-uplink   uplink        rate=100
-sense    inputs        rate=100
-fly      machine gate  rate=100
-act      outputs       rate=100
-down     telemetry     rate=100
-
-[telemetry]
-Flight   rate=50
-
-[reload]
+APP = gate_app(extra="reset_cause cause\n", telemetry_rate=50, sections="""[reload]
 machine  gate
 size     256
 ram      32
@@ -110,7 +88,7 @@ activate Safe
 
 [pyro]
 charge   arm=armSwitch  pulse=0.05  machine=gate  armed=Armed  fire=Fire
-"""
+""")
 
 CHARGE, KEY, GO = 5, 2, 3
 FIRE, DONE = 3, 4  # the machine's state numbers
@@ -120,19 +98,13 @@ FIRE, DONE = 3, 4  # the machine's state numbers
 def project(tmp_path_factory):
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.cli.machine import image_for
-    from fswkit.target.build import firmware, load
 
     d = tmp_path_factory.mktemp("reload_resume")
-    for name, text in (("gate.sv", SV), ("gate.sm", SM), ("gate.dio", DIO), ("gate.app", APP)):
-        (d / name).write_text(text)
+    app, elf = gate_firmware(d, {"gate.sv": SV, "gate.sm": SM, "gate.dio": DIO, "gate.app": APP})
     diags = Diagnostics()
-    app = load(str(d / "gate.app"), diags)
-    assert app is not None, diags.render()
-    built = firmware(app, str(d / "build"))
-    assert built.fits, built.report
     image = image_for(app, str(d / "gate.sm"), diags)
     assert image is not None, diags.render()
-    return app, built.artifact, image
+    return app, elf, image
 
 
 class Rig:

@@ -19,6 +19,8 @@ import shutil
 
 import pytest
 
+from support.gate import gate_app, gate_firmware
+
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
@@ -59,32 +61,9 @@ i      3    go
 o      5    charge
 """
 
-APP = """[application]
-board uno
-rate  100
-
-[configs]
-state_vector gate.sv
-machine      gate.sm
-io           gate.dio
-
-[time]
-source clock
-unit   ms
-
-[tasks]
-uplink   uplink        rate=100
-sense    inputs        rate=100
-fly      machine gate  rate=100
-act      outputs       rate=100
-down     telemetry     rate=100
-
-[telemetry]
-Flight   rate=10
-
-[pyro]
+APP = gate_app(sections="""[pyro]
 charge   arm=armSwitch  pulse=0.5  machine=gate  armed=Armed  fire=Fire
-"""
+""")
 
 CHARGE, KEY, GO = 5, 2, 3
 ACT = 3  # the outputs task's index in [tasks]
@@ -93,18 +72,8 @@ OK, LOCKED = 0, 7
 
 @pytest.fixture(scope="module")
 def project(tmp_path_factory):
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.target.build import firmware, load
-
-    d = tmp_path_factory.mktemp("mode_in_a_pulse")
-    for name, text in (("gate.sv", SV), ("gate.sm", SM), ("gate.dio", DIO), ("gate.app", APP)):
-        (d / name).write_text(text)
-    diags = Diagnostics()
-    app = load(str(d / "gate.app"), diags)
-    assert app is not None, diags.render()
-    built = firmware(app, str(d / "build"))
-    assert built.fits, built.report
-    return app, built.artifact
+    return gate_firmware(tmp_path_factory.mktemp("mode_in_a_pulse"),
+                         {"gate.sv": SV, "gate.sm": SM, "gate.dio": DIO, "gate.app": APP})
 
 
 @pytest.mark.parametrize("mode", [0, 1])  # disabled, safed

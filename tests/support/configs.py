@@ -19,3 +19,12 @@ def edit(path: Path, old: str, new: str) -> None:
     text = path.read_text()
     assert old in text
     path.write_text(text.replace(old, new, 1))
+
+
+def example_copy(name: str, tmp: Path) -> Path:
+    """A copy of examples/NAME in tmp/NAME without its build folder: the copy."""
+    import shutil
+
+    dst = tmp / name
+    shutil.copytree(TANK.parent / name, dst, ignore=shutil.ignore_patterns("build"))
+    return dst

@@ -163,8 +163,10 @@ def resumes(app: Application) -> bool:
 
 def _resume(app: Application) -> list[str]:
     """What a resume keeps (docs/safety.md, "A reset in flight"): the state
-    vector, each machine's bookkeeping and stored locals, the pyro gates and
-    the recorder's flight; the two banks in RAM the C runtime leaves alone."""
+    vector, each machine's bookkeeping, stored locals and windows, the pyro
+    gates, the modes of the tasks without a mode element (theirs are in the
+    state vector) and the recorder's flight; the two banks in RAM the C
+    runtime leaves alone."""
     real = real_of(app)
     spans = [("sv", "kSvSize", "the state vector")]
     for m in app.machines:
@@ -177,6 +179,9 @@ def _resume(app: Application) -> list[str]:
             spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::win)", f"sizeof {ns}::win",
                           f"{m.name}: its rolling windows"))
     spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
+    for i, t in enumerate(app.tasks):  # the ground's modes (a task with a mode element: in the state vector)
+        if t.mode is None:
+            spans.append((f"&stats[{i}].mode", "1", f"task {t.name}'s mode"))
     if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
         spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
         spans.append(("reload_ram", "sizeof reload_ram", "an uploaded machine's windows and locals"))
@@ -221,7 +226,8 @@ def resume_hash(app: Application) -> int:
 
 def _resume_begin(app: Application) -> list[str]:
     """begin()'s lines after a resume: no pulse started again, the clock
-    going on from the kept G plus a cycle, the reset cause's resumed bit."""
+    going on from the kept G plus a cycle, the tasks' modes as kept, the
+    reset cause's resumed bit."""
     per_cycle = -(-(1000 if app.time_unit == "ms" else 1000000) // app.rate)  # at least a cycle has passed
     gs = sorted({m.vars[m.g].name for m in app.machines})
     c = ["    if (resumed) {",
@@ -230,6 +236,8 @@ def _resume_begin(app: Application) -> list[str]:
         c.append(f"        if (fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u > time_base) "
                  f"time_base = fsw::load<uint64_t>(sv + E_{g}) + {per_cycle}u;")
     c.append("        time_based = true;")
+    if app.tasks:  # the ground's modes go on, as the last cycle left them
+        c.append(f"        for (uint8_t i = 0; i < {len(app.tasks)}; ++i) fsw::executor_set_task_mode(ex, i, kept_modes[i]);")
     c.append("        ex.reset_cause = static_cast<uint8_t>(ex.reset_cause | fsw::kResetResumed);")
     if app.reset_cause is not None:
         c.append(f"        sv[E_{app.reset_cause.name}] = ex.reset_cause;")
@@ -333,6 +341,10 @@ def _app_cpp(app: Application) -> str:
         c.append("    fsw::log_begin(rec, &kLogConfig);  // goes on after the newest whole record")
     if app.log is not None and resumes(app):
         c.append("    if (resumed) fsw::log_resume(rec, log_flight, log_mode);  // the flight goes on being recorded")
+    if resumes(app) and app.tasks:  # the kept modes, which the executor's start sets to each task's start=
+        modes = ", ".join(f"sv[E_{t.mode.name}]" if t.mode is not None else f"stats[{i}].mode"
+                          for i, t in enumerate(app.tasks))
+        c.append(f"    const uint8_t kept_modes[{len(app.tasks)}] = {{{modes}}};  // as kept, if resumed")
     c.append("    if (fsw::executor_begin(ex, &kConfig) != fsw::kOk) return false;")
     if resumes(app):
         c += _resume_begin(app)

@@ -55,7 +55,7 @@ element state
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
 flash 27136
-ram   1856
+ram   1920
 
 [pyro]
 drogue    arm=armSwitch  pulse=1  machine=mission  armed=Armed  fire=Apogee

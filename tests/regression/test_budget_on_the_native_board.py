@@ -18,7 +18,7 @@ def test_a_budgeted_project_loads_for_the_native_board():
     app = load_app(str(EXAMPLES / "rocket" / "rocket.app"), diags, board_override="native")
     assert diags.error_count == 0, diags
     assert app is not None and app.board.name == "native"
-    assert (app.flash_budget, app.ram_budget) == (25600, 1856)
+    assert (app.flash_budget, app.ram_budget) == (25600, 1920)
 
 
 def test_a_budget_over_an_avr_board_is_still_refused(tmp_path):

@@ -96,7 +96,10 @@ def check_out_folder(out: str, default: bool = False) -> None:
     except FileNotFoundError:
         return
     except NotADirectoryError:
-        raise BuildError(f"{out} is a file, not a folder: name a folder for the build (--out)") from None
+        from fswkit.outputs import not_a_folder
+
+        words = not_a_folder(out) or f"{out} is a file, not a folder"
+        raise BuildError(f"{words}: name a folder for the build (--out)") from None
     except OSError as e:
         raise BuildError(f"cannot read the build folder {out}: {e.strerror or e}") from None
     if not names or _kit_lock(os.path.join(out, ".lock")):
@@ -187,7 +190,12 @@ def write_files(files: dict[str, str], out: str) -> list[str]:
     that the generator did not write (its first line) is refused, never
     replaced; a `*.gen.cpp` / `*.gen.h` of the user's is never removed."""
     from fswkit.autocode.diagnostics import InputError, read_head
+    from fswkit.outputs import in_the_way
 
+    blocked = in_the_way(out)
+    if blocked is not None:  # the system would say `File exists` or `Not a directory`, of `out`
+        raise OSError(errno.ENOTDIR, f"it is {'a file' if os.path.isfile(blocked) else 'not a folder'}, "
+                      "not a folder: name a folder for the generated files", blocked)
     os.makedirs(out, exist_ok=True)
     written = []
     for name in sorted(files):

@@ -347,6 +347,18 @@ def main(args) -> int:
     from fswkit.autocode.board import BoardError, load_board
 
     target = args.name
+    if target == "":
+        sys.stderr.write("fsw new: NAME: an empty string names nothing: give the new project's folder "
+                         "(fsw new myrig)\n")
+        return 2
+    last = os.path.basename(target.rstrip(os.sep) or os.sep)
+    if last in (".", ".."):  # a folder that exists, by a name that names no project
+        real = os.path.realpath(target)
+        how = (f"from the folder above: cd .. && fsw new {shlex.quote(os.path.basename(real))}"
+               if real == os.path.realpath(os.curdir) else f"name the folder itself: fsw new {shlex.quote(real)}")
+        sys.stderr.write(f"fsw new: `{target}` names no project: a project is written into a new folder (or an "
+                         f"empty one) whose name names its files and machine; {how}\n")
+        return 2
     name = os.path.basename(os.path.normpath(target))
     try:
         board = load_board(args.board)
@@ -356,6 +368,12 @@ def main(args) -> int:
         return 2
     except OSError as e:  # the starter script is made from the machine in a temporary folder
         sys.stderr.write(f"fsw new: cannot write a temporary file: {e.strerror or e}\n")
+        return 1
+    if os.path.islink(target.rstrip(os.sep) or target):  # the project would replace the link, not fill its folder
+        real = os.path.realpath(target)
+        where = f"the folder it names, {real}" if os.path.isdir(real) else "a new name"
+        sys.stderr.write(f"fsw new: {target} is a symbolic link{'' if os.path.exists(real) else ' to nothing'}: "
+                         f"a project is written into a new folder or an empty one; give {where}\n")
         return 1
     if os.path.exists(target) and (not os.path.isdir(target) or os.listdir(target)):
         sys.stderr.write(f"fsw new: {target} already exists: choose a new folder\n")

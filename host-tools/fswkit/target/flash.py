@@ -29,6 +29,11 @@ SIGNATURES = {
 }
 
 
+# avrdude's line for each try at the bootloader that got no answer: 7.x
+# `avrdude warning: attempt 3 of 10: not in sync`, 6.x `stk500_getsync() attempt 3 of 10`
+ATTEMPT = re.compile(r"\battempt (\d+) of (\d+)\b")
+
+
 class FlashError(Exception):
     def __init__(self, message: str, code: int = EXIT_FAIL):
         super().__init__(message)
@@ -154,10 +159,12 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
         raise FlashError(f"cannot run avrdude: {e.strerror or e}") from None
     lines = []
     assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line)
-        if verbose:
-            sys.stderr.write(line)
+    try:
+        _follow(proc, lines, port, verbose)
+    except BaseException:  # Ctrl-C, SIGTERM, SIGHUP: avrdude ends with the command, never holds the port after it
+        proc.kill()
+        proc.wait()
+        raise
     code = proc.wait()
     output = "".join(lines)
     if code != 0:
@@ -166,6 +173,21 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     size = f"{int(m.group(1)):,} B, verified" if m else "written"
     print(f"fsw flash: {os.path.basename(hex_path)} is on the {board.name} at {port} ({size})")
     return EXIT_OK
+
+
+def _follow(proc, lines: list[str], port: str, verbose: bool) -> None:
+    """avrdude's output as it comes: kept in `lines`, shown with `verbose`,
+    else each try at the bootloader said in a line of ours."""
+    for line in proc.stdout:
+        lines.append(line)
+        if verbose:
+            sys.stderr.write(line)
+        else:  # each try takes avrdude seconds (5 s in 7.1): a minute of silence would look like a hang
+            attempt = ATTEMPT.search(line)
+            if attempt:
+                sys.stderr.write(f"fsw flash: no answer from a bootloader on {port} yet (attempt "
+                                 f"{attempt.group(1)} of {attempt.group(2)}; Ctrl-C stops it)\n")
+                sys.stderr.flush()
 
 
 # ---- PlatformIO ------------------------------------------------------------------------

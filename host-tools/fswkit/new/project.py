@@ -30,8 +30,8 @@ class ScaffoldError(Exception):
 def check_name(name: str) -> None:
     """A project's name names its files and its machine: an identifier."""
     if not NAME_RE.match(name):
-        raise ScaffoldError(f"`{name}` cannot name a project: use letters, digits and `_`, "
-                            "starting with a letter (it names the files and the state machine)")
+        raise ScaffoldError(f"`{name}` cannot name a project: use ASCII letters (A-Z, a-z), digits and `_`, "
+                            "not starting with a digit (it names the files and the state machine)")
     if name in KEYWORDS:
         raise ScaffoldError(f"`{name}` is a keyword of the config languages: choose another name")
 

@@ -39,7 +39,7 @@ def sketch_name(folder: str) -> str:
     name = os.path.basename(os.path.normpath(folder))
     if not SKETCH_NAME.match(name):
         raise SketchError(f"`{name}` cannot name an Arduino sketch (the folder names the sketch): use "
-                          "letters, digits, `_`, `-` and `.`, starting with a letter or digit, "
+                          "ASCII letters (A-Z, a-z), digits, `_`, `-` and `.`, starting with a letter, a digit or `_`, "
                           "at most 63 characters")
     return name
 

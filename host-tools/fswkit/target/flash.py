@@ -12,6 +12,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 
@@ -119,6 +120,27 @@ def check_board_on_port(board, listing, port: str) -> None:
                      f"a {board.name} after all")
 
 
+# ---- the upload tool's processes --------------------------------------------------------
+
+def end_group(proc: subprocess.Popen) -> None:
+    """Ends an upload tool started in a process group of its own
+    (`process_group=0`) and everything it started (PlatformIO's build, its
+    avrdude): SIGTERM, so that avrdude lets the port go, then SIGKILL to
+    what is left after a few seconds. Used when the command is stopped
+    (Ctrl-C, SIGTERM, SIGHUP), so that no upload goes on, or holds the
+    port, after the command has ended. (In a group of its own, the tool is
+    not sent a terminal's Ctrl-C directly: the command passes it on here.)"""
+    for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, None)):
+        try:
+            os.killpg(proc.pid, sig)
+        except (ProcessLookupError, PermissionError):
+            pass
+        try:
+            proc.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            continue
+
+
 # ---- avrdude ---------------------------------------------------------------------------
 
 def explain_avrdude(output: str, board, port: str, code: int) -> str:
@@ -154,7 +176,7 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
     try:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                errors="replace")
+                                errors="replace", process_group=0)
     except OSError as e:
         raise FlashError(f"cannot run avrdude: {e.strerror or e}") from None
     lines = []
@@ -162,8 +184,7 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     try:
         _follow(proc, lines, port, verbose)
     except BaseException:  # Ctrl-C, SIGTERM, SIGHUP: avrdude ends with the command, never holds the port after it
-        proc.kill()
-        proc.wait()
+        end_group(proc)
         raise
     code = proc.wait()
     output = "".join(lines)
@@ -255,9 +276,14 @@ def upload_pio(app, port: str) -> int:
     cmd = [pio, "run", "-d", ini_dir, "-e", env, "-t", "upload", "--upload-port", port]
     sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
     try:
-        code = subprocess.call(cmd)
+        proc = subprocess.Popen(cmd, process_group=0)
     except OSError as e:
         raise FlashError(f"cannot run PlatformIO: {e.strerror or e}") from None
+    try:
+        code = proc.wait()
+    except BaseException:  # PlatformIO's build and its avrdude end with the command too
+        end_group(proc)
+        raise
     if code != 0:
         raise FlashError(f"PlatformIO's upload failed (exit status {code}): its messages are above")
     print(f"fsw flash: {os.path.basename(app.path)} is on the {app.board.name} at {port} (PlatformIO `{env}`)")

@@ -108,7 +108,11 @@ def export(app: Application, folder: str) -> int:
     except OSError as e:
         sys.stderr.write(f"fsw gen: cannot write {e.filename or folder}: {e.strerror or e}\n")
         return 1
+    from fswkit.autocode.kit import ROOT
+
     fqbn = app.board.raw["arduino"]["fqbn"]
+    # pasted as it is, it finds the runtime without a sketchbook link (the README's step 1)
+    command = shlex.join(["arduino-cli", "compile", "-b", fqbn, "--library", os.path.join(ROOT, "firmware"), folder])
     sys.stderr.write(f"fsw gen: sketch {name} for the {app.board.name} in {folder} ({len(files)} files); "
-                     f"build it with: arduino-cli compile -b {fqbn} {folder}\n")
+                     f"build it with: {command}\n")
     return 0

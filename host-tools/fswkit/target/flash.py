@@ -11,6 +11,7 @@ import errno
 import json
 import os
 import re
+import shlex
 import shutil
 import signal
 import subprocess
@@ -173,7 +174,7 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     if shutil.which("avrdude") is None:
         raise FlashError("`avrdude` is not installed: run `make setup` (Debian package avrdude)")
     cmd = avrdude_command(board, hex_path, port)
-    sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
+    sys.stderr.write(f"fsw flash: {shlex.join(cmd)}\n")
     try:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 errors="replace", process_group=0)
@@ -274,7 +275,7 @@ def upload_pio(app, port: str) -> int:
     ini_dir = find_pio_project(app.path)
     env = pio_env_for(pio, ini_dir, app)
     cmd = [pio, "run", "-d", ini_dir, "-e", env, "-t", "upload", "--upload-port", port]
-    sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
+    sys.stderr.write(f"fsw flash: {shlex.join(cmd)}\n")
     try:
         proc = subprocess.Popen(cmd, process_group=0)
     except OSError as e:

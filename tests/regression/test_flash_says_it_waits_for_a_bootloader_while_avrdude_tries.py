@@ -53,5 +53,6 @@ def test_each_attempt_is_said_as_it_happens(fsw, tmp_path, monkeypatch, version)
              if line.startswith(f"fsw flash: no answer from a bootloader on {port} yet (attempt ")]
     assert len(waits) == 3, r.err
     assert "(attempt 3 of 10; Ctrl-C stops it)" in lines[waits[-1]]
-    final = [i for i, line in enumerate(lines) if line.startswith(f"fsw flash: no answer from a bootloader on {port} (")]
+    final = [i for i, line in enumerate(lines)
+             if line.startswith(f"fsw flash: no answer from a bootloader on {port} (")]
     assert final and final[0] > waits[-1], r.err

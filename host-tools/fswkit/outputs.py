@@ -69,13 +69,23 @@ def not_a_folder(folder: str) -> str | None:
     """Words for `in_the_way(folder)` (`notes.txt is a file, not a folder`),
     or None when nothing is in the way."""
     path = in_the_way(folder)
-    if path is None:
-        return None
+    return None if path is None else f"{path} is {what_is(path)}, not a folder"
+
+
+def what_is(path: str) -> str:
+    """What stands at `path`, which is no folder, in words: `a file`, `a
+    symbolic link to nothing`, `a FIFO`, `a device`, `a socket`."""
     try:
         mode = os.stat(path).st_mode
-    except OSError:  # a link to nothing
-        return f"{path} is a symbolic link to nothing, not a folder"
-    return f"{path} is {'a file' if stat.S_ISREG(mode) else 'not a regular file'}, not a folder"
+    except OSError:
+        return "a symbolic link to nothing"
+    if stat.S_ISREG(mode):
+        return "a file"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a device"
 
 
 def file_head(path: str, n: int) -> bytes | None:

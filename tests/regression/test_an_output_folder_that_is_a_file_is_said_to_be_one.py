@@ -40,3 +40,13 @@ def test_a_file_in_the_way_of_an_output_folder_is_named(tmp_path, case):
     assert "File exists" not in r.err and "Not a directory" not in r.err and "Traceback" not in r.err
     assert not re.search(re.escape(str(notes)) + r"/\w+ is a file", r.err)  # the file, not a path under it
     assert notes.read_text() == "mine\n"
+
+
+@pytest.mark.parametrize("command", ["gen", "build"])
+def test_a_link_to_nothing_in_the_way_is_said_to_be_one(tmp_path, command):
+    (tmp_path / "gone").symlink_to(tmp_path / "nowhere")
+    r = run_fsw(command, str(EXAMPLES / "tank"), "--out", str(tmp_path / "gone" / "out"))
+    assert r.code == 1, r.err
+    assert f"{tmp_path / 'gone'} is a symbolic link to nothing, not a folder" in r.err or \
+        f"cannot write {tmp_path / 'gone'}: it is a symbolic link to nothing, not a folder" in r.err, r.err
+    assert not (tmp_path / "nowhere").exists()

@@ -51,6 +51,43 @@ def same_file(a: str, b: str) -> bool:
         return os.path.realpath(a) == os.path.realpath(b)
 
 
+def in_the_way(folder: str) -> str | None:
+    """What stands where the output folder `folder` (or a folder above it)
+    must be: the path, as the user wrote it, of the first of them that
+    exists and is not a folder (a file, a FIFO, a device, a link to none);
+    None when nothing does. `notes.txt/gen` names `notes.txt`, not a path
+    under it that cannot exist."""
+    parts = os.path.normpath(folder).split(os.sep)
+    for i in range(1, len(parts) + 1):
+        path = os.sep.join(parts[:i]) or os.sep
+        if os.path.lexists(path) and not os.path.isdir(path):
+            return path
+    return None
+
+
+def not_a_folder(folder: str) -> str | None:
+    """Words for `in_the_way(folder)` (`notes.txt is a file, not a folder`),
+    or None when nothing is in the way."""
+    path = in_the_way(folder)
+    return None if path is None else f"{path} is {what_is(path)}, not a folder"
+
+
+def what_is(path: str) -> str:
+    """What stands at `path`, which is no folder, in words: `a file`, `a
+    symbolic link to nothing`, `a FIFO`, `a device`, `a socket`."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return "a symbolic link to nothing"
+    if stat.S_ISREG(mode):
+        return "a file"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a device"
+
+
 def file_head(path: str, n: int) -> bytes | None:
     """The first `n` bytes of the regular file at `path`; None for no file,
     one that cannot be read, or one that is not regular (a FIFO or a device

@@ -133,7 +133,9 @@ def folder_and_firmware(project: str, board: str | None, out: str):
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
-        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        from fswkit.outputs import not_a_folder
+
+        say(f"cannot create the output folder {out}: {not_a_folder(out) or e.strerror or e}")
         return 2
     return build(project, board)
 

@@ -121,7 +121,9 @@ def _talk(args, app, p) -> int:
         try:  # its own words: an OSError here would be taken for the port going away
             os.makedirs(args.output, exist_ok=True)
         except OSError as e:
-            _say(f"cannot create the folder {args.output}: {e.strerror or e}")
+            from fswkit.outputs import not_a_folder
+
+            _say(f"cannot create the folder {args.output}: {not_a_folder(args.output) or e.strerror or e}")
             return EXIT_FAIL
         names = _file_names(flights)
         paths = {id(f): os.path.join(args.output, names[id(f)]) for f in chosen}

@@ -234,7 +234,9 @@ def plant_run(args) -> int:
         say(str(e))
         return 2
     except OSError as e:
-        say(f"cannot create the output folder {out}: {e.strerror or e}")
+        from fswkit.outputs import not_a_folder
+
+        say(f"cannot create the output folder {out}: {not_a_folder(out) or e.strerror or e}")
         return 2
     built = build(args.project, args.board)  # into the project's build folder; `out` is the flight's
     if isinstance(built, int):

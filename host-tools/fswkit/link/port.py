@@ -165,7 +165,10 @@ def _held_serial():
 
 def not_a_port(name: str) -> str | None:
     """Why a device path cannot be a serial port, in words (None: it may
-    be one — a device, a pty, a FIFO — or is a pyserial URL)."""
+    be one — a device, a pty — or is a pyserial URL). A FIFO opens without
+    waiting and a socket not at all, so each is said to be what it is
+    before pyserial tries (it would call a FIFO a device, a socket `No such
+    device or address`)."""
     if is_url(name):
         return None
     try:
@@ -178,6 +181,10 @@ def not_a_port(name: str) -> str | None:
         return "it is a folder, not a serial port"
     if stat.S_ISREG(mode):
         return "it is a regular file, not a serial port"
+    if stat.S_ISFIFO(mode):
+        return "it is a FIFO (a named pipe), not a serial port"
+    if stat.S_ISSOCK(mode):
+        return "it is a socket, not a serial port"
     return None
 
 

@@ -11,6 +11,7 @@ import re
 import shlex
 import shutil
 import tempfile
+import textwrap
 
 from fswkit.autocode.board import Board
 from fswkit.autocode.diagnostics import Diagnostics, ranges
@@ -29,8 +30,8 @@ class ScaffoldError(Exception):
 def check_name(name: str) -> None:
     """A project's name names its files and its machine: an identifier."""
     if not NAME_RE.match(name):
-        raise ScaffoldError(f"`{name}` cannot name a project: use letters, digits and `_`, "
-                            "starting with a letter (it names the files and the state machine)")
+        raise ScaffoldError(f"`{name}` cannot name a project: use ASCII letters (A-Z, a-z), digits and `_`, "
+                            "not starting with a digit (it names the files and the state machine)")
     if name in KEYWORDS:
         raise ScaffoldError(f"`{name}` is a keyword of the config languages: choose another name")
 
@@ -237,13 +238,15 @@ platform = native
 custom_fsw_board = native
 """)
     default = board.name if board.is_avr else "native"
+    usage = (f""";   pio run                 build the firmware for the {board.name}
+;   pio run -t upload       ... and flash it
+;   pio device monitor      the serial port (fsw monitor decodes telemetry)
+""" if board.is_avr else """;   pio run                 build the program for this computer (pio run -e native)
+""")
     return f"""\
 ; PlatformIO for {name} (integrations/platformio/README.md of fswkit).
 ;
-;   pio run                 build the firmware for the {board.name}
-;   pio run -t upload       ... and flash it
-;   pio device monitor      the serial port (fsw monitor decodes telemetry)
-;
+{usage};
 ; Before every build, fswkit's hook regenerates the C++ from the configs
 ; into build/pio/src/<environment>/; a config error stops the build with its
 ; located diagnostic.
@@ -269,13 +272,42 @@ monitor_speed = {baud}
 
 
 def _readme(name: str, board: Board) -> str:
+    col = 29  # where the comments of the "Every day" block start
+
+    def line(command: str, what: str) -> str:
+        return f"    {command:<{col}}# {what}" if len(command) < col else f"    {command}   # {what}"
+
+    if board.is_avr:
+        target = f"firmware for the {_board_comment(board)}"
+        every_day = [
+            line("fsw check .", "every config: located errors and warnings"),
+            line(f"fsw test {name}.ss", "the state script against the machine"),
+            line("fsw build .", "firmware, with flash and RAM against the board's budget"),
+            line("fsw flash .", "build and upload (the board on the only serial port, or --port)"),
+            line("fsw monitor .", "live telemetry from the board"),
+            line("fsw cmd mode control safed --port PORT", "safe the control task from the ground")]
+        pio = "With PlatformIO instead: `pio run`, `pio run -t upload`."
+        last = "5. `fsw build .`, then `fsw flash .`."
+    else:  # a program for this computer: nothing to upload, no serial port
+        target = "a program for this computer (the `native` board: simulated pins and clock)"
+        every_day = [
+            line("fsw check .", "every config: located errors and warnings"),
+            line(f"fsw test {name}.ss", "the state script against the machine"),
+            line(f"fsw test --native {name}.ss", "the same, through the generated C++"),
+            line("fsw build .", f"the program: build/native/{name}"),
+            line(f"build/native/{name} 1000", "1,000 cycles on a simulated clock: the state vector in hex"),
+            line("fsw build . --board uno", "firmware for an Arduino Uno (its pin map is this one's)")]
+        pio = "With PlatformIO instead: `pio run`."
+        last = (f"5. `fsw build .`. To fly it, name your Arduino in `{name}.app` (`board uno`, `nano`\n"
+                "   or `mega2560`): `fsw flash .` then builds and uploads it.")
+    commands = "\n".join(every_day)
+    intro = textwrap.fill(f"Flight software for {name}, made with fswkit: the vehicle is described in the config "
+                          f"files below and the kit turns them into {target}. Nobody writes glue code: change "
+                          "a config, build again.", 75)
     return f"""\
 # {name}
 
-Flight software for {name}, made with fswkit: the vehicle is described in
-the config files below and the kit turns them into firmware for the
-{_board_comment(board)}. Nobody writes glue code: change a config, build
-again.
+{intro}
 
 | file | what it holds |
 |---|---|
@@ -290,14 +322,9 @@ again.
 
 Run these in this folder:
 
-    fsw check .                  # every config: located errors and warnings
-    fsw test {name}.ss{" " * max(0, 14 - len(name))}# the state script against the machine
-    fsw build .                  # firmware, with flash and RAM against the board's budget
-    fsw flash .                  # build and upload (the board on the only serial port, or --port)
-    fsw monitor .                # live telemetry from the board
-    fsw cmd mode control safed --port PORT   # safe the control task from the ground
+{commands}
 
-With PlatformIO instead: `pio run`, `pio run -t upload`.
+{pio}
 
 ## Where to start
 
@@ -309,7 +336,7 @@ With PlatformIO instead: `pio run`, `pio run -t upload`.
    visits every state (over the one here until you edit it; an edited
    script is kept unless you add `--force`); replace its TODOs with what
    must hold, and keep it passing with `fsw test {name}.ss`.
-5. `fsw build .`, then `fsw flash .`.
+{last}
 """
 
 
@@ -320,6 +347,18 @@ def main(args) -> int:
     from fswkit.autocode.board import BoardError, load_board
 
     target = args.name
+    if target == "":
+        sys.stderr.write("fsw new: NAME: an empty string names nothing: give the new project's folder "
+                         "(fsw new myrig)\n")
+        return 2
+    last = os.path.basename(target.rstrip(os.sep) or os.sep)
+    if last in (".", ".."):  # a folder that exists, by a name that names no project
+        real = os.path.realpath(target)
+        how = (f"from the folder above: cd .. && fsw new {shlex.quote(os.path.basename(real))}"
+               if real == os.path.realpath(os.curdir) else f"name the folder itself: fsw new {shlex.quote(real)}")
+        sys.stderr.write(f"fsw new: `{target}` names no project: a project is written into a new folder (or an "
+                         f"empty one) whose name names its files and machine; {how}\n")
+        return 2
     name = os.path.basename(os.path.normpath(target))
     try:
         board = load_board(args.board)
@@ -329,6 +368,12 @@ def main(args) -> int:
         return 2
     except OSError as e:  # the starter script is made from the machine in a temporary folder
         sys.stderr.write(f"fsw new: cannot write a temporary file: {e.strerror or e}\n")
+        return 1
+    if os.path.islink(target.rstrip(os.sep) or target):  # the project would replace the link, not fill its folder
+        real = os.path.realpath(target)
+        where = f"the folder it names, {real}" if os.path.isdir(real) else "a new name"
+        sys.stderr.write(f"fsw new: {target} is a symbolic link{'' if os.path.exists(real) else ' to nothing'}: "
+                         f"a project is written into a new folder or an empty one; give {where}\n")
         return 1
     if os.path.exists(target) and (not os.path.isdir(target) or os.listdir(target)):
         sys.stderr.write(f"fsw new: {target} already exists: choose a new folder\n")

@@ -39,7 +39,7 @@ def sketch_name(folder: str) -> str:
     name = os.path.basename(os.path.normpath(folder))
     if not SKETCH_NAME.match(name):
         raise SketchError(f"`{name}` cannot name an Arduino sketch (the folder names the sketch): use "
-                          "letters, digits, `_`, `-` and `.`, starting with a letter or digit, "
+                          "ASCII letters (A-Z, a-z), digits, `_`, `-` and `.`, starting with a letter, a digit or `_`, "
                           "at most 63 characters")
     return name
 
@@ -108,7 +108,11 @@ def export(app: Application, folder: str) -> int:
     except OSError as e:
         sys.stderr.write(f"fsw gen: cannot write {e.filename or folder}: {e.strerror or e}\n")
         return 1
+    from fswkit.autocode.kit import ROOT
+
     fqbn = app.board.raw["arduino"]["fqbn"]
+    # pasted as it is, it finds the runtime without a sketchbook link (the README's step 1)
+    command = shlex.join(["arduino-cli", "compile", "-b", fqbn, "--library", os.path.join(ROOT, "firmware"), folder])
     sys.stderr.write(f"fsw gen: sketch {name} for the {app.board.name} in {folder} ({len(files)} files); "
-                     f"build it with: arduino-cli compile -b {fqbn} {folder}\n")
+                     f"build it with: {command}\n")
     return 0

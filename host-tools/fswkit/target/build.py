@@ -91,6 +91,11 @@ def check_out_folder(out: str, default: bool = False) -> None:
     before (its `.lock`), so that it never adds its objects to, or
     replaces, files of the user's (a `build.log`, a `.hex` kept there).
     BuildError, before any work, otherwise."""
+    from fswkit.outputs import not_a_folder
+
+    words = not_a_folder(out)  # the folder, or one above it, is a file (or a link to nothing)
+    if words is not None:
+        raise BuildError(f"{words}: name a folder for the build (--out)")
     try:
         names = sorted(os.listdir(out))
     except FileNotFoundError:
@@ -187,7 +192,12 @@ def write_files(files: dict[str, str], out: str) -> list[str]:
     that the generator did not write (its first line) is refused, never
     replaced; a `*.gen.cpp` / `*.gen.h` of the user's is never removed."""
     from fswkit.autocode.diagnostics import InputError, read_head
+    from fswkit.outputs import in_the_way, what_is
 
+    blocked = in_the_way(out)
+    if blocked is not None:  # the system would say `File exists` or `Not a directory`, of `out`
+        raise OSError(errno.ENOTDIR, f"it is {what_is(blocked)}, not a folder: name a folder for the generated "
+                      "files", blocked)
     os.makedirs(out, exist_ok=True)
     written = []
     for name in sorted(files):

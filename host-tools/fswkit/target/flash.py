@@ -11,7 +11,9 @@ import errno
 import json
 import os
 import re
+import shlex
 import shutil
+import signal
 import subprocess
 import sys
 
@@ -27,6 +29,11 @@ SIGNATURES = {
     "1e9703": "ATmega1280",
     "1e9587": "ATmega32U4",
 }
+
+
+# avrdude's line for each try at the bootloader that got no answer: 7.x
+# `avrdude warning: attempt 3 of 10: not in sync`, 6.x `stk500_getsync() attempt 3 of 10`
+ATTEMPT = re.compile(r"\battempt (\d+) of (\d+)\b")
 
 
 class FlashError(Exception):
@@ -114,6 +121,27 @@ def check_board_on_port(board, listing, port: str) -> None:
                      f"a {board.name} after all")
 
 
+# ---- the upload tool's processes --------------------------------------------------------
+
+def end_group(proc: subprocess.Popen) -> None:
+    """Ends an upload tool started in a process group of its own
+    (`process_group=0`) and everything it started (PlatformIO's build, its
+    avrdude): SIGTERM, so that avrdude lets the port go, then SIGKILL to
+    what is left after a few seconds. Used when the command is stopped
+    (Ctrl-C, SIGTERM, SIGHUP), so that no upload goes on, or holds the
+    port, after the command has ended. (In a group of its own, the tool is
+    not sent a terminal's Ctrl-C directly: the command passes it on here.)"""
+    for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, None)):
+        try:
+            os.killpg(proc.pid, sig)
+        except (ProcessLookupError, PermissionError):
+            pass
+        try:
+            proc.wait(timeout=wait)
+        except subprocess.TimeoutExpired:
+            continue
+
+
 # ---- avrdude ---------------------------------------------------------------------------
 
 def explain_avrdude(output: str, board, port: str, code: int) -> str:
@@ -146,18 +174,19 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     if shutil.which("avrdude") is None:
         raise FlashError("`avrdude` is not installed: run `make setup` (Debian package avrdude)")
     cmd = avrdude_command(board, hex_path, port)
-    sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
+    sys.stderr.write(f"fsw flash: {shlex.join(cmd)}\n")
     try:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                errors="replace")
+                                errors="replace", process_group=0)
     except OSError as e:
         raise FlashError(f"cannot run avrdude: {e.strerror or e}") from None
     lines = []
     assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line)
-        if verbose:
-            sys.stderr.write(line)
+    try:
+        _follow(proc, lines, port, verbose)
+    except BaseException:  # Ctrl-C, SIGTERM, SIGHUP: avrdude ends with the command, never holds the port after it
+        end_group(proc)
+        raise
     code = proc.wait()
     output = "".join(lines)
     if code != 0:
@@ -166,6 +195,21 @@ def upload_avrdude(board, hex_path: str, port: str, verbose: bool) -> int:
     size = f"{int(m.group(1)):,} B, verified" if m else "written"
     print(f"fsw flash: {os.path.basename(hex_path)} is on the {board.name} at {port} ({size})")
     return EXIT_OK
+
+
+def _follow(proc, lines: list[str], port: str, verbose: bool) -> None:
+    """avrdude's output as it comes: kept in `lines`, shown with `verbose`,
+    else each try at the bootloader said in a line of ours."""
+    for line in proc.stdout:
+        lines.append(line)
+        if verbose:
+            sys.stderr.write(line)
+        else:  # each try takes avrdude seconds (5 s in 7.1): a minute of silence would look like a hang
+            attempt = ATTEMPT.search(line)
+            if attempt:
+                sys.stderr.write(f"fsw flash: no answer from a bootloader on {port} yet (attempt "
+                                 f"{attempt.group(1)} of {attempt.group(2)}; Ctrl-C stops it)\n")
+                sys.stderr.flush()
 
 
 # ---- PlatformIO ------------------------------------------------------------------------
@@ -231,11 +275,16 @@ def upload_pio(app, port: str) -> int:
     ini_dir = find_pio_project(app.path)
     env = pio_env_for(pio, ini_dir, app)
     cmd = [pio, "run", "-d", ini_dir, "-e", env, "-t", "upload", "--upload-port", port]
-    sys.stderr.write(f"fsw flash: {' '.join(cmd)}\n")
+    sys.stderr.write(f"fsw flash: {shlex.join(cmd)}\n")
     try:
-        code = subprocess.call(cmd)
+        proc = subprocess.Popen(cmd, process_group=0)
     except OSError as e:
         raise FlashError(f"cannot run PlatformIO: {e.strerror or e}") from None
+    try:
+        code = proc.wait()
+    except BaseException:  # PlatformIO's build and its avrdude end with the command too
+        end_group(proc)
+        raise
     if code != 0:
         raise FlashError(f"PlatformIO's upload failed (exit status {code}): its messages are above")
     print(f"fsw flash: {os.path.basename(app.path)} is on the {app.board.name} at {port} (PlatformIO `{env}`)")

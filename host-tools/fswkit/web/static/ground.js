@@ -254,9 +254,13 @@ function showHealth(info) {
   }));
 }
 
+// a command and the target's answer: applied, refused (the target said no, and why), or none came
+// (status null: the station's words say whether it was sent — lost, or applied with its answer lost — or not)
 function addHistory(entry) {
-  const li = el("li", { class: entry.ok ? "ok" : "refused" },
-                `${entry.text} — ${entry.ok ? "applied" : "refused: " + entry.words} (${entry.who})`);
+  const answered = entry.status !== null && entry.status !== undefined;
+  const kind = entry.ok ? "ok" : answered ? "refused" : "lost";
+  const words = entry.ok ? "applied" : answered ? `refused: ${entry.words}` : entry.words;
+  const li = el("li", { class: kind }, `${entry.text} — ${words} (${entry.who})`);
   $("history").prepend(li);
 }
 

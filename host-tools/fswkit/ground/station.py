@@ -188,6 +188,8 @@ class Station:
             return
         try:
             getattr(archive, what)(*args, **kw)
+            while archive.notices:  # what it did of itself (its file deleted and written again)
+                self._say(archive.notices.pop(0))
         except ArchiveError as e:
             if self.archive is not archive:  # another thread said it
                 return

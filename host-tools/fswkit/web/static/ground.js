@@ -7,6 +7,7 @@ const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"
 const STATE_COLORS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#9c755f",
                       "#bab0ac", "#ff9da7"];
 const MAX_POINTS = 200000;
+const TIMELINE_KEPT = 500;    // each machine's latest state changes kept in its timeline (band and list)
 
 let layout = null;
 let perSecond = 1000;
@@ -170,9 +171,11 @@ function noteState(elem, id, ts) {
   } else {
     s.list.push(`${ts.toFixed(2)} s  ${stateName(elem, id)}`);
   }
+  // the latest changes only: a machine that changes often over a long session is not drawn whole at each tick
+  if (s.segments.length > TIMELINE_KEPT) s.segments.splice(0, s.segments.length - TIMELINE_KEPT);
+  if (s.list.length > TIMELINE_KEPT) s.list.splice(0, s.list.length - TIMELINE_KEPT);
   s.current = id;
-  s.since = ts;
-  drawTimeline(elem);
+  s.since = ts;  // drawn at the link's next tick (twice a second), not at every change
 }
 
 function buildTimeline() {

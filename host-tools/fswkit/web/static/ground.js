@@ -23,6 +23,7 @@ const states = {};           // S element -> {current, since, segments: [[t0, t1
 window.fswLatency = [];
 window.fswSeqs = [];
 let lastTime = null;
+let lastSeq = null;           // the last sample frame's number
 
 function $(id) { return document.getElementById(id); }
 function el(tag, attrs, text) {
@@ -137,6 +138,9 @@ function addSamples(msg) {
   }
   const idx = {};
   msg.names.forEach((n, i) => { idx[n] = i + 1; });
+  // the frame counter went back (the station numbers frames by the target's counter): the target restarted
+  if (lastSeq !== null && msg.seq < lastSeq && msg.rows.length) restarted(msg.rows[0][0] / perSecond);
+  lastSeq = msg.seq;
   for (const row of msg.rows) {
     const ts = row[0] / perSecond;
     lastTime = ts;
@@ -160,6 +164,20 @@ function addSamples(msg) {
                                                              : fmt(values[n]);
   }
   dirty = true;
+}
+
+// the target restarted (a reset, a reflash; the station's note says why). The plot
+// and the state bands start again on its new time, the transitions list says so: the old samples are not
+// drawn over the new ones (the archive keeps them all)
+function restarted(ts) {
+  for (const k of Object.keys(series)) series[k].length = 0;
+  for (const elem of layout.state_elements) {
+    const s = states[elem];
+    s.segments = [];
+    if (s.current !== null) s.list.push(`${ts.toFixed(2)} s  (the target restarted)`);
+    s.current = null;
+    s.since = null;
+  }
 }
 
 function noteState(elem, id, ts) {

@@ -55,7 +55,10 @@ card or a USB stick, long enough to overrun the port's buffer; NORMAL syncs
 the WAL at checkpoints only, so a power cut (not a killed process) may lose
 the commits since the last checkpoint, the database still whole. A new
 archive is made complete in a temporary file beside its path and takes the
-name only then: no reader ever sees half an archive.
+name only then: no reader ever sees half an archive. A file deleted while
+it is written (SQLite would write on into the deleted file) is written
+again at its name at the next commit, with all the connection held
+(`_kept`), and said in `notices`.
 """
 
 from __future__ import annotations
@@ -161,6 +164,15 @@ def _check_version(con: sqlite3.Connection, path) -> None:
                            f"reads version {SCHEMA_VERSION}")
 
 
+def _ident(path) -> tuple[int, int] | None:
+    """The file at `path` (its device and inode), or None when there is none."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
 class Archive:
     """The writer: sessions appended to an archive (a new file, or an
     archive that exists). Thread-safe: every call takes one lock. Chunks
@@ -201,6 +213,8 @@ class Archive:
             con.close()
             raise
         self._con = con
+        self._ident = _ident(self.path)  # the file written: one deleted under it is written again (_kept)
+        self.notices: list[str] = []  # what the archive did of itself that the station must say (taken by it)
 
     def _create(self) -> None:
         """A new archive, made whole in a temporary file beside the path and
@@ -401,6 +415,58 @@ class Archive:
         if self._last_tick is None or now - self._last_tick >= COMMIT_EVERY or now < self._last_tick:
             self._commit()
             self._last_tick = now
+            self._kept()
+
+    def _kept(self) -> None:
+        """After a commit: the file deleted meanwhile (an `rm`, a cleanup
+        script) is written again at its path, with all the open connection
+        still holds (SQLite writes on into a deleted file, which vanishes
+        with everything when it is closed), and recording goes on there.
+        Said in `notices`."""
+        now = _ident(self.path)
+        if now == self._ident or self._ident is None:
+            return
+        if now is not None:  # another file took the name: it is left as it is
+            self.notices.append(f"the archive {self.path} was replaced by another file while recording: "
+                                "recording goes on in the file it was (no longer under that name)")
+            self._ident = None  # said once
+            return
+        folder = os.path.dirname(os.path.abspath(self.path))
+        tmp = None
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(self.path)}.", suffix=".part", dir=folder)
+            os.close(fd)
+            dest = sqlite3.connect(tmp, isolation_level=None)
+            try:
+                self._con.backup(dest)
+                dest.execute("PRAGMA journal_mode = WAL")
+            finally:
+                dest.close()
+        except (OSError, sqlite3.Error) as e:
+            if tmp is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            raise ArchiveError(f"the archive {self.path} was deleted while recording and cannot be written "
+                               f"again: {getattr(e, 'strerror', None) or e}") from None
+        # the deleted file's connection closed first: its WAL and index (still under the path's
+        # names, unless they went too) are folded into it and removed, not taken for the new file's
+        old, self._con = self._con, None
+        with contextlib.suppress(sqlite3.Error):
+            old.close()
+        try:
+            os.link(tmp, self.path)  # fails when the name was taken meanwhile: that file is kept
+            os.unlink(tmp)
+            con = sqlite3.connect(self.path, timeout=5.0, isolation_level=None, check_same_thread=False)
+            con.execute("PRAGMA journal_mode = WAL")
+            con.execute("PRAGMA synchronous = NORMAL")
+        except (OSError, sqlite3.Error) as e:
+            kept = tmp if os.path.exists(tmp) else self.path
+            raise ArchiveError(f"the archive {self.path} was deleted while recording; all it held is in {kept}, "
+                               f"but recording cannot go on: {getattr(e, 'strerror', None) or e}") from None
+        self._con = con
+        self._ident = _ident(self.path)
+        self.notices.append(f"the archive {self.path} was deleted while recording: written again there with "
+                            "all it held; recording goes on in it")
 
     def close(self) -> None:
         """Commits, marks the session ended, closes the file (again: nothing)."""

@@ -44,7 +44,7 @@ from fswkit.link import wire
 from fswkit.link.client import LinkTimeout, Numbers, exchange
 from fswkit.link.layout import Layout
 from fswkit.link.port import PortError, open_port, port_errors, port_key, runtime_dir
-from fswkit.link.session import Event, Session, reset_words
+from fswkit.link.session import Event, Session, max_frame, reset_words
 
 from .archive import ArchiveError
 
@@ -102,6 +102,9 @@ class Station:
         self._threads: list[threading.Thread] = []
         self._server: socket.socket | None = None
         self._carry = b""  # bytes after the last delimiter, sent to clients with the next chunk
+        # ... at most a run longer than any frame: a port that brings no delimiter (a board printing
+        # text, a baud rate not the board's) is not held for the clients byte by byte
+        self._carry_max = max_frame(layout) + 1
         self._restarts = 0
 
     # ---- life ------------------------------------------------------------------------
@@ -185,6 +188,8 @@ class Station:
             return
         try:
             getattr(archive, what)(*args, **kw)
+            while archive.notices:  # what it did of itself (its file deleted and written again)
+                self._say(archive.notices.pop(0))
         except ArchiveError as e:
             if self.archive is not archive:  # another thread said it
                 return
@@ -316,7 +321,7 @@ class Station:
         # numbering as of then) is never ahead of the first chunk it gets
         buf = self._carry + data
         cut = buf.rfind(b"\0") + 1
-        self._carry = buf[cut:]
+        self._carry = buf[cut:] if len(buf) - cut <= self._carry_max else buf[-self._carry_max:]
         with self._clients_lock:
             evs = self.session.feed(data, host)
             if cut and self._clients:  # encoded once for every client, and not at all for none
@@ -363,32 +368,45 @@ class Station:
                 text: str = "") -> dict:
         """One command, acknowledged: the ack's fields (status 0: applied).
         A REPLAY answer resynchronises the numbers and sends it again.
-        LinkTimeout when none came. Either way it is archived and told to
-        the command listeners, with who sent it and what it is (`text`,
-        else the opcode's name and the arguments in hex)."""
+        LinkTimeout when none came (lost, or applied and its acknowledgement
+        lost: the words say so); OSError when it could not be written, its
+        words `not sent: ...` when nothing of it went on the wire. Either way
+        it is archived and told to the command listeners with those words,
+        who sent it and what it is (`text`, else the opcode's name and the
+        arguments in hex)."""
         sent = time.time()
         ack = None
+        written = []  # the frames of it that went on the wire
+        words = "no acknowledgement"
         try:
             with self._uplink:
-                ack = self._exchange(op, args, tries, timeout)
+                ack = self._exchange(op, args, tries, timeout, written)
+            words = ack["reason"]
             return ack
+        except LinkTimeout as e:
+            words = f"{e}: lost, or applied and its acknowledgement lost"
+            raise LinkTimeout(words) from None
+        except OSError as e:
+            words = (f"sent, then no acknowledgement: {e} (lost, or applied and its acknowledgement lost)"
+                     if written else f"not sent: {e}")
+            raise OSError(words) from None
         finally:
             text = text or f"{wire.OP_NAMES.get(op, f'op_{op}')} {args.hex()}".strip()
             entry = {"t": "command", "who": who, "text": text, "status": None if ack is None else ack["status"],
-                     "ok": ack is not None and ack["status"] == 0,
-                     "words": "no acknowledgement" if ack is None else ack["reason"], "host_time": time.time()}
+                     "ok": ack is not None and ack["status"] == 0, "words": words, "host_time": time.time()}
             self._archive("command", who=who, text=text, op=op, args=args, sent=sent,
                           cmd_seq=None if ack is None else ack["cmd_seq"], status=entry["status"],
-                          words=entry["words"], acked=None if ack is None else entry["host_time"])
+                          words=words, acked=None if ack is None else entry["host_time"])
             for fn in list(self._command_listeners):
                 fn(entry)
 
-    def _exchange(self, op: int, args: bytes, tries: int, timeout: float) -> dict:
+    def _exchange(self, op: int, args: bytes, tries: int, timeout: float, written: list) -> dict:
         def send_and_wait(seq: int, frame: bytes) -> dict | None:
             slot = {"event": threading.Event(), "ack": None}
             self._waiting[seq] = slot  # before it goes: the reader thread fills it
             try:
                 self.write(frame)
+                written.append(seq)
                 slot["event"].wait(timeout)
             finally:
                 del self._waiting[seq]

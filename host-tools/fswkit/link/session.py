@@ -45,6 +45,8 @@ class LinkStats:
     samples: int = 0
 
 
+ACKS_KEPT = 1024  # acknowledgements a session keeps (its latest): a long session's are not all held
+
 RESET_CAUSES = ((0x01, "power-on"), (0x02, "external reset"), (0x04, "brown-out"), (0x08, "watchdog"))
 
 
@@ -97,7 +99,7 @@ class Session:
         self.values: dict[str, object] = {e.name: None for e in layout.elements}
         self.hello: dict | None = None
         self.health: dict | None = None
-        self.acks: list[dict] = []
+        self.acks: deque = deque(maxlen=ACKS_KEPT)  # the latest acknowledgements' fields, oldest first
         self.last_seq: int | None = None
         # whether last_seq is the target's whole frame counter (from a hello or
         # health frame), or only extended from the first frame's 8 bits

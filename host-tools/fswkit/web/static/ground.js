@@ -7,6 +7,7 @@ const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"
 const STATE_COLORS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#9c755f",
                       "#bab0ac", "#ff9da7"];
 const MAX_POINTS = 200000;
+const TIMELINE_KEPT = 500;    // each machine's latest state changes kept in its timeline (band and list)
 
 let layout = null;
 let perSecond = 1000;
@@ -22,6 +23,7 @@ const states = {};           // S element -> {current, since, segments: [[t0, t1
 window.fswLatency = [];
 window.fswSeqs = [];
 let lastTime = null;
+let lastSeq = null;           // the last sample frame's number
 
 function $(id) { return document.getElementById(id); }
 function el(tag, attrs, text) {
@@ -136,6 +138,9 @@ function addSamples(msg) {
   }
   const idx = {};
   msg.names.forEach((n, i) => { idx[n] = i + 1; });
+  // the frame counter went back (the station numbers frames by the target's counter): the target restarted
+  if (lastSeq !== null && msg.seq < lastSeq && msg.rows.length) restarted(msg.rows[0][0] / perSecond);
+  lastSeq = msg.seq;
   for (const row of msg.rows) {
     const ts = row[0] / perSecond;
     lastTime = ts;
@@ -161,6 +166,20 @@ function addSamples(msg) {
   dirty = true;
 }
 
+// the target restarted (a reset, a reflash; the station's note says why). The plot
+// and the state bands start again on its new time, the transitions list says so: the old samples are not
+// drawn over the new ones (the archive keeps them all)
+function restarted(ts) {
+  for (const k of Object.keys(series)) series[k].length = 0;
+  for (const elem of layout.state_elements) {
+    const s = states[elem];
+    s.segments = [];
+    if (s.current !== null) s.list.push(`${ts.toFixed(2)} s  (the target restarted)`);
+    s.current = null;
+    s.since = null;
+  }
+}
+
 function noteState(elem, id, ts) {
   const s = states[elem];
   if (s.current === id) return;
@@ -170,9 +189,11 @@ function noteState(elem, id, ts) {
   } else {
     s.list.push(`${ts.toFixed(2)} s  ${stateName(elem, id)}`);
   }
+  // the latest changes only: a machine that changes often over a long session is not drawn whole at each tick
+  if (s.segments.length > TIMELINE_KEPT) s.segments.splice(0, s.segments.length - TIMELINE_KEPT);
+  if (s.list.length > TIMELINE_KEPT) s.list.splice(0, s.list.length - TIMELINE_KEPT);
   s.current = id;
-  s.since = ts;
-  drawTimeline(elem);
+  s.since = ts;  // drawn at the link's next tick (twice a second), not at every change
 }
 
 function buildTimeline() {
@@ -254,9 +275,13 @@ function showHealth(info) {
   }));
 }
 
+// a command and the target's answer: applied, refused (the target said no, and why), or none came
+// (status null: the station's words say whether it was sent — lost, or applied with its answer lost — or not)
 function addHistory(entry) {
-  const li = el("li", { class: entry.ok ? "ok" : "refused" },
-                `${entry.text} — ${entry.ok ? "applied" : "refused: " + entry.words} (${entry.who})`);
+  const answered = entry.status !== null && entry.status !== undefined;
+  const kind = entry.ok ? "ok" : answered ? "refused" : "lost";
+  const words = entry.ok ? "applied" : answered ? `refused: ${entry.words}` : entry.words;
+  const li = el("li", { class: kind }, `${entry.text} — ${words} (${entry.who})`);
   $("history").prepend(li);
 }
 

@@ -13,10 +13,9 @@ not as refused."""
 from __future__ import annotations
 
 import sqlite3
-import threading
 
 import pytest
-from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyStream, PtyTarget, health, hello, layout_of
 
 from fswkit.ground.archive import Archive
@@ -84,7 +83,6 @@ class DeafTarget(PtyTarget):
 
 @needs_chromium
 def test_the_page_lists_an_unanswered_command_as_unanswered_not_refused(browser, tmp_path, monkeypatch):
-    import uvicorn
     from selenium.webdriver.common.by import By
 
     from fswkit.web.app import create_app
@@ -95,39 +93,32 @@ def test_the_page_lists_an_unanswered_command_as_unanswered_not_refused(browser,
     target = DeafTarget(layout)
     st = Station(layout, "tank", target.port, 115200, serve=False)
     st.start()
-    http = free_port()
-    server = uvicorn.Server(uvicorn.Config(create_app(LiveSource(st)), host="127.0.0.1", port=http,
-                                           log_level="warning", ws="websockets-sansio"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
     try:
-        wait_for(lambda: server.started, "the page's server")
-        browser.get(f"http://127.0.0.1:{http}/")
-        text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+        with served(create_app(LiveSource(st))) as url:
+            browser.get(url)
+            text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
 
-        def send(value: str):
-            box = browser.find_element(By.ID, "cmd-valveOpen")
-            box.clear()
-            box.send_keys(value)
-            browser.find_element(By.ID, "send-valveOpen").click()
-            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-            browser.find_element(By.ID, "confirm-yes").click()
-            return wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
-                                     if f"set valveOpen = {value}" in li.text], "the command in the history",
-                            timeout=15)[0]
+            def send(value: str):
+                box = browser.find_element(By.ID, "cmd-valveOpen")
+                box.clear()
+                box.send_keys(value)
+                browser.find_element(By.ID, "send-valveOpen").click()
+                wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+                browser.find_element(By.ID, "confirm-yes").click()
+                return wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
+                                         if f"set valveOpen = {value}" in li.text], "the command in the history",
+                                timeout=15)[0]
 
-        wait_for(lambda: text("link-status") == "live", "the link to show live")
-        item = send("true")
-        assert "refused" not in item.text, item.text
-        assert "after 3 tries: lost, or applied and its acknowledgement lost" in item.text
-        assert item.get_attribute("class") == "lost"
-        target.close()
-        wait_for(lambda: not st.up, "the station to see the port gone")
-        item = send("false")
-        assert "refused" not in item.text, item.text
-        assert NOT_SENT in item.text, item.text
-        assert item.get_attribute("class") == "lost"
+            wait_for(lambda: text("link-status") == "live", "the link to show live")
+            item = send("true")
+            assert "refused" not in item.text, item.text
+            assert "after 3 tries: lost, or applied and its acknowledgement lost" in item.text
+            assert item.get_attribute("class") == "lost"
+            target.close()
+            wait_for(lambda: not st.up, "the station to see the port gone")
+            item = send("false")
+            assert "refused" not in item.text, item.text
+            assert NOT_SENT in item.text, item.text
+            assert item.get_attribute("class") == "lost"
     finally:
-        server.should_exit = True
-        thread.join(5)
         st.stop()

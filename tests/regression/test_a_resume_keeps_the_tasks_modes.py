@@ -20,7 +20,7 @@ import shutil
 
 import pytest
 
-from support.gate import gate_app, gate_firmware
+from support.gate import GATE_DIO, GATE_SM, GateBoard, gate_app, gate_firmware
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -34,34 +34,9 @@ bool charge
 U8  senseMode
 """
 
-SM = """[state_vector]
-U64 time         @alias G
-U32 state        @alias S
-bool armSwitch   @read_only
-bool go          @read_only
-bool charge
+SM = GATE_SM
 
-[Safe]
-.step
-    armSwitch: -> Armed
-[Armed]
-.step
-    go: -> Fire
-[Fire]
-.entry
-    charge = true
-.step
-    T >= 1000: -> Done
-.exit
-    charge = false
-[Done]
-"""
-
-DIO = """# dir  pin  element
-i      2    armSwitch
-i      3    go
-o      5    charge
-"""
+DIO = GATE_DIO
 
 APP = gate_app(telemetry_rate=10, sections="""[pyro]
 charge   arm=armSwitch  pulse=0.5  machine=gate  armed=Armed  fire=Fire
@@ -80,34 +55,11 @@ def project(tmp_path_factory):
 
 @pytest.mark.parametrize("cause", ["brownout", "watchdog"])
 def test_the_grounds_modes_go_on_after_a_resume(project, cause):
-    from fswkit.link import wire
-    from fswkit.link.client import Numbers, exchange
-    from fswkit.link.layout import from_app
-    from fswkit.link.session import Session
-    from fswkit.param.client import SimTransport
-    from fswkit.sim.board import SimBoard
-
-    app, elf = project
-    b = SimBoard(elf, "uno", uart="control", sim_limit=60)
+    g = GateBoard(*project)
+    b, t, session = g.b, g.t, g.session
     try:
-        session = Session(from_app(app))
-        t = SimTransport(b, session)
-        t.events(0.3)
-        assert session.hello is not None
-
-        def send_and_wait(seq, frame):
-            t.send(frame)
-            end = b.time + 0.3
-            while b.time < end:
-                for ev in t.events(0.01):
-                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq:
-                        return ev.info
-            return None
-
-        numbers = Numbers(session)
-
         def safe(task):
-            ack = exchange(numbers, wire.OP_MODE, bytes([task, SAFED]), 3, send_and_wait)
+            ack = g.mode(task, SAFED)
             assert ack is not None and ack["status"] == 0, ack
 
         safe(FLY)
@@ -131,4 +83,4 @@ def test_the_grounds_modes_go_on_after_a_resume(project, cause):
         assert modes["fly"] == "safed" and modes["sense"] == "safed", modes
         assert not fired, "the safed machine fired after the reset"
     finally:
-        b.close()
+        g.close()

@@ -27,7 +27,7 @@ import shutil
 
 import pytest
 
-from support.gate import gate_app, gate_firmware
+from support.gate import GATE_DIO, gate_app, gate_firmware
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -74,11 +74,7 @@ U32 n = 0
 [Done]
 """
 
-DIO = """# dir  pin  element
-i      2    armSwitch
-i      3    go
-o      5    charge
-"""
+DIO = GATE_DIO
 
 APP = gate_app(extra="reset_cause cause\n", telemetry_rate=50, sections="""[reload]
 machine  gate

@@ -19,7 +19,7 @@ import shutil
 
 import pytest
 
-from support.gate import gate_app, gate_firmware
+from support.gate import GATE_DIO, GATE_SM, GateBoard, gate_app, gate_firmware
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -32,34 +32,9 @@ bool go
 bool charge
 """
 
-SM = """[state_vector]
-U64 time         @alias G
-U32 state        @alias S
-bool armSwitch   @read_only
-bool go          @read_only
-bool charge
+SM = GATE_SM
 
-[Safe]
-.step
-    armSwitch: -> Armed
-[Armed]
-.step
-    go: -> Fire
-[Fire]
-.entry
-    charge = true
-.step
-    T >= 1000: -> Done
-.exit
-    charge = false
-[Done]
-"""
-
-DIO = """# dir  pin  element
-i      2    armSwitch
-i      3    go
-o      5    charge
-"""
+DIO = GATE_DIO
 
 APP = gate_app(sections="""[pyro]
 charge   arm=armSwitch  pulse=0.5  machine=gate  armed=Armed  fire=Fire
@@ -78,20 +53,9 @@ def project(tmp_path_factory):
 
 @pytest.mark.parametrize("mode", [0, 1])  # disabled, safed
 def test_a_mode_command_in_a_pulse_is_locked_and_the_pulse_ends(project, mode):
-    from fswkit.link import wire
-    from fswkit.link.client import Numbers, exchange
-    from fswkit.link.layout import from_app
-    from fswkit.link.session import Session
-    from fswkit.param.client import SimTransport
-    from fswkit.sim.board import SimBoard
-
-    app, elf = project
-    b = SimBoard(elf, "uno", uart="control", sim_limit=60)
+    g = GateBoard(*project)
+    b, t = g.b, g.t
     try:
-        session = Session(from_app(app))
-        t = SimTransport(b, session)
-        t.events(0.3)
-        assert session.hello is not None
         b.set_digital(KEY, True)
         t.events(0.1)
         b.set_digital(GO, True)
@@ -100,19 +64,9 @@ def test_a_mode_command_in_a_pulse_is_locked_and_the_pulse_ends(project, mode):
         rise = b.time
         assert b.digital(CHARGE)
         t.events(0.1)
-
-        def send_and_wait(seq, frame):
-            t.send(frame)
-            end = b.time + 0.3
-            while b.time < end:
-                for ev in t.events(0.01):
-                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq:
-                        return ev.info
-            return None
-
-        ack = exchange(Numbers(session), wire.OP_MODE, bytes([ACT, mode]), 3, send_and_wait)
+        ack = g.mode(ACT, mode)
         assert ack["status"] == LOCKED, ack
         t.events(rise + 0.55 - b.time)
         assert not b.digital(CHARGE), "the pin is still high past the pulse"
     finally:
-        b.close()
+        g.close()

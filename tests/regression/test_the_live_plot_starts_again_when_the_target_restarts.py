@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import threading
 
-from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyTarget, layout_of, stream
 
 from fswkit.ground.station import Station
@@ -47,7 +47,6 @@ class Resetting(PtyTarget):
 
 
 def test_the_plot_starts_again_with_the_targets_time(browser, tmp_path, monkeypatch):
-    import uvicorn
 
     from fswkit.web.app import create_app
     from fswkit.web.source import LiveSource
@@ -57,24 +56,17 @@ def test_the_plot_starts_again_with_the_targets_time(browser, tmp_path, monkeypa
     target = Resetting(layout)
     st = Station(layout, "tank", target.port, 115200, serve=False)
     st.start()
-    http = free_port()
-    server = uvicorn.Server(uvicorn.Config(create_app(LiveSource(st)), host="127.0.0.1", port=http,
-                                           log_level="warning", ws="websockets-sansio"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
     try:
-        wait_for(lambda: server.started, "the page's server")
-        browser.get(f"http://127.0.0.1:{http}/")
-        wait_for(lambda: browser.execute_script("return series.t.length && series.t[series.t.length - 1] >= 50"),
-                 "the page to plot the target's time before its reset", timeout=15)
-        target.reset.set()
-        wait_for(lambda: browser.execute_script("return series.t.length && series.t[series.t.length - 1] < 40"),
-                 "the page to plot the time after the reset", timeout=15)
-        t = browser.execute_script("return series.t")
-        assert all(a <= b for a, b in zip(t, t[1:])), "the plot's time went back"
-        assert t[0] < 40
+        with served(create_app(LiveSource(st))) as url:
+            browser.get(url)
+            wait_for(lambda: browser.execute_script("return series.t.length && series.t[series.t.length - 1] >= 50"),
+                     "the page to plot the target's time before its reset", timeout=15)
+            target.reset.set()
+            wait_for(lambda: browser.execute_script("return series.t.length && series.t[series.t.length - 1] < 40"),
+                     "the page to plot the time after the reset", timeout=15)
+            t = browser.execute_script("return series.t")
+            assert all(a <= b for a, b in zip(t, t[1:])), "the plot's time went back"
+            assert t[0] < 40
     finally:
-        server.should_exit = True
-        thread.join(5)
         st.stop()
         target.close()

@@ -7,9 +7,8 @@ TIMELINE_KEPT changes (the band and the list), and the page keeps up."""
 
 from __future__ import annotations
 
-import threading
 
-from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyTarget, layout_of, stream
 
 from fswkit.ground.station import Station
@@ -44,7 +43,6 @@ class Flapping(PtyTarget):
 
 
 def test_a_machine_that_changes_state_often_keeps_the_page_answering(browser, tmp_path, monkeypatch):
-    import uvicorn
     from selenium.webdriver.common.by import By
 
     from fswkit.web.app import create_app
@@ -55,25 +53,18 @@ def test_a_machine_that_changes_state_often_keeps_the_page_answering(browser, tm
     target = Flapping(layout)
     st = Station(layout, "tank", target.port, 115200, serve=False)
     st.start()
-    http = free_port()
-    server = uvicorn.Server(uvicorn.Config(create_app(LiveSource(st)), host="127.0.0.1", port=http,
-                                           log_level="warning", ws="websockets-sansio"))
-    thread = threading.Thread(target=server.run, daemon=True)
-    thread.start()
     try:
-        wait_for(lambda: server.started, "the page's server")
-        browser.set_script_timeout(10)
-        browser.get(f"http://127.0.0.1:{http}/")
-        count = "return document.querySelectorAll('#transitions-state li').length"
-        wait_for(lambda: browser.execute_script(count) >= KEPT, f"{KEPT} state changes listed", timeout=40)
-        seen = browser.execute_script("return window.fswSeqs.length")
-        wait_for(lambda: browser.execute_script("return window.fswSeqs.length") > seen + 500,
-                 "the page to go on taking frames", timeout=15)
-        assert browser.execute_script(count) <= KEPT
-        assert browser.execute_script("return document.querySelectorAll('#band-state .seg').length") <= KEPT + 1
-        assert browser.find_element(By.ID, "link-status").text == "live"
+        with served(create_app(LiveSource(st))) as url:
+            browser.set_script_timeout(10)
+            browser.get(url)
+            count = "return document.querySelectorAll('#transitions-state li').length"
+            wait_for(lambda: browser.execute_script(count) >= KEPT, f"{KEPT} state changes listed", timeout=40)
+            seen = browser.execute_script("return window.fswSeqs.length")
+            wait_for(lambda: browser.execute_script("return window.fswSeqs.length") > seen + 500,
+                     "the page to go on taking frames", timeout=15)
+            assert browser.execute_script(count) <= KEPT
+            assert browser.execute_script("return document.querySelectorAll('#band-state .seg').length") <= KEPT + 1
+            assert browser.find_element(By.ID, "link-status").text == "live"
     finally:
-        server.should_exit = True
-        thread.join(5)
         st.stop()
         target.close()

@@ -1,10 +1,42 @@
 """A small pyro project on the simulated Uno for the regression tests of the
 gate and the resume (the machine `gate` fires `charge` on pin 5 after the
-key on pin 2 and `go` on pin 3): its .app, and its firmware built."""
+key on pin 2 and `go` on pin 3): its machine and table, its .app, and
+its firmware built."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+# The machine: Safe -> Armed on the key, Armed -> Fire on `go`; Fire sets
+# the charge for a second, then Done.
+GATE_SM = """[state_vector]
+U64 time         @alias G
+U32 state        @alias S
+bool armSwitch   @read_only
+bool go          @read_only
+bool charge
+
+[Safe]
+.step
+    armSwitch: -> Armed
+[Armed]
+.step
+    go: -> Fire
+[Fire]
+.entry
+    charge = true
+.step
+    T >= 1000: -> Done
+.exit
+    charge = false
+[Done]
+"""
+
+GATE_DIO = """# dir  pin  element
+i      2    armSwitch
+i      3    go
+o      5    charge
+"""
 
 
 def gate_app(*, extra: str = "", telemetry_rate: int = 10, sections: str = "") -> str:
@@ -52,3 +84,41 @@ def gate_firmware(folder: Path, files: dict[str, str]):
     built = firmware(app, str(folder / "build"))
     assert built.fits, built.report
     return app, built.artifact
+
+
+class GateBoard:
+    """The firmware on the simulated Uno with a link session: `b` the
+    board, `session`, `t` the transport (0.3 s run, the hello seen);
+    `mode(task, mode)` the ground's MODE command, its acknowledgement."""
+
+    def __init__(self, app, elf, sim_limit: float = 60):
+        from fswkit.link.client import Numbers
+        from fswkit.link.layout import from_app
+        from fswkit.link.session import Session
+        from fswkit.param.client import SimTransport
+        from fswkit.sim.board import SimBoard
+
+        self.b = SimBoard(elf, "uno", uart="control", sim_limit=sim_limit)
+        self.session = Session(from_app(app))
+        self.t = SimTransport(self.b, self.session)
+        self.numbers = Numbers(self.session)
+        self.t.events(0.3)
+        assert self.session.hello is not None
+
+    def _send_and_wait(self, seq, frame):
+        self.t.send(frame)
+        end = self.b.time + 0.3
+        while self.b.time < end:
+            for ev in self.t.events(0.01):
+                if ev.kind == "ack" and ev.info["cmd_seq"] == seq:
+                    return ev.info
+        return None
+
+    def mode(self, task: int, mode: int):
+        from fswkit.link import wire
+        from fswkit.link.client import exchange
+
+        return exchange(self.numbers, wire.OP_MODE, bytes([task, mode]), 3, self._send_and_wait)
+
+    def close(self) -> None:
+        self.b.close()

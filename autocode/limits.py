@@ -117,6 +117,15 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
             at(tele.line, 1, f"the telemetry streams need about {round(load):,} B/s but the link carries "
                              f"{round(capacity):,} B/s at {app.baud} baud: lower the stream rates or raise `baud`")
 
+    if app.pyro:  # the flight kept across a reset, in spans the runtime counts in a byte
+        from .emit.resume import MAX_RESUME_SPANS, resume_spans
+
+        n = len(resume_spans(app))
+        if n > MAX_RESUME_SPANS:
+            at(app.pyro[0].line, 1, f"keeping the flight across a reset (docs/safety.md) takes {n} parts of RAM here: "
+                                    f"at most {MAX_RESUME_SPANS} (the state vector, the pyro gates, each machine's "
+                                    "state, locals and windows, and the mode of each task without a `mode=` element): "
+                                    "give the tasks `mode=` elements, or run fewer tasks or machines")
     b = app.board
     if b.is_avr and b.ram:
         size = max(app.sv.size, 1)

@@ -18,6 +18,7 @@ from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check, window_type
 from .expr import float_key_test
 from .machine import emit_machine, stored_locals
+from .resume import resume_spans
 from .sv import emit_sv
 
 # each element type's fsw::ElemType enumerator (firmware/src/fsw_types.h;
@@ -162,31 +163,9 @@ def resumes(app: Application) -> bool:
 
 
 def _resume(app: Application) -> list[str]:
-    """What a resume keeps (docs/safety.md, "A reset in flight"): the state
-    vector, each machine's bookkeeping, stored locals and windows, the pyro
-    gates, the modes of the tasks without a mode element (theirs are in the
-    state vector) and the recorder's flight; the two banks in RAM the C
-    runtime leaves alone."""
-    real = real_of(app)
-    spans = [("sv", "kSvSize", "the state vector")]
-    for m in app.machines:
-        ns = c_ident(m.name)
-        spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::machine)", "fsw::kMachineKept",
-                      f"{m.name}: its state, entry time and last G"))
-        if stored_locals(m, real):
-            spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
-        if m.windows:  # a window not full uses the samples so far: emptied, a launch detector's 5 would be 1
-            spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::win)", f"sizeof {ns}::win",
-                          f"{m.name}: its rolling windows"))
-    spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
-    for i, t in enumerate(app.tasks):  # the ground's modes (a task with a mode element: in the state vector)
-        if t.mode is None:
-            spans.append((f"&stats[{i}].mode", "1", f"task {t.name}'s mode"))
-    if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
-        spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
-        spans.append(("reload_ram", "sizeof reload_ram", "an uploaded machine's windows and locals"))
-    if app.log is not None:
-        spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
+    """The spans a resume keeps (resume_spans) in the two banks in RAM the
+    C runtime leaves alone, and their configuration."""
+    spans = resume_spans(app)
     c = ["// ---- resuming the flight after a reset (docs/safety.md) ----",
          f"const fsw::ResumeSpan kResumeSpans[{len(spans)}] FSW_FLASH = {{"]
     for p, n, what in spans:

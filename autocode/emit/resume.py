@@ -1,0 +1,43 @@
+"""What a flight with pyro channels keeps across a brown-out or a watchdog
+reset (docs/safety.md, "A reset in flight"): the spans of RAM the flight's
+save copies into its banks, as app.py writes them into the resume's table
+and limits.py counts them at `fsw check`. No import of the application's
+model here: limits.py, which the application's check runs, imports it."""
+
+from __future__ import annotations
+
+from ..numeric import REALS
+from .common import c_ident
+from .machine import stored_locals
+
+MAX_RESUME_SPANS = 255  # ResumeConfig::n_spans, a byte (the save's loop counts it in one register)
+
+
+def resume_spans(app) -> list[tuple[str, str, str]]:
+    """What a resume keeps (docs/safety.md, "A reset in flight"), as spans
+    of RAM (address, size, what: C++ expressions): the state vector, each
+    machine's bookkeeping, stored locals and windows, the pyro gates, the
+    modes of the tasks without a mode element (theirs are in the state
+    vector), an uploaded machine's and the recorder's. At most
+    MAX_RESUME_SPANS (limits.check_limits says so at `fsw check`)."""
+    real = REALS[app.board.real]
+    spans = [("sv", "kSvSize", "the state vector")]
+    for m in app.machines:
+        ns = c_ident(m.name)
+        spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::machine)", "fsw::kMachineKept",
+                      f"{m.name}: its state, entry time and last G"))
+        if stored_locals(m, real):
+            spans.append((f"{ns}::loc", f"{ns}::kLocSize", f"{m.name}: its locals"))
+        if m.windows:  # a window not full uses the samples so far: emptied, a launch detector's 5 would be 1
+            spans.append((f"reinterpret_cast<uint8_t*>(&{ns}::win)", f"sizeof {ns}::win",
+                          f"{m.name}: its rolling windows"))
+    spans.append(("reinterpret_cast<uint8_t*>(Pyro)", "sizeof Pyro", "the pyro gates: what has fired"))
+    for i, t in enumerate(app.tasks):  # the ground's modes (a task with a mode element: in the state vector)
+        if t.mode is None:
+            spans.append((f"&stats[{i}].mode", "1", f"task {t.name}'s mode"))
+    if app.reload is not None:  # an uploaded machine goes on where it was, not from its first state
+        spans.append(("&reload.active", "1", "which machine runs: the generated one, or an uploaded slot"))
+        spans.append(("reload_ram", "sizeof reload_ram", "an uploaded machine's windows and locals"))
+    if app.log is not None:
+        spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
+    return spans

@@ -64,3 +64,38 @@ def test_a_terminals_set_and_save_show_in_the_page(exe, browser, tmp_path):
                 assert text("param-err") == ""
         finally:
             ground.stop()
+
+
+def test_a_value_being_typed_survives_a_read_again(exe, browser, tmp_path):
+    """Reading the parameters again made the table's rows again, their
+    inputs empty: a value being typed when another client's change arrived
+    was gone. The rows of the same table are kept, only their values
+    written again."""
+    from selenium.webdriver.common.by import By
+
+    from fswkit.autocode.diagnostics import Diagnostics
+    from fswkit.autocode.params import app_parameters
+    from fswkit.autocode.schema import link_plan
+    from fswkit.ground.station import Station
+    from fswkit.link.layout import from_app
+    from fswkit.target.build import load
+    from fswkit.web.app import create_app
+    from fswkit.web.source import LiveSource
+
+    app = load(str(RIG), Diagnostics())
+    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
+        ground = Station(from_app(app), str(RIG), target.port, 115200)
+        ground.start()
+        try:
+            source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
+            with served(create_app(source)) as url:
+                browser.get(url)
+                text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+                wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+                browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
+                r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
+                assert r.code == 0, r.out + r.err
+                wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
+                assert browser.find_element(By.ID, "pset-HOLD_MS").get_attribute("value") == "700"
+        finally:
+            ground.stop()

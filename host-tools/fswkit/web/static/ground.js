@@ -384,7 +384,14 @@ async function readParams() {
   const i = r.info;
   $("param-state").textContent = `${SOURCES[i.source]}${i.source >= 2 ? ", sequence " + i.seq : ""}` +
     `${i.dirty ? ", unsaved changes" : ""}${i.writing ? ", writing" : ""}`;
-  $("param-table").tBodies[0].replaceChildren(...r.params.map(p => {
+  const body = $("param-table").tBodies[0];
+  const shown = Array.from(body.rows, tr => tr.id);
+  if (shown.length === r.params.length && r.params.every((p, k) => shown[k] === `param-${p.name}`)) {
+    // the same table: its values again, and what the operator is typing kept
+    for (const p of r.params) $(`pval-${p.name}`).textContent = `${fmt(p.value)}${p.unit ? " " + p.unit : ""}`;
+    return;
+  }
+  body.replaceChildren(...r.params.map(p => {
     const tr = el("tr", { id: `param-${p.name}` });
     const input = el("input", { id: `pset-${p.name}`, size: 8, placeholder: p.type });
     const btn = el("button", { type: "button", id: `psend-${p.name}` }, "Set");

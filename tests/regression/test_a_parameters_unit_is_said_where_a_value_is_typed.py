@@ -10,14 +10,12 @@ each value it set; the page's confirmation says it too."""
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 from conftest import run_fsw
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import PtyTarget, needs_cxx
+from support.param_page import RIG, tuned_page
 from support.simfw import kept_native
-
-RIG = Path(__file__).resolve().parent.parent / "param" / "tuned"
 
 
 def test_a_number_with_a_unit_is_told_the_parameters_unit(tmp_path):
@@ -45,30 +43,11 @@ def test_set_says_the_units_of_what_it_set(tmp_path):
 def test_the_pages_confirmation_says_the_unit(browser, tmp_path):
     from selenium.webdriver.common.by import By
 
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.params import app_parameters
-    from fswkit.autocode.schema import link_plan
-    from fswkit.ground.station import Station
-    from fswkit.link.layout import from_app
-    from fswkit.target.build import load
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
-    exe = kept_native(RIG) / "tuned"
-    app = load(str(RIG), Diagnostics())
-    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
-        ground = Station(from_app(app), str(RIG), target.port, 115200)
-        ground.start()
-        try:
-            source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
-            with served(create_app(source)) as url:
-                browser.get(url)
-                text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-                wait_for(lambda: text("pval-HOLD_MS") == "500 ms", "the parameters")
-                browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
-                browser.find_element(By.ID, "psend-HOLD_MS").click()
-                wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-                assert text("confirm-text") == "Set parameter HOLD_MS = 700 ms on the target (live, until saved)?"
-                browser.find_element(By.ID, "confirm-no").click()
-        finally:
-            ground.stop()
+    with tuned_page(browser, tmp_path):
+        text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+        wait_for(lambda: text("pval-HOLD_MS") == "500 ms", "the parameters")
+        browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
+        browser.find_element(By.ID, "psend-HOLD_MS").click()
+        wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+        assert text("confirm-text") == "Set parameter HOLD_MS = 700 ms on the target (live, until saved)?"
+        browser.find_element(By.ID, "confirm-no").click()

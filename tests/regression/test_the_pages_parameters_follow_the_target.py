@@ -10,92 +10,48 @@ from __future__ import annotations
 
 import time
 
-import pytest
-
-from conftest import ROOT, run_fsw
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
-from support.linkfw import PtyTarget, needs_cxx
-from support.simfw import kept_native
+from conftest import run_fsw
+from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.linkfw import needs_cxx
+from support.param_page import RIG, tuned_page
 
 pytestmark = [needs_cxx(), needs_chromium]
-RIG = ROOT / "tests" / "param" / "tuned"
 
 
-@pytest.fixture(scope="module")
-def exe():
-    return kept_native(RIG) / "tuned"
-
-
-def test_a_terminals_set_and_save_show_in_the_page(exe, browser, tmp_path):
+def test_a_terminals_set_and_save_show_in_the_page(browser, tmp_path):
     from selenium.webdriver.common.by import By
 
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.params import app_parameters
-    from fswkit.autocode.schema import link_plan
-    from fswkit.ground.station import Station
-    from fswkit.link.layout import from_app
-    from fswkit.target.build import load
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
-    app = load(str(RIG), Diagnostics())
-    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
-        ground = Station(from_app(app), str(RIG), target.port, 115200)
-        ground.start()
-        try:
-            source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
-            with served(create_app(source)) as url:
-                browser.get(url)
-                text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-                wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
-                assert text("param-state") == "defaults"
-                # another client, through the station: the page was not asked
-                r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
-                assert r.code == 0, r.out + r.err
-                wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
-                wait_for(lambda: "unsaved changes" in text("param-state"), "the unsaved changes")
-                r = run_fsw("param", str(RIG), "set", "TRIM=7", "--port", target.port)
-                assert r.code == 0, r.err  # the store state stays the same: the SET's acknowledgement tells
-                wait_for(lambda: text("pval-TRIM") == "7", "the second value")
-                r = run_fsw("param", str(RIG), "save", "--port", target.port)
-                assert r.code == 0, r.err
-                wait_for(lambda: text("param-state") == "bank A, sequence 1", "the saved bank")
-                time.sleep(0.5)
-                assert text("param-err") == ""
-        finally:
-            ground.stop()
+    with tuned_page(browser, tmp_path) as target:
+        text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+        assert text("param-state") == "defaults"
+        # another client, through the station: the page was not asked
+        r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
+        assert r.code == 0, r.out + r.err
+        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
+        wait_for(lambda: "unsaved changes" in text("param-state"), "the unsaved changes")
+        r = run_fsw("param", str(RIG), "set", "TRIM=7", "--port", target.port)
+        assert r.code == 0, r.err  # the store state stays the same: the SET's acknowledgement tells
+        wait_for(lambda: text("pval-TRIM") == "7", "the second value")
+        r = run_fsw("param", str(RIG), "save", "--port", target.port)
+        assert r.code == 0, r.err
+        wait_for(lambda: text("param-state") == "bank A, sequence 1", "the saved bank")
+        time.sleep(0.5)
+        assert text("param-err") == ""
 
 
-def test_a_value_being_typed_survives_a_read_again(exe, browser, tmp_path):
+def test_a_value_being_typed_survives_a_read_again(browser, tmp_path):
     """Reading the parameters again made the table's rows again, their
     inputs empty: a value being typed when another client's change arrived
     was gone. The rows of the same table are kept, only their values
     written again."""
     from selenium.webdriver.common.by import By
 
-    from fswkit.autocode.diagnostics import Diagnostics
-    from fswkit.autocode.params import app_parameters
-    from fswkit.autocode.schema import link_plan
-    from fswkit.ground.station import Station
-    from fswkit.link.layout import from_app
-    from fswkit.target.build import load
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
-    app = load(str(RIG), Diagnostics())
-    with PtyTarget(exe, "--eeprom", str(tmp_path / "e.bin")) as target:
-        ground = Station(from_app(app), str(RIG), target.port, 115200)
-        ground.start()
-        try:
-            source = LiveSource(ground, params=app_parameters(app), tx_cap=link_plan(app).tx_cap)
-            with served(create_app(source)) as url:
-                browser.get(url)
-                text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-                wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
-                browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
-                r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
-                assert r.code == 0, r.out + r.err
-                wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
-                assert browser.find_element(By.ID, "pset-HOLD_MS").get_attribute("value") == "700"
-        finally:
-            ground.stop()
+    with tuned_page(browser, tmp_path) as target:
+        text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+        browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
+        r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
+        assert r.code == 0, r.out + r.err
+        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
+        assert browser.find_element(By.ID, "pset-HOLD_MS").get_attribute("value") == "700"

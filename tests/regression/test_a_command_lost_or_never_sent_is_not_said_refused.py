@@ -15,8 +15,9 @@ from __future__ import annotations
 import sqlite3
 
 import pytest
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyStream, PtyTarget, health, hello, layout_of
+from support.station_page import station_page
 
 from fswkit.ground.archive import Archive
 from fswkit.ground.station import Station
@@ -85,40 +86,31 @@ class DeafTarget(PtyTarget):
 def test_the_page_lists_an_unanswered_command_as_unanswered_not_refused(browser, tmp_path, monkeypatch):
     from selenium.webdriver.common.by import By
 
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
     monkeypatch.setenv("FSW_RUNTIME_DIR", str(tmp_path / "run"))
     layout = layout_of(TANK)
     target = DeafTarget(layout)
-    st = Station(layout, "tank", target.port, 115200, serve=False)
-    st.start()
-    try:
-        with served(create_app(LiveSource(st))) as url:
-            browser.get(url)
-            text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
+    with station_page(browser, target, layout) as st:
+        text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
 
-            def send(value: str):
-                box = browser.find_element(By.ID, "cmd-valveOpen")
-                box.clear()
-                box.send_keys(value)
-                browser.find_element(By.ID, "send-valveOpen").click()
-                wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-                browser.find_element(By.ID, "confirm-yes").click()
-                return wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
-                                         if f"set valveOpen = {value}" in li.text], "the command in the history",
-                                timeout=15)[0]
+        def send(value: str):
+            box = browser.find_element(By.ID, "cmd-valveOpen")
+            box.clear()
+            box.send_keys(value)
+            browser.find_element(By.ID, "send-valveOpen").click()
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+            browser.find_element(By.ID, "confirm-yes").click()
+            return wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
+                                     if f"set valveOpen = {value}" in li.text], "the command in the history",
+                            timeout=15)[0]
 
-            wait_for(lambda: text("link-status") == "live", "the link to show live")
-            item = send("true")
-            assert "refused" not in item.text, item.text
-            assert "after 3 tries: lost, or applied and its acknowledgement lost" in item.text
-            assert item.get_attribute("class") == "lost"
-            target.close()
-            wait_for(lambda: not st.up, "the station to see the port gone")
-            item = send("false")
-            assert "refused" not in item.text, item.text
-            assert NOT_SENT in item.text, item.text
-            assert item.get_attribute("class") == "lost"
-    finally:
-        st.stop()
+        wait_for(lambda: text("link-status") == "live", "the link to show live")
+        item = send("true")
+        assert "refused" not in item.text, item.text
+        assert "after 3 tries: lost, or applied and its acknowledgement lost" in item.text
+        assert item.get_attribute("class") == "lost"
+        target.close()
+        wait_for(lambda: not st.up, "the station to see the port gone")
+        item = send("false")
+        assert "refused" not in item.text, item.text
+        assert NOT_SENT in item.text, item.text
+        assert item.get_attribute("class") == "lost"

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import threading
 
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyTarget, layout_of, stream
+from support.station_page import station_page
 
-from fswkit.ground.station import Station
 
 pytestmark = needs_chromium
 
@@ -48,17 +48,11 @@ class Resetting(PtyTarget):
 
 def test_the_plot_starts_again_with_the_targets_time(browser, tmp_path, monkeypatch):
 
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
     monkeypatch.setenv("FSW_RUNTIME_DIR", str(tmp_path / "run"))
     layout = layout_of(TANK)
     target = Resetting(layout)
-    st = Station(layout, "tank", target.port, 115200, serve=False)
-    st.start()
     try:
-        with served(create_app(LiveSource(st))) as url:
-            browser.get(url)
+        with station_page(browser, target, layout) as st:
             wait_for(lambda: browser.execute_script("return series.t.length && series.t[series.t.length - 1] >= 50"),
                      "the page to plot the target's time before its reset", timeout=15)
             target.reset.set()
@@ -68,5 +62,4 @@ def test_the_plot_starts_again_with_the_targets_time(browser, tmp_path, monkeypa
             assert all(a <= b for a, b in zip(t, t[1:])), "the plot's time went back"
             assert t[0] < 40
     finally:
-        st.stop()
         target.close()

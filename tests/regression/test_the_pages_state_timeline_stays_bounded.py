@@ -8,10 +8,10 @@ TIMELINE_KEPT changes (the band and the list), and the page keeps up."""
 from __future__ import annotations
 
 
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyTarget, layout_of, stream
+from support.station_page import station_page
 
-from fswkit.ground.station import Station
 
 pytestmark = needs_chromium
 KEPT = 500  # ground.js's TIMELINE_KEPT
@@ -45,18 +45,12 @@ class Flapping(PtyTarget):
 def test_a_machine_that_changes_state_often_keeps_the_page_answering(browser, tmp_path, monkeypatch):
     from selenium.webdriver.common.by import By
 
-    from fswkit.web.app import create_app
-    from fswkit.web.source import LiveSource
-
     monkeypatch.setenv("FSW_RUNTIME_DIR", str(tmp_path / "run"))
     layout = layout_of(TANK)
     target = Flapping(layout)
-    st = Station(layout, "tank", target.port, 115200, serve=False)
-    st.start()
+    browser.set_script_timeout(10)
     try:
-        with served(create_app(LiveSource(st))) as url:
-            browser.set_script_timeout(10)
-            browser.get(url)
+        with station_page(browser, target, layout) as st:
             count = "return document.querySelectorAll('#transitions-state li').length"
             wait_for(lambda: browser.execute_script(count) >= KEPT, f"{KEPT} state changes listed", timeout=40)
             seen = browser.execute_script("return window.fswSeqs.length")
@@ -66,5 +60,4 @@ def test_a_machine_that_changes_state_often_keeps_the_page_answering(browser, tm
             assert browser.execute_script("return document.querySelectorAll('#band-state .seg').length") <= KEPT + 1
             assert browser.find_element(By.ID, "link-status").text == "live"
     finally:
-        st.stop()
         target.close()

@@ -15,7 +15,7 @@ from __future__ import annotations
 import sqlite3
 
 import pytest
-from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, press, wait_for  # noqa: F401 - browser: a fixture
 from support.linkstream import TANK, PtyStream, PtyTarget, health, hello, layout_of
 from support.station_page import station_page
 
@@ -96,9 +96,9 @@ def test_the_page_lists_an_unanswered_command_as_unanswered_not_refused(browser,
             box = browser.find_element(By.ID, "cmd-valveOpen")
             box.clear()
             box.send_keys(value)
-            browser.find_element(By.ID, "send-valveOpen").click()
-            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-            browser.find_element(By.ID, "confirm-yes").click()
+            press(browser, "send-valveOpen")
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
+            press(browser, "confirm-yes")
             return wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
                                      if f"set valveOpen = {value}" in li.text], "the command in the history",
                             timeout=15)[0]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 
 from conftest import run_fsw
-from support.browser import browser, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, press, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import PtyTarget, needs_cxx
 from support.param_page import RIG, tuned_page
 from support.simfw import kept_native
@@ -47,7 +47,7 @@ def test_the_pages_confirmation_says_the_unit(browser, tmp_path):
         text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
         wait_for(lambda: text("pval-HOLD_MS") == "500 ms", "the parameters")
         browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
-        browser.find_element(By.ID, "psend-HOLD_MS").click()
-        wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+        press(browser, "psend-HOLD_MS")
+        wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
         assert text("confirm-text") == "Set parameter HOLD_MS = 700 ms on the target (live, until saved)?"
-        browser.find_element(By.ID, "confirm-no").click()
+        press(browser, "confirm-no")

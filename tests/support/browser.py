@@ -34,12 +34,14 @@ def chromium():
               "--disable-background-networking", "--disable-component-update", "--disable-sync",
               "--disable-dev-shm-usage", "--window-size=1400,1000"):
         opts.add_argument(a)
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})  # for page_state
     return webdriver.Chrome(service=Service(DRIVER), options=opts)
 
 
-def wait_for(fn, what: str, timeout: float = 10.0):
+def wait_for(fn, what: str, timeout: float = 10.0, page=None):
     """What `fn()` gives once it is truthy (an exception counts as not yet),
-    polled every 0.1 s; AssertionError after `timeout` seconds."""
+    polled every 0.1 s; AssertionError after `timeout` seconds, with what
+    the page in the browser `page` showed and logged then when it is given."""
     deadline = time.monotonic() + timeout
     while True:
         try:
@@ -49,8 +51,32 @@ def wait_for(fn, what: str, timeout: float = 10.0):
         if v:
             return v
         if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
+            raise AssertionError(f"timed out waiting for {what}" + (page_state(page) if page else ""))
         time.sleep(0.1)
+
+
+def press(page, element_id: str):
+    """Clicks the element `element_id` of the page in the browser `page`,
+    scrolled to the middle of the window first, so that a panel above it
+    that grows as frames arrive does not move it under the click."""
+    from selenium.webdriver.common.by import By
+
+    el = page.find_element(By.ID, element_id)
+    page.execute_script("arguments[0].scrollIntoView({block: 'center'})", el)
+    el.click()
+
+
+def page_state(page) -> str:
+    """What a failing test's page showed and logged: its open dialogs, its
+    error lines and the browser console's messages."""
+    try:
+        shown = page.execute_script(
+            "return Array.from(document.querySelectorAll('dialog[open], .err'), "
+            "e => (e.id || e.tagName) + ': ' + e.textContent.trim()).filter(t => !t.endsWith(': ')).join('\\n')")
+        logs = "\n".join(m.get("message", "") for m in page.get_log("browser"))
+    except Exception as e:  # noqa: BLE001 - the page itself may be what failed
+        return f"\n(the page could not be read: {e})"
+    return f"\nthe page showed:\n{shown or '(no dialog, no error)'}\nthe console:\n{logs or '(nothing)'}"
 
 
 @pytest.fixture(scope="module")

@@ -23,7 +23,7 @@ from types import SimpleNamespace
 import pytest
 
 from conftest import run_fsw
-from support.browser import browser, needs_chromium, served, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, needs_chromium, press, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = pytest.mark.costly(10)
@@ -246,7 +246,7 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
                 time.sleep(1.0)  # the archive's last batch committed
 
                 # the archive tab: the session, live, in local time
-                browser.find_element(By.ID, "tab-archive").click()
+                press(browser, "tab-archive")
                 row = wait_for(lambda: browser.find_element(By.ID, "session-1"), "the sessions list")
                 started = json.loads(get(url + "api/archive/sessions")[1])["sessions"][0]["started"]
                 assert "live" in row.text and "tank" in row.text and target.port in row.text

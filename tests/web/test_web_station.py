@@ -15,7 +15,7 @@ import time
 import pytest
 
 from conftest import run_fsw
-from support.browser import browser, free_port, needs_chromium, wait_for  # noqa: F401 - browser: a fixture
+from support.browser import browser, free_port, needs_chromium, press, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
 pytestmark = [pytest.mark.costly(14), needs_cxx(), needs_chromium]
@@ -79,16 +79,16 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             # a value of the wrong type is refused in the page, before anything is sent
             box = browser.find_element(By.ID, "cmd-valveOpen")
             box.send_keys("maybe")
-            browser.find_element(By.ID, "send-valveOpen").click()
+            press(browser, "send-valveOpen")
             assert "valveOpen is bool" in text("err-valveOpen")
             assert not browser.find_element(By.ID, "confirm").get_attribute("open")
             # a command: confirmed, sent, acknowledged, in the history
             box.clear()
             box.send_keys("false")
-            browser.find_element(By.ID, "send-valveOpen").click()
-            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
+            press(browser, "send-valveOpen")
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
             assert "set valveOpen = false" in text("confirm-text")
-            browser.find_element(By.ID, "confirm-yes").click()
+            press(browser, "confirm-yes")
             # (the station's own hello may be in the history too: the page's command is looked for)
             item = wait_for(lambda: [li for li in browser.find_elements(By.CSS_SELECTOR, "#history li")
                                      if "set valveOpen = false" in li.text], "the command in the history")[0]
@@ -258,18 +258,18 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
             assert text("param-state") == "defaults"
             box = browser.find_element(By.ID, "pset-OPEN_AT")
             box.send_keys("650.5")
-            browser.find_element(By.ID, "psend-OPEN_AT").click()
-            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-            browser.find_element(By.ID, "confirm-yes").click()
+            press(browser, "psend-OPEN_AT")
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
+            press(browser, "confirm-yes")
             wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the new value")
             assert "unsaved changes" in text("param-state")
             item = browser.find_elements(By.CSS_SELECTOR, "#history li")[0]
             assert "param set OPEN_AT = 650.5" in item.text and "applied" in item.text
             box = browser.find_element(By.ID, "pset-HOLD_MS")
             box.send_keys("5")
-            browser.find_element(By.ID, "psend-HOLD_MS").click()
-            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog")
-            browser.find_element(By.ID, "confirm-yes").click()
+            press(browser, "psend-HOLD_MS")
+            wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
+            press(browser, "confirm-yes")
             wait_for(lambda: "outside its range 10..60000 ms" in text("param-err"), "the refusal")
         finally:
             server.should_exit = True

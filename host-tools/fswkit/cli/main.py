@@ -116,11 +116,23 @@ def _tcp_port(text: str) -> int:
 
 # ---- the parser -------------------------------------------------------------------
 
+def _boards() -> str:
+    """The boards the kit knows (its boards/*.toml), for the `--board` helps."""
+    from fswkit.autocode.kit import BOARDS
+
+    try:
+        names = sorted(n[:-5] for n in os.listdir(BOARDS) if n.endswith(".toml"))
+    except OSError:
+        names = []
+    return f"; boards: {', '.join(names)}" if names else ""
+
+
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="fsw", description="fswkit: flight software from configs.")
     p.add_argument("--version", action="version", version=f"fsw {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
+    boards = _boards()
 
     c = sub.add_parser("check", help="check configs (.sv .sm .ss .app) or folders of them")
     c.add_argument("paths", nargs="+", metavar="PATH")
@@ -139,7 +151,7 @@ def parser() -> argparse.ArgumentParser:
     t.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     t.add_argument("--real", choices=("f64", "f32"), default=None,
                    help="evaluation type R: binary64 (hosts, default) or binary32 (AVR boards)")
-    t.add_argument("--board", help="run with this board's evaluation type (e.g. uno: binary32)")
+    t.add_argument("--board", help="run with this board's evaluation type (e.g. uno: binary32)" + boards)
     t.add_argument("--native", action="store_true",
                    help="run the generated C++ compiled for this host instead of the interpreter")
     t.add_argument("--trace", metavar="FILE.csv", help="write every element after every step")
@@ -166,7 +178,7 @@ def parser() -> argparse.ArgumentParser:
     cp.add_argument("--sv", help="the state vector (default: the .sv beside the machine)")
     cp.add_argument("--real", choices=("f64", "f32"), default=None,
                     help="evaluation type R of the runtime that runs it (default f64)")
-    cp.add_argument("--board", help="for this board's evaluation type (e.g. uno: binary32)")
+    cp.add_argument("--board", help="for this board's evaluation type (e.g. uno: binary32)" + boards)
     cp.add_argument("-o", "--output", required=True, metavar="FILE.fsm", help="the image to write (- for standard output)")
     cp.add_argument("--layout", metavar="FILE", help="also write the state vector's layout and the state names, as "
                     "libfswsm reads them (docs/bytecode.md)")
@@ -176,7 +188,7 @@ def parser() -> argparse.ArgumentParser:
 
     gn = sub.add_parser("gen", help="generate an application's C++ from its configs")
     gn.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
-    gn.add_argument("--board", help="build for this board instead of the one the .app names")
+    gn.add_argument("--board", help="build for this board instead of the one the .app names" + boards)
     gn_out = gn.add_mutually_exclusive_group()
     gn_out.add_argument("--out", help="where to write (default PROJECT/build/BOARD/gen)")
     gn_out.add_argument("--sketch", metavar="DIR", help="write an Arduino sketch folder for arduino-cli instead")
@@ -184,13 +196,13 @@ def parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("build", help="build an application's firmware (.elf/.hex, or a host executable)")
     b.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
-    b.add_argument("--board", help="build for this board instead of the one the .app names")
+    b.add_argument("--board", help="build for this board instead of the one the .app names" + boards)
     b.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
     b.set_defaults(func=_command("target", "cmd_build"))
 
     sm = sub.add_parser("sim", help="build and run the firmware on a simulated board, UART0 on a pty")
     sm.add_argument("project", metavar="PROJECT", help="a folder with one .app, the .app file, or a firmware .elf")
-    sm.add_argument("--board", help="simulate this board (uno, mega2560, ...) instead of the one the .app names")
+    sm.add_argument("--board", help="simulate this board instead of the one the .app names" + boards)
     sm.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this much simulated time")
     sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
     sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
@@ -235,7 +247,7 @@ def parser() -> argparse.ArgumentParser:
     fl = sub.add_parser("flash", help="build the firmware and upload it to a board (avrdude or PlatformIO)")
     fl.add_argument("project", metavar="PROJECT", help="a folder with one .app, or the .app file")
     fl.add_argument("--port", help="the board's serial port (default: the only serial port connected)")
-    fl.add_argument("--board", help="flash for this board instead of the one the .app names")
+    fl.add_argument("--board", help="flash for this board instead of the one the .app names" + boards)
     fl.add_argument("--via", choices=("avrdude", "pio"), default="avrdude",
                     help="upload with avrdude (default) or with `pio run -t upload`")
     fl.add_argument("--out", help="build folder (default PROJECT/build/BOARD)")
@@ -249,7 +261,7 @@ def parser() -> argparse.ArgumentParser:
 
     nw = sub.add_parser("new", help="scaffold a new project that builds as it stands")
     nw.add_argument("name", metavar="NAME", help="the project's folder; its name names the files and machine")
-    nw.add_argument("--board", default="uno", help="the board it runs on (default uno)")
+    nw.add_argument("--board", default="uno", help="the board it runs on (default uno)" + boards)
     nw.set_defaults(func=_command("new", "cmd_new"))
 
     s = sub.add_parser("skeleton", help="a state-script skeleton that visits every state")

@@ -202,7 +202,7 @@ def plant_run(args) -> int:
     from fswkit.outputs import OutputError
     from fswkit.plant.run import SetupError, execute, prepare, refuse_inputs
     from fswkit.sim.command import build, is_elf, say
-    from fswkit.target.build import default_out
+    from fswkit.target.build import BuildError, default_output
 
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
                        ("--analog", bool(args.analog)), ("--link", args.link is not None),
@@ -226,11 +226,11 @@ def plant_run(args) -> int:
         for line in str(e).splitlines():
             sys.stderr.write(f"fsw sim: {line}\n" if line and not line.startswith((" ", "|")) else line + "\n")
         return 2
-    out = args.out or os.path.join(default_out(app), f"{args.plant}-flight")
     try:
+        out = args.out or default_output(app, f"{args.plant}-flight")
         os.makedirs(out, exist_ok=True)
         refuse_inputs(out, [args.params, args.fw_params])
-    except OutputError as e:
+    except (OutputError, BuildError) as e:
         say(str(e))
         return 2
     except OSError as e:
@@ -257,7 +257,7 @@ def tape_run(args) -> int:
     from fswkit.plant import tape_replay as tr
     from fswkit.plant.run import refuse_inputs
     from fswkit.sim.command import is_elf, say
-    from fswkit.target.build import BuildError, default_out, load
+    from fswkit.target.build import BuildError, default_output, load
     from fswkit.autocode.diagnostics import Diagnostics
 
     for opt, given in (("--duration", args.duration is not None), ("--fast", args.fast),
@@ -301,10 +301,10 @@ def tape_run(args) -> int:
             sys.stderr.write(f"fsw sim: {line}\n")
         return 2
     name = os.path.splitext(os.path.basename(args.tape))[0]
-    out = args.out or os.path.join(default_out(app), f"tape-{name}")
     try:
+        out = args.out or default_output(app, f"tape-{name}")
         refuse_inputs(out, [args.tape, args.params, args.fw_params], extra=("perturb.csv", "perturb.txt"))
-    except OutputError as e:
+    except (OutputError, BuildError) as e:
         say(str(e))
         return 2
     built = folder_and_firmware(args.project, args.board, out)

@@ -25,7 +25,7 @@ def study_run(args) -> int:
     from fswkit.plant.params import ParamsError
     from fswkit.plant.run import SetupError, prepare, refuse_users_files
     from fswkit.sim.command import build, is_elf, say
-    from fswkit.target.build import default_out
+    from fswkit.target.build import BuildError, default_output
 
     if args.jobs is not None and args.runs is None:
         say("--jobs needs --runs N (how many flights of a study fly at a time)")
@@ -95,15 +95,15 @@ def study_run(args) -> int:
     if past or disp_errors:
         return 2
     if args.run is not None:
-        return _one_run(args, app, layout, params, disp, seed, default_out, span)
+        return _one_run(args, app, layout, params, disp, seed, span)
 
-    out = args.out or os.path.join(default_out(app), "rocket-study")
     try:
+        out = args.out or default_output(app, "rocket-study")
         os.makedirs(out, exist_ok=True)
         for name in STUDY_FILES:
             check(os.path.join(out, name), [params, args.dispersion], what="study's " + name)
         refuse_users_files(out, STUDY_FILES)
-    except OutputError as e:
+    except (OutputError, BuildError) as e:
         say(str(e))
         return 2
     except OSError as e:
@@ -151,21 +151,22 @@ def study_run(args) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
-def _one_run(args, app, layout, params, disp, seed, default_out, span) -> int:
+def _one_run(args, app, layout, params, disp, seed, span) -> int:
     """`--run I`: run I of the study flown again alone, its files written."""
     from fswkit.cli.common import flown, folder_and_firmware
     from fswkit.plant import study
     from fswkit.outputs import OutputError
     from fswkit.plant.run import execute, refuse_inputs
+    from fswkit.target.build import BuildError, default_output
     from fswkit.sim.command import say
 
     setup = study.Setup(app, layout, params, "", None, disp, seed, span_s=span)
     d = study.draw_run(setup, args.run)
     sc = study.scenario_for(setup, d)
-    out = args.out or os.path.join(default_out(app), f"rocket-run-{args.run}")
     try:
+        out = args.out or default_output(app, f"rocket-run-{args.run}")
         refuse_inputs(out, [params, args.dispersion])
-    except OutputError as e:
+    except (OutputError, BuildError) as e:
         say(str(e))
         return 2
     built = folder_and_firmware(args.project, args.board, out)

@@ -174,7 +174,11 @@ def _resume(app: Application) -> list[str]:
     if app.log is not None:
         c.append("static_assert(offsetof(fsw::Recorder, mode) == offsetof(fsw::Recorder, flight) + 1, "
                  "\"the recorder's flight and mode are kept as one span\");")
-    c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
+    c.append("const uint16_t kResumeSize = " + " + ".join(
+        f"fsw::resume_span_size({n})" if n.startswith("fsw::resume_strided(") else f"static_cast<uint16_t>({n})"
+        for _, n, _ in spans) + ";")
+    if any(n.startswith("fsw::resume_strided(") for _, n, _ in spans):
+        c.append("static_assert(sizeof(fsw::TaskStats) < 128, \"a strided span's stride is at most 127 bytes\");")
     c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a check")
     c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
              f"0x{resume_hash(app):08x}UL, kResumeSize, {len(spans)}}};  // the check's seed: resume_hash")

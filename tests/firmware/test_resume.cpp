@@ -162,6 +162,64 @@ static void test_the_sequence_number_wraps(void) {
     }
 }
 
+// A strided span (resume_strided): one byte of each record of an array,
+// kept and copied back in order, and the record's other bytes left alone.
+struct Rec {
+    uint8_t before, kept, after;
+};
+static Rec recs[5];
+static uint8_t c[2];
+static const ResumeSpan kStridedSpans[3] FSW_FLASH = {
+    {c, 1}, {&recs[0].kept, resume_strided(5, sizeof(Rec))}, {c + 1, 1}};
+static const uint16_t kStridedSize = 1 + resume_span_size(resume_strided(5, sizeof(Rec))) + 1;
+static uint8_t strided_banks[2 * (kStridedSize + 3)];
+static const ResumeConfig kStrided FSW_FLASH = {kStridedSpans, strided_banks, 0x0BADF00DUL, kStridedSize, 3};
+
+static void fill_recs(uint8_t v) {
+    for (uint8_t i = 0; i < 5; ++i) {
+        recs[i].before = static_cast<uint8_t>(v + 0x10 + i);
+        recs[i].kept = static_cast<uint8_t>(v + i);
+        recs[i].after = static_cast<uint8_t>(v + 0x20 + i);
+    }
+    c[0] = static_cast<uint8_t>(v + 0x30);
+    c[1] = static_cast<uint8_t>(v + 0x31);
+}
+
+static void test_a_strided_span_keeps_a_byte_of_each_record(void) {
+    TEST_ASSERT_EQUAL_UINT16(7, kStridedSize);
+    Resume r;
+    for (uint16_t i = 0; i < sizeof strided_banks; ++i) strided_banks[i] = static_cast<uint8_t>(i * 29u + 3u);
+    TEST_ASSERT_FALSE(resume_begin(r, &kStrided, kPowerOn));
+    fill_recs(0x40);
+    resume_save(r);
+    fill_recs(0x80);
+    resume_save(r);
+    // the bank: c[0], the five kept bytes in order, c[1], then the sequence number
+    const int8_t k = resume_newest(&kStrided);
+    TEST_ASSERT_TRUE(k >= 0);
+    const uint8_t* bank = strided_banks + k * (kStridedSize + 3);
+    TEST_ASSERT_EQUAL_UINT8(0xB0, bank[0]);
+    for (uint8_t i = 0; i < 5; ++i) TEST_ASSERT_EQUAL_UINT8(0x80 + i, bank[1 + i]);
+    TEST_ASSERT_EQUAL_UINT8(0xB1, bank[6]);
+    fill_recs(0xC0);  // after the last save: the kept bytes go back to it, the others stay
+    TEST_ASSERT_TRUE(resume_begin(r, &kStrided, kBrownOut));
+    for (uint8_t i = 0; i < 5; ++i) {
+        TEST_ASSERT_EQUAL_UINT8(0x80 + i, recs[i].kept);
+        TEST_ASSERT_EQUAL_UINT8(0xD0 + i, recs[i].before);
+        TEST_ASSERT_EQUAL_UINT8(0xE0 + i, recs[i].after);
+    }
+    TEST_ASSERT_EQUAL_UINT8(0xB0, c[0]);
+    TEST_ASSERT_EQUAL_UINT8(0xB1, c[1]);
+    // every bit of the bank is in the check
+    for (uint16_t bit = 0; bit < 8u * (kStridedSize + 3); ++bit) {
+        uint8_t* const p = strided_banks + k * (kStridedSize + 3) + bit / 8;
+        *p = static_cast<uint8_t>(*p ^ (1u << (bit % 8)));
+        TEST_ASSERT_NOT_EQUAL(k, resume_newest(&kStrided));
+        *p = static_cast<uint8_t>(*p ^ (1u << (bit % 8)));
+    }
+    TEST_ASSERT_EQUAL_INT8(k, resume_newest(&kStrided));
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_a_brown_out_resumes_the_last_save);
@@ -172,6 +230,7 @@ static void run(void) {
     RUN_TEST(test_a_save_cut_short_resumes_the_one_before);
     RUN_TEST(test_a_flipped_bit_is_refused);
     RUN_TEST(test_the_sequence_number_wraps);
+    RUN_TEST(test_a_strided_span_keeps_a_byte_of_each_record);
     (void)UNITY_END();
 }
 

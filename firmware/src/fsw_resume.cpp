@@ -28,9 +28,11 @@ struct Check {
     }
 };
 
-// The spans' bytes copied to `at` and into the check: the save's loop, 9
-// cycles a byte on AVR, four bytes a turn after each span's n % 4 first
-// ones (the same sums as Check::add, in assembly: the compiler's version
+// The spans' bytes copied to `at` and into the check: the save's loop, 8.5
+// cycles a byte on AVR, eight bytes a turn after each span's n % 4 first
+// ones (an odd quad enters the first turn half way; four bytes a turn took
+// 9 cycles a byte: 6 us more a save on the rocket, for 56 B less of code)
+// (the same sums as Check::add, in assembly: the compiler's version
 // took twice as long, and the save runs every cycle). On AVR the walk of
 // the spans' table is in the assembly too: a span's address and size read
 // from flash in 4 instructions, 30 cycles a span where the compiler's
@@ -73,16 +75,23 @@ inline uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_spans
         "dec  %[odd]\n\t"
         "brne 2b\n\t"
         "3:\n\t"
+        "lsr  %B[q]\n\t"  // eight bytes a turn: an odd quad in the first turn's second half
+        "ror  %A[q]\n\t"
+        "brcc 9f\n\t"
+        "adiw %[q], 1\n\t"  // an odd number of quads: one more turn, entered half way
+        "rjmp 10f\n\t"
+        "9:\n\t"
         "sbiw %[q], 0\n\t"
         "breq 5f\n\t"
         "4:\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE
+        "10:\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE FSW_RESUME_BYTE
         "sbiw %[q], 1\n\t"
         "brne 4b\n\t"
         "5:\n\t"
         "movw r30, %[table]\n\t"
         "dec  %[n]\n\t"
-        "brne 1b\n\t"
-        "rjmp 8f\n\t"
+        "breq 8f\n\t"
+        "rjmp 1b\n\t"  // the loop is longer than a branch reaches
         "6:\n\t"  // strided: the count in the size's low byte, the stride in its high one
         "andi %B[q], 0x7F\n\t"
         "7:\n\t"

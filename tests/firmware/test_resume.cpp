@@ -220,6 +220,29 @@ static void test_a_strided_span_keeps_a_byte_of_each_record(void) {
     TEST_ASSERT_EQUAL_INT8(k, resume_newest(&kStrided));
 }
 
+// Spans of every size the save's loop handles apart: 0..3 bytes before
+// its turns of eight, an odd or an even number of quads, none.
+static uint8_t sized[183];
+static const ResumeSpan kSizedSpans[15] FSW_FLASH = {{sized + 0, 1}, {sized + 1, 2}, {sized + 3, 3}, {sized + 6, 4}, {sized + 10, 5}, {sized + 15, 6}, {sized + 21, 7}, {sized + 28, 8}, {sized + 36, 9}, {sized + 45, 12}, {sized + 57, 13}, {sized + 70, 17}, {sized + 87, 31}, {sized + 118, 32}, {sized + 150, 33}};
+static uint8_t sized_banks[2 * (183 + 3)];
+static const ResumeConfig kSized FSW_FLASH = {kSizedSpans, sized_banks, 0x5151D00DUL, 183, 15};
+
+static void test_spans_of_every_size_are_kept_whole(void) {
+    Resume r;
+    for (uint16_t i = 0; i < sizeof sized_banks; ++i) sized_banks[i] = static_cast<uint8_t>(i * 13u + 5u);
+    TEST_ASSERT_FALSE(resume_begin(r, &kSized, kPowerOn));
+    for (uint8_t k = 1; k <= 3; ++k) {  // both banks, then the first again
+        for (uint16_t i = 0; i < sizeof sized; ++i) sized[i] = static_cast<uint8_t>(i * 7u + k);
+        resume_save(r);
+        const int8_t b = resume_newest(&kSized);
+        TEST_ASSERT_TRUE(b >= 0);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(sized, sized_banks + b * (sizeof sized + 3), sizeof sized);
+        memset(sized, 0, sizeof sized);
+        TEST_ASSERT_TRUE(resume_begin(r, &kSized, kWatchdog));
+        for (uint16_t i = 0; i < sizeof sized; ++i) TEST_ASSERT_EQUAL_UINT8(static_cast<uint8_t>(i * 7u + k), sized[i]);
+    }
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_a_brown_out_resumes_the_last_save);
@@ -231,6 +254,7 @@ static void run(void) {
     RUN_TEST(test_a_flipped_bit_is_refused);
     RUN_TEST(test_the_sequence_number_wraps);
     RUN_TEST(test_a_strided_span_keeps_a_byte_of_each_record);
+    RUN_TEST(test_spans_of_every_size_are_kept_whole);
     (void)UNITY_END();
 }
 

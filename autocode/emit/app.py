@@ -81,7 +81,8 @@ def _analog_inputs(app: Application, real, scan: _Scan) -> list[str]:
         gain = real_literal(analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real), real)
         offset = real_literal(real.literal(repr(c.offset)), real)
         write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
-                 f"fsw::analog_value(fsw::io_analog_count({scan.tag}Raw, {k}), {gain}, {offset}));")
+                 f"fsw::analog_value_memo({scan.tag}Memo[{k}], fsw::io_analog_count({scan.tag}Raw, {k}), "
+                 f"{gain}, {offset}));")
         if app.sv.lock:
             write = "{ fsw::SvGuard<true> lock; " + write + " }"
         out.append(f"    {write}  // {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt")
@@ -115,6 +116,8 @@ def _tables(app: Application, real, out: list[str]) -> dict:
                        + ", ".join(str(c.pin_number) for c in chans) + "};  // "
                        + ", ".join(f"{basename(c.path)}:{c.line} {c.pin}" for c in chans))
             out.append(f"volatile uint16_t {tag}Raw[{len(chans)}];  // counts the ADC's interrupt stores")
+            out.append(f"fsw::AnalogMemo {tag}Memo[{len(chans)}];  // each input's last count and value: "
+                       "converted again when the count changed")
             out.append("")
             names[(kind, d)] = _Scan(tag, chans)
             continue

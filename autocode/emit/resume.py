@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..numeric import REALS
 from .common import c_ident
-from .machine import stored_locals
+from .machine import stored_locals, windows_watched
 
 MAX_RESUME_SPANS = 255  # ResumeConfig::n_spans, a byte (the save's loop counts it in one register)
 MAX_STRIDED = 255  # the bytes of a strided span (fsw::resume_strided: its count, a byte)
@@ -56,3 +56,19 @@ def resume_spans(app) -> list[tuple[str, str, str]]:
     if app.log is not None:
         spans.append(("&rec.flight", "2", "the recorder's flight and mode"))
     return spans
+
+
+def resume_watches(app) -> list[tuple[int, str, str]]:
+    """The spans of resume_spans the save copies only while they change
+    (fsw::ResumeWatch): (index, the C++ flag their writer sets, what). A
+    machine's windows that some of its states do not sample
+    (machine.windows_watched)."""
+    spans = resume_spans(app)
+    out = []
+    for m in app.machines:
+        if not windows_watched(m):
+            continue
+        ns = c_ident(m.name)
+        i = next(k for k, (p, _, _) in enumerate(spans) if p == f"reinterpret_cast<uint8_t*>(&{ns}::win)")
+        out.append((i, f"&{ns}::win_changed", f"{m.name}: its windows, pushed in some states only"))
+    return out

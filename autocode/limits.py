@@ -124,8 +124,9 @@ def check_limits(app, src: Source, diags: Diagnostics, sv_tok, machine_toks: dic
         if n > MAX_RESUME_SPANS:
             at(app.pyro[0].line, 1, f"keeping the flight across a reset (docs/safety.md) takes {n} parts of RAM here: "
                                     f"at most {MAX_RESUME_SPANS} (the state vector, the pyro gates, each machine's "
-                                    "state, locals and windows, and the mode of each task without a `mode=` element): "
-                                    "give the tasks `mode=` elements, or run fewer tasks or machines")
+                                    "state, locals and windows, and the modes of each run of tasks without a `mode=` "
+                                    "element, one part a run): run fewer machines, or list the tasks without a `mode=` "
+                                    "element next to each other")
     b = app.board
     if b.is_avr and b.ram:
         size = max(app.sv.size, 1)

@@ -18,7 +18,7 @@ from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check, window_type
 from .expr import float_key_test
 from .machine import emit_machine, stored_locals
-from .resume import resume_spans
+from .resume import resume_spans, resume_watches
 from .sv import emit_sv
 
 # each element type's fsw::ElemType enumerator (firmware/src/fsw_types.h;
@@ -81,7 +81,8 @@ def _analog_inputs(app: Application, real, scan: _Scan) -> list[str]:
         gain = real_literal(analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real), real)
         offset = real_literal(real.literal(repr(c.offset)), real)
         write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
-                 f"fsw::analog_value(fsw::io_analog_count({scan.tag}Raw, {k}), {gain}, {offset}));")
+                 f"fsw::analog_value_memo({scan.tag}Memo[{k}], fsw::io_analog_count({scan.tag}Raw, {k}), "
+                 f"{gain}, {offset}));")
         if app.sv.lock:
             write = "{ fsw::SvGuard<true> lock; " + write + " }"
         out.append(f"    {write}  // {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt")
@@ -115,6 +116,8 @@ def _tables(app: Application, real, out: list[str]) -> dict:
                        + ", ".join(str(c.pin_number) for c in chans) + "};  // "
                        + ", ".join(f"{basename(c.path)}:{c.line} {c.pin}" for c in chans))
             out.append(f"volatile uint16_t {tag}Raw[{len(chans)}];  // counts the ADC's interrupt stores")
+            out.append(f"fsw::AnalogMemo {tag}Memo[{len(chans)}];  // each input's last count and value: "
+                       "converted again when the count changed")
             out.append("")
             names[(kind, d)] = _Scan(tag, chans)
             continue
@@ -174,10 +177,23 @@ def _resume(app: Application) -> list[str]:
     if app.log is not None:
         c.append("static_assert(offsetof(fsw::Recorder, mode) == offsetof(fsw::Recorder, flight) + 1, "
                  "\"the recorder's flight and mode are kept as one span\");")
-    c.append("const uint16_t kResumeSize = " + " + ".join(f"static_cast<uint16_t>({n})" for _, n, _ in spans) + ";")
+    # a strided span keeps its count of bytes (fsw::resume_strided(COUNT, stride))
+    c.append("const uint16_t kResumeSize = " + " + ".join(
+        f"static_cast<uint16_t>({n.split('(')[1].split(',')[0] if n.startswith('fsw::resume_strided(') else n})"
+        for _, n, _ in spans) + ";")
+    if any(n.startswith("fsw::resume_strided(") for _, n, _ in spans):
+        c.append("static_assert(sizeof(fsw::TaskStats) < 128, \"a strided span's stride is at most 127 bytes\");")
     c.append("uint8_t resume_banks[2 * (kResumeSize + 3)] FSW_NOINIT;  // two banks: the bytes, a sequence number, a check")
+    watches = resume_watches(app)
+    if watches:
+        c.append(f"uint8_t resume_watch_state[{len(watches)}][3];  // saves since each watched span changed, its sums")
+        c.append(f"const fsw::ResumeWatch kResumeWatch[{len(watches)}] FSW_FLASH = {{")
+        for k, (i, flag, what) in enumerate(watches):
+            c.append(f"    {{{i}, {flag}, resume_watch_state[{k}]}},  // {what}")
+        c.append("};")
+    watch = f"kResumeWatch, {len(watches)}" if watches else "0, 0"
     c.append(f"const fsw::ResumeConfig kResumeConfig FSW_FLASH = {{kResumeSpans, resume_banks, "
-             f"0x{resume_hash(app):08x}UL, kResumeSize, {len(spans)}}};  // the check's seed: resume_hash")
+             f"0x{resume_hash(app):08x}UL, kResumeSize, {len(spans)}, {watch}}};  // the check's seed: resume_hash")
     c.append("fsw::Resume resume;")
     c.append("")
     return c

@@ -94,6 +94,19 @@ def still_read(succ: dict[int, list[int]], reads: dict[int, int]) -> dict[int, i
     return {s: need[c] for s, c in dag.graph["mapping"].items()}
 
 
+def windows_watched(m: M.Machine) -> bool:
+    """Whether a kept machine's rolling windows are a watched span of the
+    flight's save (fsw::ResumeWatch, docs/safety.md): copied only while
+    they change. True when some state samples none of them (window_needs):
+    there they keep their bytes, cycle after cycle (the rocket's mission,
+    from its coast on). Its code then sets `win_changed` at every push and
+    at its reset."""
+    if not m.windows:
+        return False
+    needs = window_needs(m)
+    return needs is not None and any(mask == 0 for mask in needs[0].values())
+
+
 def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
     """The locals a machine keeps in memory (its `loc` array): those that
     change, and every one in a scriptable build; parameters are apart."""
@@ -154,6 +167,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             h.append(f"    {window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
         h.append("};")
         h.append("extern Windows win;")
+        if windows_watched(m):
+            h.append("extern uint8_t win_changed;  // set when a window changes: the flight's save copies them again")
     h.append("")
     h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
     h.append("FSW_MUST_CHECK fsw::Result step();")
@@ -173,8 +188,11 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
     if params:
         c.append(f"uint8_t prm[kPrmSize] = {{{', '.join(str(b) for b in param_bytes)}}};")
+    watched = wp != "w" and windows_watched(m)
     if wp != "w":
         c.append("Windows win;  // every window empty")
+    if watched:
+        c.append("uint8_t win_changed;  // fsw::ResumeWatch: the save copies the windows while they change")
     c += ["", "namespace {", ""]
     if wp == "w":
         for w in m.windows:
@@ -248,6 +266,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             c.append(f"{pad}const fsw::Real x{k} = {arg};")
             for w in ws:
                 c.append(f"{pad}{wp}{w.index}.push(x{k});  // {src}:{w.line}")
+        if watched:
+            c.append(f"{pad}win_changed = 1;")
         if where != every:
             c += ["        break;", "    }", "    default:", "        break;", "    }"]
     moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
@@ -278,6 +298,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append("    memcpy(loc, kLocInit, sizeof loc);")
     for w in m.windows:
         c.append(f"    memset(&{wp}{w.index}, 0, sizeof {wp}{w.index});")
+    if watched:
+        c.append("    win_changed = 1;")
     c.append("}")
     if leave:
         c += ["", "void leave() {",

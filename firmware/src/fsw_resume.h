@@ -24,10 +24,39 @@ static const uint8_t kResetKeepsRam = 0x04 | 0x08;
 // The causes after which a person asked for a fresh start (or RAM is lost).
 static const uint8_t kResetFresh = 0x01 | 0x02;
 
-// One piece of RAM kept across a reset (FSW_FLASH table).
+// One piece of RAM kept across a reset (FSW_FLASH table): `n` bytes from
+// `p`, or, with kResumeStrided set in `n` (resume_strided), one byte at `p`
+// and at every `stride` bytes after it, `count` of them: a byte of each
+// record of an array (each task's mode in the executor's TaskStats), in
+// one span instead of one a byte (about 40 AVR cycles a span a save).
 struct ResumeSpan {
     uint8_t* p;
     uint16_t n;
+};
+static const uint16_t kResumeStrided = 0x8000u;
+// A strided span's `n`: `count` bytes (1..255), `stride` bytes apart (1..127).
+constexpr uint16_t resume_strided(uint8_t count, uint8_t stride) {
+    return static_cast<uint16_t>(kResumeStrided | static_cast<uint16_t>((stride & 0x7Fu) << 8) | count);
+}
+// The bytes a span keeps in a bank: `n`, or a strided span's count.
+constexpr uint16_t resume_span_size(uint16_t n) {
+    return (n & kResumeStrided) != 0 ? static_cast<uint16_t>(n & 0xFFu) : n;
+}
+
+// A span the save copies only while its bytes change (FSW_FLASH table, in
+// span order): a machine's rolling windows, pushed in some of its states
+// only (the rocket's mission: in 4 of its 10). The code that writes the
+// span sets `*changed` (the machine's pushes and its reset, generated); a
+// save that finds it set clears it and copies the span, and so does the
+// save after it (the other bank); once both banks hold the span's bytes a
+// save leaves them there and adds their check sums, kept from the copy,
+// to the bank's check (the same check bits as adding the bytes one at a
+// time: the format and the check are the same as without). `state` is the
+// span's RAM of 3 bytes: saves since it changed (0..2), then its two sums.
+struct ResumeWatch {
+    uint8_t span;       // its index in the spans' table
+    uint8_t* changed;   // set by every write of the span's bytes; cleared by the save
+    uint8_t* state;     // 3 bytes of RAM, zero at boot
 };
 
 // The kept state's description (FSW_FLASH). `banks` is 2 * (size + 3)
@@ -40,6 +69,8 @@ struct ResumeConfig {
     uint32_t schema;   // the application's link schema: another firmware's bank is not ours
     uint16_t size;     // the spans' bytes together
     uint8_t n_spans;
+    const ResumeWatch* watch;  // spans copied only while they change, or null (n_watch 0)
+    uint8_t n_watch;
 };
 
 // The bank written next, and the sequence number it gets (RAM, zeroed at boot).

@@ -43,6 +43,35 @@ static void test_every_count_converts_as_the_cast(void) {
     }
 }
 
+// A generated inputs task converts a count through its input's memo: the
+// value is analog_value's, bit for bit, whatever came before (the same
+// count again, another, the first run, the count 0xFFFF), and a count that
+// did not change is not converted again.
+static void test_the_memo_gives_analog_values_bit_for_bit(void) {
+    static AnalogMemo m;  // zero, as a generated task's before its first run
+    static const uint16_t counts[] = {0, 0, 1, 1023, 1023, 0xFFFF, 0xFFFF, 0, 512, 511, 512, 0xFFFE, 0xFFFF, 7};
+    const Real gains[] = {Real(30.54741), Real(-0.5), Real(5) / Real(1023)};
+    const Real offsets[] = {Real(76875), Real(0), Real(-20)};
+    for (uint8_t g = 0; g < 3; ++g) {
+        memset(&m, 0, sizeof m);
+        for (uint8_t i = 0; i < sizeof counts / sizeof counts[0]; ++i) {
+            const Real want = analog_value(counts[i], gains[g], offsets[g]);
+            const Real got = analog_value_memo(m, counts[i], gains[g], offsets[g]);
+            ASSERT_REAL_SAME(want, got);
+        }
+    }
+    // a literal +0 offset: -0 (a count of 0 times a negative gain) turns +0, as without the memo
+    memset(&m, 0, sizeof m);
+    ASSERT_REAL_SAME(analog_value(0, Real(-2), 0), analog_value_memo(m, 0, Real(-2), 0));
+    // the same count again is the value kept, not converted again
+    memset(&m, 0, sizeof m);
+    (void)analog_value_memo(m, 100, Real(2), Real(1));
+    const Real planted = Real(12345);
+    m.value = planted;
+    ASSERT_REAL_SAME(planted, analog_value_memo(m, 100, Real(2), Real(1)));
+    ASSERT_REAL_SAME(Real(203), analog_value_memo(m, 101, Real(2), Real(1)));  // another count: converted
+}
+
 #if FSW_REAL_IS_FLOAT
 // Bit patterns of analog_value for rocket.aio's two calibrations, as the
 // host computes them (fswkit.autocode.iotables.analog_value; the host test
@@ -292,6 +321,7 @@ static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_analog_conversion_formula);
     RUN_TEST(test_every_count_converts_as_the_cast);
+    RUN_TEST(test_the_memo_gives_analog_values_bit_for_bit);
     RUN_TEST(test_pwm_duty_from_volts);
 #if FSW_REAL_IS_FLOAT
     RUN_TEST(test_analog_conversion_matches_the_host_bit_for_bit);

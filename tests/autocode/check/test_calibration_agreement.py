@@ -66,8 +66,8 @@ def test_generated_tables_carry_the_hosts_gain(fsw, tmp_path):
     r = fsw("gen", str(EXAMPLES / "rocket"), "--out", str(tmp_path))
     assert r.code == 0, r.err
     text = (tmp_path / "app.gen.cpp").read_text()
-    rows = re.findall(r"write_F32\(sv \+ E_(\w+), fsw::analog_value\(fsw::io_analog_count\(kAnalogInRaw, \d\), "
-                      r"([-0-9.e]+)f, \(?([-0-9.e]+)f\)?\)\);", text)
+    rows = re.findall(r"write_F32\(sv \+ E_(\w+), fsw::analog_value_memo\(kAnalogInMemo\[\d\], "
+                      r"fsw::io_analog_count\(kAnalogInRaw, \d\), ([-0-9.e]+)f, \(?([-0-9.e]+)f\)?\)\);", text)
     assert [(e, f32(float(g)), float(o)) for e, g, o in rows] == [
         ("pressure", analog_gain(6250.0, 5.0, 10, F32MODE), 76875.0),
         ("accel", analog_gain(8.0, 5.0, 10, F32MODE), -20.0),

@@ -241,6 +241,7 @@ bool executor_poll(Executor& ex, bool) {
 #endif
 
 uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
+    if (!app_has(kAppModeElems)) return flash_get(ex.cfg->stats)[i].mode;  // no task has a mode element
     const ExecConfig c = executor_config(ex);
     Task t;
     read_task(c, i, t);
@@ -248,6 +249,10 @@ uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
 }
 
 void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode) {
+    if (!app_has(kAppModeElems)) {  // no task has a mode element (fsw_app.h)
+        flash_get(ex.cfg->stats)[i].mode = mode;
+        return;
+    }
     const ExecConfig c = executor_config(ex);
     Task t;
     read_task(c, i, t);

@@ -225,7 +225,8 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         const uint8_t* const sv = flash_get(ec.sv);
         for (uint8_t i = 0; i < n_tasks; ++i) {
             const TaskStats& s = stats[i];
-            const ElemOff mode_off = flash_get(tasks[i].mode_off);  // the task's mode: its element, or its record
+            const ElemOff mode_off =  // the task's mode: its element, or its record
+                app_has(kAppModeElems) ? flash_get(tasks[i].mode_off) : static_cast<ElemOff>(kNoElement);
             const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
             const uint8_t row[6] = {mode_off != kNoElement ? sv[mode_off] : s.mode,
                                     s.faults,  // saturates at 255
@@ -293,6 +294,7 @@ void service(Link& l, const LinkConfig& c, bool big) {
 FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
     const ExecConfig& ec = *flash_get(c.ex)->cfg;  // FSW_FLASH: the fields, one at a time
     if (off == flash_get(ec.reset_cause_off)) return true;
+    if (!app_has(kAppModeElems | kAppMirrors)) return false;  // no task has an element (fsw_app.h)
     const uint8_t n_tasks = flash_get(ec.n_tasks);
     const Task* const tasks = flash_get(ec.tasks);
     for (uint8_t i = 0; i < n_tasks; ++i) {

@@ -169,10 +169,12 @@ void take_sample(Link& l, const Sampling& c, const LinkStream& s, uint8_t i, uin
 }
 
 // The state vector's `lock` option (fsw_app.h: never, where the application has none).
-bool sv_lock(const LinkConfig& c) { return app_has(kAppSvLock) && flash_get(c.lock); }
+inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
+    return app_has(kAppSvLock) && flash_get(c.lock);
+}
 
 // The parameter store's source byte of hello and health frames.
-uint8_t param_source(const LinkConfig& c) {
+inline __attribute__((always_inline)) uint8_t param_source(const LinkConfig& c) {
     const ParamStore* const params = app_has(kAppParams) ? flash_get(c.params) : 0;
     return params != 0 ? params->source : static_cast<uint8_t>(kParamNone);
 }

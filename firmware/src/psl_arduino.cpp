@@ -96,13 +96,15 @@ namespace {
 __attribute__((noinline)) bool sub_period_ended() {
     g_ct.base_us += ct_sub_us();
     g_ct.ms += ct_sub_ms();
-    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + ct_sub_frac());
-    if (f >= 1000u) {
-        f = static_cast<uint16_t>(f - 1000u);
-        ++g_ct.ms;
+    if (ct_sub_frac() != 0) {  // (else ms_frac stays 0: a sub-period of whole milliseconds)
+        uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + ct_sub_frac());
+        if (f >= 1000u) {
+            f = static_cast<uint16_t>(f - 1000u);
+            ++g_ct.ms;
+        }
+        g_ct.ms_frac = f;
     }
-    g_ct.ms_frac = f;
-    if (g_ct.sub != ct_last()) {
+    if (ct_last() != 0 && g_ct.sub != ct_last()) {  // (one sub-period a cycle: `sub` stays 0)
         ++g_ct.sub;
         return false;
     }
@@ -147,7 +149,7 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             sei();
             return why;
         }
-        if (g_ct.sub == ct_last() && TCNT1 >= ct_early()) {
+        if ((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_early()) {
             // The last stretch, interrupts off: until the count wraps to 0.
             while (TCNT1 >= ct_early()) {
             }
@@ -161,7 +163,7 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
         // Background work (the link's service, the EEPROM writers) between
         // cycles, but none started in the last FSW_BACKGROUND_GUARD_US before
         // one: a pass that began there could hold the CPU past its start.
-        if (ct_spin() || (pass != 0 && background && !(g_ct.sub == ct_last() && TCNT1 >= ct_quiet()))) {
+        if (ct_spin() || (pass != 0 && background && !((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_quiet()))) {
             sei();
             return kCycleNotDue;
         }
@@ -194,7 +196,8 @@ FSW_NOINLINE uint32_t micros32() { return micros32_inline(); }  // out of line a
 uint32_t millis32() {
     const IrqState saved = critical_enter();
     bool wrapped;
-    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
+    const uint16_t frac = ct_sub_frac() != 0 ? g_ct.ms_frac : 0u;  // (stays 0 for whole milliseconds)
+    uint16_t f = static_cast<uint16_t>(frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
     uint32_t ms = g_ct.ms;
     if (wrapped) {
         ms += ct_sub_ms();

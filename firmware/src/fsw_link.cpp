@@ -186,8 +186,9 @@ inline __attribute__((always_inline)) uint8_t param_source(const LinkConfig& c) 
 // reach is on this path (a copy was 54 of the rocket's 192 bytes).
 FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     const uint64_t t = flash_get(c.now)();
-    uint8_t tb[8];  // t, little-endian: the header takes the low half, hello and health the high half
-    memcpy(tb, &t, sizeof tb);
+    // t's bytes, little-endian (fsw_config.h): the header takes the low half, hello and health the
+    // high half (read where t lies: no copy of it on the stack)
+    const uint8_t* const tb = reinterpret_cast<const uint8_t*>(&t);
     frame_begin(l, type, tb);
     const Executor& ex = *flash_get(c.ex);
     if (type == kFrameAck) {

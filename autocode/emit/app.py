@@ -430,6 +430,7 @@ APP_FEATURES = (
     (0x20, "kAppSvLock", lambda app: bool(app.sv.lock)),
     (0x40, "kAppModeElems", lambda app: any(t.mode is not None for t in app.tasks)),
     (0x80, "kAppMirrors", lambda app: any(t.overruns is not None or t.worst_us is not None for t in app.tasks)),
+    (0x400, "kAppSlowTasks", lambda app: any(t.divider > 1 for t in app.tasks)),
 )
 
 

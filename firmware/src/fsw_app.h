@@ -25,10 +25,11 @@ enum AppFeature : uint16_t {
     kAppModeElems = 0x40,    // a task whose mode is a U8 element
     kAppMirrors = 0x80,      // a task that mirrors its overruns or worst time into elements
     kAppSafeFns = 0x100,     // a task with a function it runs when safed
-    kAppTableChecks = 0x200  // the executor checks its table at run time (generated tables are
+    kAppTableChecks = 0x200, // the executor checks its table at run time (generated tables are
                              // checked when compiled: exec_task_ok, exec_config_ok)
+    kAppSlowTasks = 0x400    // a task that runs less often than every cycle (a divider above 1)
 };
-static const uint16_t kAppAllFeatures = 0x3FF;
+static const uint16_t kAppAllFeatures = 0x7FF;
 
 // The features the program's runtime has (AppFeature bits).
 extern const uint16_t app_features;

@@ -153,12 +153,12 @@ void executor_run_cycle(Executor& ex) {
 #endif
     for (; row != end; ++row, ++sp) {  // a row and its record a turn
         TaskStats& s = *sp;
-        if (s.countdown != 0) {
+        if (app_has(kAppSlowTasks) && s.countdown != 0) {  // (else every task runs every cycle: 0 stays 0)
             --s.countdown;
             continue;
         }
         const RowHead h = row_head(row);
-        s.countdown = static_cast<uint16_t>(h.divider - 1u);
+        if (app_has(kAppSlowTasks)) s.countdown = static_cast<uint16_t>(h.divider - 1u);
         uint8_t* const mode_p = mode_at(f, h.mode_off, s);
         const uint8_t mode = *mode_p;
         if (mode == kModeDisabled) continue;
@@ -181,7 +181,10 @@ void executor_run_cycle(Executor& ex) {
         // A run within the base period is within the task's (divider >= 1):
         // the product, a 32-bit multiplication, only for the longer ones.
         const uint32_t period_us = base_period(ex.period_us);
-        if (took > period_us && took > period_us * flash_get(row->divider) && s.overruns != 0xFFFFu) ++s.overruns;
+        if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
+            s.overruns != 0xFFFFu) {
+            ++s.overruns;
+        }
 #endif
         if (!app_has(kAppMirrors) || ex.mirrors == 0) continue;  // no row has an element to mirror into
         const ElemOff overruns_off = flash_get(row->overruns_off), worst_us_off = flash_get(row->worst_us_off);

@@ -416,12 +416,11 @@ void link_begin(Link& l, const LinkConfig* cfg) {
     const LinkStream* const streams = flash_get(c.streams);
     LinkStreamState* const states = flash_get(c.stream_state);
     for (uint8_t i = 0; i < n_streams; ++i) {
-        LinkStream s;
-        flash_read(&s, &streams[i], sizeof s);
+        const uint16_t every = flash_get(streams[i].every);  // (the row's one field used here)
         LinkStreamState& st = states[i];
         memset(&st, 0, sizeof st);
         uint16_t first = i;  // i mod every: streams of equal rate take turns
-        while (first >= s.every) first = static_cast<uint16_t>(first - s.every);
+        while (first >= every) first = static_cast<uint16_t>(first - every);
         st.countdown = first;
     }
     l.tx = flash_get(c.tx);

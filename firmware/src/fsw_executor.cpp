@@ -87,6 +87,18 @@ inline __attribute__((always_inline)) RowHead row_head(const Task* row) {
     static_assert(offsetof(Task, step) == 0 && offsetof(Task, ctx) == 4 && offsetof(Task, divider) == 6 &&
                       offsetof(Task, mode_off) == 10,
                   "row_head's loads follow the row's layout");
+    if (!app_has(kAppSlowTasks | kAppModeElems)) {  // (fsw_app.h) neither the divider nor the mode offset used
+        __asm__(
+            "lpm  %A[step], Z+\n\t"
+            "lpm  %B[step], Z+\n\t"
+            "adiw r30, 2\n\t"  // the safe function: read only for a safed task
+            "lpm  %A[ctx], Z+\n\t"
+            "lpm  %B[ctx], Z\n\t"
+            : [step] "=&r"(h.step), [ctx] "=&r"(h.ctx), "+z"(row));
+        h.divider = 1;
+        h.mode_off = kNoElement;
+        return h;
+    }
     __asm__(
         "lpm  %A[step], Z+\n\t"
         "lpm  %B[step], Z+\n\t"

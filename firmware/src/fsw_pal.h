@@ -158,7 +158,9 @@ struct CycleSettings {
     uint8_t last;       // n - 1
     uint8_t spin;       // period too short to sleep in: spin from mid-period
 };
-// Without a loop (the five halvings as a choice): folded whole for a constant.
+// For the periods cycle_timer_begin takes (1..1000000 us, a divisor of
+// 1000000: at most five halvings), without a loop (the halvings as a
+// choice): folded whole for a constant.
 inline __attribute__((always_inline)) CycleSettings cycle_settings(uint32_t period_us) {
     const uint32_t m = 32000u;  // the longest sub-period: x 2 ticks fits OCR1A; sums below fit 16 bits
     const uint8_t k = period_us > 16u * m ? 5u : period_us > 8u * m ? 4u : period_us > 4u * m ? 3u

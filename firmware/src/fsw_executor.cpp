@@ -36,7 +36,16 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
     ex.cfg = cfg;
     uint8_t mirrors = 0;
+    // Where the application has no check, mirror, mode element nor slow task
+    // (fsw_app.h), a row's start mode is all there is to read of it.
+    const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);
     for (uint8_t i = 0; i < c.n_tasks; ++i) {
+        if (!whole_rows) {
+            TaskStats& s = c.stats[i];
+            memset(&s, 0, sizeof s);
+            s.mode = flash_get(c.tasks[i].init_mode);  // (its record: no mode element)
+            continue;
+        }
         Task t;
         read_task(c, i, t);
         if (check && (t.step == 0 || t.divider == 0 || t.phase >= t.divider)) return kErrConfig;

@@ -253,8 +253,9 @@ def _app_cpp(app: Application) -> str:
     for m in app.machines:
         c.append(f'#include "{c_ident(m.name)}.gen.h"')
     c += ["", version_check("app.gen.cpp"), real_check(basename(app.path), real),
-          comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz."),
-          "namespace fsw_gen {", "namespace {", ""]
+          comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz.")]
+    c += _app_features(app)
+    c += ["namespace fsw_gen {", "namespace {", ""]
     tables = _tables(app, real, c)
     if app.sensors:
         c += _sensor_objects(app)
@@ -314,6 +315,9 @@ def _app_cpp(app: Application) -> str:
     c.append("};")
     cause = f"E_{app.reset_cause.name}" if app.reset_cause is not None else "fsw::kNoElement"
     c.append(f"const fsw::ExecConfig kConfig FSW_FLASH = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock}};")
+    rows = " && ".join(f"fsw::exec_task_ok({t.divider}, 0)" for t in app.tasks) or "true"
+    c.append(f"static_assert(fsw::exec_config_ok(kPeriodUs) && {rows}, "
+             "\"a task table executor_begin refuses\");  // checked here, not at run time (fsw_app.h)")
     c.append("")
     c.append("}  // namespace")
     c.append("")
@@ -428,6 +432,37 @@ def _app_cpp(app: Application) -> str:
     c.append("#endif")
     c.append("")
     return "\n".join(c)
+
+
+# fsw_app.h AppFeature: (bit, name, whether the application uses it). The
+# task table always passes no safe function (kAppSafeFns) and is checked
+# here, when compiled (kAppTableChecks: the static_assert of its rows).
+APP_FEATURES = (
+    (0x01, "kAppParams", lambda app: bool(app_parameters(app))),
+    (0x02, "kAppLog", lambda app: app.log is not None),
+    (0x04, "kAppReload", lambda app: app.reload is not None),
+    (0x08, "kAppPyro", lambda app: bool(app.pyro)),
+    (0x10, "kAppSensors", lambda app: bool(app.sensors)),
+    (0x20, "kAppSvLock", lambda app: bool(app.sv.lock)),
+    (0x40, "kAppModeElems", lambda app: any(t.mode is not None for t in app.tasks)),
+    (0x80, "kAppMirrors", lambda app: any(t.overruns is not None or t.worst_us is not None for t in app.tasks)),
+    (0x400, "kAppSlowTasks", lambda app: any(t.divider > 1 for t in app.tasks)),
+)
+
+
+def _app_features(app: Application) -> list[str]:
+    """The runtime's constants for this application (fsw_app.h): the
+    features it uses and its base period, which LTO folds into the runtime
+    (the code of the others dropped, the cycle timer's settings worked out
+    when compiling)."""
+    used = [(bit, name) for bit, name, test in APP_FEATURES if test(app)]
+    bits = sum(bit for bit, _ in used)
+    names = " | ".join(f"fsw::{name}" for _, name in used) or "none"
+    return ["namespace fsw {",
+            "// What this application uses of the runtime's optional paths (fsw_app.h): LTO drops the rest",
+            f"extern const uint16_t app_features = 0x{bits:04x};  // {names}",
+            f"extern const uint32_t app_period_us = {1000000 // app.rate}UL;  // the executor's base period",
+            "}  // namespace fsw", ""]
 
 
 def _direct_step(t: Task, tables) -> tuple[str, str] | None:

@@ -1,6 +1,7 @@
 // The cooperative executor: a fixed-rate loop over a constant task table.
 #include "fsw_executor.h"
 
+#include "fsw_app.h"
 #include "fsw_element.h"
 #include "fsw_pal.h"
 
@@ -12,8 +13,12 @@ void read_task(const ExecConfig& c, uint8_t i, Task& t) { flash_read(&t, &c.task
 
 // Where a task's mode lives: its U8 element, else its TaskStats.
 uint8_t* mode_byte(const ExecConfig& c, const Task& t, uint8_t i) {
-    return t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
+    return app_has(kAppModeElems) && t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
 }
+
+// The base period: the application's constant where it has one (fsw_app.h),
+// else the configuration's.
+inline uint32_t base_period(uint32_t configured) { return app_period_us != 0 ? app_period_us : configured; }
 
 }  // namespace
 
@@ -26,18 +31,29 @@ ExecConfig executor_config(const Executor& ex) {
 Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     ExecConfig c;
     flash_read(&c, cfg, sizeof c);
-    if (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0))) return kErrConfig;
+    // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
+    const bool check = app_has(kAppTableChecks);
+    if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
     ex.cfg = cfg;
     uint8_t mirrors = 0;
+    // Where the application has no check, mirror, mode element nor slow task
+    // (fsw_app.h), a row's start mode is all there is to read of it.
+    const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);
     for (uint8_t i = 0; i < c.n_tasks; ++i) {
+        if (!whole_rows) {
+            TaskStats& s = c.stats[i];
+            memset(&s, 0, sizeof s);
+            s.mode = flash_get(c.tasks[i].init_mode);  // (its record: no mode element)
+            continue;
+        }
         Task t;
         read_task(c, i, t);
-        if (t.step == 0 || t.divider == 0 || t.phase >= t.divider) return kErrConfig;
-        if (c.sv == 0 && (t.mode_off != kNoElement || t.overruns_off != kNoElement ||
-                          t.worst_us_off != kNoElement)) {
+        if (check && (t.step == 0 || t.divider == 0 || t.phase >= t.divider)) return kErrConfig;
+        if (check && c.sv == 0 &&
+            (t.mode_off != kNoElement || t.overruns_off != kNoElement || t.worst_us_off != kNoElement)) {
             return kErrConfig;
         }
-        if (t.overruns_off != kNoElement || t.worst_us_off != kNoElement) mirrors = 1;
+        if (app_has(kAppMirrors) && (t.overruns_off != kNoElement || t.worst_us_off != kNoElement)) mirrors = 1;
         TaskStats& s = c.stats[i];
         memset(&s, 0, sizeof s);
         s.countdown = t.phase;
@@ -45,7 +61,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     }
     pal::begin();
 #if FSW_SLEEP
-    pal::cycle_timer_begin(c.period_us);
+    pal::cycle_timer_begin(base_period(c.period_us));  // worked out when compiling for a constant
 #endif
     memset(&ex, 0, sizeof ex);  // the counters (one clear: a store a field was 4 bytes of flash a byte)
     ex.cfg = cfg;
@@ -80,6 +96,18 @@ inline __attribute__((always_inline)) RowHead row_head(const Task* row) {
     static_assert(offsetof(Task, step) == 0 && offsetof(Task, ctx) == 4 && offsetof(Task, divider) == 6 &&
                       offsetof(Task, mode_off) == 10,
                   "row_head's loads follow the row's layout");
+    if (!app_has(kAppSlowTasks | kAppModeElems)) {  // (fsw_app.h) neither the divider nor the mode offset used
+        __asm__(
+            "lpm  %A[step], Z+\n\t"
+            "lpm  %B[step], Z+\n\t"
+            "adiw r30, 2\n\t"  // the safe function: read only for a safed task
+            "lpm  %A[ctx], Z+\n\t"
+            "lpm  %B[ctx], Z\n\t"
+            : [step] "=&r"(h.step), [ctx] "=&r"(h.ctx), "+z"(row));
+        h.divider = 1;
+        h.mode_off = kNoElement;
+        return h;
+    }
     __asm__(
         "lpm  %A[step], Z+\n\t"
         "lpm  %B[step], Z+\n\t"
@@ -114,7 +142,7 @@ inline __attribute__((always_inline)) uint32_t now_us() {
 // Where a task's mode lives, for a running cycle: its U8 element, else its
 // TaskStats (mode_byte without the copies of the configuration and the row).
 inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
-    return off != kNoElement ? flash_get(f.sv) + off : &s.mode;
+    return app_has(kAppModeElems) && off != kNoElement ? flash_get(f.sv) + off : &s.mode;
 }
 
 }  // namespace
@@ -146,12 +174,12 @@ void executor_run_cycle(Executor& ex) {
 #endif
     for (; row != end; ++row, ++sp) {  // a row and its record a turn
         TaskStats& s = *sp;
-        if (s.countdown != 0) {
+        if (app_has(kAppSlowTasks) && s.countdown != 0) {  // (else every task runs every cycle: 0 stays 0)
             --s.countdown;
             continue;
         }
         const RowHead h = row_head(row);
-        s.countdown = static_cast<uint16_t>(h.divider - 1u);
+        if (app_has(kAppSlowTasks)) s.countdown = static_cast<uint16_t>(h.divider - 1u);
         uint8_t* const mode_p = mode_at(f, h.mode_off, s);
         const uint8_t mode = *mode_p;
         if (mode == kModeDisabled) continue;
@@ -162,7 +190,7 @@ void executor_run_cycle(Executor& ex) {
                 s.last_fault = r;
                 if (s.faults != 0xFFu) ++s.faults;
             }
-        } else {
+        } else if (app_has(kAppSafeFns)) {
             const TaskSafeFn safe = flash_get(row->safe);
             if (safe != 0) safe(h.ctx);
         }
@@ -173,14 +201,17 @@ void executor_run_cycle(Executor& ex) {
         if (took > s.worst_us) s.worst_us = took;
         // A run within the base period is within the task's (divider >= 1):
         // the product, a 32-bit multiplication, only for the longer ones.
-        const uint32_t period_us = ex.period_us;
-        if (took > period_us && took > period_us * flash_get(row->divider) && s.overruns != 0xFFFFu) ++s.overruns;
+        const uint32_t period_us = base_period(ex.period_us);
+        if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
+            s.overruns != 0xFFFFu) {
+            ++s.overruns;
+        }
 #endif
-        if (ex.mirrors == 0) continue;  // no row has an element to mirror into
+        if (!app_has(kAppMirrors) || ex.mirrors == 0) continue;  // no row has an element to mirror into
         const ElemOff overruns_off = flash_get(row->overruns_off), worst_us_off = flash_get(row->worst_us_off);
         if (overruns_off != kNoElement || worst_us_off != kNoElement) {
             uint8_t* const sv = flash_get(f.sv);
-            const bool lock = flash_get(f.sv_lock);
+            const bool lock = app_has(kAppSvLock) && flash_get(f.sv_lock);
             const pal::IrqState saved = lock ? pal::critical_enter() : 0;
             if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, s.overruns);
             if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, s.worst_us);
@@ -219,8 +250,8 @@ bool executor_poll(Executor& ex, bool) {
     // time: it reads nothing else.
     const uint32_t late_by = pal::micros32() - ex.next_due_us;
     if (static_cast<int32_t>(late_by) < 0) return false;
-    uint32_t period;
-    flash_read(&period, &ex.cfg->period_us, sizeof period);
+    uint32_t period = app_period_us;
+    if (period == 0) flash_read(&period, &ex.cfg->period_us, sizeof period);
     if (late_by >= period) {
         if (ex.late != 0xFFFFu) ++ex.late;
         const uint32_t missed = late_by / period;  // cycle starts that passed unserved
@@ -234,6 +265,7 @@ bool executor_poll(Executor& ex, bool) {
 #endif
 
 uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
+    if (!app_has(kAppModeElems)) return flash_get(ex.cfg->stats)[i].mode;  // no task has a mode element
     const ExecConfig c = executor_config(ex);
     Task t;
     read_task(c, i, t);
@@ -241,6 +273,10 @@ uint8_t executor_task_mode(const Executor& ex, uint8_t i) {
 }
 
 void executor_set_task_mode(Executor& ex, uint8_t i, uint8_t mode) {
+    if (!app_has(kAppModeElems)) {  // no task has a mode element (fsw_app.h)
+        flash_get(ex.cfg->stats)[i].mode = mode;
+        return;
+    }
     const ExecConfig c = executor_config(ex);
     Task t;
     read_task(c, i, t);

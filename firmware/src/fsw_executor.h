@@ -95,6 +95,13 @@ inline uint64_t executor_cycles(const Executor& ex) {
     return n;
 }
 
+// What executor_begin checks of a table, for one checked when compiled
+// (generated code's static_assert; fsw_app.h kAppTableChecks): a base
+// period, and each row's divider and phase. (Its step, the task table and
+// the stats records are there by construction.)
+constexpr bool exec_config_ok(uint32_t period_us) { return period_us != 0; }
+constexpr bool exec_task_ok(uint16_t divider, uint16_t phase) { return divider != 0 && phase < divider; }
+
 // Validates the table (dividers, phases), sets every task's initial mode,
 // starts the platform, arms the watchdog, captures the reset cause. The
 // first cycle is due at once. `cfg` points at an FSW_FLASH object that

@@ -1,6 +1,7 @@
 // Analog and digital I/O task bodies: one pass over a constant channel table.
 #include "fsw_io.h"
 
+#include "fsw_app.h"
 #include "fsw_element.h"
 #include "fsw_pal.h"
 
@@ -73,6 +74,7 @@ template <bool kAnyF64, bool kOutputs>
 Result analog_task(void* ctx) {
     AnalogTable tab;
     flash_read(&tab, ctx, sizeof tab);
+    const bool lock = app_has(kAppSvLock) && tab.lock;  // (fsw_app.h)
     for (uint8_t i = 0; i < tab.n; ++i) {
         AnalogChannel c;
         flash_read(&c, &tab.ch[i], sizeof c);
@@ -91,15 +93,15 @@ Result analog_task(void* ctx) {
                 count = pal::analog_read(c.pin);  // slow: ~100 us on AVR; before taking the lock
             }
             const Real v = analog_value(count, c.gain, c.offset);
-            const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
+            const pal::IrqState saved = lock ? pal::critical_enter() : 0;
             // Analog elements are F32 or F64 (checked at begin): no general
             // dispatch, which would link every type's conversions.
             if (kAnyF64 && c.type == kF64) write_F64(p, v); else write_F32(p, v);
-            if (tab.lock) pal::critical_exit(saved);
+            if (lock) pal::critical_exit(saved);
         } else {
-            const pal::IrqState saved = tab.lock ? pal::critical_enter() : 0;
+            const pal::IrqState saved = lock ? pal::critical_enter() : 0;
             const Real volts = (kAnyF64 && c.type == kF64) ? read_F64(p) : read_F32(p);
-            if (tab.lock) pal::critical_exit(saved);
+            if (lock) pal::critical_exit(saved);
             pal::analog_write(c.pin, pwm_duty_from_volts(volts, tab.vref));
         }
     }

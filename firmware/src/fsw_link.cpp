@@ -4,6 +4,7 @@
 // the UART.
 #include "fsw_link.h"
 
+#include "fsw_app.h"
 #include "fsw_cobs.h"
 #include "fsw_crc.h"
 #include "fsw_element.h"
@@ -167,9 +168,14 @@ void take_sample(Link& l, const Sampling& c, const LinkStream& s, uint8_t i, uin
     send_batch(l, c, s, st, i, true);
 }
 
+// The state vector's `lock` option (fsw_app.h: never, where the application has none).
+inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
+    return app_has(kAppSvLock) && flash_get(c.lock);
+}
+
 // The parameter store's source byte of hello and health frames.
-uint8_t param_source(const LinkConfig& c) {
-    const ParamStore* const params = flash_get(c.params);
+inline __attribute__((always_inline)) uint8_t param_source(const LinkConfig& c) {
+    const ParamStore* const params = app_has(kAppParams) ? flash_get(c.params) : 0;
     return params != 0 ? params->source : static_cast<uint8_t>(kParamNone);
 }
 
@@ -180,20 +186,22 @@ uint8_t param_source(const LinkConfig& c) {
 // reach is on this path (a copy was 54 of the rocket's 192 bytes).
 FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     const uint64_t t = flash_get(c.now)();
-    uint8_t tb[8];  // t, little-endian: the header takes the low half, hello and health the high half
-    memcpy(tb, &t, sizeof tb);
+    // t's bytes, little-endian (fsw_config.h): the header takes the low half, hello and health the
+    // high half (read where t lies: no copy of it on the stack)
+    const uint8_t* const tb = reinterpret_cast<const uint8_t*>(&t);
     frame_begin(l, type, tb);
     const Executor& ex = *flash_get(c.ex);
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
         put_bytes(&l.n.last_seq, 2);
-        ParamStore* const params = flash_get(c.params);
+        // what the application has of the stores (fsw_app.h), and of those what the configuration names
+        ParamStore* const params = app_has(kAppParams) ? flash_get(c.params) : 0;
         const LinkParamAckFn param_ack = flash_get(c.param_ack);
         if (params != 0 && param_ack != 0) param_ack(l, *params);
-        Recorder* const log = flash_get(c.log);
+        Recorder* const log = app_has(kAppLog) ? flash_get(c.log) : 0;
         const LinkLogAckFn log_ack = flash_get(c.log_ack);
         if (log != 0 && log_ack != 0) log_ack(l, *log);
-        ReloadStore* const reload = flash_get(c.reload);
+        ReloadStore* const reload = app_has(kAppReload) ? flash_get(c.reload) : 0;
         const LinkReloadAckFn reload_ack = flash_get(c.reload_ack);
         if (reload != 0 && reload_ack != 0) reload_ack(l, *reload);
     } else if (type == kFrameHello) {
@@ -220,7 +228,8 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         const uint8_t* const sv = flash_get(ec.sv);
         for (uint8_t i = 0; i < n_tasks; ++i) {
             const TaskStats& s = stats[i];
-            const ElemOff mode_off = flash_get(tasks[i].mode_off);  // the task's mode: its element, or its record
+            const ElemOff mode_off =  // the task's mode: its element, or its record
+                app_has(kAppModeElems) ? flash_get(tasks[i].mode_off) : static_cast<ElemOff>(kNoElement);
             const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
             const uint8_t row[6] = {mode_off != kNoElement ? sv[mode_off] : s.mode,
                                     s.faults,  // saturates at 255
@@ -228,16 +237,20 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
                                     static_cast<uint8_t>(worst), static_cast<uint8_t>(worst >> 8)};
             put_bytes(row, sizeof row);
         }
-        const PyroGate* const pyro = flash_get(c.pyro);
-        const uint8_t n_pyro = flash_get(c.n_pyro);
-        for (uint8_t i = 0; i < n_pyro; ++i) put(pyro[i].status);  // kPyro* bits (fsw_io.h)
-        for (uint8_t i = 0; i < l.n_sensors; ++i) put(l.sensors[i]);  // kSensor* codes (fsw_sensor.h)
+        if (app_has(kAppPyro)) {
+            const PyroGate* const pyro = flash_get(c.pyro);
+            const uint8_t n_pyro = flash_get(c.n_pyro);
+            for (uint8_t i = 0; i < n_pyro; ++i) put(pyro[i].status);  // kPyro* bits (fsw_io.h)
+        }
+        if (app_has(kAppSensors)) {
+            for (uint8_t i = 0; i < l.n_sensors; ++i) put(l.sensors[i]);  // kSensor* codes (fsw_sensor.h)
+        }
     } else {
         const uint16_t off = l.snapshot_at, sv_size = flash_get(c.sv_size), chunk = flash_get(c.snapshot_chunk);
         uint16_t n = static_cast<uint16_t>(sv_size - off);
         if (n > chunk) n = chunk;
         put_u16(off);
-        put_sv(flash_get(c.sv), flash_get(c.lock), off, n);
+        put_sv(flash_get(c.sv), sv_lock(c), off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
     frame_end(l, true);
@@ -284,6 +297,7 @@ void service(Link& l, const LinkConfig& c, bool big) {
 FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
     const ExecConfig& ec = *flash_get(c.ex)->cfg;  // FSW_FLASH: the fields, one at a time
     if (off == flash_get(ec.reset_cause_off)) return true;
+    if (!app_has(kAppModeElems | kAppMirrors)) return false;  // no task has an element (fsw_app.h)
     const uint8_t n_tasks = flash_get(ec.n_tasks);
     const Task* const tasks = flash_get(ec.tasks);
     for (uint8_t i = 0; i < n_tasks; ++i) {
@@ -307,7 +321,7 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
         if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
         if (executor_owns(c, w.off)) return kAckLocked;
         uint8_t* const p = flash_get(c.sv) + w.off;
-        const bool lock = flash_get(c.lock);
+        const bool lock = sv_lock(c);
         const pal::IrqState saved = lock ? pal::critical_enter() : 0;
         memcpy(p, a + 2, size);
         if (w.type == kBool) *p = *p != 0 ? 1 : 0;  // a bool is stored as 0 or 1
@@ -319,19 +333,20 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
 
 FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
     if (op == kOpSet) return apply_set(c, a, alen);
-    if (op >= kOpParamGet && op <= kOpParamInfo) {
+    // a store's commands; without the store (fsw_app.h, or none named): UNKNOWN_OP below
+    if (app_has(kAppParams) && op >= kOpParamGet && op <= kOpParamInfo) {
         ParamStore* const params = flash_get(c.params);
         const LinkParamApplyFn param_apply = flash_get(c.param_apply);
         if (params == 0 || param_apply == 0) return kAckUnknownOp;
         return param_apply(l, *params, op, a, alen);
     }
-    if (op >= kOpLogInfo && op <= kOpLogErase) {
+    if (app_has(kAppLog) && op >= kOpLogInfo && op <= kOpLogErase) {
         Recorder* const log = flash_get(c.log);
         const LinkLogApplyFn log_apply = flash_get(c.log_apply);
         if (log == 0 || log_apply == 0) return kAckUnknownOp;
         return log_apply(l, *log, op, a, alen);
     }
-    if (op >= kOpMachineInfo && op <= kOpMachineActivate) {
+    if (app_has(kAppReload) && op >= kOpMachineInfo && op <= kOpMachineActivate) {
         ReloadStore* const reload = flash_get(c.reload);
         const LinkReloadApplyFn reload_apply = flash_get(c.reload_apply);
         if (reload == 0 || reload_apply == 0) return kAckUnknownOp;
@@ -344,7 +359,8 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
         if (a[1] > kModeEnabled) return kAckBadMode;
         // the uplink task (the ground would lock itself out) and the task that ends the pyro
         // pulses (a pin high then would stay high) run always
-        if ((a[0] == flash_get(c.uplink_task) || a[0] == flash_get(c.pyro_task)) && a[1] != kModeEnabled)
+        if ((a[0] == flash_get(c.uplink_task) || (app_has(kAppPyro) && a[0] == flash_get(c.pyro_task))) &&
+            a[1] != kModeEnabled)
             return kAckLocked;
         executor_set_task_mode(ex, a[0], a[1]);
         return kAckOk;
@@ -400,12 +416,11 @@ void link_begin(Link& l, const LinkConfig* cfg) {
     const LinkStream* const streams = flash_get(c.streams);
     LinkStreamState* const states = flash_get(c.stream_state);
     for (uint8_t i = 0; i < n_streams; ++i) {
-        LinkStream s;
-        flash_read(&s, &streams[i], sizeof s);
+        const uint16_t every = flash_get(streams[i].every);  // (the row's one field used here)
         LinkStreamState& st = states[i];
         memset(&st, 0, sizeof st);
         uint16_t first = i;  // i mod every: streams of equal rate take turns
-        while (first >= s.every) first = static_cast<uint16_t>(first - s.every);
+        while (first >= every) first = static_cast<uint16_t>(first - every);
         st.countdown = first;
     }
     l.tx = flash_get(c.tx);
@@ -448,7 +463,7 @@ Result link_telemetry_task(void* p) {
             c.sv = flash_get(f.sv);
             c.ex = flash_get(f.ex);
             c.states = states;
-            c.lock = flash_get(f.lock);
+            c.lock = sv_lock(f);
             now32 = static_cast<uint32_t>(flash_get(f.now)());
             have_c = true;
         }

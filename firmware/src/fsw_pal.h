@@ -4,6 +4,7 @@
 #ifndef FSW_PAL_H
 #define FSW_PAL_H
 
+#include "fsw_app.h"
 #include "fsw_types.h"
 
 #if defined(__AVR__)
@@ -144,18 +145,58 @@ void critical_exit(IrqState saved);
 #if !defined(TIMSK1) || !defined(OCIE1B) || !defined(WGM12)
 #error "fswkit: the sleeping executor needs a 16-bit Timer1 with two compare units: set FSW_SLEEP=0"
 #endif
+// The timer's settings for a base period: a cycle of P us is n equal
+// sub-periods of P / n us, n the smallest power of two with P / n <= 32000
+// (P = 2^a 5^b, a divisor of 1000000: n <= 32), each ended by OCR1A.
+struct CycleSettings {
+    uint16_t sub_us;    // a sub-period, us; as whole ms + us:
+    uint16_t sub_ms;
+    uint16_t sub_frac;
+    uint16_t top;       // OCR1A: sub_us in ticks, less one
+    uint16_t early;     // OCR1B: the count where the CPU wakes to spin
+    uint16_t quiet;     // the count after which the last sub-period starts no background work
+    uint8_t last;       // n - 1
+    uint8_t spin;       // period too short to sleep in: spin from mid-period
+};
+// For the periods cycle_timer_begin takes (1..1000000 us, a divisor of
+// 1000000: at most five halvings), without a loop (the halvings as a
+// choice): folded whole for a constant.
+inline __attribute__((always_inline)) CycleSettings cycle_settings(uint32_t period_us) {
+    const uint32_t m = 32000u;  // the longest sub-period: x 2 ticks fits OCR1A; sums below fit 16 bits
+    const uint8_t k = period_us > 16u * m ? 5u : period_us > 8u * m ? 4u : period_us > 4u * m ? 3u
+                      : period_us > 2u * m ? 2u : period_us > m ? 1u : 0u;
+    CycleSettings c;
+    c.sub_us = static_cast<uint16_t>(period_us >> k);
+    c.sub_ms = static_cast<uint16_t>(c.sub_us / 1000u);
+    c.sub_frac = static_cast<uint16_t>(c.sub_us % 1000u);
+    c.top = static_cast<uint16_t>(c.sub_us * FSW_T1_TICKS_PER_US - 1u);
+    const uint16_t early_ticks = FSW_WAKE_EARLY_US * FSW_T1_TICKS_PER_US;
+    c.spin = c.top < 4u * early_ticks;
+    c.early = c.spin ? static_cast<uint16_t>(c.top / 2u + 1u) : static_cast<uint16_t>(c.top - early_ticks);
+    const uint16_t guard_ticks = FSW_BACKGROUND_GUARD_US * FSW_T1_TICKS_PER_US;
+    c.quiet = c.early > guard_ticks ? static_cast<uint16_t>(c.early - guard_ticks) : 0u;
+    c.last = static_cast<uint8_t>((1u << k) - 1u);
+    return c;
+}
+// The running period's settings: where the application's base period is a
+// constant (fsw_app.h app_period_us) each is a constant LTO folds into its
+// uses, and g_cs is dropped; else cycle_timer_begin keeps them in g_cs.
+extern CycleSettings g_cs;
+#define FSW_CYCLE_SETTING(field) (app_period_us != 0 ? cycle_settings(app_period_us).field : g_cs.field)
+inline __attribute__((always_inline)) uint16_t ct_sub_us() { return FSW_CYCLE_SETTING(sub_us); }
+inline __attribute__((always_inline)) uint16_t ct_sub_ms() { return FSW_CYCLE_SETTING(sub_ms); }
+inline __attribute__((always_inline)) uint16_t ct_sub_frac() { return FSW_CYCLE_SETTING(sub_frac); }
+inline __attribute__((always_inline)) uint16_t ct_early() { return FSW_CYCLE_SETTING(early); }
+inline __attribute__((always_inline)) uint16_t ct_quiet() { return FSW_CYCLE_SETTING(quiet); }
+inline __attribute__((always_inline)) uint8_t ct_last() { return FSW_CYCLE_SETTING(last); }
+inline __attribute__((always_inline)) uint8_t ct_spin() { return FSW_CYCLE_SETTING(spin); }
+#undef FSW_CYCLE_SETTING
+
 struct CycleTimer {
     uint32_t base_us;   // the clock at the start of the running sub-period
     uint32_t ms;        // milliseconds at that start, and the microseconds past them
     uint16_t ms_frac;   //   (< 1000)
-    uint16_t sub_us;    // a sub-period, us; as whole ms + us:
-    uint16_t sub_ms;
-    uint16_t sub_frac;
-    uint16_t early;     // OCR1B: the count where the CPU wakes to spin
-    uint16_t quiet;     // the count after which the last sub-period starts no background work
     uint8_t sub;        // sub-periods ended in this cycle
-    uint8_t last;       // n - 1
-    uint8_t spin;       // period too short to sleep in: spin from mid-period
     volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
     volatile uint8_t why;       // why the first of them was missed (CycleWait)
     volatile uint8_t running;   // a cycle's tasks are running
@@ -169,7 +210,7 @@ extern CycleTimer g_ct;
 // would cost micros32() (once per task run) half its 89 cycles.
 inline __attribute__((always_inline)) uint16_t cycle_elapsed_us(bool& wrapped) {
     const uint16_t t = TCNT1;
-    wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < g_ct.early;
+    wrapped = (TIFR1 & _BV(OCF1A)) != 0 && t < ct_early();
     return static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
 }
 // micros32(), inline: the executor's one clock read a task run (a call of
@@ -180,7 +221,7 @@ inline __attribute__((always_inline)) uint32_t micros32_inline() {
     bool wrapped;
     const uint16_t us = cycle_elapsed_us(wrapped);
     uint32_t t = g_ct.base_us + us;
-    if (wrapped) t += g_ct.sub_us;
+    if (wrapped) t += ct_sub_us();
     critical_exit(saved);
     return t;
 }

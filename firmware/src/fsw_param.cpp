@@ -3,6 +3,7 @@
 // the EEPROM whenever it is ready, so that nothing waits for it.
 #include "fsw_param.h"
 
+#include "fsw_app.h"
 #include "fsw_crc.h"
 #include "fsw_pal.h"
 
@@ -87,13 +88,13 @@ bool state_allows(const ParamConfig& c, const ParamDef& d) {
 }
 
 void set_bytes(const ParamConfig& c, const ParamDef& d, const uint8_t* v) {
-    const bool lock = flash_get(c.lock);
+    const bool lock = app_has(kAppSvLock) && flash_get(c.lock);  // (fsw_app.h)
     const pal::IrqState saved = lock ? pal::critical_enter() : 0;
     memcpy(d.ptr, v, elem_size(d.type));
     if (lock) pal::critical_exit(saved);
 }
 void get_bytes(const ParamConfig& c, const ParamDef& d, uint8_t* v) {
-    const bool lock = flash_get(c.lock);
+    const bool lock = app_has(kAppSvLock) && flash_get(c.lock);  // (fsw_app.h)
     const pal::IrqState saved = lock ? pal::critical_enter() : 0;
     memcpy(v, d.ptr, elem_size(d.type));
     if (lock) pal::critical_exit(saved);

@@ -5,6 +5,7 @@
 #include "fsw_config.h"
 #include "fsw_version.h"
 #include "fsw_types.h"
+#include "fsw_app.h"
 #include "fsw_f64.h"
 #include "fsw_convert.h"
 #include "fsw_element.h"

@@ -80,29 +80,31 @@ void boot() {
 #if FSW_SLEEP
 // ---- The cycle timer: Timer1 (16-bit) in CTC mode, clk/8 ---------------------
 // A cycle of P us is n equal sub-periods of S = P / n us (n the smallest
-// power of two with S <= kMaxSubUs); OCR1A = S x ticks/us - 1 ends each, its
+// power of two with S <= 32000: cycle_settings, fsw_pal.h); OCR1A = S x ticks/us - 1 ends each, its
 // compare interrupt (or cycle_wait(), when it waits for it) counts them and
 // keeps the clock. OCR1B wakes the CPU FSW_WAKE_EARLY_US before a sub-period
 // ends; in the last one cycle_wait() then spins, interrupts off, until the
 // count wraps, so a cycle starts within one spin (8 CPU cycles) of its time,
 // whatever handler ran when the CPU woke.
 CycleTimer g_ct;  // (fsw_pal.h)
+CycleSettings g_cs;
 
 namespace {
-const uint16_t kMaxSubUs = 32000u;  // x 2 ticks fits OCR1A; sums below fit 16 bits
 
 // A sub-period ended (compare interrupt, or cycle_wait() that waited for it,
 // interrupts off): the clock moves on; true when a cycle is due.
 __attribute__((noinline)) bool sub_period_ended() {
-    g_ct.base_us += g_ct.sub_us;
-    g_ct.ms += g_ct.sub_ms;
-    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + g_ct.sub_frac);
-    if (f >= 1000u) {
-        f = static_cast<uint16_t>(f - 1000u);
-        ++g_ct.ms;
+    g_ct.base_us += ct_sub_us();
+    g_ct.ms += ct_sub_ms();
+    if (ct_sub_frac() != 0) {  // (else ms_frac stays 0: a sub-period of whole milliseconds)
+        uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + ct_sub_frac());
+        if (f >= 1000u) {
+            f = static_cast<uint16_t>(f - 1000u);
+            ++g_ct.ms;
+        }
+        g_ct.ms_frac = f;
     }
-    g_ct.ms_frac = f;
-    if (g_ct.sub != g_ct.last) {
+    if (ct_last() != 0 && g_ct.sub != ct_last()) {  // (one sub-period a cycle: `sub` stays 0)
         ++g_ct.sub;
         return false;
     }
@@ -113,38 +115,23 @@ __attribute__((noinline)) bool sub_period_ended() {
 }  // namespace
 
 void cycle_timer_begin(uint32_t period_us) {
-    // P = 2^a 5^b (a divisor of 1000000): halving it at most five times
-    // gives whole sub-periods of at most kMaxSubUs (1000000 / 32 = 31250).
-    uint8_t n = 1;
-    while (period_us > kMaxSubUs) {
-        period_us >>= 1;
-        n = static_cast<uint8_t>(n << 1);
-    }
-    const uint16_t sub_us = static_cast<uint16_t>(period_us);
-    const uint16_t top = static_cast<uint16_t>(sub_us * FSW_T1_TICKS_PER_US - 1u);
-    const uint16_t early_ticks = FSW_WAKE_EARLY_US * FSW_T1_TICKS_PER_US;
+    // (for the application's constant period, worked out when compiling)
+    const CycleSettings s = cycle_settings(period_us);
     const IrqState saved = critical_enter();
     // The clock counts from here; the cycle's sub-period count, the reasons
     // and `running` start at 0 (one clear: a store a field was 4 bytes of
     // flash a byte).
     memset(&g_ct, 0, sizeof g_ct);
-    g_ct.sub_us = sub_us;
-    g_ct.sub_ms = static_cast<uint16_t>(sub_us / 1000u);
-    g_ct.sub_frac = static_cast<uint16_t>(sub_us % 1000u);
-    g_ct.spin = top < 4u * early_ticks;
-    g_ct.early = g_ct.spin ? static_cast<uint16_t>(top / 2u + 1u) : static_cast<uint16_t>(top - early_ticks);
-    const uint16_t guard_ticks = FSW_BACKGROUND_GUARD_US * FSW_T1_TICKS_PER_US;
-    g_ct.quiet = g_ct.early > guard_ticks ? static_cast<uint16_t>(g_ct.early - guard_ticks) : 0u;
-    g_ct.last = static_cast<uint8_t>(n - 1u);
+    if (app_period_us == 0) g_cs = s;  // else each is a constant where it is read (ct_*)
     g_ct.due = 1;  // the first cycle: at once, on time (why: kCycleOnTime, 0)
     TIMSK0 = static_cast<uint8_t>(TIMSK0 & ~_BV(TOIE0));  // the core's millis() stops here
     TCCR1A = 0;
     TCCR1B = 0;
     TCNT1 = 0;
-    OCR1A = top;
-    OCR1B = g_ct.early;
+    OCR1A = s.top;
+    OCR1B = s.early;
     TIFR1 = static_cast<uint8_t>(_BV(OCF1A) | _BV(OCF1B));  // writing 1 clears a flag
-    TIMSK1 = static_cast<uint8_t>(_BV(OCIE1A) | (g_ct.spin ? 0 : _BV(OCIE1B)));
+    TIMSK1 = static_cast<uint8_t>(_BV(OCIE1A) | (s.spin ? 0 : _BV(OCIE1B)));
     TCCR1B = static_cast<uint8_t>(_BV(WGM12) | _BV(CS11));  // CTC on OCR1A, clk/8: counting
     critical_exit(saved);
 }
@@ -162,9 +149,9 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             sei();
             return why;
         }
-        if (g_ct.sub == g_ct.last && TCNT1 >= g_ct.early) {
+        if ((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_early()) {
             // The last stretch, interrupts off: until the count wraps to 0.
-            while (TCNT1 >= g_ct.early) {
+            while (TCNT1 >= ct_early()) {
             }
             TIFR1 = _BV(OCF1A);  // this sub-period's end is counted here
             (void)sub_period_ended();
@@ -176,7 +163,7 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
         // Background work (the link's service, the EEPROM writers) between
         // cycles, but none started in the last FSW_BACKGROUND_GUARD_US before
         // one: a pass that began there could hold the CPU past its start.
-        if (g_ct.spin || (pass != 0 && background && !(g_ct.sub == g_ct.last && TCNT1 >= g_ct.quiet))) {
+        if (ct_spin() || (pass != 0 && background && !((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_quiet()))) {
             sei();
             return kCycleNotDue;
         }
@@ -209,11 +196,12 @@ FSW_NOINLINE uint32_t micros32() { return micros32_inline(); }  // out of line a
 uint32_t millis32() {
     const IrqState saved = critical_enter();
     bool wrapped;
-    uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
+    const uint16_t frac = ct_sub_frac() != 0 ? g_ct.ms_frac : 0u;  // (stays 0 for whole milliseconds)
+    uint16_t f = static_cast<uint16_t>(frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
     uint32_t ms = g_ct.ms;
     if (wrapped) {
-        ms += g_ct.sub_ms;
-        f = static_cast<uint16_t>(f + g_ct.sub_frac);
+        ms += ct_sub_ms();
+        f = static_cast<uint16_t>(f + ct_sub_frac());
     }
     critical_exit(saved);
     while (f >= 1000u) {  // at most 33 times

@@ -51,6 +51,13 @@ def compile_together(board: Board, cases: list[dict[str, str]], folder: str) -> 
     lines = ["#include <Arduino.h>", '#include "fswkit.h"'] if board.is_avr else \
         [f"#include {h}" for h in NATIVE_HEADERS]
     for k, files in enumerate(cases):
+        # The application's constants (fsw_app.h), which the generated file
+        # defines in the runtime's own namespace: inside the case's they would
+        # open a `fsw` of its own, which hides the runtime's from the case's
+        # code, and repeat case after case. Checked in a namespace of their own.
+        files = {name: re.sub(r"^namespace fsw \{(?=\n// What this application uses)", f"namespace fsw_app{k} {{",
+                              text, flags=re.M)
+                 for name, text in files.items()}
         cpp = write(files, os.path.join(folder, f"c{k}"))
         lines.append(f"namespace case{k} {{")
         for name, text in sorted(files.items()):

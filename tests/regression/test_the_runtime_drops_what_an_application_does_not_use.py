@@ -1,0 +1,129 @@
+"""The rocket as the 8 KB target measured it (examples/rocket without its
+recorder, parameters and pyro channels: tools/bench_firmware.py core) linked
+the runtime's code for everything any application may have: the link's
+parameter, recorder and reload commands, the pyro and sensor bytes of health
+frames, the state vector's lock, the executor's mode elements, element
+mirrors, safe functions and table checks; and it worked the cycle timer's
+settings out at boot (a division routine, 13 B of RAM holding them): 12,470 B
+of flash and 783 B of RAM, the whole rocket 24,034 B. Now the generated code
+defines what the application uses and its base period (fsw_app.h
+`app_features`, `app_period_us`), constants LTO folds into the runtime,
+which drops the rest; the link answers as it did (a command of a store the
+firmware has not: UNKNOWN_OP), and a program that does not define them (the
+runtime's tests, a hand-written sketch) gets every feature."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import struct
+import subprocess
+import sys
+
+import pytest
+
+from conftest import EXAMPLES, ROOT, run_fsw
+from fswkit.autocode import protocol as P
+from fswkit.link import wire
+from fswkit.link.session import Session
+from support.linkfw import tank_layout
+
+sim = pytest.importorskip("fswkit.sim.board")
+pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
+                                reason="gcc-avr / simavr not installed")
+
+ROCKET = EXAMPLES / "rocket"
+# What the core rocket takes now (12,470 B and 783 B before): flash, and
+# .data + .bss + .noinit.
+CORE_FLASH_MAX = 10_970
+CORE_RAM_MAX = 771
+
+
+def _core_project(tmp_path):
+    """A copy of examples/rocket as the target measured it (the benchmark's own edit of it)."""
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        from bench_firmware import without_later_features
+    finally:
+        sys.path.pop(0)
+    project = tmp_path / "rocket"
+    shutil.copytree(ROCKET, project, ignore=shutil.ignore_patterns("build"))
+    without_later_features(str(project))
+    return project
+
+
+@pytest.fixture(scope="module")
+def core(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("core")
+    project = _core_project(tmp)
+    r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
+    assert r.code == 0, r.err
+    return project, tmp / "uno"
+
+
+def _features(gen_dir) -> tuple[int, int]:
+    text = (gen_dir / "app.gen.cpp").read_text()
+    feats = re.search(r"extern const uint16_t app_features = 0x([0-9a-f]{4});", text)
+    period = re.search(r"extern const uint32_t app_period_us = (\d+)UL;", text)
+    assert feats and period, text[:2000]
+    return int(feats.group(1), 16), int(period.group(1))
+
+
+def test_the_generated_code_says_what_the_application_uses(core, tmp_path):
+    assert _features(core[1] / "gen") == (0, 10_000)
+    r = run_fsw("gen", str(ROCKET), "--out", str(tmp_path / "gen"))
+    assert r.code == 0, r.err
+    # kAppParams | kAppLog | kAppPyro (fsw_app.h), at 100 Hz
+    assert _features(tmp_path / "gen") == (0x01 | 0x02 | 0x08, 10_000)
+
+
+def test_the_core_rocket_takes_what_it_needs(core):
+    sizes = subprocess.run(["avr-size", "-A", str(core[1] / "rocket.elf")], capture_output=True, text=True,
+                           check=True).stdout
+    sec = {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\.\w+)\s+(\d+)", sizes, re.M)}
+    flash = sec[".text"] + sec[".data"]
+    ram = sec[".data"] + sec[".bss"] + sec.get(".noinit", 0)
+    assert flash <= CORE_FLASH_MAX and ram <= CORE_RAM_MAX, (flash, ram)
+    nm = subprocess.run(["avr-nm", "-C", str(core[1] / "rocket.elf")], capture_output=True, text=True,
+                        check=True).stdout
+    # the cycle timer's settings folded: neither kept in RAM nor divided out at boot
+    assert "g_cs" not in nm and "__udivmodhi4" not in nm, nm
+
+
+def test_the_link_answers_as_it_did(core):
+    project, out = core
+    lay = tank_layout(project)
+    s = Session(lay)
+    with sim.SimBoard(str(out / "rocket.elf"), "uno", analog={"A0": 0.5, "A1": 1.25, "A2": 2.5, "A3": 2.5},
+                      sim_limit=60, wall_limit=120) as b:
+        b.run_for(1.5)
+        s.feed(b.uart_read())
+        assert s.hello is not None and s.hello["schema_ok"]
+        assert s.hello["params"] == 0  # no parameter store: kParamNone
+        seq = s.hello["last_seq"]
+        tasks = [name for name, _ in lay.tasks]
+        act = tasks.index("act")
+        commands = [
+            (P.OP_PARAM_INFO, b"", "UNKNOWN_OP"), (P.OP_PARAM_GET, bytes((0, 1)), "UNKNOWN_OP"),
+            (P.OP_LOG_INFO, b"", "UNKNOWN_OP"), (P.OP_MACHINE_INFO, b"", "UNKNOWN_OP"),
+            (P.OP_MODE, bytes((tasks.index("uplink"), 1)), "LOCKED"),  # the uplink task runs always
+            (P.OP_MODE, bytes((act, 1)), "OK"),  # no pyro channel: the outputs task may be safed ...
+            (P.OP_MODE, bytes((act, 2)), "OK"),  # ... and enabled again
+            (P.OP_MODE, bytes((len(tasks), 2)), "BAD_TASK"),
+            (P.OP_SET, struct.pack("<HB", lay.element("abortCmd").index, 0), "OK"),
+            (P.OP_SET, struct.pack("<HB", lay.element("resetCause").index, 0), "NOT_WRITABLE"),
+            (P.OP_SNAPSHOT, b"", "OK"),
+        ]
+        for k, (op, args, _) in enumerate(commands, start=1):  # one at a time: one ack waits at a time
+            b.uart_write(wire.uplink(op, seq + k, args))
+            b.run_for(0.1)
+            s.feed(b.uart_read())
+        b.run_for(1.5)  # a health frame after the last command
+        s.feed(b.uart_read())
+    acks = {a["cmd_seq"]: a["status_name"] for a in s.acks}
+    assert acks == {seq + k: want for k, (_, _, want) in enumerate(commands, start=1)}, acks
+    assert s.stats.lost == 0
+    h = s.health
+    assert h is not None and h["params"] == 0 and h["pyro"] == [] and h["sensors"] == [], h
+    assert [t["mode_name"] for t in h["tasks"]] == ["enabled"] * len(tasks), h["tasks"]
+    assert h["rx_refused"] >= 2 and h["rx_malformed"] >= 4, h

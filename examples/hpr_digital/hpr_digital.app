@@ -54,7 +54,7 @@ element altitude delta=0.5
 element state
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
-flash 27648            # 27,136 until the inputs' memo and the cheaper flight save (+414 B, 2026-12-07)
+flash 27136
 ram   1920
 
 [pyro]

@@ -33,10 +33,11 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which(
                                 reason="gcc-avr / simavr not installed")
 
 ROCKET = EXAMPLES / "rocket"
-# What the core rocket takes now (12,470 B and 783 B before): flash, and
-# .data + .bss + .noinit.
-CORE_FLASH_MAX = 10_970
-CORE_RAM_MAX = 771
+# What the core rocket takes now (12,470 B and 783 B before; 10,970 B and
+# 771 B with this change alone, before the inputs kept their last
+# conversion, docs/runtime.md): flash, and .data + .bss + .noinit.
+CORE_FLASH_MAX = 11_220
+CORE_RAM_MAX = 795
 
 
 def _core_project(tmp_path):

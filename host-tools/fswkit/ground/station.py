@@ -173,10 +173,18 @@ class Station:
     def notes(self, fn) -> None:
         self._note_listeners.append(fn)
 
+    def unnotes(self, fn) -> None:
+        if fn in self._note_listeners:
+            self._note_listeners.remove(fn)
+
     def commands(self, fn) -> None:
         """`fn(entry)` after every command of every client: who, text,
         status, ok, words, host_time."""
         self._command_listeners.append(fn)
+
+    def uncommands(self, fn) -> None:
+        if fn in self._command_listeners:
+            self._command_listeners.remove(fn)
 
     def _archive(self, what: str, *args, **kw) -> None:
         """The archive's `what` (rx, event, tick, ...). An archive that cannot

@@ -104,8 +104,18 @@ class Source:
         self.publish_all([json.dumps(msg)])
 
     def publish_threadsafe(self, msg: dict) -> None:
-        if self.loop is not None:
-            self.loop.call_soon_threadsafe(self.publish, msg)
+        self.soon(self.publish, msg)
+
+    def soon(self, fn, *args) -> None:
+        """`fn(*args)` on the loop, from another thread (the station's). A
+        call that races the loop's closing (the page's server stopped) is
+        dropped: there is no page left to tell."""
+        if self.loop is None:
+            return
+        try:
+            self.loop.call_soon_threadsafe(fn, *args)
+        except RuntimeError:  # the loop is closed
+            pass
 
     def publish_all(self, texts: list) -> None:
         """Messages already encoded (JSON text; several joined by commas go as
@@ -184,11 +194,12 @@ class LiveSource(Source):
         def add():
             self.history.append(entry)
             self.publish(entry)
-        if self.loop is not None:
-            self.loop.call_soon_threadsafe(add)
+        self.soon(add)
 
     async def stop(self) -> None:
         self.station.unlisten(self._events)
+        self.station.unnotes(self._note)
+        self.station.uncommands(self._commanded)
 
     def _note(self, text: str, up: bool) -> None:
         self.note = text
@@ -204,7 +215,7 @@ class LiveSource(Source):
             return
         texts = [m for m in (_text(ev, self.layout) for ev in evs) if m is not None]
         if texts:  # one wake-up of the loop and one message of each queue for the chunk's frames
-            self.loop.call_soon_threadsafe(self.publish_all, [",".join(texts)])
+            self.soon(self.publish_all, [",".join(texts)])
 
     def _command(self, who: str, op: int, args: bytes, text: str) -> dict:
         from fswkit.link.client import LinkTimeout

@@ -63,7 +63,7 @@ def cmd_import(args) -> int:
 def cmd_truth(args) -> int:
     from fswkit.outputs import OutputError, check, output
     from fswkit.tape import TapeError, read_tape, truth_path
-    from fswkit.tape.truth import compute, format_truth
+    from fswkit.tape.truth import check_altitudes, compute, format_truth
 
     for option, value in (("--output", args.output), ("TAPE", args.tape)):
         if value == "":
@@ -74,6 +74,7 @@ def cmd_truth(args) -> int:
         if path != "-":
             check(path, (args.tape,), force=args.force, ask=True, what="truth file")
         tape = read_tape(args.tape)
+        check_altitudes(tape)
         values = compute(tape)
         name = os.path.splitext(os.path.basename(args.tape))[0]
         text = format_truth(name, tape, values, os.path.basename(args.tape))

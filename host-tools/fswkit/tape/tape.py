@@ -128,6 +128,7 @@ class Tape:
     derived: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     comments: tuple[str, ...] = ()
+    first_line: int = 0  # the file's line of row 0 (read_tape's; 0: a tape made in memory)
 
     @property
     def rows(self) -> int:
@@ -327,7 +328,7 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
             err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
     err.raise_if_any()
     return Tape(path, t, p, a, tuple(header["source"]), header["flight"][0] if header["flight"] else "",
-                tuple(header["derived"]), tuple(header["note"]), tuple(comments))
+                tuple(header["derived"]), tuple(header["note"]), tuple(comments), first)
 
 
 def read_file(path: str, limit: int) -> bytes:

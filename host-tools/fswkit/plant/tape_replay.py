@@ -576,9 +576,41 @@ def load_tape(path: str, cfg: Config):
     for key in ("apogee_s", "burnout_s"):
         if getattr(truth, key) is None:
             errors.append(f"{tpath}:1: `{key}` is missing: the checks need it")
+    errors += _truth_against(tape, truth)
     if errors:
         raise ReplayError("\n".join(errors))
     return tape, truth
+
+
+# The truth's events the checks use, in the order a flight has them (liftoff_s absent: the tape's 0 s).
+FLIGHT_EVENTS = ("liftoff_s", "burnout_s", "apogee_s", "landing_s")
+
+
+def _truth_against(tape, truth) -> list[str]:
+    """Located errors for a truth its tape cannot have: an event the checks
+    use outside the tape's rows, or not after the one before it in a
+    flight (a burnout before liftoff passes the boost's check whatever the
+    firmware does; another flight's apogee fails it by minutes)."""
+    out = []
+    prev = None
+    for key in FLIGHT_EVENTS:
+        v = getattr(truth, key)
+        if v is None:
+            if key == "liftoff_s":
+                prev = (key, 0.0)  # the tape's time base
+            continue
+        where = f"{truth.path}:{truth.lines.get(key, 1)}"
+        if prev is not None and v <= prev[1]:
+            out.append(f"{where}: {key} {v:g} s is not after {prev[0]} {prev[1]:g} s: a flight's events come in "
+                       f"the order {', '.join(FLIGHT_EVENTS)}")
+        elif v < tape.start:
+            out.append(f"{where}: {key} {v:g} s is before the tape's first row ({tape.start:g} s): the truth of "
+                       "another tape?")
+        elif v > tape.end:
+            out.append(f"{where}: {key} {v:g} s is after the tape's last row ({tape.end:g} s): the truth of "
+                       "another tape?")
+        prev = (key, v)
+    return out
 
 
 def _columns(tape) -> dict:

@@ -466,6 +466,7 @@ class Truth:
     log_end_s: float | None = None
     recorder_events: dict[str, Any] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
+    lines: dict[str, int] = field(default_factory=dict)  # key -> its line in the file (read_truth's)
 
     def events(self) -> list[tuple[str, float]]:
         """The event times (keys ending `_s`, recorder's included), earliest first."""
@@ -519,4 +520,5 @@ def read_truth(path: str) -> Truth:
     known = set(TRUTH_FLOATS) | {"name", "recorder"}
     recorder = {k: v for k, v in doc.items() if k.startswith("recorder_")}
     extra = {k: v for k, v in doc.items() if k not in known and k not in recorder}
-    return Truth(path, doc["name"], recorder_events=recorder, extra=extra, **kw)
+    lines = {k: _key_line(text, k) for k in kw if _key_line(text, k) is not None}
+    return Truth(path, doc["name"], recorder_events=recorder, extra=extra, lines=lines, **kw)

@@ -120,15 +120,21 @@ def compute(tape: Tape) -> list[tuple[str, float | None, str]]:
     first = int(np.flatnonzero(up)[0])
     k = first + int(np.argmax(h[first:]))
     top = float(h[k])
-    out.append(("apogee_s", float(t[k]), f"max of ISA pressure altitude AGL (pad = pad_pressure_pa) after a "
-                                        f"centered {SMOOTH_S:g} s moving average"))
-    out.append(("apogee_m_agl", top, ""))
     lo = k
     while lo > first and h[lo - 1] >= top - BAND_M:
         lo -= 1
     hi = k
     while hi + 1 < h.size and h[hi + 1] >= top - BAND_M:
         hi += 1
+    if hi == h.size - 1:  # never came down from it: a climb the tape cut, or no flight
+        out.append(("apogee_s", None, f"the tape ends at {t_all[-1]:.2f} s within {BAND_M:g} m of its highest "
+                                      f"smoothed altitude ({top:.1f} m AGL at {t[k]:.2f} s): no descent from it, "
+                                      "no apogee (a tape cut in the climb, or no flight)"))
+        out.append(("log_end_s", float(t_all[-1]), ""))
+        return out
+    out.append(("apogee_s", float(t[k]), f"max of ISA pressure altitude AGL (pad = pad_pressure_pa) after a "
+                                        f"centered {SMOOTH_S:g} s moving average"))
+    out.append(("apogee_m_agl", top, ""))
     out.append(("apogee_band5m_from_s", float(t[lo]), f"contiguous span around apogee_s where the smoothed altitude "
                                                     f"is within {BAND_M:g} m of apogee_m_agl: how flat the top is"))
     out.append(("apogee_band5m_to_s", float(t[hi]), ""))

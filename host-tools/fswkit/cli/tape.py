@@ -39,7 +39,8 @@ def cmd_import(args) -> int:
     except (TapeError, OutputError) as e:
         return _fail("import", e)
     if args.output != "-":
-        sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} rows, {tape.start:.2f} to "
+        sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} row{'s' if tape.rows != 1 else ''}, "
+                         f"{tape.start:.2f} to "
                          f"{tape.end:.2f} s, columns {', '.join(tape.columns_available()) or 'none'}\n")
     if args.pad_alt is not None and not any("ISA standard atmosphere with the pad at" in d for d in tape.derived):
         # the pad altitude only sets pressure made from an altitude: given and unused is said, not ignored
@@ -132,7 +133,8 @@ def show_text(tape, truth=None, truth_error: str | None = None) -> str:
             rate = f"{early:.1f} Hz median to 10 s, {late:.1f} Hz after"
         else:
             rate = f"{tape.rate_hz(col):.1f} Hz median"
-        out.append(f"  {col + ':':12s} {have.sum():,} values, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
+        n = int(have.sum())
+        out.append(f"  {col + ':':12s} {n:,} value{'s' if n != 1 else ''}, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
                    f"min {np.min(v):.4g}, max {np.max(v):.4g}")
     if tape.available("pressure_pa").any():
         alt = tape.altitude_agl()

@@ -5,8 +5,9 @@ whatever the firmware did, and one whose `apogee_s` was 500 s on a tape
 ending at 142.7 s (another flight's truth, or a typo) failed the firmware
 by 475 s. Now an event time the checks use (`liftoff_s`, `burnout_s`,
 `apogee_s`, `landing_s`) outside the tape's rows, or out of the flight's
-order (liftoff, burnout, apogee, landing), is an error at its line of the
-truth file, exit status 2, before anything is built; the shared tapes'
+order (liftoff, burnout, apogee, landing), or a `pad_pressure_pa` (which
+the truth's altitudes are taken above) beyond the ISA troposphere (a
+pressure in hPa: 1000.5), is an error at its line of the truth file, exit status 2, before anything is built; the shared tapes'
 truths load as they are."""
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ def _flight(tmp_path, old: str, new: str):
     ("apogee_s = 24.31", "apogee_s = 2.0", "apogee_s 2 s is not after burnout_s 4.48 s"),
     ("landing_s = 139.97", "landing_s = 20.0", "landing_s 20 s is not after apogee_s 24.31 s"),
     ("liftoff_s = 0.0", "liftoff_s = -9.0", "liftoff_s -9 s is before the tape's first row (-0.75 s)"),
+    ("pad_pressure_pa = 100047.7", "pad_pressure_pa = 1000.5",
+     "pad_pressure_pa 1000.5 Pa is 25,917 m ASL: beyond the ISA troposphere"),
 ])
 def test_an_event_the_tape_cannot_have_is_refused_at_its_line(tmp_path, old, new, said):
     p, line = _flight(tmp_path, old, new)

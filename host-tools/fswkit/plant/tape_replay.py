@@ -590,7 +590,9 @@ def _truth_against(tape, truth) -> list[str]:
     """Located errors for a truth its tape cannot have: an event the checks
     use outside the tape's rows, or not after the one before it in a
     flight (a burnout before liftoff passes the boost's check whatever the
-    firmware does; another flight's apogee fails it by minutes)."""
+    firmware does; another flight's apogee fails it by minutes); a pad
+    pressure, which the truth's altitudes are taken above, beyond the ISA
+    troposphere."""
     out = []
     prev = None
     for key in FLIGHT_EVENTS:
@@ -610,6 +612,17 @@ def _truth_against(tape, truth) -> list[str]:
             out.append(f"{where}: {key} {v:g} s is after the tape's last row ({tape.end:g} s): the truth of "
                        "another tape?")
         prev = (key, v)
+    pad = truth.pad_pressure_pa
+    if pad is not None:
+        from fswkit.tape import isa_altitude
+        from fswkit.tape.truth import ISA_LOW_M, ISA_TOP_M
+
+        h = float(isa_altitude(pad)) if pad > 0 else math.inf
+        if not ISA_LOW_M <= h < ISA_TOP_M:
+            out.append(f"{truth.path}:{truth.lines.get('pad_pressure_pa', 1)}: pad_pressure_pa {pad:g} Pa is "
+                       + (f"{h:,.0f} m ASL" if math.isfinite(h) else "no pressure")
+                       + f": beyond the ISA troposphere the truth's altitudes are taken in ({ISA_LOW_M / 1000:g} to "
+                       f"{ISA_TOP_M / 1000:g} km ASL): a pressure in Pa (hPa times 100)")
     return out
 
 

@@ -58,8 +58,8 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import (Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file,
-                              split_lines)
+from fswkit.tape.tape import (MAX_ERRORS, Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number,
+                              read_file, split_lines)
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -393,7 +393,8 @@ def _check_altitude_range(h: np.ndarray, pad_alt: float | None, log: Log, col: i
     err = log.err()
     name = log.raw_names[col]
     rows = log.rows if rows is None else rows
-    for i in bad.tolist():
+    err.hidden += max(0, bad.size - MAX_ERRORS)  # counted, not split (a whole log in the wrong unit)
+    for i in bad[:MAX_ERRORS].tolist():
         ln, cells = rows[i]
         err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{_unquote(cells[col])[:40]}` is {asl[i]:.0f} m ASL "
                                         f"(read as {unit}, the pad at {pad:g} m ASL): beyond the ISA troposphere "

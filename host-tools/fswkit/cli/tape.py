@@ -53,6 +53,7 @@ def cmd_import(args) -> int:
                          "for a recorder set to metres)\n")
     elif args.alt_unit is not None and not from_alt:
         sys.stderr.write("fsw tape import: --alt-unit is not used: the log has pressure of its own\n")
+    _beyond_troposphere(args.output, tape)
     late = _dropped_late(tape)
     if late:  # a clock that restarted mid-log loses what follows: said here, not only in the header
         rows = f"{late:,} rows of the log dropped: their time is" if late != 1 else \
@@ -93,6 +94,27 @@ def cmd_truth(args) -> int:
                          f"{'them' if len(missing) > 1 else 'it'}: write {' and '.join(missing)} into the truth "
                          "file by hand (its comments say why they are missing)\n")
     return EXIT_OK
+
+
+def _beyond_troposphere(output: str, tape) -> None:
+    """Says the pressures beyond the ISA troposphere that an import kept as
+    the log has them (a glitch row; docs/tapes.md), at the tape's lines
+    (rows of the tape written to standard output): `fsw tape truth`
+    refuses them."""
+    from dataclasses import replace
+
+    from fswkit.tape import TapeError, read_tape
+    from fswkit.tape.truth import check_altitudes
+
+    try:
+        check_altitudes(read_tape(output) if output != "-" else replace(tape, path="-"))
+    except TapeError as e:
+        n = len(e.messages) + e.hidden
+        sys.stderr.write(f"fsw tape import: {output}: {n:,} pressure{'s' if n != 1 else ''} beyond the ISA "
+                         f"troposphere kept as the log has {'them' if n != 1 else 'it'} (`fsw tape truth` refuses "
+                         f"{'them' if n != 1 else 'it'}):\n")
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw tape import: {line}\n")
 
 
 def _dropped_late(tape) -> int:

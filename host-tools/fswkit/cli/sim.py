@@ -270,6 +270,10 @@ def tape_run(args) -> int:
     if args.seed is not None and args.perturb is None:
         say("--seed with --tape needs --perturb N (a plain replay has no randomness)")
         return 2
+    if args.perturb is not None and not 1 <= args.perturb <= tr.MAX_PERTURB:
+        say(f"--perturb {args.perturb}: from 1 to {tr.MAX_PERTURB:,} replays (a larger run is several, each with "
+            "its own --seed)")
+        return 2
     if is_elf(args.project) or args.project.endswith(".elf"):
         say(f"{args.project}: --tape needs the project (its folder or .app), not a firmware ELF")
         return 2
@@ -312,14 +316,18 @@ def tape_run(args) -> int:
         return built
     elf, board = built
     if args.perturb is not None:
-        if args.perturb == 0:
-            say("--perturb needs at least one run")
-            return 2
+        from fswkit import outputs
+
         seed = 1 if args.seed is None else args.seed
         say(f"{args.perturb} perturbed replays of {args.tape} ({tape.span:.0f} s of flight each), seed {seed}")
         t0 = time.monotonic()
-        results = tr.robustness(tape, truth, cfg, elf, board, layout, args.perturb, seed)
-        text, ok = tr.robustness_text(results, tape, args.perturb, seed, time.monotonic() - t0)
+        complete = True
+        with outputs.stopped_by_signals():
+            try:
+                results = tr.robustness(tape, truth, cfg, elf, board, layout, args.perturb, seed)
+            except tr.StoppedRuns as e:
+                results, complete = e.results, False
+        text, ok = tr.robustness_text(results, tape, args.perturb, seed, time.monotonic() - t0, complete)
         sys.stdout.write(text)
         sys.stdout.flush()
         try:
@@ -329,6 +337,9 @@ def tape_run(args) -> int:
             say(str(e))
             return 1
         say(f"wrote {os.path.join(out, 'perturb.txt')}, {os.path.join(out, 'perturb.csv')}")
+        if not complete:
+            say(f"stopped after {len(results)} of {args.perturb} perturbed replays")
+            return 128 + (outputs.stopped_by or 2)
         return 0 if ok else 1
     say(f"replaying {args.tape} ({tape.rows:,} rows, {tape.span:.1f} s) open loop on the {board.name}")
     return flown(lambda: tr.execute(tape, truth, cfg, app, elf, board, layout, out), out)

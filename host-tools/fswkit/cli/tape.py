@@ -39,7 +39,8 @@ def cmd_import(args) -> int:
     except (TapeError, OutputError) as e:
         return _fail("import", e)
     if args.output != "-":
-        sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} rows, {tape.start:.2f} to "
+        sys.stderr.write(f"fsw tape import: {args.output}: {tape.rows:,} row{'s' if tape.rows != 1 else ''}, "
+                         f"{tape.start:.2f} to "
                          f"{tape.end:.2f} s, columns {', '.join(tape.columns_available()) or 'none'}\n")
     if args.pad_alt is not None and not any("ISA standard atmosphere with the pad at" in d for d in tape.derived):
         # the pad altitude only sets pressure made from an altitude: given and unused is said, not ignored
@@ -52,6 +53,7 @@ def cmd_import(args) -> int:
                          "for a recorder set to metres)\n")
     elif args.alt_unit is not None and not from_alt:
         sys.stderr.write("fsw tape import: --alt-unit is not used: the log has pressure of its own\n")
+    _beyond_troposphere(args.output, tape)
     late = _dropped_late(tape)
     if late:  # a clock that restarted mid-log loses what follows: said here, not only in the header
         rows = f"{late:,} rows of the log dropped: their time is" if late != 1 else \
@@ -63,7 +65,7 @@ def cmd_import(args) -> int:
 def cmd_truth(args) -> int:
     from fswkit.outputs import OutputError, check, output
     from fswkit.tape import TapeError, read_tape, truth_path
-    from fswkit.tape.truth import compute, format_truth
+    from fswkit.tape.truth import check_altitudes, compute, format_truth
 
     for option, value in (("--output", args.output), ("TAPE", args.tape)):
         if value == "":
@@ -74,6 +76,7 @@ def cmd_truth(args) -> int:
         if path != "-":
             check(path, (args.tape,), force=args.force, ask=True, what="truth file")
         tape = read_tape(args.tape)
+        check_altitudes(tape)
         values = compute(tape)
         name = os.path.splitext(os.path.basename(args.tape))[0]
         text = format_truth(name, tape, values, os.path.basename(args.tape))
@@ -91,6 +94,27 @@ def cmd_truth(args) -> int:
                          f"{'them' if len(missing) > 1 else 'it'}: write {' and '.join(missing)} into the truth "
                          "file by hand (its comments say why they are missing)\n")
     return EXIT_OK
+
+
+def _beyond_troposphere(output: str, tape) -> None:
+    """Says the pressures beyond the ISA troposphere that an import kept as
+    the log has them (a glitch row; docs/tapes.md), at the tape's lines
+    (rows of the tape written to standard output): `fsw tape truth`
+    refuses them."""
+    from dataclasses import replace
+
+    from fswkit.tape import TapeError, read_tape
+    from fswkit.tape.truth import check_altitudes
+
+    try:
+        check_altitudes(read_tape(output) if output != "-" else replace(tape, path="-"))
+    except TapeError as e:
+        n = len(e.messages) + e.hidden
+        sys.stderr.write(f"fsw tape import: {output}: {n:,} pressure{'s' if n != 1 else ''} beyond the ISA "
+                         f"troposphere kept as the log has {'them' if n != 1 else 'it'} (`fsw tape truth` refuses "
+                         f"{'them' if n != 1 else 'it'}):\n")
+        for line in str(e).splitlines():
+            sys.stderr.write(f"fsw tape import: {line}\n")
 
 
 def _dropped_late(tape) -> int:
@@ -131,7 +155,8 @@ def show_text(tape, truth=None, truth_error: str | None = None) -> str:
             rate = f"{early:.1f} Hz median to 10 s, {late:.1f} Hz after"
         else:
             rate = f"{tape.rate_hz(col):.1f} Hz median"
-        out.append(f"  {col + ':':12s} {have.sum():,} values, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
+        n = int(have.sum())
+        out.append(f"  {col + ':':12s} {n:,} value{'s' if n != 1 else ''}, {t[0]:.3f} to {t[-1]:.3f} s, {rate}, "
                    f"min {np.min(v):.4g}, max {np.max(v):.4g}")
     if tape.available("pressure_pa").any():
         alt = tape.altitude_agl()

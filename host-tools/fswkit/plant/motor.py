@@ -98,7 +98,7 @@ def impulse_problem(impulse: float, propellant_kg: float) -> str | None:
 
 
 def _number(tok: str) -> float | None:
-    if "_" in tok:  # Python reads 1_0 as 10; a motor file's numbers are plain
+    if "_" in tok or not tok.isascii():  # Python reads 1_0 as 10, and digits of any script; a motor file's are plain
         return None
     try:
         x = float(tok)
@@ -123,6 +123,8 @@ def _not_plain(tok: str) -> str | None:
         return None
     if "_" in tok:
         return "a plain number (no `_`)"
+    if not tok.isascii():
+        return "a plain number (ASCII digits)"
     return None if math.isfinite(x) else "a finite number"
 
 

@@ -538,6 +538,23 @@ def _time_unit_s(app) -> float:
 _NO_CURVE = ((0.0, 0.0), (1.0, 100.0), (1.1, 0.0))  # _motor's curve after an error: no check is made of it
 
 
+# The plant steps a motor's burn lasts at the least: the plant samples the thrust at each step's ends and
+# middle (fswkit.plant.rocket, RK4), and a burn within a step or two is not the curve's impulse (all of it
+# missed, the vehicle left on the pad).
+MIN_BURN_STEPS = 10
+
+
+def _burn_s(curve) -> float:
+    """How long a thrust curve's thrust lasts: from the last point without
+    thrust before its first with (the first point, when it has thrust) to
+    the point after its last with (the curve's end)."""
+    thrust = [i for i, (_, f) in enumerate(curve) if f > 0]
+    if not thrust:
+        return 0.0
+    first, last = thrust[0], thrust[-1]
+    return curve[min(last + 1, len(curve) - 1)][0] - curve[max(first - 1, 0)][0]
+
+
 def _motor(bind: _Binder, mot: dict) -> tuple[tuple, float]:
     """[motor]'s thrust curve and propellant mass: written in the table, or
     from the RASP file it names (fswkit.plant.motor). A propellant mass
@@ -676,6 +693,12 @@ class RocketScenario:
         if curve is not _NO_CURVE and liftoff_weight is not None and nominal.peak <= liftoff_weight:
             bind.err("motor", "file" if mot["file"] else "thrust_curve", f"the peak thrust ({nominal.peak:g} N) never exceeds the "
                      f"vehicle's weight ({liftoff_weight:.1f} N): it would never leave the pad")
+        burn = _burn_s(curve)
+        if curve is not _NO_CURVE and self.rate is not None and burn * self.rate < MIN_BURN_STEPS:
+            bind.err("motor", "file" if mot["file"] else "thrust_curve", f"the motor burns {burn:g} s: under "
+                     f"{MIN_BURN_STEPS} plant steps ({MIN_BURN_STEPS / self.rate:g} s at {self.rate} Hz), which "
+                     "sample its thrust at their ends and middles, so it would not be flown as its curve says (a "
+                     "rocket motor burns a tenth of a second and more: times in seconds?)")
         # this seed's motor: the nominal curve scaled (the clamp only matters for a draw beyond 2.5 sigma
         # with the largest impulse_sd allowed)
         self.motor_factor = max(0.5, 1.0 + (mot["impulse_sd"] or 0.0) * float(motor_rng.standard_normal()))

@@ -576,9 +576,54 @@ def load_tape(path: str, cfg: Config):
     for key in ("apogee_s", "burnout_s"):
         if getattr(truth, key) is None:
             errors.append(f"{tpath}:1: `{key}` is missing: the checks need it")
+    errors += _truth_against(tape, truth)
     if errors:
         raise ReplayError("\n".join(errors))
     return tape, truth
+
+
+# The truth's events the checks use, in the order a flight has them (liftoff_s absent: the tape's 0 s).
+FLIGHT_EVENTS = ("liftoff_s", "burnout_s", "apogee_s", "landing_s")
+
+
+def _truth_against(tape, truth) -> list[str]:
+    """Located errors for a truth its tape cannot have: an event the checks
+    use outside the tape's rows, or not after the one before it in a
+    flight (a burnout before liftoff passes the boost's check whatever the
+    firmware does; another flight's apogee fails it by minutes); a pad
+    pressure, which the truth's altitudes are taken above, beyond the ISA
+    troposphere."""
+    out = []
+    prev = None
+    for key in FLIGHT_EVENTS:
+        v = getattr(truth, key)
+        if v is None:
+            if key == "liftoff_s":
+                prev = (key, 0.0)  # the tape's time base
+            continue
+        where = f"{truth.path}:{truth.lines.get(key, 1)}"
+        if prev is not None and v <= prev[1]:
+            out.append(f"{where}: {key} {v:g} s is not after {prev[0]} {prev[1]:g} s: a flight's events come in "
+                       f"the order {', '.join(FLIGHT_EVENTS)}")
+        elif v < tape.start:
+            out.append(f"{where}: {key} {v:g} s is before the tape's first row ({tape.start:g} s): the truth of "
+                       "another tape?")
+        elif v > tape.end:
+            out.append(f"{where}: {key} {v:g} s is after the tape's last row ({tape.end:g} s): the truth of "
+                       "another tape?")
+        prev = (key, v)
+    pad = truth.pad_pressure_pa
+    if pad is not None:
+        from fswkit.tape import isa_altitude
+        from fswkit.tape.truth import ISA_LOW_M, ISA_TOP_M
+
+        h = float(isa_altitude(pad)) if pad > 0 else math.inf
+        if not ISA_LOW_M <= h < ISA_TOP_M:
+            out.append(f"{truth.path}:{truth.lines.get('pad_pressure_pa', 1)}: pad_pressure_pa {pad:g} Pa is "
+                       + (f"{h:,.0f} m ASL" if math.isfinite(h) else "no pressure")
+                       + f": beyond the ISA troposphere the truth's altitudes are taken in ({ISA_LOW_M / 1000:g} to "
+                       f"{ISA_TOP_M / 1000:g} km ASL): a pressure in Pa (hPa times 100)")
+    return out
 
 
 def _columns(tape) -> dict:
@@ -642,13 +687,15 @@ class Replay:
 
 
 def replay(tape, cfg: Config, elf: str, board, layout: Layout, log_path: str | None = None, *, truth=None,
-           columns: dict | None = None, wall_limit: float = 3600.0, log_meta: dict | None = None) -> Replay:
+           columns: dict | None = None, wall_limit: float = 3600.0, log_meta: dict | None = None,
+           stop=None) -> Replay:
     """The firmware on the simulated board, its inputs driven from the tape
     (or `columns`, a perturbed copy of its columns); the Replay. The
     truth's altitude is taken above `truth.pad_pressure_pa` (else the
-    tape's pad). On a terminal, a bar shows the seconds of the tape replayed."""
+    tape's pad). On a terminal, a bar shows the seconds of the tape replayed.
+    `stop`, a threading.Event: once set, CosimError at the next step."""
     with _one_cpu(), progress("tape replay", total=_end_s(tape, cfg), unit="s") as bar:
-        return _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar)
+        return _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar, stop)
 
 
 def _end_s(tape, cfg: Config) -> float:
@@ -658,7 +705,7 @@ def _end_s(tape, cfg: Config) -> float:
     return float(tape.time[-1]) + offset + cfg.run_on_s
 
 
-def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar) -> Replay:
+def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_meta, truth, bar, stop=None) -> Replay:
     f_cpu = int(board.f_cpu)
     t = tape.time
     cols = columns if columns is not None else _columns(tape)
@@ -715,6 +762,8 @@ def _replay(tape, cfg, elf, board, layout, log_path, columns, wall_limit, log_me
         now = 0
         j = 0
         while now < end_cycle:
+            if stop is not None and stop.is_set():
+                raise CosimError("stopped")
             until = min(end_cycle, now + chunk)
             if j < len(part_stops) and part_stops[j] < until:
                 until = part_stops[j]
@@ -1210,11 +1259,11 @@ class PerturbResult:
     notes: list = field(default_factory=list)  # the configuration's (Config.notes)
 
 
-def _one_perturbed(i, seq, tape, truth, cfg, elf, board, layout) -> PerturbResult:
+def _one_perturbed(i, seq, tape, truth, cfg, elf, board, layout, stop=None) -> PerturbResult:
     rng = np.random.Generator(np.random.PCG64(seq))
     cols = perturb(_columns(tape), tape.time, rng)
     try:
-        rp = replay(tape, cfg, elf, board, layout, truth=truth, columns=cols)
+        rp = replay(tape, cfg, elf, board, layout, truth=truth, columns=cols, stop=stop)
     except CosimError as e:
         return PerturbResult(i, {}, [], str(e), list(cfg.notes))
     nums, checks, _notes = evaluate(rp, cfg, truth, tape)
@@ -1222,26 +1271,60 @@ def _one_perturbed(i, seq, tape, truth, cfg, elf, board, layout) -> PerturbResul
     return PerturbResult(i, nums, checks, notes=list(cfg.notes))
 
 
+# The replays of one `--perturb N` (as a study's runs, fswkit.cli.sim_study.MAX_RUNS): each is drawn and
+# queued only when a worker is free, its result held in memory to the table.
+MAX_PERTURB = 1_000_000
+
+
+class StoppedRuns(Exception):
+    """Ctrl-C or a stopping signal (fswkit.outputs.Stopped) ended the
+    replays early: `results`, those that had finished, in run order."""
+
+    def __init__(self, results: list):
+        super().__init__(f"stopped after {len(results)} runs")
+        self.results = results
+
+
 def robustness(tape, truth, cfg: Config, elf: str, board, layout: Layout, n: int, seed: int,
                workers: int | None = None) -> list[PerturbResult]:
     """N perturbed replays (run i from the i-th child of SeedSequence(seed):
-    the same seed gives the same runs, whatever the number of workers)."""
-    seqs = np.random.SeedSequence(seed).spawn(n)
+    the same seed gives the same runs, whatever the number of workers).
+    StoppedRuns on Ctrl-C or a stopping signal: the replays still flying
+    stop at their next step, those not started never start."""
+    import threading
+
+    from fswkit.outputs import Stopped
+
     if workers is None:
         try:
             workers = len(os.sched_getaffinity(0))
         except (AttributeError, OSError):
             workers = os.cpu_count() or 1
     workers = max(1, min(workers, n))
-    with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool, \
-            progress("perturbed replays", total=n, unit="runs") as bar:
-        futs = [pool.submit(_one_perturbed, i, s, tape, truth, cfg, elf, board, layout) for i, s in enumerate(seqs)]
-        failed = 0
-        for done, f in enumerate(concurrent.futures.as_completed(futs), 1):
-            r = f.result()
-            failed += r.error is not None or not all(c.passed for c in r.checks)
-            bar.update(done, failed=failed)
-        return [f.result() for f in futs]
+    stop = threading.Event()
+    done: list[PerturbResult] = []
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
+    try:
+        with progress("perturbed replays", total=n, unit="runs") as bar:
+            queued: set = set()
+            nxt = failed = 0
+            while nxt < n or queued:
+                while nxt < n and len(queued) < workers:  # the i-th child of SeedSequence(seed), as spawn(n)[i]
+                    seq = np.random.SeedSequence(seed, spawn_key=(nxt,))
+                    queued.add(pool.submit(_one_perturbed, nxt, seq, tape, truth, cfg, elf, board, layout, stop))
+                    nxt += 1
+                ended, queued = concurrent.futures.wait(queued, return_when=concurrent.futures.FIRST_COMPLETED)
+                for f in ended:
+                    r = f.result()
+                    done.append(r)
+                    failed += r.error is not None or not all(c.passed for c in r.checks)
+                bar.update(len(done), failed=failed)
+    except (KeyboardInterrupt, Stopped):
+        stop.set()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise StoppedRuns(sorted(done, key=lambda r: r.index)) from None
+    pool.shutdown(wait=True)
+    return sorted(done, key=lambda r: r.index)
 
 
 ERROR_KEYS = (("launch_err_s", "launch − liftoff", "s"), ("burnout_err_s", "burnout − burnout_s", "s"),
@@ -1249,9 +1332,12 @@ ERROR_KEYS = (("launch_err_s", "launch − liftoff", "s"), ("burnout_err_s", "bu
               ("landing_err_s", "landing − landing_s", "s"), ("boost_pyro", "pyro pins during boost", ""))
 
 
-def robustness_text(results: list[PerturbResult], tape, n: int, seed: int, wall: float) -> tuple[str, bool]:
+def robustness_text(results: list[PerturbResult], tape, n: int, seed: int, wall: float,
+                    complete: bool = True) -> tuple[str, bool]:
     """The distribution of the event errors and every failed check; (text, all passed)."""
-    lines = [f"robustness: {tape.path}, {n} perturbed replays, seed {seed}, {wall:.1f} s wall",
+    runs = f"{n} perturbed replays" if complete else \
+        f"{len(results)} of {n} perturbed replays (stopped early: the table covers the runs that finished)"
+    lines = [f"robustness: {tape.path}, {runs}, seed {seed}, {wall:.1f} s wall",
              "perturbation per run (docs/sim.md): " + "; ".join(
                  f"{c}: bias sd {p.bias:g}, noise sd {p.noise:g}, spikes p={p.spike_p:g} of {p.spike[0]:g}–"
                  f"{p.spike[1]:g}, dropouts p={p.dropout_p:g} of {p.dropout_s[0]:g}–{p.dropout_s[1]:g} s"

@@ -58,8 +58,8 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import (Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number, read_file,
-                              split_lines)
+from fswkit.tape.tape import (MAX_ERRORS, Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number,
+                              read_file, split_lines)
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -90,6 +90,10 @@ class Rows:
     def where(self, keep: Callable[[list[str]], bool]) -> "Rows":
         """The rows whose cells `keep` takes, as Rows."""
         return Rows([(ln, line) for ln, line in self._lines if keep(_split(line))])
+
+    def take(self, indices) -> "Rows":
+        """The rows at `indices` (in that order), as Rows."""
+        return Rows([self._lines[i] for i in indices])
 
 
 @dataclass
@@ -373,16 +377,29 @@ def _dropped(n: int) -> list[str]:
     return [f"rows dropped: {n} with a time not after the previous row"] if n else []
 
 
-def _check_altitude_range(h: np.ndarray, pad_alt: float | None, log: Log, col: int, unit: str) -> None:
-    """An altitude column has values, within the ISA troposphere; TapeError otherwise."""
+def _check_altitude_range(h: np.ndarray, pad_alt: float | None, log: Log, col: int, unit: str, rows=None) -> None:
+    """An altitude column (m above the pad, one value per row of `rows`, the
+    log's rows when None) has values, each within the ISA troposphere;
+    TapeError otherwise, at each cell beyond it (a wrong unit, a wrong
+    --pad-alt, a glitch row)."""
     if np.isnan(h).all():
         raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
                          f"`{log.raw_names[col]}` holds no value"])
-    top = float(np.nanmax(h)) + (pad_alt or 0.0)
-    if top >= 11_000 or float(np.nanmin(h)) + (pad_alt or 0.0) < -1_000:
-        raise TapeError([f"{log.path}:{log.column_line}:{_col_of(log.raw_names, col)}: "
-                         f"`{log.raw_names[col]}` reaches {top:.0f} m ASL (read as {unit}): beyond the ISA "
-                         "troposphere the tapes use (0 to 11 km); check the unit and --pad-alt"])
+    pad = pad_alt or 0.0
+    asl = h + pad
+    bad = np.flatnonzero(~np.isnan(asl) & ((asl >= 11_000) | (asl < -1_000)))
+    if bad.size == 0:
+        return
+    err = log.err()
+    name = log.raw_names[col]
+    rows = log.rows if rows is None else rows
+    err.hidden += max(0, bad.size - MAX_ERRORS)  # counted, not split (a whole log in the wrong unit)
+    for i in bad[:MAX_ERRORS].tolist():
+        ln, cells = rows[i]
+        err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{_unquote(cells[col])[:40]}` is {asl[i]:.0f} m ASL "
+                                        f"(read as {unit}, the pad at {pad:g} m ASL): beyond the ISA troposphere "
+                                        "the tapes use (-1 to 11 km); check the unit and --pad-alt")
+    err.raise_if_any()
 
 
 # ---- AltOS ------------------------------------------------------------------------
@@ -564,7 +581,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
                    and ("axial accel (gs)" in n or "altitude (ft-agl)" in n),
                    "Time..., Axial Accel (Gs) and/or Altitude (Ft-AGL)")
 
-    def channel(col: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+    def channel(col: int, what: str) -> tuple[np.ndarray, np.ndarray, Rows]:
         tcol = max(i for i in range(col) if log.names[i].startswith("time")) if any(
             log.names[i].startswith("time") for i in range(col)) else None
         if tcol is None:
@@ -577,15 +594,15 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         t, v = t[ok], v[ok]
         keep = _increasing(t)
         late[0] += int((~keep).sum())
-        return t[keep], v[keep]
+        return t[keep], v[keep], rows.take(np.flatnonzero(ok)[keep].tolist())
 
     late = [0]
 
     ia, ih = log.index("axial accel (gs)"), log.index("altitude (ft-agl)")
-    ta, a = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0))
-    th, h = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0))
+    ta, a, _ = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0), None)
+    th, h, h_rows = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0), None)
     if th.size:
-        _check_altitude_range(h * FT, pad_alt, log, ih, "ft AGL")
+        _check_altitude_range(h * FT, pad_alt, log, ih, "ft AGL", h_rows)
     t_lift = _liftoff_accel(ta, a) if ta.size else None
     rule = "ACCEL: first 'Axial Accel (Gs)' sample above 2 g that stays above 2 g for 0.1 s"
     if t_lift is None and th.size:

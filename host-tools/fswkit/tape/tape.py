@@ -128,6 +128,7 @@ class Tape:
     derived: tuple[str, ...] = ()
     notes: tuple[str, ...] = ()
     comments: tuple[str, ...] = ()
+    first_line: int = 0  # the file's line of row 0 (read_tape's; 0: a tape made in memory)
 
     @property
     def rows(self) -> int:
@@ -327,7 +328,7 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
             err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
     err.raise_if_any()
     return Tape(path, t, p, a, tuple(header["source"]), header["flight"][0] if header["flight"] else "",
-                tuple(header["derived"]), tuple(header["note"]), tuple(comments))
+                tuple(header["derived"]), tuple(header["note"]), tuple(comments), first)
 
 
 def read_file(path: str, limit: int) -> bytes:
@@ -465,6 +466,7 @@ class Truth:
     log_end_s: float | None = None
     recorder_events: dict[str, Any] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
+    lines: dict[str, int] = field(default_factory=dict)  # key -> its line in the file (read_truth's)
 
     def events(self) -> list[tuple[str, float]]:
         """The event times (keys ending `_s`, recorder's included), earliest first."""
@@ -518,4 +520,5 @@ def read_truth(path: str) -> Truth:
     known = set(TRUTH_FLOATS) | {"name", "recorder"}
     recorder = {k: v for k, v in doc.items() if k.startswith("recorder_")}
     extra = {k: v for k, v in doc.items() if k not in known and k not in recorder}
-    return Truth(path, doc["name"], recorder_events=recorder, extra=extra, **kw)
+    lines = {k: _key_line(text, k) for k in kw if _key_line(text, k) is not None}
+    return Truth(path, doc["name"], recorder_events=recorder, extra=extra, lines=lines, **kw)

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from fswkit.tape.tape import Tape
+from fswkit.tape.tape import Tape, _Errors, isa_altitude
 
 SMOOTH_S = 0.5  # the altitude's centered moving average, by time
 BOOST_G = 2.0  # the boost: a sample above this ...
@@ -23,6 +23,34 @@ BAND_M = 5.0  # the apogee's band: the span within this of the apogee
 LANDED_BELOW_M = 100.0  # the landing: below this above the pad ...
 LANDED_WITHIN_M = 2.0  # ... from where the altitude stays within this ...
 LANDED_FOR_S = 1.0  # ... this long
+
+
+# The ISA troposphere the tapes' altitudes are worked out in (docs/tapes.md; fsw tape import refuses an
+# altitude beyond it), m above sea level.
+ISA_LOW_M, ISA_TOP_M = -1_000.0, 11_000.0
+
+
+def check_altitudes(tape: Tape) -> None:
+    """TapeError at each row whose pressure is beyond the ISA troposphere
+    (a recorder's glitch row, a cell in another unit): its altitude, and so
+    the apogee, the band and the landing worked out from it, would be no
+    flight's."""
+    have = tape.available("pressure_pa")
+    asl = isa_altitude(tape.pressure[have])
+    rows = np.flatnonzero(have)[(asl < ISA_LOW_M) | (asl >= ISA_TOP_M)]
+    if rows.size == 0:
+        return
+    err = _Errors(tape.path)
+    pad = tape.pad_pressure()
+    above = tape.altitude_agl(pad)
+    for i in rows.tolist():
+        where = f"row {i + 1}: " if not tape.first_line else ""
+        err.at(tape.first_line + i if tape.first_line else None, None,
+               f"{where}pressure_pa {tape.pressure[i]:g} is {above[i]:.0f} m above the pad, "
+               f"{float(isa_altitude(tape.pressure[i])):.0f} m ASL: beyond the ISA troposphere the truth's "
+               f"altitudes are worked in ({ISA_LOW_M / 1000:g} to {ISA_TOP_M / 1000:g} km ASL), so no apogee "
+               "or landing could be worked out from it (a glitch row? leave its cell empty)")
+    err.raise_if_any()
 
 
 def smoothed_altitude(tape: Tape, pad_pa: float) -> tuple[np.ndarray, np.ndarray]:
@@ -92,15 +120,21 @@ def compute(tape: Tape) -> list[tuple[str, float | None, str]]:
     first = int(np.flatnonzero(up)[0])
     k = first + int(np.argmax(h[first:]))
     top = float(h[k])
-    out.append(("apogee_s", float(t[k]), f"max of ISA pressure altitude AGL (pad = pad_pressure_pa) after a "
-                                        f"centered {SMOOTH_S:g} s moving average"))
-    out.append(("apogee_m_agl", top, ""))
     lo = k
     while lo > first and h[lo - 1] >= top - BAND_M:
         lo -= 1
     hi = k
     while hi + 1 < h.size and h[hi + 1] >= top - BAND_M:
         hi += 1
+    if hi == h.size - 1:  # never came down from it: a climb the tape cut, or no flight
+        out.append(("apogee_s", None, f"the tape ends at {t_all[-1]:.2f} s within {BAND_M:g} m of its highest "
+                                      f"smoothed altitude ({top:.1f} m AGL at {t[k]:.2f} s): no descent from it, "
+                                      "no apogee (a tape cut in the climb, or no flight)"))
+        out.append(("log_end_s", float(t_all[-1]), ""))
+        return out
+    out.append(("apogee_s", float(t[k]), f"max of ISA pressure altitude AGL (pad = pad_pressure_pa) after a "
+                                        f"centered {SMOOTH_S:g} s moving average"))
+    out.append(("apogee_m_agl", top, ""))
     out.append(("apogee_band5m_from_s", float(t[lo]), f"contiguous span around apogee_s where the smoothed altitude "
                                                     f"is within {BAND_M:g} m of apogee_m_agl: how flat the top is"))
     out.append(("apogee_band5m_to_s", float(t[hi]), ""))

@@ -15,6 +15,14 @@ import pytest
 
 from fswkit.testing.runner import Ran, run_fsw
 
+# The commands' tests stop runs with SIGHUP as a closed terminal does, and
+# a run under `nohup` (or a supervisor that ignores hang-ups) would pass on
+# its ignored SIGHUP to every command the tests start, which then rightly
+# keep ignoring it: the tests take the terminal's default, as an
+# interactive `make test` has it.
+if hasattr(signal, "SIGHUP") and signal.getsignal(signal.SIGHUP) == signal.SIG_IGN:
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 SHARED = ROOT.parent / "shared"

@@ -340,8 +340,8 @@ class Station:
             self.last_frame = time.monotonic()
         for ev in evs:
             if ev.kind == "ack":
-                w = self._waiting.get(ev.info["cmd_seq"])
-                if w is not None and w["ack"] is None:
+                w = self._waiting.get(ev.info["cmd_seq"])  # the command of its number and its opcode only
+                if w is not None and w["ack"] is None and w["op"] == ev.info["op"]:
                     w["ack"] = ev.info
                     w["event"].set()
             elif ev.kind == "hello":
@@ -410,7 +410,7 @@ class Station:
 
     def _exchange(self, op: int, args: bytes, tries: int, timeout: float, written: list) -> dict:
         def send_and_wait(seq: int, frame: bytes) -> dict | None:
-            slot = {"event": threading.Event(), "ack": None}
+            slot = {"event": threading.Event(), "ack": None, "op": op}
             self._waiting[seq] = slot  # before it goes: the reader thread fills it
             try:
                 self.write(frame)

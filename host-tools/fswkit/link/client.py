@@ -109,7 +109,7 @@ class Ground:
                         on_event(ev)
                     else:
                         self.events.append(ev)
-                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq and ack is None:
+                    if ev.kind == "ack" and ev.info["cmd_seq"] == seq and ev.info["op"] == op and ack is None:
                         ack = ev.info
             return ack
 

@@ -230,6 +230,8 @@ class ParamClient:
                     self.on_event(ev)
                 if ev.kind != "ack" or ev.info["cmd_seq"] not in copies:
                     continue
+                if ev.info["op"] != cmds[copies[ev.info["cmd_seq"]]][0]:  # another command's, of the same number
+                    continue
                 seq = ev.info["cmd_seq"]
                 i = copies.pop(seq)
                 sent = inflight.pop(seq, None)

@@ -103,13 +103,13 @@ def test_the_page_lists_an_unanswered_command_as_unanswered_not_refused(browser,
                                      if f"set valveOpen = {value}" in li.text], "the command in the history",
                             timeout=15)[0]
 
-        wait_for(lambda: text("link-status") == "live", "the link to show live")
+        wait_for(lambda: text("link-status") == "live", "the link to show live", page=browser)
         item = send("true")
         assert "refused" not in item.text, item.text
         assert "after 3 tries: lost, or applied and its acknowledgement lost" in item.text
         assert item.get_attribute("class") == "lost"
         target.close()
-        wait_for(lambda: not st.up, "the station to see the port gone")
+        wait_for(lambda: not st.up, "the station to see the port gone", page=browser)
         item = send("false")
         assert "refused" not in item.text, item.text
         assert NOT_SENT in item.text, item.text

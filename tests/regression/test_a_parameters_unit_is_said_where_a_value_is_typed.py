@@ -45,7 +45,7 @@ def test_the_pages_confirmation_says_the_unit(browser, tmp_path):
 
     with tuned_page(browser, tmp_path):
         text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-        wait_for(lambda: text("pval-HOLD_MS") == "500 ms", "the parameters")
+        wait_for(lambda: text("pval-HOLD_MS") == "500 ms", "the parameters", page=browser)
         browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
         press(browser, "psend-HOLD_MS")
         wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)

@@ -23,19 +23,19 @@ def test_a_terminals_set_and_save_show_in_the_page(browser, tmp_path):
 
     with tuned_page(browser, tmp_path) as target:
         text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters", page=browser)
         assert text("param-state") == "defaults"
         # another client, through the station: the page was not asked
         r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
         assert r.code == 0, r.out + r.err
-        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
-        wait_for(lambda: "unsaved changes" in text("param-state"), "the unsaved changes")
+        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal", page=browser)
+        wait_for(lambda: "unsaved changes" in text("param-state"), "the unsaved changes", page=browser)
         r = run_fsw("param", str(RIG), "set", "TRIM=7", "--port", target.port)
         assert r.code == 0, r.err  # the store state stays the same: the SET's acknowledgement tells
-        wait_for(lambda: text("pval-TRIM") == "7", "the second value")
+        wait_for(lambda: text("pval-TRIM") == "7", "the second value", page=browser)
         r = run_fsw("param", str(RIG), "save", "--port", target.port)
         assert r.code == 0, r.err
-        wait_for(lambda: text("param-state") == "bank A, sequence 1", "the saved bank")
+        wait_for(lambda: text("param-state") == "bank A, sequence 1", "the saved bank", page=browser)
         time.sleep(0.5)
         assert text("param-err") == ""
 
@@ -49,9 +49,9 @@ def test_a_value_being_typed_survives_a_read_again(browser, tmp_path):
 
     with tuned_page(browser, tmp_path) as target:
         text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+        wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters", page=browser)
         browser.find_element(By.ID, "pset-HOLD_MS").send_keys("700")
         r = run_fsw("param", str(RIG), "set", "OPEN_AT=650.5", "--port", target.port)
         assert r.code == 0, r.out + r.err
-        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal")
+        wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the value set from the terminal", page=browser)
         assert browser.find_element(By.ID, "pset-HOLD_MS").get_attribute("value") == "700"

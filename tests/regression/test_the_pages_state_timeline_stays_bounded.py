@@ -52,7 +52,7 @@ def test_a_machine_that_changes_state_often_keeps_the_page_answering(browser, tm
     try:
         with station_page(browser, target, layout) as st:
             count = "return document.querySelectorAll('#transitions-state li').length"
-            wait_for(lambda: browser.execute_script(count) >= KEPT, f"{KEPT} state changes listed", timeout=40)
+            wait_for(lambda: browser.execute_script(count) >= KEPT, f"{KEPT} state changes listed", timeout=40, page=browser)
             seen = browser.execute_script("return window.fswSeqs.length")
             wait_for(lambda: browser.execute_script("return window.fswSeqs.length") > seen + 500,
                      "the page to go on taking frames", timeout=15)

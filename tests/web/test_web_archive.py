@@ -230,9 +230,9 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
             with served(create_app(LiveSource(ground))) as url:
                 text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
                 browser.get(url)
-                wait_for(lambda: text("link-status") == "live", "the link to show live")
+                wait_for(lambda: text("link-status") == "live", "the link to show live", page=browser)
                 # the header: the frame-to-page latency's median, beside the frame count
-                wait_for(lambda: re.fullmatch(r"latency \d+(\.\d)? ms", text("link-latency")), "the latency")
+                wait_for(lambda: re.fullmatch(r"latency \d+(\.\d)? ms", text("link-latency")), "the latency", page=browser)
                 # a command through the page's route, acknowledged
                 req = urllib.request.Request(url + "api/command", method="POST", headers={"Content-Type": "application/json"},
                                              data=json.dumps({"kind": "set", "target": "valveOpen", "value": "false"}).encode())
@@ -241,13 +241,13 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
                 time.sleep(1.0)
                 # the target stops: the station's note beside the link indicator
                 target.stop()
-                wait_for(lambda: "the port went away" in text("link-note"), "the station's note")
-                wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator")
+                wait_for(lambda: "the port went away" in text("link-note"), "the station's note", page=browser)
+                wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator", page=browser)
                 time.sleep(1.0)  # the archive's last batch committed
 
                 # the archive tab: the session, live, in local time
                 press(browser, "tab-archive")
-                row = wait_for(lambda: browser.find_element(By.ID, "session-1"), "the sessions list")
+                row = wait_for(lambda: browser.find_element(By.ID, "session-1"), "the sessions list", page=browser)
                 started = json.loads(get(url + "api/archive/sessions")[1])["sessions"][0]["started"]
                 assert "live" in row.text and "tank" in row.text and target.port in row.text
                 assert _clock(started) in row.text and "running" in row.text
@@ -257,7 +257,7 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
                                   "the plot's points")
                 assert points > 50 and browser.find_element(By.CSS_SELECTOR, "#archive-chart canvas")
                 assert "#archive/1" in browser.current_url
-                wait_for(lambda: "set valveOpen = false" in text("archive-command-table"), "the command")
+                wait_for(lambda: "set valveOpen = false" in text("archive-command-table"), "the command", page=browser)
                 cmds = text("archive-command-table")
                 assert "127.0.0.1" in cmds and "applied" in cmds, cmds
                 notes = text("archive-note-list")
@@ -272,7 +272,7 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
                 w = over.size["width"]
                 ActionChains(browser).move_to_element_with_offset(over, -w // 2 + 2, 0).click_and_hold() \
                     .move_by_offset(w // 8, 0).release().perform()
-                wait_for(lambda: " of " in text("archive-range") and "whole" not in text("archive-range"), "the zoom")
+                wait_for(lambda: " of " in text("archive-range") and "whole" not in text("archive-range"), "the zoom", page=browser)
                 shown = text("archive-range")
                 lo, hi = (float(v) for v in re.match(r"([\d.]+)–([\d.]+) s", shown).groups())
                 assert 0 <= lo < hi < 2.0, shown
@@ -282,10 +282,10 @@ def test_the_archive_browser_shows_the_session_its_command_and_notes_and_exports
                 status, part = get(href)
                 assert status == 200 and part.startswith(b"target time [s],host time [s]")
                 ActionChains(browser).double_click(over).perform()
-                wait_for(lambda: "the whole session" in text("archive-range"), "the whole session again")
+                wait_for(lambda: "the whole session" in text("archive-range"), "the whole session again", page=browser)
                 # a session that is not there: the page says so
                 browser.get(url + "#archive/99")
-                wait_for(lambda: "no session 99 in the archive" in text("archive-err"), "the refusal in the page")
+                wait_for(lambda: "no session 99 in the archive" in text("archive-err"), "the refusal in the page", page=browser)
                 assert "its sessions are 1" in text("archive-err")
 
                 # the CSV download is `fsw log2csv` of the archive's session, byte for byte

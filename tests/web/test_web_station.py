@@ -66,16 +66,16 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
         try:
             browser.get(station.url)
             text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-            wait_for(lambda: text("link-status") == "live", "the link to show live")
+            wait_for(lambda: text("link-status") == "live", "the link to show live", page=browser)
             assert "tank" in browser.title
             # a value arrives and updates: the time element grows
-            t1 = wait_for(lambda: float(text("value-time")), "the time to show")
-            t2 = wait_for(lambda: float(text("value-time")) > t1 and float(text("value-time")), "the time to change")
+            t1 = wait_for(lambda: float(text("value-time")), "the time to show", page=browser)
+            t2 = wait_for(lambda: float(text("value-time")) > t1 and float(text("value-time")), "the time to change", page=browser)
             assert t2 > t1
             assert float(text("value-tankPressure")) == float(f"{volts_psi(RAW):.6g}")
             # the plot has drawn the samples (uPlot's canvas) and the state timeline its state
             assert browser.find_element(By.CSS_SELECTOR, "#chart canvas")
-            wait_for(lambda: "TankVentControl" in text("timeline"), "the state timeline")
+            wait_for(lambda: "TankVentControl" in text("timeline"), "the state timeline", page=browser)
             # a value of the wrong type is refused in the page, before anything is sent
             box = browser.find_element(By.ID, "cmd-valveOpen")
             box.send_keys("maybe")
@@ -105,7 +105,7 @@ def test_the_page_shows_the_link_commands_round_trip_and_a_stopped_target_goes_s
             assert browser.save_screenshot(os.path.join(shots, "ground-web.png"))
             # the target stops: the page says the link is stale
             target.stop()
-            wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator", timeout=10)
+            wait_for(lambda: text("link-status").startswith("stale"), "the stale indicator", timeout=10, page=browser)
             assert "last frame" in text("link-status")
         finally:
             station.close()
@@ -129,7 +129,7 @@ def test_the_page_shows_each_charges_status_from_the_health_frame(browser):
             try:
                 browser.get(station.url)
                 table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
-                wait_for(lambda: "pyro drogue" in table(), "the pyro rows of the health frame", timeout=10)
+                wait_for(lambda: "pyro drogue" in table(), "the pyro rows of the health frame", timeout=10, page=browser)
                 assert f"pyro drogue {words}" in table(), table()
                 assert "pyro main armed, continuity, not fired" in table(), table()
             finally:
@@ -165,7 +165,7 @@ def test_the_page_shows_each_sensor_parts_health(browser):
         try:
             browser.get(station.url)
             table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
-            wait_for(lambda: "sensor adxl345@spi:7" in table(), "the sensor rows of the health frame", timeout=10)
+            wait_for(lambda: "sensor adxl345@spi:7" in table(), "the sensor rows of the health frame", timeout=10, page=browser)
             assert "sensor bmp280@0x76 NO ANSWER" in table(), table()
             assert "sensor adxl345@spi:7 NO ANSWER" in table(), table()
         finally:
@@ -254,14 +254,14 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
                 time.sleep(0.02)
             browser.get(f"http://127.0.0.1:{http}/")
             text = lambda i: browser.find_element(By.ID, i).text  # noqa: E731
-            wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters")
+            wait_for(lambda: text("pval-OPEN_AT") == "800 psi", "the parameters", page=browser)
             assert text("param-state") == "defaults"
             box = browser.find_element(By.ID, "pset-OPEN_AT")
             box.send_keys("650.5")
             press(browser, "psend-OPEN_AT")
             wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
             press(browser, "confirm-yes")
-            wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the new value")
+            wait_for(lambda: text("pval-OPEN_AT") == "650.5 psi", "the new value", page=browser)
             assert "unsaved changes" in text("param-state")
             item = browser.find_elements(By.CSS_SELECTOR, "#history li")[0]
             assert "param set OPEN_AT = 650.5" in item.text and "applied" in item.text
@@ -270,7 +270,7 @@ def test_the_page_lists_and_sets_the_firmwares_parameters(browser, tmp_path):
             press(browser, "psend-HOLD_MS")
             wait_for(lambda: browser.find_element(By.ID, "confirm").get_attribute("open") is not None, "the dialog", page=browser)
             press(browser, "confirm-yes")
-            wait_for(lambda: "outside its range 10..60000 ms" in text("param-err"), "the refusal")
+            wait_for(lambda: "outside its range 10..60000 ms" in text("param-err"), "the refusal", page=browser)
         finally:
             server.should_exit = True
             thread.join(5)

@@ -49,7 +49,7 @@ class Restarted:
         elif op == OP_PARAM_GET:
             out = bytes(args[:2]) + self.block
         self.acks.append(Event("ack", 0, 0, self.t, info={
-            "cmd_seq": seq, "status": status, "status_name": {0: "OK", 12: "NO_LOAD"}[status], "reason": "",
+            "cmd_seq": seq, "op": op, "status": status, "status_name": {0: "OK", 12: "NO_LOAD"}[status], "reason": "",
             "data": out}))
 
     def events(self, wait: float):

@@ -33,7 +33,7 @@ class AlwaysBusy:
         body = wire.cobs_decode(data[1:-1])
         self.sent += 1
         self.acks.append(Event("ack", 0, 0, self.t, info={
-            "cmd_seq": body[1] | body[2] << 8, "status": 11, "status_name": "BUSY", "reason": "busy", "data": b""}))
+            "cmd_seq": body[1] | body[2] << 8, "op": body[0], "status": 11, "status_name": "BUSY", "reason": "busy", "data": b""}))
 
     def events(self, wait: float):
         self.t += max(wait, 0.001)

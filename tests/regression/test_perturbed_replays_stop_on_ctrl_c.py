@@ -41,8 +41,16 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
     p = subprocess.Popen([fsw, "sim", str(HPR), "--tape", str(TAPE), "--perturb", "400", "--out", str(out)],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, cwd=ROOT,
                          env=dict(os.environ, FSW_NO_PROGRESS="1"))
+    said = b""  # stderr up to the replays' start
     try:
-        time.sleep(40)  # the build and the first replays: the table has runs to show
+        # the build, then the replays' first line; a few seconds of them (a replay of this tape takes
+        # well under a second of CPU): the table has runs to show, and the rest are still queued
+        deadline = time.monotonic() + 240
+        while b"perturbed replays of" not in said:
+            line = p.stderr.readline()
+            assert line and time.monotonic() < deadline, said.decode()
+            said += line
+        time.sleep(6)
         os.killpg(p.pid, sig)
         t0 = time.monotonic()
         try:
@@ -54,7 +62,7 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
         if p.poll() is None:
             os.killpg(p.pid, signal.SIGKILL)
             p.communicate()
-    err = err.decode()
+    err = (said + err).decode()
     assert p.returncode == 128 + sig, (p.returncode, err)
     assert stopped_in < 30, stopped_in
     assert "Traceback" not in err, err

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from .diagnostics import read_input
 
-from .kit import BOARDS as BOARDS_DIR
+from .kit import BOARDS as BOARDS_DIR, board_names
 
 
 @dataclass(frozen=True)
@@ -57,13 +57,6 @@ class Board:
 
 class BoardError(Exception):
     pass
-
-
-def board_names() -> list[str]:
-    try:
-        return sorted(n[:-5] for n in os.listdir(BOARDS_DIR) if n.endswith(".toml"))
-    except OSError:
-        return []
 
 
 def load_board(name: str) -> Board:

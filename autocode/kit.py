@@ -21,3 +21,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RUNTIME = os.path.join(ROOT, "firmware", "src")
 BOARDS = os.path.join(ROOT, "boards")
 BUILD_MK = os.path.join(ROOT, "mk", "build.mk")
+
+
+def board_names() -> list[str]:
+    """The boards the kit knows: the names of its boards/*.toml."""
+    try:
+        return sorted(n[:-5] for n in os.listdir(BOARDS) if n.endswith(".toml"))
+    except OSError:
+        return []

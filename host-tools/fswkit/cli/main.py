@@ -532,13 +532,19 @@ def _idle_option(args) -> str | None:
     return None
 
 
+_parser: argparse.ArgumentParser | None = None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the command `argv` (None: this process's arguments, the process
     ending with it) and returns its exit status."""
     from fswkit import outputs
     from fswkit.outputs import Stream
 
-    p = parser()
+    global _parser
+    if _parser is None:  # built once a process: `fsw` run in-process again and again (the tests) reuses it
+        _parser = parser()
+    p = _parser
     args = p.parse_args(argv)
     empty = _empty_option(p, args)
     if empty is not None:  # `--trace ""` is no trace, `--out ""` not the default folder

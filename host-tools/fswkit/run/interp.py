@@ -8,6 +8,7 @@ as a direct tree walk; the tests hold the two to identical results."""
 
 from __future__ import annotations
 
+import functools
 import math
 
 from fswkit.autocode import model as M
@@ -165,12 +166,19 @@ class _Emitter:
 GLOBALS = {"_f32": f32, "_fi": f32_from_int, "_div": div, "_NAN": math.nan, "_INF": math.inf}
 
 
+@functools.lru_cache(maxsize=64)
+def _code(source: str, name: str):
+    """The compiled code of generated source: a machine run again (every
+    script of a test, each test of a batch) is not compiled again."""
+    return compile(source, f"<fswkit:{name}>", "exec")
+
+
 def compile_functions(source: str, name: str, extra: dict | None = None) -> dict:
     """The namespace of Python source generated from the model (the
     machine's or a script's functions), with the R helpers it calls."""
     namespace = dict(GLOBALS)
     namespace.update(extra or {})
-    exec(compile(source, f"<fswkit:{name}>", "exec"), namespace)  # generated from the model only
+    exec(_code(source, name), namespace)  # generated from the model only
     return namespace
 
 

@@ -281,17 +281,17 @@ def _raw_to_csv(m: M.Machine, raw: str, path: str) -> None:
                         for v in order)
     size = 8 * len(order)
     tracer = _Tracer(path, m)
-    v = [0] * len(m.vars)
     try:
         with open(raw, "rb") as f:
-            step = 0
+            step = 1
             while True:
-                row = f.read(size)
-                if len(row) < size:
+                chunk = f.read(size * 4096)  # whole rows; a partial last row (the runner stopped) is left
+                whole = len(chunk) - len(chunk) % size if size else 0
+                if not whole:
                     break
-                step += 1
-                for var, x in zip(order, struct.unpack(fmt, row)):
-                    v[var.index] = x
-                tracer.row(step, v)
+                tracer.rows_ordered(step, struct.iter_unpack(fmt, chunk[:whole]))
+                step += whole // size
+                if whole < len(chunk):
+                    break
     finally:
         tracer.close()

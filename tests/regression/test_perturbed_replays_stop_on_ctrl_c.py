@@ -43,7 +43,7 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
     out = tmp_path / "out"
     fsw = os.path.join(os.path.dirname(sys.executable), "fsw")
     # the replays' progress, as a display would get it from a worker (fswkit.progress): the stop is
-    # sent once some runs are done, however fast this machine flies them
+    # sent once a run is done (the other replay still flying), however fast this machine flies them
     sock_dir = tempfile.mkdtemp(prefix="fsw-")  # a socket's path is at most 107 bytes: not under tmp_path
     sock = os.path.join(sock_dir, "progress")
     channel = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
@@ -56,7 +56,7 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
     try:
         deadline = time.monotonic() + 300  # the build, then the first runs
         runs = 0
-        while runs < 4:
+        while runs < 1:
             left = deadline - time.monotonic()
             assert left > 0 and p.poll() is None, (runs, p.poll(), (tmp_path / "stderr").read_text())
             channel.settimeout(min(left, 5.0))

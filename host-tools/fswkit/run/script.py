@@ -5,6 +5,7 @@ know from the reference implementation."""
 from __future__ import annotations
 
 import csv
+import functools
 from dataclasses import dataclass
 
 from fswkit.autocode import model as M
@@ -160,7 +161,8 @@ def trace_header(m: M.Machine) -> bytes:
     return buf.getvalue().encode()
 
 
-def _row_maker(kinds: list[str], places) -> object:
+@functools.lru_cache(maxsize=256)
+def _row_maker(kinds: tuple[str, ...], places: tuple[int, ...]) -> object:
     """A function (step, values) -> a trace row: the step, then values[p]
     for each place p, written as the trace writes its kind (a bool as
     true/false, a float by repr, an integer as it is). Made once a trace,
@@ -181,9 +183,9 @@ class _Tracer:
         self.f = open(path, "w", newline="")
         self.w = csv.writer(self.f)
         order = _trace_order(m)
-        kinds = [var.type.kind for var in order]
-        self._row = _row_maker(kinds, [var.index for var in order])
-        self._ordered = _row_maker(kinds, range(len(order)))
+        kinds = tuple(var.type.kind for var in order)
+        self._row = _row_maker(kinds, tuple(var.index for var in order))
+        self._ordered = _row_maker(kinds, tuple(range(len(order))))
         self.w.writerow(["step"] + [var.display for var in order])
 
     def row(self, step: int, v) -> None:

@@ -14,6 +14,7 @@ import sys
 
 from fswkit import __version__
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
+from fswkit.numtext import decimal, integer
 
 
 def _command(module: str, name: str):
@@ -29,11 +30,24 @@ def _command(module: str, name: str):
 
 # ---- argument types -------------------------------------------------------------------
 
+def _number(text: str, what: str = "a number") -> float:
+    """A number as written in plain ASCII (fswkit.numtext): not `1_000`, digits of another script,
+    `nan` or `infinity`."""
+    value = decimal(text)
+    if value is None:
+        raise argparse.ArgumentTypeError(f"expected {what}, found {text!r}")
+    return value
+
+
+def _whole(text: str, what: str) -> int:
+    value = integer(text)
+    if value is None:
+        raise argparse.ArgumentTypeError(f"expected {what}, found {text!r}")
+    return value
+
+
 def _replay_speed(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    value = _number(text)
     if value != 0 and not 1e-3 <= value <= 1e6:
         raise argparse.ArgumentTypeError(f"expected 0 (as fast as possible) or a speed from 0.001 to 1000000, "
                                          f"found {text}")
@@ -41,10 +55,7 @@ def _replay_speed(text: str) -> float:
 
 
 def _nonneg_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}")
+    value = _number(text)
     if not value >= 0:
         raise argparse.ArgumentTypeError(f"expected a number >= 0, found {text}")
     return value
@@ -60,10 +71,7 @@ def _seconds(text: str) -> float:
 
 
 def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive whole number, found {text!r}")
+    value = _whole(text, "a positive whole number")
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive whole number, found {value}")
     return value
@@ -85,10 +93,7 @@ _delta_t = _int_upto(2**64 - 1, "a time step")  # the script's U64 `delta_t`
 
 
 def _nonneg_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {text!r}")
+    value = _whole(text, "a whole number >= 0")
     if value < 0:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 0, found {value}")
     return value
@@ -97,10 +102,7 @@ def _nonneg_int(text: str) -> int:
 def _pad_alt(text: str) -> float:
     """A pad's elevation in m ASL: from -500 (the Dead Sea's shore is -430)
     to 9,000 (the pressure a tape is made from stays in the ISA troposphere)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of metres, found {text!r}")
+    value = _number(text, "a number of metres")
     if not -500.0 <= value <= 9_000.0:
         raise argparse.ArgumentTypeError(f"expected a pad elevation from -500 to 9,000 m ASL, found {text}")
     return value
@@ -200,7 +202,7 @@ def parser() -> argparse.ArgumentParser:
     sm = sub.add_parser("sim", help="build and run the firmware on a simulated board, UART0 on a pty")
     sm.add_argument("project", metavar="PROJECT", help="a folder with one .app, the .app file, or a firmware .elf")
     sm.add_argument("--board", help="simulate this board instead of the one the .app names" + boards)
-    sm.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this much simulated time")
+    sm.add_argument("--duration", type=_number, metavar="SECONDS", help="stop after this much simulated time")
     sm.add_argument("--fast", action="store_true", help="run as fast as the simulator can, not in real time")
     sm.add_argument("--analog", action="append", metavar="PIN=VOLTS", help="an analog input's voltage, e.g. A0=3.2")
     sm.add_argument("--link", metavar="PATH", help="also make PATH a symbolic link to the serial port")

@@ -20,6 +20,7 @@ import numpy as np
 from fswkit.autocode import model as M
 from fswkit.autocode.evaluate import NotConstant, local_values
 from fswkit.autocode.numeric import REALS
+from fswkit.numtext import decimal
 
 from fswkit.sim.sensors import ACCELEROMETERS, AXES, BAROMETERS, find_part
 
@@ -72,11 +73,8 @@ def parse_fault(text: str) -> tuple[str, float | None]:
                          f"{', '.join(k + '[@SECONDS]' for k in PART_FAULTS)}")
     if not at:
         return name, None
-    try:
-        t = float(when)
-    except ValueError:
-        t = float("nan")
-    if not 0 <= t <= 3600:
+    t = decimal(when)
+    if t is None or not 0 <= t <= 3600:
         raise ValueError(f"--fault {text}: `@{when}` must be a simulated second from 0 to 3600 (baro-nack@12.5)")
     return name, t
 

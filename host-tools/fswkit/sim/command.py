@@ -8,6 +8,7 @@ import sys
 
 from fswkit.autocode.board import Board
 from fswkit.autocode.diagnostics import read_head
+from fswkit.numtext import decimal, integer
 from fswkit.sim.board import SimError, sim_board
 
 
@@ -82,14 +83,14 @@ def analog_args(items: list[str], board: Board) -> dict[str, float] | str:
         pin = pin.strip()
         if not sep:
             return f"--analog {item}: expected PIN=VOLTS, e.g. A0=3.2"
-        if pin.isdigit():
-            pin = next((n for n, number in board.analog_pins.items() if number == int(pin)), pin)
+        number = integer(pin)
+        if number is not None:
+            pin = next((n for n, at in board.analog_pins.items() if at == number), pin)
         if pin not in board.analog_pins:
             return f"--analog {item}: board `{board.name}` has no analog input `{pin}` " \
                    f"(it has {', '.join(f'{n} ({number})' for n, number in board.analog_pins.items())})"
-        try:
-            v = float(volts)
-        except ValueError:
+        v = decimal(volts.strip())
+        if v is None:
             return f"--analog {item}: `{volts}` is not a number of volts"
         if not 0.0 <= v <= board.adc_vref:
             return f"--analog {item}: volts must be between 0 and {board.adc_vref:g}"

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 from fswkit.autocode.iotables import analog_gain, analog_value
 from fswkit.autocode.numeric import REALS
+from fswkit.numtext import integer
 
 
 @dataclass(frozen=True)
@@ -151,14 +152,13 @@ def find_part(sensors, text: str, kinds: tuple[str, ...]):
         return None, f"the project has {len(same)} {kind} parts ({', '.join(part_name(s) for s in same)}): name one"
     where = where.strip().lower()
     bus, colon, rest = where.partition(":")
-    try:
-        if colon and bus == "spi":
-            pin = int(rest, 0)
-            hit = [s for s in same if s.bus == "spi" and s.cs_pin == pin]
-        else:
-            addr = int(rest if colon and bus == "i2c" else where, 0)
-            hit = [s for s in same if s.bus == "i2c" and s.address == addr]
-    except ValueError:
+    if colon and bus == "spi":
+        pin = integer(rest)
+        hit = [s for s in same if s.bus == "spi" and s.cs_pin == pin]
+    else:
+        pin = addr = integer(rest if colon and bus == "i2c" else where, hex_ok=True)
+        hit = [s for s in same if s.bus == "i2c" and s.address == addr]
+    if pin is None:  # plain ASCII digits, an address also 0x and hex digits (fswkit.numtext)
         return None, (f"\"{text}\": expected KIND@ADDRESS (\"{kind}@0x76\") or KIND@spi:PIN "
                       f"(\"{kind}@spi:7\")")
     if not hit:

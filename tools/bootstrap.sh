@@ -75,7 +75,7 @@ if [ ! -x "$VENV/bin/python" ]; then
     echo "bootstrap: creating the Python venv in $VENV"
     "$PYTHON" -m venv "$VENV"
 fi
-# The kit and its test tools go in with uv (from PyPI; about 4 s where pip
+# The kit and its test tools go in with uv (from PyPI; about 5 s where pip
 # takes 20), reading the package index and local wheels that pip's
 # environment names (PIP_INDEX_URL, PIP_EXTRA_INDEX_URL, PIP_FIND_LINKS). A
 # pip configuration file that names an index (uv does not read those), or

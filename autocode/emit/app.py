@@ -65,21 +65,40 @@ def _pin(app: Application, c) -> str:
 
 
 class _Scan:
-    """Analog inputs served one call each from a background scan of `tag`Pins
-    into `tag`Raw (fsw_io.h, "analog inputs, one call each")."""
+    """Analog inputs served from a background scan of `tag`Pins into
+    `tag`Raw (fsw_io.h, "analog inputs, one call each"): one call each, or
+    with `rows` one loop over the table `tag`Rows (_input_rows)."""
 
-    def __init__(self, tag: str, chans):
-        self.tag, self.chans = tag, chans
+    def __init__(self, tag: str, chans, rows: bool = False):
+        self.tag, self.chans, self.rows = tag, chans, rows
+
+
+def _input_rows(app: Application, chans) -> bool:
+    """Whether the analog inputs are converted by one loop over a flash
+    table (fsw::io_analog_inputs) rather than a call each with its
+    constants inline: two inputs or more, every element F32 and no `lock`
+    (the loop writes F32 elements unguarded). The same values bit for bit;
+    the loop's one copy of the conversion takes less flash from the second
+    input on (about 110 B an input on AVR)."""
+    return len(chans) >= 2 and not app.sv.lock and all(c.element.type.name == "F32" for c in chans)
+
+
+def _input_constants(app: Application, real, c) -> tuple[str, str]:
+    """An analog input's gain and offset as R literals: iotables.analog_gain
+    folds the converter into the .aio's scale (no division on the MCU)."""
+    gain = real_literal(analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real), real)
+    return gain, real_literal(real.literal(repr(c.offset)), real)
 
 
 def _analog_inputs(app: Application, real, scan: _Scan) -> list[str]:
     """The inputs task's lines for its analog inputs: each element takes its
-    count * gain + offset (iotables.analog_gain folds the converter into the
-    .aio's scale: no division on the MCU), then the next scan starts."""
+    count * gain + offset, then the next scan starts."""
     out = []
-    for k, c in enumerate(scan.chans):
-        gain = real_literal(analog_gain(c.scale, app.board.adc_vref, app.board.adc_bits, real), real)
-        offset = real_literal(real.literal(repr(c.offset)), real)
+    if scan.rows:
+        out.append(f"    fsw::io_analog_inputs({scan.tag}Rows, {len(scan.chans)}, {scan.tag}Memo, {scan.tag}Raw, sv);  "
+                   "// each element: count * gain + offset (the rows above)")
+    for k, c in enumerate(scan.chans if not scan.rows else ()):
+        gain, offset = _input_constants(app, real, c)
         write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
                  f"fsw::analog_value_memo({scan.tag}Memo[{k}], fsw::io_analog_count({scan.tag}Raw, {k}), "
                  f"{gain}, {offset}));")
@@ -118,8 +137,16 @@ def _tables(app: Application, real, out: list[str]) -> dict:
             out.append(f"volatile uint16_t {tag}Raw[{len(chans)}];  // counts the ADC's interrupt stores")
             out.append(f"fsw::AnalogMemo {tag}Memo[{len(chans)}];  // each input's last count and value: "
                        "converted again when the count changed")
+            rows = _input_rows(app, chans)
+            if rows:
+                out.append(f"const fsw::AnalogInput {tag}Rows[{len(chans)}] FSW_FLASH = {{")
+                for c in chans:
+                    gain, offset = _input_constants(app, real, c)
+                    out.append(f"    {{{gain}, {offset}, E_{c.element.name}}},  "
+                               f"// {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt")
+                out.append("};")
             out.append("")
-            names[(kind, d)] = _Scan(tag, chans)
+            names[(kind, d)] = _Scan(tag, chans, rows)
             continue
         if kind == "analog":
             out.append(f"const fsw::AnalogChannel {tag}Ch[] FSW_FLASH = {{")

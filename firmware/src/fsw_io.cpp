@@ -114,6 +114,19 @@ Result analog_task(void* ctx) {
 
 }  // namespace
 
+void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, const volatile uint16_t* raw,
+                      uint8_t* sv) {
+    for (uint8_t i = 0; i < n; ++i, ++rows, ++memo) {
+        const uint16_t count = io_analog_count(raw, i);
+        const uint16_t key = static_cast<uint16_t>(~count);
+        if (key == 0 || key != memo->key) {  // (analog_value_memo, the row's constants read only here)
+            memo->key = key;
+            memo->value = analog_value(count, flash_get(rows->gain), flash_get(rows->offset));
+        }
+        write_F32(sv + flash_get(rows->off), memo->value);
+    }
+}
+
 Result io_analog_task(void* ctx) { return analog_task<true, true>(ctx); }
 Result io_analog_task_f32(void* ctx) { return analog_task<false, true>(ctx); }
 Result io_analog_in_task_f32(void* ctx) { return analog_task<false, false>(ctx); }

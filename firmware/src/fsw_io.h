@@ -251,6 +251,24 @@ inline __attribute__((always_inline)) Real analog_value_memo(AnalogMemo& m, uint
     }
     return m.value;
 }
+// An analog input of a generated inputs task, FSW_FLASH: the F32 element
+// at `off` takes count * gain + offset (the generator's constants).
+struct AnalogInput {
+    Real gain;
+    Real offset;
+    ElemOff off;
+};
+// The inputs task's analog inputs, one loop over their rows: input i's F32
+// element takes analog_value_memo(memo[i], io_analog_count(raw, i), gain,
+// offset), the same value bit for bit as a call of its own with the
+// constants inline (an offset of +0 is added here: it turns -0 into +0 as
+// analog_value's shortcut does). A row's gain and offset are read out of
+// flash only when its count changed; one copy of the conversion in flash
+// for every input (about 110 B an input inline on AVR). Not for a state
+// vector with `lock` (each write is then guarded: the generator calls one
+// input at a time).
+void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, const volatile uint16_t* raw,
+                      uint8_t* sv);
 // duty = trunc(clamp(volts / vref * 255 + 0.5, 0, 255)); NaN -> 0.
 uint8_t pwm_duty_from_volts(Real volts, Real vref);
 

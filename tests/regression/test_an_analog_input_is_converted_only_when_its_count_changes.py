@@ -23,8 +23,23 @@ def test_each_analog_input_converts_through_its_memo(tmp_path):
     assert r.code == 0, r.out + r.err
     cpp = (tmp_path / "gen" / "app.gen.cpp").read_text()
     assert "fsw::AnalogMemo kAnalogInMemo[4];" in cpp, cpp
+    # the four in one loop over their rows, input i through memo i (fsw::io_analog_inputs)
+    assert "fsw::io_analog_inputs(kAnalogInRows, 4, kAnalogInMemo, kAnalogInRaw, sv);" in cpp, cpp
+    rows = re.findall(r"^    \{[^{}]*, E_(\w+)\},", cpp, re.M)
+    assert rows == ["pressure", "accel", "drogueSense", "mainSense"], rows
+    assert "fsw::analog_value(" not in cpp  # no input converted around its memo
+
+
+def test_an_input_converted_by_a_call_of_its_own_goes_through_its_memo(tmp_path):
+    proj = example_copy("rocket", tmp_path)
+    sv = proj / "rocket.sv"
+    sv.write_text("[options]\nlock\n\n" + sv.read_text())
+    r = run_fsw("gen", str(proj), "--out", str(tmp_path / "gen"))
+    assert r.code == 0, r.out + r.err
+    cpp = (tmp_path / "gen" / "app.gen.cpp").read_text()
+    # a state vector with `lock`: each input's write guarded, a call each
     calls = re.findall(r"fsw::write_F32\(sv \+ E_(\w+), fsw::analog_value_memo\(kAnalogInMemo\[(\d)\], "
                        r"fsw::io_analog_count\(kAnalogInRaw, (\d)\)", cpp)
     assert calls == [("pressure", "0", "0"), ("accel", "1", "1"), ("drogueSense", "2", "2"),
                      ("mainSense", "3", "3")], calls
-    assert "fsw::analog_value(" not in cpp  # no input converted around its memo
+    assert "io_analog_inputs" not in cpp and "fsw::analog_value(" not in cpp

@@ -69,9 +69,6 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     ex.next_due_us = pal::micros32();
 #endif
     ex.mirrors = mirrors;
-#if FSW_TASK_TIMING
-    ex.period_us = c.period_us;
-#endif
     ex.reset_cause = pal::reset_cause();
     if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
@@ -201,7 +198,7 @@ void executor_run_cycle(Executor& ex) {
         if (took > s.worst_us) s.worst_us = took;
         // A run within the base period is within the task's (divider >= 1):
         // the product, a 32-bit multiplication, only for the longer ones.
-        const uint32_t period_us = base_period(ex.period_us);
+        const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
         if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
             s.overruns != 0xFFFFu) {
             ++s.overruns;

@@ -77,11 +77,9 @@ struct Executor {
     // executor_begin from the table: a cycle then looks at no row's offsets
     // when none does).
     uint8_t mirrors;
-#if FSW_TASK_TIMING
-    // The base period (the configuration's), for each task run's overrun
-    // test: four loads from RAM where flash_get's copy was a call a run.
-    uint32_t period_us;
-#endif
+    // (The base period of each task run's overrun test is the application's
+    // constant, app_period_us, or read out of the configuration: no copy in
+    // RAM, 4 bytes a generated application never read.)
 };
 
 // Cycles run, all 64 bits: `[time] source cycle` keeps counting past the

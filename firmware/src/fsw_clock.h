@@ -16,7 +16,15 @@ static_assert(sizeof(Clock64) == 8, "Clock64: two packed words");
 
 // Extends a new 32-bit reading; a reading below the previous one is a wrap.
 // Not re-entrant: call from one context (the executor's loop).
-inline uint64_t clock64_extend(Clock64& c, uint32_t now32) {
+inline uint64_t clock64_extend(Clock64& record, uint32_t now32) {
+    Clock64* p = &record;
+#if defined(__AVR__)
+    // The record through a pointer register, not at its constant address:
+    // its bytes read and written with displacements (2 bytes of flash an
+    // access) instead of absolute ones (4), about 60 of millis64()'s 194 B.
+    __asm__("" : "+e"(p));
+#endif
+    Clock64& c = *p;
     if (now32 < c.last) ++c.high;
     c.last = now32;
     // (high << 32) | now32 is the record itself on a little-endian target

@@ -220,6 +220,10 @@ void link_poll(Link& link);
 // Whether link_poll has work: frames in the transmit buffer, control frames
 // or a snapshot waiting (the sleeping executor wakes the main loop for it).
 bool link_busy(const Link& link);
+// The body of the frame being composed, a byte or `n` bytes more: what a
+// store's ack function (below) adds after the acknowledgement's 6 bytes.
+void link_put(uint8_t b);
+void link_put_bytes(const void* p, uint16_t n);
 // A parameter command (kOpParamGet..kOpParamInfo) on the store, and what its
 // acknowledgement carries after its 6 bytes (GET's values, INFO's state,
 // the id a refusal stopped at).
@@ -231,6 +235,7 @@ void link_log_ack(Link& link, const Recorder& rec);
 // A reload command (kOpMachineInfo..kOpMachineActivate), and what its ack carries.
 uint8_t link_reload_apply(Link& link, ReloadStore& store, uint8_t op, const uint8_t* args, uint8_t len);
 void link_reload_ack(Link& link, const ReloadStore& store);
+// (The six in fsw_link_stores.cpp.)
 
 // ---- compile-time checks of the tables -------------------------------------
 // The generator emits a static_assert of each for its tables; a hand-written

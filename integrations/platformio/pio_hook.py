@@ -113,8 +113,10 @@ def needs_decimal_dig(cxx):
 # Linked as mk/build.mk links (`fsw build`): with -flto the program is
 # compiled again at the link, and without these in one section, so
 # --gc-sections cannot drop what became dead only there (a board's VM, whose
-# unused features fold away at the link: docs/bytecode.md).
-AVR_LINKFLAGS = ["-ffunction-sections", "-fdata-sections"]
+# unused features fold away at the link: docs/bytecode.md), and in the order
+# of their sources, each function near those it calls (2-byte relaxed calls:
+# -fno-toplevel-reorder, mk/build.mk).
+AVR_LINKFLAGS = ["-ffunction-sections", "-fdata-sections", "-fno-toplevel-reorder"]
 
 
 def configure_toolchain(env):

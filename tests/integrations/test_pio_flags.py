@@ -55,7 +55,8 @@ PIO_ARDUINO = {
 CODE_FLAGS = {"-ffunction-sections", "-fdata-sections", "-flto", "-mcall-prologues", "-mstrict-X",
               "-fno-move-loop-invariants", "-fno-exceptions", "-fno-threadsafe-statics"}
 LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues", "-mstrict-X",
-              "-ffunction-sections", "-fdata-sections"}  # (at the link: LTO's own compilation, mk/build.mk)
+              "-ffunction-sections", "-fdata-sections", "-fno-toplevel-reorder"}  # (at the link: LTO's own
+#                                                                                  compilation, mk/build.mk)
 
 
 def hook_linkflags() -> list[str]:
@@ -216,8 +217,9 @@ def test_a_mismatch_is_reported(tmp_path):
     assert "cxx -O: PlatformIO ['-O2', '-Os'], fsw build ['-Os']" in diffs
     assert "c define EXTRA: only in PlatformIO" in diffs
     assert "link flags: PlatformIO ['-Wl,--gc-sections', '-fdata-sections', '-ffunction-sections', '-flto', " \
-           "'-fuse-linker-plugin'], fsw build ['-Wl,--gc-sections', '-Wl,--relax', '-fdata-sections', " \
-           "'-ffunction-sections', '-flto', '-fuse-linker-plugin', '-mcall-prologues', '-mstrict-X']" in diffs
+           "'-fno-toplevel-reorder', '-fuse-linker-plugin'], fsw build ['-Wl,--gc-sections', '-Wl,--relax', '-fdata-sections', " \
+           "'-ffunction-sections', '-flto', '-fno-toplevel-reorder', '-fuse-linker-plugin', '-mcall-prologues', " \
+           "'-mstrict-X']" in diffs
 
 
 @needs_pio

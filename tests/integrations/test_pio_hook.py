@@ -17,7 +17,7 @@ from conftest import EXAMPLES, ROOT
 
 HOOK = ROOT / "integrations" / "platformio" / "pio_hook.py"
 # what the hook adds to every atmelavr build: the link's sections, as mk/build.mk links
-SECTIONS = {"LINKFLAGS": ["-ffunction-sections", "-fdata-sections"]}
+SECTIONS = {"LINKFLAGS": ["-ffunction-sections", "-fdata-sections", "-fno-toplevel-reorder"]}
 TANK = EXAMPLES / "tank"
 
 

@@ -36,7 +36,7 @@ def test_sketch_folder_holds_the_generated_code_an_ino_and_the_fqbn(fsw, tmp_pat
     yaml = (sketch / "sketch.yaml").read_text()
     assert yaml.endswith("default_fqbn: arduino:avr:uno\n")
     # fsw build's flags, named for the command line (the folder cannot carry them)
-    assert "#   --build-property 'compiler.c.elf.extra_flags=-Wl,--relax -ffunction-sections -fdata-sections'\n" \
+    assert "#   --build-property 'compiler.c.elf.extra_flags=-Wl,--relax -ffunction-sections -fdata-sections -fno-toplevel-reorder'\n" \
         in yaml
     assert "#   --build-property 'compiler.cpp.extra_flags=-mcall-prologues -mstrict-X -fno-move-loop-invariants'\n" \
         in yaml

@@ -155,7 +155,8 @@ inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
 // profile of the demo flight). The period from RAM and the clock read
 // inline (now_us) took the time between the rocket's task steps from 70
 // to 58 us a cycle (tools/bench_busy.py, 2026-12-07).
-void executor_run_cycle(Executor& ex) {
+void executor_run_cycle(Executor& ex_) {
+    Executor& ex = *by_pointer(&ex_);
     pal::watchdog_kick();
     // The configuration's fields read out of flash one at a time, only those
     // a cycle uses (no copy routine for the whole of it: a cycle's 10 us).
@@ -225,7 +226,8 @@ inline void count(uint16_t& n, uint8_t by) {
 }
 }  // namespace
 
-bool executor_poll(Executor& ex, bool background) {
+bool executor_poll(Executor& ex_, bool background) {
+    Executor& ex = *by_pointer(&ex_);
     uint8_t skipped;
     const uint8_t why = pal::cycle_wait(skipped, background);
     if (why == pal::kCycleNotDue) return false;

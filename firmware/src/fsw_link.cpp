@@ -414,7 +414,8 @@ void handle_frame(Link& l, const LinkConfig& c) {
 
 }  // namespace
 
-void link_begin(Link& l, const LinkConfig* cfg) {
+void link_begin(Link& l_, const LinkConfig* cfg) {
+    Link& l = *by_pointer(&l_);
     memset(&l, 0, sizeof l);
     l.cfg = cfg;
     // The fields one at a time (no copy of the configuration on the stack:
@@ -549,7 +550,8 @@ bool link_busy(const Link& l) {
     return l.cfg != 0 && (l.tx_len != 0 || l.pending != 0 || l.snapshot_at != kNoSnapshot);
 }
 
-void link_poll(Link& l) {
+void link_poll(Link& l_) {
+    Link& l = *by_pointer(&l_);
     if (l.cfg == 0) return;
     pump(l);
     if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;

@@ -101,6 +101,19 @@ inline void flash_read(void* dst, const void* src, size_t n) {
 #endif
 }
 
+// `p` as the compiler no longer knows it: a static object that LTO inlines
+// a function on (the executor, the link, in main()) is then addressed
+// through a pointer register, its fields at displacements (ldd/std: 2 bytes
+// of flash an access, as fast) rather than at their absolute addresses
+// (lds/sts: 4 bytes).
+template <class T>
+inline T* by_pointer(T* p) {
+#if defined(__AVR__)
+    __asm__("" : "+e"(p));
+#endif
+    return p;
+}
+
 // One byte of a constant table (marked FSW_FLASH): a single load, no copy routine.
 inline uint8_t flash_u8(const uint8_t* p) {
 #if FSW_USE_PROGMEM

@@ -115,6 +115,11 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
     return [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
 
 
+# The direct byte accesses of the state vector (bools, bytes) in a machine's
+# state functions from which they take it through a pointer register.
+SV_BY_POINTER = 4
+
+
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
                  ns: str = "fsw_gen", leave: bool = False, kept: bool = False) -> dict[str, str]:
     """`<name>.gen.h` and `<name>.gen.cpp` for one machine. `scriptable`
@@ -205,23 +210,43 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # A state id as entry and step code return it: the narrowest type that
     # holds them all (an 8-bit MCU passes and tests it in fewer instructions).
     sid = "uint8_t" if len(m.states) < 0x100 else "uint16_t" if len(m.states) < 0x10000 else "uint32_t"
+    bodies = []
     for st in m.states:
         for label in ("entry", "step", "exit"):
             stmts = getattr(st, label)
             if not stmts:
                 continue
-            ret = "void" if label == "exit" else sid
-            c.append(f"// [{st.name}] .{label}")
-            c.append(f"{ret} s{st.id}_{label}() {{")
-            _block(stmts, ex, "    ", c, src, m, label != "exit")
-            if label != "exit":
-                c.append("    return 0;")
-            c.append("}")
-            c.append("")
+            body: list[str] = []
+            _block(stmts, ex, "    ", body, src, m, label != "exit")
+            bodies.append((st, label, body))
+    # The state vector reaches the state functions as an argument of its
+    # own name, which step() took through fsw::by_pointer, when they read or
+    # write its bytes directly (bools, bytes) often enough: inlined into
+    # step(), they then address them through a pointer register, 2 bytes of
+    # flash an access where the absolute address took 4, as fast (36 B of
+    # the rocket's mission). With few such accesses the pointer register's
+    # keeping costs more than it saves (the rocket's nav: 6 B).
+    direct = sum(line.count(f"{op}(sv + ") for _, _, body in bodies for line in body
+                 for op in ("store_bool", "read_bool", "load_bool", "load<uint8_t>", "store<uint8_t>",
+                            "load<int8_t>", "store<int8_t>"))
+    areas = [("sv", f"{ns}::sv")] if direct >= SV_BY_POINTER else []
+    formals = ", ".join(f"uint8_t* const {a}" for a, _ in areas)
+    actuals = ", ".join(a for a, _ in areas)
+    for st, label, body in bodies:
+        ret = "void" if label == "exit" else sid
+        c.append(f"// [{st.name}] .{label}")
+        c.append(f"{ret} s{st.id}_{label}({formals}) {{")
+        c += body
+        if label != "exit":
+            c.append("    return 0;")
+        c.append("}")
+        c.append("")
     c.append("}  // namespace")
     c.append("")
     g, s = m.vars[m.g], m.vars[m.s]
     c.append("fsw::Result step() {")
+    for a, whole in areas:
+        c.append(f"    uint8_t* const {a} = fsw::by_pointer({whole});")
     if m.sv.lock:
         c.append("    uint64_t g;")
         c.append(f"    {{ fsw::SvGuard<true> lock; g = fsw::load<uint64_t>(sv + E_{g.name}); }}")
@@ -277,11 +302,12 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     for st in m.states:
         c.append(f"    case S_{st.name}:")
         if st.entry:
-            c.append(f"        if (machine.entering != 0) next = s{st.id}_entry();")
+            c.append(f"        if (machine.entering != 0) next = s{st.id}_entry({actuals});")
         if st.step:
-            c.append(f"        if (next == 0) next = s{st.id}_step();" if st.entry else f"        next = s{st.id}_step();")
+            c.append(f"        if (next == 0) next = s{st.id}_step({actuals});" if st.entry
+                     else f"        next = s{st.id}_step({actuals});")
         if st.exit and (st.entry or st.step):
-            c.append(f"        if (next != 0) s{st.id}_exit();")
+            c.append(f"        if (next != 0) s{st.id}_exit({actuals});")
         c.append("        break;")
     c.append("    default:")
     c.append("        break;")
@@ -307,7 +333,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
               "    switch (machine.state) {"]
         for st in m.states:
             if st.exit:
-                c.append(f"    case S_{st.name}: s{st.id}_exit(); break;")
+                c.append(f"    case S_{st.name}: s{st.id}_exit({actuals}); break;")
         c += ["    default: break;", "    }", "}"]
     c += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", ""]
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}

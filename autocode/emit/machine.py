@@ -8,6 +8,8 @@ logic; every algorithm lives in the hand-written runtime (firmware/src)."""
 
 from __future__ import annotations
 
+import re
+
 from .. import model as M
 from ..check import gotos, model_children, stmt_exprs
 from ..cnames import enumerator
@@ -219,8 +221,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             body: list[str] = []
             _block(stmts, ex, "    ", body, src, m, label != "exit")
             bodies.append((st, label, body))
-    # The state vector reaches the state functions as an argument of its
-    # own name, which step() took through fsw::by_pointer, when they read or
+    # The state vector reaches the state functions as an argument, `svp`,
+    # which step() took through fsw::by_pointer, when they read or
     # write its bytes directly (bools, bytes) often enough: inlined into
     # step(), they then address them through a pointer register, 2 bytes of
     # flash an access where the absolute address took 4, as fast (36 B of
@@ -229,11 +231,16 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     direct = sum(line.count(f"{op}(sv + ") for _, _, body in bodies for line in body
                  for op in ("store_bool", "read_bool", "load_bool", "load<uint8_t>", "store<uint8_t>",
                             "load<int8_t>", "store<int8_t>"))
-    areas = [("sv", f"{ns}::sv")] if direct >= SV_BY_POINTER else []
-    formals = ", ".join(f"uint8_t* const {a}" for a, _ in areas)
+    areas = [("svp", "sv")] if direct >= SV_BY_POINTER else []
+    used = re.compile(r"(?<![\w.:])sv \+ ")
+    if areas:  # (another name than the state vector's: no shadowing it)
+        bodies = [(st, label, [used.sub("svp + ", line) for line in body]) for st, label, body in bodies]
     actuals = ", ".join(a for a, _ in areas)
     for st, label, body in bodies:
         ret = "void" if label == "exit" else sid
+        # (unnamed where the function does not use it: no unused-parameter warning)
+        formals = ", ".join(f"uint8_t* const {a}" if any(f"{a} + " in line for line in body)
+                            else "uint8_t* const" for a, _ in areas)
         c.append(f"// [{st.name}] .{label}")
         c.append(f"{ret} s{st.id}_{label}({formals}) {{")
         c += body
@@ -333,7 +340,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
               "    switch (machine.state) {"]
         for st in m.states:
             if st.exit:
-                c.append(f"    case S_{st.name}: s{st.id}_exit({actuals}); break;")
+                c.append(f"    case S_{st.name}: s{st.id}_exit({', '.join(whole for _, whole in areas)}); break;")
         c += ["    default: break;", "    }", "}"]
     c += ["", f"}}  // namespace {name}", f"}}  // namespace {ns}", ""]
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}

@@ -119,9 +119,20 @@ void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, cons
     for (uint8_t i = 0; i < n; ++i, ++rows, ++memo) {
         const uint16_t count = io_analog_count(raw, i);
         const uint16_t key = static_cast<uint16_t>(~count);
-        if (key == 0 || key != memo->key) {  // (analog_value_memo, the row's constants read only here)
+        if (key == 0 || key != memo->key) {  // (analog_value_memo: the row's constants read only then)
             memo->key = key;
-            memo->value = analog_value(count, flash_get(rows->gain), flash_get(rows->offset));
+            const Real scaled = real_from_count(count) * flash_get(rows->gain);  // analog_value's, in its order
+            const Real offset = flash_get(rows->offset);
+#if FSW_REAL_IS_FLOAT
+            // an offset of +0 (its bits all 0) is not added: adding it only turns -0 into +0,
+            // done on the bits as analog_value does for a literal +0 (no float addition)
+            uint32_t ob, sb;
+            memcpy(&ob, &offset, sizeof ob);
+            memcpy(&sb, &scaled, sizeof sb);
+            memo->value = ob != 0 ? scaled + offset : sb == 0x80000000UL ? Real(0) : scaled;
+#else
+            memo->value = scaled + offset;
+#endif
         }
         write_F32(sv + flash_get(rows->off), memo->value);
     }

@@ -261,8 +261,8 @@ struct AnalogInput {
 // The inputs task's analog inputs, one loop over their rows: input i's F32
 // element takes analog_value_memo(memo[i], io_analog_count(raw, i), gain,
 // offset), the same value bit for bit as a call of its own with the
-// constants inline (an offset of +0 is added here: it turns -0 into +0 as
-// analog_value's shortcut does). A row's gain and offset are read out of
+// constants inline (an offset of +0 is not added on binary32 R: -0 turns
+// +0 on the bits, as analog_value's shortcut does). A row's gain and offset are read out of
 // flash only when its count changed; one copy of the conversion in flash
 // for every input (about 110 B an input inline on AVR). Not for a state
 // vector with `lock` (each write is then guarded: the generator calls one

@@ -164,13 +164,50 @@ void executor_run_cycle(Executor& ex_) {
     TaskStats* sp = flash_get(f.stats);
     const Task* row = flash_get(f.tasks);
     const Task* const end = row + flash_get(f.n_tasks);
-#if FSW_TASK_TIMING
     // One clock read per task run: a run is timed from the previous run's
     // end (the cycle's start for the first) to its own end, so it counts
-    // the executor's few instructions that find and start it too.
-    uint32_t mark = now_us();
+    // the executor's few instructions that find and start it too. The
+    // clock is read at one place, a turn's start (the cycle's, and the
+    // turn after a run): one copy of now_us()'s inline code.
+    TaskStats* ran = 0;  // the record of the task run in the turn before, and its row
+    const Task* ran_row = 0;
+#if FSW_TASK_TIMING
+    uint32_t mark = 0;
+    bool first = true;
 #endif
-    for (; row != end; ++row, ++sp) {  // a row and its record a turn
+    for (;; ++row, ++sp) {  // a row and its record a turn, and a last turn for the last run's end
+#if FSW_TASK_TIMING
+        if (first || ran != 0) {
+            const uint32_t now = now_us();
+            if (ran != 0) {
+                TaskStats& s = *ran;
+                const uint32_t took = now - mark;
+                if (took > s.worst_us) s.worst_us = took;
+                // A run within the base period is within the task's (divider >= 1):
+                // the product, a 32-bit multiplication, only for the longer ones.
+                const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
+                if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(ran_row->divider)) &&
+                    s.overruns != 0xFFFFu) {
+                    ++s.overruns;
+                }
+            }
+            mark = now;
+            first = false;
+        }
+#endif
+        if (app_has(kAppMirrors) && ran != 0 && ex.mirrors != 0) {  // (ex.mirrors: some row has an element to mirror into)
+            const ElemOff overruns_off = flash_get(ran_row->overruns_off), worst_us_off = flash_get(ran_row->worst_us_off);
+            if (overruns_off != kNoElement || worst_us_off != kNoElement) {
+                uint8_t* const sv = flash_get(f.sv);
+                const bool lock = app_has(kAppSvLock) && flash_get(f.sv_lock);
+                const pal::IrqState saved = lock ? pal::critical_enter() : 0;
+                if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, ran->overruns);
+                if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, ran->worst_us);
+                if (lock) pal::critical_exit(saved);
+            }
+        }
+        ran = 0;
+        if (row == end) break;
         TaskStats& s = *sp;
         if (app_has(kAppSlowTasks) && s.countdown != 0) {  // (else every task runs every cycle: 0 stays 0)
             --s.countdown;
@@ -192,29 +229,8 @@ void executor_run_cycle(Executor& ex_) {
             const TaskSafeFn safe = flash_get(row->safe);
             if (safe != 0) safe(h.ctx);
         }
-#if FSW_TASK_TIMING
-        const uint32_t now = now_us();
-        const uint32_t took = now - mark;
-        mark = now;
-        if (took > s.worst_us) s.worst_us = took;
-        // A run within the base period is within the task's (divider >= 1):
-        // the product, a 32-bit multiplication, only for the longer ones.
-        const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
-        if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
-            s.overruns != 0xFFFFu) {
-            ++s.overruns;
-        }
-#endif
-        if (!app_has(kAppMirrors) || ex.mirrors == 0) continue;  // no row has an element to mirror into
-        const ElemOff overruns_off = flash_get(row->overruns_off), worst_us_off = flash_get(row->worst_us_off);
-        if (overruns_off != kNoElement || worst_us_off != kNoElement) {
-            uint8_t* const sv = flash_get(f.sv);
-            const bool lock = app_has(kAppSvLock) && flash_get(f.sv_lock);
-            const pal::IrqState saved = lock ? pal::critical_enter() : 0;
-            if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, s.overruns);
-            if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, s.worst_us);
-            if (lock) pal::critical_exit(saved);
-        }
+        ran = sp;
+        ran_row = row;
     }
     if (++ex.cycles == 0) ++ex.cycles_high;
 }

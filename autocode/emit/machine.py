@@ -117,9 +117,23 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
     return [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
 
 
-# The direct byte accesses of the state vector (bools, bytes) in a machine's
-# state functions from which they take it through a pointer register.
-SV_BY_POINTER = 4
+# The bytes of the state vector, the locals or the parameters a machine's
+# state functions access directly (not through an out-of-line call) from
+# which they take that area through a pointer register.
+BY_POINTER_BYTES = 8
+_DIRECT = re.compile(r"\b(?:store_bool|read_bool|load_bool|read_[UI](\d+)|write_[UI](\d+)|load<u?int(\d+)_t>|"
+                     r"store<u?int(\d+)_t>)\((sv|loc|prm) \+ ")
+
+
+def _direct_bytes(line: str, area: str) -> int:
+    """The bytes of `area` (sv, loc, prm) that a line of a state function
+    reads or writes directly: a bool or an integer, not through a call."""
+    n = 0
+    for m in _DIRECT.finditer(line):
+        if m.group(5) == area:
+            bits = next((g for g in m.groups()[:4] if g), None)
+            n += int(bits) // 8 if bits else 1
+    return n
 
 
 def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
@@ -221,20 +235,24 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             body: list[str] = []
             _block(stmts, ex, "    ", body, src, m, label != "exit")
             bodies.append((st, label, body))
-    # The state vector reaches the state functions as an argument, `svp`,
-    # which step() took through fsw::by_pointer, when they read or
-    # write its bytes directly (bools, bytes) often enough: inlined into
-    # step(), they then address them through a pointer register, 2 bytes of
-    # flash an access where the absolute address took 4, as fast (36 B of
-    # the rocket's mission). With few such accesses the pointer register's
-    # keeping costs more than it saves (the rocket's nav: 6 B).
-    direct = sum(line.count(f"{op}(sv + ") for _, _, body in bodies for line in body
-                 for op in ("store_bool", "read_bool", "load_bool", "load<uint8_t>", "store<uint8_t>",
-                            "load<int8_t>", "store<int8_t>"))
-    areas = [("svp", "sv")] if direct >= SV_BY_POINTER else []
-    used = re.compile(r"(?<![\w.:])sv \+ ")
-    if areas:  # (another name than the state vector's: no shadowing it)
-        bodies = [(st, label, [used.sub("svp + ", line) for line in body]) for st, label, body in bodies]
+    # The state vector and the locals each reach the state functions as an
+    # argument (`svp`, `locp`), which step() took through fsw::by_pointer,
+    # when they read or write enough of its bytes directly (not through an
+    # out-of-line call: bools, integers): inlined into step(), they then
+    # address those bytes through a pointer register, 2 bytes of flash a
+    # byte where the absolute address took 4, as fast (66 B of the rocket's
+    # mission). With fewer the pointer register's keeping costs more than it
+    # saves (the rocket's nav: 6 B). Not the parameters: the AVR has three
+    # pointer registers, and a third area kept in one cost the whole
+    # rocket's mission 118 B more than it saved.
+    areas = []
+    called = any(st.entry or st.step for st in m.states)  # (else step() calls no state function)
+    for area, whole in (("sv", "sv"), ("loc", "loc")) if called else ():
+        direct = sum(_direct_bytes(line, area) for _, _, body in bodies for line in body)
+        if direct >= BY_POINTER_BYTES:
+            areas.append((area + "p", whole))
+            used = re.compile(rf"(?<![\w.:]){area} \+ ")  # (another name than the area's: no shadowing it)
+            bodies = [(st, label, [used.sub(f"{area}p + ", line) for line in body]) for st, label, body in bodies]
     actuals = ", ".join(a for a, _ in areas)
     for st, label, body in bodies:
         ret = "void" if label == "exit" else sid

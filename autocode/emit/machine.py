@@ -289,6 +289,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # after the windows it reads were pushed.
     # A group is sampled only in the states where one of its windows may
     # still be read (window_needs); elsewhere its pushes are skipped.
+    c.append("    const uint32_t state = machine.state;  // (read once: nothing changes it before the transition)")
     args: dict[str, list] = {}
     for w in m.windows:
         args.setdefault(ex.value(w.arg), []).append(w)
@@ -305,7 +306,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         pad = "    "
         if where != every:
             names = ", ".join(m.states[i].name for i in sorted(where))
-            c.append(f"    switch (machine.state) {{  // sampled where still read: {names}")
+            c.append(f"    switch (state) {{  // sampled where still read: {names}")
             for i in sorted(where):
                 c.append(f"    case S_{m.states[i].name}:")
             c.append("    {")
@@ -323,7 +324,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     moves = any(st.entry or st.step for st in m.states)  # else nothing can transition
     if moves:
         c.append(f"    {sid} next = 0;")
-    c.append("    switch (machine.state) {")
+    c.append("    switch (state) {")
     for st in m.states:
         c.append(f"    case S_{st.name}:")
         if st.entry:

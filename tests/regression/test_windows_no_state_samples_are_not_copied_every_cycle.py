@@ -36,7 +36,7 @@ def test_the_missions_windows_are_watched_and_the_navs_are_not(tmp_path):
     assert re.search(r"kResumeConfig FSW_FLASH = \{kResumeSpans, resume_banks, 0x[0-9a-f]+UL, kResumeSize, "
                      rf"{len(spans)}, kResumeWatch, 1\}};", app), app
     # every push of the mission's windows, and its reset, says so; the nav samples in every state
-    block = mission.split("switch (machine.state) {  // sampled where still read")[1].split("default:")[0]
+    block = mission.split("switch (state) {  // sampled where still read")[1].split("default:")[0]
     assert "win.w0.push(x0);" in block and "win_changed = 1;" in block, block
     assert mission.split("void reset(uint32_t initial) {")[1].split("}")[0].count("win_changed = 1;") == 1
     assert "win_changed" not in nav

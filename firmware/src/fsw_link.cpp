@@ -126,59 +126,55 @@ void put_sv(const uint8_t* sv, bool lock, uint16_t off, uint16_t n) {
     if (lock) pal::critical_exit(saved);
 }
 
-// What sampling reads of the configuration (the telemetry task reads these
-// fields out of flash one at a time, not the configuration whole).
-struct Sampling {
-    uint8_t* sv;
-    const Executor* ex;
-    LinkStreamState* states;
-    bool lock;
-};
+// The state vector's `lock` option (fsw_app.h: never, where the application has none).
+inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
+    return app_has(kAppSvLock) && flash_get(c.lock);
+}
 
 // Sends the open batch of stream i (and the current region when `with_now`).
-void send_batch(Link& l, const Sampling& c, const LinkStream& s, LinkStreamState& st, uint8_t i,
+// `row` is the stream's row in flash (FSW_FLASH), its fields read where used.
+void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
                 bool with_now) {
+    const uint16_t size = flash_get(row.size);
     const uint8_t stored = st.count;
     st.count = 0;
     // the frame's encoded size bound: body, CRC, code bytes (body / 128: a
     // bound of body / 254 without a division), delimiter
-    const uint16_t body = static_cast<uint16_t>(kLinkHeader + (stored + (with_now ? 1u : 0u)) * s.size);
+    const uint16_t body = static_cast<uint16_t>(kLinkHeader + (stored + (with_now ? 1u : 0u)) * size);
     if (!tx_room(l, static_cast<uint16_t>(body + 4u + (body >> 7)))) {
         ++l.n.dropped;
         return;
     }
     frame_begin(l, static_cast<uint8_t>(kFrameSample | i), &st.t0);
-    if (stored != 0) put_bytes(s.store, static_cast<uint16_t>(stored * s.size));
-    if (with_now && !c.lock) {
-        frame_end(l, false, c.sv + s.off, s.size);  // the region copied in as it is framed
+    if (stored != 0) put_bytes(flash_get(row.store), static_cast<uint16_t>(stored * size));
+    const bool lock = sv_lock(f);
+    uint8_t* const sv = flash_get(f.sv);
+    if (with_now && !lock) {
+        frame_end(l, false, sv + flash_get(row.off), size);  // the region copied in as it is framed
         return;
     }
-    if (with_now) put_sv(c.sv, c.lock, s.off, s.size);  // atomically, then framed
+    if (with_now) put_sv(sv, lock, flash_get(row.off), size);  // atomically, then framed
     frame_end(l, false);
 }
 
-void take_sample(Link& l, const Sampling& c, const LinkStream& s, uint8_t i, uint32_t now32) {
-    LinkStreamState& st = c.states[i];
-    const uint16_t skipped = c.ex->skipped;
+void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i, uint32_t now32) {
+    LinkStreamState& st = flash_get(f.stream_state)[i];
+    const uint16_t skipped = flash_get(f.ex)->skipped;
     // Samples of a frame are evenly spaced: a batch the executor broke by
     // skipping cycles goes out as it is (a cycle that only started late
     // still takes its sample).
-    if (st.count != 0 && skipped != st.skipped0) send_batch(l, c, s, st, i, false);
+    if (st.count != 0 && skipped != st.skipped0) send_batch(l, f, row, st, i, false);
     if (st.count == 0) {
         st.t0 = now32;
         st.skipped0 = skipped;
     }
-    if (static_cast<uint8_t>(st.count + 1u) < s.batch) {
-        sv_move(c.lock, s.store + st.count * s.size, c.sv + s.off, s.size);
+    if (static_cast<uint8_t>(st.count + 1u) < flash_get(row.batch)) {
+        const uint16_t size = flash_get(row.size);
+        sv_move(sv_lock(f), flash_get(row.store) + st.count * size, flash_get(f.sv) + flash_get(row.off), size);
         ++st.count;
         return;
     }
-    send_batch(l, c, s, st, i, true);
-}
-
-// The state vector's `lock` option (fsw_app.h: never, where the application has none).
-inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
-    return app_has(kAppSvLock) && flash_get(c.lock);
+    send_batch(l, f, row, st, i, true);
 }
 
 // The parameter store's source byte of hello and health frames.
@@ -457,9 +453,8 @@ Result link_telemetry_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     const LinkConfig& f = *l.cfg;
     pump(l);
-    Sampling c;
     uint32_t now32 = 0;
-    bool have_c = false;
+    bool have_now = false;
     const uint8_t n_streams = flash_get(f.n_streams);
     LinkStreamState* const states = flash_get(f.stream_state);
     for (uint8_t i = 0; i < n_streams; ++i) {
@@ -468,18 +463,15 @@ Result link_telemetry_task(void* p) {
             --st.countdown;
             continue;
         }
-        if (!have_c) {
-            c.sv = flash_get(f.sv);
-            c.ex = flash_get(f.ex);
-            c.states = states;
-            c.lock = sv_lock(f);
+        if (!have_now) {
             now32 = static_cast<uint32_t>(flash_get(f.now)());
-            have_c = true;
+            have_now = true;
         }
-        LinkStream s;
-        flash_read(&s, &flash_get(f.streams)[i], sizeof s);
-        st.countdown = static_cast<uint16_t>(s.every - 1u);
-        take_sample(l, c, s, i, now32);
+        // the stream's row read where its fields are used: no copy of it on the stack, on the
+        // deepest path of the rocket's (this task's frame, send_batch's, the framer's)
+        const LinkStream& row = flash_get(f.streams)[i];
+        st.countdown = static_cast<uint16_t>(flash_get(row.every) - 1u);
+        take_sample(l, f, row, i, now32);
     }
     const uint16_t health_every = flash_get(f.health_every);
     if (health_every != 0 && --l.health_countdown == 0) {

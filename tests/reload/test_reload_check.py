@@ -110,7 +110,8 @@ def test_the_generated_code_runs_the_machine_through_the_store():
     assert "kReloadAllow[1] FSW_FLASH = {0x05};  // TankVentControl Idle" in cpp
     assert "384, 64, 0, 1};" in cpp  # size, ram, EEPROM base (no parameters), mask bytes
     assert "&reload, fsw::link_reload_apply, fsw::link_reload_ack};" in cpp
-    assert "void leave();" in files["tank.gen.h"] and "case S_TankVentControl: s1_exit(); break;" in files["tank.gen.cpp"]
+    # (its locals passed as its state functions take them: through a pointer in step(), docs/codegen.md)
+    assert "void leave();" in files["tank.gen.h"] and "case S_TankVentControl: s1_exit(loc); break;" in files["tank.gen.cpp"]
     plain = emit_app(load(str(EXAMPLES / "tank"), Diagnostics()))
     assert "leave" not in plain["tank.gen.h"] and "reload" not in plain["app.gen.cpp"]
     assert ", 0, 0, 0};" in plain["app.gen.cpp"]  # the link's reload fields, empty

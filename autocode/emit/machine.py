@@ -240,11 +240,13 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # when they read or write enough of its bytes directly (not through an
     # out-of-line call: bools, integers): inlined into step(), they then
     # address those bytes through a pointer register, 2 bytes of flash a
-    # byte where the absolute address took 4, as fast (66 B of the rocket's
-    # mission). With fewer the pointer register's keeping costs more than it
-    # saves (the rocket's nav: 6 B). Not the parameters: the AVR has three
-    # pointer registers, and a third area kept in one cost the whole
-    # rocket's mission 118 B more than it saved.
+    # byte where the absolute address took 4 (66 B of the rocket's mission;
+    # an access as fast, but the registers kept cost its step 3.5 us a
+    # cycle on the demo flight, 64.1 -> 67.6 us). With fewer the pointer
+    # register's keeping costs more than it saves (the rocket's nav: 6 B).
+    # Not the parameters: the AVR has three pointer registers, and a third
+    # area kept in one cost the whole rocket's mission 118 B more than it
+    # saved.
     areas = []
     called = any(st.entry or st.step for st in m.states)  # (else step() calls no state function)
     for area, whole in (("sv", "sv"), ("loc", "loc")) if called else ():

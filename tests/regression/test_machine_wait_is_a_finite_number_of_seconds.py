@@ -10,9 +10,10 @@ import pytest
 from conftest import EXAMPLES
 
 
-@pytest.mark.parametrize("wait, message", [("nan", "expected a number >= 0, found nan"),
+@pytest.mark.parametrize("wait, message", [("nan", "expected a finite number, found 'nan'"),
                                            ("-5", "expected a number >= 0, found -5"),
-                                           ("inf", "expected a finite number of seconds, found inf")])
+                                           ("inf", "expected a finite number, found 'inf'"),
+                                           ("1e999", "expected a finite number of seconds, found 1e999")])
 def test_a_wait_that_would_never_end_is_refused(fsw, wait, message):
     r = fsw("machine", str(EXAMPLES / "stand"), "revert", "--wait", wait, "--port", "/dev/ttyNOPE")
     assert r.code == 2 and f"argument --wait: {message}" in r.err, r.err

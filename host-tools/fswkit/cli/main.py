@@ -35,6 +35,8 @@ def _number(text: str, what: str = "a number") -> float:
     `nan` or `infinity`."""
     value = decimal(text)
     if value is None:
+        if text.strip().lstrip("+-").lower() in ("nan", "inf", "infinity"):
+            what = f"a finite {what[2:] if what.startswith('a ') else what}"
         raise argparse.ArgumentTypeError(f"expected {what}, found {text!r}")
     return value
 

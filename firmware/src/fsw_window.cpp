@@ -171,7 +171,7 @@ Real roll_median_value(const RollMedianS<I>& w, const Real* sorted) {
 #if defined(__AVR__)
 template <typename I>
 Real roll_avg_mean(const RollAvgS<I>& w, typename same_t<I>::type n, Real inv) {
-    if (w.count == n && nonzero(inv) && (w.pinf | w.ninf) == 0) return (w.base + w.fresh) * inv;
+    if (w.count == n && nonzero(inv) && (w.pinf | w.ninf) == 0) return scale_pow2(w.base + w.fresh, inv);
     return roll_avg_value(w);
 }
 template Real roll_avg_mean<uint8_t>(const RollAvgS<uint8_t>&, uint8_t, Real);

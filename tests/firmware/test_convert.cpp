@@ -413,6 +413,37 @@ static void test_round_to_f32_precision_matches_the_host_conversion(void) {
 }
 #endif
 
+// A full window of a power-of-two N multiplies its sum by 1/N (fsw_window.h);
+// on binary32 R that is done on the exponent's bits where the product is
+// normal (scale_pow2): the same bits as the float routine's multiplication
+// for every exponent of x, both signs, zeros, subnormals, infinities, NaN,
+// and every 1/N up to 1/65536 (products below the normal range are
+// multiplied). Here, not in test_window.cpp, whose AVR build has no RAM
+// left for it.
+static void test_window_scale_by_a_power_of_two_is_the_product(void) {
+    for (uint16_t e = 0; e < 256u; ++e) {
+        for (uint8_t sign = 0; sign < 2u; ++sign) {
+            for (uint8_t f = 0; f < 5u; ++f) {  // fractions: 0, the lowest bit, the highest, all, some
+                const uint32_t fraction = f == 0 ? 0 : f == 1 ? 1 : f == 2 ? 0x400000UL : f == 3 ? 0x7FFFFFUL : 0x2A5F31UL;
+                const uint32_t xb = (static_cast<uint32_t>(sign) << 31) | (static_cast<uint32_t>(e) << 23) | fraction;
+                float xf;
+                memcpy(&xf, &xb, sizeof xf);
+                const Real x = static_cast<Real>(xf);  // binary64 R: the same values, one way to write the test
+                for (uint8_t k = 0; k <= 16u; ++k) {
+                    volatile Real inv = Real(1) / static_cast<Real>(1UL << k);  // volatile: the routine's product
+                    const Real want = x * inv;
+                    const Real got = scale_pow2(x, inv);
+                    if (bits_of(want) != bits_of(got)) {
+                        char msg[48];
+                        snprintf(msg, sizeof msg, "x %08lx times 2^-%u", static_cast<unsigned long>(xb), k);
+                        TEST_ASSERT_EQUAL_HEX64_MESSAGE(bits_of(want), bits_of(got), msg);
+                    }
+                }
+            }
+        }
+    }
+}
+
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_reads_of_integers_are_exact_where_R_holds_them);
@@ -430,6 +461,7 @@ static void run(void) {
     RUN_TEST(test_typed_writes_saturate_through_pointers);
     RUN_TEST(test_run_time_element_access_matches_the_typed_conversions);
     RUN_TEST(test_round_to_f32_precision_matches_binary32);
+    RUN_TEST(test_window_scale_by_a_power_of_two_is_the_product);
 #if !defined(__AVR__)
     RUN_TEST(test_64_bit_reads_match_single_rounding_reference);
     RUN_TEST(test_round_to_f32_precision_matches_the_host_conversion);

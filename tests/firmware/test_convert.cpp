@@ -416,10 +416,10 @@ static void test_round_to_f32_precision_matches_the_host_conversion(void) {
 // A full window of a power-of-two N multiplies its sum by 1/N (fsw_window.h);
 // on binary32 R that is done on the exponent's bits where the product is
 // normal (scale_pow2): the same bits as the float routine's multiplication
-// for every exponent of x, both signs, zeros, subnormals, infinities, NaN,
-// and every 1/N up to 1/65536 (products below the normal range are
-// multiplied). Here, not in test_window.cpp, whose AVR build has no RAM
-// left for it.
+// for every exponent of x, both signs, zeros, subnormals, infinities, and
+// every 1/N up to 1/65536 (products below the normal range are multiplied);
+// NaN gives NaN (whose bits nothing reads: an element stores it as +0).
+// Here, not in test_window.cpp, whose AVR build has no RAM left for it.
 static void test_window_scale_by_a_power_of_two_is_the_product(void) {
     for (uint16_t e = 0; e < 256u; ++e) {
         for (uint8_t sign = 0; sign < 2u; ++sign) {
@@ -433,6 +433,7 @@ static void test_window_scale_by_a_power_of_two_is_the_product(void) {
                     volatile Real inv = Real(1) / static_cast<Real>(1UL << k);  // volatile: the routine's product
                     const Real want = x * inv;
                     const Real got = scale_pow2(x, inv);
+                    if (want != want && got != got) continue;  // NaN: avr-libc's pattern depends on the operands' order
                     if (bits_of(want) != bits_of(got)) {
                         char msg[48];
                         snprintf(msg, sizeof msg, "x %08lx times 2^-%u", static_cast<unsigned long>(xb), k);

@@ -45,7 +45,8 @@ struct Check {
 
 // The spans' bytes copied to `at` and into the check: the save's loop, 8.5
 // cycles a byte on AVR, eight bytes a turn after each span's n % 4 first
-// ones (an odd quad enters the first turn half way; four bytes a turn took
+// ones, taken as a byte and a pair (11 cycles each, one at a time, before;
+// an odd quad enters the first turn half way; four bytes a turn took
 // 9 cycles a byte: 6 us more a save on the rocket, for 56 B less of code)
 // (the same sums as Check::add, in assembly: the compiler's version
 // took twice as long, and the save runs every cycle). On AVR the walk of
@@ -79,17 +80,17 @@ FSW_NOINLINE uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n
         "clr  r1\n\t"
         "sbrc %B[q], 7\n\t"  // kResumeStrided
         "rjmp 6f\n\t"
-        "mov  %[odd], %A[q]\n\t"
-        "lsr  %B[q]\n\t"
-        "ror  %A[q]\n\t"
-        "lsr  %B[q]\n\t"
-        "ror  %A[q]\n\t"
-        "andi %[odd], 3\n\t"
-        "breq 3f\n\t"
-        "2:\n\t" FSW_RESUME_BYTE
-        "dec  %[odd]\n\t"
-        "brne 2b\n\t"
+        "mov  %[odd], %A[q]\n\t"  // its bits 0 and 1: a byte, then a pair, before the turns
+        "sbrs %[odd], 0\n\t"
+        "rjmp 2f\n\t" FSW_RESUME_BYTE
+        "2:\n\t"
+        "sbrs %[odd], 1\n\t"
+        "rjmp 3f\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE
         "3:\n\t"
+        "lsr  %B[q]\n\t"  // quads
+        "ror  %A[q]\n\t"
+        "lsr  %B[q]\n\t"
+        "ror  %A[q]\n\t"
         "lsr  %B[q]\n\t"  // eight bytes a turn: an odd quad in the first turn's second half
         "ror  %A[q]\n\t"
         "brcc 9f\n\t"
@@ -122,7 +123,7 @@ FSW_NOINLINE uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n
         "brne 7b\n\t"
         "rjmp 5b\n\t"
         "8:\n\t"
-        : [a] "+r"(a), [b] "+r"(b), [n] "+r"(n_spans), [odd] "=&d"(odd), [q] "=&w"(quads), [table] "=&r"(table),
+        : [a] "+r"(a), [b] "+r"(b), [n] "+r"(n_spans), [odd] "=&r"(odd), [q] "=&w"(quads), [table] "=&r"(table),
           [z] "+z"(spans), [at] "+x"(at)
         :
         : "memory");

@@ -46,8 +46,8 @@ struct Check {
 // The spans' bytes copied to `at` and into the check: the save's loop, 8.5
 // cycles a byte on AVR, eight bytes a turn after each span's n % 4 first
 // ones, taken as a byte and a pair (11 cycles each, one at a time, before;
-// an odd quad enters the first turn half way; four bytes a turn took
-// 9 cycles a byte: 6 us more a save on the rocket, for 56 B less of code)
+// an odd quad enters the first turn half way; four bytes a turn took 9
+// cycles a byte: 6 us more a save on the rocket, for 56 B less of code)
 // (the same sums as Check::add, in assembly: the compiler's version
 // took twice as long, and the save runs every cycle). On AVR the walk of
 // the spans' table is in the assembly too: a span's address and size read
@@ -64,11 +64,24 @@ struct Check {
     "add %[b], %[a]\n\t"             \
     "adc %[b], __zero_reg__\n\t"
 #endif
-FSW_NOINLINE uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_spans, Check& k) {
-    if (n_spans == 0) return at;
+// The check and the place after the bytes, returned in registers (a call
+// of the loop saved and restored six registers when it wrote the check
+// through a reference, about 50 cycles of the 2 or 3 calls a save makes).
+struct Copied {
+    uint8_t* at;
+    Check k;
+};
+FSW_NOINLINE Copied copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_spans, Check k) {
+    if (n_spans == 0) {
+        const Copied c = {at, k};
+        return c;
+    }
 #if defined(__AVR__) && FSW_USE_PROGMEM  // the table in flash
+    // Every register the loop takes is one a call may change (the count of
+    // quads in r24:r25, the one such pair adiw and sbiw take): nothing to save.
     uint8_t a = k.a, b = k.b, odd;
-    uint16_t quads, table;
+    register uint16_t quads asm("r24");
+    uint16_t table;
     __asm__ __volatile__(
         "1:\n\t"
         "lpm  r0, Z+\n\t"  // the span's address, in r1:r0 for a moment
@@ -142,7 +155,8 @@ FSW_NOINLINE uint8_t* copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n
         }
     }
 #endif
-    return at;
+    const Copied c = {at, k};
+    return c;
 }
 
 // k, then the n bytes whose own sums (from {0, 0}) are z: the bits adding
@@ -177,9 +191,10 @@ uint8_t* watched_span(uint8_t* at, const ResumeSpan* span, const ResumeWatch* w,
     }
     Check z = {st[1], st[2]};
     if (st[0] < 2u) {  // this bank's bytes may be older: copied
-        z.a = 0;
-        z.b = 0;
-        at = copy_spans(at, span, 1, z);
+        const Check zero = {0, 0};
+        const Copied c = copy_spans(at, span, 1, zero);
+        at = c.at;
+        z = c.k;
         st[1] = z.a;
         st[2] = z.b;
     } else {
@@ -269,11 +284,15 @@ void resume_save(Resume& r) {
     const ResumeWatch* w = flash_get(f.watch);
     for (uint8_t i = flash_get(f.n_watch); i != 0; --i, ++w) {
         const uint8_t s = flash_get(w->span);
-        at = copy_spans(at, spans + done, static_cast<uint8_t>(s - done), k);
+        const Copied c = copy_spans(at, spans + done, static_cast<uint8_t>(s - done), k);
+        at = c.at;
+        k = c.k;
         at = watched_span(at, spans + s, w, k);
         done = static_cast<uint8_t>(s + 1u);
     }
-    at = copy_spans(at, spans + done, static_cast<uint8_t>(n_spans - done), k);
+    const Copied c = copy_spans(at, spans + done, static_cast<uint8_t>(n_spans - done), k);
+    at = c.at;
+    k = c.k;
     r.seq = static_cast<uint8_t>(r.seq + 1u);
     *at = r.seq;
     k.a = plus(k.a, r.seq);  // Check::add

@@ -16,8 +16,10 @@ uint8_t* bank_at(const ResumeConfig& c, uint8_t b) { return c.banks + b * static
 // The check: Fletcher-16, two sums modulo 255 kept with an end-around carry
 // (each in 0..255, where 255 and 0 both mean 0: the save and the check
 // compute them alike), seeded with the schema hash so that another
-// firmware's bank does not check. Every single-bit and two-bit error of a
-// bank changes it.
+// firmware's bank does not check. Every single-bit error of a bank changes
+// it, and every two-bit error but the same bit of two bytes 255 apart set
+// in one and cleared in the other (256 = 1 mod 255: +2^k and -2^k, 255
+// bytes apart, leave both sums; docs/safety.md).
 // x + y with the sums' end-around carry (Check::add's step): 0 only when
 // both are 0, else 1..255 (255 for the sums' 0).
 inline __attribute__((always_inline)) uint8_t plus(uint8_t x, uint8_t y) {

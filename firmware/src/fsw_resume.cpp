@@ -47,8 +47,9 @@ struct Check {
 
 // The spans' bytes copied to `at` and into the check: the save's loop, 8.5
 // cycles a byte on AVR, eight bytes a turn after each span's n % 4 first
-// ones, taken as a byte and a pair (11 cycles each, one at a time, before;
-// an odd quad enters the first turn half way; four bytes a turn took 9
+// ones, taken as a byte and a pair as the size's bits 0 and 1 leave it
+// for its count of quads (11 cycles a byte, one at a time, before; an odd
+// quad enters the first turn half way; four bytes a turn took 9
 // cycles a byte: 6 us more a save on the rocket, for 56 B less of code)
 // (the same sums as Check::add, in assembly: the compiler's version
 // took twice as long, and the save runs every cycle). On AVR the walk of
@@ -81,7 +82,7 @@ FSW_NOINLINE Copied copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_s
 #if defined(__AVR__) && FSW_USE_PROGMEM  // the table in flash
     // Every register the loop takes is one a call may change (the count of
     // quads in r24:r25, the one such pair adiw and sbiw take): nothing to save.
-    uint8_t a = k.a, b = k.b, odd;
+    uint8_t a = k.a, b = k.b;
     register uint16_t quads asm("r24");
     uint16_t table;
     __asm__ __volatile__(
@@ -95,17 +96,14 @@ FSW_NOINLINE Copied copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_s
         "clr  r1\n\t"
         "sbrc %B[q], 7\n\t"  // kResumeStrided
         "rjmp 6f\n\t"
-        "mov  %[odd], %A[q]\n\t"  // its bits 0 and 1: a byte, then a pair, before the turns
-        "sbrs %[odd], 0\n\t"
-        "rjmp 2f\n\t" FSW_RESUME_BYTE
+        "lsr  %B[q]\n\t"  // the size's bit 0 out to the carry: a byte before the turns
+        "ror  %A[q]\n\t"
+        "brcc 2f\n\t" FSW_RESUME_BYTE
         "2:\n\t"
-        "sbrs %[odd], 1\n\t"
-        "rjmp 3f\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE
+        "lsr  %B[q]\n\t"  // its bit 1: a pair (the size is then its quads)
+        "ror  %A[q]\n\t"
+        "brcc 3f\n\t" FSW_RESUME_BYTE FSW_RESUME_BYTE
         "3:\n\t"
-        "lsr  %B[q]\n\t"  // quads
-        "ror  %A[q]\n\t"
-        "lsr  %B[q]\n\t"
-        "ror  %A[q]\n\t"
         "lsr  %B[q]\n\t"  // eight bytes a turn: an odd quad in the first turn's second half
         "ror  %A[q]\n\t"
         "brcc 9f\n\t"
@@ -138,7 +136,7 @@ FSW_NOINLINE Copied copy_spans(uint8_t* at, const ResumeSpan* spans, uint8_t n_s
         "brne 7b\n\t"
         "rjmp 5b\n\t"
         "8:\n\t"
-        : [a] "+r"(a), [b] "+r"(b), [n] "+r"(n_spans), [odd] "=&r"(odd), [q] "=&w"(quads), [table] "=&r"(table),
+        : [a] "+r"(a), [b] "+r"(b), [n] "+r"(n_spans), [q] "=&w"(quads), [table] "=&r"(table),
           [z] "+z"(spans), [at] "+x"(at)
         :
         : "memory");

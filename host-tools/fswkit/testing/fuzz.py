@@ -133,17 +133,19 @@ def _without_local_constants():
         cache.clear()
 
 
-def _checked(p: Project) -> Project:
+def _checked(p: Project, d: str) -> Project:
+    """`p` marked valid or not, its files written into the folder `d` (one
+    folder for a whole corpus: a folder made and removed for each of its
+    projects was half of the corpus's time)."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.project import load_script
 
-    with tempfile.TemporaryDirectory() as d:
-        paths = [os.path.join(d, n) for n in NAMES]
-        for path, data in zip(paths, p.files):
-            with open(path, "wb") as f:
-                f.write(data)
-        diags = Diagnostics()
-        ok = load_script(paths[2], diags, paths[1], paths[0]) is not None and not diags.errors
+    paths = [os.path.join(d, n) for n in NAMES]
+    for path, data in zip(paths, p.files):
+        with open(path, "wb") as f:
+            f.write(data)
+    diags = Diagnostics()
+    ok = load_script(paths[2], diags, paths[1], paths[0]) is not None and not diags.errors
     return dataclasses.replace(p, valid=ok)
 
 
@@ -153,7 +155,8 @@ def corpus(generated: int = 60) -> list[Project]:
     projects = _projects_in(ROOT / "examples")
     for lang in ("sm", "ss", "sv"):  # the order a walk of golden/ gives
         projects += _projects_in(ROOT / "tests" / "autocode" / "golden" / lang)
-    return [_checked(p) for p in projects + generated_projects(generated)]
+    with tempfile.TemporaryDirectory() as d:
+        return [_checked(p, d) for p in projects + generated_projects(generated)]
 
 
 # ---- mutations -------------------------------------------------------------------------

@@ -4,7 +4,10 @@ into the tape without a word, as docs/tapes.md says it converts such rows
 as they are: the tape's truth then came out hundreds of metres off (now
 refused by `fsw tape truth`). The row is still converted as it is, but
 the import now says so, at the tape's line, and that the truth refuses
-it; a log within the troposphere says nothing of it."""
+it; a log within the troposphere says nothing of it. (1 Pa, beyond any
+barometer's range, is now refused at the log's cell:
+test_tape_import_refuses_a_log_value_no_flight_records; the Juno III's
+19,100 Pa is within it.)"""
 
 from __future__ import annotations
 
@@ -25,11 +28,11 @@ def _import(tmp_path, glitch: str):
 
 
 def test_a_glitch_pressure_is_said_at_its_tape_line(tmp_path):
-    r, out = _import(tmp_path, "1")
-    line = next(i for i, x in enumerate(out.read_text().splitlines(), 1) if x.startswith("0.1,1,"))
+    r, out = _import(tmp_path, "19100")
+    line = next(i for i, x in enumerate(out.read_text().splitlines(), 1) if x.startswith("0.1,19100,"))
     assert (f"fsw tape import: {out}: 1 pressure beyond the ISA troposphere kept as the log has it "
             "(`fsw tape truth` refuses it):") in r.err, r.err
-    assert f"fsw tape import: {out}:{line}: pressure_pa 1 is " in r.err, r.err
+    assert f"fsw tape import: {out}:{line}: pressure_pa 19100 is " in r.err, r.err
 
 
 def test_a_log_within_it_says_nothing_of_it(tmp_path):

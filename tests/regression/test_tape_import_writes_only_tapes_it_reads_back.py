@@ -6,11 +6,12 @@ time is subtracted (`0` and `1e-320`, liftoff at 1 s) became one. Every
 tape the import writes now reads back, with the log's rows: numbers the
 usual precision would merge or zero are written exactly, and rows whose
 times become equal once liftoff is subtracted are dropped and counted as
-the rows whose time is not after the previous one are."""
+the rows whose time is not after the previous one are. (A pressure of
+0.01 Pa, and log times 1e-320 s apart, are now beyond what a recorder
+logs, refused at the log's cell before any tape is written:
+test_tape_import_refuses_a_log_value_no_flight_records.)"""
 
 from __future__ import annotations
-
-import math
 
 from conftest import run_fsw
 
@@ -46,15 +47,17 @@ def test_a_time_rounded_up_does_not_pass_the_next_one(tmp_path):
 ALTOS = "#version,serial,flight,call,time,state,state_name,acceleration,pressure,altitude,height,speed\n"
 
 
-def test_a_pressure_below_the_written_precision_is_not_written_as_zero(tmp_path):
+def test_a_pressure_below_the_written_precision_is_refused_at_its_cell(tmp_path):
     rows = "".join(f"6,1,1,X,{t},2,pad,0.0{i},{p},1,1,1\n" for i, (t, p) in
                    enumerate([(0.1, "90000"), (0.2, "0.01"), (0.3, "90002")]))
-    tape, show = imported(tmp_path, "altos", ALTOS + rows)
-    assert show.code == 0, show.err
-    assert tape.pressure.tolist() == [90000.0, 0.01, 90002.0]
+    log = tmp_path / "log.csv"
+    log.write_text(ALTOS + rows)
+    r = run_fsw("tape", "import", "altos", str(log), "-o", str(tmp_path / "tape.csv"))
+    assert r.code == 1 and f"{log}:3:" in r.err and "`0.01` is beyond 1,000 to 120,000 Pa" in r.err, r.err
+    assert not (tmp_path / "tape.csv").exists()
 
 
-def test_times_equal_once_liftoff_is_subtracted_are_dropped_and_counted(tmp_path):
+def test_times_equal_once_liftoff_is_subtracted_are_refused_at_their_cell(tmp_path):
     head = "time,altitude,pressure,velocity,temperature,events,voltages\n"
     rows = []
     for i in range(60):
@@ -62,8 +65,10 @@ def test_times_equal_once_liftoff_is_subtracted_are_dropped_and_counted(tmp_path
         h = 0.0 if t < 1.0 else (t - 1.0) * 60.0
         p = 101325 * (1 - (500 + h) / 44330.77) ** (1 / 0.190263) / 100
         rows.append(f"{'1e-320' if i == 1 else f'{t:.2f}'},0,{p:.3f},0,20, -,3.8\n")
-    tape, show = imported(tmp_path, "rrc3", head + "".join(rows))
-    assert show.code == 0, show.err
-    assert tape.rows == 59  # 0 and 1e-320, both 1 s before liftoff, are one time: the second is dropped
-    assert tape.time[0] == -1.0 and math.isclose(tape.time[1], -0.9)
-    assert any("1 with a time not after the previous row" in d for d in tape.derived)
+    log = tmp_path / "log.csv"
+    log.write_text(head + "".join(rows))
+    r = run_fsw("tape", "import", "rrc3", str(log), "-o", str(tmp_path / "tape.csv"))
+    # 0 and 1e-320, both 1 s before liftoff: no recorder logs rows 1e-320 s apart
+    assert r.code == 1 and f"{log}:3:1: time (`time`): `1e-320` is " in r.err, r.err
+    assert "s after the previous row's (line 2)" in r.err and "1 µs apart" in r.err
+    assert not (tmp_path / "tape.csv").exists()

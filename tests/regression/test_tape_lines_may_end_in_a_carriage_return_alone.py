@@ -42,9 +42,9 @@ def test_an_error_is_located_on_the_cr_line(tmp_path):
 
 
 def test_a_replay_locates_a_cr_tapes_rows_too(tmp_path):
-    text = TAPE + "5000,80000,\n"  # row 6, more than 3,600 s after the first
+    text = TAPE + "5000,80000,\n"  # row 6, beyond the tapes' -3,600 to 3,600 s
     p = tmp_path / "cr.csv"
     p.write_bytes(text.replace("\n", "\r").encode())
     (tmp_path / "cr.truth.toml").write_text('name = "cr"\napogee_s = 3.0\nburnout_s = 1.0\n')
     r = run_fsw("sim", str(EXAMPLES / "hpr"), "--tape", str(p), "--out", str(tmp_path / "out"))
-    assert r.code == 2 and r.err.startswith(f"fsw sim: {p}:6: time_s 5000 is more than 3,600 s"), r.err
+    assert r.code == 2 and r.err.startswith(f"fsw sim: {p}:6:1: time_s 5000 is beyond -3,600 to 3,600 s"), r.err

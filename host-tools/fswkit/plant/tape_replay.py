@@ -543,14 +543,19 @@ MAX_SPAN_S = 3600.0  # s of tape a replay flies, from its first row to its last 
 
 def load_tape(path: str, cfg: Config):
     """(tape, truth) for a replay; ReplayError with located messages: an
-    unreadable tape or truth file, a tape whose rows span more than
+    unreadable tape or truth file, a cell beyond its range (the reader's),
+    a pressure beyond the ISA troposphere (as `fsw tape truth` refuses
+    it), a tape whose rows span more than
     MAX_SPAN_S (its simulated cycles would overflow, or the run last
     hours), a missing truth file, a column with values that the
     configuration feeds to no input."""
     from fswkit.tape import TapeError, read_tape, read_truth, truth_path
 
+    from fswkit.tape.truth import check_altitudes
+
     try:
         tape = read_tape(path)
+        check_altitudes(tape)  # the truth's altitude of a replay is worked out from every pressure, as the truth's
     except TapeError as e:
         raise ReplayError(str(e)) from None
     if tape.span > MAX_SPAN_S:

@@ -58,8 +58,9 @@ from typing import Callable
 
 import numpy as np
 
-from fswkit.tape.tape import (MAX_ERRORS, Tape, TapeError, _Errors, _text, isa_altitude, isa_pressure, number,
-                              read_file, split_lines)
+from fswkit.tape.tape import (MAX_ERRORS, MAX_STEP_S, MIN_STEP_S, RANGES, Tape, TapeError, _Errors, _text,
+                              beyond_range, isa_altitude, isa_pressure, number, read_file, split_lines, step_problem,
+                              step_text)
 
 MAX_LOG = 256 << 20  # bytes of a log read: an AltOS export with GPS columns runs ~3 MB a flight
 G0 = 9.80665  # m/s^2, AltOS's standard gravity
@@ -90,6 +91,15 @@ class Rows:
     def where(self, keep: Callable[[list[str]], bool]) -> "Rows":
         """The rows whose cells `keep` takes, as Rows."""
         return Rows([(ln, line) for ln, line in self._lines if keep(_split(line))])
+
+    def lines(self) -> np.ndarray:
+        """The rows' line numbers in the log (1-based), as an int array."""
+        return np.fromiter((ln for ln, _ in self._lines), dtype=np.int64, count=len(self._lines))
+
+    def line_text(self, ln: int) -> str:
+        """The text of the row at log line `ln` (one of these rows)."""
+        i = int(np.searchsorted(self.lines(), ln))
+        return self._lines[i][1]
 
     def take(self, indices) -> "Rows":
         """The rows at `indices` (in that order), as Rows."""
@@ -294,23 +304,65 @@ def _pressure_pa(p: np.ndarray, log: Log, col: int, rows=None) -> tuple[np.ndarr
 
 
 def _positive(p: np.ndarray, log: Log, col: int, unit: str, rows=None) -> np.ndarray:
-    """`p` (Pa, one value per row of `rows`, the log's rows when None) when every value is a finite
-    pressure above 0; otherwise TapeError at each cell that is not: a glitch
-    row of a sensor (0, negative) is the log's cell to locate, not a tape
-    the writer refuses later without a line."""
-    bad = np.flatnonzero(~np.isnan(p) & ~((p > 0) & np.isfinite(p)))
+    """`p` (Pa, one value per row of `rows`, the log's rows when None) when every value is a pressure
+    within the tape's range (fswkit.tape.PRESSURE_RANGE_PA); otherwise TapeError at each cell that is
+    not: a glitch row of a sensor (0, negative), a cell in another unit, is the log's cell to locate,
+    not a tape the writer refuses later without a line."""
+    _check_cells(p, log, col, "pressure_pa", log.raw_names[col], rows, unit=unit)
+    return p
+
+
+def _check_cells(v: np.ndarray, log: Log, col: int, column: str, what: str, rows=None, unit: str = "") -> None:
+    """TapeError at each cell of log column `col` whose value `v` (in the
+    unit of tape column `column`, one a row of `rows`, the log's rows when
+    None; NaN for an empty cell) is beyond that column's range
+    (fswkit.tape.RANGES): the cell, the value it makes, the range, what to
+    do. `unit`, a unit the cells were read in and scaled from ("hPa"), is
+    said with a value it makes."""
+    (lo, hi), _u = RANGES[column]
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(~np.isnan(v) & ~((v >= lo) & (v <= hi)))
     if bad.size == 0:
-        return p
+        return
     err = log.err()
-    name = log.raw_names[col]
     rows = log.rows if rows is None else rows
-    for i in bad.tolist():
+    err.hidden += max(0, bad.size - MAX_ERRORS)  # counted, not split (a whole column in a wrong unit)
+    for i in bad[:MAX_ERRORS].tolist():
         ln, cells = rows[i]
         cell = _unquote(cells[col])[:40]
-        why = "is not above 0 Pa" if not p[i] > 0 else f"read as {unit} is beyond the largest number once in Pa"
-        err.at(ln, _col_of(cells, col), f"{name} (`{name}`): `{cell}` {why}")
+        x = float(v[i])
+        read = f" read as {unit}" if unit and unit != _u else ""
+        if not math.isfinite(x):
+            why = f"{read} is beyond the largest number once in {_u}"
+        else:
+            made = "" if number(cell) == x else f"{read} makes {column} {x:g}, which"
+            why = f"{made} {beyond_range(column, x)}"
+        err.at(ln, _col_of(cells, col), f"{what} (`{log.raw_names[col]}`): `{cell}`{why}")
     err.raise_if_any()
-    return p
+
+
+def _check_steps(t: np.ndarray, log: Log, lines: np.ndarray, cols, whats) -> None:
+    """TapeError at each row of the tape to be written whose time `t` (s,
+    strictly increasing) lies closer to or further from the previous row's
+    than a recorder's (fswkit.tape.MIN_STEP_S, MAX_STEP_S): located at the
+    row's time cell in the log (its line in `lines`; its column `cols`, one
+    or one a row, named by `whats[col]`)."""
+    if t.size < 2:
+        return
+    steps = np.diff(t)
+    bad = np.flatnonzero((steps < MIN_STEP_S) | (steps > MAX_STEP_S)).tolist()
+    if not bad:
+        return
+    err = log.err()
+    err.hidden += max(0, len(bad) - MAX_ERRORS)
+    for i in bad[:MAX_ERRORS]:
+        ln = int(lines[i + 1])
+        col = int(cols if np.isscalar(cols) else cols[i + 1])
+        cells = _split(log.rows.line_text(ln))
+        err.at(ln, _col_of(cells, col), f"{whats[col]} (`{log.raw_names[col]}`): `{_unquote(cells[col])[:40]}` is "
+                                        f"{step_text(float(steps[i]))} s after the previous row's (line "
+                                        f"{int(lines[i])}): {step_problem(float(steps[i]))}")
+    err.raise_if_any()
 
 
 def _liftoff_accel(t: np.ndarray, a: np.ndarray) -> float | None:
@@ -431,8 +483,11 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
                    "time, pressure, acceleration, with version or state_name", wider_rows=True)
     it, ip, ia = log.index("time"), log.index("pressure"), log.index("acceleration")
     t = log.numbers(it, "time", required=True)
+    _check_cells(t, log, it, "time_s", "time")
     p_raw = log.numbers(ip, "pressure")
     a = log.numbers(ia, "acceleration") if ia is not None else np.full(t.size, math.nan)
+    if ia is not None:
+        _check_cells(a / G0 + 1.0, log, ia, "accel_g", "acceleration")
     sensor_cols = [c for c in (ia, ip, log.index("altitude"), log.index("height"),
                                log.index("speed", "accel_speed"), log.index("baro_speed")) if c is not None]
     sensors = [log.numbers(c, log.raw_names[c]) for c in sensor_cols]
@@ -450,6 +505,7 @@ def altos(path: str, pad_alt: float | None = None) -> Tape:
         keep[i] = True
         last_t, last = t[i], row
     p, unit = _pressure_pa(p_raw, log, ip)
+    _check_steps(t[keep], log, log.rows.lines()[keep], it, {it: "time"})
     t, p, a = t[keep], p[keep], a[keep]
     accel = a / G0 + 1.0
     flight = "recorder AltOS"
@@ -498,13 +554,18 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
                    "ts with filtered_altitude_AGL, or ts, id, T, P")
     ih = log.index("filtered_altitude_agl")
     if ih is not None:
-        t = log.numbers(log.index("ts"), "ts", required=True)
+        its = log.index("ts")
+        t = log.numbers(its, "ts", required=True)
+        _check_cells(t, log, its, "time_s", "ts")
         keep = _increasing(t)
         late = int((~keep).sum())
         h = log.numbers(ih, "filtered_altitude_AGL")
         _check_altitude_range(h, pad_alt, log, ih, "m AGL")
         ia = log.index("filtered_acceleration")
         a = log.numbers(ia, "filtered_acceleration") if ia is not None else np.full(t.size, math.nan)
+        if ia is not None:
+            _check_cells(a / G_CATS + 1.0, log, ia, "accel_g", "filtered_acceleration")
+        _check_steps(t[keep], log, log.rows.lines()[keep], its, {its: "ts"})
         t, h, a = t[keep], h[keep], a[keep]
         p, how = _from_altitude(h, pad_alt, "'filtered_altitude_AGL' (m, CATS's median-filtered barometric "
                                             "altitude; not the raw sensor)")
@@ -538,10 +599,13 @@ def cats(path: str, pad_alt: float | None = None) -> Tape:
             err.raise_if_any()
             first = _unquote(rows[0][1][iid])
             rows = rows.where(lambda c: _unquote(c[iid]) == first)
-        t = log.numbers(log.index("ts"), "ts", required=True, rows=rows)
+        its = log.index("ts")
+        t = log.numbers(its, "ts", required=True, rows=rows)
+        _check_cells(t, log, its, "time_s", "ts", rows)
         keep = _increasing(t)
         late = int((~keep).sum())
         p, unit = _pressure_pa(log.numbers(ip, "P", rows=rows), log, ip, rows)
+        _check_steps(t[keep], log, rows.lines()[keep], its, {its: "ts"})
         t, p = t[keep], p[keep]
         accel = np.full(t.size, math.nan)
         derived = ["time_s = log column 'ts' as is (CATS: seconds from its liftoff detection)",
@@ -581,7 +645,7 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
                    and ("axial accel (gs)" in n or "altitude (ft-agl)" in n),
                    "Time..., Axial Accel (Gs) and/or Altitude (Ft-AGL)")
 
-    def channel(col: int, what: str) -> tuple[np.ndarray, np.ndarray, Rows]:
+    def channel(col: int, what: str) -> tuple[np.ndarray, np.ndarray, Rows, int]:
         tcol = max(i for i in range(col) if log.names[i].startswith("time")) if any(
             log.names[i].startswith("time") for i in range(col)) else None
         if tcol is None:
@@ -592,15 +656,21 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
         v = log.numbers(col, what, rows=rows)
         ok = ~np.isnan(v)
         t, v = t[ok], v[ok]
+        if what == "Axial Accel":
+            _check_cells(v, log, col, "accel_g", what, rows.take(np.flatnonzero(ok).tolist()))
         keep = _increasing(t)
         late[0] += int((~keep).sum())
-        return t[keep], v[keep], rows.take(np.flatnonzero(ok)[keep].tolist())
+        taken = rows.take(np.flatnonzero(ok)[keep].tolist())
+        _check_steps(t[keep], log, taken.lines(), tcol, {tcol: f"{what} time"})  # a clock that jumped
+        spans.append((t, rows.take(np.flatnonzero(ok).tolist()), tcol, f"{what} time"))
+        return t[keep], v[keep], taken, tcol
 
     late = [0]
+    spans = []  # each channel's times (all of them), rows, time column and its name: in range once liftoff is known
 
     ia, ih = log.index("axial accel (gs)"), log.index("altitude (ft-agl)")
-    ta, a, _ = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0), None)
-    th, h, h_rows = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0), None)
+    ta, a, a_rows, a_tcol = channel(ia, "Axial Accel") if ia is not None else (np.empty(0), np.empty(0), None, 0)
+    th, h, h_rows, h_tcol = channel(ih, "Altitude") if ih is not None else (np.empty(0), np.empty(0), None, 0)
     if th.size:
         _check_altitude_range(h * FT, pad_alt, log, ih, "ft AGL", h_rows)
     t_lift = _liftoff_accel(ta, a) if ta.size else None
@@ -611,8 +681,14 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
     if t_lift is None:
         raise TapeError([f"{log.path}: no liftoff found: no accel sample above 2 g for 0.1 s and no "
                          "altitude 10 m above the pad for 0.5 s"])
+    for tt, rr, tcol, what in spans:
+        _check_cells(tt - t_lift, log, tcol, "time_s", what, rr)
     # rows: the accel clock while it lasts, then the altitude clock
     t = np.concatenate([ta, th[th > ta[-1]]]) if ta.size else th
+    later = th > ta[-1] if ta.size else np.ones(th.size, dtype=bool)
+    lines = np.concatenate([a_rows.lines() if ta.size else np.empty(0, np.int64), h_rows.lines()[later]
+                            if th.size else np.empty(0, np.int64)])
+    cols = np.concatenate([np.full(ta.size, a_tcol), np.full(int(later.sum()), h_tcol)])
     accel = np.concatenate([a, np.full(t.size - ta.size, math.nan)])
     if th.size:
         k = np.searchsorted(th, t, side="right") - 1
@@ -629,6 +705,8 @@ def raven(path: str, pad_alt: float | None = None) -> Tape:
                        "(sample-and-hold; empty before the first altitude sample); after the accel data end, "
                        "rows follow the altitude clock")
     t, kept = _from_liftoff(t, t_lift)
+    names = {**({a_tcol: "Axial Accel time"} if ta.size else {}), **({h_tcol: "Altitude time"} if th.size else {})}
+    _check_steps(t, log, lines[kept], cols[kept], names)
     p, accel = p[kept], accel[kept]
     derived += _dropped(late[0] + int((~kept).sum()))
     flight = f"recorder Featherweight Raven (FIP export); pad elevation {_pad_text(pad_alt)}"
@@ -657,10 +735,12 @@ def eggtimer(path: str, pad_alt: float | None = None, alt_unit: str = "ft") -> T
     log = read_log(path, "eggtimer", lambda n: "t" in n and "alt" in n, "T, Alt (Eggtimer)")
     it, ih = log.index("t"), log.index("alt")
     t = log.numbers(it, "T", required=True) / 1000.0
+    _check_cells(t, log, it, "time_s", "T")
     scale, what = _alt_unit(alt_unit)
     h = log.numbers(ih, "Alt") * scale
     keep = _increasing(t)
     _check_altitude_range(h, pad_alt, log, ih, f"{alt_unit} AGL")
+    _check_steps(t[keep], log, log.rows.lines()[keep], it, {it: "T"})
     t, h = t[keep], h[keep]
     p, how = _from_altitude(h, pad_alt, f"'Alt' {what}")
     derived = ["time_s = log column 'T' / 1000 (Eggtimer: ms from its flight start, 0 = liftoff)", how,
@@ -693,8 +773,9 @@ def rrc3(path: str, pad_alt: float | None = None, alt_unit: str = "ft") -> Tape:
     log = read_log(path, "rrc3", lambda n: "time" in n and ("pressure" in n or "altitude" in n)
                    and ("velocity" in n or "events" in n), "time, altitude, pressure, velocity, events")
     it, ip, ih = log.index("time"), log.index("pressure"), log.index("altitude")
-    t = log.numbers(it, "time", required=True)
+    t = t_all = log.numbers(it, "time", required=True)
     keep = _increasing(t)
+    _check_steps(t[keep], log, log.rows.lines()[keep], it, {it: "time"})  # a clock that jumped: before its liftoff
     if ip is not None:
         p, unit = _pressure_pa(log.numbers(ip, "pressure"), log, ip)
         t, p = t[keep], p[keep]
@@ -709,7 +790,9 @@ def rrc3(path: str, pad_alt: float | None = None, alt_unit: str = "ft") -> Tape:
     t_lift = _liftoff_baro(t, h)
     if t_lift is None:
         raise TapeError([f"{log.path}: no liftoff found: the altitude is never 10 m above the pad for 0.5 s"])
+    _check_cells(t_all - t_lift, log, it, "time_s", "time")  # (its steps are checked before the liftoff)
     t, kept = _from_liftoff(t, t_lift)
+    _check_steps(t, log, log.rows.lines()[keep][kept], it, {it: "time"})
     p = p[kept]
     derived = ["liftoff defined here by the BARO rule: the last sample within 1 m of the pad (median pressure "
                "altitude of the log's first second before the rise) before the altitude is 10 m above it for "

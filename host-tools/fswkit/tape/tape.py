@@ -73,6 +73,54 @@ def isa_pressure(h):
     return ISA_P0 * np.power(1.0 - np.asarray(h, dtype=float) / ISA_H0, 1.0 / ISA_N)
 
 
+# The physical range of each column (docs/tapes.md, "Ranges"): what a small rocket's recorder can log.
+# A cell beyond it is no flight's (a wrong unit, a glitch row, a clock that jumped) and is refused where it
+# is, by the reader (so by `fsw tape show`, `fsw tape truth` and `fsw sim --tape`), the writer and the
+# converters (at the log's cell).
+TIME_RANGE_S = (-3600.0, 3600.0)  # from liftoff: an hour either side (a replay flies at most an hour of tape)
+MIN_STEP_S = 1e-6  # rows at least 1 µs apart: no recorder samples at 1 MHz (the kit's formats: 10 Hz to 1 kHz)
+MAX_STEP_S = 60.0  # and at most 60 s apart: the slowest of them logs at 1 Hz or more; more is a clock that jumped
+PRESSURE_RANGE_PA = (1_000.0, 120_000.0)  # 10 to 1,200 hPa: the MS5607/MS5611's, the widest of these barometers
+ACCEL_RANGE_G = (-250.0, 250.0)  # the widest accelerometer of these recorders reads ±200 g (ADXL375), 1 g offset
+# and its calibration left room
+RANGES = {"time_s": (TIME_RANGE_S, "s"), "pressure_pa": (PRESSURE_RANGE_PA, "Pa"), "accel_g": (ACCEL_RANGE_G, "g")}
+_WHY = {"time_s": "a tape holds the hour either side of liftoff: check the time's unit, or cut the tape to the "
+                  "flight",
+        "pressure_pa": "no barometer of a flight recorder reads it (10 to 1,200 hPa): a cell in another unit, or "
+                       "a glitch row: leave the cell empty",
+        "accel_g": "no accelerometer of a flight recorder reads it (the widest reads ±200 g): a cell in another "
+                   "unit, or a glitch row: leave the cell empty"}
+
+
+def beyond_range(column: str, value: float) -> str | None:
+    """What is wrong with `value` (a finite number) in tape column `column`
+    (time_s, pressure_pa, accel_g): None when within its range (RANGES);
+    else the words after the value, `is beyond ... (the range): why and
+    what to do`. A pressure not above 0 keeps its own words."""
+    (lo, hi), unit = RANGES[column]
+    if lo <= value <= hi:
+        return None
+    if column == "pressure_pa" and not value > 0:
+        return "is not above 0 Pa"
+    return f"is beyond {lo:,.0f} to {hi:,.0f} {unit}: {_WHY[column]}"
+
+
+def step_problem(step: float) -> str | None:
+    """What is wrong with a time step of `step` s (> 0) between consecutive
+    rows: None within MIN_STEP_S to MAX_STEP_S, else the words saying why."""
+    if step < MIN_STEP_S:
+        return ("rows lie at least 1 µs apart (no recorder samples at 1 MHz): a time in another unit? delete "
+                "the row or fix its time")
+    if step > MAX_STEP_S:
+        return (f"rows of a flight lie at most {MAX_STEP_S:g} s apart (every recorder of the kit's formats logs "
+                "at 1 Hz or more): a clock that jumped? cut the tape there, or fix the times after the jump")
+    return None
+
+
+def step_text(step: float) -> str:
+    return f"{step:,.6g}"
+
+
 class TapeError(Exception):
     """A tape, truth file or log that cannot be read: every message located
     (`PATH:LINE:COL: message`, or `PATH: message` for the file as a whole)."""
@@ -319,13 +367,20 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
             values.append(v)
             col += len(cell) + 1
         t[i], p[i], a[i] = values
-        if not math.isnan(t[i]):
+        col = 1
+        for k, v in enumerate(values):
+            why = beyond_range(names[k], v) if not math.isnan(v) else None
+            if why:
+                err.at(ln, col, f"{names[k]} {v:g} {why}")
+            col += len(cells[k]) + 1
+        if not math.isnan(t[i]) and not beyond_range("time_s", t[i]):
             if t[i] <= prev:
                 err.at(ln, 1, f"time_s {cells[0].strip()} is not after the previous row's "
                               f"{prev:g}: times increase strictly")
+            elif prev > -math.inf and step_problem(t[i] - prev):
+                err.at(ln, 1, f"time_s {t[i]:g} is {step_text(t[i] - prev)} s after the previous row's {prev:g} s: "
+                              f"{step_problem(t[i] - prev)}")
             prev = max(prev, t[i])
-        if not math.isnan(p[i]) and p[i] <= 0:
-            err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
     err.raise_if_any()
     return Tape(path, t, p, a, tuple(header["source"]), header["flight"][0] if header["flight"] else "",
                 tuple(header["derived"]), tuple(header["note"]), tuple(comments), first)
@@ -411,8 +466,17 @@ def check_tape(tape: Tape) -> None:
         for name, v in (("pressure_pa", tape.pressure), ("accel_g", tape.accel)):
             if np.isinf(v).any():
                 err.at(None, None, f"{name} holds an infinite value")
-        if (tape.pressure[~np.isnan(tape.pressure)] <= 0).any():
-            err.at(None, None, "pressure_pa holds a value not above 0 Pa")
+        for name, v in (("time_s", t), ("pressure_pa", tape.pressure), ("accel_g", tape.accel)):
+            (lo, hi), _unit = RANGES[name]
+            with np.errstate(invalid="ignore"):
+                beyond = np.isfinite(v) & ((v < lo) | (v > hi))
+            for i in np.flatnonzero(beyond).tolist():
+                err.at(None, None, f"row {i + 1}: {name} {v[i]:g} {beyond_range(name, float(v[i]))}")
+        if not err.items and t.size > 1:
+            steps = np.diff(t)
+            for i in np.flatnonzero((steps < MIN_STEP_S) | (steps > MAX_STEP_S)).tolist():
+                err.at(None, None, f"row {i + 2}: time_s {t[i + 1]:g} is {step_text(steps[i])} s after the "
+                                   f"previous row's {t[i]:g} s: {step_problem(float(steps[i]))}")
     for line in tape.sources + tape.derived + tape.notes + (tape.flight,):
         if "\n" in line or "\r" in line:
             err.at(None, None, "a header text holds a line break")

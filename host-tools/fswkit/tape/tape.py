@@ -504,6 +504,15 @@ TRUTH_FLOATS = (
 )
 
 
+ALTITUDE_RANGE_M = (-12_000.0, 12_000.0)  # above the pad: the ISA troposphere the altitudes are worked in is 12 km
+# deep (-1 to 11 km ASL)
+# A truth file's numbers, by their key's ending (its unit): the range of the tape column each is worked out from
+TRUTH_RANGES = {"_m_agl": (ALTITUDE_RANGE_M, "m", "altitude above its pad"),
+                "_s": (TIME_RANGE_S, "s", "time from liftoff"),
+                "_pa": (PRESSURE_RANGE_PA, "Pa", "pressure"),
+                "_g": (ACCEL_RANGE_G, "g", "acceleration")}
+
+
 @dataclass(frozen=True)
 class Truth:
     """A tape's `.truth.toml`: the values computed from the tape (all optional
@@ -575,6 +584,18 @@ def read_truth(path: str) -> Truth:
                 err.at(_key_line(text, k), 1, f"`{k}` must be a finite number, found {v!r}")
             else:
                 kw[k] = float(v)
+    for k, v in doc.items():  # every number whose key says its unit, the recorder's own included: a flight's
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or k in TRUTH_FLOATS and k not in kw:
+            continue
+        if not math.isfinite(v):
+            err.at(_key_line(text, k), 1, f"`{k}` must be a finite number, found {v!r}")
+            continue
+        for suffix, ((lo, hi), unit, what) in TRUTH_RANGES.items():
+            if k.endswith(suffix) and not lo <= v <= hi:
+                err.at(_key_line(text, k), 1, f"`{k}` {v:g} is beyond {lo:,.0f} to {hi:,.0f} {unit}: no "
+                                              f"flight's {what} (docs/tapes.md, Ranges): the truth of another "
+                                              "tape, or a value in another unit?")
+                break
     if "recorder" in doc:
         if not isinstance(doc["recorder"], str):
             err.at(_key_line(text, "recorder"), 1, "`recorder` must be a string")

@@ -33,6 +33,22 @@ class ExprEmitter:
         self.windows = windows
         self.consts = folded_locals(m, real, scriptable)
         self.sv_lock = m.sv.lock
+        # Variables whose value a C++ local holds at the statement being
+        # emitted (var index -> its name): read there instead of the
+        # variable's bytes (autocode/emit/machine.py keeps it).
+        self.held: dict[int, str] = {}
+
+    def holdable(self, i: int) -> bool:
+        """Whether a C++ local may hold variable i's value between its
+        statements: an F32 variable read and written in binary32 R (the
+        local holds what read_F32 returns, bit for bit), not folded to a
+        constant, and not an element that interrupts may write (`lock`)."""
+        v = self.m.vars[i]
+        if v.kind == M.TIME_IN_STATE or i in self.consts or self.real.bits != 32:
+            return False
+        if v.type.kind != "float" or v.type.size != 4:
+            return False
+        return not (self.sv_lock and v.kind == M.ELEMENT)
 
     def ptr(self, v: M.Var) -> str:
         if v.kind == M.ELEMENT:
@@ -47,6 +63,8 @@ class ExprEmitter:
             return f"fsw::machine_T_real({self.prefix}machine)"
         if i in self.consts:
             return real_literal(self.consts[i], self.real)
+        if i in self.held:
+            return self.held[i]
         text = f"fsw::read_{v.type.name}({self.ptr(v)})"
         if self.sv_lock and v.kind == M.ELEMENT:
             return f"(fsw::SvGuard<true>(), {text})"
@@ -137,6 +155,8 @@ class ExprEmitter:
             return None
         if self.sv_lock and v.kind == M.ELEMENT:
             return None
+        if x.var in self.held:  # (never a NaN: what read_F32 returned)
+            return float_key_test(op, cv, v.type.size, self.ptr(v), self.held[x.var])
         return float_key_test(op, cv, v.type.size, self.ptr(v))
 
     def threshold_var(self, e: M.Expr):
@@ -309,10 +329,12 @@ class ExprEmitter:
         return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"
 
 
-def float_key_test(op: str, cv: float, size: int, ptr: str):
+def float_key_test(op: str, cv: float, size: int, ptr: str, held: str | None = None):
     """binary32 R: `R(x) op c` for the float element or local x of `size`
     bytes at `ptr` and a literal c, as integer threshold tests on x's
-    stored bytes (autocode/thresholds.py), or None when not expressible."""
+    stored bytes (autocode/thresholds.py), or None when not expressible.
+    `held`: a C++ local holding x's value (an F32's, never a NaN), tested
+    instead of the bytes (fsw::f32_key_gt, f32_key_ge)."""
     negate = op == "!="
     terms = tests("==" if negate else op, cv, size)
     if terms is None:
@@ -331,7 +353,10 @@ def float_key_test(op: str, cv: float, size: int, ptr: str):
             test = "true" if t else "false"
         else:
             key, inclusive = t
-            test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}{'UL' if bits == 32 else 'ULL'}"
+            if held is not None:
+                test = f"fsw::f32_key_{'ge' if inclusive else 'gt'}({held}, 0x{key:08x}UL)"
+            else:
+                test = f"k {'>=' if inclusive else '>'} 0x{key:0{bits // 4}x}{'UL' if bits == 32 else 'ULL'}"
         parts.append(f"!({test})" if neg else f"({test})")
     body = " && ".join(parts)
     if negate:
@@ -342,6 +367,8 @@ def float_key_test(op: str, cv: float, size: int, ptr: str):
     at_zero = all((t if isinstance(t, bool) else (zero >= t[0] if t[1] else zero > t[0])) != neg
                   for neg, t in terms)
     assert (at_zero != negate) == nan_result, "threshold terms disagree with R at +0"
+    if held is not None:
+        return body if len(parts) == 1 and not negate else f"({body})"
     if len(parts) == 1 and not negate:
         return parts[0].replace("k ", f"fsw::f{bits}_read_key({ptr}) ", 1)
     return (f"([&]() -> bool {{ const uint{bits}_t k = fsw::f{bits}_read_key({ptr}); "

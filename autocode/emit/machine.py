@@ -13,10 +13,12 @@ import re
 from .. import model as M
 from ..check import gotos, model_children, stmt_exprs
 from ..cnames import enumerator
-from ..evaluate import local_values
-from ..numeric import Real
-from .common import banner, basename, c_ident, parens, real_check, value_bytes, version_check, window_type
+from ..evaluate import NotConstant, evaluate, local_values
+from ..numeric import Real, to_type
+from .common import (banner, basename, c_ident, parens, real_check, real_literal, value_bytes, version_check,
+                     window_type)
 from .expr import ExprEmitter
+from .fastpaths import no_reads
 
 
 def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
@@ -233,7 +235,20 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             if not stmts:
                 continue
             body: list[str] = []
-            _block(stmts, ex, "    ", body, src, m, label != "exit")
+            held = _Held() if real.bits == 32 else None
+            ex.held = {}
+            _block(stmts, ex, "    ", body, src, m, label != "exit", held)
+            keep = held.worth(body) if held is not None else set()
+            if held is not None and len(keep) < len(held.decls):  # again, holding only where it paid
+                body, ex.held = [], {}
+                _block(stmts, ex, "    ", body, src, m, label != "exit", _Held(keep))
+            ex.held = {}
+            # T is the same for the whole step: one call for it where the
+            # function tests it twice or more
+            t32 = "fsw::machine_T32(machine)"
+            if sum(line.count(t32) for line in body) >= 2:
+                body = ["    const uint32_t t32 = " + t32 + ";  // T, saturated to 32 bits"] + \
+                       [line.replace(t32, "t32") for line in body]
             bodies.append((st, label, body))
     # The state vector and the locals each reach the state functions as an
     # argument (`svp`, `locp`), which step() took through fsw::by_pointer,
@@ -367,19 +382,130 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     return {f"{name}.gen.h": "\n".join(h), f"{name}.gen.cpp": "\n".join(c)}
 
 
+def _reads(e: M.Expr, out: set[int]) -> set[int]:
+    """The variables an expression reads, added to `out` (a window's argument
+    is not read where its value is: the window was sampled before the
+    state's code)."""
+    t = type(e)
+    if t is M.Ref:
+        out.add(e.var)
+    elif t is M.Arith or t is M.Cmp or t is M.Logic:
+        _reads(e.left, out)
+        _reads(e.right, out)
+    elif t is M.Neg or t is M.Not:
+        _reads(e.operand, out)
+    elif t is M.ChainCmp:
+        for o in e.operands:
+            _reads(o, out)
+    return out
+
+
+def _assigned(stmts) -> set[int]:
+    """Every variable a statement list assigns, nested ones included."""
+    out = set()
+    for st in stmts:
+        if isinstance(st, M.Assign):
+            out.add(st.var)
+        elif isinstance(st, M.If):
+            out |= _assigned(st.then) | _assigned(st.orelse)
+    return out
+
+
+def _stored_constant(m: M.Machine, real: Real, st: M.Assign) -> str | None:
+    """The literal of what an assignment of literals alone stores (and its
+    variable then reads), or None: not such an assignment, or a NaN (stored
+    as +0, read as +0: left to the bytes)."""
+    try:
+        x = evaluate(st.expr, real, no_reads)
+    except NotConstant:
+        return None
+    value = real.read(m.vars[st.var].type, to_type(m.vars[st.var].type, x))
+    return None if value != value else real_literal(value, real)
+
+
+class _Held:
+    """The C++ locals of one state function that hold an F32 variable's
+    value between its statements (ExprEmitter.held): one read, or one
+    assignment's store, that later statements read instead of the bytes
+    (on AVR each read is a call). A first emission holds at every read and
+    every assignment (`allowed` None); `worth` then tells where a local
+    paid: a read read twice or more, a store read again at all; the
+    function is emitted again holding only there (`allowed` those)."""
+
+    def __init__(self, allowed: set | None = None):
+        self.allowed = allowed
+        self.decls: list[tuple[int, str, str, tuple]] = []  # (line, name, kind, where: the statement and variable)
+
+    def take(self, out: list[str], kind: str, where: tuple) -> str | None:
+        """A name for a local at the next line of `out`, or None where it did not pay."""
+        if self.allowed is not None and where not in self.allowed:
+            return None
+        name = f"f{len(self.decls)}"
+        self.decls.append((len(out), name, kind, where))
+        return name
+
+    def worth(self, out: list[str]) -> set:
+        keep = set()
+        for at, name, kind, where in self.decls:
+            word = re.compile(rf"\b{name}\b")
+            uses = sum(len(word.findall(line)) for line in out[at + 1:])
+            if uses >= (2 if kind == "read" else 1):
+                keep.add(where)
+        return keep
+
+
 def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.Machine,
-           can_transition: bool) -> None:
+           can_transition: bool, held: _Held | None = None) -> None:
+    """The C++ of a statement list. With `held` (binary32 R), the F32
+    variables a statement reads are read once into locals before it, and
+    an assignment's stored value is kept in one, for the statements after
+    it in the same block (and the blocks inside them) to read: the same
+    values bit for bit (a statement's expressions have no side effects,
+    and nothing but the statements writes a machine's variables while its
+    step runs), with fewer calls."""
     for st in stmts:
         t = type(st)
+        if held is not None and t in (M.Assign, M.If):
+            for i in sorted(_reads(st.expr if t is M.Assign else st.cond, set())):
+                if i in ex.held or not ex.holdable(i):
+                    continue
+                plain = ex.read(i)
+                name = held.take(out, "read", (id(st), i, "read"))
+                if name is not None:
+                    out.append(f"{indent}const fsw::Real {name} = {plain};")
+                    ex.held[i] = name
         if t is M.Assign:
-            out.append(f"{indent}{ex.assign(st.var, st.expr)}  // {src}:{st.line}")
+            line = ex.assign(st.var, st.expr)
+            if held is not None and ex.holdable(st.var):
+                ex.held.pop(st.var, None)
+                plain = f"{indent}{line}  // {src}:{st.line}"
+                prefix = f"fsw::write_F32({ex.ptr(m.vars[st.var])}, "
+                name = None
+                if line.startswith(prefix) and line.endswith(");"):
+                    name = held.take(out, "write", (id(st), st.var, "write"))
+                if name is not None:
+                    out.append(f"{indent}const fsw::Real {name} = fsw::write_F32_read("
+                               f"{line[len('fsw::write_F32('):-2]});  // {src}:{st.line}")
+                    ex.held[st.var] = name
+                    continue
+                stored = _stored_constant(m, ex.real, st)
+                if stored is not None:  # a constant store: its value is a literal
+                    ex.held[st.var] = stored
+                out.append(plain)
+                continue
+            out.append(f"{indent}{line}  // {src}:{st.line}")
         elif t is M.Goto:
             out.append(f"{indent}return S_{m.states[st.state].name};  // {src}:{st.line}")
             return
         else:
             out.append(f"{indent}if {parens(ex.cond(st.cond))} {{  // {src}:{st.line}")
-            _block(st.then, ex, indent + "    ", out, src, m, can_transition)
+            before = dict(ex.held)
+            _block(st.then, ex, indent + "    ", out, src, m, can_transition, held)
             if st.orelse:
+                ex.held = dict(before)
                 out.append(f"{indent}}} else {{")
-                _block(st.orelse, ex, indent + "    ", out, src, m, can_transition)
+                _block(st.orelse, ex, indent + "    ", out, src, m, can_transition, held)
             out.append(f"{indent}}}")
+            # after the branches: what neither assigns (a local of theirs is out of scope)
+            changed = _assigned(st.then) | _assigned(st.orelse)
+            ex.held = {i: n for i, n in before.items() if i not in changed}

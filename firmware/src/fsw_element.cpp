@@ -48,6 +48,15 @@ void write_F32(uint8_t* p, Real r) {
     memcpy(&u, &r, sizeof u);
     store<uint32_t>(p, f32_bits_not_nan(u));  // NaN is stored as +0 (F32_from_real)
 }
+
+Real write_F32_read(uint8_t* p, Real r) {
+    uint32_t u;
+    memcpy(&u, &r, sizeof u);
+    u = f32_bits_not_nan(u);
+    store<uint32_t>(p, u);
+    memcpy(&r, &u, sizeof r);
+    return r;
+}
 #endif
 
 Real read_elem_typed(const uint8_t* p, uint8_t type) {

@@ -69,6 +69,18 @@ FSW_NOINLINE FSW_NOCLONE void write_F32(uint8_t* p, Real r);
 #else
 inline void write_F32(uint8_t* p, Real r) { store<float>(p, F32_from_real(r)); }
 #endif
+// write_F32, returning what read_F32(p) then reads (a NaN stored as +0 reads
+// +0): generated step code keeps it for the statements after the
+// assignment that read the variable again, with no read of their own
+// (autocode/emit/machine.py). Out of line on AVR, as write_F32.
+#if defined(__AVR__)
+FSW_NOINLINE FSW_NOCLONE Real write_F32_read(uint8_t* p, Real r);
+#else
+inline Real write_F32_read(uint8_t* p, Real r) {
+    write_F32(p, r);
+    return read_F32(p);
+}
+#endif
 inline void write_F64(uint8_t* p, Real r) { store<uint64_t>(p, F64_bits_from_real(r)); }
 inline void write_bool(uint8_t* p, Real r) { store_bool(p, bool_from_real(r)); }
 

@@ -57,6 +57,21 @@ FSW_NOINLINE uint32_t f32_read_key(const uint8_t* p);
 #else
 inline uint32_t f32_read_key(const uint8_t* p) { return f32_is_nan(p) ? 0x80000000UL : f32_key(p); }
 #endif
+// The threshold tests of a binary32 value that is not a NaN (one read_F32
+// returned): key > k and key >= k, for the key f32_read_key gives of the
+// bytes it was read from, as generated code tests a variable it holds in
+// registers (autocode/emit/machine.py). On the value's bits as a signed
+// integer: a key at or above 0x80000000 is a sign bit of 0 (the bits
+// ordered as the values), one below it a sign bit of 1 (the bits ordered
+// backwards); k is a constant, so one 32-bit comparison for a threshold
+// of 0 or above, where the key itself took a few more instructions.
+inline bool f32_key_gt(float v, uint32_t k) {
+    int32_t s;
+    memcpy(&s, &v, sizeof s);
+    if (k >= 0x80000000UL) return s > static_cast<int32_t>(k - 0x80000000UL);
+    return s >= 0 || s < static_cast<int32_t>(~k);
+}
+inline bool f32_key_ge(float v, uint32_t k) { return k == 0 || f32_key_gt(v, k - 1u); }
 inline uint64_t f64_read_key(const uint8_t* p) { return f64_is_nan(p) ? 0x8000000000000000ULL : f64_key(p); }
 
 }  // namespace fsw

@@ -79,6 +79,34 @@ static void test_f32_element_access_matches_the_value_forms(void) {
         write_F32(out, static_cast<Real>(v));
         const uint32_t want = nan ? 0UL : kPatterns[i];
         TEST_ASSERT_EQUAL_HEX32(want, load<uint32_t>(out));
+        // write_F32_read: the same store, and what read_F32 then reads there
+        uint8_t kept[4] = {0x55, 0x55, 0x55, 0x55};
+        const Real got = write_F32_read(kept, static_cast<Real>(v));
+        TEST_ASSERT_EQUAL_HEX32(want, load<uint32_t>(kept));
+        ASSERT_REAL_SAME(read_F32(kept), got);
+    }
+}
+
+// The threshold tests of a held value (generated code's f32_key_gt and
+// f32_key_ge, autocode/emit/expr.py) give what the key of its bytes gives,
+// for every class of value read_F32 returns and thresholds on both sides
+// of each one's key and at the key's ends.
+static void test_a_held_values_threshold_tests_are_its_keys(void) {
+    static const uint32_t kValues[] = {
+        0x00000000UL, 0x80000000UL, 0x3FC00000UL, 0xBF800000UL, 0x00000001UL, 0x807FFFFFUL, 0x00800000UL,
+        0x7F7FFFFFUL, 0xFF7FFFFFUL, 0x7F800000UL, 0xFF800000UL, 0x47C5E680UL, 0xC3480000UL, 0x3CB80000UL,
+    };
+    for (size_t i = 0; i < sizeof kValues / sizeof kValues[0]; ++i) {
+        uint8_t elem[4];
+        memcpy(elem, &kValues[i], 4);
+        const float v = static_cast<float>(read_F32(elem));
+        const uint32_t key = f32_read_key(elem);
+        const uint32_t ks[] = {0UL, 1UL, 0x7FFFFFFFUL, 0x80000000UL, 0x80000001UL, 0xFFFFFFFEUL, 0xFFFFFFFFUL,
+                               key - 1u, key, key + 1u, ~key, ~key + 1u};
+        for (size_t j = 0; j < sizeof ks / sizeof ks[0]; ++j) {
+            TEST_ASSERT_EQUAL(key > ks[j], f32_key_gt(v, ks[j]));
+            TEST_ASSERT_EQUAL(key >= ks[j], f32_key_ge(v, ks[j]));
+        }
     }
 }
 
@@ -451,6 +479,7 @@ static void run(void) {
     RUN_TEST(test_reads_of_64_bit_integers_round_once_to_nearest_even);
     RUN_TEST(test_reads_of_floats_turn_nan_into_zero);
     RUN_TEST(test_f32_element_access_matches_the_value_forms);
+    RUN_TEST(test_a_held_values_threshold_tests_are_its_keys);
     RUN_TEST(test_assign_u8_saturates_and_truncates);
     RUN_TEST(test_assign_signed_small_types);
     RUN_TEST(test_assign_32_bit_bounds);

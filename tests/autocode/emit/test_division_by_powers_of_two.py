@@ -65,7 +65,9 @@ def test_powers_of_two_multiply(tmp_path):
 def test_other_divisors_divide(tmp_path):
     code = step_code(tmp_path, F32MODE)
     assert " / 3.0f)" in assigned(code, "e")
-    assert "/ fsw::read_F32(loc + L_n)" in assigned(code, "f")  # written: not a constant
+    # written: not a constant (in binary32 R, the value `n = n + 1` stored, held in a local)
+    held = re.search(r"const fsw::Real (f\d+) = fsw::write_F32_read\(loc \+ L_n, ", code).group(1)
+    assert assigned(code, "f").endswith(f" / {held})")
     assert " / " in assigned(code, "g")  # not a power of two in binary32 (and 1/it is not normal)
 
 

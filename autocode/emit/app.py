@@ -302,6 +302,9 @@ def _app_cpp(app: Application) -> str:
     c.append(f"const uint32_t kPeriodUs = {1000000 // app.rate}UL;  // {app.rate} cycles per second")
     c.append("fsw::Executor ex;")
     c.append(f"fsw::TaskStats stats[{max(n, 1)}];")
+    slow = any(t.divider > 1 for t in app.tasks)
+    if slow:  # a task slower than every cycle counts down to its runs (else none is kept: kAppSlowTasks)
+        c.append(f"uint16_t countdowns[{n}];  // base cycles until each task's next run")
     c.append("")
     has_link = any(t.kind in ("telemetry", "uplink") for t in app.tasks)
     params = app_parameters(app)
@@ -341,7 +344,7 @@ def _app_cpp(app: Application) -> str:
         c.append("    {0, 0, 0, 1, 0, fsw::kNoElement, fsw::kNoElement, fsw::kNoElement, 0},")
     c.append("};")
     cause = f"E_{app.reset_cause.name}" if app.reset_cause is not None else "fsw::kNoElement"
-    c.append(f"const fsw::ExecConfig kConfig FSW_FLASH = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock}};")
+    c.append(f"const fsw::ExecConfig kConfig FSW_FLASH = {{kTasks, stats, sv, kPeriodUs, {cause}, {n}, kSvLock, {'countdowns' if slow else '0'}}};")
     rows = " && ".join(f"fsw::exec_task_ok({t.divider}, 0)" for t in app.tasks) or "true"
     c.append(f"static_assert(fsw::exec_config_ok(kPeriodUs) && {rows}, "
              "\"a task table executor_begin refuses\");  // checked here, not at run time (fsw_app.h)")

@@ -293,7 +293,7 @@ class ExprEmitter:
             return None
         v = self.m.vars[e.var]
         if v.kind == M.TIME_IN_STATE:
-            return f"{self.prefix}machine.t", v.type
+            return f"fsw::machine_T({self.prefix}machine)", v.type
         if e.var in self.consts or v.type.kind == "float":
             return None
         if v.type.kind == "bool":

@@ -79,7 +79,7 @@ def emit_script(script: M.Script, real: Real, source_line, ns: str = "fsw_gen",
     c.append("    switch (which) {")
     for k, v in enumerate(order):
         if v.kind == M.TIME_IN_STATE:
-            c.append(f"    case {k}: memcpy(out, &{ns}machine.t, 8); break;")
+            c.append(f"    case {k}: {{ const uint64_t t = fsw::machine_T({ns}machine); memcpy(out, &t, 8); break; }}")
         elif v.index in folded:  # a local folded into the code: its constant bytes
             data = ", ".join(str(b) for b in folded[v.index])
             c.append(f"    case {k}: {{ static const uint8_t b[] = {{{data}}}; memcpy(out, b, {v.type.size}); break; }}")
@@ -156,7 +156,11 @@ def _script_loop(script: M.Script, ex: ExprEmitter, outer: str, ns: str, trace: 
     c.append(f"        if (steps >= {script.max_steps}ULL) {{ outcome = 2; break; }}")
     c.append(f"        fsw::store<uint64_t>({outer}::sv + {outer}::E_{m.vars[m.g].name}, g);")
     c.append(f"        fsw::store<uint32_t>({outer}::sv + {outer}::E_{m.vars[m.s].name}, {ns}machine.state);")
-    c.append(f"        {ns}machine.t = {ns}machine.pending != 0 ? 0 : g - {ns}machine.entry_g;")
+    # T as the step will take it, for the inputs, the windows and the guards before it (0 on a
+    # state's first step): the machine's times set for it, and set back before the step
+    c.append(f"        const uint64_t last_g = {ns}machine.last_g, entry_g = {ns}machine.entry_g;")
+    c.append(f"        {ns}machine.last_g = g;")
+    c.append(f"        if ({ns}machine.pending != 0) {ns}machine.entry_g = g;")
     for w in script.windows:
         c.append(f"        sw{w.index}.push({ex.value(w.arg)});")
     if any(sec.state is not None for sec in script.sections):
@@ -183,7 +187,16 @@ def _script_loop(script: M.Script, ex: ExprEmitter, outer: str, ns: str, trace: 
             c.append(f"{ind}}}")
         if sec.state is not None:
             c.append("        }")
-    c.append(f"        if ({ns}step() != fsw::kOk) {{ ++steps; outcome = 3; break; }}")
+    c.append(f"        {ns}machine.last_g = last_g;")
+    c.append(f"        {ns}machine.entry_g = entry_g;")
+    # a refused step changes nothing: T stays what it was taken as before it (the interpreter's)
+    c.append(f"        if ({ns}step() != fsw::kOk) {{")
+    c.append(f"            {ns}machine.last_g = g;")
+    c.append(f"            if ({ns}machine.pending != 0) {ns}machine.entry_g = g;")
+    c.append("            ++steps;")
+    c.append("            outcome = 3;")
+    c.append("            break;")
+    c.append("        }")
     c.append("        ++steps;")
     c.append(trace)
     c.append("        for (int k = 0; k < nrem && outcome < 0; ++k) {")
@@ -239,7 +252,7 @@ def emit_script_avr(script: M.Script, real: Real, ns: str = "fsw_gen", entry: st
     for v in order:
         t = v.type
         if v.kind == M.TIME_IN_STATE:
-            c.append(f"    put64({ns}machine.t);  // T")
+            c.append(f"    put64(fsw::machine_T({ns}machine));  // T")
             continue
         if v.index in ex.consts:  # folded into the code: its value, widened now
             x = to_type(t, ex.consts[v.index])

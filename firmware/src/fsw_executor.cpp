@@ -53,10 +53,11 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
             (t.mode_off != kNoElement || t.overruns_off != kNoElement || t.worst_us_off != kNoElement)) {
             return kErrConfig;
         }
+        if (check && t.divider > 1 && c.countdowns == 0) return kErrConfig;  // a slow task: its countdown
         if (app_has(kAppMirrors) && (t.overruns_off != kNoElement || t.worst_us_off != kNoElement)) mirrors = 1;
         TaskStats& s = c.stats[i];
         memset(&s, 0, sizeof s);
-        s.countdown = t.phase;
+        if (app_has(kAppSlowTasks) && c.countdowns != 0) c.countdowns[i] = t.phase;
         *mode_byte(c, t, i) = t.init_mode;  // one byte: atomic on every target
     }
     pal::begin();
@@ -164,6 +165,8 @@ void executor_run_cycle(Executor& ex_) {
     TaskStats* sp = flash_get(f.stats);
     const Task* row = flash_get(f.tasks);
     const Task* const end = row + flash_get(f.n_tasks);
+    // a slow task's countdown (fsw_app.h: none where every task runs every cycle)
+    uint16_t* cp = app_has(kAppSlowTasks) ? flash_get(f.countdowns) : 0;
     // One clock read per task run: a run is timed from the previous run's
     // end (the cycle's start for the first) to its own end, so it counts
     // the executor's few instructions that find and start it too. The
@@ -209,12 +212,16 @@ void executor_run_cycle(Executor& ex_) {
         ran = 0;
         if (row == end) break;
         TaskStats& s = *sp;
-        if (app_has(kAppSlowTasks) && s.countdown != 0) {  // (else every task runs every cycle: 0 stays 0)
-            --s.countdown;
-            continue;
+        uint16_t* const countdown = cp;  // (null: every task runs every cycle)
+        if (countdown != 0) {
+            ++cp;
+            if (*countdown != 0) {
+                --*countdown;
+                continue;
+            }
         }
         const RowHead h = row_head(row);
-        if (app_has(kAppSlowTasks)) s.countdown = static_cast<uint16_t>(h.divider - 1u);
+        if (countdown != 0) *countdown = static_cast<uint16_t>(h.divider - 1u);
         uint8_t* const mode_p = mode_at(f, h.mode_off, s);
         const uint8_t mode = *mode_p;
         if (mode == kModeDisabled) continue;
@@ -222,7 +229,6 @@ void executor_run_cycle(Executor& ex_) {
             const Result r = h.step(h.ctx);
             if (r != kOk) {
                 *mode_p = kModeSafed;
-                s.last_fault = r;
                 if (s.faults != 0xFFu) ++s.faults;
             }
         } else if (app_has(kAppSafeFns)) {

@@ -34,14 +34,14 @@ static_assert(offsetof(Task, overruns_off) == offsetof(Task, mode_off) + sizeof(
                   offsetof(Task, worst_us_off) == offsetof(Task, overruns_off) + sizeof(ElemOff),
               "a task's element offsets are adjacent (the link reads them as one)");
 
-// Per-task run-time record (RAM, zero-initialised): 11 bytes.
+// Per-task run-time record (RAM, zero-initialised): 8 bytes. (A task that
+// runs less often than every cycle counts down to its next run in the
+// configuration's `countdowns`, RAM only an application with one has.)
 struct TaskStats {
     uint32_t worst_us;       // longest step (or safe) call, microseconds
     uint16_t overruns;       // calls longer than the task's period (saturates)
-    uint16_t countdown;      // base cycles until the next run
     uint8_t faults;          // steps that returned a fault (saturates at 255)
     uint8_t mode;            // the mode, for a task without a mode element
-    uint8_t last_fault;      // the last fault code its step returned
 };
 
 // Executor configuration: constant data (FSW_FLASH on AVR), like the task
@@ -54,6 +54,9 @@ struct ExecConfig {
     ElemOff reset_cause_off; // U8 element receiving the reset cause, or kNoElement
     uint8_t n_tasks;
     bool sv_lock;            // state vector `lock` option
+    uint16_t* countdowns;    // n_tasks records, base cycles until each task's next run: required
+                             // when a task's divider is above 1 (executor_begin refuses such a
+                             // table without them), else null (every task runs every cycle)
 };
 
 struct Executor {

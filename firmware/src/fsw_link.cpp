@@ -58,13 +58,21 @@ void sv_move(bool lock, void* dst, const void* src, uint16_t n) {
     if (lock) pal::critical_exit(saved);
 }
 
+// The transmit buffer, and its size: max(tx_cap, tx_size) of the
+// configuration (FSW_FLASH; read where used, no copy in the Link).
+inline uint8_t* tx_buf(const Link& l) { return flash_get(l.cfg->tx); }
+inline uint16_t tx_bytes(const Link& l) {
+    const uint16_t cap = flash_get(l.cfg->tx_cap), size = flash_get(l.cfg->tx_size);
+    return size > cap ? size : cap;
+}
+
 // Hands as much of the transmit buffer to the console as it takes now.
 void pump(Link& l) {
     if (l.tx_len == 0) return;
     uint16_t n = static_cast<uint16_t>(l.tx_len - l.tx_pos);
     const uint16_t space = pal::console_write_space();
     if (n > space) n = space;
-    pal::console_write(l.tx + l.tx_pos, n);
+    pal::console_write(tx_buf(l) + l.tx_pos, n);
     l.tx_pos = static_cast<uint16_t>(l.tx_pos + n);
     if (l.tx_pos >= l.tx_len) l.tx_len = l.tx_pos = 0;
 }
@@ -79,10 +87,11 @@ void pump(Link& l) {
 bool tx_room(Link& l, uint16_t need) {
     pump(l);
     if (l.tx_len == 0) return true;
-    const uint16_t rest = static_cast<uint16_t>(l.tx_len - l.tx_pos);
-    if (need > l.tx_size - rest) return false;
-    if (need > l.tx_size - l.tx_len) {
-        memmove(l.tx, l.tx + l.tx_pos, rest);
+    const uint16_t rest = static_cast<uint16_t>(l.tx_len - l.tx_pos), size = tx_bytes(l);
+    if (need > size - rest) return false;
+    if (need > size - l.tx_len) {
+        uint8_t* const tx = tx_buf(l);
+        memmove(tx, tx + l.tx_pos, rest);
         l.tx_len = rest;
         l.tx_pos = 0;
     }
@@ -100,7 +109,7 @@ void put_u32(uint32_t v) { put_bytes(&v, 4); }
 // time (`time` points at its little-endian bytes). The frame goes after
 // the bytes the transmit buffer still holds.
 FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
-    g_at = l.tx + l.tx_len;
+    g_at = tx_buf(l) + l.tx_len;
     uint8_t* w = g_at + 1;
     w[0] = type;
     w[1] = static_cast<uint8_t>(l.n.frames);
@@ -428,10 +437,6 @@ void link_begin(Link& l_, const LinkConfig* cfg) {
         while (first >= every) first = static_cast<uint16_t>(first - every);
         st.countdown = first;
     }
-    l.tx = flash_get(c.tx);
-    const uint16_t tx_cap = flash_get(c.tx_cap), tx_size = flash_get(c.tx_size);
-    l.tx_size = tx_size > tx_cap ? tx_size : tx_cap;
-    l.ctl_rest = static_cast<uint16_t>(l.tx_size - tx_cap);
     l.snapshot_at = kNoSnapshot;
     l.health_countdown = flash_get(c.health_every);
     l.hello_countdown = flash_get(c.hello_every);
@@ -547,7 +552,11 @@ void link_poll(Link& l_) {
     if (l.cfg == 0) return;
     pump(l);
     if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;
-    if (l.tx_len != 0 && static_cast<uint16_t>(l.tx_len - l.tx_pos) > l.ctl_rest) return;  // no room yet
+    // no room yet: the rest waiting is more than a control frame fits behind (tx_size - tx_cap)
+    if (l.tx_len != 0 && static_cast<uint16_t>(l.tx_len - l.tx_pos) >
+                             static_cast<uint16_t>(tx_bytes(l) - flash_get(l.cfg->tx_cap))) {
+        return;
+    }
     service(l, *l.cfg, true);
 }
 

@@ -171,13 +171,12 @@ struct LinkCounters {
     uint16_t last_seq;      // sequence number of the last accepted command
 };
 
+// (The transmit buffer's address and size are read out of the configuration
+// where used: no copy of them here.)
 struct Link {
     const LinkConfig* cfg;  // FSW_FLASH
-    uint8_t* tx;
-    uint16_t tx_len;        // bytes of the frames in tx, sent or not (0: free)
+    uint16_t tx_len;        // bytes of the frames in the transmit buffer, sent or not (0: free)
     uint16_t tx_pos;        // bytes of it handed to the console
-    uint16_t tx_size;       // bytes of tx: max(tx_cap, tx_size) of the configuration
-    uint16_t ctl_rest;      // the most a control frame fits behind: tx_size - tx_cap
     LinkCounters n;
     uint16_t health_countdown;
     uint16_t snapshot_at;   // next snapshot offset (0xFFFF: no snapshot under way)

@@ -15,7 +15,7 @@ namespace fsw {
 // The offsets are the Machine's (the static_assert below).
 static_assert(offsetof(Machine, last_g) == 0 && offsetof(Machine, entry_g) == 8 && offsetof(Machine, state) == 16 &&
                   offsetof(Machine, pending) == 20 && offsetof(Machine, entering) == 21 &&
-                  offsetof(Machine, started) == 22 && offsetof(Machine, t) == 23,
+                  offsetof(Machine, started) == 22,
               "machine_begin's assembly reads the Machine at these offsets");
 #define FSW_G_BYTES(op) op(0, r18) op(1, r19) op(2, r22) op(3, r23) op(4, r24) op(5, r25) op(6, r0) op(7, r1)
 #define FSW_CMP_LAST(i, g) "ldd r26, Z+" #i "\n\t" FSW_CMP_OP_##i " r26, " #g "\n\t"
@@ -29,15 +29,6 @@ static_assert(offsetof(Machine, last_g) == 0 && offsetof(Machine, entry_g) == 8 
 #define FSW_CMP_OP_7 "cpc"
 #define FSW_SET_ENTRY(i, g) "std Z+8+" #i ", " #g "\n\t"
 #define FSW_SET_LAST(i, g) "std Z+" #i ", " #g "\n\t"
-#define FSW_SUB_OP_0 "sub"
-#define FSW_SUB_OP_1 "sbc"
-#define FSW_SUB_OP_2 "sbc"
-#define FSW_SUB_OP_3 "sbc"
-#define FSW_SUB_OP_4 "sbc"
-#define FSW_SUB_OP_5 "sbc"
-#define FSW_SUB_OP_6 "sbc"
-#define FSW_SUB_OP_7 "sbc"
-#define FSW_SET_T(i, g) "ldd r26, Z+8+" #i "\n\t" FSW_SUB_OP_##i " " #g ", r26\n\t" "std Z+23+" #i ", " #g "\n\t"
 static_assert(kOk == 0 && kErrTime == 1, "machine_begin's assembly returns kOk as 0, kErrTime as 1");
 Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
     // the arguments where the call brings them (r24, r22, r20)
@@ -89,7 +80,6 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
         "std  Z+20, r26\n\t"
         "3:\n\t"
         FSW_G_BYTES(FSW_SET_LAST)
-        FSW_G_BYTES(FSW_SET_T)  // T = G - entry, the borrow carried up
         "clr  r1\n\t"
         "tst  r27\n\t"
         "breq 4f\n\t"
@@ -114,19 +104,34 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
 #undef FSW_CMP_LAST
 #undef FSW_SET_ENTRY
 #undef FSW_SET_LAST
-#undef FSW_SET_T
 #endif
 
 #if defined(__AVR__)
+namespace {
+// T = last_g - entry_g as its 32-bit halves (little-endian), a byte at a
+// time with the borrow carried up (ldd leaves the flags alone): no 64-bit
+// routine on an 8-bit MCU. The offsets are the Machine's (static_assert
+// above).
+#define FSW_T_BYTE(op, r, i) "ldd " r ", Z+" #i "\n\t" "ldd __tmp_reg__, Z+8+" #i "\n\t" op " " r ", __tmp_reg__\n\t"
+inline __attribute__((always_inline)) void T_halves(const Machine& m, uint32_t& lo, uint32_t& hi) {
+    __asm__(FSW_T_BYTE("sub", "%A[lo]", 0) FSW_T_BYTE("sbc", "%B[lo]", 1) FSW_T_BYTE("sbc", "%C[lo]", 2)
+            FSW_T_BYTE("sbc", "%D[lo]", 3) FSW_T_BYTE("sbc", "%A[hi]", 4) FSW_T_BYTE("sbc", "%B[hi]", 5)
+            FSW_T_BYTE("sbc", "%C[hi]", 6) FSW_T_BYTE("sbc", "%D[hi]", 7)
+            : [lo] "=&r"(lo), [hi] "=&r"(hi)
+            : "z"(&m), "m"(m));
+}
+#undef FSW_T_BYTE
+}  // namespace
+
 uint32_t machine_T32(const Machine& m) {
-    // The halves as bytes (little-endian): no 64-bit shift on an 8-bit MCU.
-    const uint8_t* t = reinterpret_cast<const uint8_t*>(&m.t);
-    return load<uint32_t>(t + 4) != 0 ? 0xFFFFFFFFUL : load<uint32_t>(t);
+    uint32_t lo, hi;
+    T_halves(m, lo, hi);
+    return hi != 0 ? 0xFFFFFFFFUL : lo;
 }
 
 Real machine_T_real(const Machine& m) {
-    const uint8_t* t = reinterpret_cast<const uint8_t*>(&m.t);
-    uint32_t lo = load<uint32_t>(t), hi = load<uint32_t>(t + 4);
+    uint32_t lo, hi;
+    T_halves(m, lo, hi);
     if (hi == 0) return static_cast<Real>(lo);  // correctly rounded by the float library
     // Shift right until the value fits 32 bits, OR-ing what falls off into
     // bit 0 (below the guard bit: the rounding is unchanged), convert, and

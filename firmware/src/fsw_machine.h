@@ -1,6 +1,7 @@
 // State-machine bookkeeping (spec 4.6) for generated step() functions:
-// current state, first-step flag, entry time, T in exact U64 arithmetic,
-// and the "G must strictly increase" check.
+// current state, first-step flag, entry time, T in exact U64 arithmetic
+// (worked out where it is read: G at the last step less G at the state's
+// entry), and the "G must strictly increase" check.
 #ifndef FSW_MACHINE_H
 #define FSW_MACHINE_H
 
@@ -19,22 +20,20 @@ struct Machine {
     uint8_t pending;    // 1: the next step is the first in `state`
     uint8_t entering;   // 1: the current step is the first in `state`
     uint8_t started;    // 1: at least one step was accepted (last_g valid)
-    uint64_t t;         // T of the current step: G - entry_g (last: see kMachineKept)
+    // (No copy of T, the current step's last_g - entry_g: machine_T and the
+    // functions below work it out from the two where it is read, 8 bytes of
+    // RAM a machine less.)
 };
 
-#define FSW_MACHINE_INIT(initial_state) {0, 0, (initial_state), 1, 0, 0, 0}
+#define FSW_MACHINE_INIT(initial_state) {0, 0, (initial_state), 1, 0, 0}
 
-// What a flight's resume keeps of a Machine (docs/safety.md): the fields
-// before `t`. T is worked out from G again at each step's start, before
-// anything reads it, so a resume need not keep it (16 bytes less to save
-// each cycle for a rocket's two machines).
-static const uint16_t kMachineKept = offsetof(Machine, t);
+// What a flight's resume keeps of a Machine (docs/safety.md): all of it.
+static const uint16_t kMachineKept = sizeof(Machine);
 
 // Puts the machine in `initial_state`, as before its first step.
 inline void machine_reset(Machine& m, uint32_t initial_state) {
     m.last_g = 0;
     m.entry_g = 0;
-    m.t = 0;
     m.state = initial_state;
     m.pending = 1;
     m.entering = 0;
@@ -44,7 +43,7 @@ inline void machine_reset(Machine& m, uint32_t initial_state) {
 // Steps 1-2 of spec 4.6. kErrTime (and no change at all) when G is not
 // strictly greater than at the previous step. Otherwise, on the first step
 // in a state records the entry time and sets `entering` (the caller then
-// writes m.state to S and runs .entry); sets m.t = G - entry time.
+// writes m.state to S and runs .entry). T is then G - entry time.
 FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
     if (m.started != 0 && g <= m.last_g) return kErrTime;
     m.started = 1;
@@ -54,7 +53,6 @@ FSW_MUST_CHECK inline Result machine_begin_step(Machine& m, uint64_t g) {
         m.entry_g = g;
         m.pending = 0;
     }
-    m.t = g - m.entry_g;
     return kOk;
 }
 
@@ -84,8 +82,9 @@ inline bool machine_same_tick(const Machine& m, const uint8_t* g) {
     return m.started != 0 && memcmp(g, &m.last_g, sizeof m.last_g) == 0;  // bytes: no 64-bit compare inline
 }
 
-// T, the time spent in the current state (valid after machine_begin_step).
-inline uint64_t machine_T(const Machine& m) { return m.t; }
+// T, the time spent in the current state (valid after machine_begin_step):
+// G at the step less G at the state's entry.
+inline uint64_t machine_T(const Machine& m) { return m.last_g - m.entry_g; }
 
 // T saturated to 32 bits: for a constant c < 0xFFFFFFFF, `T op c` is
 // `machine_T32(m) op c` (T >= 2^32 compares as 0xFFFFFFFF does), a 32-bit
@@ -94,7 +93,8 @@ inline uint64_t machine_T(const Machine& m) { return m.t; }
 FSW_NOINLINE uint32_t machine_T32(const Machine& m);
 #else
 inline uint32_t machine_T32(const Machine& m) {
-    return (m.t >> 32) != 0 ? 0xFFFFFFFFUL : static_cast<uint32_t>(m.t);
+    const uint64_t t = machine_T(m);
+    return (t >> 32) != 0 ? 0xFFFFFFFFUL : static_cast<uint32_t>(t);
 }
 #endif
 
@@ -110,7 +110,7 @@ inline void machine_transition(Machine& m, uint32_t target) {
 #if defined(__AVR__)
 FSW_NOINLINE FSW_NOCLONE Real machine_T_real(const Machine& m);
 #else
-inline Real machine_T_real(const Machine& m) { return real_from_U64(m.t); }
+inline Real machine_T_real(const Machine& m) { return real_from_U64(machine_T(m)); }
 #endif
 
 // `x = T` for an integer x whose largest value is hi (< 2^32): R(T)

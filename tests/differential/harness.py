@@ -416,7 +416,8 @@ class RawBatch(Batch):
               "        fwrite(sv, 1, kSvSize, out);"]
         if locs:
             d.append(f"        fwrite({name}::loc, 1, {name}::kLocSize, out);")
-        d += [f"        fwrite(&{name}::machine.t, 8, 1, out);", "    }", "    return 0;", "}", "}", ""]
+        d += [f"        const uint64_t t = fsw::machine_T({name}::machine);", "        fwrite(&t, 8, 1, out);", "    }",
+              "    return 0;", "}", "}", ""]
         files["driver.cpp"] = "\n".join(d)
         self._add_files(k, files, "driver.cpp")
         self.items.append((k, (case, m, locs, loc_size)))

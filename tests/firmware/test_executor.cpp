@@ -55,6 +55,7 @@ static void safe_fn(void* ctx) {
 // @5 (U32), reset cause @9.
 static uint8_t sv[10];
 static TaskStats stats[3];
+static uint16_t countdowns[3];  // B and C run less often than every cycle
 static Executor ex;
 
 static const Task kTasks[3] FSW_FLASH = {
@@ -65,7 +66,7 @@ static const Task kTasks[3] FSW_FLASH = {
 
 // The executor keeps a pointer to its configuration: constant data, in
 // flash on AVR.
-static const ExecConfig kConfig FSW_FLASH = {kTasks, stats, sv, 1000, 9, 3, false};
+static const ExecConfig kConfig FSW_FLASH = {kTasks, stats, sv, 1000, 9, 3, false, countdowns};
 
 void setUp(void) {
     trace_len = 0;
@@ -134,7 +135,6 @@ static void test_a_faulting_step_safes_its_task(void) {
     executor_run_cycle(ex);  // A faults here
     TEST_ASSERT_EQUAL_UINT8(kModeSafed, sv[0]);
     TEST_ASSERT_EQUAL_UINT8(1, stats[0].faults);
-    TEST_ASSERT_EQUAL_UINT8(kErrFault, stats[0].last_fault);
     trace_len = 0;
     executor_run_cycle(ex);  // cycle 2: A safed -> a, B
     TEST_ASSERT_EQUAL_STRING("aB", trace);
@@ -258,16 +258,32 @@ static const Task kBadDivider[1] FSW_FLASH = {{step_fn, 0, CTX(0), 0, 0, kNoElem
 static const Task kBadPhase[1] FSW_FLASH = {{step_fn, 0, CTX(0), 2, 2, kNoElement, kNoElement, kNoElement, 2}};
 static const Task kNoStep[1] FSW_FLASH = {{0, 0, CTX(0), 1, 0, kNoElement, kNoElement, kNoElement, 2}};
 
-static const ExecConfig kBadDividerConfig FSW_FLASH = {kBadDivider, stats, sv, 1000, 9, 1, false};
-static const ExecConfig kBadPhaseConfig FSW_FLASH = {kBadPhase, stats, sv, 1000, 9, 1, false};
-static const ExecConfig kNoStepConfig FSW_FLASH = {kNoStep, stats, sv, 1000, 9, 1, false};
-static const ExecConfig kNoPeriodConfig FSW_FLASH = {kTasks, stats, sv, 0, 9, 3, false};
+static const ExecConfig kBadDividerConfig FSW_FLASH = {kBadDivider, stats, sv, 1000, 9, 1, false, countdowns};
+static const ExecConfig kBadPhaseConfig FSW_FLASH = {kBadPhase, stats, sv, 1000, 9, 1, false, countdowns};
+static const ExecConfig kNoStepConfig FSW_FLASH = {kNoStep, stats, sv, 1000, 9, 1, false, countdowns};
+static const ExecConfig kNoPeriodConfig FSW_FLASH = {kTasks, stats, sv, 0, 9, 3, false, countdowns};
+// slow tasks (B, C) and nowhere to count down to their runs
+static const ExecConfig kNoCountdownsConfig FSW_FLASH = {kTasks, stats, sv, 1000, 9, 3, false, 0};
+// every task every cycle: no countdowns needed
+static const Task kEveryCycle[2] FSW_FLASH = {{step_fn, 0, CTX(0), 1, 0, kNoElement, kNoElement, kNoElement, 2},
+                                              {step_fn, 0, CTX(1), 1, 0, kNoElement, kNoElement, kNoElement, 2}};
+static const ExecConfig kEveryCycleConfig FSW_FLASH = {kEveryCycle, stats, sv, 1000, 9, 2, false, 0};
 
 static void test_begin_refuses_bad_tables(void) {
     TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kBadDividerConfig));
     TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kBadPhaseConfig));
     TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kNoStepConfig));
     TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kNoPeriodConfig));
+    TEST_ASSERT_EQUAL(kErrConfig, executor_begin(ex, &kNoCountdownsConfig));
+}
+
+static void test_tasks_of_every_cycle_need_no_countdowns(void) {
+    TEST_ASSERT_EQUAL(kOk, executor_begin(ex, &kEveryCycleConfig));
+    for (int c = 0; c < 3; ++c) {
+        executor_run_cycle(ex);
+        note('|');
+    }
+    TEST_ASSERT_EQUAL_STRING("AB|AB|AB|", trace);
 }
 
 #if FSW_PLATFORM_NATIVE
@@ -306,6 +322,7 @@ static void run(void) {
     RUN_TEST(test_reset_cause_is_captured);
     RUN_TEST(test_cycle_count_across_the_32_bit_wrap);
     RUN_TEST(test_begin_refuses_bad_tables);
+    RUN_TEST(test_tasks_of_every_cycle_need_no_countdowns);
 #if FSW_PLATFORM_NATIVE
     RUN_TEST(test_poll_across_the_32_bit_wrap);
 #endif

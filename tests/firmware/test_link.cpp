@@ -28,7 +28,7 @@ static const Task kTasks[2] FSW_FLASH = {
     {link_uplink_task, 0, &link, 1, 0, kNoElement, kNoElement, kNoElement, kModeEnabled},
     {link_telemetry_task, 0, &link, 1, 0, 8, kNoElement, kNoElement, kModeEnabled},
 };
-static const ExecConfig kExecConfig FSW_FLASH = {kTasks, stats, sv, 10000, kNoElement, 2, false};
+static const ExecConfig kExecConfig FSW_FLASH = {kTasks, stats, sv, 10000, kNoElement, 2, false, 0};
 static const LinkStream kStreams[2] FSW_FLASH = {
     {0, 8, 1, 2, store0},  // Sensors every run, 2 per frame
     {8, 12, 4, 1, 0},      // Cmd every 4th run

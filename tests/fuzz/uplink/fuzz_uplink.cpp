@@ -26,6 +26,7 @@ uint8_t store0[8];
 LinkStreamState states[2];
 uint8_t tx[96];
 TaskStats stats[3];
+uint16_t countdowns[3];  // the second task runs every other cycle
 Executor ex;
 Link link;
 uint64_t clock_ms;
@@ -139,7 +140,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     native::console_capture(out, sizeof out, &out_len);
     const bool slow = size > 0 && (data[0] & 1);
     if (slow) native::console_model_uart(115200, 64);
-    static const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false};
+    static const ExecConfig cfg = {kTasks, stats, sv, 10000, kNoElement, 3, false, countdowns};
     if (executor_begin(ex, &cfg) != kOk) fail("begin");
     pal::console_begin(115200UL);
     native::sim_eeprom_erase();

@@ -83,6 +83,17 @@ def _input_rows(app: Application, chans) -> bool:
     return len(chans) >= 2 and not app.sv.lock and all(c.element.type.name == "F32" for c in chans)
 
 
+def _inputs_kept(app: Application) -> bool:
+    """Whether the analog inputs' elements keep their values between runs
+    (fsw::analog_count_new: a count that did not change neither converted
+    nor written, 2 bytes of RAM an input) rather than a memo of the value
+    written at every run (fsw::AnalogMemo, 6 bytes): when nothing else
+    writes them. fsw check lets neither a machine nor the uplink write an
+    input's element; a machine replaced at run time ([reload]) is a
+    bytecode image the board's verifier lets store to any element."""
+    return app.reload is None
+
+
 def _input_constants(app: Application, real, c) -> tuple[str, str]:
     """An analog input's gain and offset as R literals: iotables.analog_gain
     folds the converter into the .aio's scale (no division on the MCU)."""
@@ -94,17 +105,30 @@ def _analog_inputs(app: Application, real, scan: _Scan) -> list[str]:
     """The inputs task's lines for its analog inputs: each element takes its
     count * gain + offset, then the next scan starts."""
     out = []
-    if scan.rows:
+    kept = _inputs_kept(app)
+    if scan.rows and kept:
+        out.append(f"    fsw::io_analog_inputs_kept({scan.tag}Rows, {len(scan.chans)}, {scan.tag}Key, {scan.tag}Raw, sv);  "
+                   "// each element: count * gain + offset (the rows above), when its count is new")
+    elif scan.rows:
         out.append(f"    fsw::io_analog_inputs({scan.tag}Rows, {len(scan.chans)}, {scan.tag}Memo, {scan.tag}Raw, sv);  "
                    "// each element: count * gain + offset (the rows above)")
     for k, c in enumerate(scan.chans if not scan.rows else ()):
         gain, offset = _input_constants(app, real, c)
+        where = f"// {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt"
+        if kept:
+            write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
+                     f"fsw::analog_value(n, {gain}, {offset}));")
+            if app.sv.lock:
+                write = "{ fsw::SvGuard<true> lock; " + write + " }"
+            out.append(f"    {{ const uint16_t n = fsw::io_analog_count({scan.tag}Raw, {k}); "
+                       f"if (fsw::analog_count_new({scan.tag}Key[{k}], n)) {write} }}  {where}")
+            continue
         write = (f"fsw::write_{c.element.type.name}(sv + E_{c.element.name}, "
                  f"fsw::analog_value_memo({scan.tag}Memo[{k}], fsw::io_analog_count({scan.tag}Raw, {k}), "
                  f"{gain}, {offset}));")
         if app.sv.lock:
             write = "{ fsw::SvGuard<true> lock; " + write + " }"
-        out.append(f"    {write}  // {basename(c.path)}:{c.line} pin {c.pin}: {c.scale!r} per volt")
+        out.append(f"    {write}  {where}")
     out.append(f"    fsw::io_analog_scan({scan.tag}Pins, {len(scan.chans)}, {scan.tag}Raw);  "
                "// the next run's counts, converted in the background")
     return out
@@ -135,8 +159,12 @@ def _tables(app: Application, real, out: list[str]) -> dict:
                        + ", ".join(str(c.pin_number) for c in chans) + "};  // "
                        + ", ".join(f"{basename(c.path)}:{c.line} {c.pin}" for c in chans))
             out.append(f"volatile uint16_t {tag}Raw[{len(chans)}];  // counts the ADC's interrupt stores")
-            out.append(f"fsw::AnalogMemo {tag}Memo[{len(chans)}];  // each input's last count and value: "
-                       "converted again when the count changed")
+            if _inputs_kept(app):
+                out.append(f"uint16_t {tag}Key[{len(chans)}];  // each input's last count: converted and written "
+                           "again when it changed (the element keeps the value)")
+            else:
+                out.append(f"fsw::AnalogMemo {tag}Memo[{len(chans)}];  // each input's last count and value: "
+                           "converted again when the count changed")
             rows = _input_rows(app, chans)
             if rows:
                 out.append(f"const fsw::AnalogInput {tag}Rows[{len(chans)}] FSW_FLASH = {{")

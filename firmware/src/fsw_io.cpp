@@ -114,6 +114,27 @@ Result analog_task(void* ctx) {
 
 }  // namespace
 
+namespace {
+
+// A row's count * gain + offset, as analog_value gives it with the row's
+// constants inline, bit for bit (its order; a +0 offset not added).
+Real row_value(const AnalogInput* row, uint16_t count) {
+    const Real scaled = real_from_count(count) * flash_get(row->gain);  // analog_value's, in its order
+    const Real offset = flash_get(row->offset);
+#if FSW_REAL_IS_FLOAT
+    // an offset of +0 (its bits all 0) is not added: adding it only turns -0 into +0,
+    // done on the bits as analog_value does for a literal +0 (no float addition)
+    uint32_t ob, sb;
+    memcpy(&ob, &offset, sizeof ob);
+    memcpy(&sb, &scaled, sizeof sb);
+    return ob != 0 ? scaled + offset : sb == 0x80000000UL ? Real(0) : scaled;
+#else
+    return scaled + offset;
+#endif
+}
+
+}  // namespace
+
 void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, const volatile uint16_t* raw,
                       uint8_t* sv) {
     for (uint8_t i = 0; i < n; ++i, ++rows, ++memo) {
@@ -121,20 +142,17 @@ void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, cons
         const uint16_t key = static_cast<uint16_t>(~count);
         if (key == 0 || key != memo->key) {  // (analog_value_memo: the row's constants read only then)
             memo->key = key;
-            const Real scaled = real_from_count(count) * flash_get(rows->gain);  // analog_value's, in its order
-            const Real offset = flash_get(rows->offset);
-#if FSW_REAL_IS_FLOAT
-            // an offset of +0 (its bits all 0) is not added: adding it only turns -0 into +0,
-            // done on the bits as analog_value does for a literal +0 (no float addition)
-            uint32_t ob, sb;
-            memcpy(&ob, &offset, sizeof ob);
-            memcpy(&sb, &scaled, sizeof sb);
-            memo->value = ob != 0 ? scaled + offset : sb == 0x80000000UL ? Real(0) : scaled;
-#else
-            memo->value = scaled + offset;
-#endif
+            memo->value = row_value(rows, count);
         }
         write_F32(sv + flash_get(rows->off), memo->value);
+    }
+}
+
+void io_analog_inputs_kept(const AnalogInput* rows, uint8_t n, uint16_t* keys, const volatile uint16_t* raw,
+                           uint8_t* sv) {
+    for (uint8_t i = 0; i < n; ++i, ++rows, ++keys) {
+        const uint16_t count = io_analog_count(raw, i);
+        if (analog_count_new(*keys, count)) write_F32(sv + flash_get(rows->off), row_value(rows, count));
     }
 }
 

@@ -251,6 +251,21 @@ inline __attribute__((always_inline)) Real analog_value_memo(AnalogMemo& m, uint
     }
     return m.value;
 }
+// The last count an input converted, where the input's element keeps its
+// value: in an application whose machines are all generated (none replaced
+// at run time), an element an input writes has no other writer (fsw check:
+// no machine and no uplink SET writes it), so a count that did not change is
+// neither converted nor written again, and the element still holds what its
+// conversion gave, bit for bit. 2 bytes of RAM an input, where an
+// AnalogMemo, which keeps the value too, takes 6. `key` is the count's
+// complement, zero before the first run; the count 0xFFFF (key 0) is new at
+// every run. True when the count is new (the key then set to it).
+inline bool analog_count_new(uint16_t& key, uint16_t count) {
+    const uint16_t k = static_cast<uint16_t>(~count);
+    if (k != 0 && k == key) return false;
+    key = k;
+    return true;
+}
 // An analog input of a generated inputs task, FSW_FLASH: the F32 element
 // at `off` takes count * gain + offset (the generator's constants).
 struct AnalogInput {
@@ -269,6 +284,11 @@ struct AnalogInput {
 // input at a time).
 void io_analog_inputs(const AnalogInput* rows, uint8_t n, AnalogMemo* memo, const volatile uint16_t* raw,
                       uint8_t* sv);
+// The same, each input through its key (analog_count_new): an element is
+// converted and written only when its count is new (an application whose
+// input elements have no other writer).
+void io_analog_inputs_kept(const AnalogInput* rows, uint8_t n, uint16_t* keys, const volatile uint16_t* raw,
+                           uint8_t* sv);
 // duty = trunc(clamp(volts / vref * 255 + 0.5, 0, 255)); NaN -> 0.
 uint8_t pwm_duty_from_volts(Real volts, Real vref);
 

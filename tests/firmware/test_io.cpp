@@ -101,6 +101,45 @@ static void test_the_inputs_loop_gives_what_each_call_gives(void) {
     TEST_ASSERT_TRUE(read_F32(sv + 10) == Real(12345));
 }
 
+// An application whose input elements have no other writer keeps a key per
+// input, not its value (io_analog_inputs_kept, analog_count_new): each
+// element holds, run after run, the bytes the memo's loop writes, and one
+// whose count did not change is neither converted nor written (the count
+// 0xFFFF, key 0, is new at every run).
+static void test_the_kept_inputs_loop_writes_what_the_memo_gives(void) {
+    static const AnalogInput rows[3] FSW_FLASH = {
+        {Real(30.54741), Real(76875), 2}, {Real(-0.5), Real(0), 10}, {Real(5) / Real(1023), Real(-20), 6}};
+    static AnalogMemo memo[3];
+    static uint16_t keys[3];  // zero, as a generated task's before its first run
+    static volatile uint16_t raw[3];
+    static const uint16_t counts[][3] = {{0, 0, 0}, {0, 0, 0}, {1, 0, 1023}, {1023, 7, 1023}, {0xFFFF, 0xFFFF, 1},
+                                         {0xFFFF, 0xFFFF, 1}, {512, 0, 511}};
+    uint8_t sv[16], want[16];
+    memset(sv, 0xA5, sizeof sv);
+    memset(want, 0xA5, sizeof want);
+    for (uint8_t r = 0; r < sizeof counts / sizeof counts[0]; ++r) {
+        for (uint8_t i = 0; i < 3; ++i) raw[i] = counts[r][i];
+        io_analog_inputs_kept(rows, 3, keys, raw, sv);
+        io_analog_inputs(rows, 3, memo, raw, want);
+        TEST_ASSERT_EQUAL_MEMORY(want, sv, sizeof sv);
+    }
+    // the same counts again: nothing written (a byte planted in an element stays) ...
+    write_F32(sv + 6, Real(12345));
+    io_analog_inputs_kept(rows, 3, keys, raw, sv);
+    TEST_ASSERT_TRUE(read_F32(sv + 6) == Real(12345));
+    // ... but a new count is converted and written
+    raw[2] = 510;
+    io_analog_inputs_kept(rows, 3, keys, raw, sv);
+    write_F32(want + 6, analog_value(510, Real(5) / Real(1023), Real(-20)));
+    TEST_ASSERT_EQUAL_MEMORY(want + 6, sv + 6, 4);
+    // the count 0xFFFF is new at every run
+    uint16_t key = 0;
+    TEST_ASSERT_TRUE(analog_count_new(key, 0xFFFF));
+    TEST_ASSERT_TRUE(analog_count_new(key, 0xFFFF));
+    TEST_ASSERT_TRUE(analog_count_new(key, 3));
+    TEST_ASSERT_FALSE(analog_count_new(key, 3));
+}
+
 #if FSW_REAL_IS_FLOAT
 // Bit patterns of analog_value for rocket.aio's two calibrations, as the
 // host computes them (fswkit.autocode.iotables.analog_value; the host test
@@ -352,6 +391,7 @@ static void run(void) {
     RUN_TEST(test_every_count_converts_as_the_cast);
     RUN_TEST(test_the_memo_gives_analog_values_bit_for_bit);
     RUN_TEST(test_the_inputs_loop_gives_what_each_call_gives);
+    RUN_TEST(test_the_kept_inputs_loop_writes_what_the_memo_gives);
     RUN_TEST(test_pwm_duty_from_volts);
 #if FSW_REAL_IS_FLOAT
     RUN_TEST(test_analog_conversion_matches_the_host_bit_for_bit);

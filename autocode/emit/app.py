@@ -15,9 +15,9 @@ from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan, link_text, schema_hash
 from ..version import __version__
 from ..types import TYPES
-from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check, window_type
-from .expr import float_key_test
-from .machine import emit_machine, stored_locals
+from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
+from .expr import ExprEmitter, float_key_test
+from .machine import declared_windows, emit_machine, stored_locals
 from .resume import resume_spans, resume_watches
 from .sv import emit_sv
 
@@ -266,7 +266,7 @@ def resume_hash(app: Application) -> int:
     lines = [f"resume {__version__} {app.board.real}"]
     for m in app.machines:
         lines.append(f"locals {m.name} " + " ".join(f"{v.type.name}:{v.name}" for v in stored_locals(m, real)))
-        lines.append(f"windows {m.name} " + " ".join(window_type(w) for w in m.windows))
+        lines.append(f"windows {m.name} " + " ".join(t for _, t in declared_windows(m, ExprEmitter(m, real, False))))
     if app.log is not None:
         lines.append("recorder")
     if app.reload is not None:

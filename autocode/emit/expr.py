@@ -31,6 +31,9 @@ class ExprEmitter:
         self.scriptable = scriptable
         self.prefix = prefix  # qualifies the machine's names from outside (scripts)
         self.windows = windows
+        # window -> how it reads, after `windows`, where it is not its own
+        # `<index>.value()` (a window kept in another's ring: shared_extremes)
+        self.window_reads: dict[int, str] = {}
         self.consts = folded_locals(m, real, scriptable)
         self.sv_lock = m.sv.lock
         # Variables whose value a C++ local holds at the statement being
@@ -91,7 +94,7 @@ class ExprEmitter:
                 return f"({self.value(e.left)} * {real_literal(inv, self.real)})"
             return f"({self.value(e.left)} {e.op} {self.value(e.right)})"
         if t is M.Roll:
-            return f"{self.windows}{e.window}.value()"
+            return f"{self.windows}{self.window_reads.get(e.window, f'{e.window}.value()')}"
         return f"fsw::real_from_truth({self.cond(e)})"
 
     def exact_reciprocal(self, e: M.Expr) -> float | None:

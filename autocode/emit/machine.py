@@ -98,6 +98,47 @@ def still_read(succ: dict[int, list[int]], reads: dict[int, int]) -> dict[int, i
     return {s: need[c] for s, c in dag.graph["mapping"].items()}
 
 
+# roll_min, roll_max and roll_range of one argument over one N up to this
+# share one ring of the last N samples (fsw::RollMinMaxN) when it keeps more
+# than one extreme: a read scans the N samples (at most 16 key comparisons
+# of binary32 samples on AVR, no float routine).
+SHARED_EXTREMES_MAX_N = 16
+
+
+def shared_extremes(m: M.Machine, ex: ExprEmitter) -> dict[int, tuple[int, str]]:
+    """The windows kept in one ring with others (fsw::RollMinMaxN): for
+    each, (the index of the window that holds the ring, which is the first
+    of them, and its read: `min()`, `max()` or `range()`). The windows of
+    roll_min, roll_max and roll_range of one argument (of no window of its
+    own) and one N of at most SHARED_EXTREMES_MAX_N, two of them or more,
+    or a roll_range alone (two extremes of its own): the same values bit
+    for bit, in 4N + 2 bytes (binary32 R, N <= 255) where a RollMinN and a
+    RollMaxN take 10N + 8."""
+    groups: dict[tuple[str, int], list] = {}
+    for w in m.windows:
+        if w.func in ("min", "max", "range") and w.size <= SHARED_EXTREMES_MAX_N and not _rolls(w.arg):
+            groups.setdefault((ex.value(w.arg), w.size), []).append(w)
+    out: dict[int, tuple[int, str]] = {}
+    for ws in groups.values():
+        if len(ws) >= 2 or ws[0].func == "range":
+            for w in ws:
+                out[w.index] = (ws[0].index, f"{w.func}()")
+    return out
+
+
+def declared_windows(m: M.Machine, ex: ExprEmitter) -> list[tuple[M.Window, str]]:
+    """The windows a machine's code declares, with their types: each of its
+    own, and one ring for those kept together (shared_extremes)."""
+    shared = shared_extremes(m, ex)
+    out = []
+    for w in m.windows:
+        if w.index not in shared:
+            out.append((w, window_type(w)))
+        elif shared[w.index][0] == w.index:
+            out.append((w, f"fsw::RollMinMaxN<{w.size}>"))
+    return out
+
+
 def windows_watched(m: M.Machine) -> bool:
     """Whether a kept machine's rolling windows are a watched span of the
     flight's save (fsw::ResumeWatch, docs/safety.md): copied only while
@@ -152,6 +193,14 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     src = basename(m.path)
     wp = "win.w" if kept and m.windows else "w"  # how the code names window i: f"{wp}{i}"
     ex = ExprEmitter(m, real, scriptable, windows=wp)
+    shared = shared_extremes(m, ex)
+    declared = declared_windows(m, ex)
+    ex.window_reads = {i: f"{holder}.{read}" for i, (holder, read) in shared.items()}
+
+    def what(w: M.Window) -> str:  # the roll_* calls a declared window serves
+        kept = [x for x in m.windows if shared.get(x.index, (None,))[0] == w.index] or [w]
+        return ", ".join(f"{basename(m.path)}:{x.line} roll_{x.func}" for x in kept)
+
     values = local_values(m, real)
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
     stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
@@ -186,8 +235,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     if wp != "w":
         h.append("// Its rolling windows, kept across a reset in flight with its locals (docs/safety.md).")
         h.append("struct Windows {")
-        for w in m.windows:
-            h.append(f"    {window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
+        for w, wtype in declared:
+            h.append(f"    {wtype} w{w.index};  // {what(w)}")
         h.append("};")
         h.append("extern Windows win;")
         if windows_watched(m):
@@ -218,8 +267,8 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append("uint8_t win_changed;  // fsw::ResumeWatch: the save copies the windows while they change")
     c += ["", "namespace {", ""]
     if wp == "w":
-        for w in m.windows:
-            c.append(f"{window_type(w)} w{w.index};  // {src}:{w.line} roll_{w.func}")
+        for w, wtype in declared:
+            c.append(f"{wtype} w{w.index};  // {what(w)}")
         if m.windows:
             c.append("")
     if stored:
@@ -328,11 +377,12 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
                 c.append(f"    case S_{m.states[i].name}:")
             c.append("    {")
             pad = "        "
-        if len(ws) == 1:
-            c.append(f"{pad}{wp}{ws[0].index}.push({arg});  // {src}:{ws[0].line}")
+        pushed = [w for w in ws if shared.get(w.index, (w.index,))[0] == w.index]  # (one push a ring)
+        if len(pushed) == 1:
+            c.append(f"{pad}{wp}{pushed[0].index}.push({arg});  // {src}:{pushed[0].line}")
         else:
             c.append(f"{pad}const fsw::Real x{k} = {arg};")
-            for w in ws:
+            for w in pushed:
                 c.append(f"{pad}{wp}{w.index}.push(x{k});  // {src}:{w.line}")
         if watched:
             c.append(f"{pad}win_changed = 1;")
@@ -365,7 +415,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     c.append("    fsw::machine_reset(machine, initial);")
     if stored:
         c.append("    memcpy(loc, kLocInit, sizeof loc);")
-    for w in m.windows:
+    for w, _ in declared:
         c.append(f"    memset(&{wp}{w.index}, 0, sizeof {wp}{w.index});")
     if watched:
         c.append("    win_changed = 1;")

@@ -107,6 +107,28 @@ void roll_min_push(RollExtS<I>& w, Real* vals, I* seqs, typename same_t<I>::type
     ext_push<I>(w, vals, seqs, n, x, false);
 }
 
+template <typename I>
+void roll_ring_push(RollRingS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
+    ring[w.head] = window_sample(x);
+    w.head = step_fwd(w.head, n);
+    if (w.count < n) ++w.count;
+}
+
+template <typename I>
+Real roll_ring_extreme(const RollRingS<I>& w, const Real* ring, bool is_max) {
+    if (w.count == 0) return Real(0);
+    I best = 0;
+    auto kb = order_key(ring[0]);
+    for (I i = 1; i < w.count; ++i) {
+        const auto k = order_key(ring[i]);
+        if (is_max ? (k > kb) : (k < kb)) {
+            kb = k;
+            best = i;
+        }
+    }
+    return ring[best];
+}
+
 // First index in [lo, hi) whose value is >= x (x > value: keep going right).
 template <typename I>
 static I lower_bound(const Real* s, I lo, I hi, Real x) {
@@ -183,6 +205,8 @@ template Real roll_avg_mean<WinIdx>(const RollAvgS<WinIdx>&, WinIdx, Real);
     template void roll_avg_push<I>(RollAvgS<I>&, Real*, I, Real);                   \
     template void roll_max_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
     template void roll_min_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
+    template void roll_ring_push<I>(RollRingS<I>&, Real*, I, Real);                  \
+    template Real roll_ring_extreme<I>(const RollRingS<I>&, const Real*, bool);      \
     template void roll_median_push<I>(RollMedianS<I>&, Real*, Real*, I, Real);       \
     template Real roll_median_value<I>(const RollMedianS<I>&, const Real*);
 FSW_WINDOW_INSTANCES(uint8_t)

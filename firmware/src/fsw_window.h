@@ -132,6 +132,15 @@ struct RollMedianS {
     I head;
 };
 
+// roll_min, roll_max and roll_range of one argument over one N, kept
+// together: a ring of the last N samples, each extreme found by a scan where
+// it is read (roll_ring_extreme).
+template <typename I>
+struct RollRingS {
+    I count;  // samples held, 0..n: ring positions 0..count-1
+    I head;   // ring position of the next sample
+};
+
 typedef RollAvgS<WinIdx> RollAvg;
 typedef RollExtS<WinIdx> RollExt;
 typedef RollMedianS<WinIdx> RollMedian;
@@ -194,6 +203,12 @@ void roll_median_push(RollMedianS<I>& w, Real* ring, Real* sorted, typename same
 template <typename I>
 Real roll_median_value(const RollMedianS<I>& w, const Real* sorted);
 
+template <typename I>
+void roll_ring_push(RollRingS<I>& w, Real* ring, typename same_t<I>::type n, Real x);
+// The least (is_max false) or the greatest of the samples held; 0 before the first.
+template <typename I>
+Real roll_ring_extreme(const RollRingS<I>& w, const Real* ring, bool is_max);
+
 // ---- typed wrappers: what generated code declares, one per call site -------
 //     static fsw::RollMedianN<100> w_tank_sm_18;   // zero-initialised
 //     w_tank_sm_18.push(x);  ...  r = w_tank_sm_18.value();
@@ -245,6 +260,27 @@ struct RollRangeN {
         lo.push(x);
     }
     Real value() const { return hi.value() - lo.value(); }
+};
+
+// roll_min, roll_max and roll_range of one argument over the same N (a
+// machine's windows of one argument, sampled together: the generator
+// declares one of these for them): one ring of the last N samples, the
+// extremes found by a scan of it where read. The same values bit for bit as
+// a RollMinN's, a RollMaxN's and a RollRangeN's of those samples (stored as
+// window_sample makes them: no NaN and no -0, so the order is total and
+// equal samples are the same bits), in 4N + 2 bytes (N <= 255, binary32 R)
+// where a RollMinN and a RollMaxN take 10N + 8; a read costs a pass over
+// the N samples, so the generator keeps it for small N.
+template <uint32_t N>
+struct RollMinMaxN {
+    FSW_WINDOW_CHECK_N(N);
+    typedef typename WinIdxFor<N>::type I;
+    RollRingS<I> s;
+    Real ring[N];
+    void push(Real x) { roll_ring_push<I>(s, ring, static_cast<I>(N), x); }
+    Real min() const { return roll_ring_extreme<I>(s, ring, false); }
+    Real max() const { return roll_ring_extreme<I>(s, ring, true); }
+    Real range() const { return max() - min(); }
 };
 
 template <uint32_t N>

@@ -324,6 +324,57 @@ static void test_byte_indexed_windows_match_the_winidx_core(void) {
 #endif
 }
 
+// One ring for a machine's roll_min, roll_max and roll_range of one
+// argument (RollMinMaxN): the values of the three windows of their own, bit
+// for bit, on samples with runs, zeros of both signs, infinities and NaNs
+// (stored as +0), from the first push on.
+template <uint32_t N>
+static void ring_matches_the_deques(void) {
+    static RollMinMaxN<N> ring;
+    static RollMinN<N> mn;
+    static RollMaxN<N> mx;
+    static RollRangeN<N> rg;
+    memset(&ring, 0, sizeof ring);
+    memset(&mn, 0, sizeof mn);
+    memset(&mx, 0, sizeof mx);
+    memset(&rg, 0, sizeof rg);
+    ASSERT_REAL_SAME(Real(0), ring.min());
+    ASSERT_REAL_SAME(Real(0), ring.max());
+    ASSERT_REAL_SAME(Real(0), ring.range());
+    const Real inf = static_cast<Real>(__builtin_inf());
+    for (uint16_t k = 0; k < 3u * N + 300u; ++k) {
+        const uint32_t r = rng();
+        Real x = static_cast<Real>(static_cast<int32_t>(r % 2001u) - 1000) / 8;
+        switch ((r >> 12) & 15u) {
+        case 0: x = Real(0); break;
+        case 1: x = -Real(0); break;
+        case 2: x = inf; break;
+        case 3: x = -inf; break;
+        case 4: x = static_cast<Real>(__builtin_nan("")); break;
+        default: break;
+        }
+        ring.push(x);
+        mn.push(x);
+        mx.push(x);
+        rg.push(x);
+        ASSERT_REAL_SAME(mn.value(), ring.min());
+        ASSERT_REAL_SAME(mx.value(), ring.max());
+        ASSERT_REAL_SAME(rg.value(), ring.range());
+    }
+}
+
+// Not on the MCU, whose 2 KB of RAM the other tests' windows fill: the
+// native binary32 build runs the same code on the same order keys.
+#if !defined(__AVR__)
+static void test_one_ring_gives_the_extremes_of_their_own_windows(void) {
+    static_assert(sizeof(RollMinMaxN<5>) < sizeof(RollMinN<5>) + sizeof(RollMaxN<5>), "one ring is smaller");
+    ring_matches_the_deques<1>();
+    ring_matches_the_deques<2>();
+    ring_matches_the_deques<5>();
+    ring_matches_the_deques<16>();
+}
+#endif
+
 #if !defined(__AVR__)
 // The language's largest window: 100000 samples.
 static void test_largest_window(void) {
@@ -357,6 +408,9 @@ static void run(void) {
     RUN_TEST(test_avg_does_not_drift);
     RUN_TEST(test_typed_wrappers_and_range);
     RUN_TEST(test_byte_indexed_windows_match_the_winidx_core);
+#if !defined(__AVR__)
+    RUN_TEST(test_one_ring_gives_the_extremes_of_their_own_windows);
+#endif
 #if !defined(__AVR__)
     RUN_TEST(test_largest_window);
 #endif

@@ -118,7 +118,7 @@
 // How long before a cycle the sleeping executor stops starting background
 // work (loop()'s service of the link and of the EEPROM writers, docs/runtime.md):
 // longer than such a pass takes, so that none holds the CPU past a cycle's
-// start (it would start late, counted as `late_other`).
+// start (it would start late, counted in `late`).
 #ifndef FSW_BACKGROUND_GUARD_US
 #  define FSW_BACKGROUND_GUARD_US 256
 #endif

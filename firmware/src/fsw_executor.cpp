@@ -253,10 +253,7 @@ bool executor_poll(Executor& ex_, bool background) {
     uint8_t skipped;
     const uint8_t why = pal::cycle_wait(skipped, background);
     if (why == pal::kCycleNotDue) return false;
-    if (why != pal::kCycleOnTime) {
-        count(ex.late, 1);
-        count(why == pal::kCycleLateOverrun ? ex.late_overrun : ex.late_other, 1);
-    }
+    if (why != pal::kCycleOnTime) count(ex.late, 1);
     count(ex.skipped, skipped);
     executor_run_cycle(ex);
     pal::cycle_end();

@@ -69,12 +69,10 @@ struct Executor {
     uint16_t late;           // cycles that started a full period or more late
     uint8_t reset_cause;     // captured at executor_begin
     uint32_t cycles_high;    // cycles run, high 32 bits: wraps of `cycles`
-    // Why cycles started late (FSW_SLEEP; `late` counts them all): the
-    // previous cycle's tasks ran past the start, or something else held
-    // the CPU then (interrupts, the link's service between cycles). Cycle
-    // starts that passed unserved are skipped and counted. All saturate.
-    uint16_t late_overrun;
-    uint16_t late_other;
+    // Cycle starts that passed unserved: skipped and counted (saturates).
+    // (Why a cycle started late -- the previous cycle's tasks ran past its
+    // start, or something else held the CPU then -- is counted nowhere:
+    // nothing sent or read those two counters, 4 bytes of RAM.)
     uint16_t skipped;
     // 1: some task mirrors its overruns or worst time into elements (set by
     // executor_begin from the table: a cycle then looks at no row's offsets

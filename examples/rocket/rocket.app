@@ -53,7 +53,7 @@ element resetCause  hold   # held: a reset in flight shows as a change
 
 [budget]               # fsw build fails above these; fsw sim adds the stack's
 flash 25600            # measured high-water mark to the RAM
-ram   1920             # (the two banks a reset in flight resumes from: 620 B of it, docs/safety.md)
+ram   1920             # (the two banks a reset in flight resumes from: 556 B of it, docs/safety.md)
 
 [pyro]                 # the charges (docs/safety.md): fsw check proves each fires only armed, in its states
 # output  settings

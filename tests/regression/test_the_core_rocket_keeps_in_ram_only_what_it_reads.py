@@ -1,7 +1,9 @@
 """The rocket as the 8 KB target measured it (issue 17: 640 B of RAM with
 the stack; 791 + 83 B) kept bytes of RAM that nothing read, or that it
 could work out from others: each task's last fault code (6 B: written at a
-fault, read by nothing, sent by nothing), each task's countdown to its next
+fault, read by nothing, sent by nothing), why each late cycle was late
+(4 B: counted apart from `late`, which health frames send, and read by
+nothing either), each task's countdown to its next
 run (12 B: every task of the rocket runs every cycle, and then the
 executor never reads it), each machine's T (16 B: always G at its last step
 less G at its state's entry, both kept), and the link's copy of where its
@@ -46,5 +48,7 @@ def test_the_core_rocket_keeps_no_byte_it_does_not_read(core):
     assert not any("countdowns" in name for name in sizes), sizes
     # the state, its flags and the two times (no T)
     assert sizes["fsw_gen::nav::machine"] == sizes["fsw_gen::mission::machine"] == 23, sizes
+    # the executor's record without its two counters of why cycles were late
+    assert sizes["fsw_gen::ex"] == 20 - 4, sizes
     # the link's record without its transmit buffer's address, size and room for a control frame
     assert sizes["fsw_gen::link"] == 76 - 6, sizes

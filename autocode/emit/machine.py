@@ -108,7 +108,7 @@ SHARED_EXTREMES_MAX_N = 16
 def shared_extremes(m: M.Machine, ex: ExprEmitter) -> dict[int, tuple[int, str]]:
     """The windows kept in one ring with others (fsw::RollMinMaxN): for
     each, (the index of the window that holds the ring, which is the first
-    of them, and its read: `min()`, `max()` or `range()`). The windows of
+    of them, and its read: `least()`, `greatest()` or `range()`). The windows of
     roll_min, roll_max and roll_range of one argument (of no window of its
     own) and one N of at most SHARED_EXTREMES_MAX_N, two of them or more,
     or a roll_range alone (two extremes of its own): the same values bit
@@ -122,7 +122,7 @@ def shared_extremes(m: M.Machine, ex: ExprEmitter) -> dict[int, tuple[int, str]]
     for ws in groups.values():
         if len(ws) >= 2 or ws[0].func == "range":
             for w in ws:
-                out[w.index] = (ws[0].index, f"{w.func}()")
+                out[w.index] = (ws[0].index, {"min": "least()", "max": "greatest()", "range": "range()"}[w.func])
     return out
 
 

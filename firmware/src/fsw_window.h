@@ -278,9 +278,10 @@ struct RollMinMaxN {
     RollRingS<I> s;
     Real ring[N];
     void push(Real x) { roll_ring_push<I>(s, ring, static_cast<I>(N), x); }
-    Real min() const { return roll_ring_extreme<I>(s, ring, false); }
-    Real max() const { return roll_ring_extreme<I>(s, ring, true); }
-    Real range() const { return max() - min(); }
+    // (Not min() and max(): Arduino.h defines those names as macros.)
+    Real least() const { return roll_ring_extreme<I>(s, ring, false); }
+    Real greatest() const { return roll_ring_extreme<I>(s, ring, true); }
+    Real range() const { return greatest() - least(); }
 };
 
 template <uint32_t N>

@@ -338,8 +338,8 @@ static void ring_matches_the_deques(void) {
     memset(&mn, 0, sizeof mn);
     memset(&mx, 0, sizeof mx);
     memset(&rg, 0, sizeof rg);
-    ASSERT_REAL_SAME(Real(0), ring.min());
-    ASSERT_REAL_SAME(Real(0), ring.max());
+    ASSERT_REAL_SAME(Real(0), ring.least());
+    ASSERT_REAL_SAME(Real(0), ring.greatest());
     ASSERT_REAL_SAME(Real(0), ring.range());
     const Real inf = static_cast<Real>(__builtin_inf());
     for (uint16_t k = 0; k < 3u * N + 300u; ++k) {
@@ -357,8 +357,8 @@ static void ring_matches_the_deques(void) {
         mn.push(x);
         mx.push(x);
         rg.push(x);
-        ASSERT_REAL_SAME(mn.value(), ring.min());
-        ASSERT_REAL_SAME(mx.value(), ring.max());
+        ASSERT_REAL_SAME(mn.value(), ring.least());
+        ASSERT_REAL_SAME(mx.value(), ring.greatest());
         ASSERT_REAL_SAME(rg.value(), ring.range());
     }
 }

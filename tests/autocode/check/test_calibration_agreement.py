@@ -66,9 +66,9 @@ def test_generated_tables_carry_the_hosts_gain(fsw, tmp_path):
     r = fsw("gen", str(EXAMPLES / "rocket"), "--out", str(tmp_path))
     assert r.code == 0, r.err
     text = (tmp_path / "app.gen.cpp").read_text()
-    # the rows of the loop that converts them (fsw::io_analog_inputs): gain, offset, element
+    # the rows of the loop that converts them (fsw::io_analog_inputs_kept): gain, offset, element
     rows = re.findall(r"^    \{([-0-9.e]+)f, \(?([-0-9.e]+)f\)?, E_(\w+)\},", text, re.M)
-    assert "fsw::io_analog_inputs(kAnalogInRows, 4, kAnalogInMemo, kAnalogInRaw, sv);" in text
+    assert "fsw::io_analog_inputs_kept(kAnalogInRows, 4, kAnalogInKey, kAnalogInRaw, sv);" in text
     assert [(e, f32(float(g)), float(o)) for g, o, e in rows] == [
         ("pressure", analog_gain(6250.0, 5.0, 10, F32MODE), 76875.0),
         ("accel", analog_gain(8.0, 5.0, 10, F32MODE), -20.0),

@@ -942,7 +942,7 @@ int fswsm_time_in_state(const fswsm* h, uint64_t* t) {
     if (h == 0) return FSWSM_E_ARG;
     if (t == 0) return refuse(h, FSWSM_E_ARG);
     if (h->image == 0) return refuse(h, FSWSM_E_NO_IMAGE);
-    *t = h->m.t;
+    *t = machine_T(h->m);
     return FSWSM_OK;
 }
 

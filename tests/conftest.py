@@ -68,8 +68,10 @@ def project_config(project_dir, tmp_path) -> dict[str, dict]:
 
 def pytest_configure(config):
     config.addinivalue_line(
-        "markers", "costly(seconds): a test file's measured cost (wall seconds on one core, its set-up "
-        "included): such files are handed to workers first, the costliest first")
+        "markers", "costly(seconds, waits=False): a test file's measured cost (wall seconds on one core, its "
+        "set-up included; waits=True: most of it spent waiting on the wall clock, a board paced to it or a "
+        "browser, not on the CPU): such files are handed to workers first, the costliest first, those that "
+        "wait between those that compute")
 
 
 def pytest_collection_modifyitems(config, items):
@@ -77,10 +79,31 @@ def pytest_collection_modifyitems(config, items):
     pytest-xdist hands whole files (--dist loadfile) to the worker that asks
     next in this order (make test passes --no-loadscope-reorder: xdist would
     otherwise put the files with the most tests first): a long file started
-    last would keep one core busy after the others are done."""
+    last would keep one core busy after the others are done. Costly files
+    that mostly wait (`waits=True`) go out between those that compute, one
+    of each in turn: the first four workers got three that wait and one
+    that computes, and one core stood idle for the run's first 40 s."""
+    def mark_of(item):
+        return item.get_closest_marker("costly")
+
     def cost(item) -> float:
-        mark = item.get_closest_marker("costly")
+        mark = mark_of(item)
         return float(mark.args[0]) if mark and mark.args else 0.0
+
+    def waits(item) -> bool:
+        mark = mark_of(item)
+        return bool(mark and mark.kwargs.get("waits", False))
 
     order = {id(item): i for i, item in enumerate(items)}
     items.sort(key=lambda item: (-cost(item), item.path.as_posix() if cost(item) else "", order[id(item)]))
+    costly = [item for item in items if cost(item)]
+    rest = items[len(costly):]
+    files: dict = {}  # path -> the file's items, the costliest file first
+    for item in costly:
+        files.setdefault(item.path, []).append(item)
+    computing = [f for f in files.values() if not waits(f[0])]
+    waiting = [f for f in files.values() if waits(f[0])]
+    turns: list = []
+    for i in range(max(len(computing), len(waiting))):
+        turns += computing[i:i + 1] + waiting[i:i + 1]
+    items[:] = [item for f in turns for item in f] + rest

@@ -17,10 +17,10 @@ TESTS = Path(__file__).resolve().parent
 
 
 class Item:
-    def __init__(self, path: str, name: str, cost: float | None):
+    def __init__(self, path: str, name: str, cost: float | None, waits: bool = False):
         self.path = Path(path)
         self.name = name
-        self._mark = None if cost is None else SimpleNamespace(args=(cost,))
+        self._mark = None if cost is None else SimpleNamespace(args=(cost,), kwargs={"waits": True} if waits else {})
 
     def get_closest_marker(self, name: str):
         return self._mark if name == "costly" else None
@@ -33,6 +33,14 @@ def test_costly_files_first_costliest_first_the_rest_in_order():
     assert [i.name for i in items] == ["c1", "c2", "b1", "b2", "e1", "a1", "a2", "d1"]
 
 
+def test_costly_files_that_wait_go_out_between_those_that_compute():
+    items = [Item("w1.py", "w1a", 29, waits=True), Item("c1.py", "c1", 17), Item("w2.py", "w2", 17, waits=True),
+             Item("w3.py", "w3", 14, waits=True), Item("w1.py", "w1b", 29, waits=True), Item("c2.py", "c2", 12),
+             Item("r.py", "r", None), Item("c3.py", "c3", 11)]
+    conftest.pytest_collection_modifyitems(None, items)
+    assert [i.name for i in items] == ["c1", "w1a", "w1b", "c2", "w2", "c3", "w3", "r"]
+
+
 def test_every_costly_mark_of_the_suite_gives_its_seconds():
     marked = 0
     for path in TESTS.rglob("test_*.py"):
@@ -42,6 +50,9 @@ def test_every_costly_mark_of_the_suite_gives_its_seconds():
                 marked += 1
                 assert len(node.args) == 1 and isinstance(node.args[0], ast.Constant), f"{path}:{node.lineno}"
                 assert isinstance(node.args[0].value, (int, float)) and node.args[0].value > 0, f"{path}:{node.lineno}"
+                for kw in node.keywords:
+                    assert kw.arg == "waits" and isinstance(kw.value, ast.Constant) and kw.value.value is True, \
+                        f"{path}:{node.lineno}"
     assert marked >= 10
 
 

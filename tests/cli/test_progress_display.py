@@ -22,7 +22,7 @@ import pytest
 
 from conftest import ROOT
 
-pytestmark = pytest.mark.costly(9)
+pytestmark = pytest.mark.costly(9, waits=True)
 
 ERASE_LINE = b"\x1b[2K"
 

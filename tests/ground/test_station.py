@@ -24,7 +24,7 @@ import pytest
 
 from support.linkfw import TANK, build_native, needs_cxx, tank_layout
 
-pytestmark = [needs_cxx(), pytest.mark.costly(29)]
+pytestmark = [needs_cxx(), pytest.mark.costly(29, waits=True)]
 FSW = os.path.join(os.path.dirname(sys.executable), "fsw")
 
 

@@ -21,7 +21,7 @@ from fswkit.link.port import open_port
 from fswkit.link.session import Session
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
-pytestmark = [needs_cxx(), pytest.mark.costly(11)]
+pytestmark = [needs_cxx(), pytest.mark.costly(11, waits=True)]
 RAW = 770  # 770 counts -> 815.4 psi: between 775 and 825, the vent valve opens
 
 

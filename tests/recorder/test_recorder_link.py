@@ -19,7 +19,7 @@ from conftest import run_fsw
 from support.linkfw import PtyTarget, needs_cxx
 from support.simfw import kept_native
 
-pytestmark = [needs_cxx(), pytest.mark.costly(17)]
+pytestmark = [needs_cxx(), pytest.mark.costly(17, waits=True)]
 RIG = Path(__file__).resolve().parent / "logged"
 
 

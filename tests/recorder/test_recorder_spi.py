@@ -26,7 +26,7 @@ from fswkit.testing.recorder_cuts import CutReport, _check_samples, power_cuts_n
 from support.linkfw import PtyTarget
 from support.simfw import OUT, kept_native, kept_sim
 
-pytestmark = pytest.mark.costly(9)
+pytestmark = pytest.mark.costly(9, waits=True)
 
 RIG = Path(__file__).resolve().parent / "spi"
 LOGGED = Path(__file__).resolve().parent / "logged"

@@ -21,7 +21,7 @@ from support.tools import rocket_with_reload
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
-              pytest.mark.costly(12)]
+              pytest.mark.costly(3)]
 
 
 def test_an_upload_over_a_lossy_9600_baud_link_activates_and_no_machine_is_safed(tmp_path):

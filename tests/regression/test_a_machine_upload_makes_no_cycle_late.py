@@ -23,7 +23,7 @@ from support.tools import rocket_with_reload
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                  reason="gcc-avr and libsimavr-dev are needed (make setup)"),
-              pytest.mark.costly(10)]
+              pytest.mark.costly(10, waits=True)]
 
 CYCLE_US = 10_000  # both applications run at 100 Hz
 # The longest step the uplink task may take through it (a command's work

@@ -20,7 +20,7 @@ from support.linkstream import TANK, PtyStream, layout_of
 from fswkit.ground.archive import Archive, ArchiveReader, sessions
 from fswkit.ground.station import Station
 
-pytestmark = pytest.mark.costly(13)  # SQLite waits 5 s for a lock, in each test
+pytestmark = pytest.mark.costly(13, waits=True)  # SQLite waits 5 s for a lock, in each test
 
 
 @pytest.fixture

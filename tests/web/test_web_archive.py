@@ -26,7 +26,7 @@ from conftest import run_fsw
 from support.browser import browser, needs_chromium, press, served, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
-pytestmark = pytest.mark.costly(10)
+pytestmark = pytest.mark.costly(10, waits=True)
 
 RAW = 770  # 815.86 psi
 

@@ -18,7 +18,7 @@ from conftest import run_fsw
 from support.browser import browser, free_port, needs_chromium, press, wait_for  # noqa: F401 - browser: a fixture
 from support.linkfw import TANK, PtyTarget, build_native, needs_cxx, tank_layout, volts_psi
 
-pytestmark = [pytest.mark.costly(14), needs_cxx(), needs_chromium]
+pytestmark = [pytest.mark.costly(14, waits=True), needs_cxx(), needs_chromium]
 RAW = 770  # 815.86 psi: the vent valve opens
 
 

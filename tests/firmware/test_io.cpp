@@ -72,31 +72,35 @@ static void test_the_memo_gives_analog_values_bit_for_bit(void) {
     ASSERT_REAL_SAME(Real(203), analog_value_memo(m, 101, Real(2), Real(1)));  // another count: converted
 }
 
+// Three inputs' rows (gain, offset, element offset; the second's offset +0)
+// and the counts of seven runs, for the two inputs loops below.
+static const AnalogInput kRows[3] FSW_FLASH = {
+    {Real(30.54741), Real(76875), 2}, {Real(-0.5), Real(0), 10}, {Real(5) / Real(1023), Real(-20), 6}};
+static const uint16_t kCounts[][3] = {{0, 0, 0}, {0, 0, 0}, {1, 0, 1023}, {1023, 7, 1023}, {0xFFFF, 0xFFFF, 1},
+                                      {0xFFFF, 0xFFFF, 1}, {512, 0, 511}};
+static const uint8_t kRuns = sizeof kCounts / sizeof kCounts[0];
+
 // A generated inputs task with two analog inputs or more converts them in
 // one loop over a flash table (io_analog_inputs): each element takes the
 // value a call of its own with its constants inline gives, bit for bit
 // (the +0 offset's -0 included), run after run, through the same memo.
 static void test_the_inputs_loop_gives_what_each_call_gives(void) {
-    static const AnalogInput rows[3] FSW_FLASH = {
-        {Real(30.54741), Real(76875), 2}, {Real(-0.5), Real(0), 10}, {Real(5) / Real(1023), Real(-20), 6}};
     static AnalogMemo memo[3], each[3];
     static volatile uint16_t raw[3];
-    static const uint16_t counts[][3] = {{0, 0, 0}, {0, 0, 0}, {1, 0, 1023}, {1023, 7, 1023}, {0xFFFF, 0xFFFF, 1},
-                                         {0xFFFF, 0xFFFF, 1}, {512, 0, 511}};
     uint8_t sv[16], want[16];
     memset(sv, 0xA5, sizeof sv);
     memset(want, 0xA5, sizeof want);
-    for (uint8_t r = 0; r < sizeof counts / sizeof counts[0]; ++r) {
-        for (uint8_t i = 0; i < 3; ++i) raw[i] = counts[r][i];
-        io_analog_inputs(rows, 3, memo, raw, sv);
-        write_F32(want + 2, analog_value_memo(each[0], counts[r][0], Real(30.54741), Real(76875)));
-        write_F32(want + 10, analog_value_memo(each[1], counts[r][1], Real(-0.5), 0));
-        write_F32(want + 6, analog_value_memo(each[2], counts[r][2], Real(5) / Real(1023), Real(-20)));
+    for (uint8_t r = 0; r < kRuns; ++r) {
+        for (uint8_t i = 0; i < 3; ++i) raw[i] = kCounts[r][i];
+        io_analog_inputs(kRows, 3, memo, raw, sv);
+        write_F32(want + 2, analog_value_memo(each[0], kCounts[r][0], Real(30.54741), Real(76875)));
+        write_F32(want + 10, analog_value_memo(each[1], kCounts[r][1], Real(-0.5), 0));
+        write_F32(want + 6, analog_value_memo(each[2], kCounts[r][2], Real(5) / Real(1023), Real(-20)));
         TEST_ASSERT_EQUAL_MEMORY(want, sv, sizeof sv);
     }
     // a count that did not change is the value kept, not converted again
     memo[1].value = Real(12345);
-    io_analog_inputs(rows, 3, memo, raw, sv);
+    io_analog_inputs(kRows, 3, memo, raw, sv);
     TEST_ASSERT_EQUAL_MEMORY(want + 2, sv + 2, 4);
     TEST_ASSERT_TRUE(read_F32(sv + 10) == Real(12345));
 }
@@ -107,29 +111,25 @@ static void test_the_inputs_loop_gives_what_each_call_gives(void) {
 // whose count did not change is neither converted nor written (the count
 // 0xFFFF, key 0, is new at every run).
 static void test_the_kept_inputs_loop_writes_what_the_memo_gives(void) {
-    static const AnalogInput rows[3] FSW_FLASH = {
-        {Real(30.54741), Real(76875), 2}, {Real(-0.5), Real(0), 10}, {Real(5) / Real(1023), Real(-20), 6}};
     static AnalogMemo memo[3];
     static uint16_t keys[3];  // zero, as a generated task's before its first run
     static volatile uint16_t raw[3];
-    static const uint16_t counts[][3] = {{0, 0, 0}, {0, 0, 0}, {1, 0, 1023}, {1023, 7, 1023}, {0xFFFF, 0xFFFF, 1},
-                                         {0xFFFF, 0xFFFF, 1}, {512, 0, 511}};
     uint8_t sv[16], want[16];
     memset(sv, 0xA5, sizeof sv);
     memset(want, 0xA5, sizeof want);
-    for (uint8_t r = 0; r < sizeof counts / sizeof counts[0]; ++r) {
-        for (uint8_t i = 0; i < 3; ++i) raw[i] = counts[r][i];
-        io_analog_inputs_kept(rows, 3, keys, raw, sv);
-        io_analog_inputs(rows, 3, memo, raw, want);
+    for (uint8_t r = 0; r < kRuns; ++r) {
+        for (uint8_t i = 0; i < 3; ++i) raw[i] = kCounts[r][i];
+        io_analog_inputs_kept(kRows, 3, keys, raw, sv);
+        io_analog_inputs(kRows, 3, memo, raw, want);
         TEST_ASSERT_EQUAL_MEMORY(want, sv, sizeof sv);
     }
     // the same counts again: nothing written (a byte planted in an element stays) ...
     write_F32(sv + 6, Real(12345));
-    io_analog_inputs_kept(rows, 3, keys, raw, sv);
+    io_analog_inputs_kept(kRows, 3, keys, raw, sv);
     TEST_ASSERT_TRUE(read_F32(sv + 6) == Real(12345));
     // ... but a new count is converted and written
     raw[2] = 510;
-    io_analog_inputs_kept(rows, 3, keys, raw, sv);
+    io_analog_inputs_kept(kRows, 3, keys, raw, sv);
     write_F32(want + 6, analog_value(510, Real(5) / Real(1023), Real(-20)));
     TEST_ASSERT_EQUAL_MEMORY(want + 6, sv + 6, 4);
     // the count 0xFFFF is new at every run

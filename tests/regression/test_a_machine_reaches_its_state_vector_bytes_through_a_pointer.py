@@ -73,31 +73,8 @@ def test_the_rockets_mission_takes_its_state_vector_through_a_pointer(tmp_path):
     assert "by_pointer" not in nav and "uint8_t s1_step() {" in nav
 
 
-def test_the_pointer_form_compiles_without_warnings(tmp_path):
-    (tmp_path / "m.sm").write_text(SM)
-    (tmp_path / "m.sv").write_text(SV)
-    diags = Diagnostics()
-    m = load_machine(str(tmp_path / "m.sm"), diags, str(tmp_path / "m.sv"))
-    assert m is not None, diags.render()
-    files = dict(emit_sv(m.sv))
-    files.update(emit_machine(m, F32MODE, leave=True))
-    for name, text in files.items():
-        (tmp_path / name).write_text(text)
-    code = files["m.gen.cpp"]
-    assert "uint8_t* const svp = fsw::by_pointer(sv);" in code and "uint8_t* const locp = fsw::by_pointer(loc);" in code
-    assert re.search(r"^uint8_t s2_entry\(uint8_t\* const svp, uint8_t\* const\) \{$", code, re.M)  # x = 0: svp
-    assert re.search(r"^void s2_exit\(uint8_t\* const svp, uint8_t\* const\) \{$", code, re.M)
-    assert "case S_One: s1_exit(sv, loc); break;" in code  # leave(): the areas themselves
-    r = subprocess.run(["g++", "-std=gnu++11", "-fsyntax-only", "-Wall", "-Wextra", "-Wshadow", "-Werror",
-                        "-DFSW_REAL_IS_FLOAT=1", "-DFSW_F64_SOFT=1", f"-I{ROOT / 'firmware' / 'src'}",
-                        f"-I{tmp_path}", str(tmp_path / "m.gen.cpp")], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
-
-
-def test_a_machine_whose_step_calls_no_state_function_takes_no_pointer(tmp_path):
-    # its one state has only an .exit, which step() never runs (leave() does): a pointer taken
-    # in step() would be an unused variable, which -Werror builds refuse
-    sm = SM[:SM.index("[One]")] + "[One]\n.exit\n    a = true\n    b = false\n    k = k + n\n    k = k + 2\n"
+def _emitted(tmp_path, sm: str) -> dict:
+    """The binary32 C++ of machine `sm` over SV, written into tmp_path: file name -> text."""
     (tmp_path / "m.sm").write_text(sm)
     (tmp_path / "m.sv").write_text(SV)
     diags = Diagnostics()
@@ -107,8 +84,28 @@ def test_a_machine_whose_step_calls_no_state_function_takes_no_pointer(tmp_path)
     files.update(emit_machine(m, F32MODE, leave=True))
     for name, text in files.items():
         (tmp_path / name).write_text(text)
-    assert "by_pointer" not in files["m.gen.cpp"]
+    return files
+
+
+def _compiles_without_warnings(tmp_path) -> None:
     r = subprocess.run(["g++", "-std=gnu++11", "-fsyntax-only", "-Wall", "-Wextra", "-Wshadow", "-Werror",
                         "-DFSW_REAL_IS_FLOAT=1", "-DFSW_F64_SOFT=1", f"-I{ROOT / 'firmware' / 'src'}",
                         f"-I{tmp_path}", str(tmp_path / "m.gen.cpp")], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_the_pointer_form_compiles_without_warnings(tmp_path):
+    code = _emitted(tmp_path, SM)["m.gen.cpp"]
+    assert "uint8_t* const svp = fsw::by_pointer(sv);" in code and "uint8_t* const locp = fsw::by_pointer(loc);" in code
+    assert re.search(r"^uint8_t s2_entry\(uint8_t\* const svp, uint8_t\* const\) \{$", code, re.M)  # x = 0: svp
+    assert re.search(r"^void s2_exit\(uint8_t\* const svp, uint8_t\* const\) \{$", code, re.M)
+    assert "case S_One: s1_exit(sv, loc); break;" in code  # leave(): the areas themselves
+    _compiles_without_warnings(tmp_path)
+
+
+def test_a_machine_whose_step_calls_no_state_function_takes_no_pointer(tmp_path):
+    # its one state has only an .exit, which step() never runs (leave() does): a pointer taken
+    # in step() would be an unused variable, which -Werror builds refuse
+    sm = SM[:SM.index("[One]")] + "[One]\n.exit\n    a = true\n    b = false\n    k = k + n\n    k = k + 2\n"
+    assert "by_pointer" not in _emitted(tmp_path, sm)["m.gen.cpp"]
+    _compiles_without_warnings(tmp_path)

@@ -15,6 +15,7 @@ import struct
 from dataclasses import dataclass
 
 from .evaluate import local_values
+from .numtext import decimal, integer
 from .numeric import REALS
 from .protocol import crc16
 from .types import ElemType
@@ -130,16 +131,15 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
             if low in ("false", "0"):
                 return False, None
             return None, f"`{p.name}` is bool: give true or false, not `{value}`"
-        try:
-            value = int(text, 0) if t.is_int else float(text)
-        except ValueError:
-            try:  # `1e3` or `3000.0` for a whole number, as a parameter file's TOML takes them
-                value = float(text) if t.is_int else None
-            except ValueError:
-                value = None
-            if value is None:
-                kind = "a whole number" if t.is_int else "a number"
-                return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}{_unit_hint(p, text)}"
+        # plain ASCII (numtext): int() and float() would take `1_000`, other scripts' digits, `nan`
+        value = integer(text, hex_ok=True) if t.is_int else None
+        if value is None:  # `1e3` or `3000.0` for a whole number, as a parameter file's TOML takes them
+            value = decimal(text)
+        if value is None and low.lstrip("+-") in ("nan", "inf", "infinity"):
+            value = float(low)  # said below as what it is: not finite, not held
+        if value is None:
+            kind = "a whole number" if t.is_int else "a number"
+            return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}{_unit_hint(p, text)}"
     if t.is_bool:
         if isinstance(value, bool):
             return value, None

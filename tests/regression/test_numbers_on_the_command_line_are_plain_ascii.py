@@ -67,10 +67,40 @@ def test_a_fault_time_is_ascii(tmp_path, fault):
 
 
 def test_plain_numbers_still_work():
-    from fswkit.numtext import decimal, integer
+    from fswkit.autocode.numtext import decimal, integer
 
     assert [decimal(t) for t in ("10", "-1.5", "+2.", ".5", "1e3", "2.5E-2")] == [10.0, -1.5, 2.0, 0.5, 1000.0, 0.025]
     assert [integer(t) for t in ("0", "42", "-7", "+3")] == [0, 42, -7, 3]
     assert integer("0x76", hex_ok=True) == 0x76 and integer("0x76") is None
     assert all(decimal(t) is None for t in NOT_NUMBERS)
     assert all(integer(t) is None for t in NOT_NUMBERS + ["1.0", "1e3"])
+
+
+@pytest.mark.parametrize("setting, words", [("HOLD_MS=1_000", "`HOLD_MS` is U16: `1_000` is not a whole number"),
+                                            ("HOLD_MS=٧٠٠", "`HOLD_MS` is U16: `٧٠٠` is not a whole number"),
+                                            ("OPEN_AT=６５０", "`OPEN_AT` is F32: `６５０` is not a number"),
+                                            ("OPEN_AT=6_50.5", "`OPEN_AT` is F32: `6_50.5` is not a number"),
+                                            ("OPEN_AT=nan", "NaN is not a value a parameter may take")])
+def test_a_parameters_value_is_ascii(tmp_path, setting, words):
+    """`fsw param set` (and `fsw test --param`, the page: autocode.params.check_value) read a value
+    with int(text, 0) and float(): `HOLD_MS=1_000` set 1000, `٧٠٠` 700."""
+    from support.param_page import RIG
+
+    r = run_fsw("param", str(RIG), "set", setting, "--port", str(tmp_path / "none"))
+    assert r.code == 2 and words in r.err and "Traceback" not in r.err, r.err
+
+
+def test_a_parameters_value_in_hex_or_with_an_exponent_still_works():
+    from fswkit.autocode.params import AppParam, check_value
+    from fswkit.autocode.types import TYPES
+
+    def param(type_name: str) -> AppParam:
+        return AppParam(id=0, name="N", machine="m", type=TYPES[type_name], default=0, min=0, max=5000, unit="",
+                        when=(), when_ids=(), off=0, state_element="S", var=0, line=1, path="m.sm")
+
+    assert check_value(param("U16"), "0x10") == (16, None)
+    assert check_value(param("U16"), " 1e3 ") == (1000, None)
+    assert check_value(param("U16"), "3000.0") == (3000, None)
+    assert check_value(param("F32"), "2.5") == (2.5, None)
+    assert check_value(param("F32"), "-0") == (0.0, None)
+    assert check_value(param("U16"), "0b101")[1] is not None

@@ -14,7 +14,7 @@ import sys
 
 from fswkit import __version__
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
-from fswkit.numtext import decimal, integer
+from fswkit.autocode.numtext import decimal, integer
 
 
 def _command(module: str, name: str):
@@ -31,7 +31,7 @@ def _command(module: str, name: str):
 # ---- argument types -------------------------------------------------------------------
 
 def _number(text: str, what: str = "a number") -> float:
-    """A number as written in plain ASCII (fswkit.numtext): not `1_000`, digits of another script,
+    """A number as written in plain ASCII (fswkit.autocode.numtext): not `1_000`, digits of another script,
     `nan` or `infinity`."""
     value = decimal(text)
     if value is None:

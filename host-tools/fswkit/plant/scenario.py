@@ -20,7 +20,7 @@ import numpy as np
 from fswkit.autocode import model as M
 from fswkit.autocode.evaluate import NotConstant, local_values
 from fswkit.autocode.numeric import REALS
-from fswkit.numtext import decimal
+from fswkit.autocode.numtext import decimal
 
 from fswkit.sim.sensors import ACCELEROMETERS, AXES, BAROMETERS, find_part
 

@@ -8,7 +8,7 @@ import sys
 
 from fswkit.autocode.board import Board
 from fswkit.autocode.diagnostics import read_head
-from fswkit.numtext import decimal, integer
+from fswkit.autocode.numtext import decimal, integer
 from fswkit.sim.board import SimError, sim_board
 
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 from fswkit.autocode.iotables import analog_gain, analog_value
 from fswkit.autocode.numeric import REALS
-from fswkit.numtext import integer
+from fswkit.autocode.numtext import integer
 
 
 @dataclass(frozen=True)
@@ -158,7 +158,7 @@ def find_part(sensors, text: str, kinds: tuple[str, ...]):
     else:
         pin = addr = integer(rest if colon and bus == "i2c" else where, hex_ok=True)
         hit = [s for s in same if s.bus == "i2c" and s.address == addr]
-    if pin is None:  # plain ASCII digits, an address also 0x and hex digits (fswkit.numtext)
+    if pin is None:  # plain ASCII digits, an address also 0x and hex digits (fswkit.autocode.numtext)
         return None, (f"\"{text}\": expected KIND@ADDRESS (\"{kind}@0x76\") or KIND@spi:PIN "
                       f"(\"{kind}@spi:7\")")
     if not hit:

@@ -15,8 +15,8 @@ import struct
 from dataclasses import dataclass
 
 from .evaluate import local_values
-from .numtext import decimal, integer
 from .numeric import REALS
+from .numtext import decimal, integer
 from .protocol import crc16
 from .types import ElemType
 

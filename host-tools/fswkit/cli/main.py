@@ -13,8 +13,8 @@ import re
 import sys
 
 from fswkit import __version__
-from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
 from fswkit.autocode.numtext import decimal, integer
+from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
 
 
 def _command(module: str, name: str):

@@ -8,6 +8,7 @@ a flight is what the user meant to type, and anything else is refused.
     decimal("2.5e-3")          # 0.0025; None for anything but [+-]digits[.digits][e[+-]digits]
     integer("42")              # 42; None for anything but [+-]digits
     integer("0x76", hex_ok=True)  # 118: a part's address may be written in hex
+    non_finite(" -Inf")        # -inf: what float() would read, said apart as not finite
 """
 
 from __future__ import annotations
@@ -33,3 +34,11 @@ def integer(text: str, hex_ok: bool = False) -> int | None:
     if hex_ok and _HEX.match(text):
         return int(text, 16)
     return None
+
+
+def non_finite(text: str) -> float | None:
+    """The NaN or infinity `text` spells as float() reads it (`nan`, `inf`,
+    `infinity`, signed, any case, spaces around), else None: a caller that
+    refuses it can say it is not finite, not that it is not a number."""
+    word = text.strip().lower()
+    return float(word) if word.lstrip("+-") in ("nan", "inf", "infinity") else None

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from .evaluate import local_values
 from .numeric import REALS
-from .numtext import decimal, integer
+from .numtext import decimal, integer, non_finite
 from .protocol import crc16
 from .types import ElemType
 
@@ -135,8 +135,8 @@ def check_value(p: AppParam, value) -> tuple[object, str | None]:
         value = integer(text, hex_ok=True) if t.is_int else None
         if value is None:  # `1e3` or `3000.0` for a whole number, as a parameter file's TOML takes them
             value = decimal(text)
-        if value is None and low.lstrip("+-") in ("nan", "inf", "infinity"):
-            value = float(low)  # said below as what it is: not finite, not held
+        if value is None:
+            value = non_finite(text)  # said below as what it is: not finite, not held
         if value is None:
             kind = "a whole number" if t.is_int else "a number"
             return None, f"`{p.name}` is {t.name}: `{text}` is not {kind}{_unit_hint(p, text)}"

@@ -83,15 +83,12 @@ def pytest_collection_modifyitems(config, items):
     that mostly wait (`waits=True`) go out between those that compute, one
     of each in turn: the first four workers got three that wait and one
     that computes, and one core stood idle for the run's first 40 s."""
-    def mark_of(item):
-        return item.get_closest_marker("costly")
-
     def cost(item) -> float:
-        mark = mark_of(item)
+        mark = item.get_closest_marker("costly")
         return float(mark.args[0]) if mark and mark.args else 0.0
 
     def waits(item) -> bool:
-        mark = mark_of(item)
+        mark = item.get_closest_marker("costly")
         return bool(mark and mark.kwargs.get("waits", False))
 
     order = {id(item): i for i, item in enumerate(items)}

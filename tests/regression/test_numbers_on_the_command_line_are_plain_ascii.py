@@ -74,6 +74,10 @@ def test_plain_numbers_still_work():
     assert integer("0x76", hex_ok=True) == 0x76 and integer("0x76") is None
     assert all(decimal(t) is None for t in NOT_NUMBERS)
     assert all(integer(t) is None for t in NOT_NUMBERS + ["1.0", "1e3"])
+    from fswkit.autocode.numtext import non_finite
+
+    assert [str(non_finite(t)) for t in ("nan", " -Inf", "+infinity")] == ["nan", "-inf", "inf"]
+    assert all(non_finite(t) is None for t in ("1", "1e999", "nanx", "١٢", ""))
 
 
 @pytest.mark.parametrize("setting, words", [("HOLD_MS=1_000", "`HOLD_MS` is U16: `1_000` is not a whole number"),

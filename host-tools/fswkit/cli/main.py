@@ -13,7 +13,7 @@ import re
 import sys
 
 from fswkit import __version__
-from fswkit.autocode.numtext import decimal, integer
+from fswkit.autocode.numtext import decimal, integer, non_finite
 from fswkit.cli.common import EXIT_CONFIG, EXIT_FAIL, EXIT_INTERNAL, EXIT_OK
 
 
@@ -35,7 +35,7 @@ def _number(text: str, what: str = "a number") -> float:
     `nan` or `infinity`."""
     value = decimal(text)
     if value is None:
-        if text.strip().lstrip("+-").lower() in ("nan", "inf", "infinity"):
+        if non_finite(text) is not None:
             what = f"a finite {what[2:] if what.startswith('a ') else what}"
         raise argparse.ArgumentTypeError(f"expected {what}, found {text!r}")
     return value

@@ -107,20 +107,27 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
 #endif
 
 #if defined(__AVR__)
-namespace {
-// T = last_g - entry_g as its 32-bit halves (little-endian), a byte at a
-// time with the borrow carried up (ldd leaves the flags alone): no 64-bit
-// routine on an 8-bit MCU. The offsets are the Machine's (static_assert
-// above).
+// T = last_g - entry_g, a byte at a time with the borrow carried up (ldd
+// leaves the flags alone): no 64-bit routine on an 8-bit MCU. One copy for
+// machine_T32 and machine_T_real, called from their assembly with the
+// Machine in Z: the low half in r22..r25, the high half in r18..r21, r0
+// changed, Z kept. The offsets are the Machine's (static_assert above).
 #define FSW_T_BYTE(op, r, i) "ldd " r ", Z+" #i "\n\t" "ldd __tmp_reg__, Z+8+" #i "\n\t" op " " r ", __tmp_reg__\n\t"
-inline __attribute__((always_inline)) void T_halves(const Machine& m, uint32_t& lo, uint32_t& hi) {
-    __asm__(FSW_T_BYTE("sub", "%A[lo]", 0) FSW_T_BYTE("sbc", "%B[lo]", 1) FSW_T_BYTE("sbc", "%C[lo]", 2)
-            FSW_T_BYTE("sbc", "%D[lo]", 3) FSW_T_BYTE("sbc", "%A[hi]", 4) FSW_T_BYTE("sbc", "%B[hi]", 5)
-            FSW_T_BYTE("sbc", "%C[hi]", 6) FSW_T_BYTE("sbc", "%D[hi]", 7)
-            : [lo] "=&r"(lo), [hi] "=&r"(hi)
-            : "z"(&m), "m"(m));
+extern "C" __attribute__((naked, noinline, used, externally_visible)) void fsw_machine_T_halves() {
+    __asm__ __volatile__(FSW_T_BYTE("sub", "r22", 0) FSW_T_BYTE("sbc", "r23", 1) FSW_T_BYTE("sbc", "r24", 2)
+                         FSW_T_BYTE("sbc", "r25", 3) FSW_T_BYTE("sbc", "r18", 4) FSW_T_BYTE("sbc", "r19", 5)
+                         FSW_T_BYTE("sbc", "r20", 6) FSW_T_BYTE("sbc", "r21", 7) "ret\n\t");
 }
 #undef FSW_T_BYTE
+
+namespace {
+inline __attribute__((always_inline)) void T_halves(const Machine& m, uint32_t& lo, uint32_t& hi) {
+    register uint32_t l __asm__("r22");
+    register uint32_t h __asm__("r18");
+    __asm__("%~call fsw_machine_T_halves" : "=r"(l), "=r"(h) : "z"(&m), "m"(m) : "r0");
+    lo = l;
+    hi = h;
+}
 }  // namespace
 
 uint32_t machine_T32(const Machine& m) {
@@ -135,20 +142,26 @@ Real machine_T_real(const Machine& m) {
     if (hi == 0) return static_cast<Real>(lo);  // correctly rounded by the float library
     // Shift right until the value fits 32 bits, OR-ing what falls off into
     // bit 0 (below the guard bit: the rounding is unchanged), convert, and
-    // scale by 2^k exactly.
+    // scale by 2^k exactly. (The loop in assembly: the compiler's copied
+    // the 64-bit value between register sets at each turn.)
     uint8_t k = 0, sticky = 0;
-    do {
-        sticky = static_cast<uint8_t>(sticky | (lo & 1u));
-        lo = (lo >> 1) | (hi << 31);
-        hi >>= 1;
-        ++k;
-    } while (hi != 0);
+    __asm__("1:\n\t"
+            "sbrc %A[lo], 0\n\t"
+            "ori  %[st], 1\n\t"
+            "lsr  %D[hi]\n\tror  %C[hi]\n\tror  %B[hi]\n\tror  %A[hi]\n\t"
+            "ror  %D[lo]\n\tror  %C[lo]\n\tror  %B[lo]\n\tror  %A[lo]\n\t"
+            "inc  %[k]\n\t"
+            "mov  __tmp_reg__, %A[hi]\n\tor   __tmp_reg__, %B[hi]\n\t"
+            "or   __tmp_reg__, %C[hi]\n\tor   __tmp_reg__, %D[hi]\n\t"
+            "brne 1b"
+            : [hi] "+r"(hi), [lo] "+r"(lo), [k] "+r"(k), [st] "+d"(sticky));
     // Times 2^k: k added to the exponent field (bits 23..30; the value is a
     // normal number from 2^31 to 2^64, so the field neither wraps nor spills).
     Real r = static_cast<Real>(lo | sticky);
     uint32_t bits;
     memcpy(&bits, &r, sizeof bits);
-    bits += static_cast<uint32_t>(static_cast<uint16_t>(k << 7)) << 16;  // k << 23, as byte moves
+    const uint16_t e = static_cast<uint16_t>(static_cast<uint16_t>(k) << 7);  // k << 23: the upper half's k << 7
+    __asm__("add %C[b], %A[e]\n\tadc %D[b], %B[e]" : [b] "+r"(bits) : [e] "r"(e));
     memcpy(&r, &bits, sizeof r);
     return r;
 }
@@ -156,15 +169,22 @@ Real machine_T_real(const Machine& m) {
 
 uint32_t round_f32_saturated(uint32_t v, uint32_t hi) {
     if (v >= 0x1000000UL) {
-        // 24 significant bits: drop s low bits, round to nearest, ties to even.
-        uint8_t s = 1;
-        while ((v >> s) >= 0x1000000UL) ++s;
-        const uint32_t unit = 1UL << s, rem = v & (unit - 1u), half = unit >> 1;
-        v -= rem;
-        if (rem > half || (rem == half && (v & unit) != 0)) {
-            v += unit;
-            if (v == 0) return hi;  // rounded up to 2^32, above any hi
+        // 24 significant bits: down to 25, what falls off OR-ed into
+        // `sticky`; the lowest of the 25 is the round bit. Round to
+        // nearest, ties to even, drop it, and shift back. (Few enough
+        // values for the call-clobbered registers: no saves.)
+        uint8_t s = 1, sticky = 0;
+        while (v >= 0x2000000UL) {
+            sticky = static_cast<uint8_t>(sticky | (static_cast<uint8_t>(v) & 1u));
+            v >>= 1;
+            ++s;
         }
+        const bool up = (v & 1u) != 0 && (sticky != 0 || (v & 2u) != 0);
+        v = (v >> 1) + up;
+        do {
+            if ((v & 0x80000000UL) != 0) return hi;  // rounded up to 2^32, above any hi
+            v <<= 1;
+        } while (--s != 0);
     }
     return v > hi ? hi : v;
 }

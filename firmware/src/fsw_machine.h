@@ -116,8 +116,10 @@ inline Real machine_T_real(const Machine& m) { return real_from_U64(machine_T(m)
 // `x = T` for an integer x whose largest value is hi (< 2^32): R(T)
 // converted to x's type, which for T >= 0 is R(T) saturated at hi: T itself
 // where R holds it, else T rounded to R's precision (binary32: 24 bits,
-// ties to even). No float code.
-uint32_t round_f32_saturated(uint32_t v, uint32_t hi);
+// ties to even). No float code. Out of line: inline, its values took the
+// registers of the machine's step around it (the rocket's mission spilled
+// them to a stack frame).
+FSW_NOINLINE uint32_t round_f32_saturated(uint32_t v, uint32_t hi);
 inline uint32_t machine_T_int(const Machine& m, uint32_t hi) {
     const uint32_t v = machine_T32(m);
 #if FSW_REAL_IS_FLOAT

@@ -25,8 +25,12 @@ struct conditional_t<false, T, F> {
 inline Real window_sample(Real x) {
     uint32_t b;
     memcpy(&b, &x, sizeof b);
-    b &= 0x7FFFFFFFUL;
-    return (b == 0 || b > 0x7F800000UL) ? Real(0) : x;  // +-0 or NaN: +0
+    // +-0 or NaN: +0. The choice is made on the bits and they are the
+    // result: a choice between two floats compiled to byte moves in
+    // reversed order and back on AVR (24 B of flash a window's push).
+    if (static_cast<uint32_t>((b & 0x7FFFFFFFUL) - 1u) >= 0x7F800000UL) b = 0;  // magnitude 0, or above infinity's
+    memcpy(&x, &b, sizeof x);
+    return x;
 }
 #else
 inline Real window_sample(Real x) { return (x != x || x == 0) ? Real(0) : x; }

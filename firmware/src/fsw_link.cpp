@@ -207,16 +207,24 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
         put_bytes(&l.n.last_seq, 2);
-        // what the application has of the stores (fsw_app.h), and of those what the configuration names
+        // what the application has of the stores (fsw_app.h), and of those what the configuration
+        // names; a store's function read only where the store is (a flash load is never dropped,
+        // even when its value is not used: 24 B of the core rocket's flash read three of them)
         ParamStore* const params = app_has(kAppParams) ? flash_get(c.params) : 0;
-        const LinkParamAckFn param_ack = flash_get(c.param_ack);
-        if (params != 0 && param_ack != 0) param_ack(l, *params);
+        if (params != 0) {
+            const LinkParamAckFn param_ack = flash_get(c.param_ack);
+            if (param_ack != 0) param_ack(l, *params);
+        }
         Recorder* const log = app_has(kAppLog) ? flash_get(c.log) : 0;
-        const LinkLogAckFn log_ack = flash_get(c.log_ack);
-        if (log != 0 && log_ack != 0) log_ack(l, *log);
+        if (log != 0) {
+            const LinkLogAckFn log_ack = flash_get(c.log_ack);
+            if (log_ack != 0) log_ack(l, *log);
+        }
         ReloadStore* const reload = app_has(kAppReload) ? flash_get(c.reload) : 0;
-        const LinkReloadAckFn reload_ack = flash_get(c.reload_ack);
-        if (reload != 0 && reload_ack != 0) reload_ack(l, *reload);
+        if (reload != 0) {
+            const LinkReloadAckFn reload_ack = flash_get(c.reload_ack);
+            if (reload_ack != 0) reload_ack(l, *reload);
+        }
     } else if (type == kFrameHello) {
         put(kLinkProtocol);
         put_u32(flash_get(c.schema));
@@ -237,8 +245,9 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         const ExecConfig& ec = *ex.cfg;  // FSW_FLASH: the fields it uses, one at a time
         const uint8_t n_tasks = flash_get(ec.n_tasks);
         const TaskStats* const stats = flash_get(ec.stats);
-        const Task* const tasks = flash_get(ec.tasks);
-        const uint8_t* const sv = flash_get(ec.sv);
+        // (the rows and the state vector only for the tasks' mode elements, fsw_app.h)
+        const Task* const tasks = app_has(kAppModeElems) ? flash_get(ec.tasks) : 0;
+        const uint8_t* const sv = app_has(kAppModeElems) ? flash_get(ec.sv) : 0;
         for (uint8_t i = 0; i < n_tasks; ++i) {
             const TaskStats& s = stats[i];
             const ElemOff mode_off =  // the task's mode: its element, or its record

@@ -552,7 +552,8 @@ Result link_uplink_task(void* p) {
     return kOk;
 }
 
-bool link_busy(const Link& l) {
+bool link_busy(const Link& l_) {
+    const Link& l = *by_pointer(&l_);
     return l.cfg != 0 && (l.tx_len != 0 || l.pending != 0 || l.snapshot_at != kNoSnapshot);
 }
 

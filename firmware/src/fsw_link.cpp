@@ -144,6 +144,9 @@ inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
 // `row` is the stream's row in flash (FSW_FLASH), its fields read where used.
 void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
                 bool with_now) {
+#if defined(__AVR__)
+    FSW_SAVES_IN_RUN("r15");  // (fsw_types.h) the registers it saves through the shared routine
+#endif
     const uint16_t size = flash_get(row.size);
     const uint8_t stored = st.count;
     st.count = 0;

@@ -109,7 +109,7 @@ inline void flash_read(void* dst, const void* src, size_t n) {
 // pops each in place, 4 B a register. The routine costs about 30 CPU
 // cycles a call more: only where a function's listing shows such a gap
 // and it does not run every cycle (send_batch: 40 B of flash, 0.8 us a
-// cycle on the demo flight; roll_avg_push would give 20 B for 2.5 us: not
+// cycle on the demo flight; roll_avg_push would give 20 B for 2.8 us: not
 // used). At worst one more register saved. (AVR only.)
 #define FSW_SAVES_IN_RUN(reg) __asm__ __volatile__("" ::: reg)
 

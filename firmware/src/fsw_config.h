@@ -107,13 +107,21 @@
 #  error "fswkit: FSW_SLEEP is implemented for AVR boards only: set FSW_SLEEP=0"
 #endif
 // How long before a cycle is due the sleeping executor wakes: longer than
-// any interrupt handler that may be running then (a UART or ADC handler
-// takes a few microseconds), so the cycle still starts on the timer's count.
+// the interrupt handlers that may run back to back then, before the CPU
+// turns interrupts off to wait out the rest (the one running when the
+// timer's compare came, then each other one pending), so the cycle still
+// starts on the timer's count. The rest is awake time spent spinning, every
+// cycle. 0, the default: 16 us, or 24 us where the application has sensor
+// parts (fsw_app.h kAppSensors: the TWI handler). The kit's handlers but
+// the TWI's take at most about 15 us back to back on a 16 MHz AVR (ADC 71
+// cycles with the vector's jump, UART receive 46, UART transmit 39, EEPROM
+// ready about 30, the timer's compare 19, and about 25 of the loop before
+// it turns interrupts off).
 #ifndef FSW_WAKE_EARLY_US
-#  define FSW_WAKE_EARLY_US 24
+#  define FSW_WAKE_EARLY_US 0
 #endif
-#if FSW_WAKE_EARLY_US < 4 || FSW_WAKE_EARLY_US > 1000
-#  error "fswkit: FSW_WAKE_EARLY_US must be 4..1000"
+#if FSW_WAKE_EARLY_US != 0 && (FSW_WAKE_EARLY_US < 4 || FSW_WAKE_EARLY_US > 1000)
+#  error "fswkit: FSW_WAKE_EARLY_US must be 0 (the kit's choice) or 4..1000"
 #endif
 // How long before a cycle the sleeping executor stops starting background
 // work (loop()'s service of the link and of the EEPROM writers, docs/runtime.md):

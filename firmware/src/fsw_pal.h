@@ -158,6 +158,10 @@ struct CycleSettings {
     uint8_t last;       // n - 1
     uint8_t spin;       // period too short to sleep in: spin from mid-period
 };
+// How long before a cycle's start the CPU wakes (fsw_config.h FSW_WAKE_EARLY_US).
+inline __attribute__((always_inline)) uint16_t wake_early_us() {
+    return FSW_WAKE_EARLY_US != 0 ? FSW_WAKE_EARLY_US : app_has(kAppSensors) ? 24u : 16u;
+}
 // For the periods cycle_timer_begin takes (1..1000000 us, a divisor of
 // 1000000: at most five halvings), without a loop (the halvings as a
 // choice): folded whole for a constant.
@@ -170,7 +174,7 @@ inline __attribute__((always_inline)) CycleSettings cycle_settings(uint32_t peri
     c.sub_ms = static_cast<uint16_t>(c.sub_us / 1000u);
     c.sub_frac = static_cast<uint16_t>(c.sub_us % 1000u);
     c.top = static_cast<uint16_t>(c.sub_us * FSW_T1_TICKS_PER_US - 1u);
-    const uint16_t early_ticks = FSW_WAKE_EARLY_US * FSW_T1_TICKS_PER_US;
+    const uint16_t early_ticks = wake_early_us() * FSW_T1_TICKS_PER_US;
     c.spin = c.top < 4u * early_ticks;
     c.early = c.spin ? static_cast<uint16_t>(c.top / 2u + 1u) : static_cast<uint16_t>(c.top - early_ticks);
     const uint16_t guard_ticks = FSW_BACKGROUND_GUARD_US * FSW_T1_TICKS_PER_US;

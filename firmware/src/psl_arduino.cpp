@@ -150,13 +150,16 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             return why;
         }
         if ((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_early()) {
-            // The last stretch, interrupts off: until the count wraps to 0.
-            while (TCNT1 >= ct_early()) {
-            }
-            TIFR1 = _BV(OCF1A);  // this sub-period's end is counted here
+            // The last stretch, interrupts off: this sub-period's end is
+            // counted first (nothing reads the clock before the count
+            // wraps: interrupts are off), in time the spin would wait out
+            // anyway, then the spin until the count wraps to 0.
             (void)sub_period_ended();
             skipped = 0;
             g_ct.running = 1;
+            while (TCNT1 >= ct_early()) {
+            }
+            TIFR1 = _BV(OCF1A);  // (counted above)
             sei();
             return kCycleOnTime;
         }

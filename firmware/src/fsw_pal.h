@@ -204,7 +204,6 @@ struct CycleTimer {
     volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
     volatile uint8_t why;       // why the first of them was missed (CycleWait)
     volatile uint8_t running;   // a cycle's tasks are running
-    volatile uint8_t woke;      // a compare interrupt ran since cycle_wait() last looked
 };
 extern CycleTimer g_ct;
 

@@ -139,7 +139,6 @@ void cycle_timer_begin(uint32_t period_us) {
 uint8_t cycle_wait(uint8_t& skipped, bool background) {
     for (uint8_t pass = 0;; ++pass) {
         cli();
-        g_ct.woke = 0;  // what follows reads all the compare interrupts change
         if (g_ct.due != 0) {  // a start passed (late), or the first cycle
             skipped = static_cast<uint8_t>(g_ct.due - 1u);
             const uint8_t why = g_ct.why;
@@ -171,22 +170,28 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             return kCycleNotDue;
         }
         // Sleep; sei's next instruction runs before any interrupt, so a
-        // wake-up cannot be lost between the test above and the sleep.
+        // wake-up cannot be lost between the test above and the sleep. The
+        // timer's compare handlers clear the sleep enable bit (SE): a sleep
+        // after one of them ran is no sleep, so none is lost between the
+        // loop's test of SE and its next sleep either.
         SMCR = _BV(SE);  // idle mode (SM2..0 = 0): timers, UART and ADC run on
-        sei();
-        sleep_cpu();
-        // Without background work only the timer's compare interrupts bring
-        // the loop anything (a cycle due, the last stretch): after another
-        // (the UART's transmit, about 18 a cycle on the demo flight; the
-        // ADC's) the CPU sleeps again at once, without the tests above
-        // (and, as above, no wake-up lost between the test and the sleep).
-        if (!background) {
-            for (;;) {
-                cli();
-                if (g_ct.woke != 0) break;
-                sei();
-                sleep_cpu();
-            }
+        if (background) {
+            __asm__ __volatile__("sei\n\tsleep" ::: "memory");
+        } else {
+            // Without background work only the timer's compare interrupts
+            // bring the loop anything (a cycle due, the last stretch): after
+            // another (the UART's transmit, about 18 a cycle on the demo
+            // flight; the ADC's) the CPU sleeps again at once, as long as SE
+            // is set: 5 cycles a wake-up (8 when the loop tested a flag the
+            // compare handlers set, with interrupts off around the test).
+            __asm__ __volatile__(
+                "sei\n\t"
+                "1:  sleep\n\t"
+                "    in   __tmp_reg__, %[smcr]\n\t"
+                "    sbrc __tmp_reg__, %[se]\n\t"
+                "    rjmp 1b\n\t" ::[smcr] "I"(_SFR_IO_ADDR(SMCR)),
+                [se] "I"(SE)
+                : "memory");
         }
         SMCR = 0;
     }
@@ -456,23 +461,23 @@ uint8_t spi_transfer(uint8_t) { return 0xFF; }
 // was missed (the running cycle overran, or something else held the CPU).
 ISR(TIMER1_COMPA_vect) {
     using fsw::pal::g_ct;
-    g_ct.woke = 1;
+    SMCR = 0;  // cycle_wait() sleeps no more (its loop reads SE)
     if (fsw::pal::sub_period_ended()) {
         if (g_ct.due == 0) g_ct.why = g_ct.running ? fsw::pal::kCycleLateOverrun : fsw::pal::kCycleLateOther;
         if (g_ct.due != 0xFFu) ++g_ct.due;
     }
 }
 // The CPU wakes to wait out the last stretch before a cycle (cycle_wait()),
-// told so by `woke`. Naked: r24 is the only register it changes (ldi and
-// sts leave the status register alone), 12 bytes where the compiler's
-// handler saves r0, r1 and SREG around the store.
+// told so by SE cleared: it sleeps no more. Naked: r24 is the only register
+// it changes (ldi and out leave the status register alone), 10 bytes where
+// the compiler's handler saves r0, r1 and SREG around the store.
 ISR(TIMER1_COMPB_vect, ISR_NAKED) {
     __asm__ __volatile__(
         "push r24\n\t"
-        "ldi r24, 1\n\t"
-        "sts %[woke], r24\n\t"
+        "ldi r24, 0\n\t"
+        "out %[smcr], r24\n\t"
         "pop r24\n\t"
-        "reti\n\t" ::[woke] "i"(&fsw::pal::g_ct.woke)
+        "reti\n\t" ::[smcr] "I"(_SFR_IO_ADDR(SMCR))
         : "memory");
 }
 #endif

@@ -1534,6 +1534,9 @@ static uint8_t* eeprom_bytes(void) {
 /* Runs until cycle `target` (when has_target), a limit, the firmware
    stopping, SIGINT, or (watch_input) a command arriving on the control
    channel. Returns why it stopped. */
+#define SMCR_ADDR 0x53 /* data-space address of SMCR on the ATmega328P and ATmega2560; SE is its bit 0 */
+#define SMCR_SE 0x01
+
 static const char* run_until(int has_target, avr_cycle_count_t target, int realtime, int watch_input) {
     interrupted = 0;
     if (halted) return avr->state == cpu_Crashed ? "crashed" : "done";
@@ -1559,7 +1562,15 @@ static const char* run_until(int has_target, avr_cycle_count_t target, int realt
             const avr_cycle_count_t c0 = a->cycle;
             const int slept = a->state == cpu_Sleeping;
             const avr_flashaddr_t pc0 = a->pc;
+            /* A SLEEP with SMCR's SE bit clear does nothing on the part; simavr
+               sleeps whatever SE holds, so such a SLEEP runs as a NOP here (its
+               opcode swapped for the NOP's for the one step).
+               tests/regression/test_the_simulated_board_does_not_sleep_with_sleep_enable_clear.py */
+            const int nop_sleep = !slept && pc0 + 1 <= a->flashend && a->flash[pc0 + 1] == 0x95 &&
+                                  a->flash[pc0] == 0x88 && !(a->data[SMCR_ADDR] & SMCR_SE);
+            if (__builtin_expect(nop_sleep, 0)) a->flash[pc0 + 1] = a->flash[pc0] = 0x00;
             int st = avr_run(a);
+            if (__builtin_expect(nop_sleep, 0)) a->flash[pc0 + 1] = 0x95, a->flash[pc0] = 0x88;
             if (__builtin_expect(cut_now, 0)) power_cut(a);
             if (prof_n) prof_step(a, c0, slept, pc0);
             if (st == cpu_Done || st == cpu_Crashed) {

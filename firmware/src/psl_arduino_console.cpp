@@ -188,24 +188,35 @@ uint16_t console_write_space() {
 }
 
 // Never waits: bytes that do not fit are dropped (callers stay within
-// console_write_space()). A byte at a time, the place wrapping at the
-// ring's end (its low byte compared, as the handler does): 10 cycles a
-// byte, in less flash than two memcpy runs.
+// console_write_space()). In two runs, to the ring's end and from its start,
+// each a plain copy (7 cycles a byte; 10 when one loop tested every place
+// for the ring's end), the place wrapped to the start when the first run
+// ends at the ring's end (the handler compares low bytes of wrapped places).
 void console_write(const uint8_t* data, uint16_t len) {
     uint8_t* p = g_tx + tx_index(FSW_TX_HEAD);
     uint8_t n = static_cast<uint8_t>(console_write_space());
     if (len < n) n = static_cast<uint8_t>(len);
     if (n == 0) return;
+    // the first run: to the ring's end (0 for 256 bytes), or all of them
+    uint8_t first = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(g_tx + FSW_CONSOLE_TX_SIZE) -
+                                         reinterpret_cast<uintptr_t>(p));
+    if (static_cast<uint8_t>(first - 1u) >= n) first = n;
+    uint8_t rest = static_cast<uint8_t>(n - first);
     __asm__ __volatile__(
         "1:  ld   __tmp_reg__, X+\n\t"
         "    st   Z+, __tmp_reg__\n\t"
+        "    dec  %[first]\n\t"
+        "    brne 1b\n\t"
         "    cpi  %A[p], lo8(%[ring] + %[size])\n\t"
         "    brne 2f\n\t"
-        "    ldi  %A[p], lo8(%[ring])\n\t"
+        "    ldi  %A[p], lo8(%[ring])\n\t"  // at the ring's end: its start
         "    ldi  %B[p], hi8(%[ring])\n\t"
-        "2:  dec  %[n]\n\t"
+        "    mov  %[first], %[rest]\n\t"  // the second run, if any
+        "    ldi  %[rest], 0\n\t"
+        "    tst  %[first]\n\t"
         "    brne 1b\n\t"
-        : [p] "+z"(p), [data] "+x"(data), [n] "+r"(n)
+        "2:\n\t"
+        : [p] "+z"(p), [data] "+x"(data), [first] "+r"(first), [rest] "+d"(rest)
         : [ring] "i"(g_tx), [size] "i"(FSW_CONSOLE_TX_SIZE)
         : "memory");
     __asm__ __volatile__("" ::: "memory");  // the bytes in the ring before the head moves over them

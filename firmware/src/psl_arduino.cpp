@@ -152,15 +152,20 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             // The last stretch, interrupts off: this sub-period's end is
             // counted first (nothing reads the clock before the count
             // wraps: interrupts are off), in time the spin would wait out
-            // anyway, then the spin until the count wraps to 0.
+            // anyway, then the spin until the count wraps to 0. Should it
+            // have wrapped meanwhile (the compare's flag is set: handlers
+            // held the CPU almost all the way from the wake-up to the
+            // cycle's time), the cycle starts up to the count's few
+            // microseconds late: counted late.
             (void)sub_period_ended();
             skipped = 0;
             g_ct.running = 1;
+            const uint8_t why = (TIFR1 & _BV(OCF1A)) != 0 ? kCycleLateOther : kCycleOnTime;
             while (TCNT1 >= ct_early()) {
             }
             TIFR1 = _BV(OCF1A);  // (counted above)
             sei();
-            return kCycleOnTime;
+            return why;
         }
         // Background work (the link's service, the EEPROM writers) between
         // cycles, but none started in the last FSW_BACKGROUND_GUARD_US before

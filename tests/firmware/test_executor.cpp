@@ -220,6 +220,34 @@ static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
     while (!executor_poll(ex)) {
     }
     TEST_ASSERT_EQUAL_UINT16(2, ex.late);
+    // Reached later and later in the last stretch (as when handlers held
+    // the CPU from the wake-up towards the start): a cycle not counted late
+    // starts on time, as an undisturbed one does (its first task at the
+    // same microsecond past the period's start, to within one); one the executor reached
+    // too late to count the sub-period's end before the wrap (it does so
+    // in the spin's time) is counted late. Both happen in the sweep.
+    while (!executor_poll(ex)) {
+    }
+    const uint16_t on_time = static_cast<uint16_t>(task0_at_us % 1000u);
+    uint16_t late = ex.late, on_time_seen = 0, late_seen = 0;
+    for (uint16_t at = 1940; at < 1999u; at = static_cast<uint16_t>(at + 3u)) {
+        noInterrupts();
+        while (TCNT1 >= 1900u) {  // (past this cycle's start: the count is small)
+        }
+        while (TCNT1 < at) {  // (top 1999: 1 ms at 0.5 us a tick)
+        }
+        while (!executor_poll(ex)) {  // (it turns interrupts on)
+        }
+        if (ex.late != late) {
+            ++late_seen;
+        } else {
+            ++on_time_seen;  // (within a spin: the clock's microsecond may differ by one)
+            TEST_ASSERT_UINT16_WITHIN(1, on_time, task0_at_us % 1000u);
+        }
+        late = ex.late;
+    }
+    TEST_ASSERT_TRUE(on_time_seen > 0 && late_seen > 0);
+    TEST_ASSERT_EQUAL_UINT16(1, ex.skipped);
 #endif
 #endif
 }

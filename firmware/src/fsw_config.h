@@ -113,10 +113,12 @@
 // starts on the timer's count. The rest is awake time spent spinning, every
 // cycle. 0, the default: 16 us, or 24 us where the application has sensor
 // parts (fsw_app.h kAppSensors: the TWI handler). The kit's handlers but
-// the TWI's take at most about 15 us back to back on a 16 MHz AVR (ADC 71
-// cycles with the vector's jump, UART receive 46, UART transmit 39, EEPROM
-// ready about 30, the timer's compare 19, and about 25 of the loop before
-// it turns interrupts off).
+// the TWI's take at most about 15 us back to back on a 16 MHz AVR (ADC up
+// to 85 cycles with the vector's jump, UART receive 47, UART transmit 39,
+// EEPROM ready about 30, the timer's compare 17, and about 25 of the loop
+// before it turns interrupts off); a start the wait reaches too late to
+// count the ending sub-period first (about 3 us) is counted late
+// (psl_arduino.cpp cycle_wait).
 #ifndef FSW_WAKE_EARLY_US
 #  define FSW_WAKE_EARLY_US 0
 #endif

@@ -1531,12 +1531,12 @@ static uint8_t* eeprom_bytes(void) {
     return d.ee;
 }
 
-/* Runs until cycle `target` (when has_target), a limit, the firmware
-   stopping, SIGINT, or (watch_input) a command arriving on the control
-   channel. Returns why it stopped. */
 #define SMCR_ADDR 0x53 /* data-space address of SMCR on the ATmega328P and ATmega2560; SE is its bit 0 */
 #define SMCR_SE 0x01
 
+/* Runs until cycle `target` (when has_target), a limit, the firmware
+   stopping, SIGINT, or (watch_input) a command arriving on the control
+   channel. Returns why it stopped. */
 static const char* run_until(int has_target, avr_cycle_count_t target, int realtime, int watch_input) {
     interrupted = 0;
     if (halted) return avr->state == cpu_Crashed ? "crashed" : "done";

@@ -75,14 +75,16 @@ test-python: setup
 ## about an hour; crashing inputs land in build/fuzz/), the uplink parser, the
 ## differential tests, and 20,000 random applications that the checker must
 ## refuse or that must compile for their board and natively (FSW_GEN_CASES),
-## and the front end's property tests at ten times their `make test` count
+## and the front end's property tests at about 17 times their `make test`
+## count (FSW_PROPERTY_SCALE 5; make test's is 0.3)
 fuzz: setup fuzz-uplink fuzz-vm
 	$(PY) tools/fuzz_frontend.py --cases $${FSW_FUZZ_EXAMPLES:-1000000} --out $(BUILD)/fuzz/frontend
 	FSW_DIFF_SEED=$${FSW_DIFF_SEED:-2} FSW_DIFF_CASES=$${FSW_DIFF_CASES:-20000} \
 	  FSW_DIFF_RAW_CASES=$${FSW_DIFF_RAW_CASES:-5000} FSW_DIFF_AVR_CASES=$${FSW_DIFF_AVR_CASES:-400} \
-	  FSW_VM_AVR_CASES=$${FSW_VM_AVR_CASES:-400} \
+	  FSW_VM_AVR_CASES=$${FSW_VM_AVR_CASES:-400} FSW_VM_CASES=$${FSW_VM_CASES:-2000} \
+	  FSW_VM_RAW_CASES=$${FSW_VM_RAW_CASES:-1000} \
 	  $(PY) -m pytest -q -p no:cacheprovider tests/differential/test_generated.py tests/differential/test_simavr.py \
-	  tests/differential/test_bytecode_avr.py
+	  tests/differential/test_bytecode.py tests/differential/test_bytecode_avr.py
 	FSW_GEN_CASES=$${FSW_GEN_CASES:-20000} $(PY) -m pytest -q -p no:cacheprovider \
 	  tests/regression/test_accepted_configs_build.py
 	FSW_PROPERTY_SCALE=$${FSW_PROPERTY_SCALE:-5} $(PY) -m pytest -q -p no:cacheprovider \

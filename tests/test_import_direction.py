@@ -7,6 +7,7 @@ function is a dependency all the same, only a later one)."""
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 from conftest import ROOT
@@ -30,15 +31,22 @@ def modules() -> dict[str, Path]:
     return out
 
 
+@functools.cache
+def _import_nodes(path: Path) -> tuple:
+    """The file's import statements, function-level ones included, read
+    once for all the tests (the modules do not change during a run)."""
+    tree = ast.parse(path.read_text(), str(path))
+    return tuple(n for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom)))
+
+
 def imports(name: str, path: Path, known: set[str]) -> list[tuple[int, str]]:
     """(line, module) of every import of a module of the kit in the file,
     relative ones resolved; `from P import x` names P.x when that is a
     module, else P. An import that resolves outside the kit's package is
     kept as its dotted name (`fswkit` alone, `fswkit.nothing`)."""
-    tree = ast.parse(path.read_text(), str(path))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     out = []
-    for node in ast.walk(tree):
+    for node in _import_nodes(path):
         if isinstance(node, ast.Import):
             out += [(node.lineno, a.name) for a in node.names if a.name.split(".")[0] == "fswkit"]
         elif isinstance(node, ast.ImportFrom):

@@ -10,9 +10,9 @@ can produce (NaN payloads, binary64 values between binary32 neighbours,
 arbitrary 64-bit integers) and compares everything the machine writes after
 every step, as test_generated.py does for the generated C++.
 
-Deterministic: the seed is fixed. FSW_VM_CASES (default 120) and
-FSW_VM_RAW_CASES (default 60) set how many cases per mode, FSW_DIFF_SEED the
-seed. On a mismatch the failure message
+Deterministic: the seed is fixed. FSW_VM_CASES (default 120; `make fuzz`
+2,000) and FSW_VM_RAW_CASES (default 60; `make fuzz` 1,000) set how many
+cases per mode, FSW_DIFF_SEED the seed. On a mismatch the failure message
 holds the case's configs (.sv/.sm/.ss) to reproduce it."""
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ from fswkit.testing import fuzz
 
 pytestmark = pytest.mark.costly(12)
 
-CASES = int(os.environ.get("FSW_FUZZ_SMOKE", "1000"))
+CASES = int(os.environ.get("FSW_FUZZ_SMOKE", "500"))
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ task and stream rates up to past their tables' 16-bit ranges; 0 to 260
 tasks; odd application file names. Hypothesis draws the projects in chunks
 of 120, one seed each; the accepted ones are compiled in one -fsyntax-only
 run per board and chunk (tests/support/cxx.py). FSW_GEN_CASES (default
-160) sets how many projects; `make fuzz` runs many more."""
+120, one chunk) sets how many projects; `make fuzz` runs 20,000."""
 
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ from fswkit.autocode.emit.app import emit_app
 from fswkit.autocode.lexer import KEYWORDS
 from fswkit.testing.strategies import RESERVED, programs
 
-CASES = int(os.environ.get("FSW_GEN_CASES", "160"))
+CASES = int(os.environ.get("FSW_GEN_CASES", "120"))
 CHUNK = 120  # projects per seed and compiler run
 BOARDS = ("uno", "nano", "mega2560", "native")
 needs_avr = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")

@@ -1,5 +1,5 @@
 """The property tests' settings and helpers (tests/autocode/{lexer,parser,
-check}, tests/run): example counts scaled by FSW_PROPERTY_SCALE (default 0.5
+check}, tests/run): example counts scaled by FSW_PROPERTY_SCALE (default 0.3
 in `make test`; `make fuzz` runs 5), shrinking of whole programs only with
 FSW_PROPERTY_SHRINK=1 (slow), and the parse/check/compare steps the tests
 share. Needs Hypothesis."""
@@ -18,7 +18,7 @@ from fswkit.autocode.numeric import F32MODE, F64MODE
 from fswkit.autocode.parser import parse_sm, parse_ss, parse_sv
 from fswkit.testing import strategies as T
 
-SCALE = float(os.environ.get("FSW_PROPERTY_SCALE", "0.5"))
+SCALE = float(os.environ.get("FSW_PROPERTY_SCALE", "0.3"))
 REAL_MODES = (F64MODE, F32MODE)
 
 

@@ -6,8 +6,8 @@ generated machines with raw element values no script can produce (NaN
 payloads, binary64 values between binary32 neighbours, arbitrary 64-bit
 integers) and compares everything the machine writes after every step.
 
-Deterministic: the seed is fixed. FSW_DIFF_CASES (default 500; `make fuzz`
-runs 20,000) and FSW_DIFF_RAW_CASES (default 300; `make fuzz` 5,000) set
+Deterministic: the seed is fixed. FSW_DIFF_CASES (default 300; `make fuzz`
+runs 20,000) and FSW_DIFF_RAW_CASES (default 200; `make fuzz` 5,000) set
 how many per mode, FSW_DIFF_SEED the seed (for long runs). On a mismatch
 the failure message holds the configs of the case (.sv/.sm/.ss) to
 reproduce it with `fsw test --native`.
@@ -28,8 +28,8 @@ import gen_programs as gp
 import harness as H
 from fswkit.autocode.numeric import REALS
 
-CASES = int(os.environ.get("FSW_DIFF_CASES", "500"))
-RAW_CASES = int(os.environ.get("FSW_DIFF_RAW_CASES", "300"))
+CASES = int(os.environ.get("FSW_DIFF_CASES", "300"))
+RAW_CASES = int(os.environ.get("FSW_DIFF_RAW_CASES", "200"))
 SEED = int(os.environ.get("FSW_DIFF_SEED", "1"))
 SHOW = 3  # mismatches printed in full
 
@@ -135,7 +135,7 @@ def test_raw_inputs_match(runs, mode):
 def test_runs_end_every_way(runs):
     """The generated scripts pass, fail an assert, run out of steps and hit
     a step error (G wrapped): every ending of the runner is compared."""
-    if CASES < 500:
+    if CASES < 300:
         pytest.skip("too few cases to expect every ending")
     endings = runs["endings"]
     assert all(n > 0 for n in endings.values()), endings
@@ -147,7 +147,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     """The generated programs make the emitter take every fast path many
     times over (counted while emitting them again, in binary32, where all of
     them exist), so a regression in any of them shows up as a mismatch."""
-    if CASES < 500:
+    if CASES < 300:
         pytest.skip("too few cases to count on every path")
     from fswkit.autocode.emit import expr, script as emit_script
     from fswkit.autocode import model as M

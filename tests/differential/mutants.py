@@ -59,10 +59,10 @@ def patch_runtime(file: str, old: str, new: str) -> None:
 
 E = expr.ExprEmitter
 MUTANTS = {
-    "int_add_limit": lambda: patch_function(E, "int_add", "- 1 - abs(k)", "+ 1 - abs(k)"),
+    "int_add_limit": lambda: patch_function(expr, "exact_sum_limit", "- 1 - abs(k)", "+ 1 - abs(k)"),
     "threshold_even": lambda: patch_function(thresholds, "greater", "return (key64(mf), even)",
                                              "return (key64(mf), not even)"),
-    "int_compare_fold": lambda: patch_function(E, "int_compare",
+    "int_compare_fold": lambda: patch_function(expr, "folded_compare",
                                                "points = (lo, hi) if not lo <= c <= hi else (lo, hi, c)",
                                                "points = (lo, hi)"),
     "const_store_negzero": lambda: patch_function(E, "constant_store", "value = to_type(t, x)",

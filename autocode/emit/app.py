@@ -310,6 +310,8 @@ def _app_cpp(app: Application) -> str:
     c += ["", version_check("app.gen.cpp"), real_check(basename(app.path), real),
           comment(f"// Board `{app.board.name}`: {app.board.mcu} at {app.board.f_cpu} Hz.")]
     c += _app_features(app)
+    if any(t.kind in ("telemetry", "uplink") for t in app.tasks):
+        c += _console_rx(app, any(t.kind == "uplink" for t in app.tasks))
     c += ["namespace fsw_gen {", "namespace {", ""]
     tables = _tables(app, real, c)
     if app.sensors:
@@ -834,6 +836,39 @@ def _link(app: Application) -> list[str]:
     c.append("fsw::Link link;")
     c.append("")
     return c
+
+
+# The UART driver's receive ring (psl_arduino_console.cpp) of an application
+# whose ground has one command in flight at a time: a command's bytes, a
+# lone delimiter the ground's handshake sends first, the command's leading
+# delimiter, its encoded frame of at most FSW_LINK_RX_CAP (24) bytes and its
+# closing delimiter, 27 in all, wait there for the uplink task's next run; a
+# ring of 32 holds 31. (Between two runs, 10 ms apart at 100 Hz, 118 bytes
+# could arrive at 115200 baud: no ring short of 128 absorbs a ground that
+# sends without waiting; the ground's clients wait for each ack: docs/telemetry.md.)
+CONSOLE_RX_ONE_COMMAND = 32
+
+
+def _console_rx(app: Application, uplink: bool) -> list[str]:
+    """The UART driver's receive ring, sized for what the ground keeps in
+    flight (docs/runtime.md, "The console"): the runtime's default
+    (FSW_CONSOLE_RX_SIZE, 64) where the ground pipelines commands (the
+    parameter client, which the reload commands go through too: its window
+    keeps up to 90 bytes in flight); CONSOLE_RX_ONE_COMMAND where it sends
+    one at a time; 4 bytes (the smallest ring) without an uplink task,
+    where nothing reads it. On a board whose console is the core's Serial,
+    nothing references it and the linker drops it."""
+    if uplink and (app_parameters(app) or app.reload is not None):
+        return ["// The UART's receive ring: the runtime's (FSW_CONSOLE_RX_SIZE): the ground pipelines commands "
+                "(parameters, reload)", ""]
+    size = CONSOLE_RX_ONE_COMMAND if uplink else 4
+    why = ("one command in flight (the ground waits for each ack): its 27 bytes at most" if uplink
+           else "no uplink task reads it")
+    return [f"// The UART's receive ring (psl_arduino_console.cpp): {why}",
+            "extern \"C\" {",
+            f"uint8_t fsw_console_rx[{size}];",
+            f"extern const uint8_t fsw_console_rx_mask = {size - 1};",
+            "}", ""]
 
 
 def _link_stores(app: Application) -> str:

@@ -35,10 +35,18 @@ uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableFo
 #error "fswkit: no USART0 on this MCU: set FSW_CONSOLE_ARDUINO_SERIAL=1"
 #endif
 
+// The receive ring and its size less one (a power of two, 4..256): the
+// application's own, sized by its generated code for what its ground keeps
+// in flight (docs/runtime.md, "The console"), else psl_arduino_console_rx.cpp's
+// (FSW_CONSOLE_RX_SIZE), which the linker takes out of the runtime's archive
+// only for a program that does not define them. LTO folds the mask into the
+// code below (an immediate operand of the handler's `andi`).
+extern "C" uint8_t fsw_console_rx[];
+extern "C" const uint8_t fsw_console_rx_mask;
+
 namespace {
 
 const uint8_t kTxMask = FSW_CONSOLE_TX_SIZE - 1;
-const uint8_t kRxMask = FSW_CONSOLE_RX_SIZE - 1;
 // UCSR0B as the driver runs it (receiver, transmitter, receive interrupt),
 // without and with the data-register-empty interrupt.
 #define FSW_UCSRB_IDLE (_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0))
@@ -54,7 +62,6 @@ const uint8_t kUcsrbSending = FSW_UCSRB_IDLE | _BV(UDRIE0);
 // SREG. Two pointers into a ring of at most 256 bytes differ in their low
 // byte, so the low bytes are all a comparison needs.
 uint8_t g_tx[FSW_CONSOLE_TX_SIZE];
-uint8_t g_rx[FSW_CONSOLE_RX_SIZE];
 volatile uint8_t g_rx_head, g_rx_tail;
 #if defined(GPIOR0) && defined(GPIOR1) && defined(GPIOR2)
 // The head (the low byte of its place, &g_tx[head]) and the tail's place
@@ -89,9 +96,9 @@ inline uint8_t tx_index(uint8_t lo) { return static_cast<uint8_t>((lo - reinterp
 // In C:
 //     const uint8_t b = UDR0;
 //     const uint8_t h = g_rx_head;
-//     const uint8_t next = (h + 1) & kRxMask;
+//     const uint8_t next = (h + 1) & fsw_console_rx_mask;
 //     if (next != g_rx_tail) {
-//         g_rx[h] = b;
+//         fsw_console_rx[h] = b;
 //         g_rx_head = next;
 //     }
 ISR(FSW_UART_RX_VECT, ISR_NAKED) {
@@ -105,14 +112,15 @@ ISR(FSW_UART_RX_VECT, ISR_NAKED) {
         "lds  r31, %[tail]\n\t"
         "cp   r24, r31\n\t"
         "breq 1f\n\t"  // full: the byte is dropped
-        "ldi  r31, 0\n\t"  // Z = g_rx + h
+        "ldi  r31, 0\n\t"  // Z = fsw_console_rx + h
         "subi r30, lo8(-(%[ring]))\n\t"
         "sbci r31, hi8(-(%[ring]))\n\t"
         "st   Z, r25\n\t"
         "sts  %[head], r24\n\t"
         "1:\n\t"
         FSW_ISR_RESTORE_R24_R25_Z_RETI ::[udr] "n"(_SFR_MEM_ADDR(UDR0)),
-        [head] "i"(&g_rx_head), [tail] "i"(&g_rx_tail), [ring] "i"(g_rx), [mask] "M"(kRxMask)
+        [head] "i"(&g_rx_head), [tail] "i"(&g_rx_tail), [ring] "i"(fsw_console_rx),
+        [mask] "M"(fsw_console_rx_mask)
         : "memory");  // it fills the ring console_read empties
 }
 
@@ -233,8 +241,8 @@ void console_write(const uint8_t* data, uint16_t len) {
 int16_t console_read() {
     const uint8_t t = g_rx_tail;
     if (t == g_rx_head) return -1;
-    const uint8_t b = g_rx[t];
-    g_rx_tail = static_cast<uint8_t>((t + 1u) & kRxMask);
+    const uint8_t b = fsw_console_rx[t];
+    g_rx_tail = static_cast<uint8_t>((t + 1u) & fsw_console_rx_mask);
     return b;
 }
 

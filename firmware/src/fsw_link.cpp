@@ -66,36 +66,37 @@ inline uint16_t tx_bytes(const Link& l) {
     return size > cap ? size : cap;
 }
 
-// Hands as much of the transmit buffer to the console as it takes now.
-void pump(Link& l) {
-    if (l.tx_len == 0) return;
-    uint16_t n = static_cast<uint16_t>(l.tx_len - l.tx_pos);
-    const uint16_t space = pal::console_write_space();
-    if (n > space) n = space;
-    pal::console_write(tx_buf(l) + l.tx_pos, n);
-    l.tx_pos = static_cast<uint16_t>(l.tx_pos + n);
-    if (l.tx_pos >= l.tx_len) l.tx_len = l.tx_pos = 0;
+// The console sends the frames from the transmit buffer where they were
+// built (pal::console_send: no copy); the core's Serial takes them only as
+// it is asked (the kit's UART driver by itself: this is then nothing).
+inline void pump() {
+    if (pal::console_needs_poll()) (void)pal::console_sending();
 }
 
-// Room for a frame of up to `need` encoded bytes behind what the transmit
-// buffer still holds; the rest is moved to the front when the frame would
-// not fit after it. The buffer is max(tx_cap, tx_size) bytes (tx_size: two
-// longest frames for a link near its line rate, the generator's choice): a
-// sample frame goes behind any rest it fits behind; a control frame, whose
-// size is known only once composed, needs room for the longest frame
-// (with one frame's buffer: an empty buffer, as it always did).
+// Room for a frame of up to `need` encoded bytes; tx_len is then where it
+// goes. The buffer (max(tx_cap, tx_size) bytes) holds at most two runs of
+// frames: the one the UART sends, and one at the buffer's front that it
+// goes on with once that one's end is out. A frame goes after the run
+// frames were added to last, or, when it does not fit there and the UART
+// is in that run, at the front, in the bytes the UART has sent; else there
+// is no room for it yet. (A sample frame's `need` is its size bound; a
+// control frame's, whose size is known only once composed, the longest
+// frame's.)
 bool tx_room(Link& l, uint16_t need) {
-    pump(l);
-    if (l.tx_len == 0) return true;
-    const uint16_t rest = static_cast<uint16_t>(l.tx_len - l.tx_pos), size = tx_bytes(l);
-    if (need > size - rest) return false;
-    if (need > size - l.tx_len) {
-        uint8_t* const tx = tx_buf(l);
-        memmove(tx, tx + l.tx_pos, rest);
-        l.tx_len = rest;
-        l.tx_pos = 0;
+    const uint8_t* const at = pal::console_sending();
+    const uint16_t size = tx_bytes(l);
+    if (at == 0) {  // every byte out: the buffer is free
+        l.tx_len = 0;
+        return need <= size;
     }
-    return true;
+    const uint16_t sent = static_cast<uint16_t>(at - tx_buf(l));  // the UART's place
+    if (sent < l.tx_len) {  // in the run frames go after: the bytes before it are free
+        if (need <= size - l.tx_len) return true;
+        if (need > sent) return false;
+        l.tx_len = 0;  // a second run, at the front
+        return true;
+    }
+    return need <= sent - l.tx_len;  // in the run before: the bytes up to it
 }
 
 // The frame being composed: its body is written raw where its encoding
@@ -119,13 +120,12 @@ FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
 
 // Frames the body in place, and `src`'s `n` bytes after it, copied in as
 // they are framed (a sample frame's current region: no second pass over
-// it). A sample frame is handed to the UART by the next pump (the next
-// frame's, or link_poll's right after the cycle: not copied into the UART's
-// ring within the telemetry task's step); a control frame at once.
-void frame_end(Link& l, bool pump_now, const uint8_t* src = 0, uint16_t n = 0) {
-    l.tx_len = static_cast<uint16_t>(l.tx_len + cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n));
+// it), and hands the frame to the UART, which sends it from there.
+void frame_end(Link& l, const uint8_t* src = 0, uint16_t n = 0) {
+    const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
+    pal::console_send(g_at, len);
+    l.tx_len = static_cast<uint16_t>(l.tx_len + len);
     ++l.n.frames;
-    if (pump_now) pump(l);
 }
 
 // State vector bytes into the frame, atomically when the lock is on.
@@ -162,11 +162,11 @@ void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamS
     const bool lock = sv_lock(f);
     uint8_t* const sv = flash_get(f.sv);
     if (with_now && !lock) {
-        frame_end(l, false, sv + flash_get(row.off), size);  // the region copied in as it is framed
+        frame_end(l, sv + flash_get(row.off), size);  // the region copied in as it is framed
         return;
     }
     if (with_now) put_sv(sv, lock, flash_get(row.off), size);  // atomically, then framed
-    frame_end(l, false);
+    frame_end(l);
 }
 
 void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i, uint32_t now32) {
@@ -278,7 +278,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_sv(flash_get(c.sv), sv_lock(c), off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
-    frame_end(l, true);
+    frame_end(l);
 }
 
 // Sends waiting control frames while the transmit buffer has room:
@@ -456,9 +456,12 @@ void link_begin(Link& l_, const LinkConfig* cfg) {
     l.pending = kPendHello;
     // A delimiter first: a reset that cut a frame short leaves the ground
     // mid-frame, and without it the boot hello would be taken as the rest
-    // of that frame and lost with it.
-    const uint8_t delimiter = 0;
-    pal::console_write(&delimiter, 1);
+    // of that frame and lost with it. (Sent from the transmit buffer, where
+    // the frames after it go behind it.)
+    uint8_t* const tx = flash_get(c.tx);
+    tx[0] = 0;
+    pal::console_send(tx, 1);
+    l.tx_len = 1;
 }
 
 // The telemetry task's step: samples the streams due and sends the sample
@@ -469,7 +472,7 @@ void link_begin(Link& l_, const LinkConfig* cfg) {
 Result link_telemetry_task(void* p) {
     Link& l = *static_cast<Link*>(p);
     const LinkConfig& f = *l.cfg;
-    pump(l);
+    pump();
     uint32_t now32 = 0;
     bool have_now = false;
     const uint8_t n_streams = flash_get(f.n_streams);
@@ -549,7 +552,7 @@ Result link_uplink_task(void* p) {
         uplink_run(l, -1);
         return kOk;
     }
-    pump(l);
+    pump();
     const int16_t b = pal::console_read();
     if (b >= 0) uplink_run(l, b);
     return kOk;
@@ -557,19 +560,15 @@ Result link_uplink_task(void* p) {
 
 bool link_busy(const Link& l_) {
     const Link& l = *by_pointer(&l_);
-    return l.cfg != 0 && (l.tx_len != 0 || l.pending != 0 || l.snapshot_at != kNoSnapshot);
+    return l.cfg != 0 && (l.pending != 0 || l.snapshot_at != kNoSnapshot ||
+                          (pal::console_needs_poll() && pal::console_sending() != 0));
 }
 
 void link_poll(Link& l_) {
     Link& l = *by_pointer(&l_);
     if (l.cfg == 0) return;
-    pump(l);
+    pump();
     if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;
-    // no room yet: the rest waiting is more than a control frame fits behind (tx_size - tx_cap)
-    if (l.tx_len != 0 && static_cast<uint16_t>(l.tx_len - l.tx_pos) >
-                             static_cast<uint16_t>(tx_bytes(l) - flash_get(l.cfg->tx_cap))) {
-        return;
-    }
     service(l, *l.cfg, true);
 }
 

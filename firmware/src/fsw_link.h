@@ -149,9 +149,8 @@ struct LinkConfig {
     const PyroGate* pyro;             // the pyro channels' gates: a status byte each in health frames
     uint8_t n_pyro;
     uint8_t pyro_task;                // index of the outputs task that ends their pulses (0xFF: none)
-    uint16_t tx_size;                 // bytes of `tx` (0: tx_cap). Above tx_cap, a sample frame may wait
-                                      // behind the unsent rest of the one before (a link near its line
-                                      // rate); a control frame behind a rest of tx_size - tx_cap
+    uint16_t tx_size;                 // bytes of `tx` (0: tx_cap). Above tx_cap, a frame may wait behind
+                                      // the unsent rest of the one before (a link near its line rate)
     ReloadStore* reload;              // machines replaced at run time (null: none; docs/reload.md)
     LinkReloadApplyFn reload_apply;   // link_reload_apply, with a store
     LinkReloadAckFn reload_ack;       // link_reload_ack, with a store
@@ -175,8 +174,8 @@ struct LinkCounters {
 // where used: no copy of them here.)
 struct Link {
     const LinkConfig* cfg;  // FSW_FLASH
-    uint16_t tx_len;        // bytes of the frames in the transmit buffer, sent or not (0: free)
-    uint16_t tx_pos;        // bytes of it handed to the console
+    uint16_t tx_len;        // where the next frame goes in the transmit buffer: the end of the run of
+                            // frames handed last (the UART sends them from there: pal::console_send)
     LinkCounters n;
     uint16_t health_countdown;
     uint16_t snapshot_at;   // next snapshot offset (0xFFFF: no snapshot under way)
@@ -213,11 +212,12 @@ inline void link_sensors(Link& link, const uint8_t* health, uint8_t n) {
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
 // From loop(), between cycles: sends waiting control frames (hello and
-// health frames only here, never in a task's step) and feeds the transmit
-// buffer to the console as it drains.
+// health frames only here, never in a task's step) (and, where the console
+// is the core's Serial, feeds it the frames as its buffer drains).
 void link_poll(Link& link);
-// Whether link_poll has work: frames in the transmit buffer, control frames
-// or a snapshot waiting (the sleeping executor wakes the main loop for it).
+// Whether link_poll has work: control frames or a snapshot waiting, or
+// frames the core's Serial has still to take (the sleeping executor wakes
+// the main loop for it; the kit's UART driver sends the frames by itself).
 bool link_busy(const Link& link);
 // The body of the frame being composed, a byte or `n` bytes more: what a
 // store's ack function (below) adds after the acknowledgement's 6 bytes.

@@ -109,7 +109,23 @@ void console_write(const uint8_t* data, uint16_t len);
 int16_t console_read();
 // Bytes console_write can take now without waiting (the transmit buffer's
 // free space): telemetry writes no more than this, so it never blocks.
+// (Not on AVR with the kit's UART0 driver, which sends only what
+// console_send hands it.)
 uint16_t console_write_space();
+// Sends the `len` bytes at `data` where they lie (no copy: the link's frames
+// go out of its own transmit buffer), after the bytes handed before. `data`
+// continues the run handed last (it starts where that one ends) or starts a
+// second run, which goes out after the first; never a third while two are
+// under way. The caller leaves the bytes as they are until
+// console_sending() has passed them. Never waits.
+void console_send(const uint8_t* data, uint16_t len);
+// The next byte the UART takes, in a run console_send handed; 0 once it has
+// taken every byte handed (the bytes may all be reused).
+const uint8_t* console_sending();
+// Whether the bytes handed go out only as the caller polls console_sending()
+// (the core's Serial, which takes them as its own buffer drains); the kit's
+// UART0 driver and the host send them by themselves.
+bool console_needs_poll();
 
 // ---- Critical section -------------------------------------------------------
 // Interrupts off on an MCU (nests: the previous state is restored); a

@@ -1,5 +1,6 @@
 // Arduino PSL, Console: the serial port. On AVR, a small interrupt-driven
-// UART0 driver (two rings, two interrupts); elsewhere, or with
+// UART0 driver (a receive ring; bytes sent where the caller keeps them;
+// two interrupts); elsewhere, or with
 // FSW_CONSOLE_ARDUINO_SERIAL=1, the core's Serial. Its own file so that a
 // build that never uses the console links neither.
 #include "fsw_config.h"
@@ -20,6 +21,48 @@ void console_write(const uint8_t* data, uint16_t len) { Serial.write(data, len);
 int16_t console_read() { return static_cast<int16_t>(Serial.read()); }
 uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableForWrite()); }
 
+// The runs handed (console_send), fed to Serial as its buffer takes them
+// whenever the caller asks where the sending is (console_needs_poll).
+namespace {
+const uint8_t* g_at;    // the next byte to hand to Serial (0: none)
+const uint8_t* g_end;   // the end of its run
+const uint8_t* g_next;  // the run after it (0: none)
+const uint8_t* g_next_end;
+}  // namespace
+
+void console_send(const uint8_t* data, uint16_t len) {
+    if (len == 0) return;
+    if (g_at == 0) {
+        g_at = data;
+        g_end = data + len;
+    } else if (data == g_end) {
+        g_end = data + len;
+    } else if (g_next == 0) {
+        g_next = data;
+        g_next_end = data + len;
+    } else if (data == g_next_end) {
+        g_next_end = data + len;
+    }
+}
+
+const uint8_t* console_sending() {
+    while (g_at != 0) {
+        uint16_t n = static_cast<uint16_t>(g_end - g_at);
+        const uint16_t room = static_cast<uint16_t>(Serial.availableForWrite());
+        if (n > room) n = room;
+        if (n == 0) break;
+        Serial.write(g_at, n);
+        g_at += n;
+        if (g_at != g_end) break;
+        g_at = g_next;
+        g_end = g_next_end;
+        g_next = 0;
+    }
+    return g_at;
+}
+
+bool console_needs_poll() { return true; }
+
 }  // namespace pal
 }  // namespace fsw
 
@@ -39,60 +82,61 @@ uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableFo
 // application's own, sized by its generated code for what its ground keeps
 // in flight (docs/runtime.md, "The console"), else psl_arduino_console_rx.cpp's
 // (FSW_CONSOLE_RX_SIZE), which the linker takes out of the runtime's archive
-// only for a program that does not define them. LTO folds the mask into the
-// code below (an immediate operand of the handler's `andi`).
+// only for a program that does not define them. (The handler reads the mask
+// where it lies, a byte of RAM: a constant of another object is no immediate
+// operand where the runtime is compiled without LTO.)
 extern "C" uint8_t fsw_console_rx[];
 extern "C" const uint8_t fsw_console_rx_mask;
 
 namespace {
 
-const uint8_t kTxMask = FSW_CONSOLE_TX_SIZE - 1;
 // UCSR0B as the driver runs it (receiver, transmitter, receive interrupt),
 // without and with the data-register-empty interrupt.
 #define FSW_UCSRB_IDLE (_BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0))
 const uint8_t kUcsrbIdle = FSW_UCSRB_IDLE;
 const uint8_t kUcsrbSending = FSW_UCSRB_IDLE | _BV(UDRIE0);
 
-// One free slot tells a full ring from an empty one. Each index has one
-// writer: the heads belong to the writer of the ring, the tails to its reader.
-// The transmit ring's tail is kept as a pointer into the ring (its place,
-// not its index), its head as the low byte of one: the handler below then
-// takes a byte, moves the tail on and wraps it with instructions that leave
-// the status register alone (ld Z+, cpse, ldi, in/out), so it saves no
-// SREG. Two pointers into a ring of at most 256 bytes differ in their low
-// byte, so the low bytes are all a comparison needs.
-uint8_t g_tx[FSW_CONSOLE_TX_SIZE];
+// One free slot tells a full receive ring from an empty one. Each index has
+// one writer: the head belongs to the handler, the tail to console_read.
 volatile uint8_t g_rx_head, g_rx_tail;
+
+// Transmit: no ring. The handler below sends the runs console_send handed,
+// where the caller keeps them (the link's transmit buffer, which frames are
+// built in): the place of the next byte (the tail; its high byte 0 when
+// every byte handed went out: RAM starts at 0x100), the end of its run, and
+// a second run to go on with at that end (its place's high byte 0: none).
+// The handler takes a byte, moves the tail on and compares it with the end
+// with instructions that leave the status register alone (ld Z+, cpse, in,
+// out, lds, sts, ldi), so it saves no SREG.
 #if defined(GPIOR0) && defined(GPIOR1) && defined(GPIOR2)
-// The head (the low byte of its place, &g_tx[head]) and the tail's place
-// in the MCU's three general-purpose I/O registers (nothing else in the kit
-// or the Arduino core uses them): the handler reads and writes them with
-// `in` and `out`, a cycle each where RAM takes two. console_begin sets them.
-#define FSW_TX_HEAD GPIOR0
+// The tail and the end's low byte in the MCU's three general-purpose I/O
+// registers (nothing else in the kit or the Arduino core uses them): the
+// handler reads and writes them with `in` and `out`, a cycle each where RAM
+// takes two. console_begin sets them.
+#define FSW_TX_END_LO GPIOR0
 #define FSW_TX_TAIL_LO GPIOR1
 #define FSW_TX_TAIL_HI GPIOR2
 #define FSW_TX_IN "in"
 #define FSW_TX_OUT "out"
 #define FSW_TX_REG(r) "I"(_SFR_IO_ADDR(r))
 #else
-volatile uint8_t g_tx_head, g_tx_tail_lo, g_tx_tail_hi;
-#define FSW_TX_HEAD g_tx_head
+volatile uint8_t g_tx_end_lo, g_tx_tail_lo, g_tx_tail_hi;
+#define FSW_TX_END_LO g_tx_end_lo
 #define FSW_TX_TAIL_LO g_tx_tail_lo
 #define FSW_TX_TAIL_HI g_tx_tail_hi
 #define FSW_TX_IN "lds"
 #define FSW_TX_OUT "sts"
 #define FSW_TX_REG(r) "i"(&(r))
 #endif
-
-// A place's index in the transmit ring, from its low byte.
-inline uint8_t tx_index(uint8_t lo) { return static_cast<uint8_t>((lo - reinterpret_cast<uintptr_t>(g_tx)) & kTxMask); }
+volatile uint8_t g_tx_end_hi;
+volatile uint8_t g_tx_next[4];  // the second run: its place, then its end (little-endian)
 
 }  // namespace
 
 // A received byte into the ring; dropped when it is full (the uplink's CRC
 // and COBS checks then refuse the frame it belonged to). Naked: it saves
 // the four registers and the status register it uses, where the compiler's
-// handler also saved r0, r1 and r18 (60 bytes of flash where it took 74).
+// handler also saved r0, r1 and r18 (62 bytes of flash where it took 74).
 // In C:
 //     const uint8_t b = UDR0;
 //     const uint8_t h = g_rx_head;
@@ -108,7 +152,8 @@ ISR(FSW_UART_RX_VECT, ISR_NAKED) {
         "lds  r30, %[head]\n\t"
         "mov  r24, r30\n\t"
         "subi r24, 0xFF\n\t"  // h + 1
-        "andi r24, %[mask]\n\t"
+        "lds  r31, %[mask]\n\t"
+        "and  r24, r31\n\t"
         "lds  r31, %[tail]\n\t"
         "cp   r24, r31\n\t"
         "breq 1f\n\t"  // full: the byte is dropped
@@ -120,24 +165,27 @@ ISR(FSW_UART_RX_VECT, ISR_NAKED) {
         "1:\n\t"
         FSW_ISR_RESTORE_R24_R25_Z_RETI ::[udr] "n"(_SFR_MEM_ADDR(UDR0)),
         [head] "i"(&g_rx_head), [tail] "i"(&g_rx_tail), [ring] "i"(fsw_console_rx),
-        [mask] "M"(fsw_console_rx_mask)
+        [mask] "i"(&fsw_console_rx_mask)
         : "memory");  // it fills the ring console_read empties
 }
 
-// The data register is free: the next byte, and the interrupt off once the
-// ring is empty (console_write turns it back on). It runs once a byte sent
-// (about 18 times a cycle on the demo flight): naked, and with no
-// instruction that changes the status register, it saves only the three
-// registers it uses: 39 cycles a byte with the vector's jump and the
-// return, where the handler that kept indices and saved SREG took 47 (the
-// compiler's, 59). The UART's control bits are the driver's own, so the
-// interrupt goes off with a store of them, not a read-modify-write. In C:
+// The data register is free: the next byte, and at its run's end the
+// second run, or the interrupt off when there is none (console_send turns
+// it back on). It runs once a byte sent (about 18 times a cycle on the demo
+// flight): naked, and with no instruction that changes the status
+// register, it saves only the three registers it uses: 37 cycles a byte
+// with the vector's jump and the return (the handler of the ring it
+// replaced took 39; the compiler's, 59). The UART's control bits are the
+// driver's own, so the interrupt goes off with a store of them, not a
+// read-modify-write. In C:
 //     uint8_t* t = tail;
 //     UDR0 = *t++;
-//     if (t == g_tx + FSW_CONSOLE_TX_SIZE) t = g_tx;
+//     if (t == end) {
+//         t = next; end = next_end; next = 0;
+//         if (t == 0) UCSR0B = kUcsrbIdle;
+//     }
 //     tail = t;
-//     if (low byte of t == head) UCSR0B = kUcsrbIdle;
-// (the interrupt is on only while the ring holds a byte).
+// (the interrupt is on only while a byte handed waits).
 ISR(FSW_UART_UDRE_VECT, ISR_NAKED) {
     __asm__ __volatile__(
         "push r24\n\t"
@@ -147,28 +195,35 @@ ISR(FSW_UART_UDRE_VECT, ISR_NAKED) {
         FSW_TX_IN "  r31, %[tail_hi]\n\t"
         "ld   r24, Z+\n\t"
         "sts  %[udr], r24\n\t"
-        "ldi  r24, lo8(%[ring] + %[size])\n\t"
+        FSW_TX_IN "  r24, %[end_lo]\n\t"
         "cpse r30, r24\n\t"
-        "rjmp 1f\n\t"
-        "ldi  r30, lo8(%[ring])\n\t"  // past the ring's end: its start
-        "ldi  r31, hi8(%[ring])\n\t"
-        "1:\n\t"
-        FSW_TX_OUT " %[tail_lo], r30\n\t"
-        FSW_TX_OUT " %[tail_hi], r31\n\t"
-        FSW_TX_IN "  r24, %[head]\n\t"
-        "cpse r30, r24\n\t"
+        "rjmp 2f\n\t"  // not the run's end (the low bytes differ)
+        "lds  r24, %[end_hi]\n\t"
+        "cpse r31, r24\n\t"
         "rjmp 2f\n\t"
-        "ldi  r24, %[idle]\n\t"  // the ring is empty: the interrupt off
+        "lds  r30, %[next]\n\t"  // the run's end: the second run's place and end
+        "lds  r31, %[next] + 1\n\t"
+        "lds  r24, %[next] + 2\n\t"
+        FSW_TX_OUT " %[end_lo], r24\n\t"
+        "lds  r24, %[next] + 3\n\t"
+        "sts  %[end_hi], r24\n\t"
+        "ldi  r24, 0\n\t"
+        "sts  %[next] + 1, r24\n\t"  // no second run now
+        "cpse r31, r24\n\t"
+        "rjmp 2f\n\t"
+        "ldi  r24, %[idle]\n\t"  // none: every byte handed went out, the interrupt off
         "sts  %[ucsrb], r24\n\t"
         "2:\n\t"
+        FSW_TX_OUT " %[tail_lo], r30\n\t"
+        FSW_TX_OUT " %[tail_hi], r31\n\t"
         "pop  r31\n\t"
         "pop  r30\n\t"
         "pop  r24\n\t"
         "reti\n\t" ::[tail_lo] FSW_TX_REG(FSW_TX_TAIL_LO),
-        [tail_hi] FSW_TX_REG(FSW_TX_TAIL_HI), [head] FSW_TX_REG(FSW_TX_HEAD), [ring] "i"(g_tx),
-        [size] "i"(FSW_CONSOLE_TX_SIZE), [udr] "n"(_SFR_MEM_ADDR(UDR0)), [ucsrb] "n"(_SFR_MEM_ADDR(UCSR0B)),
+        [tail_hi] FSW_TX_REG(FSW_TX_TAIL_HI), [end_lo] FSW_TX_REG(FSW_TX_END_LO), [end_hi] "i"(&g_tx_end_hi),
+        [next] "i"(g_tx_next), [udr] "n"(_SFR_MEM_ADDR(UDR0)), [ucsrb] "n"(_SFR_MEM_ADDR(UCSR0B)),
         [idle] "M"(FSW_UCSRB_IDLE)
-        : "memory");  // it reads the ring console_write fills
+        : "memory");  // it reads the runs console_send hands
 }
 
 namespace fsw {
@@ -180,63 +235,56 @@ namespace pal {
 // bit rate when UBRR0 is written, and would run the line at half speed.
 void console_begin(uint32_t baud) {
     const uint16_t ubrr = static_cast<uint16_t>((F_CPU / 4u / baud - 1u) / 2u);
-    UCSR0B = 0;  // the interrupts off while the ring is set empty
-    const uintptr_t ring = reinterpret_cast<uintptr_t>(g_tx);
-    FSW_TX_TAIL_LO = static_cast<uint8_t>(ring);
-    FSW_TX_TAIL_HI = static_cast<uint8_t>(ring >> 8);
-    FSW_TX_HEAD = static_cast<uint8_t>(ring);
+    UCSR0B = 0;  // the interrupts off while nothing is being sent
+    FSW_TX_TAIL_HI = 0;
+    g_tx_next[1] = 0;
     UCSR0A = _BV(U2X0);
     UBRR0 = ubrr;
     UCSR0C = static_cast<uint8_t>(_BV(UCSZ01) | _BV(UCSZ00));
     UCSR0B = kUcsrbIdle;
 }
 
-uint16_t console_write_space() {
-    return static_cast<uint8_t>((tx_index(FSW_TX_TAIL_LO) - tx_index(FSW_TX_HEAD) - 1u) & kTxMask);
+// The handler reads what this writes: with interrupts off. A run that
+// starts where the one going out (or the second) ends lengthens it; one
+// that starts elsewhere becomes the second; a third is not the contract
+// (fsw_pal.h) and is dropped.
+void console_send(const uint8_t* data, uint16_t len) {
+    if (len == 0) return;
+    const uintptr_t at = reinterpret_cast<uintptr_t>(data), end = at + len;
+    const uint8_t sreg = SREG;
+    cli();
+    if (FSW_TX_TAIL_HI == 0) {  // idle: this run goes out now
+        FSW_TX_TAIL_LO = static_cast<uint8_t>(at);
+        FSW_TX_TAIL_HI = static_cast<uint8_t>(at >> 8);
+        FSW_TX_END_LO = static_cast<uint8_t>(end);
+        g_tx_end_hi = static_cast<uint8_t>(end >> 8);
+        // A store, not a read-modify-write: the interrupt is on only while a
+        // byte handed waits, and here one does.
+        UCSR0B = kUcsrbSending;
+    } else if (at == (FSW_TX_END_LO | static_cast<uintptr_t>(g_tx_end_hi) << 8)) {
+        FSW_TX_END_LO = static_cast<uint8_t>(end);
+        g_tx_end_hi = static_cast<uint8_t>(end >> 8);
+    } else if (g_tx_next[1] == 0) {
+        g_tx_next[0] = static_cast<uint8_t>(at);
+        g_tx_next[2] = static_cast<uint8_t>(end);
+        g_tx_next[3] = static_cast<uint8_t>(end >> 8);
+        g_tx_next[1] = static_cast<uint8_t>(at >> 8);
+    } else if (at == (g_tx_next[2] | static_cast<uintptr_t>(g_tx_next[3]) << 8)) {
+        g_tx_next[2] = static_cast<uint8_t>(end);
+        g_tx_next[3] = static_cast<uint8_t>(end >> 8);
+    }
+    SREG = sreg;
 }
 
-// Never waits: bytes that do not fit are dropped (callers stay within
-// console_write_space()). In two runs, to the ring's end and from its start,
-// each a plain copy (7 cycles a byte; 10 when one loop tested every place
-// for the ring's end), the place wrapped to the start when the first run
-// ends at the ring's end (the handler compares low bytes of wrapped places).
-void console_write(const uint8_t* data, uint16_t len) {
-    uint8_t* p = g_tx + tx_index(FSW_TX_HEAD);
-    uint8_t n = static_cast<uint8_t>(console_write_space());
-    if (len < n) n = static_cast<uint8_t>(len);
-    if (n == 0) return;
-    // the first run: to the ring's end (0 for 256 bytes), or all of them
-    uint8_t first = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(g_tx + FSW_CONSOLE_TX_SIZE) -
-                                         reinterpret_cast<uintptr_t>(p));
-    if (static_cast<uint8_t>(first - 1u) >= n) first = n;
-    uint8_t rest = static_cast<uint8_t>(n - first);
-    __asm__ __volatile__(
-        "1:  ld   __tmp_reg__, X+\n\t"
-        "    st   Z+, __tmp_reg__\n\t"
-        "    dec  %[first]\n\t"
-        "    brne 1b\n\t"
-        "    cpi  %A[p], lo8(%[ring] + %[size])\n\t"
-        "    brne 2f\n\t"
-        "    ldi  %A[p], lo8(%[ring])\n\t"  // at the ring's end: its start
-        "    ldi  %B[p], hi8(%[ring])\n\t"
-        "    mov  %[first], %[rest]\n\t"  // the second run, if any
-        "    ldi  %[rest], 0\n\t"
-        "    tst  %[first]\n\t"
-        "    brne 1b\n\t"
-        "2:\n\t"
-        : [p] "+z"(p), [data] "+x"(data), [first] "+r"(first), [rest] "+d"(rest)
-        : [ring] "i"(g_tx), [size] "i"(FSW_CONSOLE_TX_SIZE)
-        : "memory");
-    __asm__ __volatile__("" ::: "memory");  // the bytes in the ring before the head moves over them
-    FSW_TX_HEAD = static_cast<uint8_t>(reinterpret_cast<uintptr_t>(p));
-    // A store, not a read-modify-write. The interrupt is on only while the
-    // ring holds a byte (its handler does not look before it takes one): it
-    // turns itself off when it takes the last, and here the ring holds the
-    // bytes just written. Should it run between the head's store and this
-    // one, the ring held a byte before this write too (it was on), so it
-    // takes that one and cannot have emptied the ring.
-    UCSR0B = kUcsrbSending;
+const uint8_t* console_sending() {
+    const uint8_t sreg = SREG;
+    cli();
+    const uintptr_t t = FSW_TX_TAIL_LO | static_cast<uintptr_t>(FSW_TX_TAIL_HI) << 8;
+    SREG = sreg;
+    return (t >> 8) != 0 ? reinterpret_cast<const uint8_t*>(t) : 0;
 }
+
+bool console_needs_poll() { return false; }
 
 int16_t console_read() {
     const uint8_t t = g_rx_tail;

@@ -6,6 +6,9 @@
 
 #include <poll.h>
 #include <stdio.h>
+#include <string.h>
+
+#include <vector>
 #include <unistd.h>
 #include <time.h>
 
@@ -49,6 +52,12 @@ uint16_t g_uart_buffer;
 uint64_t g_uart_busy_until_bits;  // simulated time (in bit times) the last queued byte ends
 uint32_t g_uart_overruns;
 uint32_t g_written;
+// console_send's runs not yet all sent, each with a copy of its bytes (console_sending)
+struct SendRun {
+    const uint8_t* at;
+    std::vector<uint8_t> bytes;
+};
+std::vector<SendRun> g_runs;
 // The EEPROM model: 1,024 bytes, erased (0xFF) at start, kept across
 // sim_reset() (as a board keeps it across resets), written through to a
 // file when one is named, and frozen after a given number of writes (a
@@ -192,6 +201,7 @@ void sim_reset() {
     g_uart_busy_until_bits = 0;
     g_uart_overruns = 0;
     g_written = 0;
+    g_runs.clear();
 }
 
 void sim_eeprom_erase() {
@@ -432,6 +442,65 @@ void console_write(const uint8_t* data, uint16_t len) {
     fwrite(data, 1, len, stdout);
     fflush(stdout);
 }
+// console_send's runs are output at once, as console_write's bytes, and
+// kept with a copy of their bytes until the model's clock has sent them: a
+// byte that changed before it went out (the caller broke the contract,
+// fsw_pal.h), or a third run, counts as an overrun.
+namespace {
+
+// Retires the bytes sent (the model's clock): each checked against its copy
+// first, since the caller may reuse them only once console_sending() has
+// passed them.
+void retire_runs() {
+    uint32_t handed = 0;
+    for (const SendRun& r : g_runs) handed += static_cast<uint32_t>(r.bytes.size());
+    const uint32_t q = g_uart_baud == 0 ? 0 : uart_queued();
+    uint32_t sent = handed > q ? handed - q : 0;
+    while (!g_runs.empty() && sent != 0) {
+        SendRun& r = g_runs.front();
+        const uint32_t n = sent < r.bytes.size() ? sent : static_cast<uint32_t>(r.bytes.size());
+        if (memcmp(r.at, r.bytes.data(), n) != 0) ++g_uart_overruns;
+        sent -= n;
+        if (n == r.bytes.size()) {
+            g_runs.erase(g_runs.begin());
+        } else {
+            r.at += n;
+            r.bytes.erase(r.bytes.begin(), r.bytes.begin() + n);
+        }
+    }
+}
+}  // namespace
+
+void console_send(const uint8_t* data, uint16_t len) {
+    if (len == 0) return;
+    retire_runs();
+    if (!g_runs.empty() && g_runs.back().at + g_runs.back().bytes.size() == data) {
+        g_runs.back().bytes.insert(g_runs.back().bytes.end(), data, data + len);
+    } else {
+        if (g_runs.size() >= 2) ++g_uart_overruns;  // a third run: not the contract
+        g_runs.push_back(SendRun{data, std::vector<uint8_t>(data, data + len)});
+    }
+    g_written += len;
+    if (g_uart_baud != 0) {
+        const uint64_t now_bits = now_us() * g_uart_baud / 1000000u;
+        if (g_uart_busy_until_bits < now_bits) g_uart_busy_until_bits = now_bits;
+        g_uart_busy_until_bits += 10u * static_cast<uint64_t>(len);
+    }
+    if (g_cap_buf != 0) {
+        for (uint16_t i = 0; i < len && *g_cap_len < g_cap_cap; ++i) g_cap_buf[(*g_cap_len)++] = data[i];
+        return;
+    }
+    fwrite(data, 1, len, stdout);
+    fflush(stdout);
+}
+
+const uint8_t* console_sending() {
+    retire_runs();
+    return g_runs.empty() ? 0 : g_runs.front().at;
+}
+
+bool console_needs_poll() { return false; }
+
 int16_t console_read() {
     if (g_in_len == 0 && g_use_stdin) {
         pollfd p = {0, POLLIN, 0};

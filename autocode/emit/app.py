@@ -763,6 +763,7 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
 
 
 LINK_BUFFER2_LOAD = 0.8  # the share of the line above which the link gets two frames' buffer
+LINK_BUFFER2_SLACK = 64  # and this much more: the UART's transmit ring that once held it (docs/telemetry.md)
 
 
 def _link(app: Application) -> list[str]:
@@ -776,13 +777,15 @@ def _link(app: Application) -> list[str]:
          f"const uint32_t kLinkSchema = 0x{app_schema_hash(app):08x}UL;",
          f"const uint16_t kLinkTxSize = {plan.tx_cap};  // the longest encoded frame"]
     # A link loaded near its line rate gets a transmit buffer of two longest
-    # frames: a sample frame then waits behind the rest of the one before (a
-    # health frame pushes the next sample past its turn) instead of being
-    # dropped. Below LINK_BUFFER2_LOAD of the line, one frame's buffer.
+    # frames and the LINK_BUFFER2_SLACK bytes the UART's transmit ring held
+    # before the UART sent the frames from this buffer: a sample frame then
+    # waits behind the rest of the one before (a health frame pushes the
+    # next sample past its turn) instead of being dropped. Below
+    # LINK_BUFFER2_LOAD of the line, one frame's buffer.
     load, capacity = link_load(app)  # the checker refuses a link that cannot carry it (autocode/limits.py)
-    tx_buffer = (2 * plan.tx_cap if plan.streams and load > LINK_BUFFER2_LOAD * capacity and 2 * plan.tx_cap <= 0xFFFF
-                 else plan.tx_cap)
-    c.append(f"uint8_t link_tx[{tx_buffer}];  // " + ("two longest frames: the link is loaded near its line rate"
+    two = 2 * plan.tx_cap + LINK_BUFFER2_SLACK
+    tx_buffer = (two if plan.streams and load > LINK_BUFFER2_LOAD * capacity and two <= 0xFFFF else plan.tx_cap)
+    c.append(f"uint8_t link_tx[{tx_buffer}];  // " + ("two longest frames and 64 B: the link is loaded near its line rate"
                                                     if tx_buffer != plan.tx_cap else "one longest frame"))
     for s in plan.streams:
         if s.batch > 1:

@@ -213,27 +213,19 @@
 #if !FSW_CONSOLE_ARDUINO_SERIAL && FSW_PLATFORM_ARDUINO && !defined(__AVR__)
 #  error "fswkit: the built-in UART driver is for AVR boards: set FSW_CONSOLE_ARDUINO_SERIAL=1"
 #endif
-// Ring buffers of the built-in UART0 driver, bytes (powers of two, 4..256).
-// Transmit: the link keeps one whole frame in its own buffer and hands it on
-// as this ring drains; a sample that finds that frame buffer still busy is
-// dropped, so the ring also absorbs what a busy cycle sends beyond what the
-// UART carries in one period (at 115200 baud and 100 Hz, ~117 bytes: a
-// sample frame, hello and health together are more). 64 bytes buffer as
-// much as HardwareSerial did; measured on the simulated Uno, 32 drops
-// samples when the ground's commands and the frames they ask for crowd a
-// cycle. Receive: a burst of commands from the ground waits here for the
-// next run of the uplink task (up to ~117 bytes arrive in a 10 ms cycle at
-// 115200 baud; one command is at most 24).
-#ifndef FSW_CONSOLE_TX_SIZE
-#  define FSW_CONSOLE_TX_SIZE 64
-#endif
+// The receive ring of the built-in UART0 driver, bytes (a power of two,
+// 4..256), for a program whose code does not size it (generated code sizes
+// its own for what its ground keeps in flight: 32 bytes where the ground
+// sends one command at a time, this where it pipelines them, the parameter
+// client's 90 bytes in flight; docs/runtime.md, "The console"). Up to ~117
+// bytes arrive in a 10 ms cycle at 115200 baud; one command is at most 24.
+// The driver has no transmit ring: it sends the link's frames from the
+// link's own transmit buffer (pal::console_send).
 #ifndef FSW_CONSOLE_RX_SIZE
 #  define FSW_CONSOLE_RX_SIZE 64
 #endif
-#if (FSW_CONSOLE_TX_SIZE & (FSW_CONSOLE_TX_SIZE - 1)) != 0 || FSW_CONSOLE_TX_SIZE < 4 || \
-    FSW_CONSOLE_TX_SIZE > 256 || (FSW_CONSOLE_RX_SIZE & (FSW_CONSOLE_RX_SIZE - 1)) != 0 || \
-    FSW_CONSOLE_RX_SIZE < 4 || FSW_CONSOLE_RX_SIZE > 256
-#  error "fswkit: FSW_CONSOLE_TX_SIZE and FSW_CONSOLE_RX_SIZE must be powers of two, 4..256"
+#if (FSW_CONSOLE_RX_SIZE & (FSW_CONSOLE_RX_SIZE - 1)) != 0 || FSW_CONSOLE_RX_SIZE < 4 || FSW_CONSOLE_RX_SIZE > 256
+#  error "fswkit: FSW_CONSOLE_RX_SIZE must be a power of two, 4..256"
 #endif
 
 // The link's receive buffer, bytes: the longest uplink frame encoded (SET of

@@ -120,9 +120,16 @@ FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
 
 // Frames the body in place, and `src`'s `n` bytes after it, copied in as
 // they are framed (a sample frame's current region: no second pass over
-// it), and hands the frame to the UART, which sends it from there.
-void frame_end(Link& l, const uint8_t* src = 0, uint16_t n = 0) {
-    const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
+// it); returns the frame's length, for hand().
+inline uint16_t frame_end(const uint8_t* src = 0, uint16_t n = 0) {
+    return cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
+}
+
+// Hands the frame just framed, `len` bytes, to the UART, which sends it
+// from where it lies. (Called by the frame's composer after frame_end
+// returned: not from within frame_end, where the call would add a frame to
+// the stack's deepest path, the framer's.)
+FSW_NOINLINE void hand(Link& l, uint16_t len) {
     pal::console_send(g_at, len);
     l.tx_len = static_cast<uint16_t>(l.tx_len + len);
     ++l.n.frames;
@@ -162,11 +169,11 @@ void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamS
     const bool lock = sv_lock(f);
     uint8_t* const sv = flash_get(f.sv);
     if (with_now && !lock) {
-        frame_end(l, sv + flash_get(row.off), size);  // the region copied in as it is framed
+        hand(l, frame_end(sv + flash_get(row.off), size));  // the region copied in as it is framed
         return;
     }
     if (with_now) put_sv(sv, lock, flash_get(row.off), size);  // atomically, then framed
-    frame_end(l);
+    hand(l, frame_end());
 }
 
 void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i, uint32_t now32) {
@@ -278,7 +285,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_sv(flash_get(c.sv), sv_lock(c), off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
-    frame_end(l);
+    hand(l, frame_end());
 }
 
 // Sends waiting control frames while the transmit buffer has room:

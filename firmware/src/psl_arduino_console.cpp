@@ -136,7 +136,8 @@ volatile uint8_t g_tx_next[4];  // the second run: its place, then its end (litt
 // A received byte into the ring; dropped when it is full (the uplink's CRC
 // and COBS checks then refuse the frame it belonged to). Naked: it saves
 // the four registers and the status register it uses, where the compiler's
-// handler also saved r0, r1 and r18 (62 bytes of flash where it took 74).
+// handler also saved r0, r1 and r18 (64 bytes of flash where it took 74;
+// the mask read where it lies, a byte of RAM: see fsw_console_rx_mask).
 // In C:
 //     const uint8_t b = UDR0;
 //     const uint8_t h = g_rx_head;

@@ -266,10 +266,10 @@ def line_rate(tmp: Path, seconds: float = 10.0):
 # frames, acks), and, where the firmware has them as functions of their own,
 # the two that build every frame on the wire (a sample frame: send_batch;
 # hello, health, ack, snapshot: send_control), from the room for it to the
-# encoded frame in the transmit buffer (a control frame's first hand-over to
-# the UART's ring included). link_poll (loop()'s hand-over between cycles,
-# where hello and health frames are built) is inlined into loop(): counted
-# only through send_control.
+# encoded frame in the transmit buffer, handed to the UART (which sends it
+# from there; before 2026-12-07 a control frame's first copy into the UART's
+# ring). link_poll (loop()'s service between cycles, where hello and health
+# frames are built) is inlined into loop(): counted only through send_control.
 LINK_TASKS = ("fsw::link_telemetry_task", "fsw::link_uplink_task")
 FRAME_BUILDERS = ("fsw::(anonymous namespace)::send_batch", "fsw::(anonymous namespace)::send_control")
 
@@ -429,7 +429,7 @@ def main() -> int:
             print("  per wire byte (simavr cycles, interrupts taken meanwhile included; each over the bytes sent in its")
             print("  own half of the run): the two link tasks' steps (sampling, sample frames, acks); frame building:")
             print("  the two functions that build every frame (send_batch, send_control: the room for it, header,")
-            print("  body, CRC, COBS; a control frame's first hand-over to the UART ring; hello and health are built")
+            print("  body, CRC, COBS; each frame handed to the UART, which sends it from there; hello and health are built")
             print("  between cycles).")
             print("  target <= 40 for frame building (before: the link tasks 97.0 per wire byte at N = 20, the frame")
             print("  builders inlined in them)")

@@ -42,7 +42,8 @@ void volatile wchar_t while xor xor_eq typeof
 TAKEN = frozenset("""
 fsw fsw_gen std sv app ex stats link begin poll run_cycle setup loop main run_script
 script_main script_avr fswkit arduino
-reload reload_image reload_ram vm_features app_features app_period_us params param_staged rec resume resume_watch_state time_base time_based
+reload reload_image reload_ram vm_features app_features app_period_us fsw_console_rx fsw_console_rx_mask params param_staged
+rec resume resume_watch_state time_base time_based
 add_time_base plus_time_base millis64 pulses samples
 log_fifo log_last log_nor_cs log_ring sensor_health
 memcpy memset memcmp memmove strcmp strlen strtoul sscanf printf fprintf sprintf snprintf

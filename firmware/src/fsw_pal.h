@@ -104,13 +104,13 @@ void digital_write(uint8_t pin, bool high);
 
 // ---- Console (the serial port) ----------------------------------------------
 void console_begin(uint32_t baud);
-void console_write(const uint8_t* data, uint16_t len);
 // Next received byte, or -1 when none is waiting.
 int16_t console_read();
-// Bytes console_write can take now without waiting (the transmit buffer's
-// free space): telemetry writes no more than this, so it never blocks.
-// (Not on AVR with the kit's UART0 driver, which sends only what
-// console_send hands it.)
+// console_write copies the bytes into the transmit buffer; console_write_space
+// is the bytes it takes now without waiting. Not on AVR with the kit's
+// UART0 driver, which has no transmit buffer: it sends what console_send
+// hands it, where it lies.
+void console_write(const uint8_t* data, uint16_t len);
 uint16_t console_write_space();
 // Sends the `len` bytes at `data` where they lie (no copy: the link's frames
 // go out of its own transmit buffer), after the bytes handed before. `data`

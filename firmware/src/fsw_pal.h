@@ -12,8 +12,7 @@
 #include <avr/io.h>
 // The start and end of a naked interrupt handler (ISR_NAKED) that uses
 // r24, r25 and Z and changes the status register: they are saved, the
-// status register through r24, and put back before `reti` (the ADC's scan,
-// the UART's receive handler).
+// status register through r24, and put back before `reti` (the UART's receive handler).
 #define FSW_ISR_SAVE_R24_R25_Z \
     "push r24\n\t"             \
     "in   r24, __SREG__\n\t"   \

@@ -23,8 +23,11 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.e
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
 # (bytes composed in place, bytes copied in from another buffer) of each frame
-CASES = [(1, 0), (2, 0), (5, 0), (60, 0), (252, 0), (253, 0), (254, 0), (255, 0), (300, 0), (508, 0), (600, 0),
-         (6, 24), (6, 247), (6, 248), (6, 249), (100, 300), (0, 1), (250, 10)]
+# (the loop counts a part's bytes in its count's low byte, each 256 in the
+# high byte: parts of 255, 256, 257, 511, 512 and 513 bytes cross that)
+CASES = [(1, 0), (2, 0), (5, 0), (60, 0), (252, 0), (253, 0), (254, 0), (255, 0), (256, 0), (257, 0), (300, 0),
+         (508, 0), (511, 0), (512, 0), (513, 0), (600, 0), (6, 24), (6, 247), (6, 248), (6, 249), (6, 256),
+         (100, 300), (0, 1), (0, 256), (250, 10)]
 MODES = 4  # 0: every byte zero; 1: no zero; 2: about one in four zero; 3: random bytes
 
 SKETCH = r"""

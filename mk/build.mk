@@ -51,7 +51,10 @@ RT_SRCS  := $(filter-out %/psl_native.cpp,$(sort $(wildcard $(RUNTIME)/*.cpp)))
 RT_HDRS  := $(wildcard $(RUNTIME)/*.h)
 CORE_SRCS := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcard $(CORE_DIR)/*.S)
 
-DEFS     := -mmcu=$(MCU) -DF_CPU=$(F_CPU)L -DARDUINO=10819 -D$(BOARD_DEFINE) -DARDUINO_ARCH_AVR
+# EXTRA_DEFS: more -D options for every object of this build, core and
+# runtime alike (a build option of docs/runtime.md, e.g.
+# -DFSW_CONSOLE_ARDUINO_SERIAL=1; the tests build with it)
+DEFS     := -mmcu=$(MCU) -DF_CPU=$(F_CPU)L -DARDUINO=10819 -D$(BOARD_DEFINE) -DARDUINO_ARCH_AVR $(EXTRA_DEFS)
 INCS     := -I$(CORE_DIR) -I$(VAR_DIR)
 SIZE_OPT := -mcall-prologues -mstrict-X -fno-move-loop-invariants
 OPT      := -Os $(SIZE_OPT) -g -ffunction-sections -fdata-sections -flto -fno-fat-lto-objects

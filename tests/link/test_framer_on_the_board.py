@@ -106,18 +106,24 @@ def expected() -> bytes:
     return bytes(out)
 
 
-def test_framed_bytes_on_the_wire_are_the_references():
+@pytest.mark.parametrize("board, defines", [("uno", ()), ("mega2560", ("FSW_CONSOLE_ARDUINO_SERIAL=1",))],
+                         ids=["uart0-driver", "arduino-serial"])
+def test_framed_bytes_on_the_wire_are_the_references(board, defines):
+    """The kit's UART0 driver, and the core's Serial behind the same
+    console_send (FSW_CONSOLE_ARDUINO_SERIAL=1: the runs fed to Serial as
+    its buffer takes them while the sketch polls console_sending; on the
+    Mega, where the sketch's buffers and Serial's two rings fit)."""
     from fswkit.sim.board import SimBoard
 
     source = SKETCH.replace("{CASES}", "{" + ", ".join(f"{{{a}, {b}}}" for a, b in CASES) + "}")
     source = source.replace("MODES", str(MODES))
-    elf = sketch_elf("framer", source)
+    elf = sketch_elf("framer", source, board, defines)
     want = expected()
     got = bytearray()
-    with SimBoard(elf, "uno", uart="control") as board:
+    with SimBoard(elf, board, uart="control") as sim:
         for _ in range(400):  # 40 simulated seconds at most; about 1.1 s of line time needed
-            board.step(board.cycles_for(0.1))
-            got += board.uart_read()
+            sim.step(sim.cycles_for(0.1))
+            got += sim.uart_read()
             if len(got) >= len(want):
                 break
     assert len(got) == len(want), (len(got), len(want))

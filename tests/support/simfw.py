@@ -113,11 +113,12 @@ def kept_sim(project):
     return built
 
 
-def sketch_elf(name: str, source: str, board: str = "uno") -> str:
-    """An Arduino sketch built with mk/build.mk (the Arduino core's flags)."""
+def sketch_elf(name: str, source: str, board: str = "uno", defines: tuple[str, ...] = ()) -> str:
+    """An Arduino sketch built with mk/build.mk (the Arduino core's flags),
+    with `defines` (`FSW_X=1`) for the core, the runtime and the sketch."""
     from fswkit.target.build import build_lock
 
-    out = OUT / f"{name}-{board}"
+    out = OUT / (f"{name}-{board}" + "".join(f"-{d.lower().replace('=', '')}" for d in defines))
     gen = out / "src"
     with build_lock(str(out), "test"):  # another test session may build the same sketch
         gen.mkdir(parents=True, exist_ok=True)
@@ -125,7 +126,8 @@ def sketch_elf(name: str, source: str, board: str = "uno") -> str:
         if not path.exists() or path.read_text() != source:
             path.write_text(source)
         r = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
-                            f"NAME={name}", "avr"] + BOARD_MAKE[board], capture_output=True, text=True)
+                            f"NAME={name}", "avr", "EXTRA_DEFS=" + " ".join(f"-D{d}" for d in defines)]
+                           + BOARD_MAKE[board], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-4000:]
     return str(out / f"{name}.elf")
 

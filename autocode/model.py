@@ -6,7 +6,7 @@ re-parses text."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from fractions import Fraction
 from typing import Union
 
@@ -331,6 +331,21 @@ class Sensor:
 
     def setting(self, key: str) -> int:
         return dict(self.settings)[key]
+
+    # Its hash, the dataclass's own (the same number, so sets of parts keep their order), worked out once:
+    # a co-simulation keys its parts' values by the part at every plant step, and the dataclass's hash
+    # walks every field (the elements' too) each time. Not pickled: a string's hash is another process's
+    # elsewhere.
+    def __hash__(self) -> int:
+        h = self.__dict__.get("_hash")
+        if h is None:
+            h = hash(tuple(getattr(self, f.name) for f in fields(self)))
+            object.__setattr__(self, "_hash", h)
+        return h
+
+    def __getstate__(self) -> dict:
+        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
+
 
 
 # ---- the application (spec §7) ----------------------------------------------------

@@ -372,6 +372,7 @@ class SimBoard:
         self.mcu = self.board.raw["sim"]["simavr_mcu"]
         self.f_cpu = int(f_cpu or self.board.f_cpu)
         self.pins = pin_map(self.board)
+        self._names: dict = {}  # ("a" | "d" | "p", an input) -> its name in a `batch` line (_batch_line)
         if uart not in ("control", "pty", "none"):
             raise ValueError(f"uart must be control, pty or none, not {uart!r}")
         self.uart = uart
@@ -569,17 +570,28 @@ class SimBoard:
 
     def _batch_line(self, word: str, until: int, analog=None, digital=None, parts=None) -> str:
         line = f"{word} {int(until)}"
+        # each input's name in the protocol, looked up once (a co-simulation sends a line a plant step)
+        names = self._names
         if analog:
             for p, v in analog.items():
-                line += f" {self.adc_channel(p)}={self._millivolts(v)}"
+                name = names.get(("a", p))
+                if name is None:
+                    name = names["a", p] = f" {self.adc_channel(p)}="
+                line += f"{name}{self._millivolts(v)}"
         if digital:
             for pin, level in digital.items():
-                port, bit = self._port_bit(pin)
-                line += f" {port}{bit}={1 if level else 0}"
+                name = names.get(("d", pin))
+                if name is None:
+                    port, bit = self._port_bit(pin)
+                    name = names["d", pin] = f" {port}{bit}="
+                line += f"{name}{1 if level else 0}"
         if parts:
             for where, values in parts.items():
                 if values:
-                    line += f" @{_part_id(where)}:" + ",".join(f"{k}={int(v)}" for k, v in values.items())
+                    name = names.get(("p", where))
+                    if name is None:
+                        name = names["p", where] = f" @{_part_id(where)}:"
+                    line += name + ",".join(f"{k}={int(v)}" for k, v in values.items())
         return line + "\n"
 
     def _batch_result(self, text: str) -> Batch:

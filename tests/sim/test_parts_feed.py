@@ -100,6 +100,61 @@ def test_a_temperature_met_again_reads_the_count_a_full_search_gives():
         assert feed.raw(pressure=100000.0, temperature=t_c)["D2"] == P.ms5611_D2_for(m, t_c), t_c
 
 
+def test_the_pressure_formula_without_its_wrapping_is_the_datasheets():
+    """parts.bmp280_P64_fn (what the feed evaluates at every plant step) is
+    bmp280_P64_of at every adc_P tried, for the datasheet's calibration and
+    random ones, at t_fines where it drops the 64-bit wrapping (its bounds
+    allow) and where it keeps the full formula; for the datasheet's part it
+    is the unwrapped one (the fast path is the one flights take)."""
+    rng = random.Random(11)
+    calibs = [P.BMP280_EXAMPLE[0]] + [
+        P.Bmp280Calib(rng.randint(1, 65535), rng.randint(-32768, 32767), rng.randint(-32768, 32767),
+                      rng.randint(1, 65535), *(rng.randint(-32768, 32767) for _ in range(8))) for _ in range(40)]
+    paths = set()
+    for c in calibs:
+        for tf in (128422, 0, 90000, 150000, -400000, rng.randint(-2 ** 20, 2 ** 20)):
+            terms = P.bmp280_P64_terms(c, tf)
+            of = P.bmp280_P64_fn(c, terms)
+            paths.add(of.__name__)
+            for a in [0, 1, 0xFFFFE, 0xFFFFF] + [rng.randint(0, 0xFFFFF) for _ in range(150)]:
+                assert of(a) == P.bmp280_P64_of(c, a, terms), (c, tf, a)
+    assert paths == {"of", "<lambda>"}  # both ways taken
+    assert P.bmp280_P64_fn(P.BMP280_EXAMPLE[0], P.bmp280_P64_terms(P.BMP280_EXAMPLE[0], 128422)).__name__ == "of"
+
+
+def test_the_walk_with_values_kept_answers_as_the_full_search():
+    """sensors._walk_nearest, given values of f already known (the feed
+    keeps them between plant steps), answers as parts._nearest_search does,
+    from any guess, rising and falling, with repeated values."""
+    from fswkit.sim.sensors import _walk_nearest
+
+    rng = random.Random(3)
+    for _ in range(3000):
+        k, off = rng.choice([-1, 1]) * rng.uniform(0.05, 3), rng.uniform(-50, 50)
+        inc = k > 0
+        hi = rng.choice([3, 50, 0xFFFFF])
+        f = (lambda x, k=k, off=off: int(k * x + off))  # monotonic, plateaus where |k| < 1
+        target = rng.uniform(min(f(0), f(hi)) - 5, max(f(0), f(hi)) + 5)
+        seen = {x: f(x) for x in (rng.randint(0, hi) for _ in range(rng.randint(0, 6)))}
+        assert _walk_nearest(f, target, rng.randint(-5, hi + 5), 0, hi, inc, seen) == \
+            P._nearest_search(f, target, 0, hi, inc)
+
+
+def test_a_parts_hash_is_the_dataclasss_and_is_not_pickled():
+    """Sensor keeps its hash (the number the dataclass's own hash gives, so
+    sets of parts keep their order) after the first time; a pickled part
+    carries no hash (another process hashes strings otherwise) and equals
+    and hashes as the original."""
+    import dataclasses
+    import pickle
+
+    fields = [getattr(BMP, f.name) for f in dataclasses.fields(BMP)]
+    assert hash(BMP) == hash(tuple(fields)) == hash(BMP)
+    copy = pickle.loads(pickle.dumps(BMP))
+    assert "_hash" not in copy.__dict__ and copy == BMP and hash(copy) == hash(BMP)
+    assert dataclasses.replace(BMP, line=2) != BMP and hash(dataclasses.replace(BMP, line=2)) != hash(BMP)
+
+
 def test_accelerometer_counts_at_the_parts_range():
     """ADXL345 in full resolution: 256 counts a g at every range, stopping at
     the range's 13 bits (+-16 g); MPU-6050 at +-8 g: 4096 a g; an axis not

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 __all__ = [
     "Bmp280Calib", "bmp280_parse_calib", "bmp280_parse_raw", "bmp280_raw_bytes", "bmp280_calib_bytes",
-    "bmp280_compensate_T", "bmp280_compensate_P64", "bmp280_P64_terms", "bmp280_P64_of", "bmp280_compensate_P32",
-    "bmp280_adc_T_for", "bmp280_adc_P_for",
+    "bmp280_compensate_T", "bmp280_compensate_P64", "bmp280_P64_terms", "bmp280_P64_of", "bmp280_P64_fn",
+    "bmp280_compensate_P32", "bmp280_adc_T_for", "bmp280_adc_P_for",
     "Ms5611Calib", "Ms5611Result", "ms5611_crc4", "ms5611_prom_words", "ms5611_parse_prom", "ms5611_compensate",
     "ms5611_D2_for", "ms5611_D1_for",
     "adxl345_bits", "adxl345_counts", "adxl345_g_per_count", "adxl345_raw_bytes",
@@ -141,6 +141,35 @@ def bmp280_P64_of(c: Bmp280Calib, adc_P: int, terms: tuple[int, int]) -> int:
     var2 = _s64(c.dig_P8 * p) >> 19
     p = _s64((_s64(_s64(p + var1) + var2) >> 8) + _s64(c.dig_P7 << 4))
     return p & 0xFFFFFFFF
+
+
+def bmp280_P64_fn(c: Bmp280Calib, terms: tuple[int, int]):
+    """adc_P -> bmp280_P64_of(c, adc_P, terms), the same value for every
+    adc_P in 0..0xFFFFF, cheaper: when no intermediate of the formula can
+    leave the signed 64-bit range for any of those adc_P at these `terms`
+    (bounds worked out here once), the formula without its wrapping, its
+    constants folded; else bmp280_P64_of itself."""
+    var1, var2 = terms
+    if var1 <= 0:
+        return lambda a: bmp280_P64_of(c, a, terms)
+    P7, P8, P9 = c.dig_P7 << 4, c.dig_P8, c.dig_P9
+    lim = 1 << 63
+    # (p << 31) - var2 for p = 1048576 - adc_P in 1..2^20 rises with p: its most negative and most positive
+    n = max(abs((1 << 31) - var2), abs((1048576 << 31) - var2))
+    q = n * 3125 // var1  # |p| after the division at most
+    s = (q >> 13) + 1  # |p >> 13| at most
+    if n * 3125 >= lim or abs(P9) * s * s >= lim or abs(P8) * q >= lim or \
+            q + (abs(P9) * s * s >> 25) + (abs(P8) * q >> 19) + abs(P7) + 2 >= lim:
+        return lambda a: bmp280_P64_of(c, a, terms)
+    # every intermediate is within range: _s64 is the identity on each (the division truncates toward
+    # zero, as C's)
+
+    def of(adc_P: int) -> int:
+        n = (((1048576 - adc_P) << 31) - var2) * 3125
+        p = n // var1 if n >= 0 else -(-n // var1)
+        s = p >> 13
+        return (((p + (P9 * s * s >> 25) + (P8 * p >> 19)) >> 8) + P7) & 0xFFFFFFFF
+    return of
 
 
 def bmp280_compensate_P32(c: Bmp280Calib, adc_P: int, t_fine: int) -> int:

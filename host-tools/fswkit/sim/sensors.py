@@ -166,48 +166,71 @@ def find_part(sensors, text: str, kinds: tuple[str, ...]):
     return hit[0], None
 
 
-def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bool) -> int:
+def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bool,
+                  seen: dict[int, float] | None = None) -> int:
     """parts._nearest_search's answer, found by galloping from `guess`
     (steps 1, 2, 4, ... until the answer is bracketed, then bisection): a
-    few evaluations when the guess is close."""
-    seen: dict[int, float] = {}
-
-    def value(x):  # each x evaluated once: the last comparison reuses the search's values
-        v = seen.get(x)
-        if v is None:
-            v = seen[x] = f(x)
-        return v
-
-    def reached(x):  # the full search's condition: its answer is the first x that reaches
-        v = value(x)
-        return v >= target if increasing else v <= target
+    few evaluations when the guess is close. `seen`: f's values already
+    known (x -> f(x)), kept and added to (f is a pure function)."""
+    if seen is None:
+        seen = {}
+    get = seen.get
+    # each x evaluated once (the last comparison reuses the search's values); an x "reaches" when f(x) is at
+    # or past the target (the full search's condition: its answer is the first x that reaches)
     x = min(max(guess, lo), hi)
+    v = get(x)
+    if v is None:
+        v = seen[x] = f(x)
     step = 1
-    if reached(x):  # the first reaching x is at or below x
+    if (v >= target) if increasing else (v <= target):  # the first reaching x is at or below x
         b = x
         while True:
             a = max(lo, b - step)
-            if a == lo or not reached(a):
+            if a == lo:
+                break
+            v = get(a)
+            if v is None:
+                v = seen[a] = f(a)
+            if not ((v >= target) if increasing else (v <= target)):
                 break
             b, step = a, step * 2
-        if a == lo and reached(lo):
-            b = lo
+        if a == lo:
+            v = get(lo)
+            if v is None:
+                v = seen[lo] = f(lo)
+            if (v >= target) if increasing else (v <= target):
+                b = lo
     else:  # above x
         a = x
         while True:
             b = min(hi, a + step)
-            if b == hi or reached(b):
+            if b == hi:
+                break
+            v = get(b)
+            if v is None:
+                v = seen[b] = f(b)
+            if (v >= target) if increasing else (v <= target):
                 break
             a, step = b, step * 2
     while a < b:  # the first reaching x in (a, b], `a` not reaching (or lo)
         m = (a + b) // 2
-        if reached(m):
+        v = get(m)
+        if v is None:
+            v = seen[m] = f(m)
+        if (v >= target) if increasing else (v <= target):
             b = m
         else:
             a = m + 1
     x = b
-    if x > lo and abs(value(x - 1) - target) <= abs(value(x) - target):
-        return x - 1
+    if x > lo:
+        v0 = get(x - 1)
+        if v0 is None:
+            v0 = seen[x - 1] = f(x - 1)
+        v = get(x)
+        if v is None:
+            v = seen[x] = f(x)
+        if abs(v0 - target) <= abs(v - target):
+            return x - 1
     return x
 
 
@@ -231,22 +254,24 @@ class _Inverse:
         self.slope: float | None = None  # counts per unit of target
         self.known: dict[int, int] | None = {} if whole else None  # ceil(2 x target) (floor) -> the answer
 
-    def __call__(self, f, target: float, full) -> int:
+    def __call__(self, f, target: float, full, seen: dict | None = None) -> int:
+        """The answer for `target`; `full()` the full search's (the first time); `seen`: f's values known
+        (x -> f(x)), kept and added to, as _walk_nearest's."""
         known = self.known
         if known is not None and math.isfinite(target):
             key = math.ceil(2.0 * target) if self.increasing else math.floor(2.0 * target)
             x = known.get(key)
             if x is None:
-                x = known[key] = self._search(f, target, full)
+                x = known[key] = self._search(f, target, full, seen)
             return x
-        return self._search(f, target, full)
+        return self._search(f, target, full, seen)
 
-    def _search(self, f, target: float, full) -> int:
+    def _search(self, f, target: float, full, seen: dict | None = None) -> int:
         x = None
         if self.last is not None and self.slope is not None:
             t0, x0 = self.last
             x = _walk_nearest(f, target, int(round(x0 + (target - t0) * self.slope)), self.lo, self.hi,
-                              self.increasing)
+                              self.increasing, seen)
         else:
             x = full()
         if self.last is not None and target != self.last[0] and x != self.last[1]:
@@ -292,10 +317,17 @@ class PartFeed:
         # the BMP280's compensations are pure functions of the raw counts (and t_fine): each raw count's
         # value is worked out once (a flight's temperatures span a few hundred adc_T; its pressures, for
         # one t_fine at a time, the few counts around the last answer)
-        self._t_of: dict[int, tuple[int, int]] = {}  # adc_T -> bmp280_compensate_T
+        self._t_of: dict[int, int] = {}  # adc_T -> bmp280_compensate_T's T
+        self._t_fine: dict[int, int] = {}  # adc_T -> bmp280_compensate_T's t_fine
         self._p_of: dict[int, int] = {}  # adc_P -> bmp280_compensate_P64 at t_fine self._p_tf
         self._p_tf: int | None = None
-        self._p_terms: tuple[int, int] = (0, 0)  # parts.bmp280_P64_terms at self._p_tf
+        self._p_fn = None  # adc_P -> bmp280_compensate_P64 at self._p_tf (parts.bmp280_P64_fn)
+        self._accel_forms: dict = {}  # the accelerometer's range setting -> _accel_form's answer
+
+    def _bmp280_T(self, adc_T: int) -> int:
+        """bmp280_compensate_T's T for adc_T (its t_fine kept in _t_fine)."""
+        T, self._t_fine[adc_T] = self._P.bmp280_compensate_T(self.calib, adc_T)
+        return T
 
     @property
     def data_format(self) -> int:
@@ -311,15 +343,11 @@ class PartFeed:
             t_c = 15.0 if temperature is None else float(temperature)
             if self._t is None or self._t[0] != t_c:
                 if self.part == "bmp280":
-                    c, t_of = self.calib, self._t_of
-
-                    def comp_t(a):
-                        r = t_of.get(a)
-                        if r is None:
-                            r = t_of[a] = P.bmp280_compensate_T(c, a)
-                        return r
-                    adc_T = self._temp(lambda a: comp_t(a)[0], t_c * 100.0, lambda: P.bmp280_adc_T_for(c, t_c))
-                    self._t = (t_c, adc_T, comp_t(adc_T)[1])
+                    c = self.calib
+                    adc_T = self._temp(self._bmp280_T, t_c * 100.0, lambda: P.bmp280_adc_T_for(c, t_c), self._t_of)
+                    if adc_T not in self._t_fine:
+                        self._bmp280_T(adc_T)
+                    self._t = (t_c, adc_T, self._t_fine[adc_T])
                 else:
                     c = self.calib
                     self._t = (t_c, self._temp(lambda d: P.ms5611_compensate(c, 0, d, True).TEMP, t_c * 100.0,
@@ -329,16 +357,10 @@ class PartFeed:
                 if pressure is not None:
                     c, tf = self.calib, self._t[2]
                     if tf != self._p_tf:  # (and t_fine's part of the formula, worked out once for it)
-                        self._p_tf, self._p_of, self._p_terms = tf, {}, P.bmp280_P64_terms(c, tf)
-                    p_of, terms = self._p_of, self._p_terms
-
-                    def comp_p(a):
-                        r = p_of.get(a)
-                        if r is None:
-                            r = p_of[a] = P.bmp280_P64_of(c, a, terms)
-                        return r
-                    out["adc_P"] = self._p(comp_p, float(pressure) * 256.0,
-                                           lambda: P.bmp280_adc_P_for(c, float(pressure), tf))
+                        self._p_tf, self._p_of = tf, {}
+                        self._p_fn = P.bmp280_P64_fn(c, P.bmp280_P64_terms(c, tf))
+                    pa = float(pressure)
+                    out["adc_P"] = self._p(self._p_fn, pa * 256.0, lambda: P.bmp280_adc_P_for(c, pa, tf), self._p_of)
             else:
                 out["D2"] = d2 = self._t[1]
                 if pressure is not None:
@@ -347,17 +369,27 @@ class PartFeed:
                                         lambda: P._nearest_search(lambda d: P.ms5611_compensate(c, d, d2, True).P,
                                                                      float(pressure), 0, 0xFFFFFF, True))
             return out
-        if self.part == "adxl345":
-            fmt = self.data_format
-            per, bits = P.adxl345_g_per_count(fmt), P.adxl345_bits(fmt)
-            lim = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1)
-        else:
-            afs = {2: 0, 4: 1, 8: 2, 16: 3}[self.settings.get("range", 16)]
-            per, lim = P.mpu6050_g_per_count(afs), (-32768, 32767)
+        per, lo, hi, names = self._accel_form()
         out = {}
-        for name, g in ((("x", x), ("y", y), ("z", z)) if self.part == "adxl345" else
-                        (("ax", x), ("ay", y), ("az", z))):
-            out[name] = min(max(int(round(float(g) / per)), lim[0]), lim[1])
+        for name, g in zip(names, (x, y, z)):
+            out[name] = min(max(int(round(float(g) / per)), lo), hi)
         if self.part == "mpu6050" and temperature is not None:
             out["temp"] = min(max(int(round((float(temperature) - 36.53) * 340.0)), -32768), 32767)
         return out
+
+    def _accel_form(self) -> tuple[float, int, int, tuple[str, str, str]]:
+        """An accelerometer's (g a count, least count, greatest count, the axes' raw names) for its
+        settings, worked out once for them (`raw` runs every plant step)."""
+        key = self.settings.get("range", 16)
+        form = self._accel_forms.get(key)
+        if form is None:
+            P = self._P
+            if self.part == "adxl345":
+                fmt = self.data_format
+                per, bits = P.adxl345_g_per_count(fmt), P.adxl345_bits(fmt)
+                form = (per, -(1 << (bits - 1)), (1 << (bits - 1)) - 1, ("x", "y", "z"))
+            else:
+                afs = {2: 0, 4: 1, 8: 2, 16: 3}[key]
+                form = (P.mpu6050_g_per_count(afs), -32768, 32767, ("ax", "ay", "az"))
+            form = self._accel_forms[key] = form
+        return form

@@ -169,13 +169,27 @@ class Rocket:
         cda = self.cd_area(t + dt / 2)
         f = self._accel
         eps = dt * 1e-6  # the ends are evaluated just inside the step: a thrust curve's steps fall between
-        a1 = f(t + eps, h, v, cda)
-        v2 = v + a1 * dt / 2
-        a2 = f(t + dt / 2, h + v * dt / 2, v2, cda)
-        v3 = v + a2 * dt / 2
-        a3 = f(t + dt / 2, h + v2 * dt / 2, v3, cda)
-        v4 = v + a3 * dt
-        a4 = f(t1 - eps, h + v3 * dt, v4, cda)
+        ign = self.ignition
+        if self.wind is None and (ign is None or min(t + eps, t + dt / 2, t1 - eps, t1) - ign >= self.motor.burn_time):
+            # no thrust anywhere in the step (before ignition, after burn-out) and still air: the thrust and
+            # the mass are the same at every instant _accel is asked about, worked out once here, and the
+            # accelerations are _accel's own arithmetic, operation for operation
+            thr, m, g, rho = self.thrust(t1), self.mass(t1), self.g, self._rho
+            a1 = (thr + -0.5 * rho(h) * v * abs(v) * cda) / m - g
+            v2 = v + a1 * dt / 2
+            a2 = (thr + -0.5 * rho(h + v * dt / 2) * v2 * abs(v2) * cda) / m - g
+            v3 = v + a2 * dt / 2
+            a3 = (thr + -0.5 * rho(h + v2 * dt / 2) * v3 * abs(v3) * cda) / m - g
+            v4 = v + a3 * dt
+            a4 = (thr + -0.5 * rho(h + v3 * dt) * v4 * abs(v4) * cda) / m - g
+        else:
+            a1 = f(t + eps, h, v, cda)
+            v2 = v + a1 * dt / 2
+            a2 = f(t + dt / 2, h + v * dt / 2, v2, cda)
+            v3 = v + a2 * dt / 2
+            a3 = f(t + dt / 2, h + v2 * dt / 2, v3, cda)
+            v4 = v + a3 * dt
+            a4 = f(t1 - eps, h + v3 * dt, v4, cda)
         h += dt * (v + 2 * v2 + 2 * v3 + v4) / 6
         v += dt * (a1 + 2 * a2 + 2 * a3 + a4) / 6
         if not (math.isfinite(h) and math.isfinite(v)):

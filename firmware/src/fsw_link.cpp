@@ -103,33 +103,43 @@ bool tx_room(Link& l, uint16_t need) {
 // goes (one byte after the frame's start, cobs_frame), then framed in one
 // pass. A frame is composed whole within one call, so one write pointer
 // serves every link; the helpers below keep each field to one short call.
-void put_u16(uint16_t v) { put_bytes(&v, 2); }  // little-endian targets (fsw_config.h)
-void put_u32(uint32_t v) { put_bytes(&v, 4); }
+// A value is stored from its registers where the body goes (little-endian
+// targets, fsw_config.h): no copy of it on the caller's stack, the control
+// frames' composer's being on the deepest path of the stack.
+FSW_NOINLINE void put_u16(uint16_t v) {
+    store<uint16_t>(g_w, v);
+    g_w += 2;
+}
+FSW_NOINLINE void put_u32(uint32_t v) {
+    store<uint32_t>(g_w, v);
+    g_w += 4;
+}
 
 // The header: type, the frame counter's low byte, the low 32 bits of the
-// time (`time` points at its little-endian bytes). The frame goes after
+// time; its high 32 bits lie after it, where the body's first 4 bytes go
+// (a health frame's are they; a hello moves them; any other frame's body
+// writes over them: every frame's room holds them). The frame goes after
 // the bytes the transmit buffer still holds.
-FSW_NOINLINE void frame_begin(Link& l, uint8_t type, const void* time) {
+FSW_NOINLINE void frame_begin(Link& l, uint8_t type, uint64_t time) {
     g_at = tx_buf(l) + l.tx_len;
     uint8_t* w = g_at + 1;
     w[0] = type;
     w[1] = static_cast<uint8_t>(l.n.frames);
-    memcpy(w + 2, time, 4);
+    store<uint64_t>(w + 2, time);
     g_w = w + 6;
 }
 
+const uint16_t kNoFrame = 0xFFFFu;  // frame_end's `n`: no frame (a sample frame with no room)
+
 // Frames the body in place, and `src`'s `n` bytes after it, copied in as
 // they are framed (a sample frame's current region: no second pass over
-// it); returns the frame's length, for hand().
-inline uint16_t frame_end(const uint8_t* src = 0, uint16_t n = 0) {
-    return cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
-}
-
-// Hands the frame just framed, `len` bytes, to the UART, which sends it
-// from where it lies. (Called by the frame's composer after frame_end
-// returned: not from within frame_end, where the call would add a frame to
-// the stack's deepest path, the framer's.)
-FSW_NOINLINE void hand(Link& l, uint16_t len) {
+// it), and hands the frame to the UART, which sends it from where it lies.
+// Called by the caller of the frame's composer (send_control, send_batch),
+// once it has returned: the framer's frame goes on the caller's, not on the
+// composer's (18 and 28 bytes, on the deepest paths of the stack).
+FSW_NOINLINE void frame_end(Link& l, const uint8_t* src, uint16_t n) {
+    if (n == kNoFrame) return;
+    const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
     pal::console_send(g_at, len);
     l.tx_len = static_cast<uint16_t>(l.tx_len + len);
     ++l.n.frames;
@@ -147,10 +157,24 @@ inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
     return app_has(kAppSvLock) && flash_get(c.lock);
 }
 
-// Sends the open batch of stream i (and the current region when `with_now`).
-// `row` is the stream's row in flash (FSW_FLASH), its fields read where used.
-void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
-                bool with_now) {
+// What a sample frame's composer leaves for its framing: the current
+// region's bytes, copied in as they are framed (`src` 0: none, the body
+// is complete), or no frame at all (`n` kNoFrame: the batch was dropped).
+struct SampleTail {
+    const uint8_t* src;
+    uint16_t n;
+};
+
+// Composes the frame of stream i's open batch (and of the current region
+// when `with_now`): header and stored samples into the transmit buffer, the
+// region left for the framer (or put in already, atomically, when the lock
+// is on). The telemetry task frames and hands it (sample_frame_end): the
+// framer is then called from the task's frame, not from this one's, and the
+// deepest path of the stack (the task's step, the framer's) is this frame's
+// 18 bytes shorter. `row` is the stream's row in flash (FSW_FLASH), its
+// fields read where used.
+SampleTail send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
+                      bool with_now) {
 #if defined(__AVR__)
     FSW_SAVES_IN_RUN("r15");  // (fsw_types.h) the registers it saves through the shared routine
 #endif
@@ -162,18 +186,15 @@ void send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamS
     const uint16_t body = static_cast<uint16_t>(kLinkHeader + (stored + (with_now ? 1u : 0u)) * size);
     if (!tx_room(l, static_cast<uint16_t>(body + 4u + (body >> 7)))) {
         ++l.n.dropped;
-        return;
+        return SampleTail{0, kNoFrame};
     }
-    frame_begin(l, static_cast<uint8_t>(kFrameSample | i), &st.t0);
+    frame_begin(l, static_cast<uint8_t>(kFrameSample | i), st.t0);
     if (stored != 0) put_bytes(flash_get(row.store), static_cast<uint16_t>(stored * size));
     const bool lock = sv_lock(f);
     uint8_t* const sv = flash_get(f.sv);
-    if (with_now && !lock) {
-        hand(l, frame_end(sv + flash_get(row.off), size));  // the region copied in as it is framed
-        return;
-    }
+    if (with_now && !lock) return SampleTail{sv + flash_get(row.off), size};  // copied in as it is framed
     if (with_now) put_sv(sv, lock, flash_get(row.off), size);  // atomically, then framed
-    hand(l, frame_end());
+    return SampleTail{0, 0};
 }
 
 void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i, uint32_t now32) {
@@ -182,7 +203,10 @@ void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i,
     // Samples of a frame are evenly spaced: a batch the executor broke by
     // skipping cycles goes out as it is (a cycle that only started late
     // still takes its sample).
-    if (st.count != 0 && skipped != st.skipped0) send_batch(l, f, row, st, i, false);
+    if (st.count != 0 && skipped != st.skipped0) {
+        const SampleTail t = send_batch(l, f, row, st, i, false);
+        frame_end(l, t.src, t.n);
+    }
     if (st.count == 0) {
         st.t0 = now32;
         st.skipped0 = skipped;
@@ -193,7 +217,8 @@ void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i,
         ++st.count;
         return;
     }
-    send_batch(l, f, row, st, i, true);
+    const SampleTail t = send_batch(l, f, row, st, i, true);
+    frame_end(l, t.src, t.n);
 }
 
 // The parameter store's source byte of hello and health frames.
@@ -202,17 +227,18 @@ inline __attribute__((always_inline)) uint8_t param_source(const LinkConfig& c) 
     return params != 0 ? params->source : static_cast<uint8_t>(kParamNone);
 }
 
-// One control frame: `type` is kFrameAck, kFrameHello, kFrameHealth or
-// kFrameSnapshot. The control path (service, send_control, the uplink's
+// One control frame composed (`type` is kFrameAck, kFrameHello,
+// kFrameHealth or kFrameSnapshot); the caller frames and hands it, so the
+// framer's frame goes on the caller's (service's), not on this one's 28
+// bytes, the deepest of the link's. The control path (service, send_control, the uplink's
 // apply) reads the configuration `c`, an FSW_FLASH object, a field at a
 // time where it uses one: no copy of the whole on the stack, whose deepest
 // reach is on this path (a copy was 54 of the rocket's 192 bytes).
 FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
-    const uint64_t t = flash_get(c.now)();
-    // t's bytes, little-endian (fsw_config.h): the header takes the low half, hello and health the
-    // high half (read where t lies: no copy of it on the stack)
-    const uint8_t* const tb = reinterpret_cast<const uint8_t*>(&t);
-    frame_begin(l, type, tb);
+    // the header takes the time's low half, hello and health its high half, which frame_begin
+    // leaves after the header (a copy of the time on this frame's stack was 8 of the bytes on the
+    // deepest path of the stack)
+    frame_begin(l, type, flash_get(c.now)());
     const Executor& ex = *flash_get(c.ex);
     if (type == kFrameAck) {
         put_bytes(&l.ack_seq, 4);  // cmd_seq, op, status
@@ -236,9 +262,10 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
             if (reload_ack != 0) reload_ack(l, *reload);
         }
     } else if (type == kFrameHello) {
+        memmove(g_w + 5, g_w, 4);  // the time's high half, after the protocol and the schema
         put(kLinkProtocol);
         put_u32(flash_get(c.schema));
-        put_bytes(tb + 4, 4);
+        g_w += 4;
         put_bytes(&l.n.frames, 4);
         put(FSW_RUNTIME_VERSION_MAJOR);
         put(FSW_RUNTIME_VERSION_MINOR);
@@ -247,7 +274,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_bytes(&l.n.last_seq, 2);
         put(param_source(c));
     } else if (type == kFrameHealth) {
-        put_bytes(tb + 4, 4);
+        g_w += 4;  // the time's high half, where frame_begin left it
         put_bytes(&l.n.frames, 8);   // frames, dropped
         put_bytes(&ex.cycles, 7);    // cycles, late, reset_cause
         put_bytes(&l.n.rx_ok, 14);   // rx_ok .. last_seq
@@ -263,11 +290,11 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
             const ElemOff mode_off =  // the task's mode: its element, or its record
                 app_has(kAppModeElems) ? flash_get(tasks[i].mode_off) : static_cast<ElemOff>(kNoElement);
             const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
-            const uint8_t row[6] = {mode_off != kNoElement ? sv[mode_off] : s.mode,
-                                    s.faults,  // saturates at 255
-                                    static_cast<uint8_t>(s.overruns), static_cast<uint8_t>(s.overruns >> 8),
-                                    static_cast<uint8_t>(worst), static_cast<uint8_t>(worst >> 8)};
-            put_bytes(row, sizeof row);
+            // the row's 6 bytes written where they go (no copy of them on the stack)
+            put(mode_off != kNoElement ? sv[mode_off] : s.mode);
+            put(s.faults);  // saturates at 255
+            put_u16(s.overruns);
+            put_u16(worst);
         }
         if (app_has(kAppPyro)) {
             const PyroGate* const pyro = flash_get(c.pyro);
@@ -285,7 +312,6 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_sv(flash_get(c.sv), sv_lock(c), off, n);
         l.snapshot_at = static_cast<uint16_t>(off + n) >= sv_size ? kNoSnapshot : static_cast<uint16_t>(off + n);
     }
-    hand(l, frame_end());
 }
 
 // Sends waiting control frames while the transmit buffer has room:
@@ -318,6 +344,7 @@ void service(Link& l, const LinkConfig& c, bool big) {
         const uint8_t may = big_ok ? p : static_cast<uint8_t>(p & kPendAck);
         l.pending = static_cast<uint8_t>(p & ~(may & (0u - may)));
         send_control(l, c, type);
+        frame_end(l, 0, 0);
     }
 }
 

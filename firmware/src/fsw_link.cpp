@@ -197,8 +197,8 @@ SampleTail send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkS
     return SampleTail{0, 0};
 }
 
-void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, uint8_t i, uint32_t now32) {
-    LinkStreamState& st = flash_get(f.stream_state)[i];
+void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
+                 uint32_t now32) {
     const uint16_t skipped = flash_get(f.ex)->skipped;
     // Samples of a frame are evenly spaced: a batch the executor broke by
     // skipping cycles goes out as it is (a cycle that only started late
@@ -510,22 +510,22 @@ Result link_telemetry_task(void* p) {
     uint32_t now32 = 0;
     bool have_now = false;
     const uint8_t n_streams = flash_get(f.n_streams);
-    LinkStreamState* const states = flash_get(f.stream_state);
-    for (uint8_t i = 0; i < n_streams; ++i) {
-        LinkStreamState& st = states[i];
-        if (st.countdown != 0) {
-            --st.countdown;
+    // the stream's row (FSW_FLASH) and record walked along with i: its row read where its fields
+    // are used, no copy of it on the stack, on the deepest path of the rocket's (this task's
+    // frame, the framer's)
+    const LinkStream* row = flash_get(f.streams);
+    LinkStreamState* st = flash_get(f.stream_state);
+    for (uint8_t i = 0; i < n_streams; ++i, ++row, ++st) {
+        if (st->countdown != 0) {
+            --st->countdown;
             continue;
         }
         if (!have_now) {
             now32 = static_cast<uint32_t>(flash_get(f.now)());
             have_now = true;
         }
-        // the stream's row read where its fields are used: no copy of it on the stack, on the
-        // deepest path of the rocket's (this task's frame, send_batch's, the framer's)
-        const LinkStream& row = flash_get(f.streams)[i];
-        st.countdown = static_cast<uint16_t>(flash_get(row.every) - 1u);
-        take_sample(l, f, row, i, now32);
+        st->countdown = static_cast<uint16_t>(flash_get(row->every) - 1u);
+        take_sample(l, f, *row, *st, i, now32);
     }
     const uint16_t health_every = flash_get(f.health_every);
     if (health_every != 0 && --l.health_countdown == 0) {

@@ -140,9 +140,9 @@ const uint16_t kNoFrame = 0xFFFFu;  // frame_end's `n`: no frame (a sample frame
 FSW_NOINLINE void frame_end(Link& l, const uint8_t* src, uint16_t n) {
     if (n == kNoFrame) return;
     const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
-    pal::console_send(g_at, len);
     l.tx_len = static_cast<uint16_t>(l.tx_len + len);
     ++l.n.frames;
+    pal::console_send(g_at, len);  // (last: nothing kept across it)
 }
 
 // State vector bytes into the frame, atomically when the lock is on.

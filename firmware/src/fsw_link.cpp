@@ -34,8 +34,9 @@ uint8_t* g_w;   // where the next body byte goes
 
 FSW_NOINLINE void link_put(uint8_t b) { *g_w++ = b; }
 FSW_NOINLINE void link_put_bytes(const void* p, uint16_t n) {
-    memcpy(g_w, p, n);
-    g_w += n;
+    uint8_t* const w = g_w;
+    g_w = w + n;
+    memcpy(w, p, n);  // last: nothing kept across it (a frame less on the stack's deep paths)
 }
 
 namespace {
@@ -81,9 +82,10 @@ inline void pump() {
 // is in that run, at the front, in the bytes the UART has sent; else there
 // is no room for it yet. (A sample frame's `need` is its size bound; a
 // control frame's, whose size is known only once composed, the longest
-// frame's.)
-bool tx_room(Link& l, uint16_t need) {
-    const uint8_t* const at = pal::console_sending();
+// frame's.) `at` is where the UART is (pal::console_sending(), asked by
+// the caller: this then calls nothing, and saves nothing on the stack's
+// deep paths, the sample frame's).
+bool tx_room(Link& l, uint16_t need, const uint8_t* at) {
     const uint16_t size = tx_bytes(l);
     if (at == 0) {  // every byte out: the buffer is free
         l.tx_len = 0;
@@ -184,7 +186,7 @@ SampleTail send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkS
     // the frame's encoded size bound: body, CRC, code bytes (body / 128: a
     // bound of body / 254 without a division), delimiter
     const uint16_t body = static_cast<uint16_t>(kLinkHeader + (stored + (with_now ? 1u : 0u)) * size);
-    if (!tx_room(l, static_cast<uint16_t>(body + 4u + (body >> 7)))) {
+    if (!tx_room(l, static_cast<uint16_t>(body + 4u + (body >> 7)), pal::console_sending())) {
         ++l.n.dropped;
         return SampleTail{0, kNoFrame};
     }
@@ -323,7 +325,7 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
 void service(Link& l, const LinkConfig& c, bool big) {
     const uint16_t tx_cap = flash_get(c.tx_cap);
     const Executor* const ex = flash_get(c.ex);
-    while (tx_room(l, tx_cap)) {
+    while (tx_room(l, tx_cap, pal::console_sending())) {
         const uint8_t p = l.pending;
         const uint8_t cycle = static_cast<uint8_t>(ex->cycles);
         const bool big_ok = big && static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;

@@ -264,14 +264,19 @@ def line_rate(tmp: Path, seconds: float = 10.0):
 # What the per-byte cost counts (simavr cycles, interrupts taken meanwhile
 # included): the two link tasks (their steps: sampling, building the sample
 # frames, acks), and, where the firmware has them as functions of their own,
-# the two that build every frame on the wire (a sample frame: send_batch;
-# hello, health, ack, snapshot: send_control), from the room for it to the
-# encoded frame in the transmit buffer, handed to the UART (which sends it
-# from there; before 2026-12-07 a control frame's first copy into the UART's
-# ring). link_poll (loop()'s service between cycles, where hello and health
-# frames are built) is inlined into loop(): counted only through send_control.
+# the three that build every frame on the wire (a sample frame: send_batch;
+# hello, health, ack, snapshot: send_control; the room for it, its header
+# and body; then frame_end, which their callers call once they returned:
+# CRC and COBS, the frame handed to the UART, which sends it from there),
+# from the room for it to the encoded frame in the transmit buffer (before
+# 2026-12-07 a control frame's first copy into the UART's ring; before its
+# evening, the composers called the framer themselves, and frame_end was
+# not a function of its own). link_poll (loop()'s service between cycles,
+# where hello and health frames are built) is inlined into loop(): counted
+# only through send_control and frame_end.
 LINK_TASKS = ("fsw::link_telemetry_task", "fsw::link_uplink_task")
-FRAME_BUILDERS = ("fsw::(anonymous namespace)::send_batch", "fsw::(anonymous namespace)::send_control")
+FRAME_BUILDERS = ("fsw::(anonymous namespace)::send_batch", "fsw::(anonymous namespace)::send_control",
+                  "fsw::(anonymous namespace)::frame_end")
 
 
 def profiled(board) -> list[tuple[str, int]]:
@@ -428,9 +433,9 @@ def main() -> int:
             print(f"  carried {10 / 11 * 100:.1f} % of the real rate at most and N = 22 and 23 dropped 32 and 66).")
             print("  per wire byte (simavr cycles, interrupts taken meanwhile included; each over the bytes sent in its")
             print("  own half of the run): the two link tasks' steps (sampling, sample frames, acks); frame building:")
-            print("  the two functions that build every frame (send_batch, send_control: the room for it, header,")
-            print("  body, CRC, COBS; each frame handed to the UART, which sends it from there; hello and health are built")
-            print("  between cycles).")
+            print("  the three functions that build every frame (send_batch, send_control: the room for it, header,")
+            print("  body; frame_end: CRC, COBS, each frame handed to the UART, which sends it from there; hello and")
+            print("  health are built between cycles).")
             print("  target <= 40 for frame building (before: the link tasks 97.0 per wire byte at N = 20, the frame")
             print("  builders inlined in them)")
         native_fill = line_rate_native(tmp)

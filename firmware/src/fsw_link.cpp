@@ -136,9 +136,10 @@ const uint16_t kNoFrame = 0xFFFFu;  // frame_end's `n`: no frame (a sample frame
 // Frames the body in place, and `src`'s `n` bytes after it, copied in as
 // they are framed (a sample frame's current region: no second pass over
 // it), and hands the frame to the UART, which sends it from where it lies.
-// Called by the caller of the frame's composer (send_control, send_batch),
-// once it has returned: the framer's frame goes on the caller's, not on the
-// composer's (18 and 28 bytes, on the deepest paths of the stack).
+// Called by the caller of the frame's composer (send_control's, service;
+// send_batch's, the telemetry task's step) once the composer has returned:
+// the framer's frame goes on the caller's, not on the composer's (18 and
+// 28 bytes then, on the deepest paths of the stack). `n` kNoFrame: none.
 FSW_NOINLINE void frame_end(Link& l, const uint8_t* src, uint16_t n) {
     if (n == kNoFrame) return;
     const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
@@ -170,10 +171,10 @@ struct SampleTail {
 // Composes the frame of stream i's open batch (and of the current region
 // when `with_now`): header and stored samples into the transmit buffer, the
 // region left for the framer (or put in already, atomically, when the lock
-// is on). The telemetry task frames and hands it (sample_frame_end): the
-// framer is then called from the task's frame, not from this one's, and the
-// deepest path of the stack (the task's step, the framer's) is this frame's
-// 18 bytes shorter. `row` is the stream's row in flash (FSW_FLASH), its
+// is on). The telemetry task's step frames and hands it (frame_end): the
+// framer is then called from the step's frame, not from this one's, and the
+// deepest path of the stack (the step's, the framer's) is this frame's 18
+// bytes shorter. `row` is the stream's row in flash (FSW_FLASH), its
 // fields read where used.
 SampleTail send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkStreamState& st, uint8_t i,
                       bool with_now) {
@@ -230,9 +231,9 @@ inline __attribute__((always_inline)) uint8_t param_source(const LinkConfig& c) 
 }
 
 // One control frame composed (`type` is kFrameAck, kFrameHello,
-// kFrameHealth or kFrameSnapshot); the caller frames and hands it, so the
-// framer's frame goes on the caller's (service's), not on this one's 28
-// bytes, the deepest of the link's. The control path (service, send_control, the uplink's
+// kFrameHealth or kFrameSnapshot); the caller (service) frames and hands it
+// (frame_end), so the framer's frame goes on the caller's, not on this
+// one's (28 bytes then, the deepest of the link's). The control path (service, send_control, the uplink's
 // apply) reads the configuration `c`, an FSW_FLASH object, a field at a
 // time where it uses one: no copy of the whole on the stack, whose deepest
 // reach is on this path (a copy was 54 of the rocket's 192 bytes).

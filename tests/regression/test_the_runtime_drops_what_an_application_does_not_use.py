@@ -49,8 +49,10 @@ ROCKET = EXAMPLES / "rocket"
 # -14 B and 1 B of RAM; 10,150 B and 601 B after the UART's buffers went
 # and before the CPU work of 2026-12-07's evening: the ADC's interrupt
 # without r25 -4 B for 1.0 us a cycle, cobs_frame's 8-bit count +6 B for
-# 1.0 us): flash, and .data + .bss + .noinit.
-CORE_FLASH_MAX = 10_152
+# 1.0 us; 10,108 B with the link's frames framed by their composers'
+# callers, for the stack, test_the_link_frames_on_its_composers_callers_stack.py):
+# flash, and .data + .bss + .noinit.
+CORE_FLASH_MAX = 10_108
 CORE_RAM_MAX = 601
 
 

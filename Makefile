@@ -141,22 +141,19 @@ fuzz-vm: $(FUZZ_VM) | $(STAMP)
 	  if [ $$st -eq 0 ]; then echo "vm fuzz: 1 passed, 0 failed"; else tail -30 $(BUILD)/fuzz/vm/log.txt; \
 	  echo "vm fuzz: 0 passed, 1 failed"; fi; exit $$st
 
-## bench: measured numbers against targets.md (deterministic counts)
+## bench: measured numbers against targets.md (deterministic counts). Every
+## bench runs, one failing or not: those that failed are named at the end,
+## and make bench then exits 1.
+BENCHES := bench bench_firmware bench_sim bench_link bench_flights bench_tapes bench_busy bench_study \
+           bench_ground bench_params bench_recorder bench_vm bench_reload
 bench: setup
-	$(PY) tools/bench.py
-	$(PY) tools/bench_firmware.py
-	$(PY) tools/bench_sim.py
-	$(PY) tools/bench_link.py
-	$(PY) tools/bench_flights.py
-	$(PY) tools/bench_tapes.py
-	$(PY) tools/bench_busy.py
-	$(PY) tools/bench_study.py
-	$(PY) tools/bench_ground.py
-	$(PY) tools/bench_params.py
-	$(PY) tools/bench_recorder.py
-	$(PY) tools/bench_vm.py
-	$(PY) tools/bench_reload.py
-	$(MAKE) --no-print-directory bench-firmware
+	@failed=""; \
+	for b in $(BENCHES); do \
+	  echo "$(PY) tools/$$b.py"; $(PY) tools/$$b.py || failed="$$failed tools/$$b.py"; \
+	done; \
+	$(MAKE) --no-print-directory bench-firmware || failed="$$failed bench-firmware"; \
+	if [ -n "$$failed" ]; then echo "make bench: failed:$$failed"; exit 1; fi; \
+	echo "make bench: every bench ran and passed"
 
 clean:
 	rm -rf $(BUILD) .pytest_cache .hypothesis

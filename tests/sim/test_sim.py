@@ -269,7 +269,10 @@ def test_tank_stack_and_ram_on_a_simulated_uno(tank_uno):
         later = b.ram_usage()
     assert first.ram == 2048
     assert first.static == _static_bytes(tank_uno)
-    assert 64 <= first.stack < first.ram - first.static  # used, and never reached the static data
+    # used (main's loop calling a task's step, an interrupt on top: 63 B on
+    # 2026-12-07, since the link frames on its composers' callers' stack),
+    # and never reached the static data
+    assert 32 <= first.stack < first.ram - first.static
     assert first.total == first.static + first.stack
     assert later.stack >= first.stack  # a high-water mark
     with SimBoard(tank_uno, "uno", analog={"A0": 3.76}, sim_limit=5) as b:

@@ -43,7 +43,7 @@ from contextlib import contextmanager
 from fswkit.link import wire
 from fswkit.link.client import LinkTimeout, Numbers, exchange
 from fswkit.link.layout import Layout
-from fswkit.link.port import PortError, open_port, port_errors, port_key, runtime_dir
+from fswkit.link.port import PortError, drain, open_port, port_errors, port_key, runtime_dir
 from fswkit.link.session import Event, Session, max_frame, reset_words
 
 from .archive import ArchiveError
@@ -368,7 +368,7 @@ class Station:
         with self._write_lock:
             self._archive("tx", time.time_ns(), data)
             port.write(data)
-            port.flush()
+            drain(port)
 
     # ---- commands ------------------------------------------------------------------------
 

@@ -8,6 +8,7 @@ import time
 
 from . import wire
 from .log import RX, TX, LogWriter
+from .port import drain
 from .session import Event, Session
 
 
@@ -92,7 +93,7 @@ class Ground:
         if self.log is not None:
             self.log.record(TX, time.time_ns(), data)
         self.port.write(data)
-        self.port.flush()
+        drain(self.port)
 
     def command(self, op: int, args: bytes = b"", tries: int = 3, timeout: float = 1.0,
                 on_event=None) -> dict:

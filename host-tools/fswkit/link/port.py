@@ -252,7 +252,20 @@ def open_port(name: str, baud: int, *, command: str | None = None, socket: str |
 
 
 def port_errors():
-    """The exceptions a port raises when it goes away (a yanked cable)."""
+    """The exceptions a port raises when it goes away (a yanked cable):
+    termios.error too, which pyserial's flush() lets out of tcdrain()."""
     import serial
 
-    return (serial.SerialException, OSError)
+    return (serial.SerialException, OSError, termios.error)
+
+
+def drain(port) -> None:
+    """`port.flush()`, the bytes written handed to the line; a device that
+    went away meanwhile is an OSError (tcdrain()'s termios.error is none,
+    and the callers of a write wait on OSError)."""
+    try:
+        port.flush()
+    except termios.error as e:
+        errno = e.args[0] if len(e.args) >= 2 and isinstance(e.args[0], int) else 5  # EIO
+        text = e.args[-1] if e.args else "Input/output error"
+        raise OSError(errno, f"the port went away: {text}") from None

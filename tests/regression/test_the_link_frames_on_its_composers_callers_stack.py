@@ -18,21 +18,19 @@ from __future__ import annotations
 
 import shutil
 import struct
-import sys
 
 import pytest
 
-from conftest import EXAMPLES, ROOT, run_fsw
 from fswkit.autocode import protocol as P
 from fswkit.link import wire
 from fswkit.link.session import Session
 from support.linkfw import tank_layout
+from support.core_rocket import build_core
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
                                 reason="gcc-avr / simavr not installed")
 
-ROCKET = EXAMPLES / "rocket"
 # 92 B before with its control paths driven as below (86 B on the demo
 # flight); 66 B now (65 B on the demo flight)
 CORE_STACK_MAX = 68
@@ -40,18 +38,8 @@ CORE_STACK_MAX = 68
 
 @pytest.fixture(scope="module")
 def core_elf(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("core")
-    sys.path.insert(0, str(ROOT / "tools"))
-    try:
-        from bench_firmware import without_later_features
-    finally:
-        sys.path.pop(0)
-    project = tmp / "rocket"
-    shutil.copytree(ROCKET, project, ignore=shutil.ignore_patterns("build"))
-    without_later_features(str(project))
-    r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
-    assert r.code == 0, r.err
-    return project, tmp / "uno" / "rocket.elf"
+    project, out = build_core(tmp_path_factory)
+    return project, out / "rocket.elf"
 
 
 def test_the_core_rockets_control_paths_keep_its_stack_small(core_elf):

@@ -17,7 +17,6 @@ import re
 import shutil
 import struct
 import subprocess
-import sys
 
 import pytest
 
@@ -27,6 +26,7 @@ from fswkit.link import wire
 from fswkit.link.layout import from_app
 from fswkit.link.session import Session
 from fswkit.param.client import RX_CAP
+from support.core_rocket import build_core, core_project
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -41,26 +41,10 @@ def _ring(elf) -> int | None:
     return int(m.group(1), 16) if m else None
 
 
-def _core_project(folder):
-    """A copy of examples/rocket as the 8 KB target measured it (tools/bench_firmware.py core)."""
-    sys.path.insert(0, str(ROOT / "tools"))
-    try:
-        from bench_firmware import without_later_features
-    finally:
-        sys.path.pop(0)
-    project = folder / "rocket"
-    shutil.copytree(ROCKET, project, ignore=shutil.ignore_patterns("build"))
-    without_later_features(str(project))
-    return project
-
-
 @pytest.fixture(scope="module")
 def core(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("core")
-    project = _core_project(tmp)
-    r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
-    assert r.code == 0, r.err
-    return project, tmp / "uno" / "rocket.elf"
+    project, out = build_core(tmp_path_factory)
+    return project, out / "rocket.elf"
 
 
 def test_one_command_in_flight_fits_the_ring():
@@ -84,7 +68,7 @@ def test_the_ring_is_sized_for_the_ground(core, tmp_path):
 
 
 def test_a_telemetry_only_application_keeps_the_smallest_ring(tmp_path):
-    project = _core_project(tmp_path)
+    project = core_project(tmp_path)
     app = project / "rocket.app"
     text = re.sub(r"(?m)^uplink\s+uplink\b.*\n", "", app.read_text())
     app.write_text(re.sub(r"\n\[uplink\]\n\w+\n", "\n", text))

@@ -18,15 +18,15 @@ import re
 import shutil
 import struct
 import subprocess
-import sys
 
 import pytest
 
-from conftest import EXAMPLES, ROOT, run_fsw
+from conftest import EXAMPLES, run_fsw
 from fswkit.autocode import protocol as P
 from fswkit.link import wire
 from fswkit.link.session import Session
 from support.linkfw import tank_layout
+from support.core_rocket import build_core
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -56,26 +56,9 @@ CORE_FLASH_MAX = 10_108
 CORE_RAM_MAX = 601
 
 
-def _core_project(tmp_path):
-    """A copy of examples/rocket as the target measured it (the benchmark's own edit of it)."""
-    sys.path.insert(0, str(ROOT / "tools"))
-    try:
-        from bench_firmware import without_later_features
-    finally:
-        sys.path.pop(0)
-    project = tmp_path / "rocket"
-    shutil.copytree(ROCKET, project, ignore=shutil.ignore_patterns("build"))
-    without_later_features(str(project))
-    return project
-
-
 @pytest.fixture(scope="module")
 def core(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("core")
-    project = _core_project(tmp)
-    r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
-    assert r.code == 0, r.err
-    return project, tmp / "uno"
+    return build_core(tmp_path_factory)
 
 
 def _features(gen_dir) -> tuple[int, int]:

@@ -14,33 +14,20 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
-import sys
 
 import pytest
 
-from conftest import EXAMPLES, ROOT, run_fsw
+from support.core_rocket import build_core
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
                                 reason="gcc-avr / simavr not installed")
 
-ROCKET = EXAMPLES / "rocket"
-
 
 @pytest.fixture(scope="module")
 def core(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("core")
-    sys.path.insert(0, str(ROOT / "tools"))
-    try:
-        from bench_firmware import without_later_features
-    finally:
-        sys.path.pop(0)
-    project = tmp / "rocket"
-    shutil.copytree(ROCKET, project, ignore=shutil.ignore_patterns("build"))
-    without_later_features(str(project))
-    r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
-    assert r.code == 0, r.err
-    return project, tmp / "uno" / "rocket.elf"
+    project, out = build_core(tmp_path_factory)
+    return project, out / "rocket.elf"
 
 
 def test_no_transmit_ring(core):

@@ -427,10 +427,12 @@ uint16_t console_write_space() {
     const uint32_t q = uart_queued();
     return static_cast<uint16_t>(q >= g_uart_buffer ? 0u : g_uart_buffer - q);
 }
-void console_write(const uint8_t* data, uint16_t len) {
+namespace {
+// Bytes onto the modelled line (its clock busy 10 bits a byte), into the
+// capture buffer when one is set, else to standard output.
+void uart_out(const uint8_t* data, uint16_t len) {
     g_written += len;
     if (g_uart_baud != 0) {
-        if (len > console_write_space()) ++g_uart_overruns;
         const uint64_t now_bits = now_us() * g_uart_baud / 1000000u;
         if (g_uart_busy_until_bits < now_bits) g_uart_busy_until_bits = now_bits;
         g_uart_busy_until_bits += 10u * static_cast<uint64_t>(len);
@@ -441,6 +443,12 @@ void console_write(const uint8_t* data, uint16_t len) {
     }
     fwrite(data, 1, len, stdout);
     fflush(stdout);
+}
+}  // namespace
+
+void console_write(const uint8_t* data, uint16_t len) {
+    if (g_uart_baud != 0 && len > console_write_space()) ++g_uart_overruns;
+    uart_out(data, len);
 }
 // console_send's runs are output at once, as console_write's bytes, and
 // kept with a copy of their bytes until the model's clock has sent them: a
@@ -480,18 +488,7 @@ void console_send(const uint8_t* data, uint16_t len) {
         if (g_runs.size() >= 2) ++g_uart_overruns;  // a third run: not the contract
         g_runs.push_back(SendRun{data, std::vector<uint8_t>(data, data + len)});
     }
-    g_written += len;
-    if (g_uart_baud != 0) {
-        const uint64_t now_bits = now_us() * g_uart_baud / 1000000u;
-        if (g_uart_busy_until_bits < now_bits) g_uart_busy_until_bits = now_bits;
-        g_uart_busy_until_bits += 10u * static_cast<uint64_t>(len);
-    }
-    if (g_cap_buf != 0) {
-        for (uint16_t i = 0; i < len && *g_cap_len < g_cap_cap; ++i) g_cap_buf[(*g_cap_len)++] = data[i];
-        return;
-    }
-    fwrite(data, 1, len, stdout);
-    fflush(stdout);
+    uart_out(data, len);
 }
 
 const uint8_t* console_sending() {

@@ -17,15 +17,12 @@ snapshot) 66 B where it was 92 B."""
 from __future__ import annotations
 
 import shutil
-import struct
 
 import pytest
 
-from fswkit.autocode import protocol as P
-from fswkit.link import wire
 from fswkit.link.session import Session
-from support.linkfw import tank_layout
 from support.core_rocket import build_core
+from support.linkfw import control_commands, send_one_at_a_time, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -52,13 +49,8 @@ def test_the_core_rockets_control_paths_keep_its_stack_small(core_elf):
         s.feed(b.uart_read())
         assert s.hello is not None and s.hello["schema_ok"]
         seq = s.hello["last_seq"]
-        abort = lay.element("abortCmd").index
-        commands = [(P.OP_PING, b""), (P.OP_HELLO, b""), (P.OP_SNAPSHOT, b""),
-                    (P.OP_SET, struct.pack("<HB", abort, 0)), (P.OP_MODE, bytes((0, 2)))]
-        for k, (op, args) in enumerate(commands, start=1):  # one at a time: one ack waits at a time
-            b.uart_write(wire.uplink(op, seq + k, args))
-            b.run_for(0.1)
-            s.feed(b.uart_read())
+        commands = control_commands(lay)
+        send_one_at_a_time(b, s, commands, seq)
         b.run_for(1.0)  # health frames, samples
         s.feed(b.uart_read())
         stack = b.stack_high_water()

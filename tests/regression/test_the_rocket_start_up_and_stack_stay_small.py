@@ -22,7 +22,7 @@ from fswkit.autocode.iotables import analog_gain
 from fswkit.autocode.numeric import F32MODE
 from fswkit.link import wire
 from fswkit.link.session import Session
-from support.linkfw import tank_layout
+from support.linkfw import control_commands, send_one_at_a_time, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -65,15 +65,10 @@ def test_the_control_paths_keep_the_rocket_stack_small(rocket):
         s.feed(b.uart_read())
         assert s.hello is not None and s.hello["schema_ok"]
         seq = s.hello["last_seq"]
-        abort = lay.element("abortCmd").index
-        commands = [(P.OP_PING, b""), (P.OP_HELLO, b""), (P.OP_SNAPSHOT, b""),
-                    (P.OP_SET, struct.pack("<HB", abort, 0)), (P.OP_MODE, bytes((0, 2))),
-                    (P.OP_PARAM_INFO, b""), (P.OP_PARAM_GET, bytes((0, 1))), (P.OP_PARAM_SAVE, b""),
-                    (P.OP_LOG_INFO, b""), (P.OP_LOG_READ, struct.pack("<HBB", 0, 0, 16))]
-        for k, (op, args) in enumerate(commands, start=1):  # one at a time: one ack waits at a time
-            b.uart_write(wire.uplink(op, seq + k, args))
-            b.run_for(0.1)
-            s.feed(b.uart_read())
+        commands = control_commands(lay) + [
+            (P.OP_PARAM_INFO, b""), (P.OP_PARAM_GET, bytes((0, 1))), (P.OP_PARAM_SAVE, b""),
+            (P.OP_LOG_INFO, b""), (P.OP_LOG_READ, struct.pack("<HBB", 0, 0, 16))]
+        send_one_at_a_time(b, s, commands, seq)
         b.run_for(1.0)  # the parameter bank written to the EEPROM, byte by byte
         s.feed(b.uart_read())
         # SET of the first parameter's own value (allowed in any state):

@@ -33,6 +33,31 @@ def tank_layout(project: Path = TANK):
     return from_app(load(str(project), Diagnostics()))
 
 
+def control_commands(lay) -> list[tuple[int, bytes]]:
+    """The link's control commands every application answers, as (op,
+    args): PING, HELLO, SNAPSHOT, a SET of the rocket's `abortCmd` to 0, a
+    MODE of task 0 to safed."""
+    import struct
+
+    from fswkit.autocode import protocol as P
+
+    abort = lay.element("abortCmd").index
+    return [(P.OP_PING, b""), (P.OP_HELLO, b""), (P.OP_SNAPSHOT, b""),
+            (P.OP_SET, struct.pack("<HB", abort, 0)), (P.OP_MODE, bytes((0, 2)))]
+
+
+def send_one_at_a_time(board, session, commands, seq: int) -> None:
+    """Each (op, args) of `commands` sent to a simulated board as command
+    seq + 1, seq + 2, ..., 0.1 s apart (one ack waits at a time), what came
+    back fed to `session`."""
+    from fswkit.link import wire
+
+    for k, (op, args) in enumerate(commands, start=1):
+        board.uart_write(wire.uplink(op, seq + k, args))
+        board.run_for(0.1)
+        session.feed(board.uart_read())
+
+
 def volts_psi(raw: int) -> float:
     """tank.aio's calibration in binary64 (the native build's R)."""
     return raw * 5.0 / 1023.0 * 250.0 + -125.0

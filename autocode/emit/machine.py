@@ -32,11 +32,16 @@ def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
     return offsets, size, b"".join(value_bytes(v.type, values[v.index]) for v in vs)
 
 
+_LEAVES = (M.Ref, M.Const)  # (most of an expression's nodes: nothing under them)
+
+
 def _rolls(e: M.Expr) -> list[M.Roll]:
     """Every window read in an expression, nested ones included."""
     out, todo = [], [e]
     while todo:
         n = todo.pop()
+        if type(n) in _LEAVES:
+            continue
         if isinstance(n, M.Roll):
             out.append(n)
         todo.extend(model_children(n))
@@ -126,10 +131,12 @@ def shared_extremes(m: M.Machine, ex: ExprEmitter) -> dict[int, tuple[int, str]]
     return out
 
 
-def declared_windows(m: M.Machine, ex: ExprEmitter) -> list[tuple[M.Window, str]]:
+def declared_windows(m: M.Machine, ex: ExprEmitter, shared: dict | None = None) -> list[tuple[M.Window, str]]:
     """The windows a machine's code declares, with their types: each of its
-    own, and one ring for those kept together (shared_extremes)."""
-    shared = shared_extremes(m, ex)
+    own, and one ring for those kept together (`shared`: shared_extremes,
+    worked out here when not given)."""
+    if shared is None:
+        shared = shared_extremes(m, ex)
     out = []
     for w in m.windows:
         if w.index not in shared:
@@ -146,9 +153,11 @@ def windows_watched(m: M.Machine) -> bool:
     there they keep their bytes, cycle after cycle (the rocket's mission,
     from its coast on). Its code then sets `win_changed` at every push and
     at its reset."""
-    if not m.windows:
-        return False
-    needs = window_needs(m)
+    return bool(m.windows) and _watched(window_needs(m))
+
+
+def _watched(needs) -> bool:
+    """windows_watched of a machine with windows, from its window_needs."""
     return needs is not None and any(mask == 0 for mask in needs[0].values())
 
 
@@ -164,18 +173,26 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
 # state functions access directly (not through an out-of-line call) from
 # which they take that area through a pointer register.
 BY_POINTER_BYTES = 8
-_DIRECT = re.compile(r"\b(?:store_bool|read_bool|load_bool|read_[UI](\d+)|write_[UI](\d+)|load<u?int(\d+)_t>|"
-                     r"store<u?int(\d+)_t>)\((sv|loc|prm) \+ ")
+_DIRECT = re.compile(r"(?:store_bool|read_bool|load_bool|read_[UI](\d+)|write_[UI](\d+)|load<u?int(\d+)_t>|"
+                     r"store<u?int(\d+)_t>)\((sv|loc|prm) \+ ")  # (at a word's start: _direct_bytes)
+_WORD = re.compile(r"\w")
 
 
-def _direct_bytes(line: str, area: str) -> int:
-    """The bytes of `area` (sv, loc, prm) that a line of a state function
-    reads or writes directly: a bool or an integer, not through a call."""
-    n = 0
-    for m in _DIRECT.finditer(line):
-        if m.group(5) == area:
-            bits = next((g for g in m.groups()[:4] if g), None)
-            n += int(bits) // 8 if bits else 1
+def _direct_bytes(text: str) -> dict[str, int]:
+    """For each area (sv, loc, prm), the bytes of it that the lines of
+    state functions in `text` read or write directly: a bool or an integer,
+    not through a call. One search of all the lines at once (no access
+    spans two lines); an access is a whole word (`\\b` in the pattern
+    would make the search try every position: three times slower)."""
+    n: dict[str, int] = {}
+    word = _WORD.match
+    for m in _DIRECT.finditer(text):
+        at = m.start()
+        if at and word(text, at - 1):
+            continue
+        a, b, c, d, area = m.groups()
+        bits = a or b or c or d
+        n[area] = n.get(area, 0) + (int(bits) // 8 if bits else 1)
     return n
 
 
@@ -194,12 +211,18 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     wp = "win.w" if kept and m.windows else "w"  # how the code names window i: f"{wp}{i}"
     ex = ExprEmitter(m, real, scriptable, windows=wp)
     shared = shared_extremes(m, ex)
-    declared = declared_windows(m, ex)
+    declared = declared_windows(m, ex, shared)
+    needs = window_needs(m) if m.windows else None  # (a machine without windows samples none)
+    watched = wp != "w" and _watched(needs)
     ex.window_reads = {i: f"{holder}.{read}" for i, (holder, read) in shared.items()}
 
+    served: dict[int, list[M.Window]] = {}  # holder -> the windows it serves, in file order
+    for x in m.windows:
+        if x.index in shared:
+            served.setdefault(shared[x.index][0], []).append(x)
+
     def what(w: M.Window) -> str:  # the roll_* calls a declared window serves
-        kept = [x for x in m.windows if shared.get(x.index, (None,))[0] == w.index] or [w]
-        return ", ".join(f"{basename(m.path)}:{x.line} roll_{x.func}" for x in kept)
+        return ", ".join(f"{src}:{x.line} roll_{x.func}" for x in served.get(w.index) or [w])
 
     values = local_values(m, real)
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
@@ -239,7 +262,7 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             h.append(f"    {wtype} w{w.index};  // {what(w)}")
         h.append("};")
         h.append("extern Windows win;")
-        if windows_watched(m):
+        if watched:
             h.append("extern uint8_t win_changed;  // set when a window changes: the flight's save copies them again")
     h.append("")
     h.append("// One step (spec 4.6). kErrTime when G did not increase: nothing changed.")
@@ -260,7 +283,6 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         c.append(f"uint8_t loc[kLocSize] = {{{', '.join(str(b) for b in init_bytes)}}};")
     if params:
         c.append(f"uint8_t prm[kPrmSize] = {{{', '.join(str(b) for b in param_bytes)}}};")
-    watched = wp != "w" and windows_watched(m)
     if wp != "w":
         c.append("Windows win;  // every window empty")
     if watched:
@@ -295,10 +317,10 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             # T is the same for the whole step: one call for it where the
             # function tests it twice or more
             t32 = "fsw::machine_T32(machine)"
-            if sum(line.count(t32) for line in body) >= 2:
-                body = ["    const uint32_t t32 = " + t32 + ";  // T, saturated to 32 bits"] + \
-                       [line.replace(t32, "t32") for line in body]
-            bodies.append((st, label, body))
+            text = "\n".join(body)  # (its lines, one text from here on)
+            if text.count(t32) >= 2:
+                text = "    const uint32_t t32 = " + t32 + ";  // T, saturated to 32 bits\n" + text.replace(t32, "t32")
+            bodies.append((st, label, text))
     # The state vector and the locals each reach the state functions as an
     # argument (`svp`, `locp`), which step() took through fsw::by_pointer,
     # when they read or write enough of its bytes directly (not through an
@@ -313,21 +335,22 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     # saved.
     areas = []
     called = any(st.entry or st.step for st in m.states)  # (else step() calls no state function)
+    direct = _direct_bytes("\n".join(text for _, _, text in bodies)) if called else {}
     for area, whole in (("sv", "sv"), ("loc", "loc")) if called else ():
-        direct = sum(_direct_bytes(line, area) for _, _, body in bodies for line in body)
-        if direct >= BY_POINTER_BYTES:
+        if direct.get(area, 0) >= BY_POINTER_BYTES:
             areas.append((area + "p", whole))
-            used = re.compile(rf"(?<![\w.:]){area} \+ ")  # (another name than the area's: no shadowing it)
-            bodies = [(st, label, [used.sub(f"{area}p + ", line) for line in body]) for st, label, body in bodies]
+            # `area + ` where no name ends in it (another name than the area's: no shadowing it); the
+            # pattern starts with the area's name, which the search looks for before trying a match
+            used = re.compile(rf"{area}(?<![\w.:]{area}) \+ ")
+            bodies = [(st, label, used.sub(f"{area}p + ", text)) for st, label, text in bodies]
     actuals = ", ".join(a for a, _ in areas)
     for st, label, body in bodies:
         ret = "void" if label == "exit" else sid
         # (unnamed where the function does not use it: no unused-parameter warning)
-        formals = ", ".join(f"uint8_t* const {a}" if any(f"{a} + " in line for line in body)
-                            else "uint8_t* const" for a, _ in areas)
+        formals = ", ".join(f"uint8_t* const {a}" if f"{a} + " in body else "uint8_t* const" for a, _ in areas)
         c.append(f"// [{st.name}] .{label}")
         c.append(f"{ret} s{st.id}_{label}({formals}) {{")
-        c += body
+        c.append(body)
         if label != "exit":
             c.append("    return 0;")
         c.append("}")
@@ -359,7 +382,6 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     args: dict[str, list] = {}
     for w in m.windows:
         args.setdefault(ex.value(w.arg), []).append(w)
-    needs = window_needs(m)
     every = frozenset(st.index for st in m.states)
     for k, (arg, ws) in enumerate(args.items()):
         if needs is None:

@@ -26,14 +26,20 @@ class Tok(NamedTuple):
 # One token, with the blanks before it (a line's blanks are no token). No
 # two kinds match at the same place, so they are tried most common first.
 _BLANKS = r"[ \t\f\v\r]*"
-_TOKEN = re.compile(_BLANKS + r"""(?:
+_KINDS = r"""
     (?P<id>[A-Za-z_][A-Za-z0-9_]*)
   | (?P<op>->|<=|>=|==|!=|[-+*/<>=!(){}:,\[\]])
   | (?P<num>(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?)
   | (?P<label>\.[A-Za-z_][A-Za-z0-9_]*)
   | (?P<annot>@[A-Za-z_][A-Za-z0-9_]*)
   | (?P<comment>\#.*)
-)""", re.X)
+"""
+_TOKEN = re.compile(_BLANKS + "(?:" + _KINDS + ")", re.X)
+# The same tokens for `_lex_clean`, each as (its blanks, then one group a
+# kind, in _KINDS' order), and any other character that is no blank as a
+# last group: the matches of a line then cover it, all but its trailing
+# blanks, and `findall` gives them as plain tuples.
+_CLEAN = re.compile("(" + _BLANKS + ")(?:" + _KINDS + r"| ([^ \t\f\v\r]))", re.X)
 _SKIP_BLANKS = re.compile(_BLANKS)
 _NUMBER_TAIL = re.compile(r"[A-Za-z0-9_.]+")
 
@@ -50,31 +56,37 @@ _NUMBER_TAIL_START = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuv
 
 def _lex_clean(n: int, text: str) -> list[Tok] | None:
     """The tokens of a line that holds nothing wrong and no tab (the common
-    case, one regex search a token); None for any other line, which
+    case, one regex search for the line); None for any other line, which
     `lex_line` reads character by character with its reports."""
     toks: list[Tok] = []
     append = toks.append
-    pos = 0
-    for m in _TOKEN.finditer(text):
-        if m.start() != pos:  # something no token starts with was skipped
+    col = 1  # of the next character
+    for blanks, name, op, num, label, annot, comment, other in _CLEAN.findall(text):
+        if blanks:
+            col += len(blanks)
+        if name:
+            append(_new_tok(Tok, (KW if name in KEYWORDS else ID, name, n, col)))
+            col += len(name)
+        elif op:
+            append(_new_tok(Tok, (OP, op, n, col)))
+            col += len(op)
+        elif num:
+            append(_new_tok(Tok, (NUM, num, n, col)))
+            col += len(num)
+            if text[col - 1:col] in _NUMBER_TAIL_START:  # `12abc`, `1.2.3`: a malformed number
+                return None
+        elif label:
+            append(_new_tok(Tok, (LABEL, label, n, col)))
+            col += len(label)
+        elif annot:
+            if annot not in ANNOTATIONS:
+                return None
+            append(_new_tok(Tok, (ANNOT, annot, n, col)))
+            col += len(annot)
+        elif comment:  # (to the end of the line)
+            break
+        else:  # a character no token starts with
             return None
-        kind = m.lastgroup
-        s = m[kind]
-        pos = m.end()
-        if kind == "comment":
-            continue
-        if kind == "num":
-            if text[pos:pos + 1] in _NUMBER_TAIL_START and pos < len(text):
-                return None
-        elif kind == "id":
-            if s in KEYWORDS:
-                kind = KW
-        elif kind == "annot":
-            if s not in ANNOTATIONS:
-                return None
-        append(_new_tok(Tok, (kind, s, n, pos - len(s) + 1)))
-    if pos != len(text) and text[pos:].strip(" \t\f\v\r"):
-        return None
     return toks
 
 

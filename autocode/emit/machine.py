@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 
 from .. import model as M
-from ..check import gotos, model_children, stmt_exprs
+from ..check import model_children
 from ..cnames import enumerator
 from ..evaluate import NotConstant, evaluate, local_values
 from ..numeric import Real, to_type
@@ -68,14 +68,31 @@ def window_needs(m: M.Machine) -> tuple[dict[int, int], dict[int, int]] | None:
     bit = {w.index: 1 << k for k, w in enumerate(m.windows)}
     reads: dict[int, int] = {}  # state -> the windows its blocks read
     succ: dict[int, list[int]] = {}
-    for st in m.states:
-        blocks = (st.entry, st.step, st.exit)
-        succ[st.index] = sorted({g.state for block in blocks for g in gotos(block)})
+    for st in m.states:  # (gotos, stmt_exprs and _rolls in one walk of the state's statements)
+        targets: set[int] = set()
+        exprs = []
+        stmts = [*st.entry, *st.step, *st.exit]
+        while stmts:
+            x = stmts.pop()
+            t = type(x)
+            if t is M.Assign:
+                exprs.append(x.expr)
+            elif t is M.Goto:
+                targets.add(x.state)
+            elif t is M.If:
+                exprs.append(x.cond)
+                stmts += x.then
+                stmts += x.orelse
         mask = 0
-        for block in blocks:
-            for e in stmt_exprs(block):
-                for r in _rolls(e):
-                    mask |= bit[r.window]
+        while exprs:
+            e = exprs.pop()
+            t = type(e)
+            if t in _LEAVES:
+                continue
+            if t is M.Roll:
+                mask |= bit[e.window]
+            exprs += model_children(e)
+        succ[st.index] = sorted(targets)
         reads[st.index] = mask
     return still_read(succ, reads), bit
 

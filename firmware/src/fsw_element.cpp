@@ -43,16 +43,10 @@ Real read_F32(const uint8_t* p) {
     return r;
 }
 
-void write_F32(uint8_t* p, Real r) {
+Real f32_write_back(Real r, uint8_t* p) {
     uint32_t u;
     memcpy(&u, &r, sizeof u);
-    store<uint32_t>(p, f32_bits_not_nan(u));  // NaN is stored as +0 (F32_from_real)
-}
-
-Real write_F32_read(uint8_t* p, Real r) {
-    uint32_t u;
-    memcpy(&u, &r, sizeof u);
-    u = f32_bits_not_nan(u);
+    u = f32_bits_not_nan(u);  // NaN is stored as +0 (F32_from_real)
     store<uint32_t>(p, u);
     memcpy(&r, &u, sizeof r);
     return r;

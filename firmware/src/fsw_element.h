@@ -63,19 +63,22 @@ inline void write_U8(uint8_t* p, Real r) { *p = U8_from_real(r); }
 inline void write_U16(uint8_t* p, Real r) { store<uint16_t>(p, U16_from_real(r)); }
 inline void write_U32(uint8_t* p, Real r) { store<uint32_t>(p, U32_from_real(r)); }
 inline void write_U64(uint8_t* p, Real r) { store<uint64_t>(p, U64_from_real(r)); }
+// write_F32_read: write_F32, returning what read_F32(p) then reads (a NaN
+// stored as +0 reads +0): generated step code keeps it for the statements
+// after the assignment that read the variable again, with no read of their
+// own (autocode/emit/machine.py).
 #if defined(__AVR__)
-// Out of line on AVR, as read_F32.
-FSW_NOINLINE FSW_NOCLONE void write_F32(uint8_t* p, Real r);
+// Out of line on AVR, as read_F32: one routine for both, which takes the
+// value first, where the float routines leave their result (r22..r25), the
+// place second, and returns what it stored (in those same registers, so it
+// costs write_F32 nothing): a value computed just before the write goes
+// in as it is (with the place first, each call moved it down to r20..r23
+// first, 4 bytes of flash a call), and write_F32_read is the same code.
+FSW_NOINLINE FSW_NOCLONE Real f32_write_back(Real r, uint8_t* p);
+inline void write_F32(uint8_t* p, Real r) { (void)f32_write_back(r, p); }
+inline Real write_F32_read(uint8_t* p, Real r) { return f32_write_back(r, p); }
 #else
 inline void write_F32(uint8_t* p, Real r) { store<float>(p, F32_from_real(r)); }
-#endif
-// write_F32, returning what read_F32(p) then reads (a NaN stored as +0 reads
-// +0): generated step code keeps it for the statements after the
-// assignment that read the variable again, with no read of their own
-// (autocode/emit/machine.py). Out of line on AVR, as write_F32.
-#if defined(__AVR__)
-FSW_NOINLINE FSW_NOCLONE Real write_F32_read(uint8_t* p, Real r);
-#else
 inline Real write_F32_read(uint8_t* p, Real r) {
     write_F32(p, r);
     return read_F32(p);

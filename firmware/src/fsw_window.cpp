@@ -40,7 +40,7 @@ static inline int8_t infinity_sign(Real x) {
 #endif
 
 template <typename I>
-void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
+void roll_avg_add(Real x, RollAvgS<I>& w, Real* ring, typename same_t<I>::type n) {
     // The sample goes into its slot first and is read back from there: the
     // same operations in the same order, with fewer values to keep across
     // the float routines' calls (on AVR no call of the register-saving
@@ -202,7 +202,7 @@ template Real roll_avg_mean<WinIdx>(const RollAvgS<WinIdx>&, WinIdx, Real);
 
 // The two index types in use: bytes for windows of up to 255 samples, WinIdx.
 #define FSW_WINDOW_INSTANCES(I)                                                      \
-    template void roll_avg_push<I>(RollAvgS<I>&, Real*, I, Real);                   \
+    template void roll_avg_add<I>(Real, RollAvgS<I>&, Real*, I);                    \
     template void roll_max_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
     template void roll_min_push<I>(RollExtS<I>&, Real*, I*, I, Real);                \
     template void roll_ring_push<I>(RollRingS<I>&, Real*, I, Real);                  \

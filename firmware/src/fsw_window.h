@@ -164,7 +164,11 @@ struct same_t {
 };
 
 template <typename I>
-void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x);
+void roll_avg_add(Real x, RollAvgS<I>& w, Real* ring, typename same_t<I>::type n);
+template <typename I>
+inline void roll_avg_push(RollAvgS<I>& w, Real* ring, typename same_t<I>::type n, Real x) {
+    roll_avg_add<I>(x, w, ring, n);
+}
 // The mean while the window holds an infinite sample: that infinity, or NaN
 // with both (inf + -inf). Only called when pinf or ninf is not 0.
 template <typename I>

@@ -86,8 +86,5 @@ uint64_t f64_bits_from_f32(float v) {
     return f64_bits_from_f32_bits(u);
 }
 
-#if defined(__AVR__)
-uint32_t f32_read_key(const uint8_t* p) { return f32_is_nan(p) ? 0x80000000UL : f32_key(p); }
-#endif
 
 }  // namespace fsw

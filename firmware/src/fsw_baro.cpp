@@ -1,6 +1,8 @@
 // BMP280 and MS5611 drivers (fsw_baro.h): state machines over fsw_twi.
 #include "fsw_baro.h"
 
+#include "fsw_convert.h"
+
 #include "fsw_pal.h"
 #include "fsw_twi.h"
 
@@ -101,8 +103,8 @@ void Bmp280::done(uint8_t status, uint32_t now) {
             adc_T_ = t;
             t_centi_ = bmp280_compensate_T(cal_, t, t_fine);
             p_q8_ = bmp280_compensate_P64(cal_, p, t_fine);
-            temp_c_ = static_cast<float>(t_centi_) / 100.0f;
-            pressure_pa_ = static_cast<float>(p_q8_) / 256.0f;
+            temp_c_ = f32_from_i32(t_centi_) / 100.0f;
+            pressure_pa_ = f32_from_u32(p_q8_) / 256.0f;
             c_.state = kBTrig;
             break;
         }
@@ -195,8 +197,8 @@ void Ms5611::done(uint8_t status, uint32_t now) {
             ms5611_compensate(cal_, d1_, d2_, true, r);
             t_centi_ = r.TEMP;
             p_ = r.P;
-            temp_c_ = static_cast<float>(t_centi_) / 100.0f;
-            pressure_pa_ = static_cast<float>(p_);
+            temp_c_ = f32_from_i32(t_centi_) / 100.0f;
+            pressure_pa_ = f32_from_i32(p_);
             break;
         }
     }

@@ -21,7 +21,7 @@ FSW_NOINLINE static Real real_from_magnitude(uint64_t m) {
     // loop rather than fast code for a path that is rarely taken.
     uint32_t hi = static_cast<uint32_t>(m >> 32);
     uint32_t lo = static_cast<uint32_t>(m);
-    if (hi == 0) return static_cast<Real>(lo);
+    if (hi == 0) return f32_from_u32(lo);
     uint8_t s = 0;
     uint8_t sticky = 0;
     do {
@@ -33,7 +33,7 @@ FSW_NOINLINE static Real real_from_magnitude(uint64_t m) {
     lo |= sticky;
     // lo >= 2^31, so its binary32 value is normal: scaling by 2^s is
     // adding s to the exponent field (no multiply routine pulled in).
-    const float f = static_cast<float>(lo);
+    const float f = f32_from_u32(lo);
     uint32_t bits;
     memcpy(&bits, &f, sizeof bits);
     bits += static_cast<uint32_t>(s) << 23;

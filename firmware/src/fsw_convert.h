@@ -15,15 +15,45 @@ inline bool truthy(Real r) { return r == r && r != 0; }
 // Comparisons and logical operators yield 1 or 0.
 inline Real real_from_truth(bool b) { return b ? Real(1) : Real(0); }
 
+// ---- integer -> binary32 -------------------------------------------------------
+// An integer of up to 32 bits as a float, rounded to nearest (ties to even)
+// as the cast does. On AVR one routine in assembly for all of them
+// (fsw_element.cpp), which takes a count of 16 bits in about 30 cycles,
+// where the float library's conversion (122 B, pulled in by the first
+// cast of an integer) works through 32 bits in 50; the runtime's and the
+// generated code's conversions all go through these, so the library's is
+// never linked. Tested against the cast (tests/firmware/test_convert.cpp).
+#if defined(__AVR__)
+extern "C" float fsw_f32_from_u16(uint16_t v);
+extern "C" float fsw_f32_from_u32(uint32_t v);
+extern "C" float fsw_f32_from_i32(int32_t v);
+inline float f32_from_u16(uint16_t v) { return fsw_f32_from_u16(v); }
+inline float f32_from_u32(uint32_t v) { return fsw_f32_from_u32(v); }
+inline float f32_from_i32(int32_t v) { return fsw_f32_from_i32(v); }
+#else
+inline float f32_from_u16(uint16_t v) { return static_cast<float>(v); }
+inline float f32_from_u32(uint32_t v) { return static_cast<float>(v); }
+inline float f32_from_i32(int32_t v) { return static_cast<float>(v); }
+#endif
+
 // ---- element value -> Real --------------------------------------------------
 // Integers round to nearest (ties to even) when R cannot hold them exactly.
 
+#if FSW_REAL_IS_FLOAT
+inline Real real_from_I8(int8_t v) { return f32_from_i32(v); }
+inline Real real_from_I16(int16_t v) { return f32_from_i32(v); }
+inline Real real_from_I32(int32_t v) { return f32_from_i32(v); }
+inline Real real_from_U8(uint8_t v) { return f32_from_u16(v); }
+inline Real real_from_U16(uint16_t v) { return f32_from_u16(v); }
+inline Real real_from_U32(uint32_t v) { return f32_from_u32(v); }
+#else
 inline Real real_from_I8(int8_t v) { return static_cast<Real>(v); }
 inline Real real_from_I16(int16_t v) { return static_cast<Real>(v); }
 inline Real real_from_I32(int32_t v) { return static_cast<Real>(v); }
 inline Real real_from_U8(uint8_t v) { return static_cast<Real>(v); }
 inline Real real_from_U16(uint16_t v) { return static_cast<Real>(v); }
 inline Real real_from_U32(uint32_t v) { return static_cast<Real>(v); }
+#endif
 Real real_from_I64(int64_t v);
 Real real_from_U64(uint64_t v);
 inline Real real_from_bool(bool v) { return v ? Real(1) : Real(0); }

@@ -85,6 +85,137 @@ Real f32_write_back(Real r, uint8_t* p) {
 }
 #endif
 
+#if defined(__AVR__)
+// fsw_convert.h: integers as floats. The value is shifted until its leading
+// one is bit 23 (a value of up to 24 bits: exact) or down to it (above:
+// the bits shifted out rounded to nearest, ties to even), the exponent
+// counted from bit 23's (127 + 23), and the float put together: the
+// exponent over the leading one's place, the 23 bits after it. None of the
+// three changes T (the signed one keeps the sign there across its call)
+// and each changes r20 and r21 at most of the registers a call may change.
+#if defined(__AVR_HAVE_JMP_CALL__)
+#define FSW_FAR_JMP "jmp "
+#define FSW_FAR_CALL "call "
+#else
+#define FSW_FAR_JMP "rjmp "
+#define FSW_FAR_CALL "rcall "
+#endif
+
+// 16 bits, v in r25:r24 (a byte, a nibble, then at most three bits: the
+// analog counts' conversion, 4 a cycle on the rocket).
+extern "C" __attribute__((naked, noinline, used, externally_visible)) float fsw_f32_from_u16(uint16_t) {
+    __asm__ __volatile__(
+        "movw r22, r24\n\t"
+        "ldi  r25, 142\n\t"  // bit 15's exponent
+        "tst  r23\n\t"
+        "brne 1f\n\t"
+        "mov  r23, r22\n\t"  // a byte
+        "clr  r22\n\t"
+        "ldi  r25, 134\n\t"
+        "tst  r23\n\t"
+        "breq 9f\n\t"  // 0: +0
+        "1:\n\t"
+        "cpi  r23, 0x10\n\t"
+        "brsh 2f\n\t"
+        "swap r23\n\t"  // a nibble (the high byte's high one is 0)
+        "swap r22\n\t"
+        "mov  r21, r22\n\t"
+        "andi r21, 0x0F\n\t"
+        "or   r23, r21\n\t"
+        "eor  r22, r21\n\t"
+        "subi r25, 4\n\t"
+        "2:\n\t"
+        "sbrc r23, 7\n\t"
+        "rjmp 3f\n\t"
+        "lsl  r22\n\t"  // a bit
+        "rol  r23\n\t"
+        "dec  r25\n\t"
+        "rjmp 2b\n\t"
+        "3:\n\t"
+        "mov  r24, r23\n\t"  // the leading one to bit 23
+        "mov  r23, r22\n\t"
+        "clr  r22\n\t"
+        "lsl  r24\n\t"  // out, and the exponent's low bit in its place
+        "lsr  r25\n\t"
+        "ror  r24\n\t"
+        "ret\n\t"
+        "9:\n\t"
+        "clr  r24\n\t"
+        "clr  r25\n\t"
+        "ret\n\t");
+}
+
+// 32 bits, v in r25..r22: below 2^16 the 16-bit conversion's.
+extern "C" __attribute__((naked, noinline, used, externally_visible)) float fsw_f32_from_u32(uint32_t) {
+    __asm__ __volatile__(
+        "tst  r25\n\t"
+        "brne 3f\n\t"
+        "tst  r24\n\t"
+        "brne 1f\n\t"
+        "movw r24, r22\n\t"
+        FSW_FAR_JMP "fsw_f32_from_u16\n\t"
+        "1:\n\t"  // 17 to 24 bits: up, a bit at a time
+        "ldi  r25, 150\n\t"
+        "2:\n\t"
+        "sbrc r24, 7\n\t"
+        "rjmp 6f\n\t"
+        "lsl  r22\n\t"
+        "rol  r23\n\t"
+        "rol  r24\n\t"
+        "dec  r25\n\t"
+        "rjmp 2b\n\t"
+        "3:\n\t"  // 25 to 32 bits: down, the bits shifted out (8 at most) in r20
+        "mov  r21, r25\n\t"
+        "ldi  r25, 150\n\t"
+        "clr  r20\n\t"
+        "4:\n\t"
+        "inc  r25\n\t"
+        "lsr  r21\n\t"
+        "ror  r24\n\t"
+        "ror  r23\n\t"
+        "ror  r22\n\t"
+        "ror  r20\n\t"
+        "tst  r21\n\t"
+        "brne 4b\n\t"
+        "sbrs r20, 7\n\t"  // below half of the last place: down
+        "rjmp 6f\n\t"
+        "lsl  r20\n\t"  // above it: up; half: to the even one
+        "brne 5f\n\t"
+        "sbrs r22, 0\n\t"
+        "rjmp 6f\n\t"
+        "5:\n\t"
+        "subi r22, 0xFF\n\t"  // + 1: a carry out of the fraction goes on into the exponent
+        "sbci r23, 0xFF\n\t"
+        "sbci r24, 0xFF\n\t"
+        "sbci r25, 0xFF\n\t"
+        "6:\n\t"
+        "lsl  r24\n\t"
+        "lsr  r25\n\t"
+        "ror  r24\n\t"
+        "ret\n\t");
+}
+
+// Signed: the magnitude's, with the sign (kept in T) on it; 0 is +0.
+extern "C" __attribute__((naked, noinline, used, externally_visible)) float fsw_f32_from_i32(int32_t) {
+    __asm__ __volatile__(
+        "bst  r25, 7\n\t"
+        "brtc 1f\n\t"
+        "com  r25\n\t"
+        "com  r24\n\t"
+        "com  r23\n\t"
+        "neg  r22\n\t"
+        "sbci r23, 0xFF\n\t"
+        "sbci r24, 0xFF\n\t"
+        "sbci r25, 0xFF\n\t"
+        "1:\n\t"
+        FSW_FAR_CALL "fsw_f32_from_u32\n\t"
+        "bld  r25, 7\n\t"
+        "ret\n\t");
+}
+#undef FSW_FAR_JMP
+#undef FSW_FAR_CALL
+#endif
+
 Real read_elem_typed(const uint8_t* p, uint8_t type) {
     switch (type) {
         case kI8: return read_I8(p);

@@ -160,62 +160,6 @@ Result io_analog_task(void* ctx) { return analog_task<true, true>(ctx); }
 Result io_analog_task_f32(void* ctx) { return analog_task<false, true>(ctx); }
 Result io_analog_in_task_f32(void* ctx) { return analog_task<false, false>(ctx); }
 
-#if FSW_REAL_IS_FLOAT && defined(__AVR__)
-// The count shifted until its bit 15 leads (a byte, a nibble, then at most
-// three bits), the exponent counted down from bit 15's (127 + 15); the
-// float is sign 0, that exponent, the 15 bits after the leading one and 8
-// zero bits. About 30 cycles where the conversion routine takes 50.
-Real real_from_count(uint16_t v) {
-    uint32_t out;
-    uint8_t e, t;
-    __asm__(
-        "clr  %A[o]\n\t"
-        "clr  %B[o]\n\t"
-        "clr  %C[o]\n\t"
-        "clr  %D[o]\n\t"
-        "mov  %[t], %A[v]\n\t"
-        "or   %[t], %B[v]\n\t"
-        "breq 9f\n\t"  // 0: +0
-        "ldi  %[e], 142\n\t"
-        "tst  %B[v]\n\t"
-        "brne 1f\n\t"
-        "mov  %B[v], %A[v]\n\t"  // a byte
-        "clr  %A[v]\n\t"
-        "ldi  %[e], 134\n\t"
-        "1:\n\t"
-        "cpi  %B[v], 0x10\n\t"
-        "brsh 2f\n\t"
-        "swap %B[v]\n\t"  // a nibble: the high byte's is 0
-        "swap %A[v]\n\t"
-        "mov  %[t], %A[v]\n\t"
-        "andi %[t], 0x0F\n\t"
-        "or   %B[v], %[t]\n\t"
-        "andi %A[v], 0xF0\n\t"
-        "subi %[e], 4\n\t"
-        "2:\n\t"
-        "sbrc %B[v], 7\n\t"
-        "rjmp 4f\n\t"
-        "3:\n\t"
-        "lsl  %A[v]\n\t"  // a bit
-        "rol  %B[v]\n\t"
-        "dec  %[e]\n\t"
-        "sbrs %B[v], 7\n\t"
-        "rjmp 3b\n\t"
-        "4:\n\t"
-        "mov  %B[o], %A[v]\n\t"
-        "lsl  %B[v]\n\t"  // the leading one out, the exponent's low bit in
-        "lsr  %[e]\n\t"
-        "ror  %B[v]\n\t"
-        "mov  %C[o], %B[v]\n\t"
-        "mov  %D[o], %[e]\n\t"
-        "9:\n\t"
-        : [o] "=&r"(out), [v] "+d"(v), [e] "=&d"(e), [t] "=&d"(t));
-    Real r;
-    memcpy(&r, &out, sizeof r);
-    return r;
-}
-#endif
-
 Result io_digital_begin(const DigitalTable* table) {
     DigitalTable tab;
     flash_read(&tab, table, sizeof tab);

@@ -3,6 +3,7 @@
 #ifndef FSW_IO_H
 #define FSW_IO_H
 
+#include "fsw_convert.h"
 #include "fsw_pal.h"
 #include "fsw_types.h"
 
@@ -209,15 +210,11 @@ void io_analog_scan_begin(const uint8_t* pins, uint8_t n, volatile uint16_t* raw
 // exactly, fswkit.autocode.iotables.analog_value).
 // An offset of +0 known when compiling (a generated call's literal) costs
 // no float addition: adding +0 only turns -0 into +0, done here on the bits.
-// A count as R: exact (every count has at most 16 bits). On AVR with
-// binary32 R the float's bits are put together from the count's leading bit
-// (real_from_count, fsw_io.cpp), where the conversion routine works through
-// 32 bits: tested against the cast for every count (tests/firmware/test_io.cpp).
-#if FSW_REAL_IS_FLOAT && defined(__AVR__)
-FSW_NOINLINE Real real_from_count(uint16_t count);
-#else
-inline Real real_from_count(uint16_t count) { return static_cast<Real>(count); }
-#endif
+// A count as R: exact (every count has at most 16 bits). On AVR the 16-bit
+// conversion of fsw_convert.h, which puts the float's bits together from the
+// count's leading bit where the float library's routine works through 32
+// bits: tested against the cast for every count (tests/firmware/test_io.cpp).
+inline Real real_from_count(uint16_t count) { return real_from_U16(count); }
 inline Real analog_value(uint16_t count, Real gain, Real offset) {
     const Real scaled = real_from_count(count) * gain;  // one rounding, never fused with the add
 #if FSW_REAL_IS_FLOAT && defined(__GNUC__)

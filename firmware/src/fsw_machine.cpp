@@ -139,7 +139,7 @@ uint32_t machine_T32(const Machine& m) {
 Real machine_T_real(const Machine& m) {
     uint32_t lo, hi;
     T_halves(m, lo, hi);
-    if (hi == 0) return static_cast<Real>(lo);  // correctly rounded by the float library
+    if (hi == 0) return f32_from_u32(lo);  // correctly rounded (fsw_convert.h)
     // Shift right until the value fits 32 bits, OR-ing what falls off into
     // bit 0 (below the guard bit: the rounding is unchanged), convert, and
     // scale by 2^k exactly. (The loop in assembly: the compiler's copied
@@ -157,7 +157,7 @@ Real machine_T_real(const Machine& m) {
             : [hi] "+r"(hi), [lo] "+r"(lo), [k] "+r"(k), [st] "+d"(sticky));
     // Times 2^k: k added to the exponent field (bits 23..30; the value is a
     // normal number from 2^31 to 2^64, so the field neither wraps nor spills).
-    Real r = static_cast<Real>(lo | sticky);
+    Real r = f32_from_u32(lo | sticky);
     uint32_t bits;
     memcpy(&bits, &r, sizeof bits);
     const uint16_t e = static_cast<uint16_t>(static_cast<uint16_t>(k) << 7);  // k << 23: the upper half's k << 7

@@ -7,6 +7,8 @@
 // shifts are arithmetic (GCC, on every target the kit builds for).
 #include "fsw_parts.h"
 
+#include "fsw_convert.h"
+
 namespace fsw {
 
 namespace {
@@ -267,7 +269,7 @@ float adxl345_g_per_count(uint8_t data_format) {
 }
 
 float adxl345_g(int16_t count, uint8_t data_format) {
-    return static_cast<float>(count) * adxl345_g_per_count(data_format);
+    return f32_from_i32(count) * adxl345_g_per_count(data_format);
 }
 
 // ---- MPU-6050 ---------------------------------------------------------------------------
@@ -287,13 +289,13 @@ float mpu6050_g_per_count(uint8_t afs_sel) {
 }
 
 float mpu6050_accel_g(int16_t count, uint8_t afs_sel) {
-    return static_cast<float>(count) * mpu6050_g_per_count(afs_sel);
+    return f32_from_i32(count) * mpu6050_g_per_count(afs_sel);
 }
 
 // Register map 4.18: Temperature in degrees C = (TEMP_OUT Register Value as
 // a signed quantity)/340 + 36.53.
 float mpu6050_temp_c(int16_t temp_out) {
-    return static_cast<float>(temp_out) / 340.0f + 36.53f;
+    return f32_from_i32(temp_out) / 340.0f + 36.53f;
 }
 
 }  // namespace fsw

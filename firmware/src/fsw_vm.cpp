@@ -878,7 +878,7 @@ void int_add(uint8_t* d, uint8_t td, const uint8_t* x, uint8_t ts, int32_t k) {
         (v < 0 ? UWide(0) - static_cast<UWide>(v) : static_cast<UWide>(v)) +
                 (k < 0 ? UWide(0) - static_cast<UWide>(static_cast<Wide>(k)) : static_cast<UWide>(k)) >
             exact) {
-        vm_write(d, td, vm_read(x, ts) + static_cast<Real>(k));
+        vm_write(d, td, vm_read(x, ts) + real_from_I32(k));
         return;
     }
     v += k;

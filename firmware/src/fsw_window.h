@@ -4,6 +4,7 @@
 #ifndef FSW_WINDOW_H
 #define FSW_WINDOW_H
 
+#include "fsw_convert.h"
 #include "fsw_types.h"
 
 namespace fsw {
@@ -179,7 +180,8 @@ inline Real roll_avg_infinite(const RollAvgS<I>& w) {
 template <typename I>
 inline Real roll_avg_value(const RollAvgS<I>& w) {
     if ((w.pinf | w.ninf) != 0) return roll_avg_infinite(w);
-    return w.count == 0 ? Real(0) : (w.base + w.fresh) / static_cast<Real>(w.count);
+    const Real n = sizeof(I) <= 2 ? real_from_U16(w.count) : real_from_U32(w.count);
+    return w.count == 0 ? Real(0) : (w.base + w.fresh) / n;
 }
 
 // The value of a window of n samples: roll_avg_value, but times `inv` (1/n,

@@ -57,6 +57,56 @@ static void test_reads_of_64_bit_integers_round_once_to_nearest_even(void) {
 #endif
 }
 
+// Integers of up to 32 bits as floats (fsw_convert.h f32_from_*: on AVR one
+// routine in assembly, which the runtime's and the generated code's
+// conversions all use) give the cast's bits: every 16-bit value, and 32-bit
+// values around each power of two (the rounding's ties, the carries into
+// the next power), both signs, and a pseudo-random run across the range.
+static void check_u32(uint32_t v) {
+    volatile uint32_t cast = v;  // no constant folding: the compiler's conversion, at run time
+    volatile int32_t scast = static_cast<int32_t>(v);
+    if (bits_of(f32_from_u32(v)) != bits_of(static_cast<float>(cast))) {
+        TEST_ASSERT_EQUAL_HEX32_MESSAGE(bits_of(static_cast<float>(cast)), bits_of(f32_from_u32(v)),
+                                        "f32_from_u32");
+    }
+    if (bits_of(f32_from_i32(static_cast<int32_t>(v))) != bits_of(static_cast<float>(scast))) {
+        TEST_ASSERT_EQUAL_HEX32_MESSAGE(bits_of(static_cast<float>(scast)),
+                                        bits_of(f32_from_i32(static_cast<int32_t>(v))), "f32_from_i32");
+    }
+}
+
+static void test_integers_convert_to_float_as_the_cast_does(void) {
+    for (uint32_t n = 0; n <= 0xFFFFu; ++n) {
+        volatile uint16_t cast = static_cast<uint16_t>(n);
+        if (bits_of(f32_from_u16(static_cast<uint16_t>(n))) != bits_of(static_cast<float>(cast))) {
+            TEST_ASSERT_EQUAL_UINT32(n, 0x10000UL);  // reports the first value that differs
+        }
+        check_u32(n);
+    }
+    for (uint8_t k = 16; k < 32; ++k) {
+        const uint32_t p = 1UL << k;
+        for (uint32_t d = 0; d <= 300; ++d) {
+            check_u32(p + d);
+            check_u32(p - d);
+            check_u32(p | (p >> 1) | d);  // 0b11...: rounds up into the next power
+            check_u32(~d);
+        }
+        for (uint8_t j = 0; j < k; ++j) {  // a half of the last place, with and without bits below it
+            check_u32(p | (1UL << j));
+            check_u32(p | (3UL << j));
+            check_u32(p | (1UL << j) | 1u);
+        }
+    }
+    uint32_t x = 0x12345678UL;
+    for (uint16_t i = 0; i < 20000; ++i) {
+        x = x * 1664525UL + 1013904223UL;
+        check_u32(x);
+        check_u32(x >> (x & 31u));
+    }
+    check_u32(0x80000000UL);  // the most negative int32_t: -2^31 exactly
+    check_u32(0xFFFFFFFFUL);
+}
+
 // F32 elements by pointer (out of line on AVR, with the NaN test on the
 // bits): the same as the value forms for every class of binary32 pattern.
 static void test_f32_element_access_matches_the_value_forms(void) {
@@ -476,6 +526,7 @@ static void test_window_scale_by_a_power_of_two_is_the_product(void) {
 static void run(void) {
     UNITY_BEGIN();
     RUN_TEST(test_reads_of_integers_are_exact_where_R_holds_them);
+    RUN_TEST(test_integers_convert_to_float_as_the_cast_does);
     RUN_TEST(test_reads_of_64_bit_integers_round_once_to_nearest_even);
     RUN_TEST(test_reads_of_floats_turn_nan_into_zero);
     RUN_TEST(test_f32_element_access_matches_the_value_forms);

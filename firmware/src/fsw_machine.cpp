@@ -168,6 +168,26 @@ Real machine_T_real(const Machine& m) {
 #endif
 
 uint32_t round_f32_saturated(uint32_t v, uint32_t hi) {
+#if defined(__AVR__)
+    if (v >= 0x1000000UL) {
+        // v as a float (f32_from_u32: rounded to 24 significant bits, ties
+        // to even, the conversion every integer takes on AVR, linked
+        // already) and back: its significand shifted up by its exponent less
+        // 23's, 1 to 8, or 9 for 2^32 (rounded up from above 2^32 - 2^7),
+        // above any hi. (The rounding written out here was 142 B.)
+        const float f = f32_from_u32(v);
+        uint8_t b[4];  // little-endian: byte 3 the sign and the exponent's high seven bits, byte 2's top bit its low one
+        memcpy(b, &f, sizeof b);
+        uint8_t e = static_cast<uint8_t>(static_cast<uint8_t>((b[3] << 1) | (b[2] >> 7)) - 150u);
+        if (e > 8) return hi;
+        b[2] = static_cast<uint8_t>(b[2] | 0x80u);  // the leading one, over the exponent's low bit
+        b[3] = 0;
+        memcpy(&v, b, sizeof v);
+        do {
+            v <<= 1;
+        } while (--e != 0);
+    }
+#else
     if (v >= 0x1000000UL) {
         // 24 significant bits: down to 25, what falls off OR-ed into
         // `sticky`; the lowest of the 25 is the round bit. Round to
@@ -186,6 +206,7 @@ uint32_t round_f32_saturated(uint32_t v, uint32_t hi) {
             v <<= 1;
         } while (--s != 0);
     }
+#endif
     return v > hi ? hi : v;
 }
 

@@ -337,7 +337,21 @@ def float_key_test(op: str, cv: float, size: int, ptr: str, held: str | None = N
     bytes at `ptr` and a literal c, as integer threshold tests on x's
     stored bytes (autocode/thresholds.py), or None when not expressible.
     `held`: a C++ local holding x's value (an F32's, never a NaN), tested
-    instead of the bytes (fsw::f32_key_gt, f32_key_ge)."""
+    instead of the bytes (fsw::f32_key_gt, f32_key_ge). An F32 no local
+    holds is read by fsw::read_F32 (a NaN reads as +0) and its value tested
+    so: the same result as its bytes' key (f32_read_key), with no routine of
+    its own for the key (54 B of the core rocket's flash)."""
+    if held is None and size == 4:
+        read = f"fsw::read_F32({ptr})"
+        test = _float_key_test(op, cv, size, ptr, read)
+        if test is None or test.count(read) <= 1:
+            return test
+        body = _float_key_test(op, cv, size, ptr, "v")  # more than one term: the value read once
+        return f"([&]() -> bool {{ const fsw::Real v = {read}; return {body}; }}())"
+    return _float_key_test(op, cv, size, ptr, held)
+
+
+def _float_key_test(op: str, cv: float, size: int, ptr: str, held: str | None):
     negate = op == "!="
     terms = tests("==" if negate else op, cv, size)
     if terms is None:

@@ -180,7 +180,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
     counting("int_add", lambda self, a, r: (bump("int_add"), "round_to_f32_precision" in r and bump("int_add slow path")))
     counting("constant_store", lambda self, a, r: (bump("constant_store"),
                                                    re.search(r"// (inf|-inf|-0\.0)$", r) and bump("constant_store NaN/inf/-0")))
-    counting("float_threshold", lambda self, a, r: (bump("float_threshold F32" if "f32_read_key" in r else
+    counting("float_threshold", lambda self, a, r: (bump("float_threshold F32" if "f32_read_key" in r or "f32_key_g" in r else
                                                          "float_threshold F64" if "f64_read_key" in r else
                                                          "int_compare folded"),
                                                     negated(a) and bump("negated constant")))

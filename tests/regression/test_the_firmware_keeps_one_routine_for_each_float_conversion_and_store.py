@@ -3,8 +3,8 @@ store (`write_F32`) and the same store returning what it stored
 (`write_F32_read`), 38 and 42 B; an analog count's conversion to a float
 (`real_from_count`, 74 B) and the float library's integer conversion
 (`__floatunsisf`/`__floatsisf`, 122 B), which T as a real, a window's
-count and a U32 variable pulled in; and a threshold key's read
-(`f32_read_key`, 70 B) that tested the bytes for a NaN apart from
+count and a U32 variable pulled in; and a threshold test's key read
+(`f32_read_key`, 70 B), which tested the bytes for a NaN apart from
 `read_F32`'s test. The store took its place first, so each call moved a
 computed value out of the registers the float routines leave it in.
 
@@ -12,9 +12,11 @@ Now a store is one routine taking the value first (`f32_write_back`, the
 value back in the same registers: `write_F32` and `write_F32_read` are
 calls of it), every integer becomes a float through one routine in
 assembly (`fsw_f32_from_u16/u32/i32`: the library's is not linked), and
-the key is read_F32's loads and NaN test with the key made in place. The
-values are the same bits (tests/firmware/test_convert.cpp tests the
-conversions against the cast on the simulated board)."""
+a threshold test of an F32 that no local holds reads it with read_F32 and
+tests the value's bits (f32_key_gt/f32_key_ge, as for one a local holds):
+no key routine is linked. The values are the same bits
+(tests/firmware/test_convert.cpp tests the conversions against the cast on
+the simulated board, and the held value's tests against its key)."""
 
 from __future__ import annotations
 
@@ -52,6 +54,10 @@ def test_integers_become_floats_through_one_routine(symbols):
     assert "fsw_f32_from_u16" in symbols and "fsw_f32_from_u32" in symbols, sorted(symbols)
 
 
-def test_a_threshold_key_is_read_as_read_F32_reads(symbols):
-    # the loads, read_F32's NaN test and the key in place: 54 B (70 with its own byte-wise test)
-    assert symbols["fsw::f32_read_key(unsigned char const*)"] <= 54, symbols["fsw::f32_read_key(unsigned char const*)"]
+def test_a_threshold_test_reads_the_value_as_read_F32_does(symbols, tmp_path_factory):
+    # `x > c` of an F32 no local holds: read_F32 and the value's bits tested, no key routine
+    _, out = build_core(tmp_path_factory)
+    mission = (out / "gen" / "mission.gen.cpp").read_text()
+    assert "f32_read_key" not in mission, mission
+    assert "fsw::f32_key_gt(fsw::read_F32(svp + E_drogueSense), 0xbf7fffffUL)" in mission, mission
+    assert not [n for n in symbols if n.startswith("fsw::f32_read_key(")], sorted(symbols)

@@ -169,13 +169,13 @@ def test_the_rocket_drives_its_pyro_pins_through_the_gate(tmp_path):
     assert r.code == 0, r.err
     app = (tmp_path / "app.gen.cpp").read_text()
     # continuity: the reading >= 1.0 as a test of its key (above that of 1.0's predecessor), as the
-    # machines test a float against a literal
+    # machines test a float against a literal: the value read_F32 reads, tested on its bits
     assert ("const bool pyro0 = fsw::pyro_gate(Pyro[0], sv[E_drogue] != 0, fsw::io_pin_read(FSW_PIN(2, D, 2)), "
             "mission::machine.state == mission::S_Apogee, 100u, "
-            "((fsw::f32_read_key(sv + E_drogueSense) > 0xbf7fffffUL) ? fsw::kPyroContinuity : 0));") in app
+            "((fsw::f32_key_gt(fsw::read_F32(sv + E_drogueSense), 0xbf7fffffUL)) ? fsw::kPyroContinuity : 0));") in app
     assert ("const bool pyro1 = fsw::pyro_gate(Pyro[1], sv[E_main] != 0, fsw::io_pin_read(FSW_PIN(2, D, 2)), "
             "mission::machine.state == mission::S_Main, 100u, "
-            "((fsw::f32_read_key(sv + E_mainSense) > 0xbf7fffffUL) ? fsw::kPyroContinuity : 0));") in app
+            "((fsw::f32_key_gt(fsw::read_F32(sv + E_mainSense), 0xbf7fffffUL)) ? fsw::kPyroContinuity : 0));") in app
     # the flight's state kept before a pulse's first high, then the pins
     save = app.index("if (((Pyro[0].status | Pyro[1].status) & fsw::kPyroRose) != 0) fsw::resume_save(resume);")
     assert app.index("const bool pyro1") < save < app.index("fsw::io_pin_write(FSW_PIN(5, D, 5), pyro0);") \

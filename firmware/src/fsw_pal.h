@@ -205,6 +205,7 @@ extern CycleSettings g_cs;
 inline __attribute__((always_inline)) uint16_t ct_sub_us() { return FSW_CYCLE_SETTING(sub_us); }
 inline __attribute__((always_inline)) uint16_t ct_sub_ms() { return FSW_CYCLE_SETTING(sub_ms); }
 inline __attribute__((always_inline)) uint16_t ct_sub_frac() { return FSW_CYCLE_SETTING(sub_frac); }
+inline __attribute__((always_inline)) uint16_t ct_top() { return FSW_CYCLE_SETTING(top); }
 inline __attribute__((always_inline)) uint16_t ct_early() { return FSW_CYCLE_SETTING(early); }
 inline __attribute__((always_inline)) uint16_t ct_quiet() { return FSW_CYCLE_SETTING(quiet); }
 inline __attribute__((always_inline)) uint8_t ct_last() { return FSW_CYCLE_SETTING(last); }

@@ -112,6 +112,71 @@ __attribute__((noinline)) bool sub_period_ended() {
     return true;
 }
 
+// The last stretch's sleep (cycle_wait): where the application has no
+// sensor parts, and its period is a constant (fsw_app.h app_period_us: the
+// clock's count of a sub-period is then the short code the lead below was
+// measured on) long enough to sleep in. (The TWI's handler is left on: its
+// control register starts the bus's next step when written, and a sensor
+// application keeps the spin from the early wake-up, FSW_WAKE_EARLY_US.)
+inline __attribute__((always_inline)) bool stretch_sleeps() {
+    return !app_has(kAppSensors) && app_period_us != 0 && !ct_spin();
+}
+// Where compare B wakes the CPU the second time: before the count wraps by
+// the wake-up (about 25 CPU cycles: the interrupt, compare B's handler),
+// the clock's count of the ending sub-period and the test of the wrap
+// (about 50 for a sub-period of whole milliseconds that ends a cycle: 77
+// on the rocket, avr-g++ 7.3), in timer ticks of 8 CPU cycles (clk/8), 12
+// (96 cycles), 2 more for a sub-period with a fraction of a millisecond to
+// count, 1 more where a cycle has several: the spin after it waits out the
+// rest, two or three ticks. (A wake-up that reaches the count's flag after
+// the wrap would count every cycle late: the margin is 19 CPU cycles on
+// the rocket. An early wake-up shorter than this lead, FSW_WAKE_EARLY_US,
+// finds the count past it: it spins, as before.)
+inline __attribute__((always_inline)) uint16_t stretch_wake() {
+    const uint16_t lead = static_cast<uint16_t>(12u + (ct_sub_frac() != 0 ? 2u : 0u) + (ct_last() != 0 ? 1u : 0u));
+    return static_cast<uint16_t>(ct_top() - lead);
+}
+
+// The kit's interrupt sources but the timer's, held off through the last
+// stretch (stretch_sleeps), so that none delays the cycle's start: the
+// UART's (receive, transmit: a byte takes 85 us at 115,200 baud, and the
+// UART's buffers hold the next) and the ADC's, each 2.5 to 5.5 us. Each
+// interrupt's flag stays as it is (the ADC's written 0, which leaves it
+// alone), so each runs once released. (The EEPROM-ready handler, about
+// 1.5 us once a byte written, 3.4 ms apart, is left on.)
+struct HeldIrqs {
+    uint8_t ucsrb;  // the UART's control bits
+    uint8_t adie;   // the ADC's interrupt enable, as it was
+};
+#if !defined(UCSR0B)
+#define FSW_HELD_UCSRB 0
+#else
+#define FSW_HELD_UCSRB (_BV(RXCIE0) | _BV(TXCIE0) | _BV(UDRIE0))
+#endif
+inline __attribute__((always_inline)) HeldIrqs hold_irqs() {
+    HeldIrqs h = {0, 0};
+    if (!stretch_sleeps()) return h;
+#if defined(UCSR0B)
+    h.ucsrb = UCSR0B;
+    UCSR0B = static_cast<uint8_t>(h.ucsrb & ~FSW_HELD_UCSRB);
+#endif
+#if defined(ADCSRA)
+    const uint8_t a = ADCSRA;
+    h.adie = static_cast<uint8_t>(a & _BV(ADIE));
+    ADCSRA = static_cast<uint8_t>(a & ~(_BV(ADIE) | _BV(ADIF)));
+#endif
+    return h;
+}
+inline __attribute__((always_inline)) void release_irqs(const HeldIrqs& h) {
+    if (!stretch_sleeps()) return;
+#if defined(UCSR0B)
+    UCSR0B = h.ucsrb;
+#endif
+#if defined(ADCSRA)
+    ADCSRA = static_cast<uint8_t>((ADCSRA & ~_BV(ADIF)) | h.adie);
+#endif
+}
+
 }  // namespace
 
 void cycle_timer_begin(uint32_t period_us) {
@@ -149,14 +214,45 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             return why;
         }
         if ((ct_last() == 0 || g_ct.sub == ct_last()) && TCNT1 >= ct_early()) {
-            // The last stretch, interrupts off: this sub-period's end is
-            // counted first (nothing reads the clock before the count
-            // wraps: interrupts are off), in time the spin would wait out
-            // anyway, then the spin until the count wraps to 0. Should it
-            // have wrapped meanwhile (the compare's flag is set: handlers
-            // held the CPU almost all the way from the wake-up to the
-            // cycle's time), the cycle starts up to the count's few
-            // microseconds late: counted late.
+            // The last stretch, interrupts off. Where the application has
+            // no sensor parts (no TWI handler), the kit's other interrupt
+            // sources are held off until the cycle starts, and the CPU
+            // sleeps again until compare B, moved to a few ticks before
+            // the count wraps (stretch_wake), wakes it, its only interrupt then
+            // (compare A's off too): it wakes at the same instruction
+            // every cycle and spins only the rest, a tick or two (a
+            // sleeping CPU is no awake time; the spin from the early
+            // wake-up was 11 us a cycle on the rocket). Anything else
+            // that wakes it (an interrupt not the kit's) sleeps it again
+            // (compare B's handler clears SE); should one hold the CPU
+            // past the wrap, the count's flag below tells. A wake-up the
+            // count is already at (a short FSW_WAKE_EARLY_US, handlers
+            // that held the CPU since the early one) is the spin's.
+            const HeldIrqs held = hold_irqs();
+            if (stretch_sleeps() && static_cast<uint16_t>(TCNT1 + 1u) < stretch_wake() &&
+                (TIFR1 & _BV(OCF1A)) == 0) {
+                OCR1B = stretch_wake();  // (compare B's flag: its handler, which woke the CPU, cleared it)
+                TIMSK1 = _BV(OCIE1B);
+                SMCR = _BV(SE);
+                __asm__ __volatile__(
+                    "sei\n\t"
+                    "1:  sleep\n\t"
+                    "    in   __tmp_reg__, %[smcr]\n\t"
+                    "    sbrc __tmp_reg__, %[se]\n\t"
+                    "    rjmp 1b\n\t"
+                    "    cli\n\t" ::[smcr] "I"(_SFR_IO_ADDR(SMCR)),
+                    [se] "I"(SE)
+                    : "memory");
+                OCR1B = ct_early();
+                TIMSK1 = static_cast<uint8_t>(_BV(OCIE1A) | _BV(OCIE1B));  // (cycle_timer_begin's: no spin)
+            }
+            // This sub-period's end is counted first (nothing reads the
+            // clock before the count wraps: interrupts are off), in time
+            // the spin would wait out anyway, then the spin until the
+            // count wraps to 0. Should it have wrapped meanwhile (the
+            // compare's flag is set: handlers held the CPU almost all the
+            // way from the wake-up to the cycle's time), the cycle starts
+            // up to the count's few microseconds late: counted late.
             (void)sub_period_ended();
             skipped = 0;
             g_ct.running = 1;
@@ -164,6 +260,7 @@ uint8_t cycle_wait(uint8_t& skipped, bool background) {
             while (TCNT1 >= ct_early()) {
             }
             TIFR1 = _BV(OCF1A);  // (counted above)
+            release_irqs(held);  // (what they held runs now, as after the spin)
             sei();
             return why;
         }

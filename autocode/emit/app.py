@@ -708,11 +708,18 @@ def _task_fn(app: Application, t: Task, tables) -> list[str]:
             out.append(f"    store_G_now(sv + E_{g});")
         else:
             out.append(f"    fsw::store<uint64_t>(sv + E_{g}, {_now(app)});")
-        if app.time_source != "cycle":  # a clock may not have ticked since the last run (docs/runtime.md)
-            out.append(f"    if (fsw::machine_same_tick({c_ident(m.name)}::machine, sv + E_{g})) return fsw::kOk;"
-                       "  // the same tick as its last step: the next run steps")
+        same_tick = f"fsw::machine_same_tick({c_ident(m.name)}::machine, sv + E_{g})"
         if app.reload is not None and app.reload.machine == t.machine:
+            if app.time_source != "cycle":  # a clock may not have ticked since the last run (docs/runtime.md)
+                out.append(f"    if ({same_tick}) return fsw::kOk;  // the same tick as its last step: the next run steps")
             out.append("    return fsw::reload_step(reload);  // the generated machine, or an uploaded image")
+        elif app.time_source != "cycle":
+            # The step first: it refuses a G that is not above its last step's
+            # (kErrTime) before it changes anything (machine_begin), so the
+            # same tick is asked about only then, not on every run.
+            out.append(f"    const fsw::Result r = {c_ident(m.name)}::step();")
+            out.append(f"    return r == fsw::kErrTime && {same_tick} ? fsw::kOk : r;"
+                       "  // the same tick as its last step: the next run steps")
         else:
             out.append(f"    return {c_ident(m.name)}::step();")
     elif t.kind in ("inputs", "outputs"):

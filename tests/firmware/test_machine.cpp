@@ -146,6 +146,38 @@ static void test_machine_begin_matches_machine_begin_step(void) {
     }
 }
 
+// A generated machine task steps first and asks whether the clock ticked
+// only when the step refused its G (autocode/emit/app.py): machine_begin
+// refuses a G not above the last before it changes anything (the Machine's
+// bytes and S alike), so the task's same-tick test then sees the last G,
+// and finds it for an equal G only.
+static void test_a_refused_machine_begin_changes_nothing_and_the_tick_tells_why(void) {
+    Machine m = FSW_MACHINE_INIT(3);
+    uint8_t g[8], s[4] = {0, 0, 0, 0};
+    const uint64_t accepted[] = {1000, 0x1FF, 0x100000000ULL, 0x100000100ULL};
+    uint64_t last = 0;
+    for (size_t i = 0; i < sizeof accepted / sizeof accepted[0]; ++i) {
+        const uint64_t G = i == 1 ? 1001 : accepted[i];  // (each above the one before)
+        memcpy(g, &G, 8);
+        TEST_ASSERT_EQUAL(kOk, machine_begin(m, g, s));
+        last = G;
+        const uint64_t refused[] = {last, last - 1, last - 0x100, last & ~0xFFULL};
+        for (size_t k = 0; k < sizeof refused / sizeof refused[0]; ++k) {
+            if (k != 0 && refused[k] == last) continue;
+            Machine before;
+            uint8_t s_before[4];
+            memcpy(&before, &m, sizeof m);
+            memcpy(s_before, s, 4);
+            memcpy(g, &refused[k], 8);
+            TEST_ASSERT_EQUAL(kErrTime, machine_begin(m, g, s));
+            TEST_ASSERT_EQUAL_MEMORY(&before, &m, sizeof m);
+            TEST_ASSERT_EQUAL_MEMORY(s_before, s, 4);
+            TEST_ASSERT_EQUAL(k == 0, machine_same_tick(m, g));  // the same tick: only the equal G
+        }
+        if (i == 1) machine_transition(m, 2);  // a pending entry, refused alike
+    }
+}
+
 // Generated machines are zero-initialised (.bss): machine_begin takes a zero
 // Machine for FSW_MACHINE_INIT(1).
 static void test_a_zero_machine_begins_in_state_1(void) {
@@ -179,6 +211,7 @@ static void run(void) {
     RUN_TEST(test_T_reads_as_R_and_converts_like_R);
     RUN_TEST(test_machine_begin_matches_machine_begin_step);
     RUN_TEST(test_a_zero_machine_begins_in_state_1);
+    RUN_TEST(test_a_refused_machine_begin_changes_nothing_and_the_tick_tells_why);
     (void)UNITY_END();
 }
 

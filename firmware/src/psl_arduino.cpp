@@ -305,11 +305,11 @@ FSW_NOINLINE uint32_t micros32() { return micros32_inline(); }  // out of line a
 
 uint32_t millis32() {
     const IrqState saved = critical_enter();
-    bool wrapped;
+    const uint16_t t = TCNT1;
     const uint16_t frac = ct_sub_frac() != 0 ? g_ct.ms_frac : 0u;  // (stays 0 for whole milliseconds)
-    uint16_t f = static_cast<uint16_t>(frac + cycle_elapsed_us(wrapped));  // < 1000 + 32000
+    uint16_t f = static_cast<uint16_t>(frac + t / FSW_T1_TICKS_PER_US);  // < 1000 + 32000
     uint32_t ms = g_ct.ms;
-    if (wrapped) {
+    if ((TIFR1 & _BV(OCF1A)) != 0 && t < ct_early()) {  // a sub-period ended, not yet counted (micros32_inline)
         ms += ct_sub_ms();
         f = static_cast<uint16_t>(f + ct_sub_frac());
     }

@@ -51,15 +51,15 @@ Result machine_begin(Machine& m, const uint8_t* g, uint8_t* s) {
         "tst  r26\n\t"
         "breq 1f\n\t"
         FSW_G_BYTES(FSW_CMP_LAST)  // last G - G borrows only when G is greater
-        "brcs 1f\n\t"
+        "brcs 2f\n\t"
         "clr  r1\n\t"  // refused: nothing changed
         "clr  %[r]\n\t"
         "inc  %[r]\n\t"  // kErrTime
         "rjmp 9f\n\t"
-        "1:\n\t"
+        "1:\n\t"  // the first step (only then: a started machine skips these 16 cycles)
         "ldi  r26, 1\n\t"
         "std  Z+22, r26\n\t"
-        "ldd  r26, Z+16\n\t"  // a zero Machine: state 1, its first step
+        "ldd  r26, Z+16\n\t"  // a zero Machine (not started, state 0): state 1, its first step
         "ldd  r27, Z+17\n\t"
         "or   r26, r27\n\t"
         "ldd  r27, Z+18\n\t"

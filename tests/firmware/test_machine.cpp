@@ -146,6 +146,26 @@ static void test_machine_begin_matches_machine_begin_step(void) {
     }
 }
 
+// Only a machine not yet started is taken for a zero Machine (state 0:
+// FSW_MACHINE_INIT(1)), as machine_begin's C version on the host says; a
+// started one's step skips that test (on AVR 16 cycles a step), and one in
+// state 0 (past every state, as a VM's image may leave it) stays there.
+static void test_only_a_machine_not_started_is_taken_for_a_zero_one(void) {
+    Machine m = FSW_MACHINE_INIT(2);
+    uint8_t g[8], s[4] = {0, 0, 0, 0};
+    uint64_t G = 5;
+    memcpy(g, &G, 8);
+    TEST_ASSERT_EQUAL(kOk, machine_begin(m, g, s));
+    m.state = 0;
+    G = 6;
+    memcpy(g, &G, 8);
+    TEST_ASSERT_EQUAL(kOk, machine_begin(m, g, s));
+    TEST_ASSERT_EQUAL_UINT32(0, m.state);
+    TEST_ASSERT_EQUAL_UINT8(0, m.entering);
+    TEST_ASSERT_EQUAL_UINT64(5, m.entry_g);
+    TEST_ASSERT_EQUAL_UINT64(6, m.last_g);
+}
+
 // A generated machine task steps first and asks whether the clock ticked
 // only when the step refused its G (autocode/emit/app.py): machine_begin
 // refuses a G not above the last before it changes anything (the Machine's
@@ -212,6 +232,7 @@ static void run(void) {
     RUN_TEST(test_machine_begin_matches_machine_begin_step);
     RUN_TEST(test_a_zero_machine_begins_in_state_1);
     RUN_TEST(test_a_refused_machine_begin_changes_nothing_and_the_tick_tells_why);
+    RUN_TEST(test_only_a_machine_not_started_is_taken_for_a_zero_one);
     (void)UNITY_END();
 }
 

@@ -124,16 +124,20 @@ inline __attribute__((always_inline)) bool stretch_sleeps() {
 // Where compare B wakes the CPU the second time: before the count wraps by
 // the wake-up (about 25 CPU cycles: the interrupt, compare B's handler),
 // the clock's count of the ending sub-period and the test of the wrap
-// (about 50 for a sub-period of whole milliseconds that ends a cycle: 77
-// on the rocket, avr-g++ 7.3), in timer ticks of 8 CPU cycles (clk/8), 12
-// (96 cycles), 2 more for a sub-period with a fraction of a millisecond to
-// count, 1 more where a cycle has several: the spin after it waits out the
-// rest, two or three ticks. (A wake-up that reaches the count's flag after
-// the wrap would count every cycle late: the margin is 19 CPU cycles on
-// the rocket. An early wake-up shorter than this lead, FSW_WAKE_EARLY_US,
-// finds the count past it: it spins, as before.)
+// (about 50 more for a sub-period of whole milliseconds that ends a cycle:
+// 77 in all on the rocket, avr-g++ 7.3), in timer ticks of 8 CPU cycles
+// (clk/8): 12 (96 cycles), 8 more for a sub-period with a fraction of a
+// millisecond to count (the millisecond it completes every few cycles is
+// about 40 cycles more: 400 Hz), 2 more where a cycle has several: the
+// spin after it waits out the rest, two or three ticks. (A wake-up that
+// reaches the count's flag after the wrap would count the cycle late, and
+// one that ends its count after the wrap starts the cycle that much late:
+// the margin is about 20 CPU cycles on the rocket; tests/regression/
+// test_the_last_microseconds_before_a_cycle_are_slept_not_spun.py flies
+// the three cases. An early wake-up shorter than this lead,
+// FSW_WAKE_EARLY_US, finds the count past it: it spins, as before.)
 inline __attribute__((always_inline)) uint16_t stretch_wake() {
-    const uint16_t lead = static_cast<uint16_t>(12u + (ct_sub_frac() != 0 ? 2u : 0u) + (ct_last() != 0 ? 1u : 0u));
+    const uint16_t lead = static_cast<uint16_t>(12u + (ct_sub_frac() != 0 ? 8u : 0u) + (ct_last() != 0 ? 2u : 0u));
     return static_cast<uint16_t>(ct_top() - lead);
 }
 

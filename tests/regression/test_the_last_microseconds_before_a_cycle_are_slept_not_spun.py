@@ -12,8 +12,9 @@ only the rest, and the cycle starts on the timer's count as before.
 
 Sampled one microsecond a cycle over the last 90 us before the toggle
 project's task sets its pin (1 kHz), the CPU sleeps again after the early
-wake-up (before: it ran from the wake-up on), and the period stays 1 ms
-to within the spin's tick."""
+wake-up (before: it ran from the wake-up on), the period stays 1 ms to
+within the spin's tick, and no cycle is counted late (the wake-up's path
+fits in the compare's lead)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ import shutil
 
 import pytest
 
+from conftest import ROOT, run_fsw
 from support.simfw import toggle_uno  # noqa: F401
 
 from fswkit.sim.board import SimBoard
@@ -44,6 +46,13 @@ def test_the_cpu_sleeps_between_the_early_wake_up_and_the_cycle(toggle_uno):  # 
             states.append(b.until(edge + (k + 1) * MS - before * US).state)
         b.until(edge + 100 * MS)
         edges = b.edges()
+        at, size = b.symbol("fsw_gen::(anonymous namespace)::ex")
+        ex = b.peek(at, size)
+    # The wake-up, the clock's count of the sub-period and the test of the
+    # wrap fit in the second compare's lead: no cycle counted late (the
+    # Executor's `late`, after its configuration's address and `cycles`).
+    assert size == 16 and int.from_bytes(ex[2:6], "little") > 100, ex.hex()
+    assert int.from_bytes(ex[6:8], "little") == 0, ex.hex()
     periods = [e2.cycle - e1.cycle for e1, e2 in zip(edges, edges[1:])]
     assert periods and all(abs(p - MS) <= 8 for p in periods), sorted(set(periods))  # one timer tick
     seen = "".join("s" if s == "sleeping" else "r" for s in states)
@@ -51,3 +60,28 @@ def test_the_cpu_sleeps_between_the_early_wake_up_and_the_cycle(toggle_uno):  # 
     assert woke > 0 and seen[:woke] == "s" * woke, seen
     # before: "r" from the wake-up to the edge, the last stretch spun
     assert seen[woke:].count("s") >= 3, seen
+
+
+@pytest.mark.parametrize("rate", [400, 25])
+def test_no_cycle_is_late_where_the_lead_counts_more(tmp_path, rate):
+    """The second compare's lead is 2 ticks longer where a sub-period has a
+    fraction of a millisecond to count (400 Hz: 2,500 us) and 1 longer where
+    a cycle has several sub-periods (25 Hz: two of 20 ms): still no cycle
+    counted late, the period exact."""
+    proj = tmp_path / "toggle"
+    shutil.copytree(ROOT / "tests" / "sim" / "toggle", proj)
+    app = proj / "toggle.app"
+    app.write_text(app.read_text().replace("rate  1000", f"rate  {rate}").replace("rate=1000", f"rate={rate}"))
+    r = run_fsw("build", str(proj), "--board", "uno", "--out", str(tmp_path / "out"))
+    assert r.code == 0, r.err
+    elf = str(tmp_path / "out" / "toggle.elf")
+    period = MS * 1000 // rate
+    with SimBoard(elf, "uno", sim_limit=10) as b:
+        b.watch(13)
+        b.run_for(40 / rate)
+        edges = b.edges()[4:]
+        at, size = b.symbol("fsw_gen::(anonymous namespace)::ex")
+        ex = b.peek(at, size)
+    periods = [e2.cycle - e1.cycle for e1, e2 in zip(edges, edges[1:])]
+    assert len(periods) > 20 and all(abs(p - period) <= 8 for p in periods), sorted(set(periods))
+    assert int.from_bytes(ex[6:8], "little") == 0, ex.hex()

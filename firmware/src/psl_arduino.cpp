@@ -144,13 +144,17 @@ inline __attribute__((always_inline)) uint16_t stretch_wake() {
 // The kit's interrupt sources but the timer's, held off through the last
 // stretch (stretch_sleeps), so that none delays the cycle's start: the
 // UART's (receive, transmit: a byte takes 85 us at 115,200 baud, and the
-// UART's buffers hold the next) and the ADC's, each 2.5 to 5.5 us. Each
-// interrupt's flag stays as it is (the ADC's written 0, which leaves it
-// alone), so each runs once released. (The EEPROM-ready handler, about
-// 1.5 us once a byte written, 3.4 ms apart, is left on.)
+// UART's buffers hold the next), the ADC's, each 2.5 to 5.5 us, and the
+// EEPROM's ready (about 2 us, once a byte written by the background
+// writers: the parameter store's, the recorder's, the reload's, the
+// features that have one, kAppEepromWriters). Each interrupt's flag stays as it is (the ADC's written 0,
+// which leaves it alone; the EEPROM's has none to clear), so each runs
+// once released.
+const uint16_t kAppEepromWriters = kAppParams | kAppLog | kAppReload;
 struct HeldIrqs {
     uint8_t ucsrb;  // the UART's control bits
     uint8_t adie;   // the ADC's interrupt enable, as it was
+    uint8_t eerie;  // the EEPROM-ready interrupt enable, as it was
 };
 #if !defined(UCSR0B)
 #define FSW_HELD_UCSRB 0
@@ -158,7 +162,7 @@ struct HeldIrqs {
 #define FSW_HELD_UCSRB (_BV(RXCIE0) | _BV(TXCIE0) | _BV(UDRIE0))
 #endif
 inline __attribute__((always_inline)) HeldIrqs hold_irqs() {
-    HeldIrqs h = {0, 0};
+    HeldIrqs h = {0, 0, 0};
     if (!stretch_sleeps()) return h;
 #if defined(UCSR0B)
     h.ucsrb = UCSR0B;
@@ -169,6 +173,12 @@ inline __attribute__((always_inline)) HeldIrqs hold_irqs() {
     h.adie = static_cast<uint8_t>(a & _BV(ADIE));
     ADCSRA = static_cast<uint8_t>(a & ~(_BV(ADIE) | _BV(ADIF)));
 #endif
+#if defined(EECR) && defined(EERIE)
+    if (app_has(kAppEepromWriters)) {
+        h.eerie = static_cast<uint8_t>(EECR & _BV(EERIE));
+        EECR = static_cast<uint8_t>(EECR & ~_BV(EERIE));  // (as its handler does: EEPE written 1 without EEMPE starts nothing)
+    }
+#endif
     return h;
 }
 inline __attribute__((always_inline)) void release_irqs(const HeldIrqs& h) {
@@ -178,6 +188,9 @@ inline __attribute__((always_inline)) void release_irqs(const HeldIrqs& h) {
 #endif
 #if defined(ADCSRA)
     ADCSRA = static_cast<uint8_t>((ADCSRA & ~_BV(ADIF)) | h.adie);
+#endif
+#if defined(EECR) && defined(EERIE)
+    if (app_has(kAppEepromWriters)) EECR = static_cast<uint8_t>(EECR | h.eerie);
 #endif
 }
 

@@ -481,7 +481,7 @@ def _app_cpp(app: Application) -> str:
         c.append("#if defined(__AVR__) && FSW_SLEEP")
         c.append("// The kit's start-up in place of the core's main() and init() (docs/runtime.md):")
         c.append("// no PWM output, and the executor's timer keeps the clock.")
-        c.append("int main() {")
+        c.append("__attribute__((OS_main)) int main() {  // never returns: no register saved for its caller")
         c.append("    fsw::pal::boot();  // the ADC on, the UART's pins released, interrupts on")
         c.append("    setup();")
         c.append("    for (;;) loop();")

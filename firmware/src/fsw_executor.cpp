@@ -155,11 +155,15 @@ inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
 // around the task steps before, about 1,030 since; a per-instruction
 // profile of the demo flight). The period from RAM and the clock read
 // inline (now_us) took the time between the rocket's task steps from 70
-// to 58 us a cycle (tools/bench_busy.py, 2026-12-07). An outer turn a
-// task run, the inner loop finding the next (no flag for the first turn:
-// 12 B of flash less, the same time). (A turn a task with the run's time
-// and record right after it, and a second copy of the clock's read before
-// the first, was 2.3 us a cycle faster on the rocket for 62 B more.)
+// to 58 us a cycle (tools/bench_busy.py, 2026-12-07). A turn a task: the
+// run's time, its record and its mirrors right after it (no turn past the
+// last run, no test of whether the turn before ran one), for a second copy
+// of the clock's inline read before the first: 2.5 us a cycle on the
+// rocket for 52 B of flash (2026-12-07, night; an outer turn a run with
+// the clock read at one place, the next task found by an inner loop, took
+// the same time as before). The kit's main(), where the cycle is inlined,
+// saves no register for its caller (OS_main): the registers this loop
+// keeps cost no stack.
 void executor_run_cycle(Executor& ex_) {
     Executor& ex = *by_pointer(&ex_);
     pal::watchdog_kick();
@@ -174,76 +178,60 @@ void executor_run_cycle(Executor& ex_) {
     // One clock read per task run, and one at the cycle's start: a run is
     // timed from the previous run's end (the cycle's start for the first)
     // to its own end, so it counts the executor's few instructions that
-    // find and start it too. The clock is read at one place, an outer
-    // turn's start (one copy of now_us()'s inline code); the inner loop
-    // finds and runs the next task.
-    TaskStats* ran = 0;  // the record of the task run last, and its row
-    const Task* ran_row = 0;
+    // find and start it too.
 #if FSW_TASK_TIMING
-    uint32_t mark = 0;
+    uint32_t mark = now_us();
 #endif
-    for (;;) {
-#if FSW_TASK_TIMING
-        const uint32_t now = now_us();
-        if (ran != 0) {
-            TaskStats& s = *ran;
-            const uint32_t took = now - mark;
-            if (took > s.worst_us) s.worst_us = took;
-            // A run within the base period is within the task's (divider >= 1):
-            // the product, a 32-bit multiplication, only for the longer ones.
-            const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
-            if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(ran_row->divider)) &&
-                s.overruns != 0xFFFFu) {
-                ++s.overruns;
+    for (; row != end; ++row, ++sp) {
+        TaskStats& s = *sp;
+        uint16_t* const countdown = cp;  // (null: every task runs every cycle)
+        if (countdown != 0) {
+            ++cp;
+            if (*countdown != 0) {
+                --*countdown;
+                continue;
             }
         }
+        const RowHead h = row_head(row);
+        if (countdown != 0) *countdown = static_cast<uint16_t>(h.divider - 1u);
+        uint8_t* const mode_p = mode_at(f, h.mode_off, s);
+        const uint8_t mode = *mode_p;
+        if (mode == kModeDisabled) continue;
+        if (mode == kModeEnabled) {
+            const Result r = h.step(h.ctx);
+            if (r != kOk) {
+                *mode_p = kModeSafed;
+                if (s.faults != 0xFFu) ++s.faults;
+            }
+        } else if (app_has(kAppSafeFns)) {
+            const TaskSafeFn safe = flash_get(row->safe);
+            if (safe != 0) safe(h.ctx);
+        }
+#if FSW_TASK_TIMING
+        const uint32_t now = now_us();
+        const uint32_t took = now - mark;
         mark = now;
+        if (took > s.worst_us) s.worst_us = took;
+        // A run within the base period is within the task's (divider >= 1):
+        // the product, a 32-bit multiplication, only for the longer ones.
+        const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
+        if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
+            s.overruns != 0xFFFFu) {
+            ++s.overruns;
+        }
 #endif
-        if (app_has(kAppMirrors) && ran != 0 && ex.mirrors != 0) {  // (ex.mirrors: some row has an element to mirror into)
-            const ElemOff overruns_off = flash_get(ran_row->overruns_off), worst_us_off = flash_get(ran_row->worst_us_off);
+        if (app_has(kAppMirrors) && ex.mirrors != 0) {  // (ex.mirrors: some row has an element to mirror into)
+            const ElemOff overruns_off = flash_get(row->overruns_off), worst_us_off = flash_get(row->worst_us_off);
             if (overruns_off != kNoElement || worst_us_off != kNoElement) {
                 uint8_t* const sv = flash_get(f.sv);
                 const bool lock = app_has(kAppSvLock) && flash_get(f.sv_lock);
                 const pal::IrqState saved = lock ? pal::critical_enter() : 0;
-                if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, ran->overruns);
-                if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, ran->worst_us);
+                if (overruns_off != kNoElement) store<uint16_t>(sv + overruns_off, s.overruns);
+                if (worst_us_off != kNoElement) store<uint32_t>(sv + worst_us_off, s.worst_us);
                 if (lock) pal::critical_exit(saved);
             }
         }
-        for (;; ++row, ++sp) {  // the next task to run
-            if (row == end) goto done;
-            TaskStats& s = *sp;
-            uint16_t* const countdown = cp;  // (null: every task runs every cycle)
-            if (countdown != 0) {
-                ++cp;
-                if (*countdown != 0) {
-                    --*countdown;
-                    continue;
-                }
-            }
-            const RowHead h = row_head(row);
-            if (countdown != 0) *countdown = static_cast<uint16_t>(h.divider - 1u);
-            uint8_t* const mode_p = mode_at(f, h.mode_off, s);
-            const uint8_t mode = *mode_p;
-            if (mode == kModeDisabled) continue;
-            if (mode == kModeEnabled) {
-                const Result r = h.step(h.ctx);
-                if (r != kOk) {
-                    *mode_p = kModeSafed;
-                    if (s.faults != 0xFFu) ++s.faults;
-                }
-            } else if (app_has(kAppSafeFns)) {
-                const TaskSafeFn safe = flash_get(row->safe);
-                if (safe != 0) safe(h.ctx);
-            }
-            ran = sp;
-            ran_row = row;
-            ++row;
-            ++sp;
-            break;
-        }
     }
-done:
     if (++ex.cycles == 0) ++ex.cycles_high;
 }
 

@@ -29,9 +29,9 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which(
                                 reason="gcc-avr / simavr not installed")
 
 # 92 B before with its control paths driven as below (86 B on the demo
-# flight); 66 B then (65 B on the demo flight); 55 B since the executor's
-# cycle finds the next task in an inner loop and the generated main()
-# saves no register for it (2026-12-07, night: 56 B on the demo flight)
+# flight); 66 B then (65 B on the demo flight); 55 B since the kit's
+# main() saves no register for its caller (OS_main, 2026-12-07, night: 56
+# B on the demo flight)
 CORE_STACK_MAX = 57
 
 

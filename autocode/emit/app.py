@@ -507,7 +507,25 @@ APP_FEATURES = (
     (0x40, "kAppModeElems", lambda app: any(t.mode is not None for t in app.tasks)),
     (0x80, "kAppMirrors", lambda app: any(t.overruns is not None or t.worst_us is not None for t in app.tasks)),
     (0x400, "kAppSlowTasks", lambda app: any(t.divider > 1 for t in app.tasks)),
+    # where the uplink reads a command: in the console's receive ring, or a buffer the ring is emptied into
+    (0x800, "kAppRxRing", lambda app: _has_uplink(app) and not _pipelined(app)),
+    (0x1000, "kAppRxBuffer", lambda app: _has_uplink(app) and _pipelined(app)),
 )
+
+
+def _has_uplink(app: Application) -> bool:
+    return any(t.kind == "uplink" for t in app.tasks)
+
+
+def _pipelined(app: Application) -> bool:
+    """Whether the application's ground pipelines its commands: the
+    parameter client, which the reload commands go through too, keeps up to
+    90 bytes in flight (docs/parameters.md). The link then takes a command's
+    bytes off the receive ring each run into a buffer of its own
+    (`link_rx`, fsw_app.h kAppRxBuffer), and the ring is the runtime's 64
+    bytes; else one command is in flight, and the link decodes it where the
+    ring (of 32) holds it (kAppRxRing)."""
+    return bool(app_parameters(app)) or app.reload is not None
 
 
 def _app_features(app: Application) -> list[str]:
@@ -832,6 +850,10 @@ def _link(app: Application) -> list[str]:
         raise GenError(f"{name}: the telemetry streams need about {round(load)} B/s but the link carries "
                        f"{round(capacity)} B/s at {app.baud} baud: lower the stream rates or raise `baud`")
     up = plan.uplink_task if plan.uplink_task is not None else 0xFF
+    rx = _has_uplink(app) and _pipelined(app)
+    if rx:
+        c.append("uint8_t link_rx[FSW_LINK_RX_CAP];  // a command's bytes, taken off the receive ring each run "
+                 "(the ground pipelines its commands)")
     c.append("const fsw::LinkConfig kLinkConfig FSW_FLASH = {")
     c.append(f"    sv, {'kLinkStreams' if plan.streams else '0'}, {'link_streams' if plan.streams else '0'}, "
              f"{'kLinkWritable' if rows else '0'}, &ex, link_now, link_tx, kLinkSchema, kSvSize,")
@@ -839,7 +861,7 @@ def _link(app: Application) -> list[str]:
              f"{plan.hello_every}, {up}, kSvLock"
              f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}"
              + (", &reload, fsw::link_reload_apply, fsw::link_reload_ack" if app.reload is not None else ", 0, 0, 0")
-             + "};")
+             + (", link_rx" if rx else ", 0") + "};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}, {len(app.pyro) + len(app.sensors)}), "
              "\"the link's transmit buffer is too small for its control frames\");")
@@ -868,7 +890,7 @@ def _console_rx(app: Application, uplink: bool) -> list[str]:
     one at a time; 4 bytes (the smallest ring) without an uplink task,
     where nothing reads it. On a board whose console is the core's Serial,
     nothing references it and the linker drops it."""
-    if uplink and (app_parameters(app) or app.reload is not None):
+    if uplink and _pipelined(app):
         return ["// The UART's receive ring: the runtime's (FSW_CONSOLE_RX_SIZE): the ground pipelines commands "
                 "(parameters, reload)", ""]
     size = CONSOLE_RX_ONE_COMMAND if uplink else 4

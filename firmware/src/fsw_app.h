@@ -27,9 +27,16 @@ enum AppFeature : uint16_t {
     kAppSafeFns = 0x100,     // a task with a function it runs when safed
     kAppTableChecks = 0x200, // the executor checks its table at run time (generated tables are
                              // checked when compiled: exec_task_ok, exec_config_ok)
-    kAppSlowTasks = 0x400    // a task that runs less often than every cycle (a divider above 1)
+    kAppSlowTasks = 0x400,   // a task that runs less often than every cycle (a divider above 1)
+    // Where the link's uplink reads a command (a program with both, the tests', chooses by its
+    // configuration's `rx`, fsw_link.h): where the console's receive ring holds it (a ground that
+    // keeps one command in flight, whose ring holds it whole) ...
+    kAppRxRing = 0x800,
+    // ... or in a receive buffer of the link's own, which the ring is emptied into each run (a
+    // ground that pipelines its commands: parameters, reload)
+    kAppRxBuffer = 0x1000
 };
-static const uint16_t kAppAllFeatures = 0x7FF;
+static const uint16_t kAppAllFeatures = 0x1FFF;
 
 // The features the program's runtime has (AppFeature bits).
 extern const uint16_t app_features;

@@ -434,20 +434,21 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
     return kAckOk;
 }
 
-// One received frame (COBS-encoded, delimiter stripped): decode, verify,
-// apply, queue the acknowledgement. Anything not verified is only counted.
-void handle_frame(Link& l, const LinkConfig& c) {
-    const int16_t n = cobs_decode(l.rx, l.rx_len);
+// One received frame, its `len` bytes at `rx` (COBS-encoded, delimiter
+// stripped), decoded where they lie: decode, verify, apply, queue the
+// acknowledgement. Anything not verified is only counted.
+inline __attribute__((always_inline)) void handle_frame(Link& l, const LinkConfig& c, uint8_t* rx, uint8_t len) {
+    const int16_t n = cobs_decode(rx, len);
     if (n < 5) {  // op, seq (2), CRC (2)
         inc16(l.n.rx_malformed);
         return;
     }
-    if (crc16(l.rx, static_cast<uint16_t>(n)) != 0) {
+    if (crc16(rx, static_cast<uint16_t>(n)) != 0) {
         inc16(l.n.rx_crc);
         return;
     }
-    const uint8_t op = l.rx[0];
-    const uint16_t seq = load<uint16_t>(l.rx + 1);
+    const uint8_t op = rx[0];
+    const uint16_t seq = load<uint16_t>(rx + 1);
     const uint16_t ahead = static_cast<uint16_t>(seq - l.n.last_seq);
     uint8_t status;
     if (ahead == 0 || ahead >= 0x8000u) {
@@ -455,7 +456,7 @@ void handle_frame(Link& l, const LinkConfig& c) {
         status = kAckReplay;
     } else {
         l.n.last_seq = seq;
-        status = apply(l, c, op, l.rx + 3, static_cast<uint8_t>(n - 5));
+        status = apply(l, c, op, rx + 3, static_cast<uint8_t>(n - 5));
         inc16(status == kAckOk ? l.n.rx_ok
               : status == kAckUnknownOp || status == kAckBadLength ? l.n.rx_malformed
                                                                     : l.n.rx_refused);
@@ -545,33 +546,66 @@ Result link_telemetry_task(void* p) {
 
 namespace {
 
+// Where the uplink reads a command (fsw_app.h kAppRxRing, kAppRxBuffer):
+// where the console's receive ring holds it (pal::console_peek: no copy),
+// or in the receive buffer the configuration names (LinkConfig rx), which
+// is read out of flash only then.
+inline __attribute__((always_inline)) bool rx_in_ring(const LinkConfig& c) {
+    return app_has(kAppRxRing) && (!app_has(kAppRxBuffer) || flash_get(c.rx) == 0);
+}
+
+// The next byte received: in the ring, the one after the command's bytes
+// so far (they stay there until its delimiter); else the ring's next.
+inline __attribute__((always_inline)) int16_t next_byte(const Link& l, bool ring) {
+    return ring ? pal::console_peek(l.rx_len) : pal::console_read();
+}
+
+// A delimiter received: the frame before it handled (or counted, when it
+// was too long), and taken off the ring where it was read there. Out of
+// line: the registers its decoding takes are then not saved on the uplink
+// run's frame, which the service's calls, the deepest path of the stack, go
+// on (on the core rocket 7 registers saved there, where 12 were).
+FSW_NOINLINE void frame_received(Link& l, const LinkConfig& c) {
+    const bool ring = rx_in_ring(c);
+    const uint8_t n = l.rx_len;
+    if (l.rx_over) {
+        inc16(l.n.rx_oversized);
+    } else if (n != 0) {
+        handle_frame(l, c, ring ? pal::console_run(n) : flash_get(c.rx), n);
+    }
+    if (ring) pal::console_drop(static_cast<uint8_t>(n + 1u));  // the frame and its delimiter
+    l.rx_len = 0;
+    l.rx_over = false;
+}
+
 // The uplink task's run past its first look: the control frames waiting
 // sent (service), then the bytes received, `b` first when the caller read
-// it already (else -1), into the frame being received; at a delimiter the
-// frame is handled and the link serviced. The configuration is read out of
-// flash a field at a time where it is used (send_control).
+// it already (else -1), into the frame being received (where the ring
+// holds it, until its delimiter, or the receive buffer); at a delimiter
+// the frame is handled and the link serviced. The configuration is read out
+// of flash a field at a time where it is used (send_control).
 FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
     const LinkConfig& c = *l.cfg;
+    const bool ring = rx_in_ring(c);
     if (l.pending != 0 || l.snapshot_at != kNoSnapshot) service(l, c, false);
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
         if (k != 0 || b < 0) {  // (else b is the byte the caller read)
             if (l.pending & kPendAck) break;  // one acknowledgement waits at a time
-            b = pal::console_read();
+            b = next_byte(l, ring);
             if (b < 0) break;
         }
         if (b == 0) {
-            if (l.rx_over) {
-                inc16(l.n.rx_oversized);
-            } else if (l.rx_len != 0) {
-                handle_frame(l, c);
-            }
-            l.rx_len = 0;
-            l.rx_over = false;
+            frame_received(l, c);
             service(l, c, false);
-        } else if (l.rx_len < sizeof l.rx) {
-            l.rx[l.rx_len++] = static_cast<uint8_t>(b);
-        } else {
+        } else if (!l.rx_over && l.rx_len < FSW_LINK_RX_CAP) {
+            if (!ring) flash_get(c.rx)[l.rx_len] = static_cast<uint8_t>(b);
+            ++l.rx_len;
+        } else {  // too long: its bytes dropped up to its delimiter
             l.rx_over = true;
+            if (ring) {
+                pal::console_drop(static_cast<uint8_t>(l.rx_len + 1u));  // those so far and this one
+                l.rx_len = 0;
+            }
         }
     }
 }
@@ -590,7 +624,7 @@ Result link_uplink_task(void* p) {
         return kOk;
     }
     pump();
-    const int16_t b = pal::console_read();
+    const int16_t b = next_byte(l, rx_in_ring(*l.cfg));
     if (b >= 0) uplink_run(l, b);
     return kOk;
 }

@@ -154,6 +154,9 @@ struct LinkConfig {
     ReloadStore* reload;              // machines replaced at run time (null: none; docs/reload.md)
     LinkReloadApplyFn reload_apply;   // link_reload_apply, with a store
     LinkReloadAckFn reload_ack;       // link_reload_ack, with a store
+    uint8_t* rx;                      // the receive buffer, FSW_LINK_RX_CAP bytes, a command's bytes are
+                                      // taken into off the console's ring (fsw_app.h kAppRxBuffer); null:
+                                      // a command is decoded where the ring holds it (kAppRxRing)
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -164,7 +167,7 @@ struct LinkCounters {
     uint16_t rx_ok;         // commands applied
     uint16_t rx_crc;        // uplink frames with a CRC mismatch
     uint16_t rx_malformed;  // bad COBS, too short, unknown opcode, wrong argument length
-    uint16_t rx_oversized;  // longer than the receive buffer
+    uint16_t rx_oversized;  // longer than FSW_LINK_RX_CAP encoded bytes
     uint16_t rx_replayed;   // sequence number not newer than the last accepted one
     uint16_t rx_refused;    // well-formed but refused (not writable, bad task or mode, locked)
     uint16_t last_seq;      // sequence number of the last accepted command
@@ -187,11 +190,11 @@ struct Link {
     uint8_t pending;        // control frames waiting for the transmit buffer
     uint8_t hello_countdown;
     uint8_t big_cycle;      // low byte of the executor cycle count at the last hello or health frame
-    uint8_t rx_len;
-    bool rx_over;
+    uint8_t rx_len;         // bytes of the command being received (in the receive buffer, or the
+                            // first bytes waiting in the console's ring: LinkConfig rx)
+    bool rx_over;           // it is longer than FSW_LINK_RX_CAP: its bytes are dropped
     uint8_t n_sensors;      // health bytes of sensor parts (link_sensors; 0: none)
     const uint8_t* sensors; // their health codes (fsw_sensor.h kSensor*), in table order
-    uint8_t rx[FSW_LINK_RX_CAP];
 };
 
 // Starts the link: zeroes its records and queues the boot hello. The caller

@@ -105,6 +105,20 @@ void digital_write(uint8_t pin, bool high);
 void console_begin(uint32_t baud);
 // Next received byte, or -1 when none is waiting.
 int16_t console_read();
+// The received bytes read where they wait, for a link that decodes a
+// command where the receive ring holds it (no buffer of its own: fsw_app.h
+// kAppRxRing, docs/runtime.md "The console"). console_peek(i): the i-th
+// byte waiting (0: the one console_read() returns next), or -1 when no more
+// than i wait. console_run(n): the first n bytes waiting (n <= those
+// waiting) in one run of memory, the ring turned when they wrap round its
+// end (interrupts off meanwhile: on an AVR about 12 cycles a byte of the
+// ring); valid until the next console_drop. console_drop(n): the first n
+// bytes waiting taken off (n <= those waiting); a ring left empty starts
+// again from its front, so that a command that arrives in an empty ring
+// lies in one run.
+int16_t console_peek(uint8_t i);
+uint8_t* console_run(uint8_t n);
+void console_drop(uint8_t n);
 // console_write copies the bytes into the transmit buffer; console_write_space
 // is the bytes it takes now without waiting. Not on AVR with the kit's
 // UART0 driver, which has no transmit buffer: it sends what console_send

@@ -18,8 +18,62 @@ namespace pal {
 
 void console_begin(uint32_t baud) { Serial.begin(baud); }
 void console_write(const uint8_t* data, uint16_t len) { Serial.write(data, len); }
-int16_t console_read() { return static_cast<int16_t>(Serial.read()); }
 uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableForWrite()); }
+
+// The received bytes read in place (fsw_pal.h): Serial's bytes are taken
+// into the application's receive ring (fsw_console_rx, which the kit's
+// UART driver fills on other builds) as far as the reader looks; the ring
+// has no other writer here.
+extern "C" uint8_t fsw_console_rx[];
+extern "C" const uint8_t fsw_console_rx_mask;
+namespace {
+uint8_t g_rx_head, g_rx_tail;
+inline uint8_t rx_waiting() { return static_cast<uint8_t>((g_rx_head - g_rx_tail) & fsw_console_rx_mask); }
+}  // namespace
+
+int16_t console_read() {
+    if (g_rx_head != g_rx_tail) {  // a byte the ring took already
+        const uint8_t b = fsw_console_rx[g_rx_tail];
+        g_rx_tail = static_cast<uint8_t>((g_rx_tail + 1u) & fsw_console_rx_mask);
+        return b;
+    }
+    return static_cast<int16_t>(Serial.read());
+}
+
+int16_t console_peek(uint8_t i) {
+    while (i >= rx_waiting()) {
+        if (rx_waiting() == fsw_console_rx_mask) return -1;  // the ring is full
+        const int c = Serial.read();
+        if (c < 0) return -1;
+        fsw_console_rx[g_rx_head] = static_cast<uint8_t>(c);
+        g_rx_head = static_cast<uint8_t>((g_rx_head + 1u) & fsw_console_rx_mask);
+    }
+    return fsw_console_rx[(g_rx_tail + i) & fsw_console_rx_mask];
+}
+
+uint8_t* console_run(uint8_t n) {
+    const uint8_t t = g_rx_tail;
+    const uint16_t size = static_cast<uint16_t>(fsw_console_rx_mask + 1u);
+    if (t + n <= size) return fsw_console_rx + t;
+    // wrapped round the ring's end: the ring turned (three reversals), its tail at the front
+    for (uint8_t k = 0; k < 3; ++k) {
+        uint8_t* a = k == 1 ? fsw_console_rx + t : fsw_console_rx;
+        uint8_t* b = k == 0 ? fsw_console_rx + t : fsw_console_rx + size;
+        while (a < --b) {
+            const uint8_t x = *a;
+            *a++ = *b;
+            *b = x;
+        }
+    }
+    g_rx_head = static_cast<uint8_t>((g_rx_head - t) & fsw_console_rx_mask);
+    g_rx_tail = 0;
+    return fsw_console_rx;
+}
+
+void console_drop(uint8_t n) {
+    g_rx_tail = static_cast<uint8_t>((g_rx_tail + n) & fsw_console_rx_mask);
+    if (g_rx_tail == g_rx_head) g_rx_tail = g_rx_head = 0;  // empty: the next bytes go from the front
+}
 
 // The runs handed (console_send), fed to Serial as its buffer takes them
 // whenever the caller asks where the sending is (console_needs_poll).
@@ -293,6 +347,67 @@ int16_t console_read() {
     const uint8_t b = fsw_console_rx[t];
     g_rx_tail = static_cast<uint8_t>((t + 1u) & fsw_console_rx_mask);
     return b;
+}
+
+// The ring read in place (fsw_pal.h). The handler writes only at the head,
+// into the bytes between it and the tail, so the bytes waiting are the
+// reader's until it moves the tail past them.
+int16_t console_peek(uint8_t i) {
+    const uint8_t t = g_rx_tail, mask = fsw_console_rx_mask;
+    if (i >= static_cast<uint8_t>((g_rx_head - t) & mask)) return -1;
+    return fsw_console_rx[(t + i) & mask];
+}
+
+namespace {
+
+void reverse(uint8_t* a, uint8_t* b) {  // [a, b)
+    while (a < --b) {
+        const uint8_t x = *a;
+        *a++ = *b;
+        *b = x;
+    }
+}
+
+// The ring turned so that the tail, `t`, is at its front, interrupts off
+// (the handler's head moves with it): three reversals, about 17 cycles a
+// byte of the ring (540 for a ring of 32). Out of line: its registers are
+// not saved on the reader's every path.
+FSW_NOINLINE void turn(uint8_t t) {
+    uint8_t* const ring = fsw_console_rx;
+    uint8_t* const end = ring + fsw_console_rx_mask + 1;
+    const uint8_t sreg = SREG;
+    cli();
+    reverse(ring, ring + t);
+    reverse(ring + t, end);
+    reverse(ring, end);
+    g_rx_head = static_cast<uint8_t>((g_rx_head - t) & fsw_console_rx_mask);
+    g_rx_tail = 0;
+    SREG = sreg;
+}
+
+}  // namespace
+
+uint8_t* console_run(uint8_t n) {
+    const uint8_t t = g_rx_tail;
+    if (t + n <= fsw_console_rx_mask + 1) return fsw_console_rx + t;
+    // They wrap round the ring's end. A ring that was emptied starts again
+    // from its front (console_drop), so only bytes that came while others
+    // waited (a ground that sends a command before the one before is
+    // answered) get here.
+    turn(t);
+    return fsw_console_rx;
+}
+
+void console_drop(uint8_t n) {
+    const uint8_t sreg = SREG;
+    cli();
+    uint8_t t = static_cast<uint8_t>((g_rx_tail + n) & fsw_console_rx_mask);
+    if (t == g_rx_head) {  // empty: the next bytes go from the front
+        t = 0;
+        g_rx_head = 0;
+    }
+    g_rx_tail = t;
+    SREG = sreg;
 }
 
 }  // namespace pal

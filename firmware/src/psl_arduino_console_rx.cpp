@@ -1,5 +1,6 @@
-// The UART0 driver's receive ring (psl_arduino_console.cpp) for a program
-// whose code does not size it: FSW_CONSOLE_RX_SIZE bytes. Generated code
+// The UART0 driver's receive ring (psl_arduino_console.cpp; with the core's
+// Serial, the ring a link that reads commands in place takes Serial's bytes
+// into) for a program whose code does not size it: FSW_CONSOLE_RX_SIZE bytes. Generated code
 // defines its own, sized for what its ground keeps in flight (docs/runtime.md,
 // "The console"). Strong definitions in an object of their own, which the
 // linker takes out of the runtime's archive only when nothing defined them
@@ -7,7 +8,7 @@
 // mask's own value even where a strong one overrides it).
 #include "fsw_config.h"
 
-#if FSW_PLATFORM_ARDUINO && !FSW_CONSOLE_ARDUINO_SERIAL
+#if FSW_PLATFORM_ARDUINO
 
 #include <stdint.h>
 

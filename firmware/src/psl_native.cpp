@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <algorithm>
 #include <vector>
 #include <unistd.h>
 #include <time.h>
@@ -509,6 +510,34 @@ int16_t console_read() {
     g_in_head = static_cast<uint16_t>((g_in_head + 1u) % sizeof g_in);
     --g_in_len;
     return b;
+}
+
+// The fed bytes read in place (fsw_pal.h), as the UART driver's ring is:
+// stdin's bytes are taken into the same ring as far as the reader looks.
+int16_t console_peek(uint8_t i) {
+    while (i >= g_in_len && g_use_stdin && g_in_len < sizeof g_in) {
+        pollfd p = {0, POLLIN, 0};
+        uint8_t b;
+        if (poll(&p, 1, 0) != 1 || read(0, &b, 1) != 1) break;
+        g_in[(g_in_head + g_in_len) % sizeof g_in] = b;
+        ++g_in_len;
+    }
+    if (i >= g_in_len) return -1;
+    return g_in[(g_in_head + i) % sizeof g_in];
+}
+
+uint8_t* console_run(uint8_t n) {
+    if (g_in_head + n > sizeof g_in) {  // wrapped round the ring's end: turned, its first byte at the front
+        std::rotate(g_in, g_in + g_in_head, g_in + sizeof g_in);
+        g_in_head = 0;
+    }
+    return g_in + g_in_head;
+}
+
+void console_drop(uint8_t n) {
+    g_in_head = static_cast<uint16_t>((g_in_head + n) % sizeof g_in);
+    g_in_len = static_cast<uint16_t>(g_in_len - n);
+    if (g_in_len == 0) g_in_head = 0;  // empty: the next bytes go from the front
 }
 
 IrqState critical_enter() {

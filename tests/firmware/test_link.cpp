@@ -36,7 +36,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -278,9 +278,9 @@ static void test_full_uart_drops_and_counts_never_blocks(void) {
 static const LinkStream kStreams2[2] FSW_FLASH = {{0, 20, 1, 1, 0}, {0, 20, 1, 1, 0}};
 static uint8_t tx2[120];
 static const LinkConfig kConfig1 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
-                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0};
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
 static const LinkConfig kConfig2 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
-                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 120, 0, 0, 0};
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 120, 0, 0, 0, 0};
 static_assert(link_stream_ok(0, 20, 1, 1, false, 20, 60) && link_config_ok(60, 20, 2, 2), "the tables are valid");
 
 static uint32_t dropped_near_line_rate(const LinkConfig* cfg) {
@@ -404,12 +404,12 @@ static void test_mode_commands(void) {
 // changes only by MODE.
 static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
 static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
 
 // Task 1 stands for the outputs task that ends the pyro pulses: it runs
 // always, as the uplink task does (docs/safety.md).
 static const LinkConfig kConfigPyro FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0};
 
 static void test_the_pyro_task_mode_is_locked(void) {
     link_begin(link, &kConfigPyro);
@@ -446,7 +446,15 @@ static void test_set_of_a_mode_element_is_locked(void) {
     TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_refused);
 }
 
-static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
+// The same link with a receive buffer of its own (fsw_app.h kAppRxBuffer:
+// a ground that pipelines its commands), the ring emptied into it each run;
+// kConfig reads a command where the console's ring holds it (kAppRxRing).
+static uint8_t rx_buf[FSW_LINK_RX_CAP];
+static const LinkConfig kConfigBuf FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
+                                                20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0,
+                                                rx_buf};
+
+static void corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
     run(1);
     // CRC error: a valid SET with one bit flipped
     uint8_t raw[64];
@@ -477,6 +485,78 @@ static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(voi
     TEST_ASSERT_TRUE(link.n.rx_malformed >= 2);
     TEST_ASSERT_EQUAL_UINT16(1, link.n.rx_ok);  // only the well-formed SET of seq 2
     TEST_ASSERT_EQUAL_INT16(0x0909, load<int16_t>(sv + 10));
+}
+
+static void test_corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
+    corrupt_truncated_oversized_frames_are_counted_not_acted_on();
+    TEST_ASSERT_EQUAL_INT16(-1, pal::console_peek(0));  // every byte taken off the ring
+}
+
+static void test_a_link_with_a_receive_buffer_counts_them_alike(void) {
+    link_begin(link, &kConfigBuf);
+    corrupt_truncated_oversized_frames_are_counted_not_acted_on();
+    TEST_ASSERT_EQUAL_INT16(-1, pal::console_peek(0));
+}
+
+// Commands whose bytes come a few at a time, over several runs of the
+// uplink task, and commands that lie across the end of the ring (256 bytes
+// here: bytes fed while others wait go round it), read where the ring holds
+// them and with the receive buffer alike: each answered, in order, and the
+// ring empty after.
+static void commands_in_pieces_and_round_the_ring(const LinkConfig* cfg) {
+    link_begin(link, cfg);
+    run(1);
+    collect();
+    uint16_t seq = 1;
+    for (uint8_t round = 0; round < 6; ++round) {
+        // a SET of `level` (7 + 2 encoded bytes, two delimiters) in three pieces a run apart
+        uint8_t raw[32];
+        CobsEncoder e;
+        cobs_begin(e, raw);
+        cobs_put(e, kOpSet);
+        cobs_put_u16(e, seq);
+        const uint8_t level[] = {4, 0, static_cast<uint8_t>(round + 1), 0x12};
+        cobs_put_bytes(e, level, 4);
+        const uint16_t len = cobs_end(e);
+        native::console_feed(raw, 3);
+        run(1);
+        native::console_feed(raw + 3, 4);
+        run(1);
+        native::console_feed(raw + 7, static_cast<uint16_t>(len - 7));
+        run(1);
+        TEST_ASSERT_EQUAL(kAckOk, ack_status(seq));
+        TEST_ASSERT_EQUAL_INT16(0x1200 | (round + 1), load<int16_t>(sv + 10));
+        ++seq;
+        // then 20 PINGs at once (7 bytes each), and 20 more once a run took the first 64 bytes: the
+        // ring (emptied, it starts from its front) holds the second 20 from byte 140 on, round its
+        // end at 256
+        for (uint8_t k = 0; k < 20; ++k) send_cmd(kOpPing, static_cast<uint16_t>(seq + k), 0, 0);
+        run(1);
+        for (uint8_t k = 20; k < 40; ++k) send_cmd(kOpPing, static_cast<uint16_t>(seq + k), 0, 0);
+        run(40);
+        collect();
+        uint8_t acks = 0;
+        for (uint8_t i = 0; i < n_frames; ++i) {
+            const Frame& f = frames[i];
+            if (f.len == 12 && f.body[0] == kFrameAck && f.body[9] == kAckOk &&
+                (f.body[6] | (f.body[7] << 8)) == seq + acks) {
+                ++acks;
+            }
+        }
+        TEST_ASSERT_EQUAL_UINT8(40, acks);
+        seq = static_cast<uint16_t>(seq + 40);
+    }
+    TEST_ASSERT_EQUAL_UINT16(6 * 41, link.n.rx_ok);
+    TEST_ASSERT_EQUAL_UINT16(0, link.n.rx_crc + link.n.rx_malformed + link.n.rx_oversized);
+    TEST_ASSERT_EQUAL_INT16(-1, pal::console_peek(0));
+}
+
+static void test_commands_in_pieces_and_round_the_ring_are_read_in_the_ring(void) {
+    commands_in_pieces_and_round_the_ring(&kConfig);
+}
+
+static void test_commands_in_pieces_and_round_the_ring_are_read_into_the_buffer(void) {
+    commands_in_pieces_and_round_the_ring(&kConfigBuf);
 }
 
 // Every third health frame brings a hello (hello_every 3): the two long
@@ -576,6 +656,9 @@ static void run_all(void) {
     RUN_TEST(test_set_of_a_mode_element_is_locked);
     RUN_TEST(test_the_pyro_task_mode_is_locked);
     RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
+    RUN_TEST(test_a_link_with_a_receive_buffer_counts_them_alike);
+    RUN_TEST(test_commands_in_pieces_and_round_the_ring_are_read_in_the_ring);
+    RUN_TEST(test_commands_in_pieces_and_round_the_ring_are_read_into_the_buffer);
     RUN_TEST(test_hello_and_health_never_share_a_cycle);
     RUN_TEST(test_ping_hello_snapshot);
     RUN_TEST(test_bad_tables_do_not_pass_the_compile_time_checks);

@@ -75,11 +75,12 @@ def _features(gen_dir) -> tuple[int, int]:
 
 
 def test_the_generated_code_says_what_the_application_uses(core, tmp_path):
-    assert _features(core[1] / "gen") == (0, 10_000)
+    # kAppRxRing (fsw_app.h): its uplink reads a command where the UART's ring holds it
+    assert _features(core[1] / "gen") == (0x800, 10_000)
     r = run_fsw("gen", str(ROCKET), "--out", str(tmp_path / "gen"))
     assert r.code == 0, r.err
-    # kAppParams | kAppLog | kAppPyro (fsw_app.h), at 100 Hz
-    assert _features(tmp_path / "gen") == (0x01 | 0x02 | 0x08, 10_000)
+    # kAppParams | kAppLog | kAppPyro | kAppRxBuffer (its ground pipelines its commands), at 100 Hz
+    assert _features(tmp_path / "gen") == (0x01 | 0x02 | 0x08 | 0x1000, 10_000)
 
 
 def test_the_core_rocket_takes_what_it_needs(core):

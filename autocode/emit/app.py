@@ -428,9 +428,6 @@ def _app_cpp(app: Application) -> str:
     if has_link:
         c.append(f"    fsw::pal::console_begin({app.baud}UL);")
         c.append("    fsw::link_begin(link, &kLinkConfig);  // its tables are checked where they are defined")
-        if app.sensors:
-            c.append(f"    fsw::link_sensors(link, sensor_health, {len(app.sensors)});  "
-                     "// a health byte per sensor part in health frames")
     c.append("    return true;")
     c.append("}")
     c.append("")
@@ -861,7 +858,8 @@ def _link(app: Application) -> list[str]:
              f"{plan.hello_every}, {up}, kSvLock"
              f"{_link_stores(app)}, {tx_buffer if tx_buffer != plan.tx_cap else 0}"
              + (", &reload, fsw::link_reload_apply, fsw::link_reload_ack" if app.reload is not None else ", 0, 0, 0")
-             + (", link_rx" if rx else ", 0") + "};")
+             + (", link_rx" if rx else ", 0")
+             + (f", sensor_health, {len(app.sensors)}" if app.sensors else ", 0, 0") + "};")
     c.append(f"static_assert(fsw::link_config_ok(kLinkTxSize, {plan.snapshot_chunk}, {len(plan.streams)}, "
              f"{len(app.tasks)}, {len(app.pyro) + len(app.sensors)}), "
              "\"the link's transmit buffer is too small for its control frames\");")

@@ -305,7 +305,9 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
             for (uint8_t i = 0; i < n_pyro; ++i) put(pyro[i].status);  // kPyro* bits (fsw_io.h)
         }
         if (app_has(kAppSensors)) {
-            for (uint8_t i = 0; i < l.n_sensors; ++i) put(l.sensors[i]);  // kSensor* codes (fsw_sensor.h)
+            const uint8_t* const sensors = flash_get(c.sensors);
+            const uint8_t n_sensors = flash_get(c.n_sensors);
+            for (uint8_t i = 0; i < n_sensors; ++i) put(sensors[i]);  // kSensor* codes (fsw_sensor.h)
         }
     } else {
         const uint16_t off = l.snapshot_at, sv_size = flash_get(c.sv_size), chunk = flash_get(c.snapshot_chunk);

@@ -157,6 +157,10 @@ struct LinkConfig {
     uint8_t* rx;                      // the receive buffer, FSW_LINK_RX_CAP bytes, a command's bytes are
                                       // taken into off the console's ring (fsw_app.h kAppRxBuffer); null:
                                       // a command is decoded where the ring holds it (kAppRxRing)
+    const uint8_t* sensors;           // the sensor parts' health codes (fsw_sensor.h kSensor*), in table
+                                      // order, RAM the inputs task keeps current: a byte each in health
+                                      // frames, after the pyro status bytes (docs/sensor-table.md)
+    uint8_t n_sensors;                // how many (0: none)
 };
 
 // Counters reported in health frames (saturating where 16-bit). Health
@@ -193,8 +197,6 @@ struct Link {
     uint8_t rx_len;         // bytes of the command being received (in the receive buffer, or the
                             // first bytes waiting in the console's ring: LinkConfig rx)
     bool rx_over;           // it is longer than FSW_LINK_RX_CAP: its bytes are dropped
-    uint8_t n_sensors;      // health bytes of sensor parts (link_sensors; 0: none)
-    const uint8_t* sensors; // their health codes (fsw_sensor.h kSensor*), in table order
 };
 
 // Starts the link: zeroes its records and queues the boot hello. The caller
@@ -203,14 +205,6 @@ struct Link {
 // were checked when they were compiled (link_*_ok below): nothing is
 // checked at run time.
 void link_begin(Link& link, const LinkConfig* cfg);
-// Sends `n` sensor health codes (fsw_sensor.h kSensor*) in each health
-// frame, after the pyro status bytes: `health` is RAM the inputs task keeps
-// current. Called after link_begin (which clears it); generated code passes
-// the sensor parts' codes in table order (docs/sensor-table.md).
-inline void link_sensors(Link& link, const uint8_t* health, uint8_t n) {
-    link.sensors = health;
-    link.n_sensors = n;
-}
 // Executor task steps (ctx = the Link): never block, never fault.
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
@@ -265,7 +259,7 @@ constexpr bool link_writable_ok(uint16_t off, uint8_t type, uint16_t sv_size) {
 // transmit buffer that holds a hello (the longest control frame but
 // health; a PARAM_INFO ack is shorter), a health frame for `n_tasks` tasks and a snapshot chunk.
 // `n_pyro`: the health frame's trailing bytes, a pyro status per channel and a
-// sensor health code per part (link_sensors).
+// sensor health code per part (LinkConfig sensors).
 constexpr bool link_config_ok(uint16_t tx_cap, uint16_t snapshot_chunk, uint8_t n_streams, uint8_t n_tasks,
                               uint8_t n_pyro = 0) {
     return n_streams <= 128 && snapshot_chunk != 0 && link_encoded_max(kLinkHeader + 20u) <= tx_cap &&

@@ -36,7 +36,7 @@ static const LinkStream kStreams[2] FSW_FLASH = {
 // writable: flag (element 3), level (4), gain (5); not a (0), b (1), mode (2)
 static const LinkWritable kWritable[3] FSW_FLASH = {{3, 9, kBool}, {4, 10, kI16}, {5, 12, kF64}};
 static const LinkConfig kConfig FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
+                                             20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0, 0, 0};
 
 static uint8_t out[8192];
 static uint16_t out_len;
@@ -278,9 +278,9 @@ static void test_full_uart_drops_and_counts_never_blocks(void) {
 static const LinkStream kStreams2[2] FSW_FLASH = {{0, 20, 1, 1, 0}, {0, 20, 1, 1, 0}};
 static uint8_t tx2[120];
 static const LinkConfig kConfig1 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
-                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0, 0, 0};
 static const LinkConfig kConfig2 FSW_FLASH = {sv, kStreams2, states, kWritable, &ex, now_fn, tx2, 0xA5A55A5AUL,
-                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 120, 0, 0, 0, 0};
+                                              20, 60, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 120, 0, 0, 0, 0, 0, 0};
 static_assert(link_stream_ok(0, 20, 1, 1, false, 20, 60) && link_config_ok(60, 20, 2, 2), "the tables are valid");
 
 static uint32_t dropped_near_line_rate(const LinkConfig* cfg) {
@@ -404,12 +404,12 @@ static void test_mode_commands(void) {
 // changes only by MODE.
 static const LinkWritable kWritableMode[2] FSW_FLASH = {{2, 8, kU8}, {4, 10, kI16}};
 static const LinkConfig kConfigMode FSW_FLASH = {sv, kStreams, states, kWritableMode, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 2, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0, 0, 0, 0};
 
 // Task 1 stands for the outputs task that ends the pyro pulses: it runs
 // always, as the uplink task does (docs/safety.md).
 static const LinkConfig kConfigPyro FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
-                                                 20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0};
+                                                 20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0};
 
 static void test_the_pyro_task_mode_is_locked(void) {
     link_begin(link, &kConfigPyro);
@@ -452,7 +452,7 @@ static void test_set_of_a_mode_element_is_locked(void) {
 static uint8_t rx_buf[FSW_LINK_RX_CAP];
 static const LinkConfig kConfigBuf FSW_FLASH = {sv, kStreams, states, kWritable, &ex, now_fn, tx, 0xA5A55A5AUL,
                                                 20, 96, 10, 20, 2, 3, 3, 0, false, 0, 0, 0, 0, 0, 0, 0, 0, 0xFF, 0, 0, 0, 0,
-                                                rx_buf};
+                                                rx_buf, 0, 0};
 
 static void corrupt_truncated_oversized_frames_are_counted_not_acted_on(void) {
     run(1);

@@ -69,7 +69,7 @@ def test_the_core_link_keeps_no_receive_buffer_of_its_own(core):
     # fsw_gen's `link` (LTO leaves its name mangled)
     link = [size for name, size in sizes.items() if re.search(r"(::|_14)link(E)?(\.lto_priv\.\d+)?$", name)]
     # 68 B before, its receive buffer 24 of them
-    assert link == [44], (link, sizes)
+    assert len(link) == 1 and link[0] <= 44, (link, sizes)
     assert not any("link_rx" in name for name in sizes), sizes
     ring = [size for name, size in sizes.items() if name == "fsw_console_rx"]
     assert ring == [32], sizes  # the ring itself as it was: one command in flight

@@ -109,7 +109,7 @@ def test_the_generated_code_runs_the_machine_through_the_store():
     assert "fsw::reload_begin(reload, &kReloadConfig);" in cpp and "fsw::reload_poll(reload);" in cpp
     assert "kReloadAllow[1] FSW_FLASH = {0x05};  // TankVentControl Idle" in cpp
     assert "384, 64, 0, 1};" in cpp  # size, ram, EEPROM base (no parameters), mask bytes
-    assert "&reload, fsw::link_reload_apply, fsw::link_reload_ack, link_rx};" in cpp  # its buffer: pipelined
+    assert "&reload, fsw::link_reload_apply, fsw::link_reload_ack, link_rx, 0, 0};" in cpp  # its buffer: pipelined
     # (its locals passed as its state functions take them: through a pointer in step(), docs/codegen.md)
     assert "void leave();" in files["tank.gen.h"] and "case S_TankVentControl: s1_exit(loc); break;" in files["tank.gen.cpp"]
     plain = emit_app(load(str(EXAMPLES / "tank"), Diagnostics()))

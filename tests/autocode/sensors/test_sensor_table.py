@@ -88,7 +88,7 @@ def test_applications_without_parts_generate_no_sensor_code(example):
     app = load(next((EXAMPLES / example).glob("*.app")))
     assert app.sensors == ()
     cpp = emit_app(app)["app.gen.cpp"]
-    for text in ("fsw_sensor.h", "fsw_accel.h", "sensors_begin", "link_sensors", "sensor_health", "sensor0"):
+    for text in ("fsw_sensor.h", "fsw_accel.h", "sensors_begin", "sensor_health", "sensor0"):
         assert text not in cpp
 
 

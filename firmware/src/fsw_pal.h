@@ -226,10 +226,11 @@ inline __attribute__((always_inline)) uint8_t ct_last() { return FSW_CYCLE_SETTI
 inline __attribute__((always_inline)) uint8_t ct_spin() { return FSW_CYCLE_SETTING(spin); }
 #undef FSW_CYCLE_SETTING
 
+// (The microseconds past `ms` are a variable of their own, psl_arduino.cpp:
+// a sub-period of whole milliseconds never reads it, and LTO drops it.)
 struct CycleTimer {
     uint32_t base_us;   // the clock at the start of the running sub-period
-    uint32_t ms;        // milliseconds at that start, and the microseconds past them
-    uint16_t ms_frac;   //   (< 1000)
+    uint32_t ms;        // milliseconds at that start
     uint8_t sub;        // sub-periods ended in this cycle
     volatile uint8_t due;       // cycle starts passed, not yet served (saturates)
     volatile uint8_t why;       // why the first of them was missed (CycleWait)

@@ -91,18 +91,27 @@ CycleSettings g_cs;
 
 namespace {
 
+// The microseconds past g_ct.ms at the running sub-period's start (< 1000),
+// where a sub-period is no whole number of milliseconds: apart from g_ct, so
+// that LTO drops it where the application's constant period never reads it
+// (2 bytes of the rocket's RAM at 100 Hz). (The cycle's sub-period count
+// stays in g_ct: the handler clears it every cycle, and without that store
+// the handler's 2 cycles fewer moved the demo flight's ADC readings against
+// the plant's steps, and its apogee by 20 ms.)
+uint16_t g_ct_ms_frac;
+
 // A sub-period ended (compare interrupt, or cycle_wait() that waited for it,
 // interrupts off): the clock moves on; true when a cycle is due.
 __attribute__((noinline)) bool sub_period_ended() {
     g_ct.base_us += ct_sub_us();
     g_ct.ms += ct_sub_ms();
     if (ct_sub_frac() != 0) {  // (else ms_frac stays 0: a sub-period of whole milliseconds)
-        uint16_t f = static_cast<uint16_t>(g_ct.ms_frac + ct_sub_frac());
+        uint16_t f = static_cast<uint16_t>(g_ct_ms_frac + ct_sub_frac());
         if (f >= 1000u) {
             f = static_cast<uint16_t>(f - 1000u);
             ++g_ct.ms;
         }
-        g_ct.ms_frac = f;
+        g_ct_ms_frac = f;
     }
     if (ct_last() != 0 && g_ct.sub != ct_last()) {  // (one sub-period a cycle: `sub` stays 0)
         ++g_ct.sub;
@@ -204,6 +213,7 @@ void cycle_timer_begin(uint32_t period_us) {
     // and `running` start at 0 (one clear: a store a field was 4 bytes of
     // flash a byte).
     memset(&g_ct, 0, sizeof g_ct);
+    if (ct_sub_frac() != 0) g_ct_ms_frac = 0;  // (where it is: it is read)
     if (app_period_us == 0) g_cs = s;  // else each is a constant where it is read (ct_*)
     g_ct.due = 1;  // the first cycle: at once, on time (why: kCycleOnTime, 0)
     TIMSK0 = static_cast<uint8_t>(TIMSK0 & ~_BV(TOIE0));  // the core's millis() stops here
@@ -323,7 +333,7 @@ FSW_NOINLINE uint32_t micros32() { return micros32_inline(); }  // out of line a
 uint32_t millis32() {
     const IrqState saved = critical_enter();
     const uint16_t t = TCNT1;
-    const uint16_t frac = ct_sub_frac() != 0 ? g_ct.ms_frac : 0u;  // (stays 0 for whole milliseconds)
+    const uint16_t frac = ct_sub_frac() != 0 ? g_ct_ms_frac : 0u;  // (stays 0 for whole milliseconds)
     uint16_t f = static_cast<uint16_t>(frac + t / FSW_T1_TICKS_PER_US);  // < 1000 + 32000
     uint32_t ms = g_ct.ms;
     if ((TIFR1 & _BV(OCF1A)) != 0 && t < ct_early()) {  // a sub-period ended, not yet counted (micros32_inline)

@@ -56,9 +56,18 @@ ROCKET = EXAMPLES / "rocket"
 # test_the_firmware_keeps_one_routine_for_each_float_conversion_and_store.py;
 # then the CPU work of 2026-12-07's night, docs/runtime.md: the last stretch
 # before a cycle slept, not spun, +144 B for 5.2 us a cycle, the rest -44 B
-# for 9 us): flash, and .data + .bss + .noinit.
-CORE_FLASH_MAX = 10_208
-CORE_RAM_MAX = 601
+# for 9 us; then the RAM work of that night, docs/runtime.md: a command read
+# where the UART's ring holds it -24 B of RAM for +256 B of flash (the ring
+# read in place, turned when a command wraps round its end, and the frame's
+# handling out of line for the stack), the sensor parts' codes named by the
+# configuration -3 B (+4 B of flash), the clock's unread millisecond
+# fraction -2 B, the frame's time put by a call of its own -6 B of flash and
+# 4 B off the stack's deepest path; the flash cap rises with them: RAM was
+# the target missed, 640 B;
+# test_the_core_link_reads_a_command_where_the_uarts_ring_holds_it.py):
+# flash, and .data + .bss + .noinit.
+CORE_FLASH_MAX = FLASHTBD
+CORE_RAM_MAX = RAMTBD
 
 
 @pytest.fixture(scope="module")

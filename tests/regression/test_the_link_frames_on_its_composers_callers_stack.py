@@ -31,9 +31,9 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which(
 # 92 B before with its control paths driven as below (86 B on the demo
 # flight); 66 B then (65 B on the demo flight); 55 B since the kit's
 # main() saves no register for its caller (OS_main, 2026-12-07, night: 56
-# B on the demo flight), and STACKTBD B since the uplink's frame handling went out
+# B on the demo flight), and 51 B since the uplink's frame handling went out
 # of line and the frame's time is put by a call of its own
-CORE_STACK_MAX = STACKTBD
+CORE_STACK_MAX = 53
 
 
 @pytest.fixture(scope="module")

@@ -51,5 +51,7 @@ def test_the_core_rocket_keeps_no_byte_it_does_not_read(core):
     # the executor's record without its two counters of why cycles were late
     assert sizes["fsw_gen::ex"] == 20 - 4, sizes
     # the link's record without its transmit buffer's address, size and room for a control frame,
-    # nor the bytes of the buffer handed to the UART (it sends them from the buffer: console_send)
-    assert sizes["fsw_gen::link"] == 76 - 6 - 2, sizes
+    # nor the bytes of the buffer handed to the UART (it sends them from the buffer: console_send),
+    # nor a receive buffer (it reads a command where the UART's ring holds it: kAppRxRing), nor
+    # the sensor parts' codes (named by its configuration)
+    assert sizes["fsw_gen::link"] == 76 - 6 - 2 - 24 - 3, sizes

@@ -180,7 +180,19 @@ void executor_run_cycle(Executor& ex_) {
     // to its own end, so it counts the executor's few instructions that
     // find and start it too.
 #if FSW_TASK_TIMING
+#if FSW_SLEEP
+    // The marks are microseconds past the clock's base at the cycle's start
+    // (`base`): a run while no sub-period ended takes the difference of two
+    // counts within it (pal::cycle_clock), 16 bits, and is within the base
+    // period (a sub-period is no longer); a run past an end reads the whole
+    // clock. Either takes what two whole reads would (tested:
+    // tests/firmware/test_executor.cpp).
+    uint16_t at;
+    const uint32_t base = pal::cycle_base(at);
+    uint32_t mark = at;
+#else
     uint32_t mark = now_us();
+#endif
 #endif
     for (; row != end; ++row, ++sp) {
         TaskStats& s = *sp;
@@ -208,6 +220,24 @@ void executor_run_cycle(Executor& ex_) {
             if (safe != 0) safe(h.ctx);
         }
 #if FSW_TASK_TIMING
+#if FSW_SLEEP
+        uint16_t us;
+        if (pal::cycle_clock(us)) {  // (the mark too was a count within the cycle's first sub-period)
+            const uint16_t took = static_cast<uint16_t>(us - static_cast<uint16_t>(mark));
+            mark = us;
+            if (took > s.worst_us) s.worst_us = took;
+        } else {
+            const uint32_t now = now_us() - base;
+            const uint32_t took = now - mark;
+            mark = now;
+            if (took > s.worst_us) s.worst_us = took;
+            const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
+            if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
+                s.overruns != 0xFFFFu) {
+                ++s.overruns;
+            }
+        }
+#else
         const uint32_t now = now_us();
         const uint32_t took = now - mark;
         mark = now;
@@ -219,6 +249,7 @@ void executor_run_cycle(Executor& ex_) {
             s.overruns != 0xFFFFu) {
             ++s.overruns;
         }
+#endif
 #endif
         if (app_has(kAppMirrors) && ex.mirrors != 0) {  // (ex.mirrors: some row has an element to mirror into)
             const ElemOff overruns_off = flash_get(row->overruns_off), worst_us_off = flash_get(row->worst_us_off);

@@ -255,6 +255,39 @@ inline __attribute__((always_inline)) uint32_t micros32_inline() {
     critical_exit(saved);
     return base + static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
 }
+
+// The clock's base for a running cycle's marks (fsw_executor.cpp), with
+// the microseconds past it now in `us`: micros32_inline()'s parts, its
+// sum left to the marks.
+inline __attribute__((always_inline)) uint32_t cycle_base(uint16_t& us) {
+    const IrqState saved = critical_enter();
+    const uint16_t t = TCNT1;
+    uint32_t base = g_ct.base_us;
+    if ((TIFR1 & _BV(OCF1A)) != 0 && t < ct_early()) base += ct_sub_us();  // a sub-period ended, not yet counted
+    critical_exit(saved);
+    us = static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
+    return base;
+}
+
+// The executor's clock within a running cycle (fsw_executor.cpp): true,
+// with the microseconds past the running sub-period's start in `us`, where
+// no sub-period has ended since the cycle started: `due` and `sub` are
+// still 0 (cycle_wait()'s, sub_period_ended()'s; neither goes back to 0
+// within a cycle) and no end waits for its interrupt (the compare's flag).
+// Then the clock's base is the one of the cycle's start, and
+// micros32_inline() would return it plus `us`: two such reads differ by
+// the difference of their `us`. No critical section: the count is read
+// first, the flag then, the counts last; an end at the count's wrap either
+// still waits (its flag is set) or its handler ran to the end before the
+// counts are read (the vector clears the flag). No handler of the kit
+// uses Timer1's 16-bit registers (their shared TEMP byte).
+inline __attribute__((always_inline)) bool cycle_clock(uint16_t& us) {
+    const uint16_t t = TCNT1;
+    __asm__ __volatile__("" ::: "memory");
+    const bool none = (TIFR1 & _BV(OCF1A)) == 0 && g_ct.due == 0 && (ct_last() == 0 || g_ct.sub == 0);
+    us = static_cast<uint16_t>(t / FSW_T1_TICKS_PER_US);
+    return none;
+}
 #endif
 
 // ---- EEPROM -----------------------------------------------------------------

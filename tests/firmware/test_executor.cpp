@@ -248,6 +248,27 @@ static void test_poll_keeps_the_rate_and_counts_late_cycles(void) {
     }
     TEST_ASSERT_TRUE(on_time_seen > 0 && late_seen > 0);
     TEST_ASSERT_EQUAL_UINT16(1, ex.skipped);
+    // A run's time: from the timer's count within the cycle while no
+    // sub-period ended (task 0, then task 1 from 300 us on), from the
+    // whole clock once one did (task 1 from 300 us to past the count's
+    // wrap): each its step's time, as two reads of the whole clock gave.
+    busy_us[0] = 300;
+    busy_us[1] = 600;
+    stats[0].worst_us = stats[1].worst_us = 0;
+    for (uint8_t i = 0; i < 2;) {  // (task 1 runs every other cycle)
+        if (executor_poll(ex)) ++i;
+    }
+    TEST_ASSERT_TRUE(stats[0].worst_us >= 300 && stats[0].worst_us < 400);
+    TEST_ASSERT_TRUE(stats[1].worst_us >= 600 && stats[1].worst_us < 700);
+    busy_us[1] = 900;
+    stats[1].worst_us = 0;
+    const uint16_t overruns = stats[1].overruns;
+    for (uint8_t i = 0; i < 2;) {
+        if (executor_poll(ex)) ++i;
+    }
+    busy_us[0] = busy_us[1] = 0;
+    TEST_ASSERT_TRUE(stats[1].worst_us >= 900 && stats[1].worst_us < 1000);
+    TEST_ASSERT_EQUAL_UINT16(overruns, stats[1].overruns);  // (within its 2,000 us)
 #endif
 #endif
 }

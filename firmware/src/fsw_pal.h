@@ -238,7 +238,8 @@ struct CycleTimer {
 };
 extern CycleTimer g_ct;
 
-// micros32(), inline: the executor's one clock read a task run (a call of
+// micros32(), inline: the executor's clock read for a task run past a
+// sub-period's end (cycle_clock below for the others; a call of
 // micros32() cost about 20 AVR cycles more each, on the rocket's seven
 // tasks about 150 a cycle). Interrupts off: the timer's count (0.5 us
 // ticks at 16 MHz) past the sub-period's start, and the start; a

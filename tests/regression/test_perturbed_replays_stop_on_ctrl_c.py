@@ -50,6 +50,7 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
     channel.bind(sock)
     env = {k: v for k, v in os.environ.items() if k not in ("FSW_NO_PROGRESS", "CI")}
     env["FSW_PROGRESS_TO"] = f"1:{sock}"
+    env["PYTHONFAULTHANDLER"] = "1"  # a SIGABRT writes every thread's stack to stderr (below: a stop not obeyed)
     err_file = open(tmp_path / "stderr", "w+b")  # noqa: SIM115 (read after the run)
     p = subprocess.Popen([fsw, "sim", str(HPR), "--tape", str(TAPE), "--perturb", "400", "--out", str(out)],
                          stdout=subprocess.PIPE, stderr=err_file, start_new_session=True, cwd=ROOT, env=env)
@@ -71,7 +72,13 @@ def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
         try:
             out_text, _ = p.communicate(timeout=60)
         except subprocess.TimeoutExpired:
-            pytest.fail("the replays went on 60 s after the stop")
+            os.kill(p.pid, signal.SIGABRT)  # where each of its threads was, for the report
+            try:
+                p.communicate(timeout=30)
+            except subprocess.TimeoutExpired:
+                pass
+            pytest.fail("the replays went on 60 s after the stop; the command's threads then:\n"
+                        + (tmp_path / "stderr").read_text(errors="replace")[-8000:])
         stopped_in = time.monotonic() - t0
     finally:
         channel.close()

@@ -1295,9 +1295,18 @@ def robustness(tape, truth, cfg: Config, elf: str, board, layout: Layout, n: int
     """N perturbed replays (run i from the i-th child of SeedSequence(seed):
     the same seed gives the same runs, whatever the number of workers).
     StoppedRuns on Ctrl-C or a stopping signal: the replays still flying
-    stop at their next step, those not started never start."""
+    stop at their next step, those not started never start.
+
+    In the main thread, SIGINT, SIGTERM and SIGHUP (those not ignored) only
+    set the stop while the replays fly, and the loop sees it within
+    STOP_POLL_S: an exception raised wherever the main thread happened to
+    be could strike inside concurrent.futures' waiting, between the locks
+    of the futures it takes one by one, and leave one held, so that the
+    replay finishing it and the pool's join waited for ever."""
+    import signal
     import threading
 
+    from fswkit import outputs
     from fswkit.outputs import Stopped
 
     if workers is None:
@@ -1307,29 +1316,50 @@ def robustness(tape, truth, cfg: Config, elf: str, board, layout: Layout, n: int
             workers = os.cpu_count() or 1
     workers = max(1, min(workers, n))
     stop = threading.Event()
+    signalled: list[int] = []
+
+    def on_signal(signum, _frame):
+        signalled.append(signum)
+        stop.set()
+
+    saved = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(sig) not in (signal.SIG_IGN, None):  # None: a handler not set from Python
+                saved[sig] = signal.signal(sig, on_signal)
     done: list[PerturbResult] = []
     pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers)
     try:
         with progress("perturbed replays", total=n, unit="runs") as bar:
             queued: set = set()
             nxt = failed = 0
-            while nxt < n or queued:
+            while (nxt < n or queued) and not stop.is_set():
                 while nxt < n and len(queued) < workers:  # the i-th child of SeedSequence(seed), as spawn(n)[i]
                     seq = np.random.SeedSequence(seed, spawn_key=(nxt,))
                     queued.add(pool.submit(_one_perturbed, nxt, seq, tape, truth, cfg, elf, board, layout, stop))
                     nxt += 1
-                ended, queued = concurrent.futures.wait(queued, return_when=concurrent.futures.FIRST_COMPLETED)
+                ended, queued = concurrent.futures.wait(queued, timeout=STOP_POLL_S,
+                                                        return_when=concurrent.futures.FIRST_COMPLETED)
                 for f in ended:
                     r = f.result()
                     done.append(r)
                     failed += r.error is not None or not all(c.passed for c in r.checks)
                 bar.update(len(done), failed=failed)
-    except (KeyboardInterrupt, Stopped):
+    except (KeyboardInterrupt, Stopped):  # not in the main thread, or before the handlers were in place
         stop.set()
+    finally:
+        for sig, handler in saved.items():
+            signal.signal(sig, handler)
+    if stop.is_set():
         pool.shutdown(wait=True, cancel_futures=True)
-        raise StoppedRuns(sorted(done, key=lambda r: r.index)) from None
+        if signalled and signalled[0] != signal.SIGINT:
+            outputs.stopped_by = signalled[0]  # the exit status names it (128 + N), as Stopped's does
+        raise StoppedRuns(sorted(done, key=lambda r: r.index))
     pool.shutdown(wait=True)
     return sorted(done, key=lambda r: r.index)
+
+
+STOP_POLL_S = 0.2  # how soon the replays' loop sees a stop
 
 
 ERROR_KEYS = (("launch_err_s", "launch − liftoff", "s"), ("burnout_err_s", "burnout − burnout_s", "s"),

@@ -164,6 +164,22 @@ inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
 // the same time as before). The kit's main(), where the cycle is inlined,
 // saves no register for its caller (OS_main): the registers this loop
 // keeps cost no stack.
+#if FSW_TASK_TIMING
+// A run timed by two whole clock reads: its worst, and an overrun when it
+// took longer than its period. A run within the base period is within the
+// task's (divider >= 1): the product, a 32-bit multiplication, only for the
+// longer ones.
+static inline __attribute__((always_inline)) void note_whole_run(TaskStats& s, uint32_t took, const ExecConfig& f,
+                                                                 const Task* row) {
+    if (took > s.worst_us) s.worst_us = took;
+    const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
+    if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
+        s.overruns != 0xFFFFu) {
+        ++s.overruns;
+    }
+}
+#endif
+
 void executor_run_cycle(Executor& ex_) {
     Executor& ex = *by_pointer(&ex_);
     pal::watchdog_kick();
@@ -228,27 +244,13 @@ void executor_run_cycle(Executor& ex_) {
             if (took > s.worst_us) s.worst_us = took;
         } else {
             const uint32_t now = now_us() - base;
-            const uint32_t took = now - mark;
+            note_whole_run(s, now - mark, f, row);
             mark = now;
-            if (took > s.worst_us) s.worst_us = took;
-            const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
-            if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
-                s.overruns != 0xFFFFu) {
-                ++s.overruns;
-            }
         }
 #else
         const uint32_t now = now_us();
-        const uint32_t took = now - mark;
+        note_whole_run(s, now - mark, f, row);
         mark = now;
-        if (took > s.worst_us) s.worst_us = took;
-        // A run within the base period is within the task's (divider >= 1):
-        // the product, a 32-bit multiplication, only for the longer ones.
-        const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
-        if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
-            s.overruns != 0xFFFFu) {
-            ++s.overruns;
-        }
 #endif
 #endif
         if (app_has(kAppMirrors) && ex.mirrors != 0) {  // (ex.mirrors: some row has an element to mirror into)

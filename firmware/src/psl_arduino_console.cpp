@@ -11,6 +11,44 @@
 
 #include "fsw_pal.h"
 
+// The receive ring and its size less one (a power of two, 4..256): the
+// application's own, sized by its generated code for what its ground keeps
+// in flight (docs/runtime.md, "The console"), else psl_arduino_console_rx.cpp's
+// (FSW_CONSOLE_RX_SIZE), which the linker takes out of the runtime's archive
+// only for a program that does not define them. (The UART0 handler reads the
+// mask where it lies, a byte of RAM: a constant of another object is no
+// immediate operand where the runtime is compiled without LTO.)
+extern "C" uint8_t fsw_console_rx[];
+extern "C" const uint8_t fsw_console_rx_mask;
+
+namespace fsw {
+namespace pal {
+namespace {
+
+void reverse(uint8_t* a, uint8_t* b) {  // [a, b)
+    while (a < --b) {
+        const uint8_t x = *a;
+        *a++ = *b;
+        *b = x;
+    }
+}
+
+// The receive ring's bytes turned so that the one at `t` is at its front
+// (a command read in place that wraps round the ring's end: console_run):
+// three reversals, about 17 cycles a byte of the ring (540 for a ring of
+// 32). Its indices are the caller's to move.
+inline void turn_bytes(uint8_t t) {
+    uint8_t* const ring = fsw_console_rx;
+    uint8_t* const end = ring + fsw_console_rx_mask + 1;
+    reverse(ring, ring + t);
+    reverse(ring + t, end);
+    reverse(ring, end);
+}
+
+}  // namespace
+}  // namespace pal
+}  // namespace fsw
+
 #if FSW_CONSOLE_ARDUINO_SERIAL
 
 namespace fsw {
@@ -24,8 +62,6 @@ uint16_t console_write_space() { return static_cast<uint16_t>(Serial.availableFo
 // into the application's receive ring (fsw_console_rx, which the kit's
 // UART driver fills on other builds) as far as the reader looks; the ring
 // has no other writer here.
-extern "C" uint8_t fsw_console_rx[];
-extern "C" const uint8_t fsw_console_rx_mask;
 namespace {
 uint8_t g_rx_head, g_rx_tail;
 inline uint8_t rx_waiting() { return static_cast<uint8_t>((g_rx_head - g_rx_tail) & fsw_console_rx_mask); }
@@ -55,16 +91,7 @@ uint8_t* console_run(uint8_t n) {
     const uint8_t t = g_rx_tail;
     const uint16_t size = static_cast<uint16_t>(fsw_console_rx_mask + 1u);
     if (t + n <= size) return fsw_console_rx + t;
-    // wrapped round the ring's end: the ring turned (three reversals), its tail at the front
-    for (uint8_t k = 0; k < 3; ++k) {
-        uint8_t* a = k == 1 ? fsw_console_rx + t : fsw_console_rx;
-        uint8_t* b = k == 0 ? fsw_console_rx + t : fsw_console_rx + size;
-        while (a < --b) {
-            const uint8_t x = *a;
-            *a++ = *b;
-            *b = x;
-        }
-    }
+    turn_bytes(t);  // wrapped round the ring's end: turned, its tail at the front
     g_rx_head = static_cast<uint8_t>((g_rx_head - t) & fsw_console_rx_mask);
     g_rx_tail = 0;
     return fsw_console_rx;
@@ -131,16 +158,6 @@ bool console_needs_poll() { return true; }
 #else
 #error "fswkit: no USART0 on this MCU: set FSW_CONSOLE_ARDUINO_SERIAL=1"
 #endif
-
-// The receive ring and its size less one (a power of two, 4..256): the
-// application's own, sized by its generated code for what its ground keeps
-// in flight (docs/runtime.md, "The console"), else psl_arduino_console_rx.cpp's
-// (FSW_CONSOLE_RX_SIZE), which the linker takes out of the runtime's archive
-// only for a program that does not define them. (The handler reads the mask
-// where it lies, a byte of RAM: a constant of another object is no immediate
-// operand where the runtime is compiled without LTO.)
-extern "C" uint8_t fsw_console_rx[];
-extern "C" const uint8_t fsw_console_rx_mask;
 
 namespace {
 
@@ -360,26 +377,13 @@ int16_t console_peek(uint8_t i) {
 
 namespace {
 
-void reverse(uint8_t* a, uint8_t* b) {  // [a, b)
-    while (a < --b) {
-        const uint8_t x = *a;
-        *a++ = *b;
-        *b = x;
-    }
-}
-
-// The ring turned so that the tail, `t`, is at its front, interrupts off
-// (the handler's head moves with it): three reversals, about 17 cycles a
-// byte of the ring (540 for a ring of 32). Out of line: its registers are
-// not saved on the reader's every path.
+// The ring turned so that the tail, `t`, is at its front (turn_bytes),
+// interrupts off (the handler's head moves with it). Out of line: its
+// registers are not saved on the reader's every path.
 FSW_NOINLINE void turn(uint8_t t) {
-    uint8_t* const ring = fsw_console_rx;
-    uint8_t* const end = ring + fsw_console_rx_mask + 1;
     const uint8_t sreg = SREG;
     cli();
-    reverse(ring, ring + t);
-    reverse(ring + t, end);
-    reverse(ring, end);
+    turn_bytes(t);
     g_rx_head = static_cast<uint8_t>((g_rx_head - t) & fsw_console_rx_mask);
     g_rx_tail = 0;
     SREG = sreg;

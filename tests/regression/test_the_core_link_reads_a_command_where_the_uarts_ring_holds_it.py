@@ -29,7 +29,7 @@ from fswkit.autocode import protocol as P
 from fswkit.link import wire
 from fswkit.link.session import Session
 from support.core_rocket import build_core, core_project
-from support.linkfw import tank_layout
+from support.linkfw import hello_seq, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -85,12 +85,9 @@ def _exchange(elf: str, board: str, project) -> tuple[dict, dict, dict]:
     act = tasks.index("act")
     counters = ("rx_ok", "rx_crc", "rx_malformed", "rx_oversized", "rx_replayed", "rx_refused")
     with sim.SimBoard(elf, board, analog=ANALOG, sim_limit=60, wall_limit=180) as b:
-        b.run_for(1.5)
-        s.feed(b.uart_read())
-        assert s.hello is not None and s.hello["schema_ok"], s.hello
+        seq = hello_seq(b, s)
         assert s.health is not None
         before = {k: s.health[k] for k in counters}
-        seq = s.hello["last_seq"]
         mode = wire.uplink(P.OP_MODE, seq + 1, bytes((act, 2)))
         pings = b"".join(wire.uplink(P.OP_PING, seq + k) for k in (2, 3, 4))
         wrapped = wire.uplink(P.OP_MODE, seq + 5, bytes((act, 2)))

@@ -22,7 +22,7 @@ import pytest
 
 from fswkit.link.session import Session
 from support.core_rocket import build_core
-from support.linkfw import control_commands, send_one_at_a_time, tank_layout
+from support.linkfw import control_commands, hello_seq, send_one_at_a_time, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -48,10 +48,7 @@ def test_the_core_rockets_control_paths_keep_its_stack_small(core_elf):
     s = Session(lay)
     with sim.SimBoard(str(elf), "uno", analog={"A0": 0.5, "A1": 1.25, "A2": 2.5, "A3": 2.5},
                       sim_limit=60, wall_limit=120) as b:
-        b.run_for(1.5)
-        s.feed(b.uart_read())
-        assert s.hello is not None and s.hello["schema_ok"]
-        seq = s.hello["last_seq"]
+        seq = hello_seq(b, s)
         commands = control_commands(lay)
         send_one_at_a_time(b, s, commands, seq)
         b.run_for(1.0)  # health frames, samples

@@ -22,7 +22,7 @@ from fswkit.autocode.iotables import analog_gain
 from fswkit.autocode.numeric import F32MODE
 from fswkit.link import wire
 from fswkit.link.session import Session
-from support.linkfw import control_commands, send_one_at_a_time, tank_layout
+from support.linkfw import control_commands, hello_seq, send_one_at_a_time, tank_layout
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -61,10 +61,7 @@ def test_the_control_paths_keep_the_rocket_stack_small(rocket):
     s = Session(lay)
     with sim.SimBoard(str(rocket), "uno", analog={"A0": 0.5, "A1": 1.25, "A2": 2.5, "A3": 2.5},
                       sim_limit=60, wall_limit=120) as b:
-        b.run_for(1.5)
-        s.feed(b.uart_read())
-        assert s.hello is not None and s.hello["schema_ok"]
-        seq = s.hello["last_seq"]
+        seq = hello_seq(b, s)
         commands = control_commands(lay) + [
             (P.OP_PARAM_INFO, b""), (P.OP_PARAM_GET, bytes((0, 1))), (P.OP_PARAM_SAVE, b""),
             (P.OP_LOG_INFO, b""), (P.OP_LOG_READ, struct.pack("<HBB", 0, 0, 16))]

@@ -23,9 +23,8 @@ import pytest
 
 from conftest import EXAMPLES, run_fsw
 from fswkit.autocode import protocol as P
-from fswkit.link import wire
 from fswkit.link.session import Session
-from support.linkfw import tank_layout
+from support.linkfw import hello_seq, send_one_at_a_time, tank_layout
 from support.core_rocket import build_core
 
 sim = pytest.importorskip("fswkit.sim.board")
@@ -116,11 +115,8 @@ def test_the_link_answers_as_it_did(core):
     s = Session(lay)
     with sim.SimBoard(str(out / "rocket.elf"), "uno", analog={"A0": 0.5, "A1": 1.25, "A2": 2.5, "A3": 2.5},
                       sim_limit=60, wall_limit=120) as b:
-        b.run_for(1.5)
-        s.feed(b.uart_read())
-        assert s.hello is not None and s.hello["schema_ok"]
+        seq = hello_seq(b, s)
         assert s.hello["params"] == 0  # no parameter store: kParamNone
-        seq = s.hello["last_seq"]
         tasks = [name for name, _ in lay.tasks]
         act = tasks.index("act")
         commands = [
@@ -134,10 +130,7 @@ def test_the_link_answers_as_it_did(core):
             (P.OP_SET, struct.pack("<HB", lay.element("resetCause").index, 0), "NOT_WRITABLE"),
             (P.OP_SNAPSHOT, b"", "OK"),
         ]
-        for k, (op, args, _) in enumerate(commands, start=1):  # one at a time: one ack waits at a time
-            b.uart_write(wire.uplink(op, seq + k, args))
-            b.run_for(0.1)
-            s.feed(b.uart_read())
+        send_one_at_a_time(b, s, [(op, args) for op, args, _ in commands], seq)  # one ack waits at a time
         b.run_for(1.5)  # a health frame after the last command
         s.feed(b.uart_read())
     acks = {a["cmd_seq"]: a["status_name"] for a in s.acks}

@@ -46,6 +46,16 @@ def control_commands(lay) -> list[tuple[int, bytes]]:
             (P.OP_SET, struct.pack("<HB", abort, 0)), (P.OP_MODE, bytes((0, 2)))]
 
 
+def hello_seq(board, session) -> int:
+    """A simulated board's first 1.5 s (its hello, and a health frame)
+    read into `session`; the hello's last command number, after which the
+    next command goes."""
+    board.run_for(1.5)
+    session.feed(board.uart_read())
+    assert session.hello is not None and session.hello["schema_ok"], session.hello
+    return session.hello["last_seq"]
+
+
 def send_one_at_a_time(board, session, commands, seq: int) -> None:
     """Each (op, args) of `commands` sent to a simulated board as command
     seq + 1, seq + 2, ..., 0.1 s apart (one ack waits at a time), what came

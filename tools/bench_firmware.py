@@ -247,20 +247,28 @@ def rocket_footprint(project: str = ROCKET, out: str = "rocket") -> dict:
             "parts": symbol_breakdown(elf, tuple(m.name for m in app.machines))}
 
 
+def variant_project(tmp: str, edit) -> str:
+    """A copy of examples/rocket in `tmp` that `edit(folder)` changed (None:
+    as it is); its folder."""
+    import shutil
+
+    proj = os.path.join(tmp, "rocket")
+    shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
+    if edit is not None:
+        edit(proj)
+    return proj
+
+
 def variant_size(edit, what: str) -> tuple[int, int]:
     """(flash, RAM: .data + .bss + .noinit) of a copy of examples/rocket
     that `edit(folder)` changed (None: as it is), built as `fsw sim` builds
     it; `what` names the variant in an error."""
-    import shutil
     import tempfile
 
     from fswkit.sim.command import build as build_for_sim
 
     with tempfile.TemporaryDirectory(prefix="fsw-bench-variant-") as tmp:
-        proj = os.path.join(tmp, "rocket")
-        shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
-        if edit is not None:
-            edit(proj)
+        proj = variant_project(tmp, edit)
         built = build_for_sim(proj, "uno", os.path.join(tmp, "out"))
         if isinstance(built, int):
             sys.exit(f"bench: building the rocket {what} failed")
@@ -309,14 +317,10 @@ def core_footprint() -> dict:
     """rocket_footprint of examples/rocket without what came after the
     target was set (without_later_features), its stack measured through
     its own demo flight."""
-    import shutil
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="fsw-bench-core-") as tmp:
-        proj = os.path.join(tmp, "rocket")
-        shutil.copytree(ROCKET, proj, ignore=shutil.ignore_patterns("build"))
-        without_later_features(proj)
-        return rocket_footprint(proj, "core")
+        return rocket_footprint(variant_project(tmp, without_later_features), "core")
 
 
 def print_core_size() -> None:

@@ -82,6 +82,148 @@ uint16_t cobs_end(CobsEncoder& e) {
     return e.len;
 }
 
+#if defined(__AVR__) && defined(__AVR_HAVE_MUL__)
+
+// On AVR the framer is a few lines of assembly (the avr-gcc calling
+// convention: buf r25:24, n r23:22, src r21:20, src_n r19:18, src2
+// r17:16, src2_n r15:14, the length back in r25:24). Its registers: the
+// frame in Z, the source in Y, X one byte past the open block's code byte
+// (a zero's code goes there with a pre-decrement store, and the next
+// block's code byte is the zero's place: X takes the frame's pointer as it
+// is), the open block's code + 1 in r24 (a full block, code 0xFF, is the
+// increment that wraps it to 0: no compare), the CRC in r13:r12 (high,
+// low), 16 in r2, the bytes left in r23:22 (its low byte counts the bytes,
+// its high byte each 256 more: a low byte of 0 on entry is the high
+// byte's 256). It saves 7 registers (the shared routine saved 17 for the
+// compiled framer: 8 bytes less stack on the deepest path, the sample
+// frame's). Each part is a call of the loop (`2:`): 23 cycles a non-zero
+// byte, 27 a zero, the CRC step 12 of them with two multiplications
+// (x = hi ^ b; r1 = x >> 4; x ^= r1; r1:r0 = x * 16, that is x >> 4 and
+// x << 4; the low byte takes x << 4; one shift of r1:r0 gives x >> 3 and
+// x << 5; the new high and low bytes in r1:r0, one movw), where avr-libc's
+// step takes 18 and the compiled one 16. A full block (254 data bytes)
+// stores its code 0xFF and takes a slot for the next code byte: bytes in
+// place move one byte on first (frames of 254 bytes and more only).
+__attribute__((naked, noinline, used)) uint16_t cobs_frame(uint8_t*, uint16_t, const uint8_t*, uint16_t,
+                                                           const uint8_t*, uint16_t) {
+    __asm__ __volatile__(
+        "    push r28\n"
+        "    push r29\n"
+        "    push r12\n"
+        "    push r13\n"
+        "    push r2\n"
+        "    push r24\n"  // buf, for the length
+        "    push r25\n"
+        "    movw r30, r24\n"
+        "    adiw r30, 1\n"   // the body's first byte, after the first code byte
+        "    movw r26, r30\n"
+        "    movw r28, r30\n"  // the body in place
+        "    ldi  r24, 16\n"
+        "    mov  r2, r24\n"
+        "    ldi  r24, 0xFF\n"  // kCrcInit
+        "    mov  r12, r24\n"
+        "    mov  r13, r24\n"
+        "    ldi  r24, 2\n"  // code 1
+        "    rcall 2f\n"  // the body, n bytes in r23:22
+        "    movw r28, r20\n"
+        "    movw r22, r18\n"
+        "    rcall 2f\n"  // src's
+        "    movw r28, r16\n"
+        "    movw r22, r14\n"
+        "    rcall 2f\n"  // src2's
+        "    mov  r25, r13\n"  // the CRC, high byte first, as body bytes (not folded in)
+        "    rcall 1f\n"
+        "    mov  r25, r12\n"
+        "    rcall 1f\n"
+        "    subi r24, 1\n"  // the last block's code
+        "    st   -X, r24\n"
+        "    st   Z+, r1\n"  // the delimiter
+        "    pop  r25\n"
+        "    pop  r24\n"
+        "    sub  r30, r24\n"  // the length
+        "    sbc  r31, r25\n"
+        "    movw r24, r30\n"
+        "    pop  r2\n"
+        "    pop  r13\n"
+        "    pop  r12\n"
+        "    pop  r29\n"
+        "    pop  r28\n"
+        "    ret\n"
+        // one byte (r25) into the frame, not into the CRC
+        "1:  st   Z+, r25\n"
+        "    tst  r25\n"
+        "    breq 3f\n"
+        "    inc  r24\n"
+        "    brne 9f\n"
+        "    ldi  r25, 0xFF\n"  // a full block: its code, and a slot for the next
+        "    st   -X, r25\n"
+        "    adiw r30, 1\n"
+        "    rjmp 4f\n"
+        "3:  subi r24, 1\n"  // a zero: the open block's code
+        "    st   -X, r24\n"
+        "4:  movw r26, r30\n"
+        "    ldi  r24, 2\n"
+        "9:  ret\n"
+        // r23:22 bytes from Y into the frame, framed and folded into the CRC
+        "2:  cp   r22, r1\n"
+        "    cpc  r23, r1\n"
+        "    breq 9b\n"
+        "    cpse r22, r1\n"
+        "    rjmp 5f\n"
+        "    subi r23, 1\n"
+        "5:  ld   r25, Y+\n"
+        "    st   Z+, r25\n"
+        "    eor  r13, r25\n"  // x = hi ^ b
+        "    mul  r13, r2\n"   // r1 = x >> 4
+        "    eor  r13, r1\n"   // x ^= x >> 4
+        "    mul  r13, r2\n"   // r0 = x << 4, r1 = x >> 4
+        "    eor  r12, r0\n"   // lo ^ x << 4
+        "    lsl  r0\n"        // x << 5, and x's bit 3 in the carry
+        "    rol  r1\n"        // x >> 3
+        "    eor  r1, r12\n"   // the new high byte: lo ^ x << 4 ^ x >> 3
+        "    eor  r0, r13\n"   // the new low byte: x ^ x << 5
+        "    movw r12, r0\n"
+        "    tst  r25\n"
+        "    breq 6f\n"  // a zero: out of the non-zero bytes' way
+        "    inc  r24\n"
+        "    breq 8f\n"  // a full block
+        "    subi r22, 1\n"
+        "    brne 5b\n"
+        "7:  subi r23, 1\n"  // 256 more, or none
+        "    brcc 5b\n"
+        "    clr  r1\n"
+        "    ret\n"
+        "6:  subi r24, 1\n"  // a zero: the open block's code
+        "    st   -X, r24\n"
+        "    movw r26, r30\n"
+        "    ldi  r24, 2\n"
+        "    subi r22, 1\n"
+        "    brne 5b\n"
+        "    rjmp 7b\n"
+        "8:  clr  r1\n"
+        "    subi r22, 1\n"  // the bytes left, whole
+        "    ldi  r24, 0xFF\n"  // the full block's code
+        "    st   -X, r24\n"
+        "    cp   r28, r30\n"
+        "    cpc  r29, r31\n"
+        "    brne 4f\n"
+        "    add  r28, r22\n"  // in place: the rest one byte on, from its end
+        "    adc  r29, r23\n"
+        "3:  cp   r28, r30\n"
+        "    cpc  r29, r31\n"
+        "    breq 3f\n"
+        "    ld   r25, -Y\n"
+        "    std  Y+1, r25\n"
+        "    rjmp 3b\n"
+        "3:  adiw r28, 1\n"
+        "4:  adiw r30, 1\n"  // the next code byte's slot
+        "    movw r26, r30\n"
+        "    ldi  r24, 2\n"
+        "    rjmp 2b\n");
+}
+
+#else
+
 namespace {
 
 // The framer's state between its runs.
@@ -99,109 +241,13 @@ struct FrameRun {
 // byte and the zero's place is the next block's. A full block (254 data
 // bytes) takes a slot for the next code byte after it: bytes in place move
 // one byte on (frames of 254 bytes and more only); bytes copied in just go
-// one byte further. On AVR a few lines of assembly (the source in Y, the
-// frame in Z, the open block's code byte behind X): 23 cycles a non-zero
-// byte, 27 a zero (the CRC 12 of them, with two multiplications, where
-// avr-libc's step takes 18: 27 and 35 before; 29 before an 8-bit count
-// and a zero's steps out of line, 32 and 18 before that; MCUs without
-// `mul` keep the 16-cycle step); it leaves the loop for a full block with
-// the bytes left in `left`, whole.
-#if defined(__AVR__)
-// crc16_step on the CRC pair (%A low byte, %B high byte) and the byte %[b],
-// in frame_copy's assembly. With `mul` 12 cycles: x = hi ^ b; r1 = x >> 4;
-// x ^= r1; r1:r0 = x * 16 (x >> 4, x << 4); the low byte takes x << 4;
-// one shift of r1:r0 gives x >> 3 and x << 5; the new bytes in r1:r0, one
-// movw. Without, 16 cycles through %[k].
-#if defined(__AVR_HAVE_MUL__)
-#define FSW_FRAME_CRC_STEP                                                    \
-    "    eor  %B[crc], %[b]\n\t"  /* x = hi ^ b, in the high byte */          \
-    "    mul  %B[crc], %[k]\n\t"  /* r1 = x >> 4 */                           \
-    "    eor  %B[crc], r1\n\t"    /* x ^= x >> 4 */                           \
-    "    mul  %B[crc], %[k]\n\t"  /* r0 = x << 4, r1 = x >> 4 */              \
-    "    eor  %A[crc], r0\n\t"    /* lo ^ x << 4 */                           \
-    "    lsl  r0\n\t"             /* x << 5, and x's bit 3 in the carry */    \
-    "    rol  r1\n\t"             /* x >> 3 */                                \
-    "    eor  r1, %A[crc]\n\t"    /* the new high byte: lo ^ x << 4 ^ x >> 3 */ \
-    "    eor  r0, %B[crc]\n\t"    /* the new low byte: x ^ x << 5 */          \
-    "    movw %A[crc], r0\n\t"
-#else
-#define FSW_FRAME_CRC_STEP                                                    \
-    "    eor  %B[crc], %[b]\n\t" /* x = hi ^ b, in the high byte */           \
-    "    mov  %[k], %B[crc]\n\t"                                             \
-    "    swap %[k]\n\t"                                                      \
-    "    andi %[k], 0x0F\n\t"                                                \
-    "    eor  %B[crc], %[k]\n\t" /* x ^= x >> 4 */                            \
-    "    mov  %[k], %B[crc]\n\t"                                             \
-    "    swap %[k]\n\t"                                                      \
-    "    andi %[k], 0xF0\n\t"    /* x << 4 */                                 \
-    "    eor  %A[crc], %[k]\n\t" /* lo ^ x << 4 */                            \
-    "    lsl  %[k]\n\t"                                                      \
-    "    eor  %[k], %B[crc]\n\t" /* x ^ x << 5: the new low byte */           \
-    "    lsr  %B[crc]\n\t"                                                   \
-    "    lsr  %B[crc]\n\t"                                                   \
-    "    lsr  %B[crc]\n\t"                                                   \
-    "    eor  %B[crc], %A[crc]\n\t" /* the new high byte */                   \
-    "    mov  %A[crc], %[k]\n\t"
-#endif
-#endif
-
-inline __attribute__((always_inline)) void frame_copy(FrameRun& r, const uint8_t* src, uint16_t left) {
+// one byte further.
+void frame_copy(FrameRun& r, const uint8_t* src, uint16_t left) {
     uint8_t* p = r.p;
     uint8_t* code_p = r.code_p;
     uint8_t code = r.code;
     uint8_t hi = r.hi, lo = r.lo;
     for (;;) {
-#if defined(__AVR__)
-        if (left != 0) {
-            // c is the open block's code + 1, so that a full block (code
-            // 0xFF) is the increment that wraps it to 0: no compare. X is
-            // one byte past the open block's code byte (a zero's code goes
-            // there with a pre-decrement store, and the next block's code
-            // byte is the zero's place: X takes the frame's pointer as it
-            // is). The CRC is a register pair (its low byte first): the
-            // step's two products end in r1:r0, new high byte and new low
-            // byte, and one movw puts them back.
-            uint8_t b, k, c = static_cast<uint8_t>(code + 1u);
-            uint8_t* cx = code_p + 1;
-            uint16_t crc = static_cast<uint16_t>(lo | hi << 8);
-            __asm__ __volatile__(
-                "    ldi  %[k], 16\n\t"
-                // the count's low byte counts the bytes, its high byte each
-                // 256 more: a low byte of 0 on entry is the high byte's 256
-                "    cpse %A[left], __zero_reg__\n\t"
-                "    rjmp 1f\n\t"
-                "    subi %B[left], 1\n\t"
-                "1:  ld   %[b], Y+\n\t"
-                "    st   Z+, %[b]\n\t"
-                FSW_FRAME_CRC_STEP
-                "    tst  %[b]\n\t"
-                "    breq 6f\n\t"  // a zero: out of the non-zero bytes' way
-                "    inc  %[c]\n\t"
-                "    breq 4f\n\t"  // a full block
-                "    subi %A[left], 1\n\t"
-                "    brne 1b\n\t"
-                "7:  subi %B[left], 1\n\t"  // 256 more, or none
-                "    brcc 1b\n\t"
-                "    rjmp 5f\n\t"
-                "6:  subi %[c], 1\n\t"  // a zero: the open block's code
-                "    st   -X, %[c]\n\t"
-                "    movw %A[cx], %A[p]\n\t"
-                "    ldi  %[c], 2\n\t"
-                "    subi %A[left], 1\n\t"
-                "    brne 1b\n\t"
-                "    rjmp 7b\n\t"
-                "4:  subi %A[left], 1\n\t"  // (the high byte as it is: the bytes left, whole)
-                "5:  clr  __zero_reg__\n\t"  // (the products' r1)
-                : [p] "+z"(p), [cx] "+x"(cx), [src] "+y"(src), [left] "+d"(left), [c] "+d"(c),
-                  [crc] "+r"(crc), [b] "=&r"(b), [k] "=&d"(k)
-                :
-                : "r0", "memory");
-            code = static_cast<uint8_t>(c - 1u);
-            code_p = cx - 1;
-            hi = static_cast<uint8_t>(crc >> 8);
-            lo = static_cast<uint8_t>(crc);
-        }
-#else
         while (left != 0) {
             const uint8_t b = *src++;
             *p++ = b;
@@ -215,7 +261,6 @@ inline __attribute__((always_inline)) void frame_copy(FrameRun& r, const uint8_t
                 break;  // a full block
             }
         }
-#endif
         if (code != 0xFFu) break;
         *code_p = 0xFFu;
         if (src == p) {  // in place: the rest one byte on
@@ -234,19 +279,14 @@ inline __attribute__((always_inline)) void frame_copy(FrameRun& r, const uint8_t
 
 }  // namespace
 
-FSW_NOINLINE uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src, uint16_t src_n) {
+uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src, uint16_t src_n, const uint8_t* src2,
+                    uint16_t src2_n) {
     FrameRun r = {buf + 1, buf, 1, 0xFFu, 0xFFu};  // the CRC from kCrcInit
-    // the body in place, then src's bytes: one loop (one copy of the
-    // framer's code) over the two parts
-    const uint8_t* part = buf + 1;
-    uint16_t part_n = n;
-    for (uint8_t k = 0; k < 2; ++k) {
-        frame_copy(r, part, part_n);
-        part = src;
-        part_n = src_n;
-    }
+    frame_copy(r, buf + 1, n);  // the body in place
+    frame_copy(r, src, src_n);
+    frame_copy(r, src2, src2_n);
     const uint8_t crc[2] = {r.hi, r.lo};  // high byte first
-    for (uint8_t i = 0; i < 2; ++i) {      // frame_copy's steps for two bytes, without its call
+    for (uint8_t i = 0; i < 2; ++i) {      // frame_copy's steps for two bytes, without the CRC
         const uint8_t b = crc[i];
         *r.p++ = b;
         if (b == 0) {
@@ -263,6 +303,8 @@ FSW_NOINLINE uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src, u
     *r.p++ = 0;
     return static_cast<uint16_t>(r.p - buf);
 }
+
+#endif
 
 int16_t cobs_decode(uint8_t* buf, uint16_t n) {
     uint16_t in = 0, out = 0;

@@ -21,7 +21,8 @@ inline uint16_t cobs_max_encoded(uint16_t n) { return static_cast<uint16_t>(n + 
 // move) and writes the delimiter. `buf` holds cobs_max_encoded(n + src_n +
 // 2) bytes. Returns the encoded length, delimiter included: the same bytes
 // as cobs_begin, cobs_put_bytes(body), cobs_end.
-uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src = 0, uint16_t src_n = 0);
+uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src = 0, uint16_t src_n = 0, const uint8_t* src2 = 0,
+                    uint16_t src2_n = 0);
 
 struct CobsEncoder {
     uint8_t* out;      // the encoded frame so far

@@ -147,9 +147,15 @@ const uint16_t kNoFrame = 0xFFFFu;  // frame_end's `n`: no frame (a sample frame
 // send_batch's, the telemetry task's step) once the composer has returned:
 // the framer's frame goes on the caller's, not on the composer's (18 and
 // 28 bytes then, on the deepest paths of the stack). `n` kNoFrame: none.
-FSW_NOINLINE void frame_end(Link& l, const uint8_t* src, uint16_t n) {
+FSW_NOINLINE void frame_end(Link& l, const uint8_t* src, uint16_t n, const LinkStream* now) {
     if (n == kNoFrame) return;
-    const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n);
+    const uint8_t* src2 = 0;
+    uint16_t n2 = 0;
+    if (now != 0) {
+        src2 = flash_get(l.cfg->sv) + flash_get(now->off);
+        n2 = flash_get(now->size);
+    }
+    const uint16_t len = cobs_frame(g_at, static_cast<uint16_t>(g_w - g_at - 1), src, n, src2, n2);
     l.tx_len = static_cast<uint16_t>(l.tx_len + len);
     ++l.n.frames;
     pal::console_send(g_at, len);  // (last: nothing kept across it)
@@ -200,11 +206,11 @@ SampleTail send_batch(Link& l, const LinkConfig& f, const LinkStream& row, LinkS
     }
     frame_begin(l, static_cast<uint8_t>(kFrameSample | i));
     put_time(st.t0);
-    if (stored != 0) put_bytes(flash_get(row.store), static_cast<uint16_t>(stored * size));
-    const bool lock = sv_lock(f);
-    uint8_t* const sv = flash_get(f.sv);
-    if (with_now && !lock) return SampleTail{sv + flash_get(row.off), size};  // copied in as it is framed
-    if (with_now) put_sv(sv, lock, flash_get(row.off), size);  // atomically, then framed
+    const uint8_t* const store = flash_get(row.store);
+    const uint16_t stored_n = static_cast<uint16_t>(stored * size);
+    if (!sv_lock(f)) return SampleTail{store, stored_n};
+    put_bytes(store, stored_n);  // the lock on: the current region copied in atomically, after them
+    if (with_now) put_sv(flash_get(f.sv), true, flash_get(row.off), size);
     return SampleTail{0, 0};
 }
 
@@ -216,7 +222,7 @@ void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, LinkStream
     // still takes its sample).
     if (st.count != 0 && skipped != st.skipped0) {
         const SampleTail t = send_batch(l, f, row, st, i, false);
-        frame_end(l, t.src, t.n);
+        frame_end(l, t.src, t.n, 0);
     }
     if (st.count == 0) {
         st.t0 = now32;
@@ -229,7 +235,9 @@ void take_sample(Link& l, const LinkConfig& f, const LinkStream& row, LinkStream
         return;
     }
     const SampleTail t = send_batch(l, f, row, st, i, true);
-    frame_end(l, t.src, t.n);
+    // the current region copied in as it is framed, after the stored samples (with the lock, put
+    // in atomically by send_batch)
+    frame_end(l, t.src, t.n, sv_lock(f) ? 0 : &row);
 }
 
 // The parameter store's source byte of hello and health frames.
@@ -358,7 +366,7 @@ void service(Link& l, const LinkConfig& c, bool big) {
         const uint8_t may = big_ok ? p : static_cast<uint8_t>(p & kPendAck);
         l.pending = static_cast<uint8_t>(p & ~(may & (0u - may)));
         send_control(l, c, type);
-        frame_end(l, 0, 0);
+        frame_end(l, 0, 0, 0);
     }
 }
 

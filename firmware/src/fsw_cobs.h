@@ -14,13 +14,16 @@ namespace fsw {
 inline uint16_t cobs_max_encoded(uint16_t n) { return static_cast<uint16_t>(n + n / 254u + 2u); }
 
 // Frames a body in place: the body lies raw at buf[1..n] (buf[0] is the
-// first code byte's), and `src_n` more bytes from `src` are copied in after
-// it as they are framed (no second pass over them). Appends the CRC-16
-// (high byte first), COBS-encodes body ‖ CRC where it lies (a non-zero byte
-// stays where it is: only zeros, and a byte after every full block of 254,
-// move) and writes the delimiter. `buf` holds cobs_max_encoded(n + src_n +
-// 2) bytes. Returns the encoded length, delimiter included: the same bytes
-// as cobs_begin, cobs_put_bytes(body), cobs_end.
+// first code byte's), and `src_n` more bytes from `src`, then `src2_n` from
+// `src2`, are copied in after it as they are framed (no second pass over
+// them: a sample frame's stored samples and its current region). Appends
+// the CRC-16 (high byte first), COBS-encodes body ‖ CRC where it lies (a
+// non-zero byte stays where it is: only zeros, and a byte after every full
+// block of 254, move) and writes the delimiter. `buf` holds
+// cobs_max_encoded(n + src_n + src2_n + 2) bytes. Returns the encoded
+// length, delimiter included: the same bytes as cobs_begin,
+// cobs_put_bytes(body ‖ src ‖ src2), cobs_end. On AVR (with `mul`) a
+// routine in assembly (fsw_cobs.cpp).
 uint16_t cobs_frame(uint8_t* buf, uint16_t n, const uint8_t* src = 0, uint16_t src_n = 0, const uint8_t* src2 = 0,
                     uint16_t src2_n = 0);
 

@@ -16,7 +16,9 @@ uint16_t crc16_update(uint16_t crc, uint8_t byte);
 
 // One byte into the CRC held as its two bytes, inline, without a table
 // (x = high ^ byte; x ^= x >> 4; crc = crc << 8 ^ x << 12 ^ x << 5 ^ x, a
-// byte at a time): about 16 AVR cycles, for the framer's loop.
+// byte at a time): about 16 AVR cycles; the framer's loop where it is
+// compiled (the AVR framer has its own 12-cycle step, fsw_cobs.cpp), the
+// recorder's block check.
 inline void crc16_step(uint8_t& hi, uint8_t& lo, uint8_t byte) {
     uint8_t x = static_cast<uint8_t>(hi ^ byte);
     x = static_cast<uint8_t>(x ^ (x >> 4));

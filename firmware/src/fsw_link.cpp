@@ -141,8 +141,10 @@ FSW_NOINLINE void put_time(uint64_t time) {
 const uint16_t kNoFrame = 0xFFFFu;  // frame_end's `n`: no frame (a sample frame with no room)
 
 // Frames the body in place, and `src`'s `n` bytes after it, copied in as
-// they are framed (a sample frame's current region: no second pass over
-// it), and hands the frame to the UART, which sends it from where it lies.
+// they are framed (a sample frame's stored samples: no copy of them into
+// the frame first), then, where `now` is a stream's row, that stream's
+// current region out of the state vector likewise, and hands the frame to
+// the UART, which sends it from where it lies.
 // Called by the caller of the frame's composer (send_control's, service;
 // send_batch's, the telemetry task's step) once the composer has returned:
 // the framer's frame goes on the caller's, not on the composer's (18 and
@@ -173,18 +175,20 @@ inline __attribute__((always_inline)) bool sv_lock(const LinkConfig& c) {
     return app_has(kAppSvLock) && flash_get(c.lock);
 }
 
-// What a sample frame's composer leaves for its framing: the current
-// region's bytes, copied in as they are framed (`src` 0: none, the body
-// is complete), or no frame at all (`n` kNoFrame: the batch was dropped).
+// What a sample frame's composer leaves for its framing: the stored
+// samples' bytes, copied in from the stream's store as they are framed
+// (`n` 0: none, or put in already with the lock on), or no frame at all
+// (`n` kNoFrame: the batch was dropped). The current region follows them
+// (frame_end's `now`).
 struct SampleTail {
     const uint8_t* src;
     uint16_t n;
 };
 
 // Composes the frame of stream i's open batch (and of the current region
-// when `with_now`): header and stored samples into the transmit buffer, the
-// region left for the framer (or put in already, atomically, when the lock
-// is on). The telemetry task's step frames and hands it (frame_end): the
+// when `with_now`): its header into the transmit buffer, the stored samples
+// and the region left for the framer, which copies them in (or put in
+// already, the region atomically, when the lock is on). The telemetry task's step frames and hands it (frame_end): the
 // framer is then called from the step's frame, not from this one's, and the
 // deepest path of the stack (the step's, the framer's) is this frame's 18
 // bytes shorter. `row` is the stream's row in flash (FSW_FLASH), its

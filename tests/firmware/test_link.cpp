@@ -184,6 +184,15 @@ static void test_framer_matches_the_incremental_encoder(void) {
         TEST_ASSERT_EQUAL_UINT16(len, clen);
         TEST_ASSERT_EQUAL_MEMORY(enc, framed, len);
         TEST_ASSERT_EQUAL_HEX8(0xEE, framed[clen]);
+        // and the rest in two parts copied in (a sample frame's stored samples, its current region)
+        const uint16_t split2 = static_cast<uint16_t>(split + (n - split) / 3u);
+        memset(framed, 0xEE, sizeof framed);
+        memcpy(framed + 1, raw, split);
+        const uint16_t tlen = cobs_frame(framed, split, raw + split, static_cast<uint16_t>(split2 - split),
+                                         raw + split2, static_cast<uint16_t>(n - split2));
+        TEST_ASSERT_EQUAL_UINT16(len, tlen);
+        TEST_ASSERT_EQUAL_MEMORY(enc, framed, len);
+        TEST_ASSERT_EQUAL_HEX8(0xEE, framed[tlen]);
     }
     for (uint16_t hi = 0; hi < 256; ++hi) {
         for (uint16_t b = 0; b < 256; ++b) {

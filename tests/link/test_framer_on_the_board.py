@@ -1,7 +1,8 @@
 """The AVR framer and UART driver on the simulated Uno, byte for byte
-against the host's reference: cobs_frame's assembly loop (its CRC, its
-zeros, its full blocks of 254 bytes, a body in place and a part copied in
-after it) and the transmit handler, which sends the runs console_send hands
+against the host's reference: cobs_frame's assembly (its CRC, its zeros,
+its full blocks of 254 bytes, a body in place and two parts copied in after
+it: a sample frame's stored samples and its current region) and the
+transmit handler, which sends the runs console_send hands
 it where they lie, goes on with a second run at a run's end and compares
 its place with the end with no instruction that changes the status
 register. Frames of every length around a block's end, with no zeros, only
@@ -22,12 +23,16 @@ from support.simfw import sketch_elf  # noqa: E402
 pytestmark = pytest.mark.skipif(shutil.which("avr-gcc") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
 
-# (bytes composed in place, bytes copied in from another buffer) of each frame
-# (the loop counts a part's bytes in its count's low byte, each 256 in the
-# high byte: parts of 255, 256, 257, 511, 512 and 513 bytes cross that)
-CASES = [(1, 0), (2, 0), (5, 0), (60, 0), (252, 0), (253, 0), (254, 0), (255, 0), (256, 0), (257, 0), (300, 0),
-         (508, 0), (511, 0), (512, 0), (513, 0), (600, 0), (6, 24), (6, 247), (6, 248), (6, 249), (6, 256),
-         (100, 300), (0, 1), (0, 256), (250, 10)]
+# (bytes composed in place, bytes copied in from a buffer, bytes copied in
+# from a second buffer after them) of each frame (the loop counts a part's
+# bytes in its count's low byte, each 256 in the high byte: parts of 255,
+# 256, 257, 511, 512 and 513 bytes cross that; a full block ends in each
+# part, and across two)
+CASES = [(1, 0, 0), (2, 0, 0), (5, 0, 0), (60, 0, 0), (252, 0, 0), (253, 0, 0), (254, 0, 0), (255, 0, 0),
+         (256, 0, 0), (257, 0, 0), (300, 0, 0), (508, 0, 0), (511, 0, 0), (512, 0, 0), (513, 0, 0), (600, 0, 0),
+         (6, 24, 0), (6, 247, 0), (6, 248, 0), (6, 249, 0), (6, 256, 0), (100, 300, 0), (0, 1, 0), (0, 256, 0),
+         (250, 10, 0), (7, 24, 24), (7, 0, 24), (0, 0, 1), (0, 0, 300), (3, 250, 4), (7, 240, 20), (100, 100, 254),
+         (0, 255, 256), (253, 1, 1)]
 MODES = 4  # 0: every byte zero; 1: no zero; 2: about one in four zero; 3: random bytes
 
 SKETCH = r"""
@@ -35,11 +40,12 @@ SKETCH = r"""
 #include "fswkit.h"
 #include "fsw_cobs.h"
 
-static uint8_t buf[1000];
-static uint8_t half[500];
-static uint8_t src[320];
+static uint8_t buf[620];
+static uint8_t half[320];
+static uint8_t src[300];
+static uint8_t src2[300];
 static uint32_t seed = 12345;
-static const uint16_t kCases[][2] = {CASES};
+static const uint16_t kCases[][3] = {CASES};
 
 static uint8_t rnd() {
     seed = seed * 1103515245UL + 12345UL;
@@ -69,7 +75,8 @@ void setup() {
         for (uint8_t i = 0; i < sizeof kCases / sizeof kCases[0]; ++i) {
             fill(buf + 1, kCases[i][0], mode);
             fill(src, kCases[i][1], mode);
-            send(buf, fsw::cobs_frame(buf, kCases[i][0], src, kCases[i][1]));
+            fill(src2, kCases[i][2], mode);
+            send(buf, fsw::cobs_frame(buf, kCases[i][0], src, kCases[i][1], src2, kCases[i][2]));
         }
     }
 }
@@ -99,9 +106,10 @@ def expected() -> bytes:
 
     out = bytearray()
     for mode in range(MODES):
-        for in_place, copied in CASES:
+        for in_place, copied, copied2 in CASES:
             body = fill(in_place, mode)
             body += fill(copied, mode)
+            body += fill(copied2, mode)
             out += wire.frame(body)
     return bytes(out)
 
@@ -115,13 +123,13 @@ def test_framed_bytes_on_the_wire_are_the_references(board, defines):
     Mega, where the sketch's buffers and Serial's two rings fit)."""
     from fswkit.sim.board import SimBoard
 
-    source = SKETCH.replace("{CASES}", "{" + ", ".join(f"{{{a}, {b}}}" for a, b in CASES) + "}")
+    source = SKETCH.replace("{CASES}", "{" + ", ".join(f"{{{a}, {b}, {c}}}" for a, b, c in CASES) + "}")
     source = source.replace("MODES", str(MODES))
     elf = sketch_elf("framer", source, board, defines)
     want = expected()
     got = bytearray()
     with SimBoard(elf, board, uart="control") as sim:
-        for _ in range(400):  # 40 simulated seconds at most; about 1.1 s of line time needed
+        for _ in range(400):  # 40 simulated seconds at most; about 1.5 s of line time needed
             sim.step(sim.cycles_for(0.1))
             got += sim.uart_read()
             if len(got) >= len(want):

@@ -1,6 +1,8 @@
 // CRC-16/CCITT-FALSE (polynomial 0x1021, init 0xFFFF, MSB first, no final
-// xor) of the telemetry link: avr-libc's _crc_xmodem_update on AVR, the same
-// bitwise algorithm elsewhere; Python's binascii.crc_hqx(data, 0xFFFF).
+// xor) of the telemetry link: on AVR a step with two multiplications
+// (fsw_crc.cpp; avr-libc's _crc_xmodem_update, the same CRC, on an AVR
+// without `mul`), the same bitwise algorithm elsewhere; Python's
+// binascii.crc_hqx(data, 0xFFFF).
 #ifndef FSW_CRC_H
 #define FSW_CRC_H
 

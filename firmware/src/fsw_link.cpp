@@ -188,7 +188,8 @@ struct SampleTail {
 // Composes the frame of stream i's open batch (and of the current region
 // when `with_now`): its header into the transmit buffer, the stored samples
 // and the region left for the framer, which copies them in (or put in
-// already, the region atomically, when the lock is on). The telemetry task's step frames and hands it (frame_end): the
+// already, the region atomically, when the lock is on). The telemetry
+// task's step frames and hands it (frame_end): the
 // framer is then called from the step's frame, not from this one's, and the
 // deepest path of the stack (the step's, the framer's) is this frame's 18
 // bytes shorter. `row` is the stream's row in flash (FSW_FLASH), its

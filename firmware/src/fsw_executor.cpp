@@ -29,21 +29,24 @@ ExecConfig executor_config(const Executor& ex) {
 }
 
 Result executor_begin(Executor& ex, const ExecConfig* cfg) {
-    ExecConfig c;
-    flash_read(&c, cfg, sizeof c);
-    // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
-    const bool check = app_has(kAppTableChecks);
-    if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
-    ex.cfg = cfg;
-    uint8_t mirrors = 0;
     // Where the application has no check, mirror, mode element nor slow task
-    // (fsw_app.h), a row's start mode is all there is to read of it.
+    // (fsw_app.h), a row's start mode is all there is to read of it, and the
+    // configuration is read a field at a time where used (FSW_FLASH: no copy
+    // of it on the stack, 24 B of the core rocket's flash); else it is copied.
+    const bool check = app_has(kAppTableChecks);
     const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);
-    for (uint8_t i = 0; i < c.n_tasks; ++i) {
+    ExecConfig c;
+    if (whole_rows) flash_read(&c, cfg, sizeof c);
+    const uint8_t n_tasks = whole_rows ? c.n_tasks : flash_get(cfg->n_tasks);
+    TaskStats* const stats = whole_rows ? c.stats : flash_get(cfg->stats);
+    // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
+    if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
+    uint8_t mirrors = 0;
+    for (uint8_t i = 0; i < n_tasks; ++i) {
         if (!whole_rows) {
-            TaskStats& s = c.stats[i];
+            TaskStats& s = stats[i];
             memset(&s, 0, sizeof s);
-            s.mode = flash_get(c.tasks[i].init_mode);  // (its record: no mode element)
+            s.mode = flash_get(flash_get(cfg->tasks)[i].init_mode);  // (its record: no mode element)
             continue;
         }
         Task t;
@@ -55,14 +58,14 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
         }
         if (check && t.divider > 1 && c.countdowns == 0) return kErrConfig;  // a slow task: its countdown
         if (app_has(kAppMirrors) && (t.overruns_off != kNoElement || t.worst_us_off != kNoElement)) mirrors = 1;
-        TaskStats& s = c.stats[i];
+        TaskStats& s = stats[i];
         memset(&s, 0, sizeof s);
         if (app_has(kAppSlowTasks) && c.countdowns != 0) c.countdowns[i] = t.phase;
         *mode_byte(c, t, i) = t.init_mode;  // one byte: atomic on every target
     }
     pal::begin();
 #if FSW_SLEEP
-    pal::cycle_timer_begin(base_period(c.period_us));  // worked out when compiling for a constant
+    pal::cycle_timer_begin(base_period(whole_rows ? c.period_us : flash_get(cfg->period_us)));  // worked out when compiling for a constant
 #endif
     memset(&ex, 0, sizeof ex);  // the counters (one clear: a store a field was 4 bytes of flash a byte)
     ex.cfg = cfg;
@@ -71,7 +74,9 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
 #endif
     ex.mirrors = mirrors;
     ex.reset_cause = pal::reset_cause();
-    if (c.reset_cause_off != kNoElement && c.sv != 0) c.sv[c.reset_cause_off] = ex.reset_cause;
+    const ElemOff reset_cause_off = whole_rows ? c.reset_cause_off : flash_get(cfg->reset_cause_off);
+    uint8_t* const sv = whole_rows ? c.sv : flash_get(cfg->sv);
+    if (reset_cause_off != kNoElement && sv != 0) sv[reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
     return kOk;
 }

@@ -394,23 +394,32 @@ FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
     return false;
 }
 
+// elem_size of each type, looked up at run time (its shifts, inline, were
+// 52 B of the core rocket's flash; the table and its load are 21).
+constexpr uint8_t kElemSizes[kBool + 1] FSW_FLASH = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8, 1};
+constexpr bool elem_sizes_ok(uint8_t t) {
+    return t > kBool || (kElemSizes[t] == elem_size(t) && elem_sizes_ok(static_cast<uint8_t>(t + 1u)));
+}
+static_assert(elem_sizes_ok(0), "kElemSizes follows elem_size");
+
 uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
     if (alen < 2) return kAckBadLength;
     const uint16_t index = load<uint16_t>(a);
     const uint8_t n_writable = flash_get(c.n_writable);
     const LinkWritable* const rows = flash_get(c.writable);
     for (uint8_t k = 0; k < n_writable; ++k) {
-        LinkWritable w;
-        flash_read(&w, &rows[k], sizeof w);
-        if (w.index != index) continue;
-        const uint8_t size = elem_size(w.type);
+        const LinkWritable& w = rows[k];  // FSW_FLASH: its fields read where used (no copy on the stack)
+        if (flash_get(w.index) != index) continue;
+        const uint8_t type = flash_get(w.type);
+        const uint8_t size = flash_get(kElemSizes[type]);  // (a known type: link_writable_ok)
         if (alen != static_cast<uint8_t>(2u + size)) return kAckBadLength;
-        if (executor_owns(c, w.off)) return kAckLocked;
-        uint8_t* const p = flash_get(c.sv) + w.off;
+        const ElemOff off = flash_get(w.off);
+        if (executor_owns(c, off)) return kAckLocked;
+        uint8_t* const p = flash_get(c.sv) + off;
         const bool lock = sv_lock(c);
         const pal::IrqState saved = lock ? pal::critical_enter() : 0;
         memcpy(p, a + 2, size);
-        if (w.type == kBool) *p = *p != 0 ? 1 : 0;  // a bool is stored as 0 or 1
+        if (type == kBool) *p = *p != 0 ? 1 : 0;  // a bool is stored as 0 or 1
         if (lock) pal::critical_exit(saved);
         return kAckOk;
     }
@@ -418,6 +427,9 @@ uint8_t apply_set(const LinkConfig& c, const uint8_t* a, uint8_t alen) {
 }
 
 FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8_t* a, uint8_t alen) {
+#if defined(__AVR__)
+    FSW_SAVES_IN_RUN("r12");  // (fsw_types.h) a command's, not a cycle's: the shared routine's cycles are paid rarely
+#endif
     if (op == kOpSet) return apply_set(c, a, alen);
     // a store's commands; without the store (fsw_app.h, or none named): UNKNOWN_OP below
     if (app_has(kAppParams) && op >= kOpParamGet && op <= kOpParamInfo) {
@@ -458,16 +470,51 @@ FSW_NOINLINE uint8_t apply(Link& l, const LinkConfig& c, uint8_t op, const uint8
     return kAckOk;
 }
 
+// The frame's COBS decoded in place, its CRC worked out on the way
+// (cobs_decode and crc16 in one pass, on 8-bit counts: a frame is at most
+// FSW_LINK_RX_CAP bytes): its length, or 0 where a block runs past its end;
+// `crc_ok`: the CRC over the decoded bytes, the frame's own last, is 0 (it
+// matches). A block's implied zero goes out as the next block's code byte is
+// read (there is one only where bytes follow). None of the frame's bytes is
+// zero (the uplink took them up to the delimiter): a code or data byte of
+// zero is not looked for.
+static_assert(FSW_LINK_RX_CAP <= 255, "FSW_LINK_RX_CAP: a frame's length is a byte");
+inline __attribute__((always_inline)) uint8_t decode_frame(uint8_t* rx, uint8_t len, bool& crc_ok) {
+    const uint8_t* in = rx;
+    uint8_t* out = rx;
+    uint8_t hi = static_cast<uint8_t>(kCrcInit >> 8), lo = static_cast<uint8_t>(kCrcInit);
+    uint8_t run = 0;     // data bytes left in the open block (0: the next byte is a code)
+    bool zero = false;   // a zero goes out before the next block
+    for (; len != 0; --len) {
+        uint8_t b = *in++;
+        if (run == 0) {  // a code byte: its block's data bytes follow
+            run = static_cast<uint8_t>(b - 1u);
+            if (run >= len) return 0;
+            const bool z = zero;
+            zero = b != 0xFFu;
+            if (!z) continue;
+            b = 0;
+        } else {
+            --run;
+        }
+        *out++ = b;
+        crc16_step(hi, lo, b);
+    }
+    crc_ok = (hi | lo) == 0;
+    return static_cast<uint8_t>(out - rx);
+}
+
 // One received frame, its `len` bytes at `rx` (COBS-encoded, delimiter
 // stripped), decoded where they lie: decode, verify, apply, queue the
 // acknowledgement. Anything not verified is only counted.
 inline __attribute__((always_inline)) void handle_frame(Link& l, const LinkConfig& c, uint8_t* rx, uint8_t len) {
-    const int16_t n = cobs_decode(rx, len);
+    bool crc_ok;
+    const uint8_t n = decode_frame(rx, len, crc_ok);
     if (n < 5) {  // op, seq (2), CRC (2)
         inc16(l.n.rx_malformed);
         return;
     }
-    if (crc16(rx, static_cast<uint16_t>(n)) != 0) {
+    if (!crc_ok) {
         inc16(l.n.rx_crc);
         return;
     }
@@ -480,7 +527,7 @@ inline __attribute__((always_inline)) void handle_frame(Link& l, const LinkConfi
         status = kAckReplay;
     } else {
         l.n.last_seq = seq;
-        status = apply(l, c, op, rx + 3, static_cast<uint8_t>(n - 5));
+        status = apply(l, c, op, rx + 3, static_cast<uint8_t>(n - 5u));
         inc16(status == kAckOk ? l.n.rx_ok
               : status == kAckUnknownOp || status == kAckBadLength ? l.n.rx_malformed
                                                                     : l.n.rx_refused);
@@ -609,6 +656,9 @@ FSW_NOINLINE void frame_received(Link& l, const LinkConfig& c) {
 // the frame is handled and the link serviced. The configuration is read out
 // of flash a field at a time where it is used (send_control).
 FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
+#if defined(__AVR__)
+    FSW_SAVES_IN_RUN("r16");  // (fsw_types.h) run only when a byte came or a frame waits, not every cycle
+#endif
     const LinkConfig& c = *l.cfg;
     const bool ring = rx_in_ring(c);
     if (l.pending != 0 || l.snapshot_at != kNoSnapshot) service(l, c, false);

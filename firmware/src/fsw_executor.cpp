@@ -16,10 +16,6 @@ uint8_t* mode_byte(const ExecConfig& c, const Task& t, uint8_t i) {
     return app_has(kAppModeElems) && t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
 }
 
-// The base period: the application's constant where it has one (fsw_app.h),
-// else the configuration's.
-inline uint32_t base_period(uint32_t configured) { return app_period_us != 0 ? app_period_us : configured; }
-
 }  // namespace
 
 ExecConfig executor_config(const Executor& ex) {
@@ -32,13 +28,15 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     // Where the application has no check, mirror, mode element nor slow task
     // (fsw_app.h), a row's start mode is all there is to read of it, and the
     // configuration is read a field at a time where used (FSW_FLASH: no copy
-    // of it on the stack, 24 B of the core rocket's flash); else it is copied.
+    // of it on the stack, nor avr-libc's memcpy_P; 62 B of the core rocket's
+    // flash); else it is copied.
     const bool check = app_has(kAppTableChecks);
     const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);
     ExecConfig c;
     if (whole_rows) flash_read(&c, cfg, sizeof c);
     const uint8_t n_tasks = whole_rows ? c.n_tasks : flash_get(cfg->n_tasks);
     TaskStats* const stats = whole_rows ? c.stats : flash_get(cfg->stats);
+    const Task* const tasks = whole_rows ? c.tasks : flash_get(cfg->tasks);  // (read once: flash_get's load stays in a loop)
     // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
     if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
     uint8_t mirrors = 0;
@@ -46,7 +44,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
         if (!whole_rows) {
             TaskStats& s = stats[i];
             memset(&s, 0, sizeof s);
-            s.mode = flash_get(flash_get(cfg->tasks)[i].init_mode);  // (its record: no mode element)
+            s.mode = flash_get(tasks[i].init_mode);  // (its record: no mode element)
             continue;
         }
         Task t;
@@ -65,7 +63,10 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     }
     pal::begin();
 #if FSW_SLEEP
-    pal::cycle_timer_begin(base_period(whole_rows ? c.period_us : flash_get(cfg->period_us)));  // worked out when compiling for a constant
+    // the base period: the application's constant where it has one (fsw_app.h; the timer's settings are
+    // then worked out when compiling), else the configuration's, read only then (a flash load is never
+    // dropped unused)
+    pal::cycle_timer_begin(app_period_us != 0 ? app_period_us : whole_rows ? c.period_us : flash_get(cfg->period_us));
 #endif
     memset(&ex, 0, sizeof ex);  // the counters (one clear: a store a field was 4 bytes of flash a byte)
     ex.cfg = cfg;
@@ -177,7 +178,7 @@ inline uint8_t* mode_at(const ExecConfig& f, ElemOff off, TaskStats& s) {
 static inline __attribute__((always_inline)) void note_whole_run(TaskStats& s, uint32_t took, const ExecConfig& f,
                                                                  const Task* row) {
     if (took > s.worst_us) s.worst_us = took;
-    const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // base_period
+    const uint32_t period_us = app_period_us != 0 ? app_period_us : flash_get(f.period_us);  // the base period
     if (took > period_us && (!app_has(kAppSlowTasks) || took > period_us * flash_get(row->divider)) &&
         s.overruns != 0xFFFFu) {
         ++s.overruns;

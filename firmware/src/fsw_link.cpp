@@ -652,8 +652,9 @@ FSW_NOINLINE void frame_received(Link& l, const LinkConfig& c) {
 }
 
 // The uplink task's run past its first look: the control frames waiting
-// sent (service), then the bytes received, `b` first when the caller read
-// it already (else -1), into the frame being received (where the ring
+// sent (service: `b` is -1 where its caller found some, or a snapshot,
+// waiting, else the byte it read, and none waits), then the bytes
+// received, `b` first, into the frame being received (where the ring
 // holds it, until its delimiter, or the receive buffer); at a delimiter
 // the frame is handled and the link serviced. The configuration is read out
 // of flash a field at a time where it is used (send_control).
@@ -663,7 +664,7 @@ FSW_NOINLINE void uplink_run(Link& l, int16_t b) {
 #endif
     const LinkConfig& c = *l.cfg;
     const bool ring = rx_in_ring(c);
-    if (l.pending != 0 || l.snapshot_at != kNoSnapshot) service(l, c, false);
+    if (b < 0) service(l, c, false);
     for (uint8_t k = 0; k < FSW_LINK_RX_PER_RUN; ++k) {
         if (k != 0 || b < 0) {  // (else b is the byte the caller read)
             if (l.pending & kPendAck) break;  // one acknowledgement waits at a time

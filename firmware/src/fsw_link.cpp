@@ -706,15 +706,20 @@ Result link_uplink_task(void* p) {
     return kOk;
 }
 
+// Whether the link was begun: a generated program begins it before its main
+// loop polls it (setup(), fsw_gen::begin), a hand-written one or a test
+// (fsw_app.h: every feature, kAppTableChecks among them) may poll it before.
+inline __attribute__((always_inline)) bool begun(const Link& l) { return !app_has(kAppTableChecks) || l.cfg != 0; }
+
 bool link_busy(const Link& l_) {
     const Link& l = *by_pointer(&l_);
-    return l.cfg != 0 && (l.pending != 0 || l.snapshot_at != kNoSnapshot ||
-                          (pal::console_needs_poll() && pal::console_sending() != 0));
+    return begun(l) && (l.pending != 0 || l.snapshot_at != kNoSnapshot ||
+                        (pal::console_needs_poll() && pal::console_sending() != 0));
 }
 
 void link_poll(Link& l_) {
     Link& l = *by_pointer(&l_);
-    if (l.cfg == 0) return;
+    if (!begun(l)) return;
     pump();
     if (l.pending == 0 && l.snapshot_at == kNoSnapshot) return;
     service(l, *l.cfg, true);

@@ -493,7 +493,9 @@ def _app_cpp(app: Application) -> str:
 
 # fsw_app.h AppFeature: (bit, name, whether the application uses it). The
 # task table always passes no safe function (kAppSafeFns) and is checked
-# here, when compiled (kAppTableChecks: the static_assert of its rows).
+# here, when compiled (kAppTableChecks: the static_assert of its rows); the
+# link is begun once, right after the reset, and polled only after
+# (kAppBeginAgain: begin() and the main loop below).
 APP_FEATURES = (
     (0x01, "kAppParams", lambda app: bool(app_parameters(app))),
     (0x02, "kAppLog", lambda app: app.log is not None),

@@ -34,9 +34,14 @@ enum AppFeature : uint16_t {
     kAppRxRing = 0x800,
     // ... or in a receive buffer of the link's own, which the ring is emptied into each run (a
     // ground that pipelines its commands: parameters, reload)
-    kAppRxBuffer = 0x1000
+    kAppRxBuffer = 0x1000,
+    // A program that may begin the link again, or poll it before it begins it: the runtime's
+    // tests, a hand-written sketch. Generated code never sets it: it begins the link once, right
+    // after the reset (whose C start-up zeroed the link's records: link_begin does not clear them
+    // again), and polls it only after (link_busy, link_poll do not ask whether it was begun).
+    kAppBeginAgain = 0x2000
 };
-static const uint16_t kAppAllFeatures = 0x1FFF;
+static const uint16_t kAppAllFeatures = 0x3FFF;
 
 // The features the program's runtime has (AppFeature bits).
 extern const uint16_t app_features;

@@ -544,7 +544,9 @@ inline __attribute__((always_inline)) void handle_frame(Link& l, const LinkConfi
 
 void link_begin(Link& l_, const LinkConfig* cfg) {
     Link& l = *by_pointer(&l_);
-    memset(&l, 0, sizeof l);
+    // (zero since the reset where the link is begun once, as generated code does: fsw_app.h kAppBeginAgain)
+    const bool clear = app_has(kAppBeginAgain);
+    if (clear) memset(&l, 0, sizeof l);
     l.cfg = cfg;
     // The fields one at a time (no copy of the configuration on the stack:
     // generated code inlines this into main(), whose frame every path pays).
@@ -555,7 +557,7 @@ void link_begin(Link& l_, const LinkConfig* cfg) {
     for (uint8_t i = 0; i < n_streams; ++i) {
         const uint16_t every = flash_get(streams[i].every);  // (the row's one field used here)
         LinkStreamState& st = states[i];
-        memset(&st, 0, sizeof st);
+        if (clear) memset(&st, 0, sizeof st);
         uint16_t first = i;  // i mod every: streams of equal rate take turns
         while (first >= every) first = static_cast<uint16_t>(first - every);
         st.countdown = first;
@@ -707,9 +709,9 @@ Result link_uplink_task(void* p) {
 }
 
 // Whether the link was begun: a generated program begins it before its main
-// loop polls it (setup(), fsw_gen::begin), a hand-written one or a test
-// (fsw_app.h: every feature, kAppTableChecks among them) may poll it before.
-inline __attribute__((always_inline)) bool begun(const Link& l) { return !app_has(kAppTableChecks) || l.cfg != 0; }
+// loop polls it (setup(), fsw_gen::begin); a hand-written one or a test
+// may poll it before (fsw_app.h kAppBeginAgain).
+inline __attribute__((always_inline)) bool begun(const Link& l) { return !app_has(kAppBeginAgain) || l.cfg != 0; }
 
 bool link_busy(const Link& l_) {
     const Link& l = *by_pointer(&l_);

@@ -199,18 +199,22 @@ struct Link {
     bool rx_over;           // it is longer than FSW_LINK_RX_CAP: its bytes are dropped
 };
 
-// Starts the link: zeroes its records and queues the boot hello. The caller
-// opens the console first (pal::console_begin: generated code passes the
-// baud rate as a constant, so the divisor is computed when compiling). `cfg` points at an FSW_FLASH object whose tables
-// were checked when they were compiled (link_*_ok below): nothing is
-// checked at run time.
+// Starts the link: zeroes its records (generated code, which begins it once,
+// right after the reset, finds them zero: fsw_app.h kAppBeginAgain) and
+// queues the boot hello. The caller opens the console first
+// (pal::console_begin: generated code passes the baud rate as a constant,
+// so the divisor is computed when compiling). `cfg` points at an FSW_FLASH
+// object whose tables were checked when they were compiled (link_*_ok
+// below): nothing is checked at run time.
 void link_begin(Link& link, const LinkConfig* cfg);
 // Executor task steps (ctx = the Link): never block, never fault.
 Result link_telemetry_task(void* link);
 Result link_uplink_task(void* link);
 // From loop(), between cycles: sends waiting control frames (hello and
 // health frames only here, never in a task's step) (and, where the console
-// is the core's Serial, feeds it the frames as its buffer drains).
+// is the core's Serial, feeds it the frames as its buffer drains). Before
+// link_begin it does nothing, and link_busy is false, in a program with
+// kAppBeginAgain (fsw_app.h; generated code begins the link first).
 void link_poll(Link& link);
 // Whether link_poll has work: control frames or a snapshot waiting, or
 // frames the core's Serial has still to take (the sleeping executor wakes

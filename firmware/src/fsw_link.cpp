@@ -356,22 +356,23 @@ void service(Link& l, const LinkConfig& c, bool big) {
         const uint8_t p = l.pending;
         const uint8_t cycle = static_cast<uint8_t>(ex->cycles);
         const bool big_ok = big && static_cast<uint8_t>(cycle - l.big_cycle) >= 2u;
+        // the frame sent: the lowest bit of those it may send (an ack, a hello, a health frame, in
+        // that order), else a snapshot chunk
+        const uint8_t may = big_ok ? p : static_cast<uint8_t>(p & kPendAck);
+        const uint8_t bit = static_cast<uint8_t>(may & (0u - may));
         uint8_t type;
-        if (p & kPendAck) {
+        if (bit == kPendAck) {
             type = kFrameAck;
-        } else if (big_ok && (p & kPendHello)) {
-            type = kFrameHello;
-        } else if (big_ok && (p & kPendHealth)) {
-            type = kFrameHealth;
+        } else if (bit != 0) {
+            static_assert(kPendHello >> 1 == kFrameHello && kPendHealth >> 1 == kFrameHealth, "service's frame types");
+            type = static_cast<uint8_t>(bit >> 1);
+            l.big_cycle = cycle;
         } else if (l.snapshot_at != kNoSnapshot) {
             type = kFrameSnapshot;
         } else {
             return;
         }
-        if (type == kFrameHello || type == kFrameHealth) l.big_cycle = cycle;
-        // the bit of the frame sent: the lowest of those it may send (none for a snapshot)
-        const uint8_t may = big_ok ? p : static_cast<uint8_t>(p & kPendAck);
-        l.pending = static_cast<uint8_t>(p & ~(may & (0u - may)));
+        l.pending = static_cast<uint8_t>(p & ~bit);
         send_control(l, c, type);
         frame_end(l, 0, 0, 0);
     }

@@ -294,10 +294,9 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
         put_u32(flash_get(c.schema));
         put_u32(time_hi);
         put_bytes(&l.n.frames, 4);
-        put(FSW_RUNTIME_VERSION_MAJOR);
-        put(FSW_RUNTIME_VERSION_MINOR);
-        put(FSW_RUNTIME_VERSION_PATCH);
-        put(ex.reset_cause);
+        // the runtime's version, then the reset cause: two bytes a store (little-endian, fsw_config.h)
+        put_u16(FSW_RUNTIME_VERSION_MAJOR | FSW_RUNTIME_VERSION_MINOR << 8);
+        put_u16(static_cast<uint16_t>(FSW_RUNTIME_VERSION_PATCH | ex.reset_cause << 8));
         put_bytes(&l.n.last_seq, 2);
         put(param_source(c));
     } else if (type == kFrameHealth) {

@@ -382,7 +382,7 @@ void service(Link& l, const LinkConfig& c, bool big) {
 // Whether the element at `off` is one the executor writes: a task's mode,
 // overruns or worst_us, the reset cause. Modes change only by MODE, and the
 // executor's records never by the ground, whatever the writable table lists.
-FSW_NOINLINE bool executor_owns(const LinkConfig& c, ElemOff off) {
+bool executor_owns(const LinkConfig& c, ElemOff off) {
     const ExecConfig& ec = *flash_get(c.ex)->cfg;  // FSW_FLASH: the fields, one at a time
     if (off == flash_get(ec.reset_cause_off)) return true;
     if (!app_has(kAppModeElems | kAppMirrors)) return false;  // no task has an element (fsw_app.h)

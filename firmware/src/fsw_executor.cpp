@@ -36,7 +36,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     if (whole_rows) flash_read(&c, cfg, sizeof c);
     const uint8_t n_tasks = whole_rows ? c.n_tasks : flash_get(cfg->n_tasks);
     TaskStats* const stats = whole_rows ? c.stats : flash_get(cfg->stats);
-    const Task* const tasks = whole_rows ? c.tasks : flash_get(cfg->tasks);  // (read once: flash_get's load stays in a loop)
+    const Task* const tasks = whole_rows ? c.tasks : flash_get(cfg->tasks);  // (read once: a flash load stays in a loop)
     // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
     if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
     uint8_t mirrors = 0;

@@ -315,7 +315,9 @@ FSW_NOINLINE void send_control(Link& l, const LinkConfig& c, uint8_t type) {
             const TaskStats& s = stats[i];
             const ElemOff mode_off =  // the task's mode: its element, or its record
                 app_has(kAppModeElems) ? flash_get(tasks[i].mode_off) : static_cast<ElemOff>(kNoElement);
-            const uint16_t worst = static_cast<uint16_t>(s.worst_us > 0xFFFFu ? 0xFFFFu : s.worst_us);
+            // worst_us saturated to 16 bits: its high half looked at, not a 32-bit compare (14 B)
+            const uint16_t worst =
+                static_cast<uint16_t>(s.worst_us >> 16) != 0 ? 0xFFFFu : static_cast<uint16_t>(s.worst_us);
             // the row's 6 bytes written where they go (no copy of them on the stack)
             put(mode_off != kNoElement ? sv[mode_off] : s.mode);
             put(s.faults);  // saturates at 255

@@ -507,6 +507,92 @@ static void test_a_link_with_a_receive_buffer_counts_them_alike(void) {
     TEST_ASSERT_EQUAL_INT16(-1, pal::console_peek(0));
 }
 
+// The uplink decodes a frame's COBS and checks its CRC in one pass of its
+// own (fsw_link.cpp decode_frame): each frame is classified as the
+// library's cobs_decode and crc16 (the reference) classify it, malformed (a
+// block past its end, fewer than 5 bytes), a CRC error, or handled (its op
+// and sequence number acknowledged, one of the counters of a handled
+// command moved): random frames of 1..FSW_LINK_RX_CAP bytes, PINGs and an
+// unknown opcode with zeros in their sequence numbers and arguments, as
+// they were encoded, with a byte changed, cut short, or noise; read where
+// the ring holds them and with the receive buffer alike.
+static void frames_are_classified_as_the_reference_does(const LinkConfig* cfg) {
+    link_begin(link, cfg);
+    run(1);
+    uint32_t x = 4242;
+    uint16_t seq = 1;
+    uint16_t handled = 0, malformed = 0, crc_errors = 0;
+    for (uint16_t trial = 0; trial < 4000; ++trial) {
+        uint8_t raw[64];
+        uint16_t len;
+        x = x * 1103515245u + 12345u;
+        const uint8_t kind = static_cast<uint8_t>(x >> 28);  // 0..15
+        if (kind < 3) {  // noise: non-zero bytes
+            len = static_cast<uint16_t>(1u + (x >> 8) % FSW_LINK_RX_CAP);
+            for (uint16_t i = 0; i < len; ++i) {
+                x = x * 1103515245u + 12345u;
+                raw[i] = static_cast<uint8_t>(1u + (x >> 16) % 255u);
+            }
+        } else {
+            CobsEncoder e;
+            cobs_begin(e, raw);
+            cobs_put(e, (x >> 8 & 1) != 0 ? kOpPing : 0x30);
+            cobs_put_u16(e, (x >> 9 & 7) != 0 ? seq++ : static_cast<uint16_t>(x >> 12 & 0x0F00));  // 0: a replay
+            const uint8_t n_args = static_cast<uint8_t>(x >> 16 & 3) == 0 ? static_cast<uint8_t>(x >> 18 & 15) : 0;
+            for (uint8_t k = 0; k < n_args; ++k) {
+                x = x * 1103515245u + 12345u;
+                cobs_put(e, static_cast<uint8_t>(x >> 24) < 64 ? 0 : static_cast<uint8_t>(x >> 16));
+            }
+            len = static_cast<uint16_t>(cobs_end(e) - 1u);  // without its delimiter
+            x = x * 1103515245u + 12345u;
+            if (kind < 7) {  // a byte changed (never to zero: that would end the frame)
+                const uint16_t i = static_cast<uint16_t>((x >> 8) % len);
+                raw[i] = static_cast<uint8_t>(raw[i] ^ (1u + (x >> 16) % 255u));
+                if (raw[i] == 0) raw[i] = 1;
+            } else if (kind < 10) {  // cut short
+                len = static_cast<uint16_t>(1u + (x >> 8) % len);
+            }
+        }
+        uint8_t ref[64];
+        memcpy(ref, raw, len);
+        const int16_t d = cobs_decode(ref, len);
+        const bool bad = d < 5, crc_bad = !bad && crc16(ref, static_cast<uint16_t>(d)) != 0;
+        const LinkCounters n0 = link.n;
+        raw[len] = 0;
+        native::console_feed(raw, static_cast<uint16_t>(len + 1u));
+        run(2);
+        out_len = 0;
+        const LinkCounters& n = link.n;
+        TEST_ASSERT_EQUAL_UINT16(n0.rx_oversized, n.rx_oversized);
+        TEST_ASSERT_EQUAL_UINT16(n0.rx_crc + (crc_bad ? 1 : 0), n.rx_crc);
+        const uint16_t moved = static_cast<uint16_t>(n.rx_ok + n.rx_malformed + n.rx_replayed + n.rx_refused -
+                                                     (n0.rx_ok + n0.rx_malformed + n0.rx_replayed + n0.rx_refused));
+        if (bad) {
+            ++malformed;
+            TEST_ASSERT_EQUAL_UINT16(n0.rx_malformed + 1, n.rx_malformed);
+            TEST_ASSERT_EQUAL_UINT16(1, moved);
+        } else if (crc_bad) {
+            ++crc_errors;
+            TEST_ASSERT_EQUAL_UINT16(0, moved);
+        } else {
+            ++handled;
+            TEST_ASSERT_EQUAL_UINT16(1, moved);
+            TEST_ASSERT_EQUAL_HEX8(ref[0], link.ack_op);
+            TEST_ASSERT_EQUAL_HEX16(load<uint16_t>(ref + 1), link.ack_seq);
+        }
+    }
+    TEST_ASSERT_TRUE(handled > 1000 && malformed > 500 && crc_errors > 500);
+    TEST_ASSERT_EQUAL_INT16(-1, pal::console_peek(0));  // every byte taken off the ring
+}
+
+static void test_frames_are_classified_as_the_reference_does_in_the_ring(void) {
+    frames_are_classified_as_the_reference_does(&kConfig);
+}
+
+static void test_frames_are_classified_as_the_reference_does_in_the_buffer(void) {
+    frames_are_classified_as_the_reference_does(&kConfigBuf);
+}
+
 // Commands whose bytes come a few at a time, over several runs of the
 // uplink task, and commands that lie across the end of the ring (256 bytes
 // here: bytes fed while others wait go round it), read where the ring holds
@@ -666,6 +752,8 @@ static void run_all(void) {
     RUN_TEST(test_the_pyro_task_mode_is_locked);
     RUN_TEST(test_corrupt_truncated_oversized_frames_are_counted_not_acted_on);
     RUN_TEST(test_a_link_with_a_receive_buffer_counts_them_alike);
+    RUN_TEST(test_frames_are_classified_as_the_reference_does_in_the_ring);
+    RUN_TEST(test_frames_are_classified_as_the_reference_does_in_the_buffer);
     RUN_TEST(test_commands_in_pieces_and_round_the_ring_are_read_in_the_ring);
     RUN_TEST(test_commands_in_pieces_and_round_the_ring_are_read_into_the_buffer);
     RUN_TEST(test_hello_and_health_never_share_a_cycle);

@@ -2,7 +2,9 @@
 // framer (the body written raw where its encoding goes, then its CRC-16 and
 // COBS in one pass: what the link uses), an incremental encoder (the same
 // bytes, built a call at a time: the tests' reference) and an in-place
-// decoder.
+// decoder (the tests' and the ground's reference: the link's uplink decodes
+// a frame and checks its CRC in one pass of its own, fsw_link.cpp
+// decode_frame).
 #ifndef FSW_COBS_H
 #define FSW_COBS_H
 

@@ -28,7 +28,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     // Where the application has no check, mirror, mode element nor slow task
     // (fsw_app.h), a row's start mode is all there is to read of it, and the
     // configuration is read a field at a time where used (FSW_FLASH: no copy
-    // of it on the stack, nor avr-libc's memcpy_P; 62 B of the core rocket's
+    // of it on the stack, nor avr-libc's memcpy_P; 46 B of the core rocket's
     // flash); else it is copied.
     const bool check = app_has(kAppTableChecks);
     const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);

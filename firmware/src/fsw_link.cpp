@@ -119,8 +119,9 @@ FSW_NOINLINE void put_u32(uint32_t v) {
 
 // The header: type, the frame counter's low byte (frame_begin), then the
 // low 32 bits of the time; its high 32 bits lie after it, where the body's
-// first 4 bytes go (a health frame's are they; a hello moves them; any other
-// frame's body writes over them: every frame's room holds them): put_time.
+// first 4 bytes go (a health frame's are they; a hello takes them and puts
+// them again after its first 5; any other frame's body writes over them:
+// every frame's room holds them): put_time.
 // The frame goes after the bytes the transmit buffer still holds. Two
 // calls, each of which saves nothing: with the time an argument of the
 // first, in r14-r21, avr-gcc saved the four of them that are call-saved,

@@ -137,9 +137,14 @@ def test_a_changed_header_rebuilds_the_objects_that_include_it(sketch):
 def test_another_host_compiler_is_another_native_build(fsw, tmp_path, monkeypatch):
     """`fsw test --native` caches its compiled runners: the compiler's
     identity is part of the cache key, so an upgraded compiler at the
-    same path compiles anew."""
+    same path compiles anew. (The runtime's objects, keyed the same way,
+    are put in each identity's entry from the run's own cache: the
+    wrapper runs that same g++ with the same flags, so they are the ones
+    it would compile, and the runners are what this test watches.)"""
+    from fswkit.autocode.numeric import F64MODE
     from fswkit.run import native
 
+    compiled = os.path.dirname(native.runtime_objects(F64MODE)[0])  # the run's cache: compiled there once
     cxx = tmp_path / "bin" / "g++"
     cxx.parent.mkdir()
     monkeypatch.setenv("FSW_CACHE_DIR", str(tmp_path / "cache"))
@@ -149,6 +154,8 @@ def test_another_host_compiler_is_another_native_build(fsw, tmp_path, monkeypatc
     for version in ("12.1", "12.2.0"):
         cxx.write_text(f'#!/bin/sh\n[ "$1" = --version ] && {{ echo "g++ {version}"; exit 0; }}\nexec g++ "$@"\n')
         cxx.chmod(0o755)
+        key = native._key({"(the runtime alone)": ""}, F64MODE)  # this identity's entry for the runtime
+        shutil.copytree(compiled, tmp_path / "cache" / "native" / key)
         r = fsw("test", "--native", script)
         assert r.code == 0, r.err
         runners.append(sorted(p.parent.name for p in (tmp_path / "cache").rglob("runner")))

@@ -58,8 +58,7 @@ test: setup-and-firmware test-python test-firmware
 # build there (the Debian packages not installed yet) is built again and
 # reported by test-firmware. A set-up machine finds both up to date.
 setup-and-firmware:
-	@$(MAKE) --no-print-directory fw-build-ahead & ahead=$$!; \
-	  $(MAKE) --no-print-directory setup; status=$$?; wait $$ahead; exit $$status
+	@$(MAKE) --no-print-directory -j2 setup fw-build-ahead
 
 # pytest on every core (pytest-xdist), a test file's tests on one worker so
 # that a module's costly set-up (a wheel, a firmware build) runs once. Two

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
+from support.caches import native_runtime
 
 needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
 
@@ -116,11 +117,10 @@ def firmware(tmp_path_factory) -> Path:
     r = run_fsw("gen", str(proj), "--out", str(d / "gen"))
     assert r.code == 0, r.err
     (d / "main.cpp").write_text(MAIN)
-    rt = sorted(p for p in (ROOT / "firmware" / "src").glob("*.cpp") if not p.name.startswith("psl_arduino"))
-    exe = d / "fw"
+    exe = d / "fw"  # linked with the runtime's objects as a native build links them
     subprocess.run(["g++", "-std=c++11", "-O1", "-fno-exceptions", "-fno-rtti", "-DFSW_NO_MAIN",
                     f"-I{ROOT / 'firmware' / 'src'}", f"-I{d / 'gen'}", str(d / "main.cpp"),
-                    *sorted(str(p) for p in (d / "gen").glob("*.cpp")), *map(str, rt), "-o", str(exe)],
+                    *sorted(str(p) for p in (d / "gen").glob("*.cpp")), *native_runtime(), "-o", str(exe)],
                    check=True, capture_output=True)
     return exe
 

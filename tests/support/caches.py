@@ -22,3 +22,11 @@ def seeded(folder, real=F64MODE) -> str:
     entry = os.path.dirname(objs[0])
     shutil.copytree(entry, os.path.join(folder, "native", os.path.basename(entry)))
     return str(folder)
+
+
+def native_runtime() -> list[str]:
+    """The runtime's objects as a native build links them (`fsw build
+    --board native`, fswkit.target.libcache.native_objects: binary64, the
+    kit's flags), compiled once into the run's cache: a test that compiles
+    its own program against the runtime compiles only that program."""
+    return native.runtime_objects(F64MODE)

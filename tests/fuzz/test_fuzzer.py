@@ -54,8 +54,9 @@ def test_a_planted_crash_is_found_and_saved(projects, tmp_path, monkeypatch):
         return real(self)
 
     monkeypatch.setattr(parser.Parser, "primary", primary)
-    o = fuzz.fuzz(600, seed=3, workers=2, timeout=20, out=tmp_path, cli_every=0, projects=projects)
-    assert o.failed > 0 and o.passed + o.failed == 600
+    # about one case in 18 reaches it: 11 of these 200 (38 of 600, the first at case 20)
+    o = fuzz.fuzz(200, seed=3, workers=2, timeout=20, out=tmp_path, cli_every=0, projects=projects)
+    assert o.failed > 0 and o.passed + o.failed == 200
     assert any("ZeroDivisionError" in s and "planted" in s for s in o.signatures)
     saved = [p for p in tmp_path.iterdir() if p.name.startswith("crash-")]
     assert saved and (saved[0] / "error.txt").read_text().count("planted")

@@ -1,9 +1,12 @@
-"""A test's own kit cache, with the runtime's native objects already in it.
+"""A test's own kit cache, with the runtime's native objects already in it;
+and those objects for a test's own native program.
 
 Tests that need an empty cache to watch what a compile leaves behind (its
 temporary folder, its runner) need not watch the runtime compile as well:
 the runtime's objects (about 2.5 s of CPU from nothing) are compiled once
-into the run's cache, and copied from there into the test's."""
+into the run's cache, and copied from there into the test's. A test that
+compiles a program of its own against the runtime links them from there
+(`native_runtime`), as a native build does."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup setup-and-firmware demo docs-img test test-python fuzz fuzz-uplink fuzz-vm bench clean
+.PHONY: all setup setup-and-firmware fuzz-build-ahead demo docs-img test test-python fuzz fuzz-uplink fuzz-vm bench clean
 
 include mk/firmware.mk
 
@@ -51,14 +51,21 @@ docs-img: setup
 ## (R = binary64 and binary32) and on a simulated ATmega328P
 test: setup-and-firmware test-python test-firmware
 
-# The set-up, with the Unity suites compiled meanwhile (fw-build-ahead,
-# mk/firmware.mk): on a fresh clone tools/bootstrap.sh mostly waits on the
-# network while it fills the venv, and the suites' compile (about 50 s of
-# CPU) fits in that wait instead of running after pytest. Whatever fails to
-# build there (the Debian packages not installed yet) is built again and
-# reported by test-firmware. A set-up machine finds both up to date.
+# The set-up, with what needs no venv compiled meanwhile: the Unity suites
+# (fw-build-ahead, mk/firmware.mk) and the two libFuzzer binaries that
+# tests/fuzz/test_fuzz_vm.py and tests/link/test_fuzz_uplink.py run
+# (fuzz-build-ahead). On a fresh clone tools/bootstrap.sh mostly waits on the
+# network while it fills the venv, and those compiles (about 50 and 13 s of
+# CPU) fit in that wait instead of running after pytest or inside it.
+# Whatever fails to build there (the Debian packages not installed yet) is
+# built again, and reported, by the target that runs it. A set-up machine
+# finds everything up to date.
 setup-and-firmware:
-	@$(MAKE) --no-print-directory -j2 setup fw-build-ahead
+	@$(MAKE) --no-print-directory -j2 setup fw-build-ahead fuzz-build-ahead
+
+fuzz-build-ahead:
+	@mkdir -p $(BUILD)/fuzz
+	@$(MAKE) --no-print-directory -k $(FUZZ_UPLINK) $(FUZZ_VM) > $(BUILD)/fuzz/build-ahead.log 2>&1 || true
 
 # pytest on every core (pytest-xdist), a test file's tests on one worker so
 # that a module's costly set-up (a wheel, a firmware build) runs once. Two

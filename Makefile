@@ -8,7 +8,7 @@ FSW     := $(VENV)/bin/fsw
 STAMP   := $(VENV)/.bootstrapped
 BUILD   ?= build
 
-.PHONY: all setup setup-and-firmware fuzz-build-ahead demo docs-img test test-python fuzz fuzz-uplink fuzz-vm bench clean
+.PHONY: all setup setup-and-build-ahead fuzz-build-ahead demo docs-img test test-python fuzz fuzz-uplink fuzz-vm bench clean
 
 include mk/firmware.mk
 
@@ -49,7 +49,7 @@ docs-img: setup
 
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P
-test: setup-and-firmware test-python test-firmware
+test: setup-and-build-ahead test-python test-firmware
 
 # The set-up, with what needs no venv compiled meanwhile: the Unity suites
 # (fw-build-ahead, mk/firmware.mk) and the two libFuzzer binaries that
@@ -60,7 +60,7 @@ test: setup-and-firmware test-python test-firmware
 # Whatever fails to build there (the Debian packages not installed yet) is
 # built again, and reported, by the target that runs it. A set-up machine
 # finds everything up to date.
-setup-and-firmware:
+setup-and-build-ahead:
 	@$(MAKE) --no-print-directory -j2 setup fw-build-ahead fuzz-build-ahead
 
 fuzz-build-ahead:

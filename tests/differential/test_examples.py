@@ -4,6 +4,7 @@ this host, in binary64 and in binary32."""
 
 from __future__ import annotations
 
+import os
 import shutil
 
 import pytest
@@ -23,8 +24,6 @@ def _runtime_objects():
     own cache, where the other tests compile them too (same compiler,
     flags and sources: the same key), rather than compiled again into
     this file's (on a fresh clone, about 5 s of CPU)."""
-    import os
-
     from fswkit.autocode.numeric import REALS
     from fswkit.run import native
 

@@ -44,6 +44,7 @@
 #define _GNU_SOURCE
 #include <simavr/avr_adc.h>
 #include <simavr/avr_eeprom.h>
+#include <simavr/avr_extint.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_spi.h>
 #include <simavr/avr_timer.h>
@@ -53,6 +54,7 @@
 #include <simavr/sim_avr.h>
 #include <simavr/sim_cycle_timers.h>
 #include <simavr/sim_elf.h>
+#include <simavr/sim_interrupts.h>
 #include <simavr/sim_io.h>
 #include <simavr/sim_irq.h>
 #include <simavr/sim_time.h>
@@ -375,6 +377,69 @@ static void on_pin(struct avr_irq_t* irq, uint32_t value, void* param) {
     edges[n_edges].bit = w->bit;
     edges[n_edges].level = level;
     n_edges++;
+}
+
+/* ---- INT0/INT1 held low ----------------------------------------------------------- */
+/* simavr polls an external interrupt pin that goes low while its sense
+   control says "low level" (EICRA's reset value) every cycle until the pin
+   goes high, asking the port's state through avr_ioctl, which asks every
+   peripheral in turn: examples/rocket's arming switch on D2 (INT0), low on
+   the pad before arming, made that two thirds of the simulator's CPU in a
+   flight. The same poll here reads the pin's register directly: one poll
+   per low edge, the same cycle timer every cycle, the same interrupt raised
+   when it would be, so the simulation is the same cycle for cycle. simavr's
+   own is turned off after every reset (its module turns it on again); a
+   reset simavr makes by itself (the watchdog's) keeps simavr's until the
+   next reset the harness makes, which is the same poll. */
+typedef struct {
+    avr_extint_t* x;
+    uint8_t n;
+    avr_io_addr_t r_pin; /* the PINx register of the interrupt's pin */
+} lvl_src_t;
+static lvl_src_t lvl_src[EXTINT_COUNT];
+
+static avr_cycle_count_t lvl_poll(struct avr_t* a, avr_cycle_count_t when, void* param) {
+    const lvl_src_t* s = *(lvl_src_t**)param;
+    const avr_extint_t* x = s->x;
+    if ((a->data[s->r_pin] >> x->eint[s->n].port_pin) & 1u) { /* high again: done (as simavr's) */
+        free(param);
+        return 0;
+    }
+    if (a->sreg[S_I]) {
+        avr_int_vector_t* v = &s->x->eint[s->n].vector;
+        if (!(avr_regbit_get(a, v->raised) || v->pending)) avr_raise_interrupt(a, v);
+    }
+    return when + 1;
+}
+
+static void lvl_notify(struct avr_irq_t* irq, uint32_t value, void* param) {
+    (void)irq;
+    lvl_src_t* s = param;
+    avr_extint_t* x = s->x;
+    if (value || x->eint[s->n].strict_lvl_trig) return; /* not low, or simavr's own poll is on */
+    if (avr_regbit_get_array(avr, x->eint[s->n].isc, 2) != 0) return; /* not "low level" (as simavr decides) */
+    lvl_src_t** poll = malloc(sizeof *poll); /* one a low edge, as simavr's */
+    if (!poll) return;
+    *poll = s;
+    avr_cycle_timer_register(avr, 1, lvl_poll, poll);
+}
+
+static void lvl_setup(avr_t* a) {
+    avr_extint_t* x = NULL;
+    for (avr_io_t* io = a->io_port; io; io = io->next)
+        if (!strcmp(io->kind, "extint")) x = (avr_extint_t*)io;
+    if (!x) return;
+    for (uint8_t n = 0; n < EXTINT_COUNT; n++) {
+        if (!x->eint[n].port_ioctl || !x->eint[n].isc[1].reg) continue; /* absent, or edges only */
+        const char port = (char)(x->eint[n].port_ioctl & 0xFF);
+        avr_ioport_t* io_port = NULL;
+        for (avr_io_t* io = a->io_port; io; io = io->next)
+            if (!strcmp(io->kind, "port") && ((avr_ioport_t*)io)->name == port) io_port = (avr_ioport_t*)io;
+        if (!io_port) continue; /* simavr's poll stays */
+        lvl_src[n] = (lvl_src_t){x, n, io_port->r_pin};
+        x->eint[n].strict_lvl_trig = 0;
+        avr_irq_register_notify(x->io.irq + n, lvl_notify, &lvl_src[n]);
+    }
 }
 
 static avr_cycle_count_t on_target(struct avr_t* a, avr_cycle_count_t when, void* param) {
@@ -1439,6 +1504,7 @@ static void mcu_reset(avr_t* a, int cause) {
     }
     avr_cycle_count_t cycle = a->cycle;
     avr_reset(a);
+    lvl_setup(a);
     a->cycle = cycle;
     for (int i = 0; i < MAX_WATCH; i++) {
         if (!watches[i].active) continue;
@@ -2541,6 +2607,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     avr_init(avr);
+    lvl_setup(avr);
     avr->log = LOG_ERROR;
     avr->sleep = no_wall_sleep; /* a sleeping core skips to its next event; pacing is run()'s */
     if (fw.flashbase + fw.flashsize > avr->flashend + 1u) {

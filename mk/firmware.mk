@@ -25,7 +25,7 @@ FW_AVR_CC     ?= avr-gcc
 
 # Suites: one file per scenario, tests/firmware/test_<name>.cpp.
 FW_SUITES     := convert f64 window machine tank executor clock sv io pyro link param resume parts vm vm_step
-FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts vm vm_step
+FW_AVR_SUITES := convert f64 window machine tank executor clock sv io pyro resume parts vm vm_step float
 # Suites that talk to the simulated board's sensor parts on the AVR (harness
 # -I): built and run natively and on AVR like the others, but not in the
 # PlatformIO view (tests/integrations/pio has one folder per FW_SUITES

@@ -212,6 +212,91 @@ extern "C" __attribute__((naked, noinline, used, externally_visible)) float fsw_
         "bld  r25, 7\n\t"
         "ret\n\t");
 }
+
+// Binary32 addition and subtraction, the compiler's __addsf3 and __subsf3
+// ahead of avr-libc's (weak: where a program links avr-libc's file of the
+// two anyway, its pair is taken, and nothing else changes). One case is
+// worked out here: the operands' signs differ (after the subtraction's
+// flip) and their exponents are the same, 24 or above and not all ones.
+// The difference is then exact (Sterbenz's lemma: it has no bits below
+// the operands' last place, and fewer above it) and normal: the
+// significands' difference, signed, shifted up until its leading one is
+// bit 23 (a byte, then a bit at a time, the exponent counted down with
+// it), or +0 where they are equal, what IEEE 754 rounding to nearest gives
+// too. Every other case is avr-libc's __addsf3: its __addsf3x, rounded by
+// its __fp_round (tests/firmware/test_float.cpp: the same bits). On the
+// rocket nav's two subtractions of pressures near each other (a reading
+// less the last one taken, the pad's pressure less the average) and the
+// accelerometer's offset (a count's volts less 20 g near 1 g) take this
+// path, about 3 a cycle: avr-libc unpacked both operands, shifted their
+// cancelled bits out one at a time (8 cycles each) and rounded, where
+// nothing is left to round.
+extern "C" __attribute__((naked, noinline, used, externally_visible)) void __subsf3() {
+    __asm__ __volatile__(
+        ".weak __subsf3\n\t"
+        ".weak __addsf3\n\t"
+        "subi r21, 0x80\n\t"  // a - b = a + (-b)
+        ".global __addsf3\n"
+        "__addsf3:\n\t"
+        "mov  r26, r25\n\t"  // the signs differ, the exponents' high seven bits are the same ...
+        "eor  r26, r21\n\t"
+        "cpi  r26, 0x80\n\t"
+        "brne 8f\n\t"
+        "mov  r26, r24\n\t"  // ... and their low bits
+        "eor  r26, r20\n\t"
+        "brmi 8f\n\t"
+        "mov  r26, r24\n\t"  // E, the exponent: 24 or above (a normal difference: 2^-126 at least) ...
+        "lsl  r26\n\t"
+        "mov  r26, r25\n\t"
+        "rol  r26\n\t"
+        "cpi  r26, 24\n\t"
+        "brlo 8f\n\t"
+        "cpi  r26, 0xFF\n\t"  // ... and not all ones (an infinity or a NaN)
+        "breq 8f\n\t"
+        "sub  r22, r18\n\t"  // the significands' difference (the leading ones cancel), 24-bit two's complement
+        "sbc  r23, r19\n\t"
+        "sbc  r24, r20\n\t"
+        "breq 7f\n\t"  // (sbc keeps Z only while every byte was 0) equal: +0
+        "brpl 1f\n\t"
+        "com  r24\n\t"  // b's magnitude the larger: the magnitude, and b's sign
+        "com  r23\n\t"
+        "neg  r22\n\t"
+        "sbci r23, 0xFF\n\t"
+        "sbci r24, 0xFF\n\t"
+        "subi r25, 0x80\n\t"
+        "1:\n\t"  // up a byte while the top one is 0
+        "tst  r24\n\t"
+        "brne 3f\n\t"
+        "mov  r24, r23\n\t"
+        "mov  r23, r22\n\t"
+        "clr  r22\n\t"
+        "subi r26, 8\n\t"
+        "rjmp 1b\n\t"
+        "3:\n\t"  // then a bit at a time until the leading one is bit 23
+        "brmi 5f\n\t"
+        "4:\n\t"
+        "dec  r26\n\t"
+        "lsl  r22\n\t"
+        "rol  r23\n\t"
+        "rol  r24\n\t"
+        "brpl 4b\n\t"
+        "5:\n\t"  // the leading one out, E in its place, the sign
+        "lsl  r24\n\t"
+        "lsr  r26\n\t"
+        "ror  r24\n\t"
+        "andi r25, 0x80\n\t"
+        "or   r25, r26\n\t"
+        "ret\n\t"
+        "7:\n\t"  // +0 (r22..r24 are 0)
+        "clr  r25\n\t"
+        "ret\n\t"
+        "8:\n\t"  // avr-libc's __addsf3
+        "clr  r27\n\t"
+        "clr  r26\n\t"
+        FSW_FAR_CALL "__addsf3x\n\t"
+        FSW_FAR_JMP "__fp_round\n\t");
+}
+
 #undef FSW_FAR_JMP
 #undef FSW_FAR_CALL
 #endif

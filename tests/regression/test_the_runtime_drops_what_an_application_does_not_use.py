@@ -78,7 +78,12 @@ ROCKET = EXAMPLES / "rocket"
 # begun, fsw_app.h kAppBeginAgain, 1.2 us a cycle less: 10,038 B
 # with the CPU work above, +32 B where the two meet in the link): flash,
 # and .data + .bss + .noinit.
-CORE_FLASH_MAX = 10_038
+# docs/runtime.md; then the kit's float addition ahead of avr-libc's, a
+# difference within one exponent worked out without its rounding, +116 B
+# for 11.0 us a cycle: CPU was the target missed (413.6 us, target 400),
+# test_a_float_difference_within_one_exponent_is_worked_out_without_the_librarys_rounding.py):
+# flash, and .data + .bss + .noinit.
+CORE_FLASH_MAX = 10_426
 CORE_RAM_MAX = 572
 
 

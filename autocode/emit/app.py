@@ -13,11 +13,12 @@ from ..limits import link_load
 from ..numeric import REALS
 from ..params import app_parameters
 from ..schema import app_schema_hash, link_plan, link_text, schema_hash
+from ..unparse import model_expr
 from ..version import __version__
 from ..types import TYPES
 from .common import basename, banner, c_ident, c_string, real_check, real_literal, version_check
 from .expr import ExprEmitter, float_key_test
-from .machine import declared_windows, emit_machine, stored_locals
+from .machine import cached_sums, declared_windows, emit_machine, stored_locals
 from .resume import resume_spans, resume_watches
 from .sv import emit_sv
 
@@ -266,6 +267,9 @@ def resume_hash(app: Application) -> int:
     lines = [f"resume {__version__} {app.board.real}"]
     for m in app.machines:
         lines.append(f"locals {m.name} " + " ".join(f"{v.type.name}:{v.name}" for v in stored_locals(m, real)))
+        sums = cached_sums(m, real)
+        if sums:  # the sums kept after the locals (none: the lines, and the check, as before them)
+            lines.append(f"sums {m.name} " + " ".join(model_expr(node, m).replace(" ", "") for _, node, _ in sums))
         lines.append(f"windows {m.name} " + " ".join(t for _, t in declared_windows(m, ExprEmitter(m, real, False))))
     if app.log is not None:
         lines.append("recorder")

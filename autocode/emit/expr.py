@@ -40,6 +40,12 @@ class ExprEmitter:
         # emitted (var index -> its name): read there instead of the
         # variable's bytes (autocode/emit/machine.py keeps it).
         self.held: dict[int, str] = {}
+        # `x + c` / `x - c` / `c - x` kept in a slot of their own, worked out
+        # where x is written (sum_key -> the slot's read; machine.py's
+        # cached_sums), and the slots to work out again at a write of x
+        # (var index -> [(slot name, the expression)]).
+        self.cached: dict[tuple, str] = {}
+        self.sum_writes: dict[int, list[tuple[str, M.Arith]]] = {}
 
     def holdable(self, i: int) -> bool:
         """Whether a C++ local may hold variable i's value between its
@@ -89,6 +95,10 @@ class ExprEmitter:
         if t is M.Neg:
             return f"(-{self.value(e.operand)})"
         if t is M.Arith:
+            if self.cached:
+                slot = self.cached.get(sum_key(e, self.known))
+                if slot is not None:
+                    return slot
             inv = self.exact_reciprocal(e.right) if e.op == "/" else None
             if inv is not None:  # x / 2^k is x * 2^-k, bit for bit: no division on the MCU
                 return f"({self.value(e.left)} * {real_literal(inv, self.real)})"
@@ -330,6 +340,22 @@ class ExprEmitter:
             # T saturated to 32 bits tests the same against such a c (fsw_machine.h).
             return f"(fsw::machine_T32({self.prefix}machine) {op} {c}UL)"
         return f"({text} {op} {c}{'LL' if t.signed else 'ULL'})"
+
+
+def sum_key(e: M.Arith, known) -> tuple | None:
+    """What `x + c`, `x - c` or `c - x` (x a variable, c a known finite
+    constant: `known` gives it) computes, as a key equal for every copy of
+    it: (op, x, which side x is on, c's bits); None for any other
+    arithmetic. A finite c: the sum of x's stored value (never a NaN) and c
+    is never a NaN, so an F32 slot keeps it exactly."""
+    if e.op not in ("+", "-"):
+        return None
+    for x, other, side in ((e.left, e.right, 0), (e.right, e.left, 1)):
+        if type(x) is M.Ref:
+            c = known(other)
+            if c is not None and math.isfinite(c):
+                return e.op, x.var, side, struct.pack("<d", c)
+    return None
 
 
 def float_key_test(op: str, cv: float, size: int, ptr: str, held: str | None = None):

@@ -17,8 +17,9 @@ from ..evaluate import NotConstant, evaluate, local_values
 from ..numeric import Real, to_type
 from .common import (banner, basename, c_ident, parens, real_check, real_literal, value_bytes, version_check,
                      window_type)
-from .expr import ExprEmitter
+from .expr import ExprEmitter, sum_key
 from .fastpaths import no_reads
+from ..unparse import model_expr
 
 
 def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:
@@ -186,6 +187,72 @@ def stored_locals(m: M.Machine, real: Real, scriptable: bool = False) -> list:
     return [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
 
 
+def cached_sums(m: M.Machine, real: Real, scriptable: bool = False) -> list[tuple[tuple, M.Arith, set[int]]]:
+    """The sums a machine keeps in slots of their own after its locals, in
+    the order first read: `x + c`, `x - c` or `c - x` (expr.sum_key) that a
+    .step reads, of an F32 local x that no .step writes (its .entry or .exit
+    blocks may: once a state), with R binary32. A slot holds the sum of x's
+    stored value and c, worked out at each write of x and in the locals'
+    initial bytes; a step reads it where it added (`still + STILL_BAND`, the
+    rocket's mission in Descent: two float routines a step less). Not in a
+    scriptable build, where a script writes locals. (sum_key, the first
+    expression, the indexes of the states whose .step reads it) each."""
+    if scriptable or real.bits != 32:
+        return []
+    ex = ExprEmitter(m, real, scriptable)
+    stored = {v.index for v in stored_locals(m, real, scriptable)}
+    in_step: set[int] = set()
+    for st in m.states:
+        in_step |= _assigned(st.step)
+    found: dict[tuple, M.Arith] = {}
+    readers: dict[tuple, set[int]] = {}
+    state = 0
+
+    def visit(e) -> None:
+        t = type(e)
+        if t in _LEAVES:
+            return
+        if t is M.Arith:
+            key = sum_key(e, ex.known)
+            if key is not None and key[1] in stored and key[1] not in in_step:
+                v = m.vars[key[1]]
+                if v.type.kind == "float" and v.type.size == 4:
+                    found.setdefault(key, e)
+                    readers.setdefault(key, set()).add(state)
+                    return
+        if t is M.Arith or t is M.Cmp or t is M.Logic:
+            visit(e.left)
+            visit(e.right)
+        elif t is M.Neg or t is M.Not:
+            visit(e.operand)
+        elif t is M.ChainCmp:
+            for o in e.operands:
+                visit(o)
+
+    def visit_block(stmts) -> None:
+        for st in stmts:
+            if isinstance(st, M.Assign):
+                visit(st.expr)
+            elif isinstance(st, M.If):
+                visit(st.cond)
+                visit_block(st.then)
+                visit_block(st.orelse)
+
+    for st in m.states:
+        state = st.index
+        visit_block(st.step)
+    return [(key, e, readers[key]) for key, e in found.items()]
+
+
+def _entered_before_read(m: M.Machine, var: int, readers: set[int]) -> bool:
+    """Whether every state in `readers` (those whose .step reads a sum of
+    `var`: only a .step reads its slot, cached_sums) writes `var` at the top
+    level of its .entry: a state's first step runs its .entry first, so the
+    slot is worked out before any read of it and its initial bytes are
+    never read."""
+    return all(any(isinstance(st, M.Assign) and st.var == var for st in m.states[i].entry) for i in readers)
+
+
 # The bytes of the state vector, the locals or the parameters a machine's
 # state functions access directly (not through an out-of-line call) from
 # which they take that area through a pointer register.
@@ -245,6 +312,21 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
     params = [] if scriptable else [v for v in m.vars if v.param is not None]
     stored = [v for v in m.vars if v.kind == M.LOCAL and v.index not in ex.consts and v not in params]
     offsets, size, init_bytes = _packed(stored, values)
+    sums = cached_sums(m, real, scriptable)
+    step_sums: dict[tuple, str] = {}  # what the .step functions read of them
+    for k, (key, node, readers) in enumerate(sums):
+        x = m.vars[key[1]]
+        if _entered_before_read(m, x.index, readers):
+            value = 0.0  # never read before a write of x: 0, and the locals stay in .bss where they were
+        else:
+            # the sum of x's initial value as stored (an F32: never a NaN) and c
+            start = real.read(x.type, values[x.index])
+            value = evaluate(node, real, lambda i: start if i == x.index else ex.consts[i])
+        init_bytes += value_bytes(x.type, to_type(x.type, value))
+        step_sums[key] = f"fsw::read_F32(loc + C_{k})"
+        ex.sum_writes.setdefault(x.index, []).append((f"C_{k}", node))
+    sum_offsets = [size + 4 * k for k in range(len(sums))]
+    size += 4 * len(sums)
     poff, psize, param_bytes = _packed(params, values)
     assert m.states[0].id == 1, "a zero fsw::Machine starts in state 1"
     guard = f"{ns.upper()}_{name.upper()}_H"
@@ -260,6 +342,9 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
         h.append("enum : uint16_t {")
         for v in stored:
             h.append(f"    {enumerator('L_', v.name)} = {offsets[v.index]},  // {v.type.name}")
+        for k, (key, node, _) in enumerate(sums):
+            h.append(f"    C_{k} = {sum_offsets[k]},  // F32: {model_expr(node, m)} ({src}:{node.line}), "
+                     f"worked out where {m.vars[key[1]].name} is written")
         h.append("};")
         h.append(f"static const uint16_t kLocSize = {size};")
         h.append("extern uint8_t loc[kLocSize];")
@@ -325,12 +410,14 @@ def emit_machine(m: M.Machine, real: Real, scriptable: bool = False,
             body: list[str] = []
             held = _Held() if real.bits == 32 else None
             ex.held = {}
+            ex.cached = step_sums if label == "step" else {}
             _block(stmts, ex, "    ", body, src, m, label != "exit", held)
             keep = held.worth(body) if held is not None else set()
             if held is not None and len(keep) < len(held.decls):  # again, holding only where it paid
                 body, ex.held = [], {}
                 _block(stmts, ex, "    ", body, src, m, label != "exit", _Held(keep))
             ex.held = {}
+            ex.cached = {}
             # T is the same for the whole step: one call for it where the
             # function tests it twice or more
             t32 = "fsw::machine_T32(machine)"
@@ -576,13 +663,18 @@ def _block(stmts, ex: ExprEmitter, indent: str, out: list[str], src: str, m: M.M
                     out.append(f"{indent}const fsw::Real {name} = fsw::write_F32_read("
                                f"{line[len('fsw::write_F32('):-2]});  // {src}:{st.line}")
                     ex.held[st.var] = name
-                    continue
-                stored = _stored_constant(m, ex.real, st)
-                if stored is not None:  # a constant store: its value is a literal
-                    ex.held[st.var] = stored
-                out.append(plain)
-                continue
-            out.append(f"{indent}{line}  // {src}:{st.line}")
+                else:
+                    stored = _stored_constant(m, ex.real, st)
+                    if stored is not None:  # a constant store: its value is a literal
+                        ex.held[st.var] = stored
+                    out.append(plain)
+            else:
+                out.append(f"{indent}{line}  // {src}:{st.line}")
+            # the sums kept in slots of their own, from the value just stored (cached_sums)
+            for slot, node in ex.sum_writes.get(st.var, ()):
+                cached, ex.cached = ex.cached, {}
+                out.append(f"{indent}fsw::write_F32(loc + {slot}, {ex.value(node)});  // {src}:{st.line}")
+                ex.cached = cached
         elif t is M.Goto:
             out.append(f"{indent}return S_{m.states[st.state].name};  // {src}:{st.line}")
             return

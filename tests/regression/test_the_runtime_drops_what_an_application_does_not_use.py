@@ -81,10 +81,14 @@ ROCKET = EXAMPLES / "rocket"
 # docs/runtime.md; then the kit's float addition ahead of avr-libc's, a
 # difference within one exponent worked out without its rounding, +116 B
 # for 11.0 us a cycle: CPU was the target missed (413.6 us, target 400),
-# test_a_float_difference_within_one_exponent_is_worked_out_without_the_librarys_rounding.py):
+# test_a_float_difference_within_one_exponent_is_worked_out_without_the_librarys_rounding.py;
+# then the mission's `still +- STILL_BAND` kept where `still` is written,
+# +70 B and +8 B of RAM for 6.3 us a cycle (the RAM's target, 640 B with the
+# stack, still met: 580 + 52 B),
+# test_a_locals_sum_with_a_constant_is_worked_out_where_the_local_is_written.py):
 # flash, and .data + .bss + .noinit.
-CORE_FLASH_MAX = 10_426
-CORE_RAM_MAX = 572
+CORE_FLASH_MAX = 10_496
+CORE_RAM_MAX = 580
 
 
 @pytest.fixture(scope="module")

@@ -15,11 +15,11 @@ from ..check import model_children
 from ..cnames import enumerator
 from ..evaluate import NotConstant, evaluate, local_values
 from ..numeric import Real, to_type
+from ..unparse import model_expr
 from .common import (banner, basename, c_ident, parens, real_check, real_literal, value_bytes, version_check,
                      window_type)
 from .expr import ExprEmitter, sum_key
 from .fastpaths import no_reads
-from ..unparse import model_expr
 
 
 def _packed(vs, values) -> tuple[dict[int, int], int, bytes]:

@@ -21,7 +21,6 @@ import re
 import struct
 
 from fswkit.autocode.diagnostics import Diagnostics
-from fswkit.autocode.emit.app import resume_hash  # noqa: F401 (the slots are in the resume's check: below)
 from fswkit.autocode.emit.machine import cached_sums, emit_machine
 from fswkit.autocode.numeric import REALS
 from fswkit.autocode.project import load_machine

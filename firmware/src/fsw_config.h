@@ -239,8 +239,11 @@
 #endif
 // Bytes of the parameter store's stage queue (PARAM_STAGE arguments waiting
 // for the EEPROM; docs/parameters.md). A STAGE that does not fit is BUSY.
+// The longest STAGE a frame carries: FSW_LINK_RX_CAP encoded bytes less a
+// COBS code byte, the opcode and sequence number (3) and the CRC (2), 18
+// bytes; fsw_param.h refuses a queue that could not take it.
 #ifndef FSW_PARAM_QUEUE
-#  define FSW_PARAM_QUEUE 24
+#  define FSW_PARAM_QUEUE 18
 #endif
 
 // The bytecode VM (fsw_vm.h, docs/bytecode.md). Its operand stack, in Reals

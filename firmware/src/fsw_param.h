@@ -67,6 +67,9 @@ constexpr uint16_t param_eeprom_end(uint16_t base, uint16_t size) {
 }
 
 // FSW_PARAM_QUEUE (bytes of the stage queue): fsw_config.h.
+static_assert(FSW_PARAM_QUEUE >= FSW_LINK_RX_CAP - 6 && FSW_PARAM_QUEUE <= 255,
+              "FSW_PARAM_QUEUE must take the longest STAGE a frame carries (FSW_LINK_RX_CAP - 6 bytes): "
+              "a longer one would be BUSY for ever");
 
 // The store's run-time record (RAM).
 struct ParamStore {

@@ -15,7 +15,13 @@
 # adjust-and-restore sequences around it; 62 B of the rocket's flash), and one
 # that costs nothing measurable: -fno-move-loop-invariants (values hoisted out
 # of loops hold registers an 8-bit MCU then saves and reloads; 70 B of the
-# rocket's flash, its busy time per cycle unchanged). (-fno-gcse would save
+# rocket's flash, its busy time per cycle unchanged). Two more trade a
+# little CPU for flash: -fno-tree-vrp (no value-range propagation: its
+# jump threading copies blocks) and -fira-algorithm=priority (register
+# allocation by priority, not by Chaitin-Briggs colouring): together -162 B
+# of the core rocket's flash and 4 B of its stack, +2.8 us a cycle awake
+# (380.8 -> 383.6 us, target 400; 58 B a us), -122 B of the whole rocket's
+# for +2.1 us (2026-12-07, night; docs/runtime.md). (-fno-gcse would save
 # 230 B more, but costs 26 B of measured stack and slows nav: not used.)
 # The link repeats -ffunction-sections -fdata-sections: LTO compiles the
 # program again at the link, and without them puts it in one section each,
@@ -56,7 +62,7 @@ CORE_SRCS := $(wildcard $(CORE_DIR)/*.c) $(wildcard $(CORE_DIR)/*.cpp) $(wildcar
 # -DFSW_CONSOLE_ARDUINO_SERIAL=1; the tests build with it)
 DEFS     := -mmcu=$(MCU) -DF_CPU=$(F_CPU)L -DARDUINO=10819 -D$(BOARD_DEFINE) -DARDUINO_ARCH_AVR $(EXTRA_DEFS)
 INCS     := -I$(CORE_DIR) -I$(VAR_DIR)
-SIZE_OPT := -mcall-prologues -mstrict-X -fno-move-loop-invariants
+SIZE_OPT := -mcall-prologues -mstrict-X -fno-move-loop-invariants -fno-tree-vrp -fira-algorithm=priority
 OPT      := -Os $(SIZE_OPT) -g -ffunction-sections -fdata-sections -flto -fno-fat-lto-objects
 CFLAGS   := -std=gnu11 $(OPT) $(DEFS) $(INCS)
 CXXFLAGS := -std=gnu++11 $(OPT) -fno-exceptions -fno-rtti -fno-threadsafe-statics \

@@ -53,7 +53,8 @@ PIO_ARDUINO = {
 # The flags compared, besides -mmcu, -std, -O and the defines: those that
 # decide the code.
 CODE_FLAGS = {"-ffunction-sections", "-fdata-sections", "-flto", "-mcall-prologues", "-mstrict-X",
-              "-fno-move-loop-invariants", "-fno-exceptions", "-fno-threadsafe-statics"}
+              "-fno-move-loop-invariants", "-fno-tree-vrp", "-fira-algorithm=priority", "-fno-exceptions",
+              "-fno-threadsafe-statics"}
 LINK_FLAGS = {"-flto", "-fuse-linker-plugin", "-Wl,--gc-sections", "-Wl,--relax", "-mcall-prologues", "-mstrict-X",
               "-ffunction-sections", "-fdata-sections", "-fno-toplevel-reorder"}  # (at the link: LTO's own
 #                                                                                  compilation, mk/build.mk)
@@ -205,7 +206,7 @@ def test_a_mismatch_is_reported(tmp_path):
     ini = (ROOT / "platformio.ini").read_text()
     ini = ini.replace("board_build.f_cpu = 16000000L\nboard_build.variant = standard",
                       "board_build.f_cpu = 8000000L\nboard_build.variant = standard", 1)
-    ini = ini.replace("build_flags = -mcall-prologues -mstrict-X -fno-move-loop-invariants -Wl,--relax",
+    ini = ini.replace("build_flags = -mcall-prologues -mstrict-X -fno-move-loop-invariants -fno-tree-vrp -fira-algorithm=priority -Wl,--relax",
                       "build_flags = -O2 -DEXTRA=1", 1)
     assert "8000000L" in ini and "-O2 -DEXTRA=1" in ini
     project = tmp_path / "project"

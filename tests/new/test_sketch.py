@@ -38,7 +38,7 @@ def test_sketch_folder_holds_the_generated_code_an_ino_and_the_fqbn(fsw, tmp_pat
     # fsw build's flags, named for the command line (the folder cannot carry them)
     assert "#   --build-property 'compiler.c.elf.extra_flags=-Wl,--relax -ffunction-sections -fdata-sections -fno-toplevel-reorder'\n" \
         in yaml
-    assert "#   --build-property 'compiler.cpp.extra_flags=-mcall-prologues -mstrict-X -fno-move-loop-invariants'\n" \
+    assert "#   --build-property 'compiler.cpp.extra_flags=-mcall-prologues -mstrict-X -fno-move-loop-invariants -fno-tree-vrp -fira-algorithm=priority'\n" \
         in yaml
     ref = tmp_path / "ref"
     assert fsw("gen", str(TANK), "--out", str(ref)).code == 0

@@ -32,8 +32,10 @@ pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which(
 # flight); 66 B then (65 B on the demo flight); 55 B since the kit's
 # main() saves no register for its caller (OS_main, 2026-12-07, night: 56
 # B on the demo flight), and 51 B since the uplink's frame handling went out
-# of line and the frame's time is put by a call of its own
-CORE_STACK_MAX = 53
+# of line and the frame's time is put by a call of its own; 47 B since the
+# compiler's value-range propagation is off and its register allocation is
+# by priority (mk/build.mk, 2026-12-07, night)
+CORE_STACK_MAX = 49
 
 
 @pytest.fixture(scope="module")
@@ -57,4 +59,4 @@ def test_the_core_rockets_control_paths_keep_its_stack_small(core_elf):
     acks = {a["cmd_seq"]: a["status_name"] for a in s.acks}
     assert acks == {seq + k: "OK" for k in range(1, len(commands) + 1)}, acks
     assert s.stats.lost == 0
-    assert 48 <= stack <= CORE_STACK_MAX, stack
+    assert 44 <= stack <= CORE_STACK_MAX, stack

@@ -223,13 +223,14 @@ board = {pio.get("board", board.name)}
 custom_fsw_board = {board.name}
 ; compiled as `fsw build` compiles for the {board.name} (the kit's boards/{board.name}.toml
 ; and mk/build.mk): its MCU, clock, variant and board define, plus shared
-; register save/restore, linker relaxation and two flags that keep an 8-bit
-; MCU's registers free (9 % of the tank's flash)
+; register save/restore, linker relaxation, two flags that keep an 8-bit
+; MCU's registers free (9 % of the tank's flash) and two that trade a
+; little CPU for flash
 board_build.mcu = {board.mcu}
 board_build.f_cpu = {board.f_cpu}L
 board_build.variant = {ard.get("variant", "standard")}
 board_build.extra_flags = -D{ard.get("board_define", "ARDUINO_AVR_UNO")}
-build_flags = -mcall-prologues -mstrict-X -fno-move-loop-invariants -Wl,--relax
+build_flags = -mcall-prologues -mstrict-X -fno-move-loop-invariants -fno-tree-vrp -fira-algorithm=priority -Wl,--relax
 """)
     envs.append("""\
 [env:native]

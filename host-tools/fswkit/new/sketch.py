@@ -26,7 +26,7 @@ SKETCH_NAME = re.compile(r"[0-9A-Za-z_][0-9A-Za-z_.-]{0,62}\Z")
 # (The link's -ffunction-sections -fdata-sections: LTO compiles the program
 # again there, and a board's VM drops its unused features only then; its
 # -fno-toplevel-reorder keeps each function near those it calls.)
-SIZE_FLAGS = "-mcall-prologues -mstrict-X -fno-move-loop-invariants"  # mk/build.mk's SIZE_OPT
+SIZE_FLAGS = "-mcall-prologues -mstrict-X -fno-move-loop-invariants -fno-tree-vrp -fira-algorithm=priority"  # mk/build.mk's SIZE_OPT
 BUILD_PROPERTIES = {"compiler.c.extra_flags": SIZE_FLAGS, "compiler.cpp.extra_flags": SIZE_FLAGS,
                     "compiler.c.elf.extra_flags": "-Wl,--relax -ffunction-sections -fdata-sections -fno-toplevel-reorder"}
 

@@ -82,7 +82,9 @@ def test_batch_is_the_five_commands_of_a_step_in_one(probe_uno):
                 results.append(_steps_one_command_at_a_time(b, plan))
             else:
                 results.append([b.batch(until, analog, digital) for until, analog, digital in plan])
-            assert b.cycle == plan[-1][0]
+            # at the target or at most one instruction past it (docs/sim.md: the board stops between
+            # instructions; the longest takes 5 cycles, an interrupt's entry 4 more)
+            assert plan[-1][0] <= b.cycle < plan[-1][0] + 9, b.cycle
     batched, single = results
     assert batched == single
     assert b"".join(s.uart for s in batched) == b"probe ready\n"

@@ -254,14 +254,29 @@ def overlaps(a, b) -> bool:
 
 
 @pytest.mark.parametrize("count, period", [(300, 1), (60, 1), (40, 3), (12, 1)])
-def test_state_names_never_overlap(clash, tmp_path, count, period):
+def test_state_names_never_overlap(clash, tmp_path, count, period, monkeypatch):
+    """The figure `fsw plot` draws and writes (logs.figure's, kept as the
+    command made it: one figure, its layout the one written) has every
+    name where it overlaps no other, inside the page, above the panels."""
     layout = layout_of(clash)
     log = write_log(tmp_path / "many.fswlog", layout, clash_frames(layout, count, period))
     layout, events = decoded(log)
     elements = ["time_s", "frame", "target", "volts"]
     data = logs.plot_data(layout, events, elements)
     assert len(data.transitions) == (count - 1) // period
-    fig, unlabelled = logs.figure(layout, data, elements, "many")
+    drawn = []
+    figure = logs.figure
+
+    def keep(*args, **kw):
+        drawn.append(figure(*args, **kw))
+        return drawn[-1]
+    monkeypatch.setattr(logs, "figure", keep)
+    out = tmp_path / "many.svg"
+    r = run_fsw("plot", str(log), "-e", *elements, "-o", str(out))
+    assert r.code == 0 and f"{len(data.transitions)} state transitions" in r.err, r.err
+    assert out.read_text().startswith("<?xml")
+    [(fig, unlabelled)] = drawn
+    assert (f"{unlabelled} state names left out" in r.err) == bool(unlabelled)
     renderer = fig.canvas.get_renderer()
     labels = [t for t in fig.axes[0].texts if t.get_gid() == "state-label"]
     shown = [t for t in labels if t.get_visible()]
@@ -277,12 +292,6 @@ def test_state_names_never_overlap(clash, tmp_path, count, period):
     assert all(b.y0 >= panels_top for b in boxes)
     if unlabelled:
         assert f"{unlabelled} more state names" in fig.axes[0].get_title(loc="right")
-    # and what was written is what the figure shows
-    out = tmp_path / "many.svg"
-    r = run_fsw("plot", str(log), "-e", *elements, "-o", str(out))
-    assert r.code == 0 and f"{len(data.transitions)} state transitions" in r.err, r.err
-    assert (f"{unlabelled} state names left out" in r.err) == bool(unlabelled)
-    assert out.read_text().startswith("<?xml")
 
 
 def test_booleans_are_shaded_where_true_and_axes_say_units(clash, tmp_path):

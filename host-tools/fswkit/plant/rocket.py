@@ -129,7 +129,18 @@ class Rocket:
         return 1.0 if c.inflate_s <= 0 else min(1.0, (t - at) / c.inflate_s)
 
     def cd_area(self, t: float) -> float:
-        return self.body_cd_area + sum(c.cd_area * self.inflation(n, t) for n, c in self.chutes.items())
+        """The body's CdA plus each chute's as inflated at `t` (the chutes'
+        sum first, in their order: `inflation`'s arithmetic, worked out here
+        in line, as the integrator asks every step)."""
+        deployed = self.deployed
+        total = 0
+        for n, c in self.chutes.items():
+            at = deployed.get(n)
+            if at is None or t < at:
+                total += c.cd_area * 0.0
+            else:
+                total += c.cd_area * (1.0 if c.inflate_s <= 0 else min(1.0, (t - at) / c.inflate_s))
+        return self.body_cd_area + total
 
     def density(self, h: float | None = None) -> float:
         return self._rho(self.h if h is None else h)
@@ -183,6 +194,7 @@ class Rocket:
             v4 = v + a3 * dt
             a4 = (thr + -0.5 * rho(h + v3 * dt) * v4 * abs(v4) * cda) / m - g
         else:
+            thr = None
             a1 = f(t + eps, h, v, cda)
             v2 = v + a1 * dt / 2
             a2 = f(t + dt / 2, h + v * dt / 2, v2, cda)
@@ -203,6 +215,9 @@ class Rocket:
             self.h = self.v = self.a = 0.0
             return
         self.h, self.v = h, v
-        self.a = f(t1, h, v, cda)
+        if thr is None:
+            self.a = f(t1, h, v, cda)
+        else:  # _accel's arithmetic with the step's thrust and mass (those at t1)
+            self.a = (thr + -0.5 * rho(h) * v * abs(v) * cda) / m - g
         if h > self.apogee_h:
             self.apogee_h, self.apogee_t = h, t1

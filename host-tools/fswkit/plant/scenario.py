@@ -262,12 +262,20 @@ class Noise:
         self.rng, self.sigma, self.block = rng, sigma, block
         self.buf: list[float] = []
         self.i = 0
+        # the generator's state since the last block was drawn (None: not read yet): it only changes when a
+        # block is drawn, and reading it (a new dict) at every save cost more than the steps between saves
+        self._state: dict | None = None
 
     def save(self) -> tuple:
-        return self.buf, self.i, self.rng.bit_generator.state  # buf is replaced, never changed in place
+        if self._state is None:
+            self._state = self.rng.bit_generator.state
+        return self.buf, self.i, self._state  # buf is replaced, never changed in place
 
     def restore(self, saved: tuple) -> None:
-        self.buf, self.i, self.rng.bit_generator.state = saved
+        self.buf, self.i, state = saved
+        if state is not self._state:  # a block was drawn since: the generator goes back to before it
+            self.rng.bit_generator.state = state
+            self._state = state
 
     def __call__(self) -> float:
         if not self.sigma:
@@ -275,6 +283,7 @@ class Noise:
         if self.i == len(self.buf):
             self.buf = (self.rng.standard_normal(self.block) * self.sigma).tolist()
             self.i = 0
+            self._state = None
         self.i += 1
         return self.buf[self.i - 1]
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import functools
+import itertools
 from dataclasses import dataclass
 
 from fswkit.autocode import model as M
@@ -163,17 +164,19 @@ def trace_header(m: M.Machine) -> bytes:
 
 @functools.lru_cache(maxsize=256)
 def _row_maker(kinds: tuple[str, ...], places: tuple[int, ...]) -> object:
-    """A function (step, values) -> a trace row: the step, then values[p]
-    for each place p, written as the trace writes its kind (a bool as
-    true/false, a float by repr, an integer as it is). Made once a trace,
-    from the machine's variable kinds and small integers only: a row a step
-    costs one call, not a loop over the variables."""
+    """A function (step, values) -> a trace row's line, its line end
+    included: the step, then values[p] for each place p, written as the
+    trace writes its kind (a bool as true/false, a float by repr, an
+    integer as it is), comma-separated, as the csv module writes them (no
+    field of these needs quoting) and ends its lines (CR LF). Made once a
+    trace, from the machine's variable kinds and small integers only: a
+    row a step costs one call, not a loop over the variables."""
     cols = []
     for k, at in zip(kinds, places):
         at = int(at)
-        cols.append(f"('true' if v[{at}] else 'false')" if k == "bool" else f"repr(v[{at}])" if k == "float"
-                    else f"v[{at}]")
-    return eval(f"lambda step, v: (step, {''.join(c + ', ' for c in cols)})")  # noqa: S307 (ints and fixed text)
+        cols.append(f"{{'true' if v[{at}] else 'false'}}" if k == "bool" else f"{{v[{at}]!r}}" if k == "float"
+                    else f"{{v[{at}]}}")
+    return eval(f"lambda step, v: f\"{{step}}{''.join(',' + c for c in cols)}\\r\\n\"")  # noqa: S307 (ints and fixed text)
 
 
 class _Tracer:
@@ -181,21 +184,21 @@ class _Tracer:
 
     def __init__(self, path: str, m: M.Machine):
         self.f = open(path, "w", newline="")
-        self.w = csv.writer(self.f)
         order = _trace_order(m)
         kinds = tuple(var.type.kind for var in order)
         self._row = _row_maker(kinds, tuple(var.index for var in order))
         self._ordered = _row_maker(kinds, tuple(range(len(order))))
-        self.w.writerow(["step"] + [var.display for var in order])
+        csv.writer(self.f).writerow(["step"] + [var.display for var in order])
+        self._write = self.f.write
 
     def row(self, step: int, v) -> None:
         """The row of step `step`: `v` the variables by index."""
-        self.w.writerow(self._row(step, v))
+        self._write(self._row(step, v))
 
     def rows_ordered(self, first: int, values) -> None:
         """Rows from step `first` on: `values` an iterable of tuples, each a
         step's variables in the trace's column order."""
-        self.w.writerows(self._ordered(step, t) for step, t in enumerate(values, first))
+        self.f.writelines(map(self._ordered, itertools.count(first), values))
 
     def close(self) -> None:
         self.f.close()

@@ -249,6 +249,9 @@ class RunResult:
     stop: str
 
 
+_new = object.__new__
+
+
 @dataclass(frozen=True)
 class Edge:
     cycle: int
@@ -591,15 +594,18 @@ class SimBoard:
                     name = names.get(("p", where))
                     if name is None:
                         name = names["p", where] = f" @{_part_id(where)}:"
-                    line += name + ",".join(f"{k}={int(v)}" for k, v in values.items())
+                    line += name + ",".join([f"{k}={int(v)}" for k, v in values.items()])
         return line + "\n"
 
     def _batch_result(self, text: str) -> Batch:
         # `ok cycle=C time=S state=ST stop=R uart=HEX n=K overflow=F EDGE... [guard=HEX]`, read
         # by position: one step of a co-simulation, kept cheap
         toks = text.split(" ")
-        self.cycle = int(toks[1][6:])
-        run = RunResult(self.cycle, float(toks[2][5:]), toks[3][6:], toks[4][5:])
+        self.cycle = cycle = int(toks[1][6:])
+        # the frozen dataclass's fields set as its __init__ would, without its four object.__setattr__ calls
+        run = _new(RunResult)
+        d = run.__dict__
+        d["cycle"], d["time"], d["state"], d["stop"] = cycle, float(toks[2][5:]), toks[3][6:], toks[4][5:]
         guard = b""
         if toks[-1].startswith("guard="):
             guard = bytes.fromhex(toks.pop()[6:])

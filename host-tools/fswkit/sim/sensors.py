@@ -181,6 +181,19 @@ def _walk_nearest(f, target: float, guess: int, lo: int, hi: int, increasing: bo
     v = get(x)
     if v is None:
         v = seen[x] = f(x)
+    if lo < x < hi:  # the answer next to the guess (as a rule): what the walk below finds then, in one look
+        if (v >= target) if increasing else (v <= target):
+            v0 = get(x - 1)
+            if v0 is None:
+                v0 = seen[x - 1] = f(x - 1)
+            if not ((v0 >= target) if increasing else (v0 <= target)):  # x is the first that reaches
+                return x - 1 if abs(v0 - target) <= abs(v - target) else x
+        else:
+            v1 = get(x + 1)
+            if v1 is None:
+                v1 = seen[x + 1] = f(x + 1)
+            if (v1 >= target) if increasing else (v1 <= target):  # x + 1 is
+                return x if abs(v - target) <= abs(v1 - target) else x + 1
     step = 1
     if (v >= target) if increasing else (v <= target):  # the first reaching x is at or below x
         b = x
@@ -372,7 +385,8 @@ class PartFeed:
         per, lo, hi, names = self._accel_form()
         out = {}
         for name, g in zip(names, (x, y, z)):
-            out[name] = min(max(int(round(float(g) / per)), lo), hi)
+            # an axis at 0 g (those the plant does not feed) reads 0 counts, the formula's answer (lo < 0 < hi)
+            out[name] = 0 if g == 0 else min(max(int(round(float(g) / per)), lo), hi)
         if self.part == "mpu6050" and temperature is not None:
             out["temp"] = min(max(int(round((float(temperature) - 36.53) * 340.0)), -32768), 32767)
         return out

@@ -174,15 +174,7 @@ __attribute__((naked, noinline, used)) uint16_t cobs_frame(uint8_t*, uint16_t, c
         "5:  ld   r25, Y+\n"
         "    st   Z+, r25\n"
         "    eor  r13, r25\n"  // x = hi ^ b
-        "    mul  r13, r2\n"   // r1 = x >> 4
-        "    eor  r13, r1\n"   // x ^= x >> 4
-        "    mul  r13, r2\n"   // r0 = x << 4, r1 = x >> 4
-        "    eor  r12, r0\n"   // lo ^ x << 4
-        "    lsl  r0\n"        // x << 5, and x's bit 3 in the carry
-        "    rol  r1\n"        // x >> 3
-        "    eor  r1, r12\n"   // the new high byte: lo ^ x << 4 ^ x >> 3
-        "    eor  r0, r13\n"   // the new low byte: x ^ x << 5
-        "    movw r12, r0\n"
+        FSW_CRC_STEP_MUL("r13", "r12", "r2")  // (fsw_crc.h: r2 holds 16)
         "    tst  r25\n"
         "    breq 6f\n"  // a zero: out of the non-zero bytes' way
         "    inc  r24\n"

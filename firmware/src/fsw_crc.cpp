@@ -15,15 +15,7 @@ uint16_t crc16_update(uint16_t crc, uint8_t byte) {
     __asm__(
         "eor  %B[crc], %[b]\n\t"  // x = hi ^ b, in the high byte
         "ldi  %[k], 16\n\t"
-        "mul  %B[crc], %[k]\n\t"  // r1 = x >> 4
-        "eor  %B[crc], r1\n\t"    // x ^= x >> 4
-        "mul  %B[crc], %[k]\n\t"  // r0 = x << 4, r1 = x >> 4
-        "eor  %A[crc], r0\n\t"    // lo ^ x << 4
-        "lsl  r0\n\t"             // x << 5, and x's bit 3 in the carry
-        "rol  r1\n\t"             // x >> 3
-        "eor  r1, %A[crc]\n\t"    // the new high byte: lo ^ x << 4 ^ x >> 3
-        "eor  r0, %B[crc]\n\t"    // the new low byte: x ^ x << 5
-        "movw %A[crc], r0\n\t"
+        FSW_CRC_STEP_MUL("%B[crc]", "%A[crc]", "%[k]")
         "clr  __zero_reg__"
         : [crc] "+r"(crc), [k] "=&d"(k)
         : [b] "r"(byte)

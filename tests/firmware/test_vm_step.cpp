@@ -62,6 +62,37 @@ void test_the_vm_steps_typed_instructions(void) {
     TEST_ASSERT_EQUAL_INT16(32767, load<int16_t>(sv + 16));  // 3 + 40000, saturated
 }
 
+// kJInt of an 8-byte integer (G, U64) under each comparison, against a
+// constant whose bytes all differ, for values that differ from it in the
+// low byte, a middle one, the top one, or not at all: the AVR's compare
+// chain (fsw_vm.cpp's u64_order) orders them as the C integers do.
+void test_the_vm_orders_8_byte_integers(void) {
+    const uint64_t c = 0x0102030405060708ULL;
+    const uint64_t values[] = {0, 0x0102030305060708ULL, c - 1, c, c + 1, c + 0xFF00, 0x0202030405060708ULL,
+                               0xF102030405060707ULL};
+    Image im;
+    Machine m;
+    for (uint8_t cmp = 0; cmp < 6; ++cmp) {  // <, <=, >, >=, ==, !=
+        uint8_t code[] = {JINT, 0, 0, kU64, static_cast<uint8_t>(0x80 | cmp), 8, 7, 6, 5, 4, 3, 2, 1, 2, 0,
+                          GOTO, 1, END};  // the test holds: past the goto, in A
+        step_image(im, code, sizeof code, 1);
+        TEST_ASSERT_EQUAL_UINT(kVmOk, verify(im));
+        for (uint8_t k = 0; k < sizeof values / sizeof values[0]; ++k) {
+            const uint64_t v = values[k];
+            const bool holds = cmp == 0   ? v < c
+                               : cmp == 1 ? v <= c
+                               : cmp == 2 ? v > c
+                               : cmp == 3 ? v >= c
+                               : cmp == 4 ? v == c
+                                          : v != c;
+            memset(sv, 0, sizeof sv);
+            vm_reset(im.b, ram, m, 1);
+            store<uint64_t>(sv, v);
+            TEST_ASSERT_EQUAL_UINT(kOk, vm_step(im.b, kLayout, sv, ram, m));
+            TEST_ASSERT_EQUAL_UINT32_MESSAGE(holds ? 1 : 2, m.state, "the order of an 8-byte integer");
+        }
+    }
+}
 
 void test_the_vm_steps_the_good_image(void) {
     Image im;
@@ -97,6 +128,7 @@ void test_the_vm_steps_the_good_image(void) {
 FSW_TEST_MAIN([] {
     UNITY_BEGIN();
     RUN_TEST(test_the_vm_steps_typed_instructions);
+    RUN_TEST(test_the_vm_orders_8_byte_integers);
     RUN_TEST(test_the_vm_steps_the_good_image);
     (void)UNITY_END();
 })

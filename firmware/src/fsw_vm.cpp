@@ -792,6 +792,38 @@ FSW_VM_INLINE bool is_nan(const uint8_t* x, uint8_t n) {
     return ((x[2] & 0x7Fu) | x[1] | x[0]) != 0;
 }
 
+#if defined(__AVR__)
+// key_holds of a binary64 not a NaN, on an AVR: its key's bytes (x's, ending
+// at `xe`, xored with `neg`, 0xFF for a negative x, the top one with `neg`
+// | 0x80: a negative x's every bit flipped, another's sign bit) against
+// the constant's (ending at `ce`) from the top down, left at the first
+// that differs, unrolled (7 cycles a byte, against the loop's 14), in
+// scratch registers and the pointer registers: no register saves.
+FSW_VM_INLINE bool key8_holds(const uint8_t* xe, const uint8_t* ce, uint8_t neg, bool inclusive) {
+    uint8_t a, b;
+    __asm__("ld %0, -X\n\t" "eor %0, %6\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+            "mov %0, %5\n\t"  // every byte equal: inclusive
+            "rjmp 2f\n"
+            "1:\n\t"
+            "ldi %0, 0\n\t"   // below (ldi leaves the flags: C is key < c)
+            "brlo 2f\n\t"
+            "ldi %0, 1\n"      // above
+            "2:"
+            : "=&d"(a), "=&r"(b), "+x"(xe), "+z"(ce)
+            : "r"(neg), "r"(static_cast<uint8_t>(inclusive)), "r"(static_cast<uint8_t>(neg | 0x80u))
+            : "cc", "memory");
+    (void)b;
+    return a != 0;
+}
+#endif
+
 // kJKey's test: whether the key of the float at `x` (n = 4 or 8 bytes; a
 // NaN reads as +0, fsw_f64.h) is greater than (inclusive: at least) the key
 // at `c`. The key flips every bit of a negative pattern and the sign bit
@@ -804,6 +836,9 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
             if (*--c != 0) return false;
         return inclusive;
     }
+#if defined(__AVR__)
+    if (n == 8) return key8_holds(x + 8, c, (x[7] & 0x80u) != 0 ? 0xFF : 0x00, inclusive);
+#endif
     x += n;
     const uint8_t neg = (x[-1] & 0x80u) != 0 ? 0xFF : 0x00;
     uint8_t k = static_cast<uint8_t>(*--x ^ (neg | 0x80u));  // a negative key flips the sign bit too

@@ -793,35 +793,44 @@ FSW_VM_INLINE bool is_nan(const uint8_t* x, uint8_t n) {
 }
 
 #if defined(__AVR__)
-// key_holds of a binary64 not a NaN, on an AVR: its key's bytes (x's, ending
-// at `xe`, xored with `neg`, 0xFF for a negative x, the top one with `neg`
-// | 0x80: a negative x's every bit flipped, another's sign bit) against
-// the constant's (ending at `ce`) from the top down, left at the first
-// that differs, unrolled (7 cycles a byte, against the loop's 14), in
-// scratch registers and the pointer registers: no register saves.
-FSW_VM_INLINE bool key8_holds(const uint8_t* xe, const uint8_t* ce, uint8_t neg, bool inclusive) {
+// key_holds of a float not a NaN (n = 4 or 8 bytes), on an AVR: its key's
+// bytes (x's, ending at `xe`, xored with `neg`, 0xFF for a negative x, the
+// top one with `neg` | 0x80: a negative x's every bit flipped, another's
+// sign bit) against the constant's (ending at `ce`) from the top down,
+// left at the first that differs, unrolled (7 cycles a byte, against the
+// loop's 14), in scratch registers and the pointer registers: no register
+// saves.
+#define FSW_VM_KEY_TOP "ld %0, -X\n\t" "eor %0, %6\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+#define FSW_VM_KEY_BYTE "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
+#define FSW_VM_KEY_END                                                                            \
+    "mov %0, %5\n\t" /* every byte equal: inclusive */                                         \
+    "rjmp 2f\n"                                                                                 \
+    "1:\n\t"                                                                                   \
+    "ldi %0, 0\n\t" /* below (ldi leaves the flags: C is key < c) */                          \
+    "brlo 2f\n\t"                                                                              \
+    "ldi %0, 1\n" /* above */                                                                   \
+    "2:"
+FSW_VM_INLINE bool key_holds_avr(const uint8_t* xe, const uint8_t* ce, uint8_t n, uint8_t neg, bool inclusive) {
     uint8_t a, b;
-    __asm__("ld %0, -X\n\t" "eor %0, %6\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "ld %0, -X\n\t" "eor %0, %4\n\t" "ld %1, -Z\n\t" "cp %0, %1\n\t" "brne 1f\n\t"
-            "mov %0, %5\n\t"  // every byte equal: inclusive
-            "rjmp 2f\n"
-            "1:\n\t"
-            "ldi %0, 0\n\t"   // below (ldi leaves the flags: C is key < c)
-            "brlo 2f\n\t"
-            "ldi %0, 1\n"      // above
-            "2:"
-            : "=&d"(a), "=&r"(b), "+x"(xe), "+z"(ce)
-            : "r"(neg), "r"(static_cast<uint8_t>(inclusive)), "r"(static_cast<uint8_t>(neg | 0x80u))
-            : "cc", "memory");
+    const uint8_t top = static_cast<uint8_t>(neg | 0x80u), incl = inclusive ? 1 : 0;
+    if (n == 8) {
+        __asm__(FSW_VM_KEY_TOP FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE
+                    FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_END
+                : "=&d"(a), "=&r"(b), "+x"(xe), "+z"(ce)
+                : "r"(neg), "r"(incl), "r"(top)
+                : "cc", "memory");
+    } else {
+        __asm__(FSW_VM_KEY_TOP FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_BYTE FSW_VM_KEY_END
+                : "=&d"(a), "=&r"(b), "+x"(xe), "+z"(ce)
+                : "r"(neg), "r"(incl), "r"(top)
+                : "cc", "memory");
+    }
     (void)b;
     return a != 0;
 }
+#undef FSW_VM_KEY_TOP
+#undef FSW_VM_KEY_BYTE
+#undef FSW_VM_KEY_END
 #endif
 
 // kJKey's test: whether the key of the float at `x` (n = 4 or 8 bytes; a
@@ -837,8 +846,8 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
         return inclusive;
     }
 #if defined(__AVR__)
-    if (n == 8) return key8_holds(x + 8, c, (x[7] & 0x80u) != 0 ? 0xFF : 0x00, inclusive);
-#endif
+    return key_holds_avr(x + n, c, n, (x[n - 1u] & 0x80u) != 0 ? 0xFF : 0x00, inclusive);
+#else
     x += n;
     const uint8_t neg = (x[-1] & 0x80u) != 0 ? 0xFF : 0x00;
     uint8_t k = static_cast<uint8_t>(*--x ^ (neg | 0x80u));  // a negative key flips the sign bit too
@@ -848,6 +857,7 @@ FSW_VM_INLINE bool key_holds(const uint8_t* x, uint8_t n, const uint8_t* c, bool
         if (--n == 0) return inclusive;
         k = static_cast<uint8_t>(*--x ^ neg);
     }
+#endif
 }
 
 #if defined(__AVR__)

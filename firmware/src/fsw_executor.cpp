@@ -16,6 +16,13 @@ uint8_t* mode_byte(const ExecConfig& c, const Task& t, uint8_t i) {
     return app_has(kAppModeElems) && t.mode_off != kNoElement ? c.sv + t.mode_off : &c.stats[i].mode;
 }
 
+// A field of the configuration: from its copy where executor_begin made
+// one, else out of flash (FSW_FLASH), read where used.
+template <typename T>
+inline __attribute__((always_inline)) T config_field(bool copied, const T& copy, const T& in_flash) {
+    return copied ? copy : flash_get(in_flash);
+}
+
 }  // namespace
 
 ExecConfig executor_config(const Executor& ex) {
@@ -34,9 +41,9 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     const bool whole_rows = check || app_has(kAppMirrors | kAppModeElems | kAppSlowTasks);
     ExecConfig c;
     if (whole_rows) flash_read(&c, cfg, sizeof c);
-    const uint8_t n_tasks = whole_rows ? c.n_tasks : flash_get(cfg->n_tasks);
-    TaskStats* const stats = whole_rows ? c.stats : flash_get(cfg->stats);
-    const Task* const tasks = whole_rows ? c.tasks : flash_get(cfg->tasks);  // (read once: a flash load stays in a loop)
+    const uint8_t n_tasks = config_field(whole_rows, c.n_tasks, cfg->n_tasks);
+    TaskStats* const stats = config_field(whole_rows, c.stats, cfg->stats);
+    const Task* const tasks = config_field(whole_rows, c.tasks, cfg->tasks);  // (read once: a flash load stays in a loop)
     // (a generated table was checked when compiled: exec_config_ok, exec_task_ok)
     if (check && (c.period_us == 0 || (c.n_tasks != 0 && (c.tasks == 0 || c.stats == 0)))) return kErrConfig;
     uint8_t mirrors = 0;
@@ -66,7 +73,7 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
     // the base period: the application's constant where it has one (fsw_app.h; the timer's settings are
     // then worked out when compiling), else the configuration's, read only then (a flash load is never
     // dropped unused)
-    pal::cycle_timer_begin(app_period_us != 0 ? app_period_us : whole_rows ? c.period_us : flash_get(cfg->period_us));
+    pal::cycle_timer_begin(app_period_us != 0 ? app_period_us : config_field(whole_rows, c.period_us, cfg->period_us));
 #endif
     memset(&ex, 0, sizeof ex);  // the counters (one clear: a store a field was 4 bytes of flash a byte)
     ex.cfg = cfg;
@@ -75,8 +82,8 @@ Result executor_begin(Executor& ex, const ExecConfig* cfg) {
 #endif
     ex.mirrors = mirrors;
     ex.reset_cause = pal::reset_cause();
-    const ElemOff reset_cause_off = whole_rows ? c.reset_cause_off : flash_get(cfg->reset_cause_off);
-    uint8_t* const sv = whole_rows ? c.sv : flash_get(cfg->sv);
+    const ElemOff reset_cause_off = config_field(whole_rows, c.reset_cause_off, cfg->reset_cause_off);
+    uint8_t* const sv = config_field(whole_rows, c.sv, cfg->sv);
     if (reset_cause_off != kNoElement && sv != 0) sv[reset_cause_off] = ex.reset_cause;
     pal::watchdog_begin();
     return kOk;

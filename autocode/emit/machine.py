@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 
 from .. import model as M
-from ..check import model_children
+from ..check import model_children, stmt_exprs
 from ..cnames import enumerator
 from ..evaluate import NotConstant, evaluate, local_values
 from ..numeric import Real, to_type
@@ -206,11 +206,10 @@ def cached_sums(m: M.Machine, real: Real, scriptable: bool = False) -> list[tupl
         in_step |= _assigned(st.step)
     found: dict[tuple, M.Arith] = {}
     readers: dict[tuple, set[int]] = {}
-    state = 0
 
-    def visit(e) -> None:
+    def visit(e, state: int) -> None:
         t = type(e)
-        if t in _LEAVES:
+        if t in _LEAVES or t is M.Roll:  # (a window's argument is the window's sampling, not the step's)
             return
         if t is M.Arith:
             key = sum_key(e, ex.known)
@@ -220,27 +219,12 @@ def cached_sums(m: M.Machine, real: Real, scriptable: bool = False) -> list[tupl
                     found.setdefault(key, e)
                     readers.setdefault(key, set()).add(state)
                     return
-        if t is M.Arith or t is M.Cmp or t is M.Logic:
-            visit(e.left)
-            visit(e.right)
-        elif t is M.Neg or t is M.Not:
-            visit(e.operand)
-        elif t is M.ChainCmp:
-            for o in e.operands:
-                visit(o)
-
-    def visit_block(stmts) -> None:
-        for st in stmts:
-            if isinstance(st, M.Assign):
-                visit(st.expr)
-            elif isinstance(st, M.If):
-                visit(st.cond)
-                visit_block(st.then)
-                visit_block(st.orelse)
+        for c in model_children(e):
+            visit(c, state)
 
     for st in m.states:
-        state = st.index
-        visit_block(st.step)
+        for e in stmt_exprs(st.step):
+            visit(e, st.index)
     return [(key, e, readers[key]) for key, e in found.items()]
 
 

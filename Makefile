@@ -47,6 +47,28 @@ docs-img: setup
 	FSW_SCREENSHOTS=docs/img $(PY) -m pytest -q -p no:cacheprovider tests/web/test_web_station.py \
 	  tests/web/test_web_archive.py
 
+# The tests' compiles go through ccache (Debian's ccache, which
+# tools/bootstrap.sh installs): its folder of compiler names first on PATH, so
+# every avr-gcc, avr-g++, gcc, g++ and clang++ that the kit's builds and the
+# tests start looks its object up by the hash of its preprocessed source,
+# its flags and the compiler, and compiles only on a miss. About 800
+# compiles a run are the same from run to run (the runtime for a build
+# variant, the examples' generated code) and half of them repeat within one
+# run (the same program built in two tests' folders). The cache is in the
+# kit's cache folder ($FSW_CACHE_DIR, else ~/.cache/fswkit), ccache/, at
+# most 2 GB; the folder a source was compiled in is left out of the hash
+# (CCACHE_NOHASHDIR), so a program's debug information may name the folder
+# of the build that filled the entry. Links (LTO's code generation among
+# them), failed compiles and calls with several sources are never cached.
+# FSW_CCACHE=0 runs the compilers themselves.
+ifneq ($(FSW_CCACHE),0)
+FSW_CACHE_ROOT := $(or $(FSW_CACHE_DIR),$(or $(XDG_CACHE_HOME),$(HOME)/.cache)/fswkit)
+test test-python test-firmware setup-and-build-ahead fw-build-ahead fuzz-build-ahead: export PATH := /usr/lib/ccache:$(PATH)
+test test-python test-firmware setup-and-build-ahead fw-build-ahead fuzz-build-ahead: export CCACHE_DIR := $(FSW_CACHE_ROOT)/ccache
+test test-python test-firmware setup-and-build-ahead fw-build-ahead fuzz-build-ahead: export CCACHE_NOHASHDIR := 1
+test test-python test-firmware setup-and-build-ahead fw-build-ahead fuzz-build-ahead: export CCACHE_MAXSIZE := 2G
+endif
+
 ## test: every test suite: pytest, then the runtime's Unity suites natively
 ## (R = binary64 and binary32) and on a simulated ATmega328P
 test: setup-and-build-ahead test-python test-firmware

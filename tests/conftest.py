@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 import os
 import shutil
@@ -62,6 +63,22 @@ def project_config(project_dir, tmp_path) -> dict[str, dict]:
                        capture_output=True, text=True, env=env, timeout=120)
     assert r.returncode == 0, r.stderr + r.stdout
     return {section: dict(options) for section, options in json.loads(r.stdout[r.stdout.index("["):])}
+
+
+# ---- the collector (Python's cyclic garbage collector) ----
+
+def pytest_collection_finish(session):
+    """Everything collection made (the test modules, the kit's modules,
+    pytest's items: most of what a worker holds) moved out of the cyclic
+    collector's sight, and its young generation collected every 20,000
+    allocations where it was every 700: a full collection otherwise walks
+    all of it again and again while the tests allocate (a system-wide
+    profile of `make test` put 5 % of its CPU in the workers' collector).
+    Objects are still freed by their reference counts as before; only
+    cycles wait longer."""
+    gc.collect()
+    gc.freeze()
+    gc.set_threshold(20000, 20, 20)
 
 
 # ---- the order files are handed out in (make test: pytest-xdist, --dist loadfile) ----

@@ -9,10 +9,11 @@ PYTHON=${PYTHON:-python3}
 
 # Debian packages: the AVR toolchain and Arduino core, the simulated board,
 # avrdude for flashing, graphviz to render `fsw graph`, valgrind for `make bench`,
-# clang and its runtime (libFuzzer, sanitizers) for the uplink fuzzer.
+# clang and its runtime (libFuzzer, sanitizers) for the uplink fuzzer, ccache
+# for `make test`'s compiles (Makefile).
 APT_PACKAGES=(gcc-avr avr-libc binutils-avr avrdude arduino-core-avr simavr libsimavr-dev
               g++ make graphviz valgrind clang libclang-rt-14-dev
-              chromium chromium-driver)
+              chromium chromium-driver ccache)
 # Installed where the distribution has them: arduino-ctags, which arduino-cli
 # runs on an exported sketch's .ino with Debian's Arduino core
 # (integrations/arduino-cli/README.md).

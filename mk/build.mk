@@ -93,6 +93,12 @@ NATIVE_SRCS := $(filter-out %/psl_arduino.cpp,$(sort $(wildcard $(RUNTIME)/*.cpp
 # another board, with other flags or another compiler rebuilds everything
 # and an unchanged one rebuilds nothing. Headers are decided per object by
 # the compiler's dependency files (-MMD -MP), the Arduino core's included.
+# AVR_TOOLS_KEY: a hash of the AVR tools' identity (each one's path, size,
+# date and version, and the C library's path, size and date) computed by
+# the caller for the tools make runs here (`fsw build` passes it,
+# fswkit.target.build.make_args): it stands in the stamp for the tools and
+# their C library, which make otherwise asks itself for (tool_id, file_id:
+# five shells and the tools' --version, about 30 ms of CPU a run).
 tool_id = $(shell p=$$(command -v $(1)) && echo "$$p=$$(readlink -f "$$p") $$(stat -Lc '%s %Y' "$$p")" \
               "$$($(1) --version 2>&1 | head -n 1)")
 file_id = $(shell f=$$($(1)) && echo "$$f $$(stat -Lc '%s %Y' "$$f" 2>/dev/null)")
@@ -101,11 +107,15 @@ GOALS      := $(or $(MAKECMDGOALS),avr)
 AVR_STAMP  := $(OUT)/.config-avr
 NATIVE_STAMP := $(OUT)/.config-native
 ifneq ($(filter-out native $(OUT)/$(NAME),$(GOALS)),)
+ifneq ($(AVR_TOOLS_KEY),)
+AVR_TOOLS := tools=$(AVR_TOOLS_KEY)
+else
+AVR_TOOLS := cc=$(call tool_id,$(AVR_CC)) cxx=$(call tool_id,$(AVR_CXX)) ar=$(call tool_id,$(AVR_AR)) \
+    objcopy=$(call tool_id,$(AVR_OBJCOPY)) libc=$(call file_id,$(AVR_CC) -mmcu=$(MCU) -print-file-name=libc.a)
+endif
 AVR_CONFIG := mcu=$(MCU) f_cpu=$(F_CPU) variant=$(VARIANT) board=$(BOARD_DEFINE) \
     arduino=$(realpath $(ARDUINO)) runtime=$(realpath $(RUNTIME)) gen=$(realpath $(GEN)) \
-    cflags=$(CFLAGS) cxxflags=$(CXXFLAGS) warn=$(WARN) ldflags=$(LDFLAGS) \
-    cc=$(call tool_id,$(AVR_CC)) cxx=$(call tool_id,$(AVR_CXX)) ar=$(call tool_id,$(AVR_AR)) \
-    objcopy=$(call tool_id,$(AVR_OBJCOPY)) libc=$(call file_id,$(AVR_CC) -mmcu=$(MCU) -print-file-name=libc.a) \
+    cflags=$(CFLAGS) cxxflags=$(CXXFLAGS) warn=$(WARN) ldflags=$(LDFLAGS) $(AVR_TOOLS) \
     sources=$(notdir $(CORE_SRCS) $(RT_SRCS) $(GEN_SRCS)) libs=$(LIBS) $(LIBS_KEY)
 ifneq ($(file <$(AVR_STAMP)),$(AVR_CONFIG))
 $(shell mkdir -p $(OUT))

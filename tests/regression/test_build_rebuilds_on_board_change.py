@@ -113,6 +113,24 @@ def test_every_build_input_decides_a_rebuild(sketch):
         built = now
 
 
+def test_another_tools_key_rebuilds(sketch):
+    """AVR_TOOLS_KEY, the tools' identity `fsw build` passes in place of
+    make asking the tools (fswkit.target.libcache.avr_tools_key), is part
+    of the configuration: another key rebuilds, the same one nothing."""
+    root, gen, arduino, _ = sketch
+    out = root / "out-tools-key"
+    built = {}
+    for key in ("a" * 20, "b" * 20, "b" * 20):
+        r = subprocess.run(["make", "--no-print-directory", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
+                            "NAME=sketch", f"ARDUINO={arduino}", f"AVR_TOOLS_KEY={key}", str(out / "gen/sketch.o")]
+                           + [f"{k}={v}" for k, v in UNO.items()], capture_output=True, text=True)
+        assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+        assert f"tools={key}" in (out / ".config-avr").read_text()
+        built.setdefault(key, []).append((out / "gen" / "sketch.o").stat().st_mtime_ns)
+    assert built["b" * 20][0] != built["a" * 20][0], "another tools key did not rebuild"
+    assert built["b" * 20][1] == built["b" * 20][0], "the same tools key rebuilt"
+
+
 def test_a_changed_header_rebuilds_the_objects_that_include_it(sketch):
     root, gen, arduino, _ = sketch
     out = root / "out-headers"

@@ -153,6 +153,23 @@ def test_the_key_follows_the_runtime_and_the_makefile(cache, tmp_path, monkeypat
     assert libcache.avr_key("atmega2560", 16000000, "mega", "ARDUINO_AVR_MEGA2560", args[-1]) != key
 
 
+def test_the_tools_key_follows_the_tools(tmp_path, monkeypatch):
+    """mk/build.mk's AVR_TOOLS_KEY, which `fsw build` passes in place of
+    make asking the tools: another compiler first on PATH (the same one
+    behind a wrapper) is another key, and so a rebuild."""
+    from fswkit.target import libcache
+
+    key = libcache.avr_tools_key("atmega328p")
+    assert libcache.avr_tools_key("atmega328p") == key and len(key) == 20
+    assert libcache.avr_tools_key("atmega2560") != key  # another MCU's C library
+    wrapper = tmp_path / "bin" / "avr-objcopy"
+    wrapper.parent.mkdir()
+    wrapper.write_text(f"#!/bin/sh\nexec {shutil.which('avr-objcopy')} \"$@\"\n")
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{wrapper.parent}{os.pathsep}{os.environ['PATH']}")
+    assert libcache.avr_tools_key("atmega328p") != key
+
+
 def _blocked(tmp_path, monkeypatch) -> None:
     """A cache folder that cannot be made: a file is in its place."""
     blocked = tmp_path / "not-a-folder"

@@ -460,7 +460,9 @@ def make_args(app: Application, out: str, jobs: int = 2, cached: bool = False) -
                              "run `make setup` (or tools/bootstrap.sh)")
         board = {"MCU": b.mcu, "F_CPU": b.f_cpu, "VARIANT": ard.get("variant", "standard"),
                  "BOARD_DEFINE": ard.get("board_define", "ARDUINO_AVR_UNO")}
-        args += ["avr"] + [f"{k}={v}" for k, v in board.items()]
+        from fswkit.target.libcache import avr_tools_key
+
+        args += ["avr"] + [f"{k}={v}" for k, v in board.items()] + [f"AVR_TOOLS_KEY={avr_tools_key(b.mcu)}"]
         avr = dict(board, ARDUINO=ARDUINO)
         artifact = os.path.join(out, name + ".elf")
     else:

@@ -40,7 +40,7 @@ from fswkit.autocode.kit import BUILD_MK, RUNTIME
 LINKED = "fsw-libs"  # the build folder's links to the entry it uses
 ARCHIVES = ("core.a", "libfswkit.a")
 _MAKE_SAFE = re.compile(r"^[A-Za-z0-9_./+-]+$")  # a path make takes as a prerequisite
-_libc: dict[tuple, str] = {}
+_libc: dict[tuple, str] = {}  # {(the compiler's identity, mcu): the C library's path}
 
 
 def _tree_hash(h, folder: str) -> None:
@@ -60,18 +60,42 @@ def _tree_hash(h, folder: str) -> None:
 
 def _libc_identity(cc: str, mcu: str) -> str:
     """The C library the compiler links for `mcu` (its headers come with
-    it): path, size and date."""
-    key = (cc, mcu)
+    it): path, size and date. The compiler is asked for its path once per
+    compiler (its identity: path, size, date, version), the file looked at
+    on every call."""
+    from fswkit.run.native import compiler_identity
+
+    key = (compiler_identity(cc), mcu)
     if key not in _libc:
         try:
             r = subprocess.run([cc, f"-mmcu={mcu}", "-print-file-name=libc.a"], capture_output=True, text=True,
                                timeout=60)
-            path = r.stdout.strip()
-            st = os.stat(path)
-            _libc[key] = f"{path} {st.st_size} {st.st_mtime_ns}"
+            _libc[key] = r.stdout.strip()
         except (OSError, subprocess.TimeoutExpired):
-            _libc[key] = ""
-    return _libc[key]
+            return ""
+    try:
+        st = os.stat(_libc[key])
+    except OSError:
+        return ""
+    return f"{_libc[key]} {st.st_size} {st.st_mtime_ns}"
+
+
+AVR_TOOLS = ("avr-gcc", "avr-g++", "avr-gcc-ar", "avr-objcopy")  # mk/build.mk's AVR_CC, AVR_CXX, AVR_AR, AVR_OBJCOPY
+
+
+def avr_tools_key(mcu: str) -> str:
+    """mk/build.mk's AVR_TOOLS_KEY for its default tools: the hash of each
+    one's identity (path, size, date, version) and of the C library's
+    (path, size, date) for `mcu`. A tool replaced or upgraded is another
+    key, and make rebuilds as it would have found by asking the tools
+    itself."""
+    from fswkit.run.native import compiler_identity
+
+    h = hashlib.sha256(b"fswkit avr tools 1\0")
+    for tool in AVR_TOOLS:
+        h.update(compiler_identity(tool).encode() + b"\0")
+    h.update(_libc_identity("avr-gcc", mcu).encode() + b"\0")
+    return h.hexdigest()[:20]
 
 
 def avr_key(mcu: str, f_cpu: int, variant: str, define: str, arduino: str) -> str:

@@ -19,6 +19,7 @@ import shutil
 import pytest
 
 from conftest import EXAMPLES
+from support.simfw import kept_folder
 from support.tools import rocket_with_reload
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
@@ -69,7 +70,7 @@ def test_the_link_s_service_between_cycles_makes_none_late_at_9600_baud_through_
     _check(r, "mission")
 
 
-def test_the_stand_vent_controller_uploaded_and_activated_at_100_hz_on_an_uno(tmp_path):
+def test_the_stand_vent_controller_uploaded_and_activated_at_100_hz_on_an_uno():
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.cli.machine import image_for
     from fswkit.reload.sim import timed_upload
@@ -78,7 +79,7 @@ def test_the_stand_vent_controller_uploaded_and_activated_at_100_hz_on_an_uno(tm
     d = Diagnostics()
     app = load(str(EXAMPLES / "stand"), d)
     assert app is not None, d.render()
-    built = firmware(app, str(tmp_path / "stand"))
+    built = firmware(app, str(kept_folder(EXAMPLES / "stand", "uno")))  # kept between runs
     assert built.fits, built.report
     got = image_for(app, str(EXAMPLES / "stand" / "tank_700.sm"), d)
     assert got is not None, d.render()

@@ -30,6 +30,7 @@ from fswkit.link import wire
 from fswkit.link.session import Session
 from support.core_rocket import build_core, core_project
 from support.linkfw import hello_seq, tank_layout
+from support.simfw import OUT
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -47,16 +48,22 @@ def core(tmp_path_factory):
 
 def _serial_core(tmp_path_factory):
     """The core rocket generated for the Mega and built with its console on
-    the core's Serial (mk/build.mk's EXTRA_DEFS): (project, elf)."""
-    tmp = tmp_path_factory.mktemp("core-serial")
-    project = core_project(tmp)
-    gen = tmp / "gen"
-    r = run_fsw("gen", str(project), "--board", "mega2560", "--out", str(gen))
-    assert r.code == 0, r.err
-    out = tmp / "out"
-    p = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
-                        "NAME=rocket", "avr", "EXTRA_DEFS=-DFSW_CONSOLE_ARDUINO_SERIAL=1"] + MEGA,
-                       capture_output=True, text=True)
+    the core's Serial (mk/build.mk's EXTRA_DEFS): (project, elf). Built
+    into build/sim-tests/ as support.core_rocket builds the Uno's (kept
+    between runs: make rebuilds what changed, and nothing when nothing did)."""
+    from fswkit.target.build import build_lock
+    from fswkit.target.libcache import avr_tools_key
+
+    project = core_project(tmp_path_factory.mktemp("core-serial"))
+    out = OUT / "core-rocket-mega2560-console-serial"
+    gen = out / "gen"
+    with build_lock(str(out), "test"):  # another test session may build it too
+        r = run_fsw("gen", str(project), "--board", "mega2560", "--out", str(gen))
+        assert r.code == 0, r.err
+        p = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
+                            "NAME=rocket", "avr", "EXTRA_DEFS=-DFSW_CONSOLE_ARDUINO_SERIAL=1",
+                            f"AVR_TOOLS_KEY={avr_tools_key('atmega2560')}"] + MEGA,
+                           capture_output=True, text=True)
     assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-4000:]
     return project, out / "rocket.elf"
 

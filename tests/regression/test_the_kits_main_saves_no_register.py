@@ -12,20 +12,21 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
-from conftest import EXAMPLES, run_fsw
+from conftest import EXAMPLES
+from support.simfw import project_elf
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed")
 
 
-def test_the_rockets_main_pushes_nothing_for_its_caller(tmp_path):
-    r = run_fsw("build", str(EXAMPLES / "rocket"), "--board", "uno", "--out", str(tmp_path / "out"))
-    assert r.code == 0, r.err
-    gen = (tmp_path / "out" / "gen" / "app.gen.cpp").read_text()
+def test_the_rockets_main_pushes_nothing_for_its_caller():
+    elf = Path(project_elf(str(EXAMPLES / "rocket"), "uno"))  # kept between runs (support.simfw)
+    gen = (elf.parent / "gen" / "app.gen.cpp").read_text()
     assert "__attribute__((OS_main)) int main() {" in gen
-    dis = subprocess.run(["avr-objdump", "-d", str(tmp_path / "out" / "rocket.elf")], capture_output=True,
+    dis = subprocess.run(["avr-objdump", "-d", str(elf)], capture_output=True,
                          text=True, check=True).stdout
     body = dis[dis.index("<main>:\n"):]
     head = [line.split("\t")[2] for line in body.splitlines()[1:12] if line.count("\t") >= 2]

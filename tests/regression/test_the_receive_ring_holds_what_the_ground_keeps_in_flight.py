@@ -27,6 +27,7 @@ from fswkit.link.layout import from_app
 from fswkit.link.session import Session
 from fswkit.param.client import RX_CAP
 from support.core_rocket import build_core, core_project
+from support.simfw import project_elf
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -60,11 +61,10 @@ def test_one_command_in_flight_fits_the_ring():
     assert burst == 27 and ring == 32 and burst <= ring - 1  # one free slot tells full from empty
 
 
-def test_the_ring_is_sized_for_the_ground(core, tmp_path):
+def test_the_ring_is_sized_for_the_ground(core):
     assert _ring(core[1]) == 32  # no parameters, no reload: one command in flight
-    r = run_fsw("build", str(ROCKET), "--out", str(tmp_path / "uno"))
-    assert r.code == 0, r.err
-    assert _ring(tmp_path / "uno" / "rocket.elf") == 64  # parameters: the client pipelines
+    elf = project_elf(str(ROCKET), "uno")  # kept between runs (support.simfw)
+    assert _ring(elf) == 64  # parameters: the client pipelines
 
 
 def test_a_telemetry_only_application_keeps_the_smallest_ring(tmp_path):

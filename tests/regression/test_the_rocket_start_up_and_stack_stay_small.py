@@ -13,6 +13,7 @@ from __future__ import annotations
 import shutil
 import struct
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -23,6 +24,7 @@ from fswkit.autocode.numeric import F32MODE
 from fswkit.link import wire
 from fswkit.link.session import Session
 from support.linkfw import control_commands, hello_seq, send_one_at_a_time, tank_layout
+from support.simfw import project_elf
 
 sim = pytest.importorskip("fswkit.sim.board")
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or shutil.which("simavr") is None,
@@ -40,11 +42,8 @@ def _symbols(elf) -> dict[str, str]:
 
 
 @pytest.fixture(scope="module")
-def rocket(tmp_path_factory):
-    out = tmp_path_factory.mktemp("rocket")
-    r = run_fsw("build", str(ROCKET), "--out", str(out))
-    assert r.code == 0, r.err
-    return out / "rocket.elf"
+def rocket():
+    return Path(project_elf(str(ROCKET), "uno"))  # kept between runs (support.simfw)
 
 
 def test_a_firmware_without_pwm_links_no_timer0_tick(rocket):

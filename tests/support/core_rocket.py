@@ -1,7 +1,10 @@
 """The core rocket: examples/rocket as issue 17's size target measured it,
 without the recorder, the parameters and the pyro channels that came after
 (tools/bench_firmware.py core, whose own edit of the configs this is), built
-for the Uno once per test process and shared by the files that read it."""
+for the Uno once per test process and shared by the files that read it,
+into build/sim-tests/ (kept between runs as support.simfw keeps its
+builds: the generated code does not name the project's folder, so a run
+that changed nothing finds the firmware up to date and links nothing)."""
 
 from __future__ import annotations
 
@@ -31,11 +34,13 @@ def build_core(tmp_path_factory) -> tuple[Path, Path]:
     """(the core rocket's project, its `fsw build --out` folder: rocket.elf,
     gen/), built the first time a test of this process asks. Tests read
     them and never change them."""
+    from support.simfw import OUT
+
     global _built
     if _built is None:
-        tmp = tmp_path_factory.mktemp("core")
-        project = core_project(tmp)
-        r = run_fsw("build", str(project), "--out", str(tmp / "uno"))
+        project = core_project(tmp_path_factory.mktemp("core"))
+        out = OUT / "core-rocket-uno"
+        r = run_fsw("build", str(project), "--out", str(out))
         assert r.code == 0, r.err
-        _built = project, tmp / "uno"
+        _built = project, out
     return _built

@@ -121,7 +121,7 @@ def sketch_elf(name: str, source: str, board: str = "uno", defines: tuple[str, .
     archives compiled once for every build of the board, not again in
     each sketch's folder (about 1.5 s of CPU a sketch on a fresh clone)."""
     from fswkit.target.build import ARDUINO, build_lock
-    from fswkit.target.libcache import make_vars
+    from fswkit.target.libcache import avr_tools_key, make_vars
 
     out = OUT / (f"{name}-{board}" + "".join(f"-{d.lower().replace('=', '')}" for d in defines))
     gen = out / "src"
@@ -130,11 +130,11 @@ def sketch_elf(name: str, source: str, board: str = "uno", defines: tuple[str, .
         path = gen / f"{name}.cpp"
         if not path.exists() or path.read_text() != source:
             path.write_text(source)
-        cached = []
+        avr = dict(arg.split("=", 1) for arg in BOARD_MAKE[board])
+        cached = [f"AVR_TOOLS_KEY={avr_tools_key(avr['MCU'])}"]  # as `fsw build` passes it
         if not defines:  # the cache's archives are the board's without EXTRA_DEFS
-            avr = dict(arg.split("=", 1) for arg in BOARD_MAKE[board])
-            cached = [f"LIBS={out / v[5:]}" if v.startswith("LIBS=") else v  # make runs outside `out` here
-                      for v in make_vars(str(out), dict(avr, F_CPU=int(avr["F_CPU"]), ARDUINO=ARDUINO), 2)]
+            cached += [f"LIBS={out / v[5:]}" if v.startswith("LIBS=") else v  # make runs outside `out` here
+                       for v in make_vars(str(out), dict(avr, F_CPU=int(avr["F_CPU"]), ARDUINO=ARDUINO), 2)]
         r = subprocess.run(["make", "--no-print-directory", "-j2", "-f", str(BUILD_MK), f"GEN={gen}", f"OUT={out}",
                             f"NAME={name}", "avr", "EXTRA_DEFS=" + " ".join(f"-D{d}" for d in defines)]
                            + BOARD_MAKE[board] + cached, capture_output=True, text=True)

@@ -24,6 +24,7 @@ import shutil
 import pytest
 
 from conftest import EXAMPLES
+from support.simfw import kept_folder
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -36,14 +37,14 @@ def volts_g(g: float) -> float:
 
 
 @pytest.fixture(scope="module")
-def rocket(tmp_path_factory):
+def rocket():
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.target.build import firmware, load
 
     d = Diagnostics()
     app = load(str(EXAMPLES / "rocket" / "rocket.app"), d)
     assert app is not None, d.render()
-    built = firmware(app, str(tmp_path_factory.mktemp("rocket")))
+    built = firmware(app, str(kept_folder(EXAMPLES / "rocket", "uno")))  # kept between runs (support.simfw)
     assert built.fits, built.report
     return app, built.artifact
 

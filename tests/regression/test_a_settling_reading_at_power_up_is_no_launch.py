@@ -18,6 +18,7 @@ import shutil
 import pytest
 
 from conftest import EXAMPLES
+from support.simfw import kept_folder
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -31,7 +32,7 @@ ARMED, BOOST = 2, 3
 
 
 @pytest.mark.parametrize("name", sorted(EXAMPLE))
-def test_a_settling_reading_at_power_up_with_the_key_on_is_no_launch(tmp_path, name):
+def test_a_settling_reading_at_power_up_with_the_key_on_is_no_launch(name):
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.link.layout import from_app
     from fswkit.link.session import Session
@@ -42,7 +43,7 @@ def test_a_settling_reading_at_power_up_with_the_key_on_is_no_launch(tmp_path, n
     d = Diagnostics()
     app = load(str(EXAMPLES / name / f"{name}.app"), d)
     assert app is not None, d.render()
-    built = firmware(app, str(tmp_path / "out"))
+    built = firmware(app, str(kept_folder(EXAMPLES / name, "uno")))  # kept between runs (support.simfw)
     assert built.fits, built.report
     volts, pad = EXAMPLE[name]
     b = SimBoard(built.artifact, "uno", uart="control", sim_limit=60,

@@ -23,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES, ROOT
+from support.simfw import kept_folder
 
 pytestmark = pytest.mark.skipif(shutil.which("avr-g++") is None or not os.path.exists("/usr/include/simavr/sim_avr.h"),
                                 reason="gcc-avr and libsimavr-dev are needed (make setup)")
@@ -38,13 +39,13 @@ def volts(psi: float) -> float:
 
 
 @pytest.fixture(scope="module")
-def stand(tmp_path_factory):
+def stand():
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.target.build import firmware, load
 
     app = load(str(STAND), Diagnostics())
     assert app is not None and app.reload is not None
-    built = firmware(app, str(tmp_path_factory.mktemp("stand")))
+    built = firmware(app, str(kept_folder(STAND, "uno")))  # kept between runs (support.simfw)
     assert built.fits, built.report
     return app, built.artifact
 

@@ -24,7 +24,7 @@ import shutil
 import pytest
 
 from conftest import ROOT, run_fsw
-from support.simfw import toggle_uno  # noqa: F401
+from support.simfw import OUT, toggle_uno  # noqa: F401
 
 from fswkit.sim.board import SimBoard
 
@@ -72,9 +72,10 @@ def test_no_cycle_is_late_where_the_lead_counts_more(tmp_path, rate):
     shutil.copytree(ROOT / "tests" / "sim" / "toggle", proj)
     app = proj / "toggle.app"
     app.write_text(app.read_text().replace("rate  1000", f"rate  {rate}").replace("rate=1000", f"rate={rate}"))
-    r = run_fsw("build", str(proj), "--board", "uno", "--out", str(tmp_path / "out"))
+    out = OUT / f"toggle-{rate}hz-uno"  # kept between runs (support.simfw): the same configs, nothing to relink
+    r = run_fsw("build", str(proj), "--board", "uno", "--out", str(out))
     assert r.code == 0, r.err
-    elf = str(tmp_path / "out" / "toggle.elf")
+    elf = str(out / "toggle.elf")
     period = MS * 1000 // rate
     with SimBoard(elf, "uno", sim_limit=10) as b:
         b.watch(13)

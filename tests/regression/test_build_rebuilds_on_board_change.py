@@ -7,6 +7,7 @@ dependency files for headers), and nothing else does."""
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import struct
@@ -76,10 +77,25 @@ def _stamps(out: Path) -> dict[str, int]:
 
 
 @pytest.fixture(scope="module")
-def sketch(tmp_path_factory):
+def sketch():
     """A sketch and a private copy of the Arduino core (whose headers the
-    tests change)."""
-    root = tmp_path_factory.mktemp("rebuild")
+    tests change), made afresh in each run at one place in build/sim-tests/
+    (held while the module runs): the objects are compiled from sources at
+    the same paths in every run, which ccache, where the build uses it,
+    then serves (from a new temporary folder each run, every one of them
+    was compiled again)."""
+    from support.simfw import OUT
+
+    OUT.mkdir(parents=True, exist_ok=True)
+    root = OUT / "rebuild-on-board-change"
+    with open(f"{root}.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        shutil.rmtree(root, ignore_errors=True)
+        root.mkdir()
+        yield _sketch(root)
+
+
+def _sketch(root: Path):
     arduino = root / "arduino"
     shutil.copytree(ARDUINO / "cores", arduino / "cores")
     for v in ("standard", "eightanaloginputs", "mega"):

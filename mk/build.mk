@@ -170,14 +170,26 @@ $(OUT)/$(NAME).overflow.elf: $(GEN_OBJS) $(ARCHIVES) $(CONFIG)
 -include $(CORE_OBJS:.o=.d) $(RT_OBJS:.o=.d) $(GEN_OBJS:.o=.d)
 
 # ---- host executable ----------------------------------------------------------
+# Each source its own object (in OUT/native/, headers decided per object by
+# -MMD -MP, as above), then the link: an edited source recompiles alone,
+# and a compiler cache (ccache) can keep every object, which it cannot for
+# a command that compiles several sources at once.
 native: $(OUT)/$(NAME)
+NATIVE_GEN_OBJS := $(patsubst $(GEN)/%.cpp,$(OUT)/native/gen/%.o,$(GEN_SRCS))
+NATIVE_CONFIG_DEPS := $(NATIVE_STAMP) $(THIS_MK)
+$(OUT)/native/gen/%.o: $(GEN)/%.cpp $(NATIVE_CONFIG_DEPS)
+	@mkdir -p $(@D)
+	$(HOST_CXX) $(NATIVE_FLAGS) $(DEPS) -I$(RUNTIME) -I$(GEN) -c $< -o $@
 ifneq ($(NATIVE_RT),)
 NATIVE_RT_OBJS := $(sort $(wildcard $(NATIVE_RT)/*.o))
-$(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_RT_OBJS) $(wildcard $(GEN)/*.h) $(RT_HDRS) $(NATIVE_STAMP) $(THIS_MK)
-	@mkdir -p $(@D)
-	$(HOST_CXX) $(NATIVE_FLAGS) -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_RT_OBJS) -pthread
 else
-$(OUT)/$(NAME): $(GEN_SRCS) $(NATIVE_SRCS) $(wildcard $(GEN)/*.h) $(RT_HDRS) $(NATIVE_STAMP) $(THIS_MK)
+NATIVE_RT_OBJS := $(patsubst $(RUNTIME)/%.cpp,$(OUT)/native/rt/%.o,$(NATIVE_SRCS))
+$(OUT)/native/rt/%.o: $(RUNTIME)/%.cpp $(NATIVE_CONFIG_DEPS)
 	@mkdir -p $(@D)
-	$(HOST_CXX) $(NATIVE_FLAGS) -I$(RUNTIME) -I$(GEN) -o $@ $(GEN_SRCS) $(NATIVE_SRCS) -pthread
+	$(HOST_CXX) $(NATIVE_FLAGS) $(DEPS) -I$(RUNTIME) -I$(GEN) -c $< -o $@
 endif
+$(OUT)/$(NAME): $(NATIVE_GEN_OBJS) $(NATIVE_RT_OBJS) $(NATIVE_CONFIG_DEPS)
+	@mkdir -p $(@D)
+	$(HOST_CXX) $(NATIVE_FLAGS) -o $@ $(NATIVE_GEN_OBJS) $(NATIVE_RT_OBJS) -pthread
+
+-include $(NATIVE_GEN_OBJS:.o=.d) $(filter $(OUT)/native/%,$(NATIVE_RT_OBJS:.o=.d))

@@ -169,6 +169,25 @@ def _key(cxx: str, bits: int) -> str:
 
 
 _build_lock = threading.Lock()
+LINK_ONLY = ("-shared",)  # with the -Wl, options: LIB_CXXFLAGS's for the link alone
+
+
+def _build_step(cmd: list[str], cwd: str, bits: int) -> None:
+    """One compiler run of the library's build, in `cwd`: a failure is
+    BuildError, said as the disk's when the disk is full."""
+    from fswkit.run import native
+
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
+    if r.returncode != 0:
+        from fswkit.outputs import host_write_faults
+
+        full = host_write_faults((r.stdout + r.stderr).splitlines())
+        if full:  # the disk, not the kit
+            raise BuildError(f"cannot write libfswsm{bits} into the kit's cache {native.cache_dir()}: "
+                             f"{'; '.join(full)} (FSW_CACHE_DIR names another folder)")
+        errors = [ln.strip()[:300] for ln in r.stderr.splitlines() if "error" in ln]
+        raise BuildError(f"libfswsm{bits} did not compile (a defect of fswkit, or an unusual compiler): "
+                         + " ".join(cmd) + "".join("\n  " + e for e in errors[:6]))
 
 
 def library_path(real: str = "f64") -> str:
@@ -193,19 +212,18 @@ def library_path(real: str = "f64") -> str:
         tmp = native.private_tmp(out)
         with native.removed_when_done(tmp):
             os.makedirs(tmp, exist_ok=True)
-            cmd = ([cxx] + LIB_CXXFLAGS + native.compiler_flags(cxx) + native.FLAGS[bits] + ["-I", RUNTIME, "-I", HOST]
-                   + sources() + ["-o", os.path.join(tmp, os.path.basename(lib))])
-            r = subprocess.run(cmd, capture_output=True, text=True)
-            if r.returncode != 0:
-                from fswkit.outputs import host_write_faults
-
-                full = host_write_faults((r.stdout + r.stderr).splitlines())
-                if full:  # the disk, not the kit
-                    raise BuildError(f"cannot write libfswsm{bits} into the kit's cache {native.cache_dir()}: "
-                                     f"{'; '.join(full)} (FSW_CACHE_DIR names another folder)")
-                errors = [ln.strip()[:300] for ln in r.stderr.splitlines() if "error" in ln]
-                raise BuildError(f"libfswsm{bits} did not compile (a defect of fswkit, or an unusual compiler): "
-                                 + " ".join(cmd) + "".join("\n  " + e for e in errors[:6]))
+            # each source its own object (in the temporary folder, removed
+            # once linked), then the link: a compiler cache (ccache) can keep
+            # every object, which it cannot for one command of several sources
+            flags = LIB_CXXFLAGS + native.compiler_flags(cxx) + native.FLAGS[bits]
+            os.makedirs(os.path.join(tmp, "obj"))
+            objs = []
+            for src in sources():
+                objs.append(os.path.join("obj", os.path.basename(src)[:-4] + ".o"))
+                _build_step([cxx] + [f for f in flags if f not in LINK_ONLY and not f.startswith("-Wl,")]
+                            + ["-I", RUNTIME, "-I", HOST, "-c", src, "-o", objs[-1]], tmp, bits)
+            _build_step([cxx] + flags + objs + ["-o", os.path.basename(lib)], tmp, bits)
+            shutil.rmtree(os.path.join(tmp, "obj"))
             try:
                 os.replace(tmp, out)
             except OSError:  # another process built the same library first

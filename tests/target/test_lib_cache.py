@@ -214,7 +214,22 @@ def test_a_native_build_links_the_runtimes_objects(fsw, tmp_path, monkeypatch):
     assert r.code == 0, r.err
     log = (out / "build.log").read_text()
     assert "NATIVE_RT=fsw-libs" in log and "fsw-libs/fsw_machine.o" in log
-    assert not any(" -c " in line or "firmware/src/fsw_machine.cpp" in line for line in log.splitlines()[1:])
+    # only the generated sources are compiled (one object each), no runtime source
+    compiles = [line for line in log.splitlines()[1:] if " -c " in line]
+    assert compiles and all(" -c gen/" in line for line in compiles), compiles
+    assert not any("firmware/src/fsw_machine.cpp" in line for line in log.splitlines()[1:])
+    # an object per source, then the link: the executable byte for byte the
+    # one a single command of the same flags makes of the sources and objects
+    link = log.splitlines()[-1].split()
+    assert link[-1] == "-pthread" and "-o" in link, link
+    flags = link[1:link.index("-o")]
+    runtime = log.splitlines()[0].split("RUNTIME=", 1)[1].split()[0]
+    one = subprocess.run([link[0], *flags, f"-I{runtime}", "-Igen", "-o", "tank.one",
+                          *sorted(f"gen/{p.name}" for p in (out / "gen").glob("*.cpp")),
+                          *sorted(f"fsw-libs/{p.name}" for p in (out / "fsw-libs").glob("*.o")), "-pthread"],
+                         capture_output=True, text=True, cwd=out)
+    assert one.returncode == 0, one.stderr
+    assert (out / "tank.one").read_bytes() == (out / "tank").read_bytes()
     # with a cache it cannot write, the build compiles the runtime itself
     _blocked(tmp_path, monkeypatch)
     alone = tmp_path / "alone"

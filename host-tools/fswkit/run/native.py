@@ -136,8 +136,9 @@ def runtime_objects(real: Real) -> list[str]:
     tmp = private_tmp(out)
     with removed_when_done(tmp):
         os.makedirs(tmp, exist_ok=True)
-        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-c"]
-                 + runtime_sources(), out, cwd=tmp)
+        for src in runtime_sources():  # one object a command: a compiler cache (ccache) can keep each
+            _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-c", src,
+                     "-o", os.path.basename(src)[:-4] + ".o"], out, cwd=tmp)
         try:
             os.replace(tmp, out)
         except OSError:  # another process compiled the same runtime first
@@ -162,9 +163,20 @@ def compile_script(script: M.Script, real: Real, source_line) -> str:
         for name, text in files.items():
             with open(os.path.join(tmp, name), "w") as f:
                 f.write(text)
-        cpp = [os.path.join(tmp, n) for n in sorted(files) if n.endswith(".cpp")]
-        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", tmp] + cpp
-                 + runtime_objects(real) + ["-o", os.path.join(tmp, "runner")], out)
+        # Each generated source its own object (removed once linked), then
+        # the link: compiled in the temporary folder under names relative to
+        # it, so a compiler cache (ccache) finds the same command and source
+        # wherever the folder is, which it cannot for one command of
+        # several sources.
+        os.makedirs(os.path.join(tmp, "obj"))
+        objs = []
+        for name in sorted(n for n in files if n.endswith(".cpp")):
+            objs.append(os.path.join("obj", name[:-4] + ".o"))
+            _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", ".", "-c",
+                     name, "-o", objs[-1]], out, cwd=tmp)
+        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + objs + runtime_objects(real)
+                 + ["-o", "runner"], out, cwd=tmp)
+        shutil.rmtree(os.path.join(tmp, "obj"))
         try:
             os.replace(tmp, out)
         except OSError:  # another process built the same runner first

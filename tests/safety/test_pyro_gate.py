@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
+from support import cxx
 from support.caches import native_runtime
 
 needs_cxx = pytest.mark.skipif(shutil.which("g++") is None, reason="no host C++ compiler")
@@ -118,10 +119,10 @@ def firmware(tmp_path_factory) -> Path:
     assert r.code == 0, r.err
     (d / "main.cpp").write_text(MAIN)
     exe = d / "fw"  # linked with the runtime's objects as a native build links them
-    subprocess.run(["g++", "-std=c++11", "-O1", "-fno-exceptions", "-fno-rtti", "-DFSW_NO_MAIN",
-                    f"-I{ROOT / 'firmware' / 'src'}", f"-I{d / 'gen'}", str(d / "main.cpp"),
-                    *sorted(str(p) for p in (d / "gen").glob("*.cpp")), *native_runtime(), "-o", str(exe)],
-                   check=True, capture_output=True)
+    r = cxx.program(["-std=c++11", "-O1", "-fno-exceptions", "-fno-rtti", "-DFSW_NO_MAIN",
+                     f"-I{ROOT / 'firmware' / 'src'}", "-Igen"], [d / "main.cpp", *sorted((d / "gen").glob("*.cpp"))],
+                    exe, d, native_runtime())
+    assert r.returncode == 0, r.stderr[-3000:]
     return exe
 
 

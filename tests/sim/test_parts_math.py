@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from fswkit.sim import parts as P
+from support import cxx
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "firmware" / "src"
@@ -103,9 +104,10 @@ def driver(tmp_path_factory) -> Path:
     d = tmp_path_factory.mktemp("parts")
     (d / "driver.cpp").write_text(DRIVER)
     exe = d / "driver"
-    subprocess.run(["g++", "-std=c++11", "-O2", "-fno-exceptions", "-fno-rtti", "-fsanitize=undefined",
-                    "-fno-sanitize-recover=all", "-Wall", "-Wextra", "-Werror", f"-I{SRC}", str(d / "driver.cpp"),
-                    str(SRC / "fsw_parts.cpp"), "-o", str(exe)], check=True, capture_output=True, text=True)
+    r = cxx.program(["-std=c++11", "-O2", "-fno-exceptions", "-fno-rtti", "-fsanitize=undefined",
+                     "-fno-sanitize-recover=all", "-Wall", "-Wextra", "-Werror", f"-I{SRC}"],
+                    [d / "driver.cpp", SRC / "fsw_parts.cpp"], exe, d)
+    assert r.returncode == 0, r.stderr[-3000:]
     return exe
 
 

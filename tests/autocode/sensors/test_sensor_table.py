@@ -17,6 +17,7 @@ import pytest
 from conftest import EXAMPLES, ROOT, run_fsw
 from fswkit.autocode.emit.app import emit_app, sensor_args
 from fswkit.autocode.sensors import sensor_name
+from support import cxx
 from support.caches import native_runtime
 from support.sensor_project import load, write_project
 
@@ -158,9 +159,9 @@ def test_a_native_bmp280_app_writes_the_pressure_element(tmp_path):
     (tmp_path / "main.cpp").write_text(MAIN)
     runtime = ROOT / "firmware" / "src"
     exe = tmp_path / "app"  # linked with the runtime's objects as a native build links them
-    r = subprocess.run(["g++", "-std=gnu++11", "-O1", "-fno-exceptions", "-fno-rtti", "-Wall", "-Wextra", "-Werror",
-                        "-DFSW_NO_MAIN", f"-I{runtime}", f"-I{gen}", "-o", str(exe), *map(str, gen.glob("*.cpp")),
-                        str(tmp_path / "main.cpp"), *native_runtime(), "-pthread"], capture_output=True, text=True)
+    r = cxx.program(["-std=gnu++11", "-O1", "-fno-exceptions", "-fno-rtti", "-Wall", "-Wextra", "-Werror",
+                     "-DFSW_NO_MAIN", f"-I{runtime}", "-Igen"], [*sorted(gen.glob("*.cpp")), tmp_path / "main.cpp"],
+                    exe, tmp_path, native_runtime(), ["-pthread"])
     assert r.returncode == 0, r.stderr[-3000:]
     out = subprocess.run([str(exe)], capture_output=True, text=True, check=True, cwd=tmp_path).stdout.splitlines()
     boot, answering, gone = (ln.split() for ln in out)

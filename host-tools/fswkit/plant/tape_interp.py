@@ -104,15 +104,22 @@ def analog_inputs(cfg, columns: dict) -> tuple[dict, dict]:
     value all the replay, for the igniters' continuity inputs), each the
     board's count (the same counts and millivolts as tape_replay gives the
     board) through the calibration in binary32."""
-    series = {}
+    series, constant, _counts = _analog_inputs(cfg, columns)
+    return series, constant
+
+
+def _analog_inputs(cfg, columns: dict) -> tuple[dict, dict, dict]:
+    """analog_inputs' (series, constant), and the counts they were read
+    from (column -> counts_series; the replay's `counts`)."""
+    series, counts = {}, {}
     for col, s in cfg.sensors.items():
         if s is None:
             continue
-        counts = counts_series(columns[col], s, cfg.missing, cfg.silent_volts)
-        series[s.element] = _readings(s, counts.tolist())
+        counts[col] = counts_series(columns[col], s, cfg.missing, cfg.silent_volts)
+        series[s.element] = _readings(s, counts[col].tolist())
     constant = {ig.sensor.element: _reading(ig.sensor, ig.counts) for ig in getattr(cfg, "igniters", {}).values()}
     series.update(part_inputs(cfg, columns))
-    return series, constant
+    return series, constant, counts
 
 
 def part_inputs(cfg, columns: dict) -> dict:
@@ -187,7 +194,7 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     t = tape.time
     cols = columns if columns is not None else _columns(tape)
     offset = cfg.pad_s - float(t[0])
-    values, constant = analog_inputs(cfg, cols)
+    values, constant, counts = _analog_inputs(cfg, cols)
     arm = _element_of(app, cfg.arm_pin)
     pins = [(role, _element_of(app, p), p) for role, p in (("drogue", cfg.drogue_pin), ("main", cfg.main_pin))
             if p is not None]
@@ -197,7 +204,9 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     sv = {e.name: (0.0 if e.type.kind == "float" else 0) for e in app.sv.elements}
     k_mission = app.machines.index(mission)
     states = mission.states
-    at_row = t + offset
+    at_row = (t + offset).tolist()  # (each step compares with a row's time: Python floats, the same values)
+    n_rows = len(at_row)
+    inputs = list(values.items())
     end_s = float(t[-1]) + offset + cfg.run_on_s
     steps = int(end_s * 1000) // step_ms
     run = Run(columns=())
@@ -208,10 +217,11 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
         g = k * step_ms
         now = g / 1000.0
         sampled = (k - 1) * step_ms / 1000.0  # the previous step's scan (the first step's: at boot)
-        while row + 1 < len(t) and at_row[row + 1] <= sampled:
+        while row + 1 < n_rows and at_row[row + 1] <= sampled:
             row += 1
-        for name, series in values.items():
-            sv[name] = series[max(row, 0)]
+        r0 = max(row, 0)
+        for name, series in inputs:
+            sv[name] = series[r0]
         sv.update(constant)  # the igniters: intact all the replay (open loop)
         if arm is not None:
             sv[arm] = now >= cfg.arm_s
@@ -238,8 +248,6 @@ def replay(app, cfg, tape, *, truth=None, columns: dict | None = None) -> Replay
     run.steps = steps
     run.sim_s = end_s
     th = smoothed_altitude(tape, _pad(tape, truth))
-    counts = {c: counts_series(cols[c], s, cfg.missing, cfg.silent_volts) for c, s in cfg.sensors.items()
-              if s is not None}
     return Replay(run, offset, counts, {c: missing_spans(t, v) for c, v in _columns(tape).items()}, *th)
 
 

@@ -666,17 +666,27 @@ def counts_series(values: np.ndarray, sensor: AnalogSensor, missing: str, silent
     """The converter's count at each row: the value through the sensor; an
     empty cell holds the last count ("hold"; before the first value, the
     first value's) or reads `silent_volts` ("silent")."""
-    out = np.empty(values.size, dtype=np.int64)
     silent = sensor.counts(silent_volts)
     have = ~np.isnan(values)
     first = sensor.count_of(float(values[have][0])) if have.any() else silent
     last = first if missing == "hold" else silent
-    for i, v in enumerate(values.tolist()):
+    hold = missing == "hold"
+    # each distinct value's count worked out once (count_of is a pure function of it; a tape's rows repeat
+    # a few thousand values), the counts gathered in a list and made an array at the end
+    memo: dict[float, int] = {}
+    count_of = sensor.count_of
+    out = []
+    append = out.append
+    for v in values.tolist():
         if v != v:
-            out[i] = last if missing == "hold" else silent
+            append(last if hold else silent)
         else:
-            last = out[i] = sensor.count_of(v)
-    return out
+            c = memo.get(v)
+            if c is None:
+                c = memo[v] = count_of(v)
+            last = c
+            append(c)
+    return np.array(out, dtype=np.int64)
 
 
 # ---- the replay ----------------------------------------------------------------------------

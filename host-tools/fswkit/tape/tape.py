@@ -335,22 +335,43 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
     if not rows:
         err.at(n + 1, len(column_line) + 1, "no data rows after the column line")
         err.raise_if_any()
-    t = np.empty(len(rows))
-    p = np.empty(len(rows))
-    a = np.empty(len(rows))
+    # the columns gathered as Python floats, made arrays at the end
+    t: list[float] = []
+    p: list[float] = []
+    a: list[float] = []
     names = COLUMNS
     prev = -math.inf
+    isfinite, nan = math.isfinite, math.nan
     for i, line in enumerate(rows):
         ln = first + i
         if line.startswith("#"):
             err.at(ln, 1, "a `#` line among the data rows: header lines come before the column line")
-            t[i] = p[i] = a[i] = math.nan
+            t.append(math.nan), p.append(math.nan), a.append(math.nan)
             continue
         cells = line.split(",")
         if len(cells) != 3:
             err.at(ln, 1, f"expected 3 cells ({COLUMN_LINE}), found {len(cells)}")
-            t[i] = p[i] = a[i] = math.nan
+            t.append(math.nan), p.append(math.nan), a.append(math.nan)
             continue
+        # the usual row, read in one go: ASCII without `_`, each cell a finite number (float() of the cell
+        # is `number` of the stripped cell: float() strips no more than str.strip) or empty (math.nan; the
+        # time never); any other row is read cell by cell below, with its errors
+        c0, c1, c2 = cells
+        if line.isascii() and "_" not in line:
+            try:
+                tv, pv, av = float(c0), float(c1) if c1 else nan, float(c2) if c2 else nan
+            except ValueError:
+                pass
+            else:
+                if isfinite(tv) and (isfinite(pv) or not c1) and (isfinite(av) or not c2):
+                    t.append(tv), p.append(pv), a.append(av)
+                    if tv <= prev:
+                        err.at(ln, 1, f"time_s {cells[0].strip()} is not after the previous row's "
+                                      f"{prev:g}: times increase strictly")
+                    prev = max(prev, tv)
+                    if pv <= 0:
+                        err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
+                    continue
         col = 1
         values = []
         for k, cell in enumerate(cells):
@@ -366,14 +387,16 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
                 err.at(ln, col, "time_s is empty: every row needs its time")
             values.append(v)
             col += len(cell) + 1
-        t[i], p[i], a[i] = values
-        if not math.isnan(t[i]):
-            if t[i] <= prev:
+        tv, pv, av = values
+        t.append(tv), p.append(pv), a.append(av)
+        if not math.isnan(tv):
+            if tv <= prev:
                 err.at(ln, 1, f"time_s {cells[0].strip()} is not after the previous row's "
                               f"{prev:g}: times increase strictly")
-            prev = max(prev, t[i])
-        if not math.isnan(p[i]) and p[i] <= 0:
+            prev = max(prev, tv)
+        if not math.isnan(pv) and pv <= 0:
             err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
+    t, p, a = np.array(t, dtype=float), np.array(p, dtype=float), np.array(a, dtype=float)
     err.raise_if_any()
     _range_errors(err, rows, first, t, p, a)
     err.raise_if_any()

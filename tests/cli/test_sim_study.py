@@ -25,7 +25,7 @@ import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
 
-pytestmark = pytest.mark.costly(8)
+pytestmark = pytest.mark.costly(6)
 
 ROCKET = EXAMPLES / "rocket"
 DISPERSION = ROCKET / "dispersion.toml"

@@ -34,6 +34,7 @@ from __future__ import annotations
 from .appcheck import Parts, check_app, complete
 from .appsyntax import parse_app
 from .board import load_board
+from .collect import fewer_collections
 from .diagnostics import APP, Diagnostics, read_source
 from .limits import check_limits
 from .model import TASK_KINDS, TASK_MODES, Application, Channel, Stream, Task
@@ -41,6 +42,7 @@ from .model import TASK_KINDS, TASK_MODES, Application, Channel, Stream, Task
 __all__ = ["TASK_KINDS", "TASK_MODES", "Application", "Channel", "Stream", "Task", "application", "load_app"]
 
 
+@fewer_collections()
 def load_app(path: str, diags: Diagnostics, board_override: str | None = None,
              instead: dict[str, str] | None = None) -> Application | None:
     """The checked application with its state vector, machines and tables;

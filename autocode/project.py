@@ -7,6 +7,7 @@ import os
 
 from . import model as M
 from .check import check_literals, check_sm, check_ss, check_ss_alone, check_sv, machine_exprs, script_exprs
+from .collect import fewer_collections
 from .diagnostics import SM, SS, Diagnostics, Source, decode, read_input, read_source
 from .parser import parse_sm, parse_ss, parse_sv
 
@@ -51,6 +52,7 @@ def _app_state_vector(app: str) -> str | None:
     return rows[0].path if len(rows) == 1 else None
 
 
+@fewer_collections()
 def load_sv(path: str, diags: Diagnostics) -> M.StateVector | None:
     from .diagnostics import SV
 
@@ -60,6 +62,7 @@ def load_sv(path: str, diags: Diagnostics) -> M.StateVector | None:
     return check_sv(parse_sv(src, diags), src, diags)
 
 
+@fewer_collections()
 def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
                  warnings: bool = False) -> M.Machine | None:
     """The checked machine, or None with every error in `diags`."""
@@ -91,6 +94,7 @@ def load_machine(sm_path: str, diags: Diagnostics, sv_path: str | None = None,
     return m if not mine.errors else None
 
 
+@fewer_collections()
 def load_script(ss_path: str, diags: Diagnostics, sm_path: str | None = None,
                 sv_path: str | None = None, real=None) -> M.Script | None:
     """The checked script, or None with every error in `diags`. `real`: the

@@ -362,7 +362,15 @@ def run_case(files: tuple[bytes, bytes, bytes], workdir: str, cli: bool = False,
     """Runs one case; raises (AssertionError or the front end's own
     exception) when an invariant breaks. Loaders whose inputs did not
     change (`changed`: 0 .sv, 1 .sm, 2 .ss) are not run again on their own:
-    `load_script` still reads all three."""
+    `load_script` still reads all three. The collector runs as seldom as
+    in the loaders (fswkit.autocode.collect) for the whole case."""
+    from fswkit.autocode.collect import fewer_collections
+
+    with fewer_collections():
+        _run_case(files, workdir, cli, changed)
+
+
+def _run_case(files: tuple[bytes, bytes, bytes], workdir: str, cli: bool, changed: frozenset) -> None:
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.numeric import F32MODE, F64MODE
     from fswkit.autocode.project import load_machine, load_script, load_sv

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from fswkit.autocode import model as M
 from fswkit.autocode.check import failure_diagnostics
+from fswkit.autocode.collect import fewer_collections
 from fswkit.autocode.diagnostics import Diagnostic
 from fswkit.autocode.numeric import Real
 from fswkit.run.interp import ERR_TIME, MachineRun, _Emitter, compile_functions
@@ -84,11 +85,13 @@ def _compile(script: M.Script, real: Real):
     return ns, checks
 
 
+@fewer_collections()
 def run(script: M.Script, real: Real, trace_path: str | None = None, source_line=None,
         cover: bool = False) -> Result:
     """Runs a checked script. `source_line(path, line)` gives the text of a
     script line for the failure diagnostic. `cover`: the result names the
-    transitions taken and the states entered."""
+    transitions taken and the states entered. The collector runs as seldom
+    as in the loaders (fswkit.autocode.collect)."""
     m = script.machine
     run_ = MachineRun(m, real, script.init_state, cover=cover)
     ns, checks = _compile(script, real)

@@ -17,6 +17,7 @@ holds the case's configs (.sv/.sm/.ss) to reproduce it."""
 
 from __future__ import annotations
 
+import functools
 import os
 import shlex
 import shutil
@@ -40,13 +41,27 @@ needs_cxx = pytest.mark.skipif(shutil.which(shlex.split(H.default_cxx())[0]) is 
                                reason="no host C++ compiler")
 
 
+@functools.lru_cache(maxsize=2)
+def _loaded(n: int) -> tuple:
+    """The first `n` cases with their checked scripts and `source_line`s,
+    drawn and checked once for every test of the module that reads them."""
+    return tuple((c, *H.load(c)) for c in gp.cases(SEED, n))
+
+
+@functools.lru_cache(maxsize=1)
+def _raw_loaded() -> tuple[list, list]:
+    """The raw-input cases and their checked machines, for both modes."""
+    cases = [gp.machine_case(SEED, k) for k in range(RAW_CASES)]
+    return cases, [H.load_machine(c) for c in cases]
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     work = H.scratch_dir(str(tmp_path_factory.getbasetemp()))
     out = {"f64": [], "f32": [], "endings": {"passed": 0, "failed": 0}, "steps": 0}
     try:
-        cases = gp.cases(SEED, CASES)
-        loaded = [(c, *H.load(c)) for c in cases]
+        loaded = _loaded(CASES)
+        cases = [c for c, _, _ in loaded]
         with ThreadPoolExecutor(H.JOBS) as pool:
             batches = {}
             for mode in ("f64", "f32"):
@@ -100,8 +115,7 @@ def test_cases_exercise_the_vm(runs):
 @pytest.mark.parametrize("mode", ["f64", "f32"])
 def test_vm_matches_interpreter_on_raw_inputs(tmp_path, mode):
     real = REALS[mode]
-    cases = [gp.machine_case(SEED, k) for k in range(RAW_CASES)]
-    machines = [H.load_machine(c) for c in cases]
+    cases, machines = _raw_loaded()
     with ThreadPoolExecutor(H.JOBS) as pool:
         b = VmRawBatch(str(tmp_path), real, pool)
         for c, m in zip(cases, machines):
@@ -120,8 +134,7 @@ def test_vm_matches_interpreter_on_raw_inputs(tmp_path, mode):
 def test_every_generated_image_verifies():
     """The host verifier accepts every image the compiler writes, in both
     evaluation types, and refuses each one for the other type."""
-    for c in gp.cases(SEED, min(CASES, 200)):
-        s, _ = H.load(c)
+    for c, s, _ in _loaded(min(CASES, 200)):
         layout = V.layout_of(s.machine.sv)
         for mode in ("f64", "f32"):
             im = compile_machine(s.machine, REALS[mode])
@@ -137,8 +150,7 @@ def test_cases_exercise_the_typed_instructions():
 
     for mode, typed in (("f64", (V.JINT, V.SETK, V.IADD, V.JCMP)), ("f32", (V.JKEY, V.JINT, V.SETK, V.IADD, V.JCMP))):
         seen = Counter()
-        for c in gp.cases(SEED, min(CASES, 200)):
-            s, _ = H.load(c)
+        for c, s, _ in _loaded(min(CASES, 200)):
             seen.update(V.opcodes(compile_machine(s.machine, REALS[mode]), V.layout_of(s.machine.sv)))
         assert all(seen[op] >= 20 for op in typed), (mode, {hex(op): seen[op] for op in typed})
 
@@ -258,8 +270,7 @@ def test_stack_depth_bounds_what_the_verifier_finds():
                 yield from exprs(st.orelse)
 
     equal = 0
-    for c in gp.cases(SEED, min(CASES, 200)):
-        s, _ = H.load(c)
+    for c, s, _ in _loaded(min(CASES, 200)):
         m = s.machine
         deepest = max([stack_depth(e) for st in m.states for b in (st.entry, st.step, st.exit) for e in exprs(b)]
                       + [stack_depth(w.arg) for w in m.windows] + [0])

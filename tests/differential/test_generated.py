@@ -15,6 +15,7 @@ docs/differential.md says what is covered and what was found."""
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 import shlex
@@ -49,7 +50,7 @@ def runs(tmp_path_factory):
     for start in range(0, max(CASES, RAW_CASES), CHUNK):
         work = H.scratch_dir(str(tmp_path_factory.getbasetemp()))
         try:
-            _run_chunk(out, work, gp.cases(SEED, max(0, min(CHUNK, CASES - start)), start),
+            _run_chunk(out, work, _loaded(start, max(0, min(CHUNK, CASES - start))),
                        [gp.machine_case(SEED, k) for k in range(start, min(start + CHUNK, RAW_CASES))])
         finally:
             shutil.rmtree(work, ignore_errors=True)
@@ -58,8 +59,16 @@ def runs(tmp_path_factory):
     return out
 
 
-def _run_chunk(out: dict, work: str, cases: list, raw_cases: list) -> None:
-    loaded = [(c, *H.load(c)) for c in cases]
+@functools.lru_cache(maxsize=1)
+def _loaded(start: int, n: int) -> tuple:
+    """Cases start.. start + n - 1, each with its checked script and its
+    `source_line`: drawn and checked once for the fixture and the fast-path
+    count, whose first chunk they share (the last one drawn is kept)."""
+    return tuple((c, *H.load(c)) for c in gp.cases(SEED, n, start))
+
+
+def _run_chunk(out: dict, work: str, loaded: tuple, raw_cases: list) -> None:
+    cases = [c for c, _, _ in loaded]
     machines = [H.load_machine(c) for c in raw_cases]
     modes = ("f64", "f32")
     with ThreadPoolExecutor(H.JOBS) as pool:
@@ -194,8 +203,7 @@ def test_generator_reaches_the_fast_paths(monkeypatch):
                 bump("chain split, negated constant")
         return r
     monkeypatch.setattr(E, "cond", cond)
-    for c in gp.cases(SEED, min(CASES, 1000)):
-        script, source_line = H.load(c)
+    for c, script, source_line in _loaded(0, min(CASES, 1000)):
         files = emit_script.script_files(script, REALS["f32"], source_line)
         m = script.machine
         counts["folded local"] += sum(1 for v in m.vars if v.kind == M.LOCAL and f"L_{v.name} =" not in

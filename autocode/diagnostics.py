@@ -88,29 +88,36 @@ class Columns:
     """`visual_col` of one line at increasing indices, in time linear in the
     line (`visual_col` for every token of a long line with tabs was
     quadratic: a 100 KB line took seconds). Like `str.expandtabs`, a CR
-    counts one column and restarts the tab stops."""
+    counts one column and restarts the tab stops. The line's tabs and line
+    ends are found once: a call that passes none is a few additions."""
 
-    __slots__ = ("text", "index", "length", "pos")
+    __slots__ = ("stops", "k", "index", "length", "pos")
 
     def __init__(self, text: str):
-        self.text = text
+        # (index, is a tab) of every tab, CR or LF, in order
+        self.stops = [(m.start(), m.group() == "\t") for m in _TAB_OR_RESET.finditer(text)]
+        self.k = 0  # stops[k] is the first at or after `index`
         self.index = self.length = self.pos = 0  # expanded length and tab-stop position at `index`
 
     def __call__(self, index: int) -> int:
         if index < self.index:
-            self.index = self.length = self.pos = 0
-        i, length, pos = self.index, self.length, self.pos
-        for m in _TAB_OR_RESET.finditer(self.text, i, index):
-            k = m.start() - i
-            length, pos = length + k, pos + k
-            if m.group() == "\t":
+            self.k = self.index = self.length = self.pos = 0
+        i, length, pos, k = self.index, self.length, self.pos, self.k
+        stops = self.stops
+        n = len(stops)
+        while k < n and stops[k][0] < index:
+            at, tab = stops[k]
+            d = at - i
+            length, pos = length + d, pos + d
+            if tab:
                 step = TAB - pos % TAB
                 length, pos = length + step, pos + step
             else:
                 length, pos = length + 1, 0
-            i = m.end()
-        k = index - i
-        self.index, self.length, self.pos = index, length + k, pos + k
+            i = at + 1
+            k += 1
+        d = index - i
+        self.index, self.length, self.pos, self.k = index, length + d, pos + d, k
         return self.length + 1
 
 

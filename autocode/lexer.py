@@ -90,13 +90,49 @@ def _lex_clean(n: int, text: str) -> list[Tok] | None:
     return toks
 
 
+def _lex_clean_tabs(n: int, text: str) -> list[Tok] | None:
+    """`_lex_clean` for a line with tabs (indented with them, say): the same
+    search, each token's column its visual column (`Columns`, as
+    `lex_line` gives it); None for a line with anything wrong."""
+    toks: list[Tok] = []
+    append = toks.append
+    cols = Columns(text)
+    pos = 0  # index of the next character
+    for blanks, name, op, num, label, annot, comment, other in _CLEAN.findall(text):
+        if blanks:
+            pos += len(blanks)
+        if name:
+            append(_new_tok(Tok, (KW if name in KEYWORDS else ID, name, n, cols(pos))))
+            pos += len(name)
+        elif op:
+            append(_new_tok(Tok, (OP, op, n, cols(pos))))
+            pos += len(op)
+        elif num:
+            append(_new_tok(Tok, (NUM, num, n, cols(pos))))
+            pos += len(num)
+            if text[pos:pos + 1] in _NUMBER_TAIL_START:  # `12abc`, `1.2.3`: a malformed number
+                return None
+        elif label:
+            append(_new_tok(Tok, (LABEL, label, n, cols(pos))))
+            pos += len(label)
+        elif annot:
+            if annot not in ANNOTATIONS:
+                return None
+            append(_new_tok(Tok, (ANNOT, annot, n, cols(pos))))
+            pos += len(annot)
+        elif comment:  # (to the end of the line)
+            break
+        else:  # a character no token starts with
+            return None
+    return toks
+
+
 def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> list[Tok]:
     """Tokens of line `n` (without its newline). Lexical errors are reported
     and the offending characters skipped."""
-    if "\t" not in text:
-        toks = _lex_clean(n, text)
-        if toks is not None:
-            return toks
+    toks = _lex_clean(n, text) if "\t" not in text else _lex_clean_tabs(n, text)
+    if toks is not None:
+        return toks
     toks: list[Tok] = []
     pos, end = 0, len(text)
     match = _TOKEN.match

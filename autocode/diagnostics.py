@@ -196,10 +196,8 @@ class Diagnostics:
             self.warning_count += n
 
     def _keep(self, d: Diagnostic) -> None:
-        if d in self._seen:
-            return
-        key = hash(d)
-        if key in self._hidden_keys:
+        key = hash(d)  # once: a kept diagnostic's hash is in _seen_keys too
+        if key in self._hidden_keys or (key in self._seen_keys and d in self._seen):
             return
         file_key, line_key = (d.path, d.severity), (d.path, d.line, d.severity)
         if self._per_file.get(file_key, 0) >= PER_FILE or self._per_line.get(line_key, 0) >= PER_LINE:

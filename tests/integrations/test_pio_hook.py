@@ -214,7 +214,11 @@ def test_decimal_dig_is_defined_only_where_the_toolchain_lacks_it(tmp_path):
 def test_debian_avr_gcc_needs_decimal_dig(tmp_path):
     # Debian's avr-gcc 5.4 leaves DECIMAL_DIG undefined in C++: the Arduino
     # core's WString.cpp needs it.
-    real = os.path.realpath(shutil.which("avr-g++"))
+    # The compiler itself, not ccache's stand-in of that name (make test
+    # puts /usr/lib/ccache first on PATH): a link to ccache answers no
+    # -dumpversion of its own and would skip this test.
+    found = [os.path.realpath(p) for p in (shutil.which("avr-g++", path=d) for d in os.get_exec_path()) if p]
+    real = next((p for p in found if os.path.basename(p) != "ccache"), found[0])
     tool = tmp_path / "toolchain"
     (tool / "bin").mkdir(parents=True)
     (tool / "bin" / "avr-g++").symlink_to(real)

@@ -70,13 +70,14 @@ def project_config(project_dir, tmp_path) -> dict[str, dict]:
 def pytest_collection_finish(session):
     """The cyclic garbage collector's young generation collected every
     20,000 allocations where it was every 700, and each older one after 20
-    collections of the one below where it was 10: a worker holds everything collection made (the test modules,
-    the kit's modules, pytest's items), which each full collection walks
-    again (a system-wide profile of `make test` put 5 % of its CPU in the
-    workers' collector). Objects are still freed by their reference counts
-    as before; only cycles wait longer. (`gc.freeze()` after collection
-    would spare more, but hides what it froze from `gc.get_referrers`, and
-    Hypothesis's check of a registered random generator then warns.)"""
+    collections of the one below where it was 10: a worker holds
+    everything collection made (the test modules, the kit's modules,
+    pytest's items), which each full collection walks again (a system-wide
+    profile of `make test` put 5 % of its CPU in the workers' collector).
+    Objects are still freed by their reference counts as before; only
+    cycles wait longer. (`gc.freeze()` after collection is not used: it
+    hides what it froze from `gc.get_referrers`, and Hypothesis's check of
+    a registered random generator then warns.)"""
     gc.collect()
     gc.set_threshold(20000, 20, 20)
 

@@ -8,22 +8,20 @@ built."""
 from __future__ import annotations
 
 import csv
-import json
 import os
 import re
 import shlex
 import shutil
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import pytest
 
 from conftest import EXAMPLES, ROOT, run_fsw
+from support.progress import ProgressChannel
 
 pytestmark = pytest.mark.costly(6)
 
@@ -90,38 +88,21 @@ def test_a_small_study_and_the_replay_of_one_of_its_runs(tmp_path: Path):
 def test_ctrl_c_ends_a_study_with_the_runs_done(tmp_path: Path):
     short = _short(tmp_path, 12)
     out = tmp_path / "study"
-    # the study's progress, as a display would get it from a worker (fswkit.progress): Ctrl-C is pressed once
-    # a run is done (the others still flying), however fast this machine flies them
-    sock_dir = tempfile.mkdtemp(prefix="fsw-")  # a socket's path is at most 107 bytes: not under tmp_path
-    sock = os.path.join(sock_dir, "progress")
-    channel = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-    channel.bind(sock)
-    env = {k: v for k, v in os.environ.items() if k not in ("FSW_NO_PROGRESS", "CI")}
-    env.update(PYTHONPATH=str(ROOT / "host-tools") + os.pathsep + str(ROOT), FSW_PROGRESS_TO=f"1:{sock}")
-    p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "sim", str(ROCKET), "--plant", "rocket", "--params",
-                          str(short), "--runs", "40", "--jobs", "2", "--out", str(out)],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=ROOT,
-                         start_new_session=True)
-    try:
-        deadline = time.monotonic() + 300  # the build, then the first runs
-        runs = 0
-        while runs < 1:
-            left = deadline - time.monotonic()
-            assert left > 0 and p.poll() is None, (runs, p.poll())
-            channel.settimeout(min(left, 5.0))
-            try:
-                message = json.loads(channel.recv(65536))
-            except TimeoutError:
-                continue
-            if message["l"] == "study" and message["k"] == "u":
-                runs = message["d"]
-        os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
-        stdout, stderr = p.communicate(timeout=120)
-    finally:
-        channel.close()
-        shutil.rmtree(sock_dir)
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGKILL)
+    # the study's progress, as a display would get it from a worker: Ctrl-C is pressed once a run is done
+    # (the others still flying), however fast this machine flies them
+    with ProgressChannel() as channel:
+        p = subprocess.Popen([sys.executable, "-m", "fswkit.cli", "sim", str(ROCKET), "--plant", "rocket",
+                              "--params", str(short), "--runs", "40", "--jobs", "2", "--out", str(out)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+                             env=channel.env(PYTHONPATH=str(ROOT / "host-tools") + os.pathsep + str(ROOT)),
+                             start_new_session=True)
+        try:
+            channel.wait_done("study", p)
+            os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+            stdout, stderr = p.communicate(timeout=120)
+        finally:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
     assert "Traceback" not in stderr, stderr
     assert p.returncode == 130, stderr
     assert "stopped early" in stdout and "stopped after" in stderr

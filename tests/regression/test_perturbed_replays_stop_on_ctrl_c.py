@@ -11,19 +11,16 @@ refused before the build, as `--perturb 0` now is."""
 
 from __future__ import annotations
 
-import json
 import os
 import signal
-import shutil
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 
 import pytest
 
 from conftest import EXAMPLES, ROOT, SHARED, run_fsw
+from support.progress import ProgressChannel
 
 HPR = EXAMPLES / "hpr"
 TAPE = SHARED / "flights" / "ndrt2020_raven.csv"
@@ -42,51 +39,34 @@ def test_a_count_out_of_range_is_refused_before_the_build(tmp_path, n):
 def test_a_stopped_robustness_run_keeps_what_it_flew(tmp_path, sig):
     out = tmp_path / "out"
     fsw = os.path.join(os.path.dirname(sys.executable), "fsw")
-    # the replays' progress, as a display would get it from a worker (fswkit.progress): the stop is
-    # sent once a run is done (the other replay still flying), however fast this machine flies them
-    sock_dir = tempfile.mkdtemp(prefix="fsw-")  # a socket's path is at most 107 bytes: not under tmp_path
-    sock = os.path.join(sock_dir, "progress")
-    channel = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
-    channel.bind(sock)
-    env = {k: v for k, v in os.environ.items() if k not in ("FSW_NO_PROGRESS", "CI")}
-    env["FSW_PROGRESS_TO"] = f"1:{sock}"
-    env["PYTHONFAULTHANDLER"] = "1"  # a SIGABRT writes every thread's stack to stderr (below: a stop not obeyed)
+    # the replays' progress, as a display would get it from a worker: the stop is sent once a run is done
+    # (the other replay still flying), however fast this machine flies them
     err_file = open(tmp_path / "stderr", "w+b")  # noqa: SIM115 (read after the run)
-    p = subprocess.Popen([fsw, "sim", str(HPR), "--tape", str(TAPE), "--perturb", "400", "--out", str(out)],
-                         stdout=subprocess.PIPE, stderr=err_file, start_new_session=True, cwd=ROOT, env=env)
-    try:
-        deadline = time.monotonic() + 300  # the build, then the first runs
-        runs = 0
-        while runs < 1:
-            left = deadline - time.monotonic()
-            assert left > 0 and p.poll() is None, (runs, p.poll(), (tmp_path / "stderr").read_text())
-            channel.settimeout(min(left, 5.0))
-            try:
-                message = json.loads(channel.recv(65536))
-            except TimeoutError:
-                continue
-            if message["l"] == "perturbed replays" and message["k"] == "u":
-                runs = message["d"]
-        os.killpg(p.pid, sig)
-        t0 = time.monotonic()
+    with ProgressChannel() as channel:
+        # PYTHONFAULTHANDLER: a SIGABRT writes every thread's stack to stderr (below: a stop not obeyed)
+        p = subprocess.Popen([fsw, "sim", str(HPR), "--tape", str(TAPE), "--perturb", "400", "--out", str(out)],
+                             stdout=subprocess.PIPE, stderr=err_file, start_new_session=True, cwd=ROOT,
+                             env=channel.env(PYTHONFAULTHANDLER="1"))
         try:
-            out_text, _ = p.communicate(timeout=60)
-        except subprocess.TimeoutExpired:
-            os.kill(p.pid, signal.SIGABRT)  # where each of its threads was, for the report
+            channel.wait_done("perturbed replays", p, why=lambda: (tmp_path / "stderr").read_text())
+            os.killpg(p.pid, sig)
+            t0 = time.monotonic()
             try:
-                p.communicate(timeout=30)
+                out_text, _ = p.communicate(timeout=60)
             except subprocess.TimeoutExpired:
-                pass
-            pytest.fail("the replays went on 60 s after the stop; the command's threads then:\n"
-                        + (tmp_path / "stderr").read_text(errors="replace")[-8000:])
-        stopped_in = time.monotonic() - t0
-    finally:
-        channel.close()
-        shutil.rmtree(sock_dir)
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.communicate()
-        err_file.close()
+                os.kill(p.pid, signal.SIGABRT)  # where each of its threads was, for the report
+                try:
+                    p.communicate(timeout=30)
+                except subprocess.TimeoutExpired:
+                    pass
+                pytest.fail("the replays went on 60 s after the stop; the command's threads then:\n"
+                            + (tmp_path / "stderr").read_text(errors="replace")[-8000:])
+            stopped_in = time.monotonic() - t0
+        finally:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.communicate()
+            err_file.close()
     err = (tmp_path / "stderr").read_text()
     assert p.returncode == 128 + sig, (p.returncode, err)
     assert stopped_in < 30, stopped_in

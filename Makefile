@@ -172,7 +172,7 @@ fuzz-vm: $(FUZZ_VM) | $(STAMP)
 	@for sm in examples/*/*.sm; do \
 	  $(FSW) compile $$sm --real f64 -o $(BUILD)/fuzz/vm/corpus/$$(basename $$(dirname $$sm))-$$(basename $$sm .sm).fsm \
 	    >/dev/null 2>&1 || true; done
-	@$(FUZZ_VM) -runs=0 tests/fuzz/vm/regressions 2>$(BUILD)/fuzz/vm/regressions.txt || \
+	@$(FUZZ_VM) -runs=0 -artifact_prefix=$(BUILD)/fuzz/vm/ tests/fuzz/vm/regressions 2>$(BUILD)/fuzz/vm/regressions.txt || \
 	  { tail -30 $(BUILD)/fuzz/vm/regressions.txt; echo "vm fuzz: 0 passed, 1 failed (a past finding, tests/fuzz/vm/regressions)"; exit 1; }
 	@$(FUZZ_VM) -runs=$(FUZZ_RUNS) -max_total_time=$(FUZZ_SECONDS) -seed=1 -max_len=4096 -print_final_stats=1 \
 	    -artifact_prefix=$(BUILD)/fuzz/vm/ $(BUILD)/fuzz/vm/corpus 2>$(BUILD)/fuzz/vm/log.txt; st=$$?; \

@@ -8,8 +8,8 @@ every 10 of those) a long config has the collector walk that growing heap,
 and every object the process already holds, again and again: about half
 the CPU of reading a 40,000-line machine inside a test process, for
 nothing found. `fewer_collections` sets a young collection every 100,000
-allocations for as long as it is entered (the same thresholds `fsw` gives
-its commands), then puts the caller's thresholds back. Collections still
+allocations for as long as it is entered (`fsw` runs each of its
+commands in it too), then puts the caller's thresholds back. Collections still
 run, and an explicit `gc.collect()` is untouched: only how often the
 collector looks changes, never what a load returns or reports.
 

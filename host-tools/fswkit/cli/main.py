@@ -458,24 +458,24 @@ def _fewer_collections(process_ends: bool, command: str):
     hardly any cycles; at the collector's default thresholds it walks that
     growing heap again and again (a third of `fsw check` of a big machine).
     Young collections every 100,000 allocations instead of 700, for the
-    command only. When the process ends with the command (`fsw`, `python -m
+    command only (fswkit.autocode.collect, as the loaders have it). When the process ends with the command (`fsw`, `python -m
     fswkit.cli`), what is left is frozen first: the interpreter's last
     collection at exit would walk it all once more for nothing (another
     0.4 s of CPU after a big machine). `fsw check` and `fsw gen` in such a
     process run without the collector: even every 100,000 allocations it
     finds nothing among their objects (a 20,000-line machine leaves the
     same memory without it), for a tenth of their CPU."""
-    saved = gc.get_threshold()
+    from fswkit.autocode.collect import fewer_collections
+
     enabled = gc.isenabled()
     if process_ends and command in _READ_AND_END:
         gc.disable()
-    gc.set_threshold(100_000, 50, 100)
     try:
-        yield
+        with fewer_collections():
+            yield
     finally:
         if process_ends:
             gc.freeze()
-        gc.set_threshold(*saved)
         if enabled:
             gc.enable()
 

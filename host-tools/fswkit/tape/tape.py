@@ -357,6 +357,7 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
         # is `number` of the stripped cell: float() strips no more than str.strip) or empty (math.nan; the
         # time never); any other row is read cell by cell below, with its errors
         c0, c1, c2 = cells
+        values = None
         if line.isascii() and "_" not in line:
             try:
                 tv, pv, av = float(c0), float(c1) if c1 else nan, float(c2) if c2 else nan
@@ -364,29 +365,23 @@ def parse_tape(data: bytes | str, path: str) -> Tape:
                 pass
             else:
                 if isfinite(tv) and (isfinite(pv) or not c1) and (isfinite(av) or not c2):
-                    t.append(tv), p.append(pv), a.append(av)
-                    if tv <= prev:
-                        err.at(ln, 1, f"time_s {cells[0].strip()} is not after the previous row's "
-                                      f"{prev:g}: times increase strictly")
-                    prev = max(prev, tv)
-                    if pv <= 0:
-                        err.at(ln, len(cells[0]) + 2, f"pressure_pa {cells[1].strip()} is not above 0 Pa")
-                    continue
-        col = 1
-        values = []
-        for k, cell in enumerate(cells):
-            v = _cell_value(cell)
-            if v is None:
-                s = cell.strip()
-                what = "not a finite number" if s.lower().lstrip("+-") in ("nan", "inf", "infinity") \
-                    else "not a number"
-                err.at(ln, col, f"{names[k]}: `{s[:40]}` is {what} (leave the cell empty for "
-                                "\"not available\")" if k else f"{names[k]}: `{s[:40]}` is {what}")
-                v = math.nan
-            elif k == 0 and math.isnan(v):
-                err.at(ln, col, "time_s is empty: every row needs its time")
-            values.append(v)
-            col += len(cell) + 1
+                    values = tv, pv, av
+        if values is None:
+            col = 1
+            values = []
+            for k, cell in enumerate(cells):
+                v = _cell_value(cell)
+                if v is None:
+                    s = cell.strip()
+                    what = "not a finite number" if s.lower().lstrip("+-") in ("nan", "inf", "infinity") \
+                        else "not a number"
+                    err.at(ln, col, f"{names[k]}: `{s[:40]}` is {what} (leave the cell empty for "
+                                    "\"not available\")" if k else f"{names[k]}: `{s[:40]}` is {what}")
+                    v = math.nan
+                elif k == 0 and math.isnan(v):
+                    err.at(ln, col, "time_s is empty: every row needs its time")
+                values.append(v)
+                col += len(cell) + 1
         tv, pv, av = values
         t.append(tv), p.append(pv), a.append(av)
         if not math.isnan(tv):

@@ -7,7 +7,6 @@ dependency files for headers), and nothing else does."""
 
 from __future__ import annotations
 
-import fcntl
 import os
 import shutil
 import struct
@@ -86,12 +85,9 @@ def sketch():
     was compiled again)."""
     from support.simfw import OUT
 
-    OUT.mkdir(parents=True, exist_ok=True)
-    root = OUT / "rebuild-on-board-change"
-    with open(f"{root}.lock", "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        shutil.rmtree(root, ignore_errors=True)
-        root.mkdir()
+    from support.held import fresh_folder
+
+    with fresh_folder(OUT / "rebuild-on-board-change") as root:
         yield _sketch(root)
 
 

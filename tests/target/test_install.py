@@ -11,7 +11,6 @@ path file."""
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import os
 import shutil
@@ -25,6 +24,7 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES, ROOT
+from support.held import fresh_folder
 
 pytestmark = [pytest.mark.skipif(shutil.which("avr-g++") is None, reason="gcc-avr not installed"), pytest.mark.costly(9)]
 SIMAVR = os.path.exists("/usr/include/simavr/sim_avr.h")
@@ -58,11 +58,7 @@ def installed(tmp_path_factory):
     """A fresh venv with the kit installed from its wheel; its `bin` folder.
     The venv's place is held while the module runs (another test run of
     this tree waits for it)."""
-    place = _venv_place()
-    with open(f"{place}.lock", "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        shutil.rmtree(place, ignore_errors=True)
-        place.mkdir()
+    with fresh_folder(_venv_place()) as place:
         yield _install(tmp_path_factory, place)
 
 

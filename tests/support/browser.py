@@ -57,8 +57,9 @@ def wait_for(fn, what: str, timeout: float = 10.0, page=None):
 
 def press(page, element_id: str):
     """Clicks the element `element_id` of the page in the browser `page`,
-    scrolled to the middle of the window first, so that a panel above it
-    that grows as frames arrive does not move it under the click."""
+    scrolled to the middle of the window first (the page's panels keep
+    their size as frames arrive: test_the_page_does_not_move_under_a_click_
+    as_frames_arrive)."""
     from selenium.webdriver.common.by import By
 
     el = page.find_element(By.ID, element_id)

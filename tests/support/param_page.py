@@ -10,9 +10,11 @@ RIG = Path(__file__).resolve().parents[1] / "param" / "tuned"
 
 
 @contextlib.contextmanager
-def tuned_page(browser, tmp_path: Path):
+def tuned_page(browser, tmp_path: Path, until: Path | None = None):
     """The rig's target (its EEPROM in tmp_path), its station and the page
-    open in `browser`: yields the target (its `port`)."""
+    open in `browser`: yields the target (its `port`). With `until`, the
+    target starts only once that file exists: the page is open on a silent
+    port until then."""
     from fswkit.autocode.diagnostics import Diagnostics
     from fswkit.autocode.params import app_parameters
     from fswkit.autocode.schema import link_plan
@@ -27,7 +29,10 @@ def tuned_page(browser, tmp_path: Path):
     from support.simfw import kept_native
 
     app = load(str(RIG), Diagnostics())
-    with PtyTarget(kept_native(RIG) / "tuned", "--eeprom", str(tmp_path / "e.bin")) as target:
+    run = (kept_native(RIG) / "tuned", "--eeprom", str(tmp_path / "e.bin"))
+    if until is not None:
+        run = ("/bin/sh", "-c", 'while [ ! -e "$0" ]; do sleep 0.02; done; exec "$@"', str(until), *map(str, run))
+    with PtyTarget(*run) as target:
         ground = Station(from_app(app), str(RIG), target.port, 115200)
         ground.start()
         try:

@@ -129,7 +129,8 @@ def test_the_page_shows_each_charges_status_from_the_health_frame(browser):
             try:
                 browser.get(station.url)
                 table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
-                wait_for(lambda: "pyro drogue" in table(), "the pyro rows of the health frame", timeout=10, page=browser)
+                wait_for(lambda: "pyro drogue armed" in table(), "the pyro rows of the health frame", timeout=10,
+                         page=browser)
                 assert f"pyro drogue {words}" in table(), table()
                 assert "pyro main armed, continuity, not fired" in table(), table()
             finally:
@@ -165,7 +166,8 @@ def test_the_page_shows_each_sensor_parts_health(browser):
         try:
             browser.get(station.url)
             table = lambda: browser.find_element(By.ID, "link-table").text  # noqa: E731
-            wait_for(lambda: "sensor adxl345@spi:7" in table(), "the sensor rows of the health frame", timeout=10, page=browser)
+            wait_for(lambda: "sensor adxl345@spi:7 NO" in table(), "the sensor rows of the health frame", timeout=10,
+                     page=browser)
             assert "sensor bmp280@0x76 NO ANSWER" in table(), table()
             assert "sensor adxl345@spi:7 NO ANSWER" in table(), table()
         finally:

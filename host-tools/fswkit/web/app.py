@@ -67,7 +67,8 @@ def layout_json(source: Source) -> dict:
     return {"name": lay.name, "schema": f"0x{lay.schema:08x}", "time_unit": lay.time_unit, "rate": lay.rate,
             "has_params": bool(getattr(source, "params", ())),
             "elements": elements, "tasks": [{"name": n, "kind": k} for n, k in lay.tasks],
-            "state_elements": list(lay.states), "has_uplink": lay.has_uplink}
+            "state_elements": list(lay.states), "has_uplink": lay.has_uplink,
+            "pyro": list(lay.pyro), "sensors": list(lay.sensors)}
 
 
 def archive_of(source: Source) -> tuple[str | None, object]:

@@ -55,6 +55,7 @@ async function start() {
   buildCommands();
   for (const s of layout.state_elements) states[s] = { current: null, since: null, segments: [], list: [] };
   buildTimeline();
+  buildHealth();
   if (layout.has_params) { $("parameters").hidden = false; $("param-refresh").addEventListener("click", readParams);
                            readParams(); }
   connect();
@@ -259,20 +260,38 @@ function medianLatency() {
   return 1000 * (last.length % 2 ? last[m] : (last[m - 1] + last[m]) / 2);
 }
 
-function showHealth(info) {
-  const rows = [["reset cause", info.reset_words], ["cycles", info.cycles], ["late starts", info.late],
-                ["frames sent", info.frames], ["frames dropped (busy)", info.dropped],
-                ["commands applied", info.rx_ok], ["CRC errors", info.rx_crc], ["malformed", info.rx_malformed],
-                ["refused", info.rx_refused], ["replayed", info.rx_replayed]]
-    .concat((info.pyro || []).map(p => [`pyro ${p.name}`, p.words]))
-    .concat((info.sensors || []).map(s => [`sensor ${s.name}`, s.words]));
-  $("link-table").tBodies[0].replaceChildren(...rows.map(([k, v]) => {
-    const tr = el("tr"); tr.append(el("th", {}, k), el("td", {}, fmt(v))); return tr; }));
-  $("task-table").tBodies[0].replaceChildren(...info.tasks.map(t => {
+// The link and task tables have their rows from the start, a dash in each
+// value until the first health frame: the layout names every row (the
+// fixed counters, each pyro channel, each sensor part, each task), so a
+// frame fills cells in place and nothing below moves under the operator's
+// click (a Set button of the parameters, say) as the frames arrive.
+const HEALTH_ROWS = [["reset cause", "reset_words"], ["cycles", "cycles"], ["late starts", "late"],
+                     ["frames sent", "frames"], ["frames dropped (busy)", "dropped"],
+                     ["commands applied", "rx_ok"], ["CRC errors", "rx_crc"], ["malformed", "rx_malformed"],
+                     ["refused", "rx_refused"], ["replayed", "rx_replayed"]];
+const TASK_CELLS = ["mode_name", "faults", "overruns", "worst_us"];
+
+function buildHealth() {
+  const labels = HEALTH_ROWS.map(([k]) => k).concat(layout.pyro.map(n => `pyro ${n}`),
+                                                   layout.sensors.map(n => `sensor ${n}`));
+  $("link-table").tBodies[0].replaceChildren(...labels.map((k, i) => {
+    const tr = el("tr"); tr.append(el("th", {}, k), el("td", { id: `health-${i}` }, "—")); return tr; }));
+  $("task-table").tBodies[0].replaceChildren(...layout.tasks.map(t => {
     const tr = el("tr", { id: `task-${t.name}` });
-    for (const v of [t.name, t.kind, t.mode_name, t.faults, t.overruns, t.worst_us]) tr.append(el("td", {}, fmt(v)));
+    tr.append(el("td", {}, t.name), el("td", {}, t.kind));
+    for (const k of TASK_CELLS) tr.append(el("td", { class: `task-${k}` }, "—"));
     return tr;
   }));
+}
+
+function showHealth(info) {
+  const cells = HEALTH_ROWS.map(([, k]) => info[k]).concat((info.pyro || []).map(p => p.words),
+                                                          (info.sensors || []).map(s => s.words));
+  cells.forEach((v, i) => { const td = $(`health-${i}`); if (td) td.textContent = fmt(v); });
+  for (const t of info.tasks) {
+    const tr = $(`task-${t.name}`);
+    if (tr) TASK_CELLS.forEach((k, j) => { tr.cells[2 + j].textContent = fmt(t[k]); });
+  }
 }
 
 // a command and the target's answer: applied, refused (the target said no, and why), or none came

@@ -43,7 +43,8 @@ from contextlib import contextmanager
 from fswkit.link import wire
 from fswkit.link.client import LinkTimeout, Numbers, exchange
 from fswkit.link.layout import Layout
-from fswkit.link.port import PortError, drain, open_port, port_errors, port_key, runtime_dir
+from fswkit.link.port import (PortError, drain, open_port, port_errors, port_identity, port_key, port_returned,
+                              runtime_dir)
 from fswkit.link.session import Event, Session, max_frame, reset_words
 
 from .archive import ArchiveError
@@ -106,6 +107,7 @@ class Station:
         # text, a baud rate not the board's) is not held for the clients byte by byte
         self._carry_max = max_frame(layout) + 1
         self._restarts = 0
+        self._identity: tuple | None = None  # link.port.port_identity of the port opened
 
     # ---- life ------------------------------------------------------------------------
 
@@ -113,6 +115,7 @@ class Station:
         """Opens the port (PortBusy / PortError when it cannot) and starts
         serving."""
         self.port = open_port(self.port_name, self.baud, command="fsw ground", socket=self.socket_path)
+        self._identity = port_identity(self.port_name)  # what the port must be to be opened again
         if self.archive is not None:
             try:
                 self.archive.begin(layout=self.layout, project=self.project, port=self.port_name, baud=self.baud,
@@ -294,16 +297,21 @@ class Station:
             port.close()
         self.up = False
         self._carry = b""
-        self._say(f"the port went away ({e}); waiting for it to come back")
+        never = self._identity is not None and self._identity[0] == "pty"
+        self._say(f"the port went away ({e}); "
+                  + (port_returned(self.port_name, self._identity) if never else "waiting for it to come back"))
 
     def _reopen(self) -> None:
         self._archive("tick")  # the note that the port went away, and the last bytes, committed
         if self._stop.wait(REOPEN_S):
             return
+        if port_returned(self.port_name, self._identity) is not None:
+            return  # not there yet, or another program's pseudo-terminal now
         try:
             self.port = open_port(self.port_name, self.baud, command="fsw ground", socket=self.socket_path)
         except PortError:
             return
+        self._identity = port_identity(self.port_name)
         self.up = True
         self.reconnects += 1
         self.session.deframer.resync()  # a frame cut by the pull is not one

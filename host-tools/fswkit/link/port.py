@@ -163,6 +163,49 @@ def _held_serial():
     return Held
 
 
+PTY_SLAVE_MAJORS = range(136, 144)  # Linux's Unix98 pseudo-terminal slaves (/dev/pts/N)
+
+
+def port_identity(name: str) -> tuple | None:
+    """What a port that went away must still be to be opened again (None:
+    whatever device comes back at the name, as a USB adapter plugged in
+    again does). A pseudo-terminal does not come back: once its other end
+    closed, the next one the system makes takes the same number, another
+    program's (a terminal window's, say). Named by its own /dev/pts path,
+    it is ("pty", device) and is never opened again; named by a link (a
+    simulator's or socat's `link=`), it is the link itself, and a link made
+    again is the port back."""
+    if is_url(name):
+        return None
+    try:
+        st = os.stat(name)
+        link = os.lstat(name)
+    except OSError:
+        return None
+    if not stat.S_ISCHR(st.st_mode) or os.major(st.st_rdev) not in PTY_SLAVE_MAJORS:
+        return None
+    if stat.S_ISLNK(link.st_mode):
+        return ("link", link.st_dev, link.st_ino, link.st_ctime_ns)
+    return ("pty", st.st_rdev)
+
+
+def port_returned(name: str, identity: tuple | None) -> str | None:
+    """None when the port `name` may be opened again (the port whose
+    identity was `identity`, `port_identity`'s, may be back), else why not."""
+    if identity is None:
+        return None
+    if identity[0] == "pty":
+        return ("it was a pseudo-terminal, and one does not come back: the next one takes the same number "
+                "(another program's); start the station again on the new port")
+    try:
+        link = os.lstat(name)
+    except OSError:
+        return "its link is not there"
+    if (link.st_dev, link.st_ino, link.st_ctime_ns) == identity[1:]:
+        return "its link still names the pseudo-terminal that closed"
+    return None
+
+
 def not_a_port(name: str) -> str | None:
     """Why a device path cannot be a serial port, in words (None: it may
     be one — a device, a pty — or is a pyserial URL). A FIFO opens without

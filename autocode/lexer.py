@@ -55,70 +55,36 @@ _NUMBER_TAIL_START = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuv
 
 
 def _lex_clean(n: int, text: str) -> list[Tok] | None:
-    """The tokens of a line that holds nothing wrong and no tab (the common
-    case, one regex search for the line); None for any other line, which
-    `lex_line` reads character by character with its reports."""
+    """The tokens of a line that holds nothing wrong (the common case, one
+    regex search for the line), each at its visual column (`Columns`, as
+    `lex_line` gives it, where the line has a tab); None for any other
+    line, which `lex_line` reads character by character with its reports."""
     toks: list[Tok] = []
     append = toks.append
-    col = 1  # of the next character
-    for blanks, name, op, num, label, annot, comment, other in _CLEAN.findall(text):
-        if blanks:
-            col += len(blanks)
-        if name:
-            append(_new_tok(Tok, (KW if name in KEYWORDS else ID, name, n, col)))
-            col += len(name)
-        elif op:
-            append(_new_tok(Tok, (OP, op, n, col)))
-            col += len(op)
-        elif num:
-            append(_new_tok(Tok, (NUM, num, n, col)))
-            col += len(num)
-            if text[col - 1:col] in _NUMBER_TAIL_START:  # `12abc`, `1.2.3`: a malformed number
-                return None
-        elif label:
-            append(_new_tok(Tok, (LABEL, label, n, col)))
-            col += len(label)
-        elif annot:
-            if annot not in ANNOTATIONS:
-                return None
-            append(_new_tok(Tok, (ANNOT, annot, n, col)))
-            col += len(annot)
-        elif comment:  # (to the end of the line)
-            break
-        else:  # a character no token starts with
-            return None
-    return toks
-
-
-def _lex_clean_tabs(n: int, text: str) -> list[Tok] | None:
-    """`_lex_clean` for a line with tabs (indented with them, say): the same
-    search, each token's column its visual column (`Columns`, as
-    `lex_line` gives it); None for a line with anything wrong."""
-    toks: list[Tok] = []
-    append = toks.append
-    cols = Columns(text)
+    cols = Columns(text) if "\t" in text else None
     pos = 0  # index of the next character
     for blanks, name, op, num, label, annot, comment, other in _CLEAN.findall(text):
         if blanks:
             pos += len(blanks)
+        col = pos + 1 if cols is None else cols(pos)
         if name:
-            append(_new_tok(Tok, (KW if name in KEYWORDS else ID, name, n, cols(pos))))
+            append(_new_tok(Tok, (KW if name in KEYWORDS else ID, name, n, col)))
             pos += len(name)
         elif op:
-            append(_new_tok(Tok, (OP, op, n, cols(pos))))
+            append(_new_tok(Tok, (OP, op, n, col)))
             pos += len(op)
         elif num:
-            append(_new_tok(Tok, (NUM, num, n, cols(pos))))
+            append(_new_tok(Tok, (NUM, num, n, col)))
             pos += len(num)
             if text[pos:pos + 1] in _NUMBER_TAIL_START:  # `12abc`, `1.2.3`: a malformed number
                 return None
         elif label:
-            append(_new_tok(Tok, (LABEL, label, n, cols(pos))))
+            append(_new_tok(Tok, (LABEL, label, n, col)))
             pos += len(label)
         elif annot:
             if annot not in ANNOTATIONS:
                 return None
-            append(_new_tok(Tok, (ANNOT, annot, n, cols(pos))))
+            append(_new_tok(Tok, (ANNOT, annot, n, col)))
             pos += len(annot)
         elif comment:  # (to the end of the line)
             break
@@ -130,7 +96,7 @@ def _lex_clean_tabs(n: int, text: str) -> list[Tok] | None:
 def lex_line(src: Source, n: int, text: str, diags: Diagnostics, lang: str) -> list[Tok]:
     """Tokens of line `n` (without its newline). Lexical errors are reported
     and the offending characters skipped."""
-    toks = _lex_clean(n, text) if "\t" not in text else _lex_clean_tabs(n, text)
+    toks = _lex_clean(n, text)
     if toks is not None:
         return toks
     toks: list[Tok] = []

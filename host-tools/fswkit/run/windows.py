@@ -75,9 +75,10 @@ class AvgWindow(Window):
 
 
 class _Extremum(Window):
-    """Monotonic deque of (update number, value): the front is the extremum.
-    The two kinds each spell the update out with their own comparison (a
-    callback a sample cost a third of a state script's step)."""
+    """Monotonic deque of (update number, value): the front is the least.
+    MaxWindow keeps its samples negated, so that both kinds run the one
+    update with its one comparison inline (a comparison callback a sample
+    cost a third of a state script's step)."""
 
     __slots__ = ("mono", "count")
 
@@ -86,13 +87,8 @@ class _Extremum(Window):
         self.mono: deque[tuple[int, float]] = deque()
         self.count = 0
 
-
-class MinWindow(_Extremum):
-    __slots__ = ()
-
-    def push(self, x: float) -> float:
-        if x != x or x == 0:
-            x = 0.0
+    def _least(self, x: float) -> float:
+        """Adds `x` (a number, not NaN); the least of the window."""
         mono = self.mono
         while mono and mono[-1][1] >= x:
             mono.pop()
@@ -104,21 +100,19 @@ class MinWindow(_Extremum):
         return mono[0][1]
 
 
+class MinWindow(_Extremum):
+    __slots__ = ()
+
+    def push(self, x: float) -> float:
+        return self._least(0.0 if x != x or x == 0 else x)
+
+
 class MaxWindow(_Extremum):
     __slots__ = ()
 
     def push(self, x: float) -> float:
-        if x != x or x == 0:
-            x = 0.0
-        mono = self.mono
-        while mono and mono[-1][1] <= x:
-            mono.pop()
-        count = self.count
-        mono.append((count, x))
-        self.count = count + 1
-        if mono[0][0] <= count - self.n:
-            mono.popleft()
-        return mono[0][1]
+        # (+ 0.0: a zero comes back as 0.0, not the -0.0 its negation gives)
+        return -self._least(0.0 if x != x or x == 0 else -x) + 0.0
 
 
 class RangeWindow(Window):

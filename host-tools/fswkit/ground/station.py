@@ -375,8 +375,14 @@ class Station:
             raise OSError("the port is not open (it went away)")
         with self._write_lock:
             self._archive("tx", time.time_ns(), data)
-            port.write(data)
-            drain(port)
+            try:
+                port.write(data)
+                drain(port)
+            except (TypeError, AttributeError):
+                # pyserial writing a port the reader closed under it (it went away): its descriptor is None
+                if port.is_open:
+                    raise
+                raise OSError("the port is not open (it went away)") from None
 
     # ---- commands ------------------------------------------------------------------------
 

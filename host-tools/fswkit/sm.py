@@ -212,18 +212,10 @@ def library_path(real: str = "f64") -> str:
         tmp = native.private_tmp(out)
         with native.removed_when_done(tmp):
             os.makedirs(tmp, exist_ok=True)
-            # each source its own object (in the temporary folder, removed
-            # once linked), then the link: a compiler cache (ccache) can keep
-            # every object, which it cannot for one command of several sources
-            flags = LIB_CXXFLAGS + native.compiler_flags(cxx) + native.FLAGS[bits]
-            os.makedirs(os.path.join(tmp, "obj"))
-            objs = []
-            for src in sources():
-                objs.append(os.path.join("obj", os.path.basename(src)[:-4] + ".o"))
-                _build_step([cxx] + [f for f in flags if f not in LINK_ONLY and not f.startswith("-Wl,")]
-                            + ["-I", RUNTIME, "-I", HOST, "-c", src, "-o", objs[-1]], tmp, bits)
-            _build_step([cxx] + flags + objs + ["-o", os.path.basename(lib)], tmp, bits)
-            shutil.rmtree(os.path.join(tmp, "obj"))
+            flags = [cxx] + LIB_CXXFLAGS + native.compiler_flags(cxx) + native.FLAGS[bits]
+            native.objects_then_link(lambda cmd: _build_step(cmd, tmp, bits),
+                                     [f for f in flags if f not in LINK_ONLY and not f.startswith("-Wl,")]
+                                     + ["-I", RUNTIME, "-I", HOST], flags, sources(), os.path.basename(lib), tmp)
             try:
                 os.replace(tmp, out)
             except OSError:  # another process built the same library first

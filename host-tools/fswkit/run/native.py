@@ -97,6 +97,24 @@ def _key(files: dict[str, str], real: Real) -> str:
     return h.hexdigest()[:20]
 
 
+def objects_then_link(run, compile_cmd: list[str], link_cmd: list[str], sources: list[str], exe: str,
+                      cwd: str, libraries: list[str] = ()) -> None:
+    """Each of `sources` compiled by `compile_cmd` to an object of its own
+    (in `cwd`/obj, removed once linked), then the objects and `libraries`
+    linked by `link_cmd` into `exe`; `run(cmd)` runs each command in `cwd`
+    (and raises on a failure). A compiler cache (ccache) keeps every object,
+    which it cannot for one command of several sources; a source named
+    relative to `cwd` is the same command wherever the folder is."""
+    obj = os.path.join(cwd, "obj")
+    os.makedirs(obj)
+    objs = []
+    for src in sources:
+        objs.append(os.path.join("obj", os.path.splitext(os.path.basename(src))[0] + ".o"))
+        run(compile_cmd + ["-c", src, "-o", objs[-1]])
+    run(link_cmd + objs + list(libraries) + ["-o", exe])
+    shutil.rmtree(obj)
+
+
 def _compile(cmd: list[str], out: str, cwd: str | None = None) -> None:
     """Runs the compiler: a failure is NativeError (the kit's defect), or
     OSError naming the cache folder when the disk there is full or
@@ -163,20 +181,11 @@ def compile_script(script: M.Script, real: Real, source_line) -> str:
         for name, text in files.items():
             with open(os.path.join(tmp, name), "w") as f:
                 f.write(text)
-        # Each generated source its own object (removed once linked), then
-        # the link: compiled in the temporary folder under names relative to
-        # it, so a compiler cache (ccache) finds the same command and source
-        # wherever the folder is, which it cannot for one command of
-        # several sources.
-        os.makedirs(os.path.join(tmp, "obj"))
-        objs = []
-        for name in sorted(n for n in files if n.endswith(".cpp")):
-            objs.append(os.path.join("obj", name[:-4] + ".o"))
-            _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + ["-I", RUNTIME, "-I", ".", "-c",
-                     name, "-o", objs[-1]], out, cwd=tmp)
-        _compile([CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits] + objs + runtime_objects(real)
-                 + ["-o", "runner"], out, cwd=tmp)
-        shutil.rmtree(os.path.join(tmp, "obj"))
+        # the generated sources named relative to the temporary folder, so
+        # that ccache finds the same commands wherever the folder is
+        flags = [CXX] + CXXFLAGS + compiler_flags(CXX) + FLAGS[real.bits]
+        objects_then_link(lambda cmd: _compile(cmd, out, cwd=tmp), flags + ["-I", RUNTIME, "-I", "."], flags,
+                          sorted(n for n in files if n.endswith(".cpp")), "runner", tmp, runtime_objects(real))
         try:
             os.replace(tmp, out)
         except OSError:  # another process built the same runner first

@@ -458,8 +458,9 @@ def _fewer_collections(process_ends: bool, command: str):
     hardly any cycles; at the collector's default thresholds it walks that
     growing heap again and again (a third of `fsw check` of a big machine).
     Young collections every 100,000 allocations instead of 700, for the
-    command only (fswkit.autocode.collect, as the loaders have it). When the process ends with the command (`fsw`, `python -m
-    fswkit.cli`), what is left is frozen first: the interpreter's last
+    command only (fswkit.autocode.collect, as the loaders have it). When
+    the process ends with the command (`fsw`, `python -m fswkit.cli`),
+    what is left is frozen first: the interpreter's last
     collection at exit would walk it all once more for nothing (another
     0.4 s of CPU after a big machine). `fsw check` and `fsw gen` in such a
     process run without the collector: even every 100,000 allocations it
